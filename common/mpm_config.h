@@ -1,0 +1,97 @@
+/* Case files: `[section]` headers and `key = value` lines, read with libinih, giving dotted
+ * keys ("grid.dx"). A section name may itself be dotted to name an instance
+ * ("[geometry.block]" gives "geometry.block.type").
+ *
+ * Every valid key is declared in a schema (mpm_key_spec tables that each module adds). A
+ * spec key may contain "*" as one dotted component, matching any instance name
+ * ("geometry.*.type"). Validation reports, on rank 0, one line per problem of the form
+ *     case.ini:12: grid.dx = -1: must be > 0 (grid spacing, m). <what to do>
+ * naming the nearest valid key for an unknown key. Command-line overrides
+ * ("time.t_end=0.01") are entries like any other, with the origin "command line".
+ *
+ * Values are kept as text; typed getters parse them (and fall back to the spec's default).
+ * All ranks hold the same entries: rank 0 reads the file and broadcasts its text. */
+#ifndef MPM_CONFIG_H
+#define MPM_CONFIG_H
+
+#include <mpi.h>
+#include <stdio.h>
+
+typedef enum {
+  MPM_KEY_REAL,   /* one real number */
+  MPM_KEY_INT,    /* one integer */
+  MPM_KEY_BOOL,   /* true/false, yes/no, on/off, 1/0 */
+  MPM_KEY_STRING, /* free text */
+  MPM_KEY_ENUM,   /* one of choices, "a|b|c" */
+  MPM_KEY_REALS,  /* 1..max_count reals separated by blanks or commas */
+  MPM_KEY_NAMES,  /* 1.. names separated by blanks or commas */
+  MPM_KEY_PATH    /* a file that must exist; relative to the case file's folder */
+} mpm_key_type;
+
+typedef struct mpm_key_spec {
+  const char *key;     /* dotted, "*" matches one instance component */
+  mpm_key_type type;
+  const char *def;     /* default as text, NULL if the key is required (when its section is used) */
+  double min, max;     /* inclusive range for REAL, INT and each of REALS (use -HUGE_VAL/HUGE_VAL) */
+  int min_exclusive;   /* 1: value must be > min rather than >= min */
+  int max_count;       /* REALS: most values allowed (0 = any) */
+  const char *choices; /* ENUM: "a|b|c" */
+  const char *help;    /* one line: meaning, unit, what a sensible value is */
+} mpm_key_spec;
+
+typedef struct mpm_config mpm_config;
+
+int mpm_config_new(mpm_config **cfg, MPI_Comm comm);
+void mpm_config_destroy(mpm_config **cfg);
+
+/* Add n specs (the table must outlive cfg). */
+int mpm_config_add_schema(mpm_config *cfg, const mpm_key_spec *specs, int n);
+
+/* Read a case file: rank 0 reads it, every rank parses the same text. A missing or
+ * unreadable file, or a syntax error, is reported with the file (and line). */
+int mpm_config_read_file(mpm_config *cfg, const char *path);
+/* Parse case text; origin names it in messages ("case.ini"), dir resolves relative paths. */
+int mpm_config_read_string(mpm_config *cfg, const char *text, const char *origin,
+                           const char *dir);
+/* One "key=value" override from the command line; replaces an earlier value. */
+int mpm_config_override(mpm_config *cfg, const char *assignment);
+
+/* Check every entry against the schema: unknown keys (with the nearest valid key), types,
+ * ranges, enum choices, file existence, required keys of every used instance. Reports
+ * every problem before returning MPM_ERR_INPUT. */
+int mpm_config_validate(const mpm_config *cfg);
+
+/* Typed getters: the entry if set, else the spec's default; MPM_ERR_INPUT (with a message)
+ * if the key is not in the schema, is required and missing, or does not parse. */
+int mpm_config_get_real(const mpm_config *cfg, const char *key, double *value);
+int mpm_config_get_int(const mpm_config *cfg, const char *key, int *value);
+int mpm_config_get_bool(const mpm_config *cfg, const char *key, int *value);
+/* String, enum, names and path values; the pointer stays valid while cfg lives. A path is
+ * returned resolved against the case file's folder. */
+int mpm_config_get_string(const mpm_config *cfg, const char *key, const char **value);
+/* Up to max values; *count is how many were given. */
+int mpm_config_get_reals(const mpm_config *cfg, const char *key, double *values, int max,
+                         int *count);
+
+/* 1 if the key was set in the file or on the command line. */
+int mpm_config_has(const mpm_config *cfg, const char *key);
+
+/* Instance names used under a prefix, in order of first appearance: for "geometry" and
+ * entries geometry.a.type, geometry.b.lo it gives {"a", "b"}. *names is owned by cfg. */
+int mpm_config_instances(const mpm_config *cfg, const char *prefix, const char *const **names,
+                         int *count);
+
+/* Where a key was set: "case.ini:12", "command line", or "default". */
+const char *mpm_config_where(const mpm_config *cfg, const char *key);
+
+/* Report a problem with a key found by a consumer (a box outside the domain, say), in the
+ * same one-line form as validation, on rank 0; returns MPM_ERR_INPUT. */
+int mpm_config_fail(const mpm_config *cfg, const char *key, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+
+/* The resolved configuration as case-file text: every schema key of every section in use,
+ * with its value and, as a comment, where it came from. Feeding it back in gives the same
+ * configuration. *text is malloc'ed. */
+int mpm_config_resolved_text(const mpm_config *cfg, char **text);
+
+#endif

@@ -1,0 +1,87 @@
+/* The shared background grid: a Cartesian node lattice split over an MPI Cartesian
+ * communicator into boxes, with per-phase nodal fields.
+ *
+ * Geometry. The domain [lo, hi] holds ncells[d] cells of size dx; node i sits at
+ * lo + i dx. Global node indices run over [-pad, ncells + pad]: the pad layers outside the
+ * domain exist so that a particle anywhere inside the domain finds every node of its stencil
+ * (wall conditions act on them later).
+ *
+ * Ownership. Rank coordinate c along d owns cells [cell_lo, cell_hi) and the nodes of
+ * those cells' lower faces; the last rank along d also owns node ncells, and the first and
+ * last ranks own the pad layers on their side. Every node has exactly one owner.
+ *
+ * Box. A rank stores its owned nodes plus `ghost` layers on every side (as wide as the
+ * shape function reaches); the local array of one field spans global nodes
+ * [box_lo[d], box_lo[d] + box_n[d]) with x fastest. P2G adds into ghost nodes;
+ * mpm_grid_halo_reverse() sums ghosts into owners, mpm_grid_halo_forward() copies owners
+ * into ghosts. A box is the unit a refinement level will later add over part of a level. */
+#ifndef MPM_GRID_H
+#define MPM_GRID_H
+
+#include "mpm_shape.h"
+#include "mpm_types.h"
+
+#define MPM_GRID_MAX_PHASES 4
+
+/* Nodal fields of one phase (one module), each an array of box nodes. */
+typedef struct mpm_grid_phase {
+  char name[32];
+  double *m_i;                   /* mass */
+  double *mv_i[MPM_MAX_DIM];     /* momentum */
+  double *f_i[MPM_MAX_DIM];      /* force (internal + external) */
+  double *v_i[MPM_MAX_DIM];      /* velocity */
+  double *a_i[MPM_MAX_DIM];      /* acceleration */
+  double *normal_i[MPM_MAX_DIM]; /* mass-gradient normal, for contact */
+} mpm_grid_phase;
+
+typedef struct mpm_grid {
+  MPI_Comm comm;              /* Cartesian communicator (owned) */
+  int rank, size;
+  int dim;
+  int nproc[MPM_MAX_DIM];     /* ranks per direction */
+  int coord[MPM_MAX_DIM];     /* this rank's coordinates */
+  int nbr[MPM_MAX_DIM][2];    /* lower, upper neighbour (MPI_PROC_NULL at walls) */
+  double lo[MPM_MAX_DIM], hi[MPM_MAX_DIM], dx;
+  int ncells[MPM_MAX_DIM];
+  mpm_shape_kind shape;
+  int ghost, pad;
+  int *cell_split[MPM_MAX_DIM]; /* nproc[d]+1 cell offsets: rank c owns [split[c], split[c+1]) */
+  int own_lo[MPM_MAX_DIM], own_hi[MPM_MAX_DIM]; /* owned nodes [lo, hi), global indices */
+  int box_lo[MPM_MAX_DIM], box_n[MPM_MAX_DIM];  /* stored nodes, owned + ghosts */
+  mpm_lidx nnodes;                              /* product of box_n */
+  int nphases;
+  mpm_grid_phase phase[MPM_GRID_MAX_PHASES];
+} mpm_grid;
+
+/* Build the grid over comm. nproc[d] = 0 lets MPI choose the split. The domain [lo, hi] must
+ * be a whole number of cells of size dx (to 1e-9 relative); each rank needs at least `ghost`
+ * cells per direction. Collective. */
+int mpm_grid_new(mpm_grid **grid, MPI_Comm comm, int dim, const double *lo, const double *hi,
+                 double dx, mpm_shape_kind shape, const int *nproc);
+void mpm_grid_destroy(mpm_grid **grid);
+
+/* Add a set of nodal fields for a phase; returns its index in *index. */
+int mpm_grid_add_phase(mpm_grid *grid, const char *name, int *index);
+
+/* Zero m, mv and f of one phase on every box node. */
+void mpm_grid_phase_zero(mpm_grid *grid, int phase);
+
+/* Local (box) index of global node (i, j, k); the caller guarantees it is in the box. */
+static inline mpm_lidx mpm_grid_local_index(const mpm_grid *g, const int *gi) {
+  mpm_lidx l = gi[g->dim - 1] - g->box_lo[g->dim - 1];
+  for (int d = g->dim - 2; d >= 0; --d) l = l * g->box_n[d] + (gi[d] - g->box_lo[d]);
+  return l;
+}
+
+/* Is box node l owned by this rank? */
+int mpm_grid_node_is_owned(const mpm_grid *g, mpm_lidx l);
+
+/* Rank (in grid->comm) that owns the cell containing x; -1 if x is outside [lo, hi). */
+int mpm_grid_owner_of(const mpm_grid *g, const double *x);
+
+/* Sum ghost contributions into their owners, for nfields box arrays (collective). */
+int mpm_grid_halo_reverse(mpm_grid *grid, double *const *fields, int nfields);
+/* Copy owner values into the ghosts, for nfields box arrays (collective). */
+int mpm_grid_halo_forward(mpm_grid *grid, double *const *fields, int nfields);
+
+#endif

@@ -1,0 +1,60 @@
+/* Output: parallel HDF5 snapshots with an XDMF index, and atomic checkpoints.
+ *
+ * Snapshot OUTDIR/snap_NNNNNN.h5 (written collectively, to a temporary name, then renamed):
+ *   /                 attributes time (double), step (int64), dim (int), config (string:
+ *                     the resolved case text), version (string)
+ *   /<phase>/id       int64 [N]
+ *   /<phase>/<field>  double [N][ncomp] for every particle field (x is [N][dim])
+ *   /grid/<phase>/m, /grid/<phase>/v  (optional) nodal mass [Nz][Ny][Nx] and velocity
+ *                     [Nz][Ny][Nx][dim] over the global node lattice including pad layers
+ * OUTDIR/series.xmf indexes every snapshot written so far (a temporal collection of
+ * Polyvertex grids per phase, and CoRectMesh grids for grid fields) and is rewritten
+ * atomically after each snapshot, so it is valid XML at every moment.
+ *
+ * Checkpoint (any path; written to PATH.tmp, then renamed by rank 0 once complete):
+ *   /  attributes config (string), nranks (int), and named double attributes from the caller
+ *   /<phase>/id int64 [N], /<phase>/data double [ncomp][N] (component-major, rank order),
+ *   /<phase>/counts int64 [nranks] particles per writing rank, /<phase> attribute id_next. */
+#ifndef MPM_OUTPUT_H
+#define MPM_OUTPUT_H
+
+#include "mpm_grid.h"
+#include "mpm_particles.h"
+
+typedef struct mpm_output mpm_output;
+
+/* Prepare output into dir (created by rank 0 if missing). config_text is stored in every
+ * file. Collective. If append is set (a restart), the XDMF index keeps the snapshots listed
+ * in an existing series.xmf with time <= t_restart. */
+int mpm_output_new(mpm_output **out, MPI_Comm comm, const char *dir, const char *config_text,
+                   int dim, int append, double t_restart);
+void mpm_output_destroy(mpm_output **out);
+
+/* Write one snapshot of nphases particle sets; grid may be NULL (no grid fields); the grid
+ * phases written are those whose names match a particle phase. Collective. */
+int mpm_output_snapshot(mpm_output *out, double t, long step, const mpm_particles *const *phases,
+                        const char *const *names, int nphases, const mpm_grid *grid);
+
+/* Number of snapshots written (or kept from an earlier run); the next gets this index. */
+int mpm_output_count(const mpm_output *out);
+
+/* Write a checkpoint atomically. Collective. */
+int mpm_checkpoint_write(MPI_Comm comm, const char *path, const char *config_text,
+                         const char *const *attr_names, const double *attr_values, int nattr,
+                         const mpm_particles *const *phases, const char *const *names,
+                         int nphases);
+
+typedef struct mpm_checkpoint mpm_checkpoint;
+
+/* Open a checkpoint for reading (collective); a missing or foreign file is an input error
+ * naming the path. */
+int mpm_checkpoint_open(mpm_checkpoint **ck, MPI_Comm comm, const char *path);
+void mpm_checkpoint_close(mpm_checkpoint **ck);
+const char *mpm_checkpoint_config(const mpm_checkpoint *ck);
+int mpm_checkpoint_attr(const mpm_checkpoint *ck, const char *name, double *value);
+/* Fill p (already created with the fields of the phase) with the stored particles: on the
+ * same number of ranks each rank gets exactly what it wrote, in the same order; otherwise
+ * the ranks get even chunks and the caller migrates. Sets p->id_next. Collective. */
+int mpm_checkpoint_read_particles(mpm_checkpoint *ck, const char *phase, mpm_particles *p);
+
+#endif

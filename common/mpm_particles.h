@@ -1,0 +1,73 @@
+/* Particle storage for one module: structure of arrays, component-major.
+ *
+ * A particle set has named fields (x, v, F, m, ...), each with ncomp components. All reals
+ * live in one block `data` of ncomp_total * n doubles: component c of every particle is the
+ * contiguous run data[c*n .. c*n + n). The first `nstate` components (the state fields,
+ * listed first) form the module's ODE state, which ARKODE integrates as one serial
+ * N_Vector wrapping data[0 .. nstate*n). By convention field 0 is the position x and field 1
+ * the velocity v, each with dim components.
+ *
+ * Ids are global and survive migration, sorting, injection and removal. Every change of the
+ * particle count goes through mpm_particles_edit(), which rebuilds the block; callers that
+ * hold an N_Vector over the state must re-wrap it (and call the integrator's Resize). */
+#ifndef MPM_PARTICLES_H
+#define MPM_PARTICLES_H
+
+#include "mpm_grid.h"
+#include "mpm_types.h"
+
+#define MPM_PARTICLES_MAX_FIELDS 16
+
+typedef struct mpm_field_desc {
+  const char *name;
+  int ncomp;
+} mpm_field_desc;
+
+typedef struct mpm_particles {
+  int dim;
+  int nfields, nstate_fields;
+  mpm_field_desc field[MPM_PARTICLES_MAX_FIELDS];
+  int offset[MPM_PARTICLES_MAX_FIELDS]; /* first component of each field */
+  int ncomp;                            /* components in all fields */
+  int nstate;                           /* components in the state fields */
+  mpm_lidx n;                           /* particles on this rank */
+  mpm_gidx *id;
+  double *data;
+  mpm_gidx id_next; /* next free global id; equal on every rank */
+} mpm_particles;
+
+/* A set with no particles. The first nstate_fields fields are the state; fields 0 and 1
+ * must be x and v with dim components each. */
+int mpm_particles_new(mpm_particles **p, int dim, const mpm_field_desc *fields, int nfields,
+                      int nstate_fields);
+void mpm_particles_destroy(mpm_particles **p);
+
+/* Start of component c of field f. */
+static inline double *mpm_particles_comp(const mpm_particles *p, int f, int c) {
+  return p->data + (size_t)(p->offset[f] + c) * (size_t)p->n;
+}
+
+/* Field index by name, or -1. */
+int mpm_particles_find(const mpm_particles *p, const char *name);
+
+/* Keep the particles with keep[i] != 0 (all if keep is NULL), in order, and append nadd new
+ * ones with ids add_id and data add_data (component-major: ncomp * nadd). Local. */
+int mpm_particles_edit(mpm_particles *p, const unsigned char *keep, mpm_lidx nadd,
+                       const mpm_gidx *add_id, const double *add_data);
+
+/* Append nadd particles with fresh global ids (collective: ids are numbered in rank
+ * order from id_next). */
+int mpm_particles_inject(mpm_particles *p, MPI_Comm comm, mpm_lidx nadd, const double *add_data);
+
+/* Send every particle to the rank owning its cell. *changed (may be NULL) is set to 1 on
+ * every rank if any rank's set changed. A particle outside the domain is an error naming
+ * its id and position. Collective over grid->comm. */
+int mpm_particles_migrate(mpm_particles *p, const mpm_grid *grid, int *changed);
+
+/* Reorder the particles by the cell that contains them (x fastest), stably. Local. */
+int mpm_particles_sort(mpm_particles *p, const mpm_grid *grid);
+
+/* Global particle count (collective). */
+int mpm_particles_global_count(const mpm_particles *p, MPI_Comm comm, mpm_gidx *count);
+
+#endif
