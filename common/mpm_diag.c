@@ -1,0 +1,86 @@
+/* Diagnostics CSV. Only rank 0 holds a FILE; other ranks hold a handle that does nothing. */
+#include "mpm_diag.h"
+
+#include "mpm_error.h"
+
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+struct mpm_diag {
+  FILE *f;
+  int ncols;
+};
+
+/* Keep the header and the rows with time <= t_keep of an existing file. */
+static int truncate_after(const char *path, double t_keep, char **kept) {
+  FILE *f = fopen(path, "r");
+  if (!f) MPM_FAIL(MPM_ERR_FILE, "cannot reopen diagnostics '%s': %s", path, strerror(errno));
+  size_t cap = 1 << 16, len = 0;
+  char *buf, line[8192];
+  MPM_ALLOC(buf, cap);
+  for (int first = 1; fgets(line, sizeof line, f); first = 0) {
+    if (!first && strtod(line, NULL) > t_keep) break;
+    size_t k = strlen(line);
+    if (len + k + 1 > cap) {
+      char *nb = realloc(buf, cap = 2 * (len + k + 1));
+      if (!nb) {
+        free(buf);
+        fclose(f);
+        MPM_FAIL(MPM_ERR_MEMORY, "out of memory reading '%s'", path);
+      }
+      buf = nb;
+    }
+    memcpy(buf + len, line, k + 1);
+    len += k;
+  }
+  fclose(f);
+  *kept = buf;
+  return 0;
+}
+
+int mpm_diag_open(mpm_diag **d, MPI_Comm comm, const char *path, int ncols,
+                  const char *const *names, int append, double t_keep) {
+  int rank, status = 0;
+  MPM_CALL_MPI(MPI_Comm_rank(comm, &rank));
+  MPM_ALLOC(*d, 1);
+  (*d)->ncols = ncols;
+  if (rank == 0) {
+    char *kept = NULL;
+    if (append && truncate_after(path, t_keep, &kept) != 0) kept = NULL;
+    (*d)->f = fopen(path, "w");
+    if (!(*d)->f) {
+      mpm_log_all(MPM_LOG_ERROR, "cannot write diagnostics '%s': %s; check that the output folder is writable", path, strerror(errno));
+      status = MPM_ERR_FILE;
+    } else if (kept && kept[0]) {
+      fputs(kept, (*d)->f);
+    } else {
+      for (int c = 0; c < ncols; ++c) fprintf((*d)->f, "%s%s", c ? "," : "", names[c]);
+      fputc('\n', (*d)->f);
+    }
+    free(kept);
+    if ((*d)->f) fflush((*d)->f);
+  }
+  MPM_CALL_MPI(MPI_Bcast(&status, 1, MPI_INT, 0, comm));
+  if (status) {
+    mpm_diag_close(d);
+    return mpm_trace(__FILE__, __LINE__, __func__, status);
+  }
+  return 0;
+}
+
+int mpm_diag_row(mpm_diag *d, const double *values) {
+  if (!d->f) return 0;
+  for (int c = 0; c < d->ncols; ++c) fprintf(d->f, "%s%.17g", c ? "," : "", values[c]);
+  fputc('\n', d->f);
+  if (fflush(d->f) != 0) MPM_FAIL(MPM_ERR_FILE, "cannot write a diagnostics row: %s", strerror(errno));
+  return 0;
+}
+
+void mpm_diag_close(mpm_diag **d) {
+  if (!d || !*d) return;
+  if ((*d)->f) fclose((*d)->f);
+  free(*d);
+  *d = NULL;
+}

@@ -1,0 +1,377 @@
+/* The distributed background grid: Cartesian decomposition, box layout, nodal fields and
+ * the halo exchanges. mpm_grid.h states the contract (ownership, box layout); this file
+ * keeps these invariants:
+ *
+ * - grid->comm is a non-periodic Cartesian communicator made with reorder = 0, so a rank
+ *   number means the same in grid->comm as in the communicator the caller passed.
+ * - Along d, coordinate c owns cells [cell_split[d][c], cell_split[d][c+1]) with
+ *   cell_split[d][c] = (ncells * c) / nproc, so every rank owns at least
+ *   floor(ncells / nproc) >= ghost cells: a ghost layer only ever reaches the next rank.
+ * - The box is [own_lo - ghost, own_hi + ghost) per direction. Directions d >= dim are
+ *   degenerate (box_lo = own_lo = 0, box_n = own_hi = 1) so that loops can always run over
+ *   three indices.
+ * - Neighbours along d have the same owned range in every other direction, hence the same
+ *   box_n there: a slab has the same size on both ends of a message.
+ * - The halo exchanges go one direction at a time over slabs that span the whole box in
+ *   the other directions, ghosts included. What moved along direction 0 is then carried
+ *   along direction 1, and so on, so edge and corner values reach diagonal neighbours in
+ *   dim steps with face neighbours only. */
+#include "mpm_grid.h"
+#include "mpm_error.h"
+
+#include <limits.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static const char g_axis[MPM_MAX_DIM] = {'x', 'y', 'z'};
+
+/* Fail on an input error that every rank detects alike: one message (from rank 0), not one
+ * per rank. */
+#define FAIL_INPUT(...)                                                                            \
+  do {                                                                                             \
+    mpm_log(MPM_LOG_ERROR, __VA_ARGS__);                                                           \
+    return mpm_trace(__FILE__, __LINE__, __func__, MPM_ERR_INPUT);                                 \
+  } while (0)
+
+/* Send and receive buffers of the halo exchanges, grown on demand and kept between calls
+ * because the exchanges run several times per step. */
+typedef struct halo_scratch {
+  double *send, *recv;
+  size_t cap; /* doubles in each buffer */
+} halo_scratch;
+
+/* ---- construction ---------------------------------------------------------------------- */
+
+/* Cells per direction from the domain and dx; the domain must be a whole number of cells. */
+static int count_cells(int dim, const double *lo, const double *hi, double dx, int *ncells) {
+  if (dim < 1 || dim > MPM_MAX_DIM) FAIL_INPUT("grid: dimension %d is not 1-3", dim);
+  if (!(dx > 0) || !isfinite(dx))
+    FAIL_INPUT("grid: the cell size dx = %g must be positive and finite", dx);
+  for (int d = 0; d < dim; ++d) {
+    const double r = (hi[d] - lo[d]) / dx, n = nearbyint(r);
+    if (!(n >= 1) || n > INT_MAX / 4 || fabs(r - n) > 1e-9 * fabs(r))
+      FAIL_INPUT("grid: the domain [%g, %g] along %c holds %.12g cells of size dx = %g; it must "
+                 "hold a positive whole number of cells: change the domain bounds or dx",
+                 lo[d], hi[d], g_axis[d], r, dx);
+    ncells[d] = (int)n;
+  }
+  return 0;
+}
+
+/* Ranks per direction: the caller's where given, MPI's choice where 0. */
+static int choose_nproc(int size, int dim, const int *nproc, int *dims) {
+  int given = 1, all = 1;
+  for (int d = 0; d < dim; ++d) {
+    dims[d] = nproc ? nproc[d] : 0;
+    if (dims[d] < 0) FAIL_INPUT("grid: %d ranks along %c", dims[d], g_axis[d]);
+    if (dims[d] > 0) given *= dims[d];
+    all = all && dims[d] > 0;
+  }
+  if (all ? given != size : size % given != 0)
+    FAIL_INPUT("grid: the requested ranks per direction (product %d) do not fit the %d ranks "
+               "of the run; give counts whose product is the number of ranks, or 0 to let MPI "
+               "choose",
+               given, size);
+  MPM_CALL_MPI(MPI_Dims_create(size, dim, dims));
+  return 0;
+}
+
+/* Every rank needs at least `ghost` cells per direction (see the file comment). */
+static int check_cells_per_rank(const mpm_grid *g) {
+  for (int d = 0; d < g->dim; ++d)
+    if (g->ncells[d] / g->nproc[d] < g->ghost)
+      FAIL_INPUT("grid: %d cells along %c over %d ranks leave %d cells on some rank, fewer than "
+                 "the %d ghost layers of the %s shape; use fewer ranks or a finer grid",
+                 g->ncells[d], g_axis[d], g->nproc[d], g->ncells[d] / g->nproc[d], g->ghost,
+                 mpm_shape_name(g->shape));
+  return 0;
+}
+
+static int make_comm(mpm_grid *g, MPI_Comm comm) {
+  int periods[MPM_MAX_DIM] = {0, 0, 0};
+  /* reorder = 0: rank numbers stay those of comm, which callers rely on. */
+  MPM_CALL_MPI(MPI_Cart_create(comm, g->dim, g->nproc, periods, 0, &g->comm));
+  MPM_CALL_MPI(MPI_Comm_rank(g->comm, &g->rank));
+  MPM_CALL_MPI(MPI_Comm_size(g->comm, &g->size));
+  MPM_CALL_MPI(MPI_Cart_coords(g->comm, g->rank, g->dim, g->coord));
+  for (int d = 0; d < g->dim; ++d)
+    MPM_CALL_MPI(MPI_Cart_shift(g->comm, d, 1, &g->nbr[d][0], &g->nbr[d][1]));
+  return 0;
+}
+
+/* cell_split, owned range and box of this rank, per the header's ownership rule. */
+static int make_layout(mpm_grid *g) {
+  long long nnodes = 1;
+  for (int d = 0; d < g->dim; ++d) {
+    const int np = g->nproc[d], c = g->coord[d];
+    MPM_ALLOC(g->cell_split[d], np + 1);
+    for (int k = 0; k <= np; ++k) g->cell_split[d][k] = (int)((long long)g->ncells[d] * k / np);
+    g->own_lo[d] = c == 0 ? -g->pad : g->cell_split[d][c];
+    g->own_hi[d] = c == np - 1 ? g->ncells[d] + 1 + g->pad : g->cell_split[d][c + 1];
+    g->box_lo[d] = g->own_lo[d] - g->ghost;
+    g->box_n[d] = g->own_hi[d] - g->own_lo[d] + 2 * g->ghost;
+    nnodes *= g->box_n[d];
+  }
+  if (nnodes > INT32_MAX)
+    MPM_FAIL(MPM_ERR_INPUT,
+             "grid: %lld nodes on one rank exceed the local index range; use more ranks or a "
+             "coarser grid",
+             nnodes);
+  g->nnodes = (mpm_lidx)nnodes;
+  return 0;
+}
+
+/* Directions beyond dim: one node, owned, no neighbours. */
+static void set_unused_dims(mpm_grid *g) {
+  for (int d = 0; d < MPM_MAX_DIM; ++d) {
+    g->nbr[d][0] = g->nbr[d][1] = MPI_PROC_NULL;
+    g->nproc[d] = 1;
+    g->box_n[d] = g->own_hi[d] = 1;
+  }
+}
+
+static int grid_setup(mpm_grid *g, MPI_Comm comm, const double *lo, const double *hi, double dx,
+                      const int *nproc) {
+  int size;
+  MPM_CALL(count_cells(g->dim, lo, hi, dx, g->ncells));
+  MPM_CALL_MPI(MPI_Comm_size(comm, &size));
+  MPM_CALL(choose_nproc(size, g->dim, nproc, g->nproc));
+  MPM_CALL(check_cells_per_rank(g));
+  for (int d = 0; d < g->dim; ++d) g->lo[d] = lo[d], g->hi[d] = hi[d];
+  g->dx = dx;
+  MPM_CALL(make_comm(g, comm));
+  int rc = make_layout(g);
+  if (!rc && !(g->scratch = calloc(1, sizeof(halo_scratch))))
+    rc = mpm_trace(__FILE__, __LINE__, __func__, MPM_ERR_MEMORY);
+  /* A failure from here on may be local: agree on it, so no rank keeps a grid alone. */
+  MPM_CALL_MPI(MPI_Allreduce(MPI_IN_PLACE, &rc, 1, MPI_INT, MPI_MAX, g->comm));
+  MPM_CALL(rc);
+  return 0;
+}
+
+int mpm_grid_new(mpm_grid **grid, MPI_Comm comm, int dim, const double *lo, const double *hi,
+                 double dx, mpm_shape_kind shape, const int *nproc) {
+  mpm_grid *g;
+  *grid = NULL;
+  if ((unsigned)shape >= MPM_SHAPE_COUNT)
+    FAIL_INPUT("grid: unknown shape function kind %d", (int)shape);
+  MPM_ALLOC(g, 1);
+  g->comm = MPI_COMM_NULL;
+  set_unused_dims(g);
+  g->dim = dim;
+  g->shape = shape;
+  g->ghost = g->pad = mpm_shape_ghost_width(shape);
+  const int rc = grid_setup(g, comm, lo, hi, dx, nproc);
+  if (rc) {
+    mpm_grid_destroy(&g);
+    return mpm_trace(__FILE__, __LINE__, __func__, rc);
+  }
+  *grid = g;
+  return 0;
+}
+
+static void phase_free(mpm_grid_phase *ph) {
+  free(ph->m_i);
+  for (int d = 0; d < MPM_MAX_DIM; ++d) {
+    free(ph->mv_i[d]), free(ph->f_i[d]), free(ph->v_i[d]);
+    free(ph->a_i[d]), free(ph->normal_i[d]);
+  }
+  memset(ph, 0, sizeof *ph);
+}
+
+void mpm_grid_destroy(mpm_grid **grid) {
+  if (!grid || !*grid) return;
+  mpm_grid *g = *grid;
+  for (int p = 0; p < g->nphases; ++p) phase_free(&g->phase[p]);
+  for (int d = 0; d < MPM_MAX_DIM; ++d) free(g->cell_split[d]);
+  halo_scratch *s = g->scratch;
+  if (s) free(s->send), free(s->recv), free(s);
+  if (g->comm != MPI_COMM_NULL) MPI_Comm_free(&g->comm);
+  free(g);
+  *grid = NULL;
+}
+
+/* ---- nodal fields ---------------------------------------------------------------------- */
+
+static int phase_alloc(mpm_grid_phase *ph, int dim, mpm_lidx n) {
+  MPM_ALLOC(ph->m_i, n);
+  for (int d = 0; d < dim; ++d) {
+    MPM_ALLOC(ph->mv_i[d], n);
+    MPM_ALLOC(ph->f_i[d], n);
+    MPM_ALLOC(ph->v_i[d], n);
+    MPM_ALLOC(ph->a_i[d], n);
+    MPM_ALLOC(ph->normal_i[d], n);
+  }
+  return 0;
+}
+
+int mpm_grid_add_phase(mpm_grid *grid, const char *name, int *index) {
+  if (grid->nphases >= MPM_GRID_MAX_PHASES)
+    FAIL_INPUT("grid: cannot add phase '%s': at most %d phases", name ? name : "",
+               MPM_GRID_MAX_PHASES);
+  mpm_grid_phase *ph = &grid->phase[grid->nphases];
+  const int rc = phase_alloc(ph, grid->dim, grid->nnodes);
+  if (rc) {
+    phase_free(ph);
+    return mpm_trace(__FILE__, __LINE__, __func__, rc);
+  }
+  snprintf(ph->name, sizeof ph->name, "%s", name ? name : "");
+  if (index) *index = grid->nphases;
+  grid->nphases++;
+  return 0;
+}
+
+void mpm_grid_phase_zero(mpm_grid *grid, int phase) {
+  mpm_grid_phase *ph = &grid->phase[phase];
+  const size_t bytes = (size_t)grid->nnodes * sizeof(double);
+  memset(ph->m_i, 0, bytes);
+  for (int d = 0; d < grid->dim; ++d) memset(ph->mv_i[d], 0, bytes), memset(ph->f_i[d], 0, bytes);
+}
+
+/* ---- ownership ------------------------------------------------------------------------- */
+
+int mpm_grid_node_is_owned(const mpm_grid *g, mpm_lidx l) {
+  for (int d = 0; d < g->dim; ++d) {
+    const int gi = g->box_lo[d] + (int)(l % g->box_n[d]);
+    l /= g->box_n[d];
+    if (gi < g->own_lo[d] || gi >= g->own_hi[d]) return 0;
+  }
+  return 1;
+}
+
+/* Rank coordinate owning cell c: the last k with split[k] <= c (split is increasing). */
+static int coord_of_cell(const int *split, int np, int c) {
+  int a = 0, b = np;
+  while (b - a > 1) {
+    const int m = (a + b) / 2;
+    if (split[m] <= c)
+      a = m;
+    else
+      b = m;
+  }
+  return a;
+}
+
+int mpm_grid_owner_of(const mpm_grid *g, const double *x) {
+  int coords[MPM_MAX_DIM], rank;
+  for (int d = 0; d < g->dim; ++d) {
+    if (!(x[d] >= g->lo[d] && x[d] < g->hi[d])) return -1; /* also rejects NaN */
+    int c = (int)floor((x[d] - g->lo[d]) / g->dx);
+    if (c >= g->ncells[d]) c = g->ncells[d] - 1; /* x just below hi may round up */
+    coords[d] = coord_of_cell(g->cell_split[d], g->nproc[d], c);
+  }
+  if (MPI_Cart_rank(g->comm, coords, &rank) != MPI_SUCCESS) return -1;
+  return rank;
+}
+
+/* ---- halo exchange --------------------------------------------------------------------- */
+
+/* Box-local index ranges of a slab: [start, start + ghost) along d, the whole box across. */
+typedef struct slab {
+  int lo[MPM_MAX_DIM], hi[MPM_MAX_DIM];
+} slab;
+
+static slab slab_along(const mpm_grid *g, int d, int start) {
+  slab s;
+  for (int e = 0; e < MPM_MAX_DIM; ++e) s.lo[e] = 0, s.hi[e] = g->box_n[e];
+  s.lo[d] = start, s.hi[d] = start + g->ghost;
+  return s;
+}
+
+static size_t slab_nodes(const slab *s) {
+  size_t n = 1;
+  for (int e = 0; e < MPM_MAX_DIM; ++e) n *= (size_t)(s->hi[e] - s->lo[e]);
+  return n;
+}
+
+/* Start of the x-row (j, k) of a box array. */
+static double *box_row(const mpm_grid *g, double *f, int j, int k) {
+  return f + ((size_t)k * (size_t)g->box_n[1] + (size_t)j) * (size_t)g->box_n[0];
+}
+
+static void slab_pack(const mpm_grid *g, const slab *s, double *const *fields, int nfields,
+                      double *buf) {
+  const size_t nx = (size_t)(s->hi[0] - s->lo[0]);
+  for (int f = 0; f < nfields; ++f)
+    for (int k = s->lo[2]; k < s->hi[2]; ++k)
+      for (int j = s->lo[1]; j < s->hi[1]; ++j, buf += nx)
+        memcpy(buf, box_row(g, fields[f], j, k) + s->lo[0], nx * sizeof *buf);
+}
+
+/* Write a packed slab into the fields: added (reverse) or copied (forward). */
+static void slab_unpack(const mpm_grid *g, const slab *s, double *const *fields, int nfields,
+                        const double *buf, int add) {
+  const size_t nx = (size_t)(s->hi[0] - s->lo[0]);
+  for (int f = 0; f < nfields; ++f)
+    for (int k = s->lo[2]; k < s->hi[2]; ++k)
+      for (int j = s->lo[1]; j < s->hi[1]; ++j, buf += nx) {
+        double *row = box_row(g, fields[f], j, k) + s->lo[0];
+        if (add)
+          for (size_t i = 0; i < nx; ++i) row[i] += buf[i];
+        else
+          memcpy(row, buf, nx * sizeof *buf);
+      }
+}
+
+/* Make room for the largest message of an exchange of nfields arrays. */
+static int scratch_reserve(mpm_grid *g, int nfields) {
+  halo_scratch *s = g->scratch;
+  size_t need = 0;
+  for (int d = 0; d < g->dim; ++d) {
+    const slab sl = slab_along(g, d, 0);
+    need = MPM_MAX(need, slab_nodes(&sl) * (size_t)nfields);
+  }
+  if (need > INT_MAX)
+    MPM_FAIL(MPM_ERR_INPUT, "grid: a halo message of %zu values is too large for MPI", need);
+  if (need <= s->cap) return 0;
+  free(s->send), free(s->recv);
+  s->cap = 0;
+  MPM_ALLOC(s->send, need);
+  MPM_ALLOC(s->recv, need);
+  s->cap = need;
+  return 0;
+}
+
+/* One direction of an exchange, both ways. For side 0 the slab at send_at[0] goes to the
+ * lower neighbour while the upper neighbour's message lands in the slab at recv_at[0];
+ * side 1 mirrors it. A wall neighbour is MPI_PROC_NULL and Sendrecv does nothing there. */
+static int exchange_dir(mpm_grid *g, int d, double *const *fields, int nfields,
+                        const int send_at[2], const int recv_at[2], int add) {
+  halo_scratch *s = g->scratch;
+  for (int side = 0; side < 2; ++side) {
+    const int to = g->nbr[d][side], from = g->nbr[d][1 - side], tag = 100 + 2 * d + side;
+    const slab out = slab_along(g, d, send_at[side]), in = slab_along(g, d, recv_at[side]);
+    const int count = (int)(slab_nodes(&out) * (size_t)nfields);
+    if (to != MPI_PROC_NULL) slab_pack(g, &out, fields, nfields, s->send);
+    MPM_CALL_MPI(MPI_Sendrecv(s->send, count, MPI_DOUBLE, to, tag, s->recv, count, MPI_DOUBLE, from,
+                              tag, g->comm, MPI_STATUS_IGNORE));
+    if (from != MPI_PROC_NULL) slab_unpack(g, &in, fields, nfields, s->recv, add);
+  }
+  return 0;
+}
+
+int mpm_grid_halo_reverse(mpm_grid *grid, double *const *fields, int nfields) {
+  const int gw = grid->ghost;
+  MPM_CALL(scratch_reserve(grid, nfields));
+  for (int d = 0; d < grid->dim; ++d) {
+    const int n = grid->box_n[d];
+    /* My ghosts [0, g) and [n-g, n) are the neighbours' outermost owned layers. */
+    const int send_at[2] = {0, n - gw}, recv_at[2] = {n - 2 * gw, gw};
+    MPM_CALL(exchange_dir(grid, d, fields, nfields, send_at, recv_at, 1));
+  }
+  return 0;
+}
+
+int mpm_grid_halo_forward(mpm_grid *grid, double *const *fields, int nfields) {
+  const int gw = grid->ghost;
+  MPM_CALL(scratch_reserve(grid, nfields));
+  for (int d = 0; d < grid->dim; ++d) {
+    const int n = grid->box_n[d];
+    /* My outermost owned layers are the neighbours' ghosts. */
+    const int send_at[2] = {gw, n - 2 * gw}, recv_at[2] = {n - gw, 0};
+    MPM_CALL(exchange_dir(grid, d, fields, nfields, send_at, recv_at, 0));
+  }
+  return 0;
+}

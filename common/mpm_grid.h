@@ -51,6 +51,7 @@ typedef struct mpm_grid {
   mpm_lidx nnodes;                              /* product of box_n */
   int nphases;
   mpm_grid_phase phase[MPM_GRID_MAX_PHASES];
+  void *scratch; /* private to mpm_grid.c: halo message buffers, reused between calls */
 } mpm_grid;
 
 /* Build the grid over comm. nproc[d] = 0 lets MPI choose the split. The domain [lo, hi] must

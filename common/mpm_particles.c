@@ -1,0 +1,423 @@
+/* Particle storage: the component-major block, edits, injection of fresh ids, migration to
+ * the owning rank and sorting by cell. mpm_particles.h states the layout; this file keeps
+ * these invariants:
+ *
+ * - data holds ncomp * n doubles, component c of particle i at data[c * n + i]; id[i] is
+ *   the global id of particle i. The block is only ever replaced whole (install()), so n,
+ *   id and data always change together.
+ * - Ids are unique over all ranks and never reused: id_next exceeds every id handed out
+ *   and is equal on every rank (inject() advances it by the global count on every rank).
+ * - Migration keeps the order of the particles that stay and appends arrivals in source
+ *   rank order; sorting is stable. A run is therefore reproducible for a given rank count.
+ * - Collective operations never leave a rank behind: every local failure (a particle out of
+ *   the domain, an allocation) is agreed on with an MPI_Allreduce before the next
+ *   collective, so all ranks return the same error instead of deadlocking. */
+#include "mpm_particles.h"
+#include "mpm_error.h"
+
+#include <inttypes.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* ---- construction ---------------------------------------------------------------------- */
+
+static int check_fields(int dim, const mpm_field_desc *fields, int nfields, int nstate_fields) {
+  if (dim < 1 || dim > MPM_MAX_DIM) MPM_FAIL(MPM_ERR_INPUT, "particles: dimension %d", dim);
+  if (nfields < 2 || nfields > MPM_PARTICLES_MAX_FIELDS)
+    MPM_FAIL(MPM_ERR_INPUT, "particles: %d fields; need 2 (x, v) to %d", nfields,
+             MPM_PARTICLES_MAX_FIELDS);
+  if (nstate_fields < 0 || nstate_fields > nfields)
+    MPM_FAIL(MPM_ERR_INPUT, "particles: %d state fields out of %d", nstate_fields, nfields);
+  if (fields[0].ncomp != dim || fields[1].ncomp != dim)
+    MPM_FAIL(MPM_ERR_INPUT, "particles: fields 0 and 1 (x and v) need %d components", dim);
+  for (int f = 0; f < nfields; ++f) {
+    if (!fields[f].name || !fields[f].name[0] || fields[f].ncomp < 1)
+      MPM_FAIL(MPM_ERR_INPUT, "particles: field %d needs a name and at least one component", f);
+    for (int e = 0; e < f; ++e)
+      if (strcmp(fields[e].name, fields[f].name) == 0)
+        MPM_FAIL(MPM_ERR_INPUT, "particles: field '%s' is listed twice", fields[f].name);
+  }
+  return 0;
+}
+
+/* The set keeps its own copies of the names: descriptors often come from temporary tables. */
+static int copy_fields(mpm_particles *p, const mpm_field_desc *fields, int nfields) {
+  for (int f = 0; f < nfields; ++f) {
+    const size_t len = strlen(fields[f].name) + 1;
+    char *name;
+    MPM_ALLOC(name, len);
+    memcpy(name, fields[f].name, len);
+    p->field[f].name = name;
+    p->field[f].ncomp = fields[f].ncomp;
+    p->offset[f] = p->ncomp;
+    p->ncomp += fields[f].ncomp;
+    p->nfields = f + 1;
+  }
+  return 0;
+}
+
+int mpm_particles_new(mpm_particles **p, int dim, const mpm_field_desc *fields, int nfields,
+                      int nstate_fields) {
+  mpm_particles *s;
+  *p = NULL;
+  MPM_CALL(check_fields(dim, fields, nfields, nstate_fields));
+  MPM_ALLOC(s, 1);
+  s->dim = dim;
+  s->nstate_fields = nstate_fields;
+  int rc = copy_fields(s, fields, nfields);
+  if (!rc) rc = mpm_particles_edit(s, NULL, 0, NULL, NULL); /* an empty, non-NULL block */
+  if (rc) {
+    mpm_particles_destroy(&s);
+    return mpm_trace(__FILE__, __LINE__, __func__, rc);
+  }
+  for (int f = 0; f < nstate_fields; ++f) s->nstate += fields[f].ncomp;
+  *p = s;
+  return 0;
+}
+
+void mpm_particles_destroy(mpm_particles **p) {
+  if (!p || !*p) return;
+  for (int f = 0; f < (*p)->nfields; ++f) free((char *)(*p)->field[f].name);
+  free((*p)->id);
+  free((*p)->data);
+  free(*p);
+  *p = NULL;
+}
+
+int mpm_particles_find(const mpm_particles *p, const char *name) {
+  for (int f = 0; f < p->nfields; ++f)
+    if (strcmp(p->field[f].name, name) == 0) return f;
+  return -1;
+}
+
+/* ---- the block ------------------------------------------------------------------------- */
+
+static int block_alloc(const mpm_particles *p, mpm_lidx n, mpm_gidx **id, double **data) {
+  MPM_ALLOC(*id, n);
+  *data = calloc((size_t)p->ncomp * (size_t)n + 1, sizeof **data);
+  if (!*data) {
+    free(*id), *id = NULL;
+    MPM_FAIL(MPM_ERR_MEMORY, "particles: cannot allocate %d particles", (int)n);
+  }
+  return 0;
+}
+
+/* Replace the block by (n, id, data), which the set now owns. */
+static void install(mpm_particles *p, mpm_lidx n, mpm_gidx *id, double *data) {
+  free(p->id), free(p->data);
+  p->n = n, p->id = id, p->data = data;
+}
+
+static mpm_lidx count_kept(const mpm_particles *p, const unsigned char *keep) {
+  if (!keep) return p->n;
+  mpm_lidx k = 0;
+  for (mpm_lidx i = 0; i < p->n; ++i) k += keep[i] != 0;
+  return k;
+}
+
+/* Copy the kept particles, in order, to the front of a block with room for nnew. */
+static void copy_kept(const mpm_particles *p, const unsigned char *keep, mpm_lidx nnew,
+                      mpm_gidx *id, double *data) {
+  mpm_lidx k = 0;
+  for (mpm_lidx i = 0; i < p->n; ++i)
+    if (!keep || keep[i]) id[k++] = p->id[i];
+  for (int c = 0; c < p->ncomp; ++c) {
+    const double *src = p->data + (size_t)c * (size_t)p->n;
+    double *dst = data + (size_t)c * (size_t)nnew;
+    k = 0;
+    for (mpm_lidx i = 0; i < p->n; ++i)
+      if (!keep || keep[i]) dst[k++] = src[i];
+  }
+}
+
+int mpm_particles_edit(mpm_particles *p, const unsigned char *keep, mpm_lidx nadd,
+                       const mpm_gidx *add_id, const double *add_data) {
+  if (nadd < 0 || (nadd > 0 && (!add_id || !add_data)))
+    MPM_FAIL(MPM_ERR_INPUT, "particles: cannot add %d particles without ids and data", (int)nadd);
+  const mpm_lidx kept = count_kept(p, keep);
+  if ((int64_t)kept + nadd > INT32_MAX)
+    MPM_FAIL(MPM_ERR_INPUT, "particles: %d + %d particles exceed the local index range", (int)kept,
+             (int)nadd);
+  const mpm_lidx nnew = kept + nadd;
+  mpm_gidx *id;
+  double *data;
+  MPM_CALL(block_alloc(p, nnew, &id, &data));
+  copy_kept(p, keep, nnew, id, data);
+  if (nadd > 0) memcpy(id + kept, add_id, (size_t)nadd * sizeof *id);
+  for (int c = 0; c < p->ncomp && nadd > 0; ++c)
+    memcpy(data + (size_t)c * (size_t)nnew + (size_t)kept, add_data + (size_t)c * (size_t)nadd,
+           (size_t)nadd * sizeof *data);
+  install(p, nnew, id, data);
+  return 0;
+}
+
+int mpm_particles_inject(mpm_particles *p, MPI_Comm comm, mpm_lidx nadd, const double *add_data) {
+  int rank;
+  mpm_gidx mine = nadd > 0 ? nadd : 0, before = 0, total = 0;
+  MPM_CALL_MPI(MPI_Comm_rank(comm, &rank));
+  MPM_CALL_MPI(MPI_Exscan(&mine, &before, 1, MPM_MPI_GIDX, MPI_SUM, comm));
+  MPM_CALL_MPI(MPI_Allreduce(&mine, &total, 1, MPM_MPI_GIDX, MPI_SUM, comm));
+  if (rank == 0) before = 0; /* MPI_Exscan leaves rank 0's result undefined */
+  const mpm_gidx first = p->id_next + before;
+  p->id_next += total; /* on every rank, even if the local edit below fails */
+  mpm_gidx *ids;
+  MPM_ALLOC(ids, mine);
+  for (mpm_lidx i = 0; i < (mpm_lidx)mine; ++i) ids[i] = first + i;
+  const int rc = mpm_particles_edit(p, NULL, nadd, ids, add_data);
+  free(ids);
+  MPM_CALL(rc);
+  return 0;
+}
+
+int mpm_particles_global_count(const mpm_particles *p, MPI_Comm comm, mpm_gidx *count) {
+  mpm_gidx n = p->n;
+  MPM_CALL_MPI(MPI_Allreduce(&n, count, 1, MPM_MPI_GIDX, MPI_SUM, comm));
+  return 0;
+}
+
+/* ---- migration ------------------------------------------------------------------------- */
+
+_Static_assert(sizeof(mpm_gidx) == sizeof(double), "a particle id must fit a double's slot");
+
+/* The buffers of one migration. A record is the id (its bits in one double slot) followed by
+ * the ncomp components. count/displ hold [0, size) for sends, [size, 2 size) for receives,
+ * in records. */
+typedef struct migration {
+  int *dest;
+  unsigned char *keep;
+  int *count, *displ;
+  double *sendbuf, *recvbuf;
+  mpm_gidx *id; /* the new block, filled after the exchange */
+  double *data;
+  mpm_lidx nmove, nkeep, nrecv;
+} migration;
+
+static void migration_free(migration *m) {
+  free(m->dest), free(m->keep), free(m->count), free(m->displ);
+  free(m->sendbuf), free(m->recvbuf), free(m->id), free(m->data);
+}
+
+/* calloc for code that must still reach a collective: failure is recorded in *rc. */
+static void *try_alloc(size_t n, size_t size, int *rc) {
+  void *q = calloc(n ? n : 1, size);
+  if (!q && !*rc) {
+    mpm_log_all(MPM_LOG_ERROR, "particles: cannot allocate %zu bytes", n * size);
+    *rc = mpm_trace(__FILE__, __LINE__, __func__, MPM_ERR_MEMORY);
+  }
+  return q;
+}
+
+/* "(x, y[, z])"; buf must hold 3 numbers (80 characters is plenty). */
+static void format_point(char *buf, size_t len, const double *x, int dim) {
+  snprintf(buf, len,
+           dim == 1   ? "(%.9g)"
+           : dim == 2 ? "(%.9g, %.9g)"
+                      : "(%.9g, %.9g, %.9g)",
+           x[0], dim > 1 ? x[1] : 0.0, dim > 2 ? x[2] : 0.0);
+}
+
+static int report_outside(const mpm_particles *p, const mpm_grid *g, mpm_lidx i, mpm_lidx nout) {
+  char at[128], lo[128], hi[128];
+  double x[MPM_MAX_DIM];
+  for (int d = 0; d < p->dim; ++d) x[d] = mpm_particles_comp(p, 0, d)[i];
+  format_point(at, sizeof at, x, p->dim);
+  format_point(lo, sizeof lo, g->lo, g->dim);
+  format_point(hi, sizeof hi, g->hi, g->dim);
+  MPM_FAIL(MPM_ERR_UNPHYSICAL,
+           "particle %" PRId64 " at %s left the domain [%s, %s] (%d particle(s) outside on this "
+           "rank); reduce the time step or check the boundary conditions that hold it in",
+           p->id[i], at, lo, hi, (int)nout);
+}
+
+/* Owner of every particle; fails naming the first particle outside the domain. */
+static int find_owners(const mpm_particles *p, const mpm_grid *g, migration *m) {
+  mpm_lidx nout = 0, first = -1;
+  for (mpm_lidx i = 0; i < p->n; ++i) {
+    double x[MPM_MAX_DIM];
+    for (int d = 0; d < p->dim; ++d) x[d] = mpm_particles_comp(p, 0, d)[i];
+    m->dest[i] = mpm_grid_owner_of(g, x);
+    if (m->dest[i] < 0 && nout++ == 0) first = i;
+    m->keep[i] = m->dest[i] == g->rank;
+    m->nmove += m->dest[i] != g->rank;
+  }
+  return nout ? report_outside(p, g, first, nout) : 0;
+}
+
+static void prefix_sum(const int *count, int *displ, int n) {
+  displ[0] = 0;
+  for (int r = 1; r < n; ++r) displ[r] = displ[r - 1] + count[r - 1];
+}
+
+/* Pack the movers by destination rank, in particle order within each destination. */
+static void pack_movers(const mpm_particles *p, const mpm_grid *g, migration *m) {
+  const size_t rec = 1 + (size_t)p->ncomp;
+  for (mpm_lidx i = 0; i < p->n; ++i) {
+    if (m->keep[i]) continue;
+    double *r = m->sendbuf + (size_t)m->displ[m->dest[i]]++ * rec;
+    memcpy(r, &p->id[i], sizeof *r);
+    for (int c = 0; c < p->ncomp; ++c) r[1 + c] = p->data[(size_t)c * (size_t)p->n + i];
+  }
+  prefix_sum(m->count, m->displ, g->size); /* packing advanced displ; restore it */
+}
+
+/* Everything before the first collective: owners, send counts and the packed movers. */
+static int plan_sends(const mpm_particles *p, const mpm_grid *g, migration *m) {
+  int rc = 0;
+  m->dest = try_alloc((size_t)p->n, sizeof *m->dest, &rc);
+  m->keep = try_alloc((size_t)p->n, sizeof *m->keep, &rc);
+  m->count = try_alloc(2 * (size_t)g->size, sizeof *m->count, &rc);
+  m->displ = try_alloc(2 * (size_t)g->size, sizeof *m->displ, &rc);
+  if (rc) return rc;
+  MPM_CALL(find_owners(p, g, m));
+  m->nkeep = p->n - m->nmove;
+  for (mpm_lidx i = 0; i < p->n; ++i) m->count[m->dest[i]] += !m->keep[i];
+  prefix_sum(m->count, m->displ, g->size);
+  m->sendbuf = try_alloc((size_t)m->nmove * (1 + (size_t)p->ncomp), sizeof(double), &rc);
+  if (rc) return rc;
+  pack_movers(p, g, m);
+  return 0;
+}
+
+/* After the counts arrived: receive offsets and room for arrivals and the new block. */
+static int plan_receives(const mpm_particles *p, const mpm_grid *g, migration *m) {
+  int rc = 0, *rcount = m->count + g->size;
+  int64_t nrecv = 0;
+  for (int r = 0; r < g->size; ++r) nrecv += rcount[r];
+  if (nrecv + m->nkeep > INT32_MAX)
+    MPM_FAIL(MPM_ERR_INPUT,
+             "particles: %" PRId64 " particles would exceed the local index range of one "
+             "rank; use more ranks",
+             nrecv + m->nkeep);
+  m->nrecv = (mpm_lidx)nrecv;
+  prefix_sum(rcount, m->displ + g->size, g->size);
+  m->recvbuf = try_alloc((size_t)m->nrecv * (1 + (size_t)p->ncomp), sizeof(double), &rc);
+  m->id = try_alloc((size_t)(m->nkeep + m->nrecv), sizeof *m->id, &rc);
+  m->data = try_alloc((size_t)(m->nkeep + m->nrecv) * (size_t)p->ncomp, sizeof(double), &rc);
+  return rc;
+}
+
+static int alltoallv_records(const mpm_particles *p, const mpm_grid *g, migration *m) {
+  MPI_Datatype rec;
+  const int bytes = (int)((1 + (size_t)p->ncomp) * sizeof(double));
+  /* Bytes, not doubles: the id travels as raw bits in a double slot. */
+  MPM_CALL_MPI(MPI_Type_contiguous(bytes, MPI_BYTE, &rec));
+  MPM_CALL_MPI(MPI_Type_commit(&rec));
+  const int rc = MPI_Alltoallv(m->sendbuf, m->count, m->displ, rec, m->recvbuf, m->count + g->size,
+                               m->displ + g->size, rec, g->comm);
+  MPI_Type_free(&rec);
+  if (rc != MPI_SUCCESS) MPM_FAIL(MPM_ERR_MPI, "MPI_Alltoallv failed with MPI error %d", rc);
+  return 0;
+}
+
+/* Kept particles first, in order, then the arrivals in source rank order. */
+static void assemble(mpm_particles *p, migration *m) {
+  const size_t rec = 1 + (size_t)p->ncomp, nnew = (size_t)(m->nkeep + m->nrecv);
+  copy_kept(p, m->keep, (mpm_lidx)nnew, m->id, m->data);
+  for (mpm_lidx j = 0; j < m->nrecv; ++j) {
+    const double *r = m->recvbuf + (size_t)j * rec;
+    const size_t i = (size_t)(m->nkeep + j);
+    memcpy(&m->id[i], r, sizeof *r);
+    for (int c = 0; c < p->ncomp; ++c) m->data[(size_t)c * nnew + i] = r[1 + c];
+  }
+  install(p, (mpm_lidx)nnew, m->id, m->data);
+  m->id = NULL, m->data = NULL;
+}
+
+static int exchange(mpm_particles *p, const mpm_grid *g, migration *m) {
+  MPM_CALL_MPI(MPI_Alltoall(m->count, 1, MPI_INT, m->count + g->size, 1, MPI_INT, g->comm));
+  int rc = plan_receives(p, g, m);
+  MPM_CALL_MPI(MPI_Allreduce(MPI_IN_PLACE, &rc, 1, MPI_INT, MPI_MAX, g->comm));
+  MPM_CALL(rc);
+  MPM_CALL(alltoallv_records(p, g, m));
+  assemble(p, m);
+  return 0;
+}
+
+int mpm_particles_migrate(mpm_particles *p, const mpm_grid *grid, int *changed) {
+  migration m = {0};
+  int status[2]; /* error code, whether anything moves; agreed on by every rank */
+  if (changed) *changed = 0;
+  status[0] = plan_sends(p, grid, &m);
+  status[1] = m.nmove > 0;
+  int rc = MPI_Allreduce(MPI_IN_PLACE, status, 2, MPI_INT, MPI_MAX, grid->comm);
+  if (rc != MPI_SUCCESS) {
+    migration_free(&m);
+    MPM_FAIL(MPM_ERR_MPI, "MPI_Allreduce failed with MPI error %d", rc);
+  }
+  rc = status[0]; /* a rank with no bad particle returns the error some other rank found */
+  if (!rc && status[1]) {
+    rc = exchange(p, grid, &m);
+    if (changed) *changed = !rc;
+  }
+  migration_free(&m);
+  MPM_CALL(rc);
+  return 0;
+}
+
+/* ---- sorting --------------------------------------------------------------------------- */
+
+/* Cell coordinate along d of every particle, clamped into the grid: a particle outside the
+ * domain is migrate()'s error to report, sorting only needs a key. */
+static void cell_coords(const mpm_particles *p, const mpm_grid *g, int d, int *cell) {
+  const double *x = mpm_particles_comp(p, 0, d);
+  const int last = g->ncells[d] - 1;
+  for (mpm_lidx i = 0; i < p->n; ++i) {
+    const double r = (x[i] - g->lo[d]) / g->dx;
+    cell[i] = !(r >= 0) ? 0 : r >= last ? last : (int)r;
+  }
+}
+
+/* One stable counting-sort pass of the permutation `perm` by key[perm[i]] in [0, nkeys). */
+static void counting_pass(const int *key, int nkeys, mpm_lidx n, const mpm_lidx *perm,
+                          mpm_lidx *out, mpm_lidx *start) {
+  memset(start, 0, ((size_t)nkeys + 1) * sizeof *start);
+  for (mpm_lidx i = 0; i < n; ++i) start[key[perm[i]] + 1]++;
+  for (int k = 0; k < nkeys; ++k) start[k + 1] += start[k];
+  for (mpm_lidx i = 0; i < n; ++i) out[start[key[perm[i]]]++] = perm[i];
+}
+
+static int apply_permutation(mpm_particles *p, const mpm_lidx *perm) {
+  mpm_gidx *id;
+  double *data;
+  MPM_CALL(block_alloc(p, p->n, &id, &data));
+  for (mpm_lidx k = 0; k < p->n; ++k) id[k] = p->id[perm[k]];
+  for (int c = 0; c < p->ncomp; ++c) {
+    const double *src = p->data + (size_t)c * (size_t)p->n;
+    double *dst = data + (size_t)c * (size_t)p->n;
+    for (mpm_lidx k = 0; k < p->n; ++k) dst[k] = src[perm[k]];
+  }
+  install(p, p->n, id, data);
+  return 0;
+}
+
+/* Least significant direction first (x), so that after the last pass the order is that of
+ * the linear cell index with x fastest; each pass is a counting sort over one direction's
+ * cells, which keeps the work O(n + ncells[d]) however large the whole grid is. */
+static int sort_passes(mpm_particles *p, const mpm_grid *g, int *cell, mpm_lidx *perm,
+                       mpm_lidx *tmp, mpm_lidx *start) {
+  for (mpm_lidx i = 0; i < p->n; ++i) perm[i] = i;
+  for (int d = 0; d < p->dim; ++d) {
+    cell_coords(p, g, d, cell);
+    counting_pass(cell, g->ncells[d], p->n, perm, tmp, start);
+    mpm_lidx *t = perm;
+    perm = tmp, tmp = t;
+  }
+  return apply_permutation(p, perm);
+}
+
+int mpm_particles_sort(mpm_particles *p, const mpm_grid *grid) {
+  if (p->n < 2) return 0;
+  int maxcells = 0, *cell = NULL, rc = 0;
+  mpm_lidx *perm = NULL, *tmp = NULL, *start = NULL;
+  for (int d = 0; d < p->dim; ++d) maxcells = MPM_MAX(maxcells, grid->ncells[d]);
+  cell = try_alloc((size_t)p->n, sizeof *cell, &rc);
+  perm = try_alloc((size_t)p->n, sizeof *perm, &rc);
+  tmp = try_alloc((size_t)p->n, sizeof *tmp, &rc);
+  start = try_alloc((size_t)maxcells + 1, sizeof *start, &rc);
+  if (!rc) rc = sort_passes(p, grid, cell, perm, tmp, start);
+  free(cell), free(perm), free(tmp), free(start);
+  MPM_CALL(rc);
+  return 0;
+}

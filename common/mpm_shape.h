@@ -34,10 +34,12 @@ static inline int mpm_shape_support(mpm_shape_kind kind) {
   return s[kind];
 }
 
-/* Ghost layers a box needs on each side so that every particle in its cells reaches only
- * nodes it stores: the stencil of a particle in cell c spans nodes c-1 .. c+2 at most. */
+/* Ghost layers a box needs on each side. The stencil of a particle in cell c spans nodes
+ * c-1 .. c+2 at most; one more layer lets a particle drift up to one cell past its rank's
+ * cells during a step (the CFL limit keeps a step under one cell) before migration moves it
+ * between steps. The driver checks the drift and rejects a step that goes further. */
 static inline int mpm_shape_ghost_width(mpm_shape_kind kind) {
-  return kind == MPM_SHAPE_LINEAR ? 1 : 2;
+  return kind == MPM_SHAPE_LINEAR ? 2 : 3;
 }
 
 /* GIMP with a particle half-width lp (grid units, 0 < lp <= 0.5). */

@@ -1,0 +1,56 @@
+/* Phase timers: accumulated MPI_Wtime() intervals in a process-wide table. */
+#include "mpm_timer.h"
+
+#include "mpm_error.h"
+
+#include <errno.h>
+#include <stdio.h>
+#include <string.h>
+
+static struct {
+  double total[MPM_T_COUNT], started[MPM_T_COUNT];
+} g_timer;
+
+static const char *const g_names[MPM_T_COUNT] = {
+#define MPM_X_NAME(id, name) name,
+    MPM_TIMER_LIST(MPM_X_NAME)
+#undef MPM_X_NAME
+};
+
+void mpm_timer_reset(void) { memset(&g_timer, 0, sizeof g_timer); }
+void mpm_timer_start(mpm_timer_phase phase) { g_timer.started[phase] = MPI_Wtime(); }
+void mpm_timer_stop(mpm_timer_phase phase) {
+  g_timer.total[phase] += MPI_Wtime() - g_timer.started[phase];
+}
+double mpm_timer_seconds(mpm_timer_phase phase) { return g_timer.total[phase]; }
+const char *mpm_timer_name(mpm_timer_phase phase) { return g_names[phase]; }
+
+int mpm_timer_reduce(MPI_Comm comm, double *max, double *mean) {
+  int size;
+  MPM_CALL_MPI(MPI_Comm_size(comm, &size));
+  MPM_CALL_MPI(MPI_Allreduce(g_timer.total, max, MPM_T_COUNT, MPI_DOUBLE, MPI_MAX, comm));
+  MPM_CALL_MPI(MPI_Allreduce(g_timer.total, mean, MPM_T_COUNT, MPI_DOUBLE, MPI_SUM, comm));
+  for (int k = 0; k < MPM_T_COUNT; ++k) mean[k] /= size;
+  return 0;
+}
+
+int mpm_timer_report(MPI_Comm comm, const char *path) {
+  double max[MPM_T_COUNT], mean[MPM_T_COUNT];
+  int rank;
+  MPM_CALL(mpm_timer_reduce(comm, max, mean));
+  MPM_CALL_MPI(MPI_Comm_rank(comm, &rank));
+  if (rank != 0) return 0;
+  const double total = max[MPM_T_TOTAL] > 0 ? max[MPM_T_TOTAL] : 1.0;
+  mpm_log(MPM_LOG_INFO, "%-10s %12s %12s %8s", "phase", "max [s]", "mean [s]", "share");
+  for (int k = 0; k < MPM_T_COUNT; ++k)
+    mpm_log(MPM_LOG_INFO, "%-10s %12.4f %12.4f %7.1f%%", g_names[k], max[k], mean[k],
+            100.0 * max[k] / total);
+  if (!path) return 0;
+  FILE *f = fopen(path, "w");
+  if (!f) MPM_FAIL(MPM_ERR_FILE, "cannot write timers to '%s': %s", path, strerror(errno));
+  fprintf(f, "phase,max_s,mean_s,fraction\n");
+  for (int k = 0; k < MPM_T_COUNT; ++k)
+    fprintf(f, "%s,%.6e,%.6e,%.4f\n", g_names[k], max[k], mean[k], max[k] / total);
+  if (fclose(f) != 0) MPM_FAIL(MPM_ERR_FILE, "cannot write timers to '%s'", path);
+  return 0;
+}

@@ -1,0 +1,374 @@
+/* Solid module: seeding, and the module phases of an MPM right-hand side.
+ *
+ * Invariants: particle field order is x, v, F | m, V0, body (see solid_particles_new); body
+ * holds a small integer stored as a double. The per-body index lists used for batched
+ * stress evaluation are rebuilt at each P2G, so they never go stale after migration,
+ * sorting or injection. */
+#include "solid_module.h"
+
+#include "mpm_error.h"
+#include "mpm_geometry.h"
+#include "mpm_kernels.h"
+#include "mpm_timer.h"
+#include "solid_material.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+enum { F_X, F_V, F_F, F_M, F_V0, F_BODY, F_COUNT };
+
+typedef struct {
+  char section[96];
+  solid_material *mat;
+  double rho;
+} solid_body;
+
+typedef struct {
+  int nbodies;
+  solid_body *body;
+  double gravity[MPM_MAX_DIM];
+  double lp;             /* GIMP half-width in cells */
+  mpm_lidx cap;          /* capacity of the scratch arrays */
+  double *vsig, *scratch; /* V sigma (dim^2 n); G2P output v, a, L ((2 dim + dim^2) n) */
+  mpm_lidx *idx, *count;  /* particle indices grouped by body; counts per body */
+} solid_content;
+
+const mpm_key_spec solid_keys[] = {
+    {"solid.*.geometry", MPM_KEY_STRING, NULL, 0, 0, 0, 0, NULL,
+     "name of the [geometry.NAME] region the body fills"},
+    {"solid.*.material", MPM_KEY_ENUM, NULL, 0, 0, 0, 0, "linear_elastic",
+     "material model of the body"},
+    {"solid.*.density", MPM_KEY_REAL, NULL, 0, HUGE_VAL, 1, 0, NULL, "mass density, kg/m^3"},
+    {"solid.*.E", MPM_KEY_REAL, NULL, 0, HUGE_VAL, 1, 0, NULL, "Young's modulus, Pa"},
+    {"solid.*.nu", MPM_KEY_REAL, "0.3", 0, 0.4999, 0, 0, NULL, "Poisson's ratio, [0, 0.5)"},
+    {"solid.*.velocity", MPM_KEY_REALS, "0 0 0", -HUGE_VAL, HUGE_VAL, 0, 3, NULL,
+     "initial velocity, m/s (dim values; extra values are ignored)"},
+    {"solid.*.ppc", MPM_KEY_INT, "2", 1, 8, 0, 0, NULL, "particles per cell per direction"},
+};
+const int solid_nkeys = (int)(sizeof solid_keys / sizeof solid_keys[0]);
+
+int solid_particles_new(mpm_particles **p, int dim) {
+  const mpm_field_desc fields[F_COUNT] = {{"x", dim}, {"v", dim}, {"F", dim * dim},
+                                          {"m", 1},   {"V0", 1},  {"body", 1}};
+  return mpm_particles_new(p, dim, fields, F_COUNT, 3);
+}
+
+static int key_of(char *key, size_t size, const char *section, const char *name) {
+  snprintf(key, size, "%s.%s", section, name);
+  return 0;
+}
+
+/* Seed one body and append it to the particle set. */
+static int seed_body(mpm_module *m, const mpm_config *cfg, int b, double *lp) {
+  solid_content *sc = m->content;
+  mpm_particles *p = m->particles;
+  const mpm_grid *g = m->grid;
+  const int dim = g->dim;
+  char key[160];
+  const char *geom;
+  int ppc, nv;
+  double v0[3] = {0, 0, 0};
+  key_of(key, sizeof key, sc->body[b].section, "geometry");
+  MPM_CALL(mpm_config_get_string(cfg, key, &geom));
+  key_of(key, sizeof key, sc->body[b].section, "ppc");
+  MPM_CALL(mpm_config_get_int(cfg, key, &ppc));
+  key_of(key, sizeof key, sc->body[b].section, "velocity");
+  MPM_CALL(mpm_config_get_reals(cfg, key, v0, 3, &nv));
+  *lp = fmin(*lp, 0.5 / ppc);
+
+  mpm_region *region = NULL;
+  MPM_CALL(mpm_region_from_config(&region, cfg, dim, geom));
+  double rlo[3], rhi[3];
+  mpm_region_bounds(region, rlo, rhi);
+  for (int d = 0; d < dim; ++d)
+    if (rlo[d] < g->lo[d] || rhi[d] > g->hi[d]) {
+      mpm_region_destroy(&region);
+      key_of(key, sizeof key, sc->body[b].section, "geometry");
+      return mpm_config_fail(cfg, key,
+                             "region '%s' spans [%g, %g] along axis %d, outside the domain "
+                             "[%g, %g]; move the region or enlarge [domain]",
+                             geom, rlo[d], rhi[d], d, g->lo[d], g->hi[d]);
+    }
+  mpm_lidx n;
+  double *x;
+  mpm_gidx *id;
+  int rc = mpm_region_seed(region, g, ppc, b * mpm_region_seed_span(g, ppc), &n, &x, &id);
+  mpm_region_destroy(&region);
+  MPM_CALL(rc);
+
+  double *data;
+  MPM_ALLOC(data, (size_t)p->ncomp * (size_t)(n ? n : 1));
+  const double vol = pow(g->dx / ppc, dim);
+  for (mpm_lidx i = 0; i < n; ++i) {
+    for (int d = 0; d < dim; ++d) {
+      data[(size_t)(p->offset[F_X] + d) * n + i] = x[(size_t)d * n + i];
+      data[(size_t)(p->offset[F_V] + d) * n + i] = v0[d];
+      data[(size_t)(p->offset[F_F] + d * dim + d) * n + i] = 1.0;
+    }
+    data[(size_t)p->offset[F_M] * n + i] = sc->body[b].rho * vol;
+    data[(size_t)p->offset[F_V0] * n + i] = vol;
+    data[(size_t)p->offset[F_BODY] * n + i] = b;
+  }
+  rc = mpm_particles_edit(p, NULL, n, id, data);
+  free(data);
+  free(x);
+  free(id);
+  MPM_CALL(rc);
+  /* Ids of later injections start past every lattice id. */
+  p->id_next = MPM_MAX(p->id_next, (b + 1) * mpm_region_seed_span(g, ppc));
+  mpm_gidx total;
+  MPM_CALL(mpm_particles_global_count(p, g->comm, &total));
+  if (total == 0)
+    return mpm_config_fail(cfg, key, "body '%s' has no particles: its geometry '%s' lies "
+                                     "outside the domain or is thinner than a particle spacing",
+                           sc->body[b].section, geom);
+  mpm_log(MPM_LOG_INFO, "solid body %s: %lld particles, material %s", sc->body[b].section,
+          (long long)total, sc->body[b].mat->ops->name);
+  return 0;
+}
+
+/* Grow the scratch arrays to the current particle count. */
+static int ensure_scratch(mpm_module *m) {
+  solid_content *sc = m->content;
+  const mpm_lidx n = m->particles->n;
+  const int dim = m->grid->dim;
+  if (n <= sc->cap && sc->vsig) return 0;
+  free(sc->vsig);
+  free(sc->scratch);
+  free(sc->idx);
+  sc->cap = n + n / 4 + 16;
+  MPM_ALLOC(sc->vsig, (size_t)dim * dim * sc->cap);
+  MPM_ALLOC(sc->scratch, (size_t)(2 * dim + dim * dim) * sc->cap);
+  MPM_ALLOC(sc->idx, sc->cap);
+  return 0;
+}
+
+/* Group particle indices by body (a counting sort of the body field). */
+static void group_by_body(mpm_module *m) {
+  solid_content *sc = m->content;
+  const mpm_particles *p = m->particles;
+  const double *body = mpm_particles_comp(p, F_BODY, 0);
+  mpm_lidx start[64] = {0};
+  memset(sc->count, 0, sizeof(mpm_lidx) * (size_t)sc->nbodies);
+  for (mpm_lidx i = 0; i < p->n; ++i) sc->count[(int)body[i]]++;
+  for (int b = 1; b < sc->nbodies; ++b) start[b] = start[b - 1] + sc->count[b - 1];
+  for (mpm_lidx i = 0; i < p->n; ++i) sc->idx[start[(int)body[i]]++] = i;
+}
+
+static int solid_p2g(mpm_module *m, double t, const double *y) {
+  (void)t;
+  solid_content *sc = m->content;
+  const mpm_particles *p = m->particles;
+  const int dim = p->dim;
+  const mpm_lidx n = p->n;
+  MPM_CALL(ensure_scratch(m));
+  mpm_timer_start(MPM_T_STRESS);
+  group_by_body(m);
+  const mpm_lidx *idx = sc->idx;
+  for (int b = 0; b < sc->nbodies; ++b) {
+    const solid_stress_batch batch = {dim,    n, sc->count[b], idx, y + (size_t)p->offset[F_F] * n,
+                                      mpm_particles_comp(p, F_V0, 0), sc->vsig};
+    sc->body[b].mat->ops->stress(sc->body[b].mat, &batch);
+    idx += sc->count[b];
+  }
+  mpm_timer_stop(MPM_T_STRESS);
+
+  mpm_timer_start(MPM_T_P2G);
+  mpm_p2g_args a = {.n = n, .m = mpm_particles_comp(p, F_M, 0), .vsig = sc->vsig, .lp = sc->lp};
+  for (int d = 0; d < dim; ++d) {
+    a.x[d] = y + (size_t)(p->offset[F_X] + d) * n;
+    a.v[d] = y + (size_t)(p->offset[F_V] + d) * n;
+    a.gravity[d] = sc->gravity[d];
+  }
+  mpm_kernels_get(dim)->p2g(m->grid, m->phase, &a);
+  mpm_timer_stop(MPM_T_P2G);
+  return 0;
+}
+
+static int solid_grid_update(mpm_module *m, double t, double h) {
+  (void)t;
+  mpm_grid_phase_update(m->grid, m->phase, h);
+  return 0;
+}
+
+/* dx/dt = sum S v_i, dv/dt = sum S a_i, dF/dt = L F with L = sum v_i (x) grad S. */
+static int solid_g2p(mpm_module *m, double t, const double *y, double *ydot, double h) {
+  (void)t, (void)h;
+  solid_content *sc = m->content;
+  const mpm_particles *p = m->particles;
+  const mpm_grid_phase *ph = &m->grid->phase[m->phase];
+  const int dim = p->dim;
+  const mpm_lidx n = p->n;
+  double *L = sc->scratch + (size_t)2 * dim * n;
+  mpm_g2p_args a = {.n = n, .lp = sc->lp, .L_out = L};
+  for (int d = 0; d < dim; ++d) {
+    a.x[d] = y + (size_t)(p->offset[F_X] + d) * n;
+    a.v_i[d] = ph->v_i[d];
+    a.a_i[d] = ph->a_i[d];
+    a.v_out[d] = ydot + (size_t)(p->offset[F_X] + d) * n;
+    a.a_out[d] = ydot + (size_t)(p->offset[F_V] + d) * n;
+  }
+  mpm_kernels_get(dim)->g2p(m->grid, &a);
+  const double *F = y + (size_t)p->offset[F_F] * n;
+  double *Fdot = ydot + (size_t)p->offset[F_F] * n;
+  for (int r = 0; r < dim; ++r)
+    for (int c = 0; c < dim; ++c) {
+      double *out = Fdot + (size_t)(r * dim + c) * n;
+      for (mpm_lidx i = 0; i < n; ++i) out[i] = 0.0;
+      for (int k = 0; k < dim; ++k) {
+        const double *Lrk = L + (size_t)(r * dim + k) * n, *Fkc = F + (size_t)(k * dim + c) * n;
+        for (mpm_lidx i = 0; i < n; ++i) out[i] += Lrk[i] * Fkc[i];
+      }
+    }
+  return 0;
+}
+
+static double solid_stable_dt(const mpm_module *m, const double *y) {
+  const solid_content *sc = m->content;
+  const mpm_particles *p = m->particles;
+  const double *body = mpm_particles_comp(p, F_BODY, 0);
+  double dt = HUGE_VAL;
+  for (mpm_lidx i = 0; i < p->n; ++i) {
+    double v2 = 0.0;
+    for (int d = 0; d < p->dim; ++d) {
+      const double v = y[(size_t)(p->offset[F_V] + d) * p->n + i];
+      v2 += v * v;
+    }
+    const solid_body *b = &sc->body[(int)body[i]];
+    dt = fmin(dt, m->grid->dx / (b->mat->ops->wave_speed(b->mat, b->rho) + sqrt(v2)));
+  }
+  return dt;
+}
+
+static double det(int dim, const double *F, mpm_lidx n, mpm_lidx i) {
+#define A(r, c) F[(size_t)((r) * dim + (c)) * n + i]
+  if (dim == 2) return A(0, 0) * A(1, 1) - A(0, 1) * A(1, 0);
+  return A(0, 0) * (A(1, 1) * A(2, 2) - A(1, 2) * A(2, 1)) -
+         A(0, 1) * (A(1, 0) * A(2, 2) - A(1, 2) * A(2, 0)) +
+         A(0, 2) * (A(1, 0) * A(2, 1) - A(1, 1) * A(2, 0));
+#undef A
+}
+
+static int solid_check(const mpm_module *m, const double *y, mpm_fault *fault) {
+  if (mpm_module_check_positions(m, y, fault)) return 1;
+  const mpm_particles *p = m->particles;
+  const double *F = y + (size_t)p->offset[F_F] * p->n;
+  for (mpm_lidx i = 0; i < p->n; ++i) {
+    const double J = det(p->dim, F, p->n, i);
+    if (J <= 0.0) {
+      fault->set = 1;
+      fault->id = p->id[i];
+      for (int d = 0; d < p->dim; ++d) fault->x[d] = y[(size_t)d * p->n + i];
+      snprintf(fault->cause, sizeof fault->cause,
+               "the deformation gradient is inverted (J = %.3g <= 0)", J);
+      return 1;
+    }
+  }
+  return 0;
+}
+
+static void solid_sums(const mpm_module *m, mpm_module_sums *s) {
+  const solid_content *sc = m->content;
+  const mpm_particles *p = m->particles;
+  const int dim = p->dim;
+  const double *mass = mpm_particles_comp(p, F_M, 0), *V0 = mpm_particles_comp(p, F_V0, 0);
+  const double *body = mpm_particles_comp(p, F_BODY, 0);
+  memset(s, 0, sizeof *s);
+  for (mpm_lidx i = 0; i < p->n; ++i) {
+    double F[9];
+    s->mass += mass[i];
+    for (int d = 0; d < dim; ++d) {
+      const double v = mpm_particles_comp(p, F_V, d)[i];
+      s->momentum[d] += mass[i] * v;
+      s->kinetic += 0.5 * mass[i] * v * v;
+    }
+    for (int c = 0; c < dim * dim; ++c) F[c] = mpm_particles_comp(p, F_F, c)[i];
+    const solid_body *b = &sc->body[(int)body[i]];
+    s->internal += V0[i] * b->mat->ops->energy_density(b->mat, dim, F);
+  }
+}
+
+static void solid_destroy(mpm_module *m) {
+  solid_content *sc = m->content;
+  if (sc) {
+    for (int b = 0; b < sc->nbodies; ++b) solid_material_destroy(&sc->body[b].mat);
+    free(sc->body);
+    free(sc->vsig);
+    free(sc->scratch);
+    free(sc->idx);
+    free(sc->count);
+    free(sc);
+  }
+  mpm_particles_destroy(&m->particles);
+}
+
+static const mpm_module_ops solid_ops = {
+    solid_p2g, solid_grid_update, solid_g2p, solid_stable_dt, solid_check, solid_sums, NULL,
+    solid_destroy,
+};
+
+/* Read the bodies' sections and build their materials. */
+static int read_bodies(mpm_module *m, const mpm_config *cfg) {
+  solid_content *sc = m->content;
+  const char *const *names;
+  int count, nv;
+  MPM_CALL(mpm_config_instances(cfg, "solid", &names, &count));
+  if (count > 64) return mpm_config_fail(cfg, "solid", "at most 64 solid bodies are supported");
+  MPM_ALLOC(sc->body, count);
+  MPM_ALLOC(sc->count, count);
+  sc->nbodies = count;
+  for (int b = 0; b < count; ++b) {
+    char key[160];
+    const char *type;
+    snprintf(sc->body[b].section, sizeof sc->body[b].section, "solid.%s", names[b]);
+    key_of(key, sizeof key, sc->body[b].section, "density");
+    MPM_CALL(mpm_config_get_real(cfg, key, &sc->body[b].rho));
+    key_of(key, sizeof key, sc->body[b].section, "material");
+    MPM_CALL(mpm_config_get_string(cfg, key, &type));
+    MPM_CALL(solid_material_create(&sc->body[b].mat, type, cfg, sc->body[b].section));
+  }
+  double g[3] = {0, 0, 0};
+  MPM_CALL(mpm_config_get_reals(cfg, "physics.gravity", g, 3, &nv));
+  memcpy(sc->gravity, g, sizeof g);
+  return 0;
+}
+
+int solid_module_create(mpm_module **mp, const mpm_config *cfg, mpm_grid *grid, int seed) {
+  const char *const *names;
+  int count;
+  *mp = NULL;
+  MPM_CALL(mpm_config_instances(cfg, "solid", &names, &count));
+  if (count == 0) return 0;
+  mpm_module *m;
+  MPM_ALLOC(m, 1);
+  *mp = m;
+  snprintf(m->name, sizeof m->name, "solid");
+  m->ops = &solid_ops;
+  m->grid = grid;
+  solid_content *sc;
+  MPM_ALLOC(sc, 1);
+  m->content = sc;
+  sc->lp = 0.5;
+  int rc = solid_particles_new(&m->particles, grid->dim);
+  if (!rc) rc = mpm_grid_add_phase(grid, "solid", &m->phase);
+  if (!rc) rc = read_bodies(m, cfg);
+  for (int b = 0; !rc && b < sc->nbodies; ++b) {
+    double lp = sc->lp;
+    if (seed) rc = seed_body(m, cfg, b, &lp);
+    else {
+      char key[160];
+      int ppc;
+      key_of(key, sizeof key, sc->body[b].section, "ppc");
+      rc = mpm_config_get_int(cfg, key, &ppc);
+      lp = fmin(lp, 0.5 / ppc);
+    }
+    sc->lp = lp;
+  }
+  if (rc) {
+    mpm_module_destroy(mp);
+    return mpm_trace(__FILE__, __LINE__, __func__, rc);
+  }
+  return 0;
+}

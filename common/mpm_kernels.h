@@ -1,0 +1,45 @@
+/* P2G and G2P kernels, compiled once for 2-D and once for 3-D from mpm_kernels_dim.c.
+ *
+ * Everything above the kernels is dimension-agnostic and reaches them through the small
+ * per-dimension table returned by mpm_kernels_get(dim). Inside a kernel the shape kind is
+ * switched once per call, outside the particle loop, so the stencil code is specialised per
+ * kind: no indirect call per particle.
+ *
+ * Particle arrays are component-major (see mpm_particles.h): component a of a vector is an
+ * array of n doubles; a tensor T_ab is component a*dim + b. */
+#ifndef MPM_KERNELS_H
+#define MPM_KERNELS_H
+
+#include "mpm_grid.h"
+
+typedef struct mpm_p2g_args {
+  mpm_lidx n;
+  const double *x[MPM_MAX_DIM]; /* positions */
+  const double *v[MPM_MAX_DIM]; /* velocities */
+  const double *m;              /* masses */
+  const double *vsig;           /* V_p sigma_p, dim*dim components of n, or NULL */
+  double gravity[MPM_MAX_DIM];  /* body acceleration */
+  double lp;                    /* GIMP particle half-width in cells */
+} mpm_p2g_args;
+
+typedef struct mpm_g2p_args {
+  mpm_lidx n;
+  const double *x[MPM_MAX_DIM];
+  const double *v_i[MPM_MAX_DIM]; /* nodal velocity to interpolate (and differentiate) */
+  const double *a_i[MPM_MAX_DIM]; /* nodal acceleration to interpolate */
+  double lp;
+  double *v_out[MPM_MAX_DIM]; /* sum_i S_ip v_i */
+  double *a_out[MPM_MAX_DIM]; /* sum_i S_ip a_i */
+  double *L_out;              /* sum_i v_i (x) grad S_ip, dim*dim components, or NULL */
+} mpm_g2p_args;
+
+typedef struct mpm_kernels {
+  int dim;
+  /* Add m_i, (m v)_i and f_i = sum S m g - sum V sigma grad S into phase fields. */
+  void (*p2g)(mpm_grid *grid, int phase, const mpm_p2g_args *a);
+  void (*g2p)(const mpm_grid *grid, const mpm_g2p_args *a);
+} mpm_kernels;
+
+const mpm_kernels *mpm_kernels_get(int dim);
+
+#endif

@@ -1,0 +1,151 @@
+/* Dimension-specific P2G and G2P; included by mpm_kernels2.c and mpm_kernels3.c with
+ * MPM_DIM set to 2 or 3 (the p4est way: one source, two compilations). Not compiled alone.
+ *
+ * A stencil is the tensor product of 1-D weights: S = w0[i] w1[j] (w2[k]) and
+ * dS/dx_d = dw_d / dx times the other weights. The kind is a compile-time constant inside
+ * each specialised loop (the always-inline helpers are called with a literal). */
+#include <math.h>
+
+#if MPM_DIM == 2
+#define DIMFN(name) name##_2d
+#else
+#define DIMFN(name) name##_3d
+#endif
+
+#define MPM_INLINE static inline __attribute__((always_inline))
+
+/* Stencil of one particle: box-local index of its first node, weights, gradients. */
+typedef struct {
+  mpm_lidx first;
+  double w[MPM_DIM][MPM_SHAPE_MAX_SUPPORT];
+  double g[MPM_DIM][MPM_SHAPE_MAX_SUPPORT]; /* physical derivative, 1/dx applied */
+} DIMFN(stencil);
+
+MPM_INLINE void DIMFN(stencil_eval)(const mpm_grid *g, mpm_shape_kind kind, const double *x,
+                                    double lp, DIMFN(stencil) * s) {
+  const double inv_dx = 1.0 / g->dx;
+  int gi[MPM_DIM];
+  for (int d = 0; d < MPM_DIM; ++d) {
+    gi[d] = mpm_shape_1d(kind, (x[d] - g->lo[d]) * inv_dx, lp, s->w[d], s->g[d]);
+    for (int k = 0; k < MPM_SHAPE_MAX_SUPPORT; ++k) s->g[d][k] *= inv_dx;
+  }
+  s->first = mpm_grid_local_index(g, gi);
+}
+
+MPM_INLINE void DIMFN(p2g_loop)(mpm_grid *g, mpm_grid_phase *ph, const mpm_p2g_args *a,
+                                mpm_shape_kind kind) {
+  const int S = mpm_shape_support(kind);
+  const mpm_lidx sy = g->box_n[0];
+#if MPM_DIM == 3
+  const mpm_lidx sz = (mpm_lidx)g->box_n[0] * g->box_n[1];
+#endif
+  for (mpm_lidx p = 0; p < a->n; ++p) {
+    double x[MPM_DIM], mv[MPM_DIM], sig[MPM_DIM][MPM_DIM];
+    const double m = a->m[p];
+    for (int d = 0; d < MPM_DIM; ++d) x[d] = a->x[d][p], mv[d] = m * a->v[d][p];
+    for (int r = 0; r < MPM_DIM; ++r)
+      for (int c = 0; c < MPM_DIM; ++c)
+        sig[r][c] = a->vsig ? a->vsig[(size_t)(r * MPM_DIM + c) * (size_t)a->n + p] : 0.0;
+    DIMFN(stencil) s;
+    DIMFN(stencil_eval)(g, kind, x, a->lp, &s);
+#if MPM_DIM == 3
+    for (int k = 0; k < S; ++k)
+#else
+    const int k = 0;
+#endif
+      for (int j = 0; j < S; ++j)
+        for (int i = 0; i < S; ++i) {
+#if MPM_DIM == 3
+          const double wjk = s.w[1][j] * s.w[2][k];
+          const double grad[3] = {s.g[0][i] * wjk, s.w[0][i] * s.g[1][j] * s.w[2][k],
+                                  s.w[0][i] * s.w[1][j] * s.g[2][k]};
+          const mpm_lidx l = s.first + i + j * sy + k * sz;
+#else
+        (void)k;
+        const double wjk = s.w[1][j];
+        const double grad[2] = {s.g[0][i] * wjk, s.w[0][i] * s.g[1][j]};
+        const mpm_lidx l = s.first + i + j * sy;
+#endif
+          const double w = s.w[0][i] * wjk;
+          ph->m_i[l] += w * m;
+          for (int d = 0; d < MPM_DIM; ++d) {
+            double f = w * m * a->gravity[d];
+            for (int c = 0; c < MPM_DIM; ++c) f -= sig[d][c] * grad[c];
+            ph->mv_i[d][l] += w * mv[d];
+            ph->f_i[d][l] += f;
+          }
+        }
+  }
+}
+
+static void DIMFN(p2g)(mpm_grid *g, int phase, const mpm_p2g_args *a) {
+  mpm_grid_phase *ph = &g->phase[phase];
+  switch (g->shape) {
+  case MPM_SHAPE_LINEAR: DIMFN(p2g_loop)(g, ph, a, MPM_SHAPE_LINEAR); break;
+  case MPM_SHAPE_GIMP: DIMFN(p2g_loop)(g, ph, a, MPM_SHAPE_GIMP); break;
+  case MPM_SHAPE_QUADRATIC: DIMFN(p2g_loop)(g, ph, a, MPM_SHAPE_QUADRATIC); break;
+  default: DIMFN(p2g_loop)(g, ph, a, MPM_SHAPE_CUBIC); break;
+  }
+}
+
+MPM_INLINE void DIMFN(g2p_loop)(const mpm_grid *g, const mpm_g2p_args *a, mpm_shape_kind kind) {
+  const int S = mpm_shape_support(kind);
+  const mpm_lidx sy = g->box_n[0];
+#if MPM_DIM == 3
+  const mpm_lidx sz = (mpm_lidx)g->box_n[0] * g->box_n[1];
+#endif
+  for (mpm_lidx p = 0; p < a->n; ++p) {
+    double x[MPM_DIM], v[MPM_DIM] = {0}, acc[MPM_DIM] = {0}, L[MPM_DIM][MPM_DIM] = {{0}};
+    for (int d = 0; d < MPM_DIM; ++d) x[d] = a->x[d][p];
+    DIMFN(stencil) s;
+    DIMFN(stencil_eval)(g, kind, x, a->lp, &s);
+#if MPM_DIM == 3
+    for (int k = 0; k < S; ++k)
+#else
+    const int k = 0;
+#endif
+      for (int j = 0; j < S; ++j)
+        for (int i = 0; i < S; ++i) {
+#if MPM_DIM == 3
+          const double wjk = s.w[1][j] * s.w[2][k];
+          const double grad[3] = {s.g[0][i] * wjk, s.w[0][i] * s.g[1][j] * s.w[2][k],
+                                  s.w[0][i] * s.w[1][j] * s.g[2][k]};
+          const mpm_lidx l = s.first + i + j * sy + k * sz;
+#else
+        (void)k;
+        const double wjk = s.w[1][j];
+        const double grad[2] = {s.g[0][i] * wjk, s.w[0][i] * s.g[1][j]};
+        const mpm_lidx l = s.first + i + j * sy;
+#endif
+          const double w = s.w[0][i] * wjk;
+          for (int d = 0; d < MPM_DIM; ++d) {
+            const double vi = a->v_i[d][l];
+            v[d] += w * vi;
+            acc[d] += w * a->a_i[d][l];
+            for (int c = 0; c < MPM_DIM; ++c) L[d][c] += vi * grad[c];
+          }
+        }
+    for (int d = 0; d < MPM_DIM; ++d) {
+      a->v_out[d][p] = v[d];
+      a->a_out[d][p] = acc[d];
+    }
+    if (a->L_out)
+      for (int r = 0; r < MPM_DIM; ++r)
+        for (int c = 0; c < MPM_DIM; ++c)
+          a->L_out[(size_t)(r * MPM_DIM + c) * (size_t)a->n + p] = L[r][c];
+  }
+}
+
+static void DIMFN(g2p)(const mpm_grid *g, const mpm_g2p_args *a) {
+  switch (g->shape) {
+  case MPM_SHAPE_LINEAR: DIMFN(g2p_loop)(g, a, MPM_SHAPE_LINEAR); break;
+  case MPM_SHAPE_GIMP: DIMFN(g2p_loop)(g, a, MPM_SHAPE_GIMP); break;
+  case MPM_SHAPE_QUADRATIC: DIMFN(g2p_loop)(g, a, MPM_SHAPE_QUADRATIC); break;
+  default: DIMFN(g2p_loop)(g, a, MPM_SHAPE_CUBIC); break;
+  }
+}
+
+const mpm_kernels DIMFN(mpm_kernels) = {MPM_DIM, DIMFN(p2g), DIMFN(g2p)};
+
+#undef DIMFN
+#undef MPM_INLINE

@@ -1,0 +1,67 @@
+/* Module helpers shared by every module: destruction, the nodal update, particle checks. */
+#include "mpm_module.h"
+
+#include "mpm_error.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+
+void mpm_module_destroy(mpm_module **m) {
+  if (!m || !*m) return;
+  if ((*m)->ops && (*m)->ops->destroy) (*m)->ops->destroy(*m);
+  free(*m);
+  *m = NULL;
+}
+
+void mpm_grid_phase_update(mpm_grid *grid, int phase, double h) {
+  mpm_grid_phase *ph = &grid->phase[phase];
+  const int dim = grid->dim;
+  double mmax = 0.0;
+  for (mpm_lidx l = 0; l < grid->nnodes; ++l) mmax = fmax(mmax, ph->m_i[l]);
+  /* Nodes touched only by the far tail of a stencil carry roundoff-sized mass; dividing by it
+   * would amplify noise, so they are treated as empty. */
+  const double mmin = 1e-14 * mmax;
+  for (mpm_lidx l = 0; l < grid->nnodes; ++l) {
+    const double m = ph->m_i[l];
+    for (int d = 0; d < dim; ++d) {
+      if (m > mmin) {
+        const double a = ph->f_i[d][l] / m;
+        ph->a_i[d][l] = a;
+        ph->v_i[d][l] = ph->mv_i[d][l] / m + h * a;
+      } else {
+        ph->a_i[d][l] = ph->v_i[d][l] = 0.0;
+      }
+    }
+  }
+}
+
+static int fault_at(const mpm_particles *p, const double *y, mpm_lidx i, mpm_fault *fault,
+                    const char *cause) {
+  fault->set = 1;
+  fault->id = p->id[i];
+  for (int d = 0; d < p->dim; ++d) fault->x[d] = y[(size_t)d * p->n + i];
+  snprintf(fault->cause, sizeof fault->cause, "%s", cause);
+  return 1;
+}
+
+int mpm_module_check_positions(const mpm_module *m, const double *y, mpm_fault *fault) {
+  const mpm_particles *p = m->particles;
+  const mpm_grid *g = m->grid;
+  const mpm_lidx n = p->n;
+  for (size_t k = 0; k < (size_t)p->nstate * (size_t)n; ++k)
+    if (!isfinite(y[k])) return fault_at(p, y, (mpm_lidx)(k % (size_t)(n ? n : 1)), fault,
+                                         "a state value is not finite (NaN or Inf)");
+  for (mpm_lidx i = 0; i < n; ++i)
+    for (int d = 0; d < p->dim; ++d) {
+      const double x = y[(size_t)d * n + i];
+      if (!(x >= g->lo[d] && x < g->hi[d]))
+        return fault_at(p, y, i, fault, "the particle left the domain");
+      const int cell = (int)floor((x - g->lo[d]) / g->dx);
+      const int c = g->coord[d];
+      if (cell < g->cell_split[d][c] - 1 || cell > g->cell_split[d][c + 1])
+        return fault_at(p, y, i, fault,
+                        "the particle moved more than one cell within one step");
+    }
+  return 0;
+}

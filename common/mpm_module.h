@@ -1,0 +1,67 @@
+/* A physics module (solid, fluid): an object with an ops table, in the SUNDIALS N_Vector
+ * shape. A module owns its particles and a phase of nodal fields on the shared grid, and
+ * exposes the phases of an MPM right-hand side; the coupler decides their order:
+ *
+ *   zero grid phase -> p2g -> [halo reverse] -> [coupling] -> grid_update -> [halo forward]
+ *   -> g2p
+ *
+ * y and ydot are the module's block of the ODE state, laid out like the state fields of its
+ * particle set (component-major, stride n). h is the step size of the classic MPM update
+ * (the grid velocity is advanced by h before G2P) and 0 for a method-of-lines RHS. */
+#ifndef MPM_MODULE_H
+#define MPM_MODULE_H
+
+#include "mpm_config.h"
+#include "mpm_grid.h"
+#include "mpm_particles.h"
+
+/* What went wrong with a particle, for recoverable RHS errors and the final message. */
+typedef struct mpm_fault {
+  int set;
+  mpm_gidx id;
+  double x[MPM_MAX_DIM];
+  char cause[160];
+} mpm_fault;
+
+/* Local sums over a module's particles, reduced by the caller. */
+typedef struct mpm_module_sums {
+  double mass, momentum[MPM_MAX_DIM], kinetic, internal;
+} mpm_module_sums;
+
+typedef struct mpm_module mpm_module;
+
+typedef struct mpm_module_ops {
+  int (*p2g)(mpm_module *m, double t, const double *y);
+  int (*grid_update)(mpm_module *m, double t, double h);
+  int (*g2p)(mpm_module *m, double t, const double *y, double *ydot, double h);
+  /* Largest stable step on this rank (before the CFL factor). */
+  double (*stable_dt)(const mpm_module *m, const double *y);
+  /* Local check of a state: fills *fault and returns 1 if it is unphysical. */
+  int (*check)(const mpm_module *m, const double *y, mpm_fault *fault);
+  void (*sums)(const mpm_module *m, mpm_module_sums *s);
+  /* After an accepted step and migration (history updates, regularisation). Optional. */
+  int (*post_step)(mpm_module *m);
+  void (*destroy)(mpm_module *m);
+} mpm_module_ops;
+
+struct mpm_module {
+  char name[32];
+  const mpm_module_ops *ops;
+  void *content;
+  mpm_particles *particles;
+  mpm_grid *grid;
+  int phase; /* index of this module's nodal fields on grid */
+};
+
+/* Call ops->destroy and free the module; accepts NULL. */
+void mpm_module_destroy(mpm_module **m);
+
+/* Nodal update of one phase on every box node: v = mv/m, a = f/m, then v += h a; nodes
+ * with m below a tiny fraction of the largest nodal mass get v = a = 0. */
+void mpm_grid_phase_update(mpm_grid *grid, int phase, double h);
+
+/* Shared particle checks: NaN in the state, a particle outside the domain, or one that has
+ * drifted more than one cell beyond this rank's cells during a step. */
+int mpm_module_check_positions(const mpm_module *m, const double *y, mpm_fault *fault);
+
+#endif

@@ -1,0 +1,337 @@
+/* ERKStep driver of the coupled MPM system (see mpm_integrator.h). */
+#include "mpm_integrator.h"
+
+#include "mpm_error.h"
+#include "mpm_sundials.h"
+#include "mpm_timer.h"
+
+#include <arkode/arkode_erkstep.h>
+#include <math.h>
+#include <nvector/nvector_mpimanyvector.h>
+#include <nvector/nvector_serial.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define MPM_MAX_MODULES 4
+
+struct mpm_integrator {
+  MPI_Comm comm;
+  SUNContext ctx;
+  void *ark;
+  N_Vector y, sub[MPM_MAX_MODULES];
+  mpm_grid *grid;
+  mpm_module *mod[MPM_MAX_MODULES];
+  int nmod;
+  mpm_method method;
+  double rtol, atol, cfl, dt_max;
+  int max_retries;
+  double h_classic;  /* step of the classic update during its RHS call */
+  mpm_fault fault;   /* last unphysical state seen by the RHS (same on every rank) */
+  int rhs_error;     /* a non-recoverable failure inside the RHS */
+  long steps, rhs_evals, fails, retries;
+  double t_last;     /* time of the last accepted state */
+};
+
+const mpm_key_spec mpm_integrator_keys[] = {
+    {"time.t_end", MPM_KEY_REAL, NULL, 0, HUGE_VAL, 1, 0, NULL, "end time of the run, s"},
+    {"time.method", MPM_KEY_ENUM, "bs32", 0, 0, 0, 0, "usl|heun_euler|bs32|zonneveld43|dp54",
+     "time method: usl (classic MPM, fixed CFL step) or an adaptive embedded ERK pair"},
+    {"time.rtol", MPM_KEY_REAL, "1e-6", 0, 1, 1, 0, NULL, "relative tolerance (adaptive)"},
+    {"time.atol", MPM_KEY_REAL, "1e-9", 0, HUGE_VAL, 1, 0, NULL,
+     "absolute tolerance (adaptive), in state units (m, m/s, 1)"},
+    {"time.cfl", MPM_KEY_REAL, "0.4", 0, 1, 1, 0, NULL,
+     "fraction of the stable step dx / (c + |v|) allowed"},
+    {"time.dt_max", MPM_KEY_REAL, "inf", 0, HUGE_VAL, 1, 0, NULL, "largest step, s"},
+    {"time.max_retries", MPM_KEY_INT, "8", 0, 100, 0, 0, NULL,
+     "restarts with a 4x smaller step after an unphysical stage before the run stops"},
+};
+const int mpm_integrator_nkeys = (int)(sizeof mpm_integrator_keys / sizeof mpm_integrator_keys[0]);
+
+static const char *const g_method_names[MPM_METHOD_COUNT] = {"usl", "heun_euler", "bs32",
+                                                             "zonneveld43", "dp54"};
+const char *mpm_method_name(mpm_method m) { return g_method_names[m]; }
+
+/* ---- the right-hand side ---------------------------------------------------------------- */
+
+static double *module_data(N_Vector y, int k) {
+  return N_VGetArrayPointer(N_VGetSubvector_MPIManyVector(y, k));
+}
+
+/* Agree on a fault across ranks: the lowest rank that has one broadcasts it. */
+static int share_fault(mpm_integrator *it, mpm_fault *local) {
+  int rank, size, who;
+  MPI_Comm_rank(it->comm, &rank);
+  MPI_Comm_size(it->comm, &size);
+  int mine = local->set ? rank : size;
+  MPM_CALL_MPI(MPI_Allreduce(&mine, &who, 1, MPI_INT, MPI_MIN, it->comm));
+  if (who == size) return 0;
+  if (rank == who) it->fault = *local;
+  MPM_CALL_MPI(MPI_Bcast(&it->fault, (int)sizeof it->fault, MPI_BYTE, who, it->comm));
+  return 1;
+}
+
+static int halo(mpm_integrator *it, int reverse) {
+  double *f[MPM_MAX_MODULES * (1 + 2 * MPM_MAX_DIM)];
+  int nf = 0;
+  const int dim = it->grid->dim;
+  for (int k = 0; k < it->nmod; ++k) {
+    mpm_grid_phase *ph = &it->grid->phase[it->mod[k]->phase];
+    if (reverse) f[nf++] = ph->m_i;
+    for (int d = 0; d < dim; ++d) {
+      f[nf++] = reverse ? ph->mv_i[d] : ph->v_i[d];
+      f[nf++] = reverse ? ph->f_i[d] : ph->a_i[d];
+    }
+  }
+  mpm_timer_start(MPM_T_HALO);
+  int rc = reverse ? mpm_grid_halo_reverse(it->grid, f, nf) : mpm_grid_halo_forward(it->grid, f, nf);
+  mpm_timer_stop(MPM_T_HALO);
+  return rc;
+}
+
+/* P2G -> reverse halo -> grid update -> forward halo -> G2P, over every module. */
+static int mpm_cycle(mpm_integrator *it, double t, N_Vector y, N_Vector ydot) {
+  for (int k = 0; k < it->nmod; ++k) {
+    mpm_grid_phase_zero(it->grid, it->mod[k]->phase);
+    MPM_CALL(it->mod[k]->ops->p2g(it->mod[k], t, module_data(y, k)));
+  }
+  MPM_CALL(halo(it, 1));
+  mpm_timer_start(MPM_T_GRID);
+  for (int k = 0; k < it->nmod; ++k)
+    MPM_CALL(it->mod[k]->ops->grid_update(it->mod[k], t, it->h_classic));
+  mpm_timer_stop(MPM_T_GRID);
+  MPM_CALL(halo(it, 0));
+  mpm_timer_start(MPM_T_G2P);
+  for (int k = 0; k < it->nmod; ++k)
+    MPM_CALL(it->mod[k]->ops->g2p(it->mod[k], t, module_data(y, k), module_data(ydot, k),
+                                  it->h_classic));
+  mpm_timer_stop(MPM_T_G2P);
+  return 0;
+}
+
+static int rhs(mpm_sunreal t, N_Vector y, N_Vector ydot, void *user) {
+  mpm_integrator *it = user;
+  mpm_fault local = {0};
+  it->rhs_evals++;
+  for (int k = 0; k < it->nmod && !local.set; ++k)
+    it->mod[k]->ops->check(it->mod[k], module_data(y, k), &local);
+  if (share_fault(it, &local)) return 1;
+  if (mpm_cycle(it, t, y, ydot) != 0) {
+    it->rhs_error = 1;
+    return -1;
+  }
+  return 0;
+}
+
+/* Stable step: the CFL fraction of min over modules and ranks of dx / (c + |v|). */
+static int stable_step(mpm_integrator *it, N_Vector y, double *hstab) {
+  double h = HUGE_VAL;
+  for (int k = 0; k < it->nmod; ++k)
+    h = fmin(h, it->mod[k]->ops->stable_dt(it->mod[k], module_data(y, k)));
+  h *= it->cfl;
+  MPM_CALL_MPI(MPI_Allreduce(&h, hstab, 1, MPI_DOUBLE, MPI_MIN, it->comm));
+  if (*hstab > it->dt_max) *hstab = it->dt_max;
+  return 0;
+}
+
+static int estab(N_Vector y, mpm_sunreal t, mpm_sunreal *hstab, void *user) {
+  (void)t;
+  double h;
+  if (stable_step(user, y, &h) != 0) return -1;
+  *hstab = isfinite(h) ? h : 0.0; /* 0: no limit */
+  return 0;
+}
+
+/* ARKODE's own messages become debug lines; the driver reports failures itself. */
+static void ark_errors(int code, const char *module, const char *func, char *msg, void *user) {
+  (void)user;
+  mpm_log(MPM_LOG_DEBUG, "ARKODE %s %s (%d): %s", module, func, code, msg);
+}
+
+/* ---- state vector ------------------------------------------------------------------------ */
+
+static void free_state(mpm_integrator *it) {
+  if (it->y) N_VDestroy(it->y);
+  for (int k = 0; k < it->nmod; ++k)
+    if (it->sub[k]) N_VDestroy(it->sub[k]);
+  it->y = NULL;
+  memset(it->sub, 0, sizeof it->sub);
+}
+
+static int wrap_state(mpm_integrator *it) {
+  free_state(it);
+  for (int k = 0; k < it->nmod; ++k) {
+    mpm_particles *p = it->mod[k]->particles;
+    it->sub[k] = N_VMake_Serial((sunindextype)p->nstate * p->n, p->data, it->ctx);
+    if (!it->sub[k]) MPM_FAIL(MPM_ERR_SUNDIALS, "cannot wrap the %s state", it->mod[k]->name);
+  }
+  it->y = N_VMake_MPIManyVector(it->comm, it->nmod, it->sub, it->ctx);
+  if (!it->y) MPM_FAIL(MPM_ERR_SUNDIALS, "cannot build the MPIManyVector state");
+  return 0;
+}
+
+/* ---- life cycle --------------------------------------------------------------------------- */
+
+static int read_settings(mpm_integrator *it, const mpm_config *cfg) {
+  const char *method;
+  MPM_CALL(mpm_config_get_string(cfg, "time.method", &method));
+  for (int m = 0; m < MPM_METHOD_COUNT; ++m)
+    if (strcmp(method, g_method_names[m]) == 0) it->method = (mpm_method)m;
+  MPM_CALL(mpm_config_get_real(cfg, "time.rtol", &it->rtol));
+  MPM_CALL(mpm_config_get_real(cfg, "time.atol", &it->atol));
+  MPM_CALL(mpm_config_get_real(cfg, "time.cfl", &it->cfl));
+  MPM_CALL(mpm_config_get_real(cfg, "time.dt_max", &it->dt_max));
+  MPM_CALL(mpm_config_get_int(cfg, "time.max_retries", &it->max_retries));
+  return 0;
+}
+
+int mpm_integrator_new(mpm_integrator **itp, const mpm_config *cfg, mpm_grid *grid,
+                       mpm_module **modules, int nmodules) {
+  if (nmodules < 1 || nmodules > MPM_MAX_MODULES)
+    MPM_FAIL(MPM_ERR_INPUT, "a run needs 1 to %d modules, got %d", MPM_MAX_MODULES, nmodules);
+  mpm_integrator *it;
+  MPM_ALLOC(it, 1);
+  *itp = it;
+  it->comm = grid->comm;
+  it->grid = grid;
+  it->nmod = nmodules;
+  for (int k = 0; k < nmodules; ++k) it->mod[k] = modules[k];
+  MPM_CALL(read_settings(it, cfg));
+  if (mpm_sun_context_create(&it->comm, &it->ctx) != 0)
+    MPM_FAIL(MPM_ERR_SUNDIALS, "SUNContext_Create failed");
+  return wrap_state(it);
+}
+
+void mpm_integrator_destroy(mpm_integrator **it) {
+  if (!it || !*it) return;
+  if ((*it)->ark) ERKStepFree(&(*it)->ark);
+  free_state(*it);
+  if ((*it)->ctx) SUNContext_Free(&(*it)->ctx);
+  free(*it);
+  *it = NULL;
+}
+
+/* The classic update: one stage, y_{n+1} = y_n + h f(t_n, y_n), with h known to f. */
+static int set_classic_table(mpm_integrator *it) {
+  ARKodeButcherTable B = ARKodeButcherTable_Alloc(1, SUNFALSE);
+  if (!B) MPM_FAIL(MPM_ERR_MEMORY, "cannot allocate a Butcher table");
+  B->A[0][0] = 0.0, B->b[0] = 1.0, B->c[0] = 0.0, B->q = 1, B->p = 0;
+  int flag = ERKStepSetTable(it->ark, B);
+  ARKodeButcherTable_Free(B);
+  MPM_CALL_SUN(flag);
+  return 0;
+}
+
+static int configure(mpm_integrator *it, double h0) {
+  static const ARKODE_ERKTableID tables[MPM_METHOD_COUNT] = {
+      ARKODE_HEUN_EULER_2_1_2, ARKODE_HEUN_EULER_2_1_2, ARKODE_BOGACKI_SHAMPINE_4_2_3,
+      ARKODE_ZONNEVELD_5_3_4, ARKODE_DORMAND_PRINCE_7_4_5};
+  MPM_CALL_SUN(ERKStepSetUserData(it->ark, it));
+  MPM_CALL_SUN(ERKStepSetErrHandlerFn(it->ark, ark_errors, NULL));
+  MPM_CALL_SUN(ERKStepSetMaxNumSteps(it->ark, -1));
+  if (it->method == MPM_METHOD_USL) {
+    MPM_CALL(set_classic_table(it));
+    MPM_CALL_SUN(ERKStepSetFixedStep(it->ark, h0 > 0 ? h0 : 1.0));
+    return 0;
+  }
+  MPM_CALL_SUN(ERKStepSetTableNum(it->ark, tables[it->method]));
+  MPM_CALL_SUN(ERKStepSStolerances(it->ark, it->rtol, it->atol));
+  MPM_CALL_SUN(ERKStepSetStabilityFn(it->ark, estab, it));
+  MPM_CALL_SUN(ERKStepSetCFLFraction(it->ark, 1.0)); /* time.cfl is applied in estab */
+  if (isfinite(it->dt_max)) MPM_CALL_SUN(ERKStepSetMaxStep(it->ark, it->dt_max));
+  if (h0 > 0) MPM_CALL_SUN(ERKStepSetInitStep(it->ark, h0));
+  return 0;
+}
+
+int mpm_integrator_start(mpm_integrator *it, double t, double h0) {
+  if (it->ark) ERKStepFree(&it->ark);
+  MPM_CALL(wrap_state(it));
+  it->ark = ERKStepCreate(rhs, t, it->y, it->ctx);
+  if (!it->ark) MPM_FAIL(MPM_ERR_SUNDIALS, "ERKStepCreate failed");
+  it->t_last = t;
+  return configure(it, h0);
+}
+
+int mpm_integrator_resize(mpm_integrator *it, double t) {
+  MPM_CALL(wrap_state(it));
+  MPM_CALL_SUN(ERKStepResize(it->ark, it->y, 1.0, t, NULL, NULL));
+  return 0;
+}
+
+double mpm_integrator_next_step(const mpm_integrator *it) {
+  mpm_sunreal h = 0;
+  ERKStepGetCurrentStep(it->ark, &h);
+  return h;
+}
+
+void mpm_integrator_counts(const mpm_integrator *it, long *steps, long *rhs_evals, long *fails,
+                           long *retries) {
+  *steps = it->steps, *rhs_evals = it->rhs_evals, *fails = it->fails, *retries = it->retries;
+}
+
+static int report_fault(const mpm_integrator *it, double t) {
+  const mpm_fault *f = &it->fault;
+  char where[96];
+  if (it->grid->dim == 2) snprintf(where, sizeof where, "(%.6g, %.6g)", f->x[0], f->x[1]);
+  else snprintf(where, sizeof where, "(%.6g, %.6g, %.6g)", f->x[0], f->x[1], f->x[2]);
+  mpm_log(MPM_LOG_ERROR,
+          "the run stopped at t = %.6g after %d retries with smaller steps: particle %lld at %s: "
+          "%s. Reduce time.cfl or time.rtol, refine the grid, or check the material "
+          "parameters and boundary conditions near that point",
+          t, it->max_retries, (long long)f->id, where, f->cause);
+  return MPM_ERR_UNPHYSICAL;
+}
+
+#define MPM_RETRY (-1)
+
+/* One attempt with the classic step scaled by `scale`: 0 = accepted, MPM_RETRY = an
+ * unphysical stage (retry smaller), otherwise an error code. */
+static int attempt(mpm_integrator *it, double tstop, double scale, double *t, double *h) {
+  mpm_sunreal tret = it->t_last;
+  if (it->method == MPM_METHOD_USL) {
+    double hs;
+    MPM_CALL(stable_step(it, it->y, &hs));
+    if (!(hs > 0) || !isfinite(hs)) hs = tstop - it->t_last;
+    it->h_classic = fmin(scale * hs, tstop - it->t_last);
+    MPM_CALL_SUN(ERKStepSetFixedStep(it->ark, it->h_classic));
+  }
+  MPM_CALL_SUN(ERKStepSetStopTime(it->ark, tstop));
+  it->fault.set = 0;
+  it->rhs_error = 0;
+  int flag = ERKStepEvolve(it->ark, tstop, it->y, &tret, ARK_ONE_STEP);
+  if (flag >= 0) {
+    mpm_sunreal hl;
+    ERKStepGetLastStep(it->ark, &hl);
+    *t = it->t_last = tret, *h = hl;
+    return 0;
+  }
+  if (it->fault.set) return MPM_RETRY;
+  MPM_FAIL(it->rhs_error ? MPM_ERR_INTERNAL : MPM_ERR_SUNDIALS,
+           "ERKStep failed at t = %.6g with flag %d", it->t_last, flag);
+}
+
+int mpm_integrator_step(mpm_integrator *it, double tstop, double *t, double *h) {
+  double scale = 1.0;
+  const double h_tried = mpm_integrator_next_step(it);
+  for (int tries = 0;; ++tries) {
+    long nfail = 0;
+    int rc = attempt(it, tstop, scale, t, h);
+    ERKStepGetNumErrTestFails(it->ark, &nfail);
+    if (rc == 0) {
+      it->steps++;
+      it->fails += nfail;
+      return 0;
+    }
+    if (rc != MPM_RETRY) return mpm_trace(__FILE__, __LINE__, __func__, rc);
+    if (tries >= it->max_retries) return report_fault(it, it->t_last);
+    it->retries++;
+    scale *= 0.25;
+    mpm_log(MPM_LOG_DEBUG, "retrying from t = %.6g with a smaller step: particle %lld: %s",
+            it->t_last, (long long)it->fault.id, it->fault.cause);
+    /* ERKStep cannot retry a recoverable explicit RHS failure itself: restart it from the
+     * last accepted state (the particle data) with a quarter of the step it tried. */
+    MPM_CALL(mpm_integrator_start(it, it->t_last, it->method == MPM_METHOD_USL
+                                                       ? 0.0
+                                                       : scale * fabs(h_tried)));
+  }
+}

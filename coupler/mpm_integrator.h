@@ -1,0 +1,61 @@
+/* Time integration of the coupled modules with ARKODE's ERKStep.
+ *
+ * The ODE state is an MPIManyVector with one serial subvector per module, each wrapping the
+ * state block of the module's particle set (no copy). The RHS is the MPM cycle owned by the
+ * coupler: P2G of every module, reverse halo, grid update, forward halo, G2P.
+ *
+ * Methods: the classic MPM update (USL) is a one-stage explicit table taken with a fixed
+ * step set before every step from the stability limit; the grid velocity is advanced by
+ * that step before G2P, as the classic update needs. The adaptive methods are embedded ERK
+ * pairs with error control and the same stability limit.
+ *
+ * Failures: an unphysical stage (NaN, J <= 0, a particle outside the domain or too far out
+ * of its box) makes the RHS return a recoverable flag on every rank. ERKStep 6.4 cannot
+ * retry after a recoverable explicit RHS failure, so the integrator restarts itself from the
+ * last accepted state with a quarter of the step, up to max_retries times in a row, and then
+ * fails with a message that names the particle, its position and the cause. */
+#ifndef MPM_INTEGRATOR_H
+#define MPM_INTEGRATOR_H
+
+#include "mpm_config.h"
+#include "mpm_module.h"
+
+typedef enum {
+  MPM_METHOD_USL,         /* classic MPM update, fixed step from the CFL limit */
+  MPM_METHOD_HEUN_EULER,  /* ERK 2(1), unstable for undamped waves: for comparison */
+  MPM_METHOD_BS32,        /* Bogacki-Shampine 3(2) */
+  MPM_METHOD_ZONNEVELD43, /* Zonneveld 4(3) */
+  MPM_METHOD_DP54,        /* Dormand-Prince 5(4) */
+  MPM_METHOD_COUNT
+} mpm_method;
+
+extern const mpm_key_spec mpm_integrator_keys[];
+extern const int mpm_integrator_nkeys;
+
+typedef struct mpm_integrator mpm_integrator;
+
+int mpm_integrator_new(mpm_integrator **it, const mpm_config *cfg, mpm_grid *grid,
+                       mpm_module **modules, int nmodules);
+void mpm_integrator_destroy(mpm_integrator **it);
+
+/* (Re)start the integration at (t, current particle state) with first step h0 (0: let
+ * ARKODE choose). A fresh ERKStep instance each time, so a run that passes through a
+ * checkpoint and a run restarted from it take the same steps. */
+int mpm_integrator_start(mpm_integrator *it, double t, double h0);
+
+/* Take one accepted step, not past tstop. *t is the new time, *h the step taken. */
+int mpm_integrator_step(mpm_integrator *it, double tstop, double *t, double *h);
+
+/* The particle sets changed (count, order or storage): re-wrap the state. Collective. */
+int mpm_integrator_resize(mpm_integrator *it, double t);
+
+/* Step ARKODE would try next (for checkpoints). */
+double mpm_integrator_next_step(const mpm_integrator *it);
+
+/* Counters since creation: steps, RHS evaluations, failed (error-test) steps, retries. */
+void mpm_integrator_counts(const mpm_integrator *it, long *steps, long *rhs, long *fails,
+                           long *retries);
+
+const char *mpm_method_name(mpm_method m);
+
+#endif

@@ -1,0 +1,366 @@
+/* The simulation object and its step loop (see mpm_sim.h). */
+#include "mpm_sim.h"
+
+#include "mpm_diag.h"
+#include "mpm_error.h"
+#include "mpm_geometry.h"
+#include "mpm_integrator.h"
+#include "mpm_output.h"
+#include "mpm_timer.h"
+#include "solid_module.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#define SIM_MAX_MODULES 4
+
+struct mpm_sim {
+  MPI_Comm comm;
+  int rank, size;
+  mpm_config *cfg;
+  char *config_text;
+  mpm_grid *grid;
+  mpm_module *mod[SIM_MAX_MODULES];
+  int nmod;
+  mpm_integrator *it;
+  mpm_output *out;
+  mpm_diag *diag;
+  double t, t_end, h_next;
+  long step;
+  double out_interval, ckpt_interval;
+  long out_next, ckpt_next; /* index k of the next output / checkpoint at time k * interval */
+  int sort_every, snapshots, grid_fields, progress;
+  const char *dir;
+  int restarted;
+  double particle_steps;
+};
+
+static const mpm_key_spec sim_keys[] = {
+    {"run.name", MPM_KEY_STRING, "mpmfsi", 0, 0, 0, 0, NULL, "name of the run"},
+    {"run.log_level", MPM_KEY_ENUM, "info", 0, 0, 0, 0, "error|warn|info|debug|trace",
+     "how much to log; debug also prints the traceback of a failure"},
+    {"run.log_all_ranks", MPM_KEY_BOOL, "false", 0, 0, 0, 0, NULL, "log on every rank"},
+    {"run.progress", MPM_KEY_BOOL, "true", 0, 0, 0, 0, NULL,
+     "progress line with ETA when stderr is a terminal"},
+    {"run.sort_every", MPM_KEY_INT, "20", 0, 1e9, 0, 0, NULL,
+     "sort particles by cell every N steps (0: never)"},
+    {"domain.dim", MPM_KEY_INT, "2", 2, 3, 0, 0, NULL, "spatial dimension, 2 or 3"},
+    {"domain.lo", MPM_KEY_REALS, NULL, -HUGE_VAL, HUGE_VAL, 0, 3, NULL, "lower corner, m"},
+    {"domain.hi", MPM_KEY_REALS, NULL, -HUGE_VAL, HUGE_VAL, 0, 3, NULL, "upper corner, m"},
+    {"grid.dx", MPM_KEY_REAL, NULL, 0, HUGE_VAL, 1, 0, NULL,
+     "cell size, m; the domain must be a whole number of cells"},
+    {"grid.shape", MPM_KEY_ENUM, "quadratic", 0, 0, 0, 0, "linear|gimp|quadratic|cubic",
+     "shape function"},
+    {"grid.ranks", MPM_KEY_REALS, "0 0 0", 0, 65536, 0, 3, NULL,
+     "MPI ranks per direction (0: let MPI choose)"},
+    {"physics.gravity", MPM_KEY_REALS, "0 0 0", -HUGE_VAL, HUGE_VAL, 0, 3, NULL,
+     "body acceleration, m/s^2"},
+    {"output.dir", MPM_KEY_STRING, "out", 0, 0, 0, 0, NULL, "output folder"},
+    {"output.interval", MPM_KEY_REAL, "0", 0, HUGE_VAL, 0, 0, NULL,
+     "time between snapshots, s (0: t_end / 10)"},
+    {"output.snapshots", MPM_KEY_BOOL, "true", 0, 0, 0, 0, NULL, "write HDF5 snapshots"},
+    {"output.grid_fields", MPM_KEY_BOOL, "false", 0, 0, 0, 0, NULL,
+     "add nodal mass and velocity to the snapshots"},
+    {"output.checkpoint_interval", MPM_KEY_REAL, "0", 0, HUGE_VAL, 0, 0, NULL,
+     "time between checkpoints, s (0: only at the end)"},
+};
+
+int mpm_sim_add_schema(mpm_config *cfg) {
+  MPM_CALL(mpm_config_add_schema(cfg, sim_keys, (int)(sizeof sim_keys / sizeof sim_keys[0])));
+  MPM_CALL(mpm_config_add_schema(cfg, mpm_integrator_keys, mpm_integrator_nkeys));
+  MPM_CALL(mpm_config_add_schema(cfg, mpm_geometry_keys, mpm_geometry_nkeys));
+  MPM_CALL(mpm_config_add_schema(cfg, solid_keys, solid_nkeys));
+  return 0;
+}
+
+/* ---- set-up ---------------------------------------------------------------------------- */
+
+static int read_domain(const mpm_config *cfg, int *dim, double *lo, double *hi) {
+  int nlo, nhi;
+  MPM_CALL(mpm_config_get_int(cfg, "domain.dim", dim));
+  MPM_CALL(mpm_config_get_reals(cfg, "domain.lo", lo, 3, &nlo));
+  MPM_CALL(mpm_config_get_reals(cfg, "domain.hi", hi, 3, &nhi));
+  if (nlo != *dim) return mpm_config_fail(cfg, "domain.lo", "needs %d values, got %d", *dim, nlo);
+  if (nhi != *dim) return mpm_config_fail(cfg, "domain.hi", "needs %d values, got %d", *dim, nhi);
+  for (int d = 0; d < *dim; ++d)
+    if (!(hi[d] > lo[d]))
+      return mpm_config_fail(cfg, "domain.hi", "component %d (%g) must exceed domain.lo (%g)", d,
+                             hi[d], lo[d]);
+  return 0;
+}
+
+static int build_grid(mpm_sim *s) {
+  int dim, nr, nproc[3] = {0, 0, 0};
+  double lo[3], hi[3], dx, ranks[3] = {0, 0, 0};
+  const char *shape;
+  MPM_CALL(read_domain(s->cfg, &dim, lo, hi));
+  MPM_CALL(mpm_config_get_real(s->cfg, "grid.dx", &dx));
+  MPM_CALL(mpm_config_get_string(s->cfg, "grid.shape", &shape));
+  MPM_CALL(mpm_config_get_reals(s->cfg, "grid.ranks", ranks, 3, &nr));
+  for (int d = 0; d < dim && d < nr; ++d) nproc[d] = (int)ranks[d];
+  for (int d = 0; d < dim; ++d) {
+    const double cells = (hi[d] - lo[d]) / dx;
+    if (fabs(cells - round(cells)) > 1e-9 * cells)
+      return mpm_config_fail(s->cfg, "grid.dx",
+                             "the domain length %g along axis %d is not a whole number of cells "
+                             "of %g (%.6g cells); adjust grid.dx or the domain",
+                             hi[d] - lo[d], d, dx, cells);
+  }
+  MPM_CALL(mpm_grid_new(&s->grid, s->comm, dim, lo, hi, dx, mpm_shape_parse(shape), nproc));
+  mpm_log(MPM_LOG_INFO, "grid: %d-D, %d x %d%s cells of %g, %s, %d ranks (%d x %d%s)", dim,
+          s->grid->ncells[0], s->grid->ncells[1], dim == 3 ? " x ..." : "", dx, shape, s->size,
+          s->grid->nproc[0], s->grid->nproc[1], dim == 3 ? " x ..." : "");
+  return 0;
+}
+
+static int read_run_settings(mpm_sim *s) {
+  MPM_CALL(mpm_config_get_real(s->cfg, "time.t_end", &s->t_end));
+  MPM_CALL(mpm_config_get_real(s->cfg, "output.interval", &s->out_interval));
+  MPM_CALL(mpm_config_get_real(s->cfg, "output.checkpoint_interval", &s->ckpt_interval));
+  MPM_CALL(mpm_config_get_int(s->cfg, "run.sort_every", &s->sort_every));
+  MPM_CALL(mpm_config_get_bool(s->cfg, "run.progress", &s->progress));
+  MPM_CALL(mpm_config_get_bool(s->cfg, "output.snapshots", &s->snapshots));
+  MPM_CALL(mpm_config_get_bool(s->cfg, "output.grid_fields", &s->grid_fields));
+  MPM_CALL(mpm_config_get_string(s->cfg, "output.dir", &s->dir));
+  if (s->out_interval <= 0) s->out_interval = s->t_end / 10;
+  if (s->ckpt_interval <= 0) s->ckpt_interval = HUGE_VAL;
+  return 0;
+}
+
+static int build_modules(mpm_sim *s, int seed) {
+  mpm_module *solid = NULL;
+  MPM_CALL(solid_module_create(&solid, s->cfg, s->grid, seed));
+  if (solid) s->mod[s->nmod++] = solid;
+  if (s->nmod == 0)
+    return mpm_config_fail(s->cfg, "solid",
+                           "the case defines no bodies: add a [solid.NAME] section");
+  return 0;
+}
+
+static const char *const g_diag_cols[] = {
+    "t", "step", "dt", "particles", "mass", "px", "py", "pz", "kinetic", "internal", "total",
+    "rhs_evals"};
+enum { NDIAG = (int)(sizeof g_diag_cols / sizeof g_diag_cols[0]) };
+
+static int open_outputs(mpm_sim *s, int append) {
+  char path[4096];
+  MPM_CALL(mpm_config_resolved_text(s->cfg, &s->config_text));
+  MPM_CALL(mpm_output_new(&s->out, s->comm, s->dir, s->config_text, s->grid->dim, append, s->t));
+  snprintf(path, sizeof path, "%s/diagnostics.csv", s->dir);
+  MPM_CALL(mpm_diag_open(&s->diag, s->comm, path, NDIAG, g_diag_cols, append, s->t));
+  return 0;
+}
+
+static int sim_alloc(mpm_sim **sp, mpm_config *cfg) {
+  mpm_sim *s;
+  MPM_ALLOC(s, 1);
+  *sp = s;
+  s->cfg = cfg;
+  s->comm = MPI_COMM_WORLD;
+  MPI_Comm_rank(s->comm, &s->rank);
+  MPI_Comm_size(s->comm, &s->size);
+  MPM_CALL(read_run_settings(s));
+  return build_grid(s);
+}
+
+int mpm_sim_create(mpm_sim **sp, mpm_config *cfg) {
+  MPM_CALL(sim_alloc(sp, cfg));
+  mpm_sim *s = *sp;
+  MPM_CALL(build_modules(s, 1));
+  s->out_next = 0;
+  s->ckpt_next = 1;
+  return mpm_integrator_new(&s->it, cfg, s->grid, s->mod, s->nmod);
+}
+
+static int ckpt_attr(const mpm_checkpoint *ck, const char *name, double *v) {
+  return mpm_checkpoint_attr(ck, name, v);
+}
+
+int mpm_sim_restart(mpm_sim **sp, mpm_config *cfg, const char *path) {
+  MPM_CALL(sim_alloc(sp, cfg));
+  mpm_sim *s = *sp;
+  MPM_CALL(build_modules(s, 0));
+  mpm_checkpoint *ck = NULL;
+  MPM_CALL(mpm_checkpoint_open(&ck, s->comm, path));
+  double step, out_next, ckpt_next;
+  int rc = ckpt_attr(ck, "t", &s->t);
+  if (!rc) rc = ckpt_attr(ck, "step", &step);
+  if (!rc) rc = ckpt_attr(ck, "h_next", &s->h_next);
+  if (!rc) rc = ckpt_attr(ck, "out_next", &out_next);
+  if (!rc) rc = ckpt_attr(ck, "ckpt_next", &ckpt_next);
+  for (int k = 0; !rc && k < s->nmod; ++k)
+    rc = mpm_checkpoint_read_particles(ck, s->mod[k]->name, s->mod[k]->particles);
+  mpm_checkpoint_close(&ck);
+  MPM_CALL(rc);
+  s->step = (long)step;
+  s->out_next = (long)out_next;
+  s->ckpt_next = (long)ckpt_next;
+  for (int k = 0; k < s->nmod; ++k) MPM_CALL(mpm_particles_migrate(s->mod[k]->particles, s->grid, NULL));
+  MPM_CALL(mpm_integrator_new(&s->it, cfg, s->grid, s->mod, s->nmod));
+  s->restarted = 1;
+  mpm_log(MPM_LOG_INFO, "restarted from %s at t = %.6g, step %ld", path, s->t, s->step);
+  return 0;
+}
+
+void mpm_sim_destroy(mpm_sim **sp) {
+  if (!sp || !*sp) return;
+  mpm_sim *s = *sp;
+  mpm_integrator_destroy(&s->it);
+  for (int k = 0; k < s->nmod; ++k) mpm_module_destroy(&s->mod[k]);
+  mpm_output_destroy(&s->out);
+  mpm_diag_close(&s->diag);
+  mpm_grid_destroy(&s->grid);
+  free(s->config_text);
+  free(s);
+  *sp = NULL;
+}
+
+/* ---- the step loop --------------------------------------------------------------------- */
+
+static int write_snapshot(mpm_sim *s) {
+  const mpm_particles *p[SIM_MAX_MODULES];
+  const char *names[SIM_MAX_MODULES];
+  for (int k = 0; k < s->nmod; ++k) p[k] = s->mod[k]->particles, names[k] = s->mod[k]->name;
+  mpm_timer_start(MPM_T_IO);
+  int rc = mpm_output_snapshot(s->out, s->t, s->step, p, names, s->nmod,
+                               s->grid_fields ? s->grid : NULL);
+  mpm_timer_stop(MPM_T_IO);
+  return rc;
+}
+
+static int write_checkpoint(mpm_sim *s, const char *path) {
+  const mpm_particles *p[SIM_MAX_MODULES];
+  const char *names[SIM_MAX_MODULES];
+  for (int k = 0; k < s->nmod; ++k) p[k] = s->mod[k]->particles, names[k] = s->mod[k]->name;
+  const char *attr[] = {"t", "step", "h_next", "out_next", "ckpt_next"};
+  const double val[] = {s->t, (double)s->step, s->h_next, (double)s->out_next,
+                        (double)s->ckpt_next};
+  mpm_timer_start(MPM_T_IO);
+  int rc = mpm_checkpoint_write(s->comm, path, s->config_text, attr, val, 5, p, names, s->nmod);
+  mpm_timer_stop(MPM_T_IO);
+  MPM_CALL(rc);
+  mpm_log(MPM_LOG_INFO, "checkpoint %s at t = %.6g", path, s->t);
+  return 0;
+}
+
+static int diagnostics(mpm_sim *s, double dt) {
+  double local[8] = {0}, sum[8];
+  for (int k = 0; k < s->nmod; ++k) {
+    mpm_module_sums m;
+    s->mod[k]->ops->sums(s->mod[k], &m);
+    local[0] += s->mod[k]->particles->n;
+    local[1] += m.mass;
+    for (int d = 0; d < MPM_MAX_DIM; ++d) local[2 + d] += m.momentum[d];
+    local[5] += m.kinetic;
+    local[6] += m.internal;
+  }
+  MPM_CALL_MPI(MPI_Allreduce(local, sum, 8, MPI_DOUBLE, MPI_SUM, s->comm));
+  long steps, rhs, fails, retries;
+  mpm_integrator_counts(s->it, &steps, &rhs, &fails, &retries);
+  const double row[NDIAG] = {s->t,   (double)s->step, dt,     sum[0], sum[1],          sum[2],
+                             sum[3], sum[4],          sum[5], sum[6], sum[5] + sum[6], (double)rhs};
+  s->particle_steps += sum[0];
+  return mpm_diag_row(s->diag, row);
+}
+
+/* Move particles to their owners and sort them now and then; tell the integrator. */
+static int after_step(mpm_sim *s) {
+  int changed_any = 0;
+  mpm_timer_start(MPM_T_MIGRATE);
+  for (int k = 0; k < s->nmod; ++k) {
+    int changed = 0;
+    MPM_CALL(mpm_particles_migrate(s->mod[k]->particles, s->grid, &changed));
+    if (s->sort_every > 0 && s->step % s->sort_every == 0) {
+      MPM_CALL(mpm_particles_sort(s->mod[k]->particles, s->grid));
+      changed = 1;
+    }
+    changed_any |= changed;
+    if (s->mod[k]->ops->post_step) MPM_CALL(s->mod[k]->ops->post_step(s->mod[k]));
+  }
+  if (changed_any) MPM_CALL(mpm_integrator_resize(s->it, s->t));
+  mpm_timer_stop(MPM_T_MIGRATE);
+  return 0;
+}
+
+static void progress(mpm_sim *s, double dt, double wall0, int final) {
+  static double last = 0;
+  if (!s->progress || s->rank != 0 || !isatty(STDERR_FILENO)) return;
+  const double now = MPI_Wtime();
+  if (!final && now - last < 0.5) return;
+  last = now;
+  const double frac = s->t / s->t_end, eta = frac > 0 ? (now - wall0) * (1 - frac) / frac : 0;
+  fprintf(stderr, "\rstep %8ld  t = %-11.5g dt = %-10.3g %5.1f%%  ETA %6.0f s  ", s->step, s->t,
+          dt, 100 * frac, eta);
+  if (final) fputc('\n', stderr);
+  fflush(stderr);
+}
+
+static int write_summary(mpm_sim *s, double wall) {
+  long steps, rhs, fails, retries;
+  mpm_integrator_counts(s->it, &steps, &rhs, &fails, &retries);
+  char path[4096];
+  snprintf(path, sizeof path, "%s/timers.csv", s->dir);
+  MPM_CALL(mpm_timer_report(s->comm, path));
+  mpm_log(MPM_LOG_INFO,
+          "done: t = %.6g, %ld steps (%ld rhs evaluations, %ld error-test failures, %ld "
+          "retries), %.3f s wall, %.3g particle-steps/s",
+          s->t, steps, rhs, fails, retries, wall, s->particle_steps / wall);
+  if (s->rank != 0) return 0;
+  snprintf(path, sizeof path, "%s/summary.json", s->dir);
+  FILE *f = fopen(path, "w");
+  if (!f) MPM_FAIL(MPM_ERR_FILE, "cannot write '%s'", path);
+  fprintf(f,
+          "{\"t\": %.17g, \"steps\": %ld, \"rhs_evals\": %ld, \"error_test_fails\": %ld, "
+          "\"retries\": %ld, \"wall_s\": %.6f, \"ranks\": %d, \"particle_steps\": %.17g, "
+          "\"particle_steps_per_s\": %.6g}\n",
+          s->t, steps, rhs, fails, retries, wall, s->size, s->particle_steps,
+          s->particle_steps / wall);
+  fclose(f);
+  return 0;
+}
+
+int mpm_sim_run(mpm_sim *s) {
+  char path[4096];
+  MPM_CALL(open_outputs(s, s->restarted));
+  mpm_timer_reset();
+  mpm_timer_start(MPM_T_TOTAL);
+  const double wall0 = MPI_Wtime();
+  MPM_CALL(mpm_integrator_start(s->it, s->t, s->h_next));
+  if (s->out_next == 0) {
+    MPM_CALL(diagnostics(s, 0.0));
+    if (s->snapshots) MPM_CALL(write_snapshot(s));
+    s->out_next = 1;
+  }
+  const double t_stop = s->t_end * (1 - 1e-14);
+  double dt = 0.0;
+  while (s->t < t_stop) {
+    const double t_out = fmin(s->out_next * s->out_interval, s->t_end);
+    const double t_ckpt = s->ckpt_next * s->ckpt_interval;
+    MPM_CALL(mpm_integrator_step(s->it, fmin(t_out, t_ckpt), &s->t, &dt));
+    s->step++;
+    MPM_CALL(after_step(s));
+    MPM_CALL(diagnostics(s, dt));
+    progress(s, dt, wall0, 0);
+    if (s->t >= t_out * (1 - 1e-14)) {
+      if (s->snapshots) MPM_CALL(write_snapshot(s));
+      s->out_next++;
+    }
+    if (s->t >= t_ckpt * (1 - 1e-14) && s->t < t_stop) {
+      s->h_next = mpm_integrator_next_step(s->it);
+      s->ckpt_next++;
+      snprintf(path, sizeof path, "%s/checkpoint_%06ld.h5", s->dir, s->ckpt_next - 1);
+      MPM_CALL(write_checkpoint(s, path));
+      /* Exactly what a restart from this file does. */
+      MPM_CALL(mpm_integrator_start(s->it, s->t, s->h_next));
+    }
+  }
+  progress(s, dt, wall0, 1);
+  s->h_next = mpm_integrator_next_step(s->it);
+  snprintf(path, sizeof path, "%s/checkpoint_final.h5", s->dir);
+  MPM_CALL(write_checkpoint(s, path));
+  mpm_timer_stop(MPM_T_TOTAL);
+  return write_summary(s, MPI_Wtime() - wall0);
+}

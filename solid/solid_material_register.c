@@ -1,0 +1,43 @@
+/* The registry of built-in material models. Add a model here with one line. */
+#include "solid_material.h"
+
+#include "mpm_error.h"
+
+#include <stdlib.h>
+#include <stdio.h>
+#include <string.h>
+
+extern const solid_material_ops solid_linear_elastic_ops;
+
+static const solid_material_ops *const g_models[] = {
+    &solid_linear_elastic_ops,
+};
+static const int g_nmodels = (int)(sizeof g_models / sizeof g_models[0]);
+
+const char *solid_material_names(void) { return "linear_elastic"; }
+
+int solid_material_create(solid_material **mat, const char *type, const mpm_config *cfg,
+                          const char *section) {
+  for (int k = 0; k < g_nmodels; ++k) {
+    if (strcmp(g_models[k]->name, type) != 0) continue;
+    MPM_ALLOC(*mat, 1);
+    (*mat)->ops = g_models[k];
+    int rc = g_models[k]->create(*mat, cfg, section);
+    if (rc) {
+      solid_material_destroy(mat);
+      return mpm_trace(__FILE__, __LINE__, __func__, rc);
+    }
+    return 0;
+  }
+  char key[128];
+  snprintf(key, sizeof key, "%s.material", section);
+  return mpm_config_fail(cfg, key, "unknown material model '%s'; registered models: %s", type,
+                         solid_material_names());
+}
+
+void solid_material_destroy(solid_material **mat) {
+  if (!mat || !*mat) return;
+  if ((*mat)->ops && (*mat)->ops->destroy) (*mat)->ops->destroy(*mat);
+  free(*mat);
+  *mat = NULL;
+}

@@ -1,0 +1,24 @@
+/* The solid MPM module: elastic bodies seeded from case-file geometry, each with its own
+ * material model, integrated as x, v and F on the particles.
+ *
+ * State fields: x (dim), v (dim), F (dim*dim). Other fields: m (mass), V0 (reference
+ * volume), body (index of the [solid.NAME] section the particle came from). */
+#ifndef SOLID_MODULE_H
+#define SOLID_MODULE_H
+
+#include "mpm_config.h"
+#include "mpm_module.h"
+
+/* Keys of [solid.NAME] sections. */
+extern const mpm_key_spec solid_keys[];
+extern const int solid_nkeys;
+
+/* Field layout of solid particles (for checkpoints). */
+int solid_particles_new(mpm_particles **p, int dim);
+
+/* Build the module over grid with its own phase of nodal fields. With seed = 1 the bodies
+ * are seeded from their geometry; with seed = 0 the particle set starts empty (a restart
+ * fills it). *m is NULL if the case has no [solid.*] section. Collective. */
+int solid_module_create(mpm_module **m, const mpm_config *cfg, mpm_grid *grid, int seed);
+
+#endif

@@ -1,0 +1,112 @@
+"""Every class of bad input gives one error line naming the file, the line and the key,
+exits with status 2, and starts nothing (no output folder appears).
+
+Each case edits the valid ballistic2d.ini in one place, writes it to a temporary file and
+runs `mpmfsi run` on it. The expected key and line are derived from the edit, not typed in.
+"""
+import os
+import re
+import sys
+import tempfile
+
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "tools"))
+import mpmtest as mt  # noqa: E402
+
+BASE = open(mt.case("ballistic2d.ini")).read()
+passed = failed = 0
+
+
+def check(cond, msg):
+    global passed, failed
+    passed, failed = (passed + 1, failed) if cond else (passed, failed + 1)
+    print(("ok   " if cond else "FAIL ") + msg)
+
+
+def line_of(text, needle):
+    for k, line in enumerate(text.splitlines(), 1):
+        if needle in line:
+            return k
+    raise AssertionError(f"{needle!r} not in the case")
+
+
+# (name, old text, new text, key expected in the message, extra words expected)
+CASES = [
+    ("unknown key", "dx = 0.1", "dxx = 0.1", "grid.dxx", "grid.dx"),
+    ("wrong type", "dx = 0.1", "dx = abc", "grid.dx", None),
+    ("integer expected", "dim = 2", "dim = 2.5", "domain.dim", None),
+    ("negative modulus", "E = 1e6", "E = -5", "solid.block.E", None),
+    ("zero density", "density = 1000", "density = 0", "solid.block.density", None),
+    ("Poisson ratio 0.5", "nu = 0.3", "nu = 0.5", "solid.block.nu", None),
+    ("unstable CFL", "method = bs32", "method = bs32\ncfl = 1.5", "time.cfl", None),
+    ("unknown method", "method = bs32", "method = rk99", "time.method", "bs32"),
+    ("unknown material", "material = linear_elastic", "material = unobtainium",
+     "solid.block.material", "linear_elastic"),
+    ("box outside the domain", "hi = 1.0 2.5", "hi = 1.0 5.5", "solid.block.geometry", "domain"),
+    ("domain not whole cells", "dx = 0.1", "dx = 0.3", "grid.dx", "whole number"),
+    ("wrong vector length", "lo = 0 0\n", "lo = 0 0 0\n", "domain.lo", None),
+    ("malformed line", "[physics]", "[physics]\nthis line has no equals sign", None, "syntax"),
+    ("missing required key", "density = 1000\n", "", "solid.block.density", "required"),
+    ("duplicate key", "dx = 0.1", "dx = 0.1\ndx = 0.2", "grid.dx", None),
+]
+
+
+def expect_error(name, text, key, words, line, args=()):
+    with tempfile.TemporaryDirectory() as tmp:
+        path = os.path.join(tmp, "case.ini")
+        with open(path, "w") as f:
+            f.write(text)
+        out = os.path.join(tmp, "out")
+        p = mt.run(["run", path, f"output.dir={out}", "run.progress=false"] + list(args),
+                   check=False)
+        errors = [l for l in p.stderr.splitlines() if l.startswith("error:")]
+        ok = p.returncode == 2 and len(errors) == 1 and not os.path.exists(out)
+        msg = errors[0] if errors else p.stderr.strip().replace("\n", " | ")[:300]
+        if ok and line is not None:
+            ok = f"case.ini:{line}:" in msg
+        if ok and key:
+            ok = key in msg
+        if ok and words:
+            ok = words in msg
+        check(ok, f"{name}: exit {p.returncode}: {msg}")
+
+
+for name, old, new, key, words in CASES:
+    assert old in BASE, old
+    text = BASE.replace(old, new, 1)
+    line = line_of(text, new.splitlines()[-1]) if new else None
+    if name == "missing required key":
+        line = None  # reported at the section, not at a line
+    if name == "duplicate key":
+        line = line_of(text, "dx = 0.2")
+    if name == "box outside the domain":
+        line = line_of(text, "geometry = block")
+    expect_error(name, text, key, words, line)
+
+# Overrides on the command line are named as such.
+expect_error("bad override", BASE, "grid.dx", "command line", None, ["grid.dx=-1"])
+expect_error("malformed override", BASE, None, "command line", None, ["grid.dx"])
+
+# A polygon file that does not exist.
+poly = BASE.replace("type = box\nlo = 0.5 2.0\nhi = 1.0 2.5",
+                    "type = polygon\nfile = no_such_vertices.csv")
+expect_error("missing polygon file", poly, "geometry.block.file", None,
+             line_of(poly, "no_such_vertices"))
+
+# A missing case file.
+p = mt.run(["run", "/nonexistent/case.ini"], check=False)
+errors = [l for l in p.stderr.splitlines() if l.startswith("error:")]
+check(p.returncode == 2 and len(errors) == 1 and "/nonexistent/case.ini" in errors[0],
+      f"missing case file: exit {p.returncode}: {errors[0] if errors else p.stderr.strip()}")
+
+# `check` on a good case prints a resolved configuration that reads back identically.
+with tempfile.TemporaryDirectory() as tmp:
+    p = mt.run(["check", mt.case("ballistic2d.ini")])
+    path = os.path.join(tmp, "resolved.ini")
+    with open(path, "w") as f:
+        f.write(p.stdout)
+    q = mt.run(["check", path])
+    strip = lambda s: re.sub(r"\s*#.*", "", s).strip()
+    check(strip(p.stdout) == strip(q.stdout) and "t_end = 0.3" in p.stdout,
+          "check: the resolved configuration reads back to itself")
+
+sys.exit(mt.report("test_bad_input", passed, failed))

@@ -1,0 +1,336 @@
+/* test_migrate: particle storage under MPI, in 2-D and 3-D.
+ *
+ * - edit: removal keeps order, additions go to the end, data travel with ids;
+ * - inject: ids are numbered in rank order from id_next, which ends equal on every rank;
+ * - sort: cell keys (x fastest) are nondecreasing, ties keep their order, data follow ids;
+ * - migrate: a few thousand particles seeded anywhere do 50 steps of a random walk of up to
+ *   1.5 cells (reflected at the walls) and migrate after each. After every step the global
+ *   count, the id multiset (sum of ids and of their squares), ownership of every particle and
+ *   every value (a function of the id; the position is recomputed from the walk) are checked,
+ *   and at the end rank 0 checks that the gathered ids are exactly 0 .. N-1;
+ * - a particle outside the domain makes migrate fail with MPM_ERR_UNPHYSICAL on every rank.
+ * The walk is a hash of (id, step), so it does not depend on where a particle lives. */
+#include "mpm_particles.h"
+#include "mpm_error.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static int g_rank, g_size, g_fail;
+
+#define CHECK(cond, ...)                                                                           \
+  do {                                                                                             \
+    if (!(cond) && g_fail++ < 20) {                                                                \
+      fprintf(stderr, "[%d] %s:%d: check failed: %s: ", g_rank, __FILE__, __LINE__, #cond);        \
+      fprintf(stderr, __VA_ARGS__);                                                                \
+      fputc('\n', stderr);                                                                         \
+    }                                                                                              \
+  } while (0)
+
+enum { NPART = 3000, NSTEPS = 50, NQ = 4 };
+
+static const mpm_field_desc g_fields[4] = {{"x", 0}, {"v", 0}, {"q", NQ}, {"s", 1}};
+
+/* ---- deterministic functions of the id ------------------------------------------------- */
+
+static uint64_t mix(uint64_t z) { /* splitmix64 */
+  z += 0x9e3779b97f4a7c15ULL;
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+  return z ^ (z >> 31);
+}
+
+/* Uniform in [0, 1) from (id, step, d). */
+static double uniform(mpm_gidx id, int step, int d) {
+  return (double)(mix(mix(mix((uint64_t)id) + (uint64_t)step) + (uint64_t)d) >> 11) * 0x1.0p-53;
+}
+
+/* Value of component c of field f (not x) for particle id. */
+static double value_of(mpm_gidx id, int f, int c) {
+  return (double)id * 0.75 + 10.0 * f + c;
+}
+
+/* Reflect a coordinate into [lo, hi); a step is shorter than the domain. */
+static double reflect(double x, double lo, double hi) {
+  if (x < lo) x = 2.0 * lo - x;
+  if (x >= hi) x = 2.0 * hi - x;
+  return x >= hi ? nextafter(hi, lo) : x;
+}
+
+static double walk_step(const mpm_grid *g, mpm_gidx id, int step, int d, double x) {
+  if (step == 0)
+    return reflect(g->lo[d] + uniform(id, 0, d) * (g->hi[d] - g->lo[d]), g->lo[d], g->hi[d]);
+  return reflect(x + (2.0 * uniform(id, step, d) - 1.0) * 1.5 * g->dx, g->lo[d], g->hi[d]);
+}
+
+/* Position of particle id after `steps` steps of the walk. */
+static void walk_position(const mpm_grid *g, mpm_gidx id, int steps, double *x) {
+  for (int d = 0; d < g->dim; ++d) {
+    x[d] = walk_step(g, id, 0, d, 0.0);
+    for (int s = 1; s <= steps; ++s) x[d] = walk_step(g, id, s, d, x[d]);
+  }
+}
+
+/* Set every value of particle i from its id, the position after `steps` steps. */
+static void set_particle(mpm_particles *p, const mpm_grid *g, mpm_lidx i, int steps) {
+  double x[3];
+  walk_position(g, p->id[i], steps, x);
+  for (int d = 0; d < p->dim; ++d) mpm_particles_comp(p, 0, d)[i] = x[d];
+  for (int f = 1; f < p->nfields; ++f)
+    for (int c = 0; c < p->field[f].ncomp; ++c)
+      mpm_particles_comp(p, f, c)[i] = value_of(p->id[i], f, c);
+}
+
+static int particle_ok(const mpm_particles *p, const mpm_grid *g, mpm_lidx i, int steps) {
+  double x[3];
+  walk_position(g, p->id[i], steps, x);
+  for (int d = 0; d < p->dim; ++d)
+    if (mpm_particles_comp(p, 0, d)[i] != x[d]) return 0;
+  for (int f = 1; f < p->nfields; ++f)
+    for (int c = 0; c < p->field[f].ncomp; ++c)
+      if (mpm_particles_comp(p, f, c)[i] != value_of(p->id[i], f, c)) return 0;
+  return 1;
+}
+
+static mpm_particles *new_set(int dim) {
+  mpm_field_desc fields[4];
+  memcpy(fields, g_fields, sizeof fields);
+  fields[0].ncomp = fields[1].ncomp = dim;
+  mpm_particles *p = NULL;
+  CHECK(mpm_particles_new(&p, dim, fields, 4, 2) == 0, "particles_new");
+  return p;
+}
+
+static mpm_grid *new_grid(int dim) {
+  const double lo2[3] = {0, 0, 0}, hi2[3] = {2.0, 1.5, 0};        /* 16 x 12 cells */
+  const double lo3[3] = {-0.5, 0, 0.2}, hi3[3] = {0.5, 0.8, 0.8}; /* 10 x 8 x 6 */
+  const int nproc[3] = {0, 0, 0};
+  mpm_grid *g = NULL;
+  CHECK(mpm_grid_new(&g, MPI_COMM_WORLD, dim, dim == 2 ? lo2 : lo3, dim == 2 ? hi2 : hi3,
+                     dim == 2 ? 0.125 : 0.1, MPM_SHAPE_QUADRATIC, nproc) == 0,
+        "grid_new");
+  return g;
+}
+
+/* ---- local operations ------------------------------------------------------------------ */
+
+/* n particles with ids first, first + 1, ..., at the walk's start. */
+static void append_local(mpm_particles *p, const mpm_grid *g, mpm_gidx first, mpm_lidx n) {
+  mpm_gidx *id = calloc((size_t)n, sizeof *id);
+  double *data = calloc((size_t)n * (size_t)p->ncomp, sizeof *data);
+  const mpm_lidx n0 = p->n;
+  for (mpm_lidx i = 0; i < n; ++i) id[i] = first + i;
+  CHECK(mpm_particles_edit(p, NULL, n, id, data) == 0, "edit append");
+  for (mpm_lidx i = n0; i < p->n; ++i) set_particle(p, g, i, 0);
+  free(id), free(data);
+}
+
+static void test_edit(int dim) {
+  mpm_particles *p = new_set(dim);
+  mpm_grid *g = new_grid(dim);
+  CHECK(mpm_particles_find(p, "q") == 2 && mpm_particles_find(p, "nope") == -1, "find");
+  CHECK(p->ncomp == 2 * dim + NQ + 1 && p->nstate == 2 * dim && p->offset[3] == 2 * dim + NQ,
+        "layout");
+  append_local(p, g, 100, 10);
+  unsigned char keep[10] = {1, 0, 1, 1, 0, 1, 1, 1, 1, 0};
+  mpm_gidx add_id[2] = {500, 501};
+  double add_data[2 * (2 * 3 + NQ + 1)] = {0};
+  CHECK(mpm_particles_edit(p, keep, 2, add_id, add_data) == 0, "edit");
+  const mpm_gidx want[9] = {100, 102, 103, 105, 106, 107, 108, 500, 501};
+  CHECK(p->n == 9, "n = %d", (int)p->n);
+  for (mpm_lidx i = 0; i < p->n && i < 9; ++i) {
+    CHECK(p->id[i] == want[i], "id %d", (int)i);
+    if (i < 7)
+      CHECK(particle_ok(p, g, i, 0), "data of %d after edit", (int)i);
+    else
+      CHECK(mpm_particles_comp(p, 2, 0)[i] == 0.0, "added data");
+  }
+  memset(keep, 0, sizeof keep);
+  CHECK(mpm_particles_edit(p, keep, 0, NULL, NULL) == 0 && p->n == 0, "remove all");
+  mpm_particles_destroy(&p);
+  mpm_grid_destroy(&g);
+  CHECK(!p, "destroy clears the pointer");
+}
+
+/* Cell key with x fastest, as the header defines the sort order. */
+static long cell_key(const mpm_particles *p, const mpm_grid *g, mpm_lidx i) {
+  long key = 0;
+  for (int d = p->dim - 1; d >= 0; --d) {
+    const int c = (int)floor((mpm_particles_comp(p, 0, d)[i] - g->lo[d]) / g->dx);
+    key = key * g->ncells[d] + MPM_MIN(c, g->ncells[d] - 1);
+  }
+  return key;
+}
+
+static void test_sort(int dim) {
+  mpm_particles *p = new_set(dim);
+  mpm_grid *g = new_grid(dim);
+  append_local(p, g, 1000 * g_rank, 2000); /* about 10 per cell: many ties */
+  CHECK(mpm_particles_sort(p, g) == 0, "sort");
+  CHECK(p->n == 2000, "n after sort");
+  for (mpm_lidx i = 0; i < p->n; ++i) {
+    CHECK(particle_ok(p, g, i, 0), "data of %d after sort", (int)i);
+    if (i == 0) continue;
+    const long a = cell_key(p, g, i - 1), b = cell_key(p, g, i);
+    CHECK(a < b || (a == b && p->id[i - 1] < p->id[i]), "order at %d: keys %ld %ld", (int)i, a, b);
+  }
+  mpm_particles_destroy(&p);
+  mpm_grid_destroy(&g);
+}
+
+/* ---- collective operations ------------------------------------------------------------- */
+
+static int same_on_all_ranks(mpm_gidx v) {
+  mpm_gidx lo = v, hi = v;
+  MPI_Allreduce(MPI_IN_PLACE, &lo, 1, MPM_MPI_GIDX, MPI_MIN, MPI_COMM_WORLD);
+  MPI_Allreduce(MPI_IN_PLACE, &hi, 1, MPM_MPI_GIDX, MPI_MAX, MPI_COMM_WORLD);
+  return lo == hi;
+}
+
+/* Inject n particles with zero data; returns the first id this rank should get. */
+static mpm_gidx inject(mpm_particles *p, mpm_lidx n) {
+  mpm_gidx mine = n, before = 0;
+  MPI_Exscan(&mine, &before, 1, MPM_MPI_GIDX, MPI_SUM, MPI_COMM_WORLD);
+  if (g_rank == 0) before = 0;
+  const mpm_gidx first = p->id_next + before;
+  double *zero = calloc((size_t)n * (size_t)p->ncomp + 1, sizeof *zero);
+  CHECK(mpm_particles_inject(p, MPI_COMM_WORLD, n, zero) == 0, "inject");
+  free(zero);
+  return first;
+}
+
+static void test_inject(int dim) {
+  mpm_particles *p = new_set(dim);
+  mpm_gidx total = 0;
+  for (int round = 0; round < 3; ++round) {
+    const mpm_lidx n = (g_rank + round) % 3, n0 = p->n; /* some ranks add none */
+    const mpm_gidx first = inject(p, n);
+    for (mpm_lidx i = 0; i < n; ++i) CHECK(p->id[n0 + i] == first + i, "injected id");
+    mpm_gidx added = n;
+    MPI_Allreduce(MPI_IN_PLACE, &added, 1, MPM_MPI_GIDX, MPI_SUM, MPI_COMM_WORLD);
+    total += added;
+    CHECK(p->id_next == total && same_on_all_ranks(p->id_next), "id_next %ld", (long)p->id_next);
+  }
+  mpm_gidx count = -1;
+  CHECK(mpm_particles_global_count(p, MPI_COMM_WORLD, &count) == 0 && count == total, "count");
+  mpm_particles_destroy(&p);
+}
+
+/* Sum of ids and of their squares over all ranks (unsigned: garbage ids must not overflow). */
+static void id_sums(const mpm_particles *p, uint64_t sums[2]) {
+  sums[0] = sums[1] = 0;
+  for (mpm_lidx i = 0; i < p->n; ++i) {
+    const uint64_t id = (uint64_t)p->id[i];
+    sums[0] += id, sums[1] += id * id;
+  }
+  MPI_Allreduce(MPI_IN_PLACE, sums, 2, MPI_UINT64_T, MPI_SUM, MPI_COMM_WORLD);
+}
+
+static void check_state(const mpm_particles *p, const mpm_grid *g, int step) {
+  mpm_gidx count = -1;
+  uint64_t sums[2];
+  const uint64_t n = NPART;
+  CHECK(mpm_particles_global_count(p, MPI_COMM_WORLD, &count) == 0 && count == NPART,
+        "step %d: %ld particles", step, (long)count);
+  id_sums(p, sums);
+  CHECK(sums[0] == n * (n - 1) / 2 && sums[1] == (n - 1) * n * (2 * n - 1) / 6, "step %d: id sums",
+        step);
+  for (mpm_lidx i = 0; i < p->n; ++i) {
+    double x[3];
+    for (int d = 0; d < p->dim; ++d) x[d] = mpm_particles_comp(p, 0, d)[i];
+    CHECK(mpm_grid_owner_of(g, x) == g_rank, "step %d: particle %ld on the wrong rank", step,
+          (long)p->id[i]);
+    CHECK(particle_ok(p, g, i, step), "step %d: data of particle %ld", step, (long)p->id[i]);
+  }
+}
+
+/* Rank 0 gathers every id; they must be exactly 0 .. NPART-1. */
+static void check_all_ids(const mpm_particles *p) {
+  int n = (int)p->n, *counts = calloc((size_t)g_size, sizeof *counts);
+  int *displs = calloc((size_t)g_size, sizeof *displs);
+  mpm_gidx *all = calloc(NPART, sizeof *all);
+  MPI_Gather(&n, 1, MPI_INT, counts, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  for (int r = 1; r < g_size; ++r) displs[r] = displs[r - 1] + counts[r - 1];
+  if (g_rank == 0) CHECK(displs[g_size - 1] + counts[g_size - 1] == NPART, "gathered count");
+  MPI_Gatherv(p->id, n, MPM_MPI_GIDX, all, counts, displs, MPM_MPI_GIDX, 0, MPI_COMM_WORLD);
+  if (g_rank == 0) {
+    char *seen = calloc(NPART, 1);
+    for (int k = 0; k < NPART; ++k) {
+      CHECK(all[k] >= 0 && all[k] < NPART && !seen[all[k]], "id %ld", (long)all[k]);
+      if (all[k] >= 0 && all[k] < NPART) seen[all[k]] = 1;
+    }
+    free(seen);
+  }
+  free(counts), free(displs), free(all);
+}
+
+static void walk(mpm_particles *p, const mpm_grid *g, int step) {
+  for (int d = 0; d < p->dim; ++d) {
+    double *x = mpm_particles_comp(p, 0, d);
+    for (mpm_lidx i = 0; i < p->n; ++i) x[i] = walk_step(g, p->id[i], step, d, x[i]);
+  }
+}
+
+static void test_migrate(int dim) {
+  mpm_particles *p = new_set(dim);
+  mpm_grid *g = new_grid(dim);
+  const mpm_lidx n = NPART / g_size + (g_rank < NPART % g_size);
+  int changed = -1;
+  inject(p, n);
+  for (mpm_lidx i = 0; i < p->n; ++i) set_particle(p, g, i, 0); /* anywhere in the domain */
+  CHECK(mpm_particles_migrate(p, g, &changed) == 0 && changed == (g_size > 1), "first migrate");
+  check_state(p, g, 0);
+  CHECK(mpm_particles_migrate(p, g, &changed) == 0 && changed == 0, "nothing to move");
+  for (int step = 1; step <= NSTEPS; ++step) {
+    walk(p, g, step);
+    CHECK(mpm_particles_migrate(p, g, &changed) == 0, "migrate at step %d", step);
+    if (step % 10 == 0) CHECK(mpm_particles_sort(p, g) == 0, "sort at step %d", step);
+    check_state(p, g, step);
+  }
+  check_all_ids(p);
+  mpm_particles_destroy(&p);
+  mpm_grid_destroy(&g);
+}
+
+/* One rank holds a particle at x (outside the domain); every rank must get the error. */
+static void expect_unphysical(int dim, int bad_rank, double bad_x) {
+  mpm_particles *p = new_set(dim);
+  mpm_grid *g = new_grid(dim);
+  int changed = -1;
+  inject(p, 20);
+  for (mpm_lidx i = 0; i < p->n; ++i) set_particle(p, g, i, 0);
+  if (g_rank == bad_rank) mpm_particles_comp(p, 0, 0)[p->n / 2] = bad_x;
+  const int rc = mpm_particles_migrate(p, g, &changed);
+  CHECK(rc == MPM_ERR_UNPHYSICAL && changed == 0 && p->n == 20, "migrate returned %d", rc);
+  mpm_particles_destroy(&p);
+  mpm_grid_destroy(&g);
+}
+
+static void test_errors(int dim) {
+  if (g_rank == 0) fprintf(stderr, "expected errors follow (%d-D):\n", dim);
+  expect_unphysical(dim, g_size - 1, 10.0);
+  expect_unphysical(dim, 0, NAN);
+  MPI_Barrier(MPI_COMM_WORLD); /* reached only if no rank was left in a collective */
+}
+
+int main(int argc, char **argv) {
+  MPI_Init(&argc, &argv);
+  MPI_Comm_rank(MPI_COMM_WORLD, &g_rank);
+  MPI_Comm_size(MPI_COMM_WORLD, &g_size);
+  mpm_log_init(MPI_COMM_WORLD, MPM_LOG_INFO, 0);
+  for (int dim = 2; dim <= 3; ++dim) {
+    test_edit(dim);
+    test_inject(dim);
+    test_sort(dim);
+    test_migrate(dim);
+    test_errors(dim);
+  }
+  MPI_Allreduce(MPI_IN_PLACE, &g_fail, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
+  if (g_rank == 0)
+    printf("test_migrate on %d ranks: %s (%d failures)\n", g_size, g_fail ? "FAILED" : "passed",
+           g_fail);
+  MPI_Finalize();
+  return g_fail != 0;
+}

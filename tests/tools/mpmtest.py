@@ -1,0 +1,66 @@
+"""Helpers for the end-to-end tests: run mpmfsi (serially or under mpiexec) and read its
+output. Run with Debian's /usr/bin/python3, which has h5py."""
+import os
+import subprocess
+import sys
+import xml.etree.ElementTree as ET
+
+import h5py
+import numpy as np
+
+BIN = os.environ.get("MPMFSI_BIN", "mpmfsi")
+MPIEXEC = os.environ.get("MPIEXEC", "mpiexec")
+SOURCE = os.environ.get("MPMFSI_SOURCE_DIR", os.path.join(os.path.dirname(__file__), "..", ".."))
+
+
+def case(name):
+    return os.path.join(SOURCE, "cases", name)
+
+
+def run(args, ranks=1, check=True):
+    """Run `mpmfsi args...`; returns the CompletedProcess (stdout, stderr as text)."""
+    cmd = [BIN] + list(args)
+    if ranks > 1:
+        cmd = [MPIEXEC, "-n", str(ranks)] + cmd
+    p = subprocess.run(cmd, capture_output=True, text=True, timeout=1200)
+    if check and p.returncode != 0:
+        sys.stderr.write(p.stdout + p.stderr)
+        raise SystemExit(f"command failed ({p.returncode}): {' '.join(cmd)}")
+    return p
+
+
+def snapshots(outdir):
+    """(time, path) of every snapshot named in series.xmf, in order."""
+    root = ET.parse(os.path.join(outdir, "series.xmf")).getroot()
+    files = []
+    for grid in root.iter("Grid"):
+        if grid.get("GridType") == "Collection":
+            continue
+        t = grid.find("Time")
+        item = grid.find(".//DataItem")
+        if t is None or item is None:
+            continue
+        path = item.text.strip().split(":")[0]
+        entry = (float(t.get("Value")), os.path.join(outdir, path))
+        if entry not in files:
+            files.append(entry)
+    return sorted(files)
+
+
+def particles(path, phase="solid"):
+    """dict id -> row of field values; and the fields as arrays sorted by id."""
+    with h5py.File(path, "r") as f:
+        g = f[phase]
+        ids = g["id"][()]
+        order = np.argsort(ids)
+        out = {"id": ids[order]}
+        for name in g:
+            if name != "id":
+                out[name] = g[name][()][order]
+        out["time"] = float(f.attrs["time"])
+    return out
+
+
+def report(name, passed, failed):
+    print(f"{name}: {passed} passed, {failed} failed")
+    return 1 if failed else 0
