@@ -1,0 +1,1329 @@
+/* Case-file configuration: entries read from case files and the command line, checked
+ * against a schema of key specs (see mpm_config.h).
+ *
+ * Invariants:
+ *  - An entry's key is dotted (letters, digits, '_', '-'; '.' between non-empty components)
+ *    and has at least one dot. Its value has no line break, no surrounding blanks and no
+ *    comment, so "key = value" read back gives the same value (resolved_text relies on it).
+ *  - Keys are unique. Entries keep the order in which keys first appeared, which is the
+ *    instance order; a later source replaces a value in place.
+ *  - Strings handed out (getters, where, instances) live as long as cfg: a replaced string
+ *    is retired, not freed.
+ *  - Every rank holds the same entries; messages go through mpm_log (rank 0 only).
+ * Entries and specs are searched linearly: case files hold tens to hundreds of keys.
+ *
+ * libinih splits lines into sections and name = value pairs. Our reader feeds it one line
+ * at a time, so it knows the line number when the handler runs, and it checks each line
+ * first: inih reports only the first bad line and not why, and truncates section names
+ * longer than 49 bytes, so the reader reports syntax errors itself, hands inih a blank line
+ * instead, and keeps the full section name. */
+#define _POSIX_C_SOURCE 200809L
+
+#include "mpm_config.h"
+#include "mpm_error.h"
+
+#include <ctype.h>
+#include <errno.h>
+#include <ini.h>
+#include <limits.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdbool.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+typedef struct {
+  char *key, *value;
+  char *path;  /* value resolved against its file's folder (what a PATH key means) */
+  char *where; /* "case.ini:12" or "command line" */
+  int line;    /* 0 for the command line */
+  int source;  /* read call that set it: a key twice in one file is an error */
+} entry;
+
+typedef struct {
+  char *prefix;
+  char **names;
+  int count;
+} name_list;
+
+struct mpm_config {
+  MPI_Comm comm;
+  const mpm_key_spec **specs;
+  size_t nspecs, cap_specs;
+  entry *entries;
+  size_t n, cap;
+  char **retired; /* replaced strings, still pointed to by earlier getter results */
+  size_t nretired, cap_retired;
+  name_list *lists; /* instances() results, cached because cfg owns them */
+  size_t nlists, cap_lists;
+  int nsources;
+};
+
+/* ---- growable arrays and strings ----------------------------------------------------- */
+
+/* Make arr (cap items) hold at least need items, or fail the calling function. */
+#define RESERVE(arr, need, cap)                                                                    \
+  do {                                                                                             \
+    if ((need) > (cap)) {                                                                          \
+      size_t c_ = (cap) ? (cap) : 8;                                                               \
+      while (c_ < (need)) c_ *= 2;                                                                 \
+      void *p_ = realloc((arr), c_ * sizeof *(arr));                                               \
+      if (!p_) MPM_FAIL(MPM_ERR_MEMORY, "out of memory while handling the configuration");         \
+      (arr) = p_;                                                                                  \
+      (cap) = c_;                                                                                  \
+    }                                                                                              \
+  } while (0)
+
+/* Text built piece by piece; after a failed allocation it stays marked failed. */
+typedef struct {
+  char *s;
+  size_t len, cap;
+  int failed;
+} sbuf;
+
+static void sb_add(sbuf *b, const char *s, size_t n) {
+  if (b->failed) return;
+  if (b->len + n + 1 > b->cap) {
+    size_t cap = b->cap ? b->cap : 64;
+    while (cap < b->len + n + 1) cap *= 2;
+    char *p = realloc(b->s, cap);
+    if (!p) {
+      b->failed = 1;
+      return;
+    }
+    b->s = p;
+    b->cap = cap;
+  }
+  memcpy(b->s + b->len, s, n);
+  b->len += n;
+  b->s[b->len] = '\0';
+}
+
+static void sb_str(sbuf *b, const char *s) {
+  sb_add(b, s, strlen(s));
+}
+
+static void sb_vprintf(sbuf *b, const char *fmt, va_list ap) {
+  va_list ap2;
+  va_copy(ap2, ap);
+  int n = vsnprintf(NULL, 0, fmt, ap2);
+  va_end(ap2);
+  char *tmp = n >= 0 ? malloc((size_t)n + 1) : NULL;
+  if (!tmp) {
+    b->failed = 1;
+    return;
+  }
+  vsnprintf(tmp, (size_t)n + 1, fmt, ap);
+  sb_add(b, tmp, (size_t)n);
+  free(tmp);
+}
+
+__attribute__((format(printf, 2, 3))) static void sb_printf(sbuf *b, const char *fmt, ...) {
+  va_list ap;
+  va_start(ap, fmt);
+  sb_vprintf(b, fmt, ap);
+  va_end(ap);
+}
+
+/* The text (the caller frees it), or NULL if an allocation failed. */
+static char *sb_take(sbuf *b) {
+  if (!b->s) sb_add(b, "", 0);
+  if (b->failed) free(b->s);
+  char *s = b->failed ? NULL : b->s;
+  *b = (sbuf){0};
+  return s;
+}
+
+static char *dup_n(const char *s, size_t n) {
+  char *p = malloc(n + 1);
+  if (p) {
+    memcpy(p, s, n);
+    p[n] = '\0';
+  }
+  return p;
+}
+
+/* ---- text helpers -------------------------------------------------------------------- */
+
+/* Messages quote user text shortened, with control bytes as '?', to stay on one line. */
+enum { SHOW_MAX = 120 };
+typedef struct {
+  char s[SHOW_MAX + 4];
+} shown;
+
+static shown show_n(const char *s, size_t n) {
+  shown out;
+  size_t k = n > SHOW_MAX ? SHOW_MAX : n;
+  for (size_t i = 0; i < k; ++i) {
+    unsigned char c = (unsigned char)s[i];
+    out.s[i] = (char)(c < 0x20 || c == 0x7f ? '?' : c);
+  }
+  strcpy(out.s + k, n > k ? "..." : "");
+  return out;
+}
+
+static shown show(const char *s) {
+  return show_n(s, strlen(s));
+}
+
+/* The blanks inih strips (isspace in the C locale, without the newline). */
+static int is_blank(int c) {
+  return c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v';
+}
+
+static void trim(const char **s, size_t *n) {
+  while (*n && is_blank((unsigned char)**s)) ++*s, --*n;
+  while (*n && is_blank((unsigned char)(*s)[*n - 1])) --*n;
+}
+
+/* Cut a comment: '#' or ';' at the start or after a blank or '='. A value can thus never
+ * start with a comment character, which keeps "key = value" lines unambiguous. */
+static void cut_comment(const char *s, size_t *n) {
+  for (size_t i = 0; i < *n; ++i) {
+    if (s[i] != '#' && s[i] != ';') continue;
+    if (i == 0 || is_blank((unsigned char)s[i - 1]) || s[i - 1] == '=') {
+      *n = i;
+      return;
+    }
+  }
+}
+
+static int key_char(int c) {
+  return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' ||
+         c == '-';
+}
+
+/* 1 if s[0..n) is dotted: non-empty components of key characters; with wild, a component
+ * may also be exactly "*". */
+static int dotted_ok(const char *s, size_t n, int wild) {
+  size_t start = 0;
+  for (size_t i = 0; i <= n; ++i) {
+    if (i < n && s[i] != '.') {
+      if (!key_char((unsigned char)s[i]) && !(wild && s[i] == '*')) return 0;
+      continue;
+    }
+    size_t len = i - start;
+    if (len == 0 || (len > 1 && memchr(s + start, '*', len))) return 0;
+    start = i + 1;
+  }
+  return 1;
+}
+
+/* Length of the section part of a dotted key (up to its last dot). */
+static size_t section_len(const char *key) {
+  const char *dot = strrchr(key, '.');
+  return dot ? (size_t)(dot - key) : 0;
+}
+
+static int is_star(const char *p, size_t n) {
+  return n == 1 && *p == '*';
+}
+
+/* 1 if key matches the spec pattern component by component, "*" matching any one. */
+static int key_matches(const char *pat, const char *key) {
+  for (;;) {
+    size_t pl = strcspn(pat, "."), kl = strcspn(key, ".");
+    if (!is_star(pat, pl) && (pl != kl || memcmp(pat, key, pl) != 0)) return 0;
+    pat += pl, key += kl;
+    if (!*pat || !*key) return !*pat && !*key;
+    ++pat, ++key;
+  }
+}
+
+/* If key lies in a section matching pat[0..n) (components, "*" = any) and goes on past it,
+ * the length of that section's name in key; else 0. */
+static size_t section_in(const char *key, const char *pat, size_t n) {
+  const char *k = key, *p = pat, *end = pat + n;
+  for (;;) {
+    size_t pl = strcspn(p, "."), kl = strcspn(k, ".");
+    if (pl > (size_t)(end - p)) pl = (size_t)(end - p);
+    if (!is_star(p, pl) && (pl != kl || memcmp(p, k, pl) != 0)) return 0;
+    p += pl, k += kl;
+    if (*k != '.') return 0;
+    if (p >= end) return (size_t)(k - key);
+    ++p, ++k;
+  }
+}
+
+/* ---- lookup and lifetime ------------------------------------------------------------- */
+
+static const char *help_of(const mpm_key_spec *sp) {
+  return sp->help ? sp->help : "";
+}
+
+/* " (help)" as three "%s" arguments, or nothing when there is no help text. */
+#define PAREN(h) (*(h) ? " (" : ""), (h), (*(h) ? ")" : "")
+
+/* The spec of key: an exact one first, else the first wildcard that matches. */
+static const mpm_key_spec *find_spec(const mpm_config *cfg, const char *key) {
+  const mpm_key_spec *wild = NULL;
+  for (size_t i = 0; i < cfg->nspecs; ++i) {
+    const mpm_key_spec *sp = cfg->specs[i];
+    if (strcmp(sp->key, key) == 0) return sp;
+    if (!wild && strchr(sp->key, '*') && key_matches(sp->key, key)) wild = sp;
+  }
+  return wild;
+}
+
+static entry *find_entry(const mpm_config *cfg, const char *key) {
+  for (size_t i = 0; i < cfg->n; ++i)
+    if (strcmp(cfg->entries[i].key, key) == 0) return &cfg->entries[i];
+  return NULL;
+}
+
+int mpm_config_new(mpm_config **cfg, MPI_Comm comm) {
+  MPM_ALLOC(*cfg, 1);
+  (*cfg)->comm = comm;
+  return 0;
+}
+
+static void free_names(name_list *l) {
+  for (int k = 0; k < l->count; ++k) free(l->names[k]);
+  free(l->names);
+  free(l->prefix);
+}
+
+void mpm_config_destroy(mpm_config **cfg) {
+  if (!cfg || !*cfg) return;
+  mpm_config *c = *cfg;
+  for (size_t i = 0; i < c->n; ++i) {
+    entry *e = &c->entries[i];
+    free(e->key), free(e->value), free(e->path), free(e->where);
+  }
+  for (size_t i = 0; i < c->nretired; ++i) free(c->retired[i]);
+  for (size_t i = 0; i < c->nlists; ++i) free_names(&c->lists[i]);
+  free(c->entries), free(c->retired), free(c->lists), free(c->specs), free(c);
+  *cfg = NULL;
+}
+
+/* ---- checking one value -------------------------------------------------------------- */
+
+/* A value being checked or read, with what a message needs to name it. */
+typedef struct {
+  const mpm_key_spec *sp;
+  const char *key, *value;
+  const char *path;  /* resolved, for PATH keys */
+  const char *where; /* NULL for a default */
+  int line;          /* 0: command line or default (relative paths start at the cwd) */
+} item;
+
+/* One line: "where: key = value: msg (help)". */
+static void report(const item *it, const char *msg, int with_help) {
+  const char *help = it->sp && with_help ? help_of(it->sp) : "";
+  mpm_log(MPM_LOG_ERROR, "%s%s%s = %s%s: %s%s%s%s", it->where ? it->where : "",
+          it->where ? ": " : "", show(it->key).s, show(it->value).s, it->where ? "" : " (default)",
+          msg, PAREN(help));
+}
+
+__attribute__((format(printf, 2, 3))) static int bad(const item *it, const char *fmt, ...) {
+  sbuf b = {0};
+  va_list ap;
+  va_start(ap, fmt);
+  sb_vprintf(&b, fmt, ap);
+  va_end(ap);
+  report(it, b.failed ? fmt : b.s, 1);
+  free(b.s);
+  return MPM_ERR_INPUT;
+}
+
+/* Strict number parsing: the whole text must be the number. */
+static int parse_real(const char *s, size_t n, double *v) {
+  char *end;
+  if (n == 0 || is_blank((unsigned char)*s)) return -1;
+  errno = 0;
+  double x = strtod(s, &end);
+  if (end != s + n || !isfinite(x) || (errno == ERANGE && fabs(x) == HUGE_VAL)) return -1;
+  *v = x;
+  return 0;
+}
+
+/* 0, -1 if not an integer, -2 if out of the range of int. */
+static int parse_int(const char *s, int *v) {
+  char *end;
+  if (!*s || is_blank((unsigned char)*s)) return -1;
+  errno = 0;
+  long x = strtol(s, &end, 10);
+  if (*end) return -1;
+  if (errno == ERANGE || x < INT_MIN || x > INT_MAX) return -2;
+  *v = (int)x;
+  return 0;
+}
+
+static int parse_bool(const char *s, int *v) {
+  static const char *const words[] = {"false", "true", "no", "yes", "off", "on", "0", "1"};
+  for (int i = 0; i < 8; ++i)
+    if (strcasecmp(s, words[i]) == 0) {
+      *v = i % 2;
+      return 0;
+    }
+  return -1;
+}
+
+/* Next blank- or comma-separated item of s at or after *pos; 0 when there is none. */
+static int next_item(const char *s, size_t *pos, const char **item_s, size_t *item_n) {
+  size_t i = *pos;
+  while (s[i] && (is_blank((unsigned char)s[i]) || s[i] == ',')) ++i;
+  if (!s[i]) return 0;
+  size_t j = i;
+  while (s[j] && !is_blank((unsigned char)s[j]) && s[j] != ',') ++j;
+  *item_s = s + i, *item_n = j - i, *pos = j;
+  return 1;
+}
+
+/* Specs that leave min and max at 0 mean "no range" (a range of one point makes no sense). */
+static int has_range(const mpm_key_spec *sp) {
+  return !(sp->min == 0 && sp->max == 0 && !sp->min_exclusive);
+}
+
+static int in_range(const mpm_key_spec *sp, double x) {
+  if (!has_range(sp)) return 1;
+  if (sp->min_exclusive ? !(x > sp->min) : !(x >= sp->min)) return 0;
+  return x <= sp->max;
+}
+
+/* "> 0", ">= 0", "<= 1", "in (0, 1]" ... */
+static shown range_text(const mpm_key_spec *sp) {
+  shown r;
+  int lo = isfinite(sp->min), hi = isfinite(sp->max);
+  if (lo && hi)
+    snprintf(r.s, sizeof r.s, "in %c%.10g, %.10g]", sp->min_exclusive ? '(' : '[', sp->min,
+             sp->max);
+  else if (lo)
+    snprintf(r.s, sizeof r.s, "%s %.10g", sp->min_exclusive ? ">" : ">=", sp->min);
+  else if (hi)
+    snprintf(r.s, sizeof r.s, "<= %.10g", sp->max);
+  else
+    snprintf(r.s, sizeof r.s, "finite");
+  return r;
+}
+
+static int check_real(const item *it) {
+  double x;
+  if (parse_real(it->value, strlen(it->value), &x) != 0)
+    return bad(it, "expected a finite real number");
+  if (!in_range(it->sp, x)) return bad(it, "must be %s", range_text(it->sp).s);
+  return 0;
+}
+
+static int check_int(const item *it) {
+  int x = 0, rc = parse_int(it->value, &x);
+  if (rc == -1) return bad(it, "expected a whole number");
+  if (rc == -2) return bad(it, "too large for an integer");
+  if (!in_range(it->sp, x)) return bad(it, "must be %s", range_text(it->sp).s);
+  return 0;
+}
+
+static int check_enum(const item *it) {
+  const char *c = it->sp->choices ? it->sp->choices : "";
+  size_t n = strlen(it->value);
+  for (;;) {
+    size_t len = strcspn(c, "|");
+    if (len == n && memcmp(c, it->value, n) == 0) return 0;
+    if (!c[len]) break;
+    c += len + 1;
+  }
+  return bad(it, "expected one of %s", it->sp->choices ? it->sp->choices : "(none)");
+}
+
+static int check_reals(const item *it) {
+  const mpm_key_spec *sp = it->sp;
+  size_t pos = 0, n;
+  const char *s;
+  int count = 0;
+  double x;
+  while (next_item(it->value, &pos, &s, &n)) {
+    ++count;
+    if (parse_real(s, n, &x) != 0)
+      return bad(it, "value %d ('%s') is not a finite real number", count, show_n(s, n).s);
+    if (!in_range(sp, x)) return bad(it, "value %d (%g) must be %s", count, x, range_text(sp).s);
+  }
+  if (count == 0) return bad(it, "expected one or more real numbers");
+  if (sp->max_count > 0 && count > sp->max_count)
+    return bad(it, "too many values: %d given, at most %d", count, sp->max_count);
+  return 0;
+}
+
+static int check_names(const item *it) {
+  size_t pos = 0, n;
+  const char *s;
+  if (!next_item(it->value, &pos, &s, &n)) return bad(it, "expected one or more names");
+  return 0;
+}
+
+static int check_path(const item *it) {
+  struct stat st;
+  if (!*it->value) return bad(it, "expected the path of a file");
+  const char *from = it->line > 0 ? "the case file's folder" : "the current folder";
+  if (stat(it->path, &st) != 0)
+    return bad(it, "cannot open '%s': %s; check the path (relative paths start at %s)", it->path,
+               strerror(errno), from);
+  if (S_ISDIR(st.st_mode)) return bad(it, "'%s' is a folder; give a file", it->path);
+  return 0;
+}
+
+/* 0 if the value fits its spec; else reports it and returns MPM_ERR_INPUT. */
+static int check_value(const item *it) {
+  int v;
+  switch (it->sp->type) {
+  case MPM_KEY_REAL:
+    return check_real(it);
+  case MPM_KEY_INT:
+    return check_int(it);
+  case MPM_KEY_BOOL:
+    if (parse_bool(it->value, &v) == 0) return 0;
+    return bad(it, "expected true or false (or yes/no, on/off, 1/0)");
+  case MPM_KEY_STRING:
+    return 0;
+  case MPM_KEY_ENUM:
+    return check_enum(it);
+  case MPM_KEY_REALS:
+    return check_reals(it);
+  case MPM_KEY_NAMES:
+    return check_names(it);
+  case MPM_KEY_PATH:
+    return check_path(it);
+  }
+  return bad(it, "internal error: unknown key type %d", (int)it->sp->type);
+}
+
+static item entry_item(const mpm_key_spec *sp, const entry *e) {
+  return (item){sp, e->key, e->value, e->path, e->where, e->line};
+}
+
+/* ---- schema ------------------------------------------------------------------------ */
+
+/* A spec table is program text: a bad one is an internal error, found when it is added. */
+static int check_spec(const mpm_config *cfg, const mpm_key_spec *sp) {
+  const char *k = sp->key;
+  if (!k || !dotted_ok(k, strlen(k), 1) || !strchr(k, '.') || strcmp(strrchr(k, '.'), ".*") == 0)
+    MPM_FAIL(MPM_ERR_INTERNAL, "schema key '%s' is not section.key ('*' only for an instance)",
+             k ? show(k).s : "(null)");
+  if ((unsigned)sp->type > MPM_KEY_PATH)
+    MPM_FAIL(MPM_ERR_INTERNAL, "schema key '%s' has an unknown type", show(k).s);
+  if (sp->type == MPM_KEY_ENUM && (!sp->choices || !*sp->choices))
+    MPM_FAIL(MPM_ERR_INTERNAL, "schema key '%s' is an enum without choices", show(k).s);
+  for (size_t i = 0; i < cfg->nspecs; ++i)
+    if (strcmp(cfg->specs[i]->key, k) == 0)
+      MPM_FAIL(MPM_ERR_INTERNAL, "schema key '%s' is declared twice", show(k).s);
+  item it = {sp, k, sp->def, sp->def, NULL, 0};
+  if (sp->def && sp->type != MPM_KEY_PATH && check_value(&it) != 0)
+    MPM_FAIL(MPM_ERR_INTERNAL, "schema key '%s' has a bad default", show(k).s);
+  return 0;
+}
+
+int mpm_config_add_schema(mpm_config *cfg, const mpm_key_spec *specs, int n) {
+  if (n < 0 || (n > 0 && !specs)) MPM_FAIL(MPM_ERR_INTERNAL, "bad schema table (n = %d)", n);
+  RESERVE(cfg->specs, cfg->nspecs + (size_t)n, cfg->cap_specs);
+  for (int i = 0; i < n; ++i) {
+    MPM_CALL(check_spec(cfg, &specs[i]));
+    cfg->specs[cfg->nspecs++] = &specs[i];
+  }
+  return 0;
+}
+
+/* ---- entries ------------------------------------------------------------------------- */
+
+/* Where an entry comes from. */
+typedef struct {
+  const char *origin; /* file name or "command line" */
+  const char *dir;    /* folder for relative paths; NULL for the current one */
+  int line;           /* 0 for the command line */
+  int source;
+} place;
+
+static char *resolve_path(const char *dir, const char *value) {
+  if (!dir || !*dir || strcmp(dir, ".") == 0 || !*value || value[0] == '/') return strdup(value);
+  sbuf b = {0};
+  sb_str(&b, dir);
+  if (dir[strlen(dir) - 1] != '/') sb_add(&b, "/", 1);
+  sb_str(&b, value);
+  return sb_take(&b);
+}
+
+static char *where_text(const place *at) {
+  if (at->line <= 0) return strdup(at->origin);
+  sbuf b = {0};
+  sb_printf(&b, "%s:%d", at->origin, at->line);
+  return sb_take(&b);
+}
+
+static int duplicate(const entry *e, const place *at) {
+  mpm_log(MPM_LOG_ERROR, "%s:%d: %s is set twice (lines %d and %d); keep one", at->origin, at->line,
+          show(e->key).s, e->line, at->line);
+  return MPM_ERR_INPUT;
+}
+
+/* Replace e's value in place, keeping its position; the old strings are retired. */
+static void replace(mpm_config *cfg, entry *e, entry *n) {
+  cfg->retired[cfg->nretired++] = e->value;
+  cfg->retired[cfg->nretired++] = e->path;
+  cfg->retired[cfg->nretired++] = e->where;
+  e->value = n->value, e->path = n->path, e->where = n->where;
+  e->line = n->line, e->source = n->source;
+}
+
+static int set_entry(mpm_config *cfg, const char *key, const char *value, const place *at) {
+  entry *e = find_entry(cfg, key);
+  if (e && e->source == at->source) return duplicate(e, at);
+  if (e)
+    RESERVE(cfg->retired, cfg->nretired + 3, cfg->cap_retired);
+  else
+    RESERVE(cfg->entries, cfg->n + 1, cfg->cap);
+  entry n = {NULL,           strdup(value), resolve_path(at->dir, value),
+             where_text(at), at->line,      at->source};
+  if (!e) n.key = strdup(key);
+  if (!n.value || !n.path || !n.where || (!e && !n.key)) {
+    free(n.key), free(n.value), free(n.path), free(n.where);
+    MPM_FAIL(MPM_ERR_MEMORY, "out of memory storing '%s'", show(key).s);
+  }
+  if (e)
+    replace(cfg, e, &n);
+  else
+    cfg->entries[cfg->n++] = n;
+  return 0;
+}
+
+/* ---- reading case text ------------------------------------------------------------- */
+
+typedef struct {
+  mpm_config *cfg;
+  place at;         /* at.line is the line last served to inih */
+  const char *next; /* start of the next unread line */
+  sbuf line;        /* cleaned line being served, with its '\n' */
+  size_t served;    /* bytes of line already handed to inih */
+  sbuf section;     /* current section name; empty before the first header */
+  int section_ok;   /* 0 after a bad header: its keys are skipped (already reported) */
+  int rc;           /* first failure */
+} parser;
+
+__attribute__((format(printf, 2, 3))) static int parse_error(parser *ps, const char *fmt, ...) {
+  sbuf b = {0};
+  va_list ap;
+  va_start(ap, fmt);
+  sb_vprintf(&b, fmt, ap);
+  va_end(ap);
+  mpm_log(MPM_LOG_ERROR, "%s:%d: %s", ps->at.origin, ps->at.line, b.failed ? fmt : b.s);
+  free(b.s);
+  if (!ps->rc) ps->rc = MPM_ERR_INPUT;
+  return 0;
+}
+
+static int lex_section(parser *ps, const char *s, size_t n) {
+  const char *close = memchr(s, ']', n);
+  ps->section_ok = 0;
+  ps->section.len = 0;
+  if (!close)
+    return parse_error(ps, "syntax error: '[' without a closing ']' in '%s'", show_n(s, n).s);
+  if (close != s + n - 1)
+    return parse_error(ps, "syntax error: unexpected text after ']' in '%s'", show_n(s, n).s);
+  const char *name = s + 1;
+  size_t len = (size_t)(close - name);
+  trim(&name, &len);
+  if (!dotted_ok(name, len, 0))
+    return parse_error(ps,
+                       "syntax error: bad section name '[%s]': use letters, digits, '_' or "
+                       "'-', with '.' between parts",
+                       show_n(name, len).s);
+  sb_add(&ps->section, name, len);
+  ps->section_ok = 1;
+  return 1;
+}
+
+/* 1 if the cleaned, non-empty line s[0..n) can go to inih; else reports it. */
+static int lex_line(parser *ps, const char *s, size_t n) {
+  if (s[0] == '[') return lex_section(ps, s, n);
+  const char *eq = memchr(s, '=', n);
+  if (!eq)
+    return parse_error(ps, "syntax error: expected 'key = value' or '[section]', got '%s'",
+                       show_n(s, n).s);
+  size_t kn = (size_t)(eq - s);
+  trim(&s, &kn);
+  if (kn == 0) return parse_error(ps, "syntax error: no key before '='");
+  if (!dotted_ok(s, kn, 0))
+    return parse_error(ps,
+                       "syntax error: bad key '%s': use letters, digits, '_' or '-', with '.' "
+                       "between parts",
+                       show_n(s, kn).s);
+  if (!ps->section_ok) return 0;
+  if (ps->section.len == 0)
+    return parse_error(ps, "key '%s' is outside any section; put it under a [section] header",
+                       show_n(s, kn).s);
+  return 1;
+}
+
+/* Clean the next physical line (blanks, comment, a leading byte-order mark) into ps->line;
+ * a bad line becomes blank. */
+static void next_line(parser *ps) {
+  const char *s = ps->next, *eol = strchr(s, '\n');
+  size_t n = eol ? (size_t)(eol - s) : strlen(s);
+  ps->next = s + n + (eol != NULL);
+  ps->at.line++;
+  ps->line.len = 0;
+  ps->served = 0;
+  if (ps->at.line == 1 && n >= 3 && memcmp(s, "\xEF\xBB\xBF", 3) == 0) s += 3, n -= 3;
+  trim(&s, &n);
+  cut_comment(s, &n);
+  trim(&s, &n);
+  if (n && !lex_line(ps, s, n)) n = 0;
+  sb_add(&ps->line, s, n);
+  sb_add(&ps->line, "\n", 1);
+}
+
+/* inih's fgets-like reader: one cleaned line per call (the buffer holds the longest). */
+static char *read_line(char *str, int num, void *stream) {
+  parser *ps = stream;
+  if (ps->served == ps->line.len) {
+    if (!*ps->next) return NULL;
+    next_line(ps);
+  }
+  if (ps->line.failed) {
+    ps->rc = MPM_ERR_MEMORY;
+    return NULL;
+  }
+  size_t n = ps->line.len - ps->served;
+  if (num < 2 || n > (size_t)num - 1) {
+    mpm_log(MPM_LOG_ERROR, "internal error: line %d does not fit inih's buffer", ps->at.line);
+    ps->rc = MPM_ERR_INTERNAL;
+    return NULL;
+  }
+  memcpy(str, ps->line.s + ps->served, n);
+  str[n] = '\0';
+  ps->served += n;
+  return str;
+}
+
+/* inih's handler; inih's section argument may be truncated, so the reader's name is used. */
+static int on_pair(void *user, const char *section, const char *name, const char *value) {
+  parser *ps = user;
+  sbuf key = {0};
+  (void)section;
+  sb_add(&key, ps->section.s, ps->section.len);
+  sb_add(&key, ".", 1);
+  sb_str(&key, name);
+  int rc = key.failed ? MPM_ERR_MEMORY : set_entry(ps->cfg, key.s, value, &ps->at);
+  if (rc && !ps->rc) ps->rc = rc;
+  free(key.s);
+  return 1;
+}
+
+static size_t longest_line(const char *s) {
+  size_t best = 0;
+  while (*s) {
+    size_t n = strcspn(s, "\n");
+    if (n > best) best = n;
+    s += n + (s[n] == '\n');
+  }
+  return best;
+}
+
+/* Debian's libinih exposes its build options as variables. For one parse we want a heap
+ * line buffer that holds the longest line (the default is 200 bytes, and a longer line
+ * would be split silently) and no multi-line values. Like all of reading, not thread-safe. */
+typedef struct {
+  bool use_stack, allow_realloc, allow_multiline, stop_on_first_error, allow_no_value;
+  int max_line, initial_alloc;
+} ini_options;
+
+static ini_options ini_options_set(int line_bytes) {
+  ini_options old = {ini_use_stack,           ini_allow_realloc,  ini_allow_multiline,
+                     ini_stop_on_first_error, ini_allow_no_value, ini_max_line,
+                     ini_initial_alloc};
+  ini_use_stack = ini_allow_realloc = ini_allow_multiline = false;
+  ini_stop_on_first_error = ini_allow_no_value = false;
+  ini_max_line = ini_initial_alloc = line_bytes;
+  return old;
+}
+
+static void ini_options_restore(const ini_options *o) {
+  ini_use_stack = o->use_stack, ini_allow_realloc = o->allow_realloc;
+  ini_allow_multiline = o->allow_multiline, ini_stop_on_first_error = o->stop_on_first_error;
+  ini_allow_no_value = o->allow_no_value;
+  ini_max_line = o->max_line, ini_initial_alloc = o->initial_alloc;
+}
+
+int mpm_config_read_string(mpm_config *cfg, const char *text, const char *origin, const char *dir) {
+  if (!cfg || !text) MPM_FAIL(MPM_ERR_INTERNAL, "mpm_config_read_string: NULL argument");
+  parser ps = {.cfg = cfg,
+               .at = {origin ? origin : "(text)", dir, 0, ++cfg->nsources},
+               .next = text,
+               .section_ok = 1};
+  size_t longest = longest_line(text);
+  if (longest > (size_t)INT_MAX - 8) {
+    mpm_log(MPM_LOG_ERROR, "%s: a line is longer than %d bytes; is this a case file?", ps.at.origin,
+            INT_MAX - 8);
+    return MPM_ERR_INPUT;
+  }
+  ini_options saved = ini_options_set((int)longest + 3);
+  int r = ini_parse_stream(read_line, &ps, on_pair, &ps);
+  ini_options_restore(&saved);
+  free(ps.line.s);
+  free(ps.section.s);
+  if (r == -2 && !ps.rc) ps.rc = MPM_ERR_MEMORY;
+  if (r > 0 && !ps.rc) {
+    mpm_log(MPM_LOG_ERROR, "%s:%d: syntax error", ps.at.origin, r);
+    ps.rc = MPM_ERR_INPUT;
+  }
+  return ps.rc ? mpm_trace(__FILE__, __LINE__, __func__, ps.rc) : 0;
+}
+
+/* Rank 0's part of read_file: the whole file, or an errno value. */
+static int slurp(const char *path, char **text, size_t *len) {
+  FILE *f = fopen(path, "rb");
+  if (!f) return errno ? errno : EIO;
+  sbuf b = {0};
+  char chunk[1 << 16];
+  size_t got;
+  while ((got = fread(chunk, 1, sizeof chunk, f)) > 0) sb_add(&b, chunk, got);
+  int err = ferror(f) ? (errno ? errno : EIO) : 0;
+  fclose(f);
+  *len = b.len;
+  *text = sb_take(&b);
+  if (!err && !*text) err = ENOMEM;
+  if (err) free(*text), *text = NULL;
+  return err;
+}
+
+/* Broadcast the text in pieces that fit an int count. */
+static int bcast_text(MPI_Comm comm, char *text, size_t len) {
+  for (size_t off = 0; off < len;) {
+    size_t piece = len - off < (size_t)INT_MAX ? len - off : (size_t)INT_MAX;
+    MPM_CALL_MPI(MPI_Bcast(text + off, (int)piece, MPI_CHAR, 0, comm));
+    off += piece;
+  }
+  return 0;
+}
+
+/* Every rank gets the file's text; a file rank 0 cannot read fails on every rank. */
+static int share_file(MPI_Comm comm, const char *path, char **text, size_t *len) {
+  int rank;
+  long long head[2] = {0, 0}; /* length or -1, errno */
+  MPM_CALL_MPI(MPI_Comm_rank(comm, &rank));
+  if (rank == 0) {
+    int err = slurp(path, text, len);
+    head[0] = err ? -1 : (long long)*len;
+    head[1] = err;
+  }
+  MPM_CALL_MPI(MPI_Bcast(head, 2, MPI_LONG_LONG, 0, comm));
+  if (head[0] < 0) {
+    mpm_log(MPM_LOG_ERROR, "cannot read case file '%s': %s; check the path", path,
+            strerror((int)head[1]));
+    return MPM_ERR_FILE;
+  }
+  if (rank != 0) {
+    *len = (size_t)head[0];
+    MPM_ALLOC(*text, *len + 1);
+  }
+  int rc = bcast_text(comm, *text, *len);
+  if (rc) free(*text), *text = NULL;
+  return rc;
+}
+
+static char *dirname_of(const char *path) {
+  const char *slash = strrchr(path, '/');
+  if (!slash) return strdup(".");
+  return dup_n(path, slash == path ? 1 : (size_t)(slash - path));
+}
+
+/* A NUL byte would silently end the text early: refuse the file instead. */
+static int check_nul(const char *path, const char *text, size_t len) {
+  const char *nul = memchr(text, '\0', len);
+  if (!nul) return 0;
+  int line = 1;
+  for (const char *p = text; p < nul; ++p) line += *p == '\n';
+  mpm_log(MPM_LOG_ERROR, "%s:%d: contains a NUL byte; a case file is text", path, line);
+  return MPM_ERR_INPUT;
+}
+
+int mpm_config_read_file(mpm_config *cfg, const char *path) {
+  char *text = NULL;
+  size_t len = 0;
+  MPM_CALL(share_file(cfg->comm, path, &text, &len));
+  int rc = check_nul(path, text, len);
+  char *dir = rc ? NULL : dirname_of(path);
+  if (!rc && !dir) rc = MPM_ERR_MEMORY;
+  if (!rc) rc = mpm_config_read_string(cfg, text, path, dir);
+  free(dir);
+  free(text);
+  return rc ? mpm_trace(__FILE__, __LINE__, __func__, rc) : 0;
+}
+
+int mpm_config_override(mpm_config *cfg, const char *assignment) {
+  const char *eq = strchr(assignment, '='), *k = assignment, *v = eq ? eq + 1 : "";
+  size_t kn = eq ? (size_t)(eq - k) : 0, vn = strlen(v);
+  trim(&k, &kn);
+  if (!eq || !dotted_ok(k, kn, 0) || !memchr(k, '.', kn) || strchr(v, '\n')) {
+    mpm_log(MPM_LOG_ERROR,
+            "command line: expected key=value, got '%s'; keys name their section, as in "
+            "time.t_end=0.01",
+            show(assignment).s);
+    return MPM_ERR_INPUT;
+  }
+  trim(&v, &vn);
+  cut_comment(v, &vn);
+  trim(&v, &vn);
+  char *key = dup_n(k, kn), *value = dup_n(v, vn);
+  place at = {"command line", NULL, 0, ++cfg->nsources};
+  int rc = key && value ? set_entry(cfg, key, value, &at) : MPM_ERR_MEMORY;
+  free(key), free(value);
+  return rc ? mpm_trace(__FILE__, __LINE__, __func__, rc) : 0;
+}
+
+/* ---- validation ---------------------------------------------------------------------- */
+
+/* Levenshtein distance, letters compared without case (a wrong case is a near miss), or
+ * limit + 1 if it exceeds limit. Only a band of width 2 limit + 1 is computed, so a long
+ * garbage key costs length x limit, not length squared. */
+static size_t edit_distance(const char *a, const char *b, size_t limit) {
+  size_t na = strlen(a), nb = strlen(b), inf = limit + 1;
+  if ((na > nb ? na - nb : nb - na) > limit) return inf;
+  size_t *row = malloc((nb + 1) * sizeof *row);
+  if (!row) return inf;
+  for (size_t j = 0; j <= nb; ++j) row[j] = j <= limit ? j : inf;
+  for (size_t i = 1; i <= na; ++i) {
+    size_t lo = i > limit ? i - limit : 1, hi = i + limit < nb ? i + limit : nb;
+    size_t diag = row[lo - 1];
+    row[lo - 1] = lo == 1 && i <= limit ? i : inf; /* column lo - 1 leaves the band */
+    size_t best_row = row[lo - 1];
+    for (size_t j = lo; j <= hi; ++j) {
+      size_t up = row[j];
+      size_t d = diag + (tolower((unsigned char)a[i - 1]) != tolower((unsigned char)b[j - 1]));
+      if (up + 1 < d) d = up + 1;
+      if (row[j - 1] + 1 < d) d = row[j - 1] + 1;
+      row[j] = d < inf ? d : inf;
+      diag = up;
+      if (row[j] < best_row) best_row = row[j];
+    }
+    if (best_row > limit) { /* the distance can only grow from here */
+      free(row);
+      return inf;
+    }
+  }
+  size_t d = row[nb] < inf ? row[nb] : inf;
+  free(row);
+  return d;
+}
+
+/* The spec key with each "*" replaced by key's component at the same place. */
+static char *instantiate(const char *pat, const char *key) {
+  sbuf b = {0};
+  for (;;) {
+    size_t pl = strcspn(pat, "."), kl = strcspn(key, ".");
+    if (is_star(pat, pl) && kl)
+      sb_add(&b, key, kl);
+    else
+      sb_add(&b, pat, pl);
+    pat += pl, key += kl;
+    if (!*pat) break;
+    sb_add(&b, ".", 1);
+    ++pat;
+    if (*key) ++key;
+  }
+  return sb_take(&b);
+}
+
+/* The valid key nearest to key, if it is near enough to be a likely typo; else NULL. */
+static char *nearest_key(const mpm_config *cfg, const char *key) {
+  /* A third of the key, at least 2 and at most 8: beyond that it is no typo. */
+  size_t len = strlen(key), limit = len / 3 < 2 ? 2 : len / 3 > 8 ? 8 : len / 3;
+  size_t best_d = SIZE_MAX;
+  char *best = NULL;
+  for (size_t i = 0; i < cfg->nspecs; ++i) {
+    char *cand = instantiate(cfg->specs[i]->key, key);
+    size_t d = cand ? edit_distance(key, cand, limit) : SIZE_MAX;
+    if (d <= limit && d < best_d) {
+      free(best);
+      best = cand, best_d = d;
+    } else
+      free(cand);
+  }
+  return best;
+}
+
+/* "dx, lo, hi": the keys of the schema section that key names, if there is one. */
+static char *section_keys(const mpm_config *cfg, const char *key) {
+  sbuf b = {0};
+  for (size_t i = 0; i < cfg->nspecs; ++i) {
+    const char *sk = cfg->specs[i]->key;
+    size_t n = section_len(sk);
+    if (section_in(key, sk, n) != section_len(key)) continue;
+    if (b.len) sb_add(&b, ", ", 2);
+    sb_str(&b, sk + n + 1);
+  }
+  return b.len ? sb_take(&b) : (free(b.s), NULL);
+}
+
+static void unknown_key(const mpm_config *cfg, const entry *e) {
+  char *near = nearest_key(cfg, e->key), *keys = near ? NULL : section_keys(cfg, e->key);
+  if (near)
+    mpm_log(MPM_LOG_ERROR, "%s: unknown key '%s'; did you mean '%s'?", e->where, show(e->key).s,
+            show(near).s);
+  else if (keys)
+    mpm_log(MPM_LOG_ERROR, "%s: unknown key '%s'; [%s] has: %s", e->where, show(e->key).s,
+            show_n(e->key, section_len(e->key)).s, keys);
+  else
+    mpm_log(MPM_LOG_ERROR, "%s: unknown key '%s'; no section or key of that name exists", e->where,
+            show(e->key).s);
+  free(near), free(keys);
+}
+
+/* 1 if entry j is the first entry of the section (matching pat[0..plen)) that it lies in. */
+static int first_in_section(const mpm_config *cfg, size_t j, const char *pat, size_t plen) {
+  const char *key = cfg->entries[j].key;
+  size_t len = section_in(key, pat, plen);
+  for (size_t i = 0; i < j; ++i)
+    if (section_in(cfg->entries[i].key, pat, plen) == len &&
+        memcmp(cfg->entries[i].key, key, len) == 0)
+      return 0;
+  return 1;
+}
+
+static int section_has(const mpm_config *cfg, const char *sec, size_t len, const char *last) {
+  for (size_t i = 0; i < cfg->n; ++i) {
+    const char *k = cfg->entries[i].key;
+    if (strncmp(k, sec, len) == 0 && k[len] == '.' && strcmp(k + len + 1, last) == 0) return 1;
+  }
+  return 0;
+}
+
+/* A key without a default that is not marked optional must be set in every section used. */
+static int is_required(const mpm_key_spec *sp) { return !sp->def && !sp->optional; }
+
+/* Every used section that lacks the required key sp: one message each. */
+static int check_required(const mpm_config *cfg, const mpm_key_spec *sp) {
+  size_t plen = section_len(sp->key);
+  const char *last = sp->key + plen + 1;
+  int bad_any = 0;
+  for (size_t j = 0; j < cfg->n; ++j) {
+    const entry *e = &cfg->entries[j];
+    size_t len = section_in(e->key, sp->key, plen);
+    if (!len || !first_in_section(cfg, j, sp->key, plen) || section_has(cfg, e->key, len, last))
+      continue;
+    mpm_log(MPM_LOG_ERROR, "%s: [%s] lacks the required key '%s'%s%s%s; add '%s = ...' to it",
+            e->where, show_n(e->key, len).s, last, PAREN(help_of(sp)), last);
+    bad_any = 1;
+  }
+  return bad_any;
+}
+
+int mpm_config_validate(const mpm_config *cfg) {
+  int bad_any = 0;
+  for (size_t i = 0; i < cfg->n; ++i) {
+    const entry *e = &cfg->entries[i];
+    const mpm_key_spec *sp = find_spec(cfg, e->key);
+    item it = entry_item(sp, e);
+    if (!sp)
+      unknown_key(cfg, e), bad_any = 1;
+    else if (check_value(&it) != 0)
+      bad_any = 1;
+  }
+  for (size_t i = 0; i < cfg->nspecs; ++i)
+    if (is_required(cfg->specs[i]) && check_required(cfg, cfg->specs[i])) bad_any = 1;
+  return bad_any ? mpm_trace(__FILE__, __LINE__, __func__, MPM_ERR_INPUT) : 0;
+}
+
+/* ---- getters ------------------------------------------------------------------------- */
+
+static const char *const g_type_names[] = {"real", "int",   "bool",  "string",
+                                           "enum", "reals", "names", "path"};
+
+/* The checked value of key, if its type is one of the mask's (1 << type) bits. */
+static int lookup(const mpm_config *cfg, const char *key, unsigned types, item *it) {
+  const mpm_key_spec *sp = find_spec(cfg, key);
+  if (!sp) MPM_FAIL(MPM_ERR_INPUT, "internal error: '%s' is not a key of the schema", show(key).s);
+  if (!(types & (1u << sp->type)))
+    MPM_FAIL(MPM_ERR_INTERNAL, "internal error: '%s' is a %s key, read as another type",
+             show(key).s, g_type_names[sp->type]);
+  const entry *e = find_entry(cfg, key);
+  if (e)
+    *it = entry_item(sp, e);
+  else if (sp->def)
+    *it = (item){sp, key, sp->def, sp->def, NULL, 0};
+  else {
+    size_t n = section_len(key);
+    mpm_log(MPM_LOG_ERROR, "missing required key '%s'%s%s%s; add '%s = ...' under [%s]",
+            show(key).s, PAREN(help_of(sp)), key + n + 1, show_n(key, n).s);
+    return MPM_ERR_INPUT;
+  }
+  return check_value(it);
+}
+
+#define TYPE_BIT(t) (1u << (t))
+
+int mpm_config_get_real(const mpm_config *cfg, const char *key, double *value) {
+  item it;
+  MPM_CALL(lookup(cfg, key, TYPE_BIT(MPM_KEY_REAL) | TYPE_BIT(MPM_KEY_INT), &it));
+  return parse_real(it.value, strlen(it.value), value) == 0 ? 0 : MPM_ERR_INTERNAL;
+}
+
+int mpm_config_get_int(const mpm_config *cfg, const char *key, int *value) {
+  item it;
+  MPM_CALL(lookup(cfg, key, TYPE_BIT(MPM_KEY_INT), &it));
+  return parse_int(it.value, value) == 0 ? 0 : MPM_ERR_INTERNAL;
+}
+
+int mpm_config_get_bool(const mpm_config *cfg, const char *key, int *value) {
+  item it;
+  MPM_CALL(lookup(cfg, key, TYPE_BIT(MPM_KEY_BOOL), &it));
+  return parse_bool(it.value, value) == 0 ? 0 : MPM_ERR_INTERNAL;
+}
+
+int mpm_config_get_string(const mpm_config *cfg, const char *key, const char **value) {
+  item it;
+  MPM_CALL(lookup(cfg, key,
+                  TYPE_BIT(MPM_KEY_STRING) | TYPE_BIT(MPM_KEY_ENUM) | TYPE_BIT(MPM_KEY_NAMES) |
+                      TYPE_BIT(MPM_KEY_PATH),
+                  &it));
+  *value = it.sp->type == MPM_KEY_PATH ? it.path : it.value;
+  return 0;
+}
+
+int mpm_config_get_reals(const mpm_config *cfg, const char *key, double *values, int max,
+                         int *count) {
+  item it;
+  size_t pos = 0, n;
+  const char *s;
+  MPM_CALL(lookup(cfg, key, TYPE_BIT(MPM_KEY_REALS) | TYPE_BIT(MPM_KEY_REAL), &it));
+  *count = 0;
+  while (next_item(it.value, &pos, &s, &n)) {
+    if (*count == max) return bad(&it, "too many values: at most %d are read", max);
+    if (parse_real(s, n, &values[*count]) != 0) return MPM_ERR_INTERNAL;
+    ++*count;
+  }
+  return 0;
+}
+
+int mpm_config_has(const mpm_config *cfg, const char *key) {
+  return find_entry(cfg, key) != NULL;
+}
+
+const char *mpm_config_where(const mpm_config *cfg, const char *key) {
+  const entry *e = find_entry(cfg, key);
+  return e ? e->where : "default";
+}
+
+/* ---- instances ----------------------------------------------------------------------- */
+
+/* The instance names under prefix (prefix.NAME.key), in order of first appearance. */
+static int collect_names(const mpm_config *cfg, const char *prefix, name_list *out) {
+  size_t plen = strlen(prefix);
+  MPM_ALLOC(out->names, cfg->n); /* at most one name per entry */
+  for (size_t i = 0; i < cfg->n; ++i) {
+    const char *k = cfg->entries[i].key, *name = k + plen + 1;
+    if (strncmp(k, prefix, plen) != 0 || k[plen] != '.') continue;
+    size_t len = strcspn(name, ".");
+    if (!name[len]) continue; /* prefix.key, not prefix.NAME.key */
+    int seen = 0;
+    for (int j = 0; j < out->count && !seen; ++j)
+      seen = strlen(out->names[j]) == len && memcmp(out->names[j], name, len) == 0;
+    if (seen) continue;
+    if (!(out->names[out->count] = dup_n(name, len)))
+      MPM_FAIL(MPM_ERR_MEMORY, "out of memory listing instances");
+    out->count++;
+  }
+  return 0;
+}
+
+static int same_list(const name_list *a, const name_list *b) {
+  if (strcmp(a->prefix, b->prefix) != 0 || a->count != b->count) return 0;
+  for (int i = 0; i < a->count; ++i)
+    if (strcmp(a->names[i], b->names[i]) != 0) return 0;
+  return 1;
+}
+
+/* The cached copy of l, adding l if there is none. On success l belongs to the cache. */
+static int cache_list(mpm_config *c, name_list *l, char ***names) {
+  for (size_t i = 0; i < c->nlists; ++i)
+    if (same_list(&c->lists[i], l)) {
+      free_names(l);
+      *names = c->lists[i].names;
+      return 0;
+    }
+  RESERVE(c->lists, c->nlists + 1, c->cap_lists);
+  c->lists[c->nlists++] = *l;
+  *names = l->names;
+  return 0;
+}
+
+int mpm_config_instances(const mpm_config *cfg, const char *prefix, const char *const **names,
+                         int *count) {
+  /* A list handed out must live as long as cfg, so cfg keeps it: a logically const cache.
+   * The cast is sound: mpm_config_new allocates cfg, it is never defined const. */
+  mpm_config *c = (mpm_config *)cfg;
+  name_list l = {strdup(prefix), NULL, 0};
+  char **kept = NULL;
+  int rc = l.prefix ? collect_names(cfg, prefix, &l) : MPM_ERR_MEMORY;
+  if (!rc) rc = cache_list(c, &l, &kept);
+  if (rc) {
+    free_names(&l);
+    return mpm_trace(__FILE__, __LINE__, __func__, rc);
+  }
+  *names = (const char *const *)kept;
+  *count = l.count;
+  return 0;
+}
+
+/* ---- reporting a consumer's problem -------------------------------------------------- */
+
+/* A key that is not set, or a section name: locate it by the first entry inside it. */
+static void fail_unset(const mpm_config *cfg, const char *key, const char *msg) {
+  size_t n = strlen(key), sec = section_len(key);
+  for (size_t i = 0; i < cfg->n; ++i) {
+    const entry *e = &cfg->entries[i];
+    if (strncmp(e->key, key, n) == 0 && e->key[n] == '.') {
+      mpm_log(MPM_LOG_ERROR, "%s: [%s]: %s", e->where, show(key).s, msg);
+      return;
+    }
+  }
+  for (size_t i = 0; sec && i < cfg->n; ++i) {
+    const entry *e = &cfg->entries[i];
+    if (strncmp(e->key, key, sec) == 0 && e->key[sec] == '.') {
+      mpm_log(MPM_LOG_ERROR, "%s: %s: %s", e->where, show(key).s, msg);
+      return;
+    }
+  }
+  mpm_log(MPM_LOG_ERROR, "%s: %s", show(key).s, msg);
+}
+
+int mpm_config_fail(const mpm_config *cfg, const char *key, const char *fmt, ...) {
+  sbuf b = {0};
+  va_list ap;
+  va_start(ap, fmt);
+  sb_vprintf(&b, fmt, ap);
+  va_end(ap);
+  const char *msg = b.failed ? fmt : b.s;
+  const entry *e = find_entry(cfg, key);
+  const mpm_key_spec *sp = find_spec(cfg, key);
+  item it = {sp, key, sp ? sp->def : NULL, NULL, NULL, 0};
+  if (e) it = entry_item(sp, e);
+  if (it.value)
+    report(&it, msg, 0); /* the consumer's message says enough: no help text */
+  else
+    fail_unset(cfg, key, msg);
+  free(b.s);
+  return MPM_ERR_INPUT;
+}
+
+/* ---- resolved text ------------------------------------------------------------------- */
+
+typedef struct {
+  sbuf b;
+  const mpm_config *cfg;
+  char *cwd; /* NULL if unknown */
+} emitter;
+
+static char *current_dir(void) {
+  for (size_t size = 256; size < ((size_t)1 << 20); size *= 2) {
+    char *buf = malloc(size);
+    if (!buf) return NULL;
+    if (getcwd(buf, size)) return buf;
+    free(buf);
+    if (errno != ERANGE) return NULL;
+  }
+  return NULL;
+}
+
+/* Paths are written absolute, so the text names the same files wherever it is read. */
+static void emit_path(emitter *em, const char *path) {
+  if (path[0] && path[0] != '/' && em->cwd) {
+    sb_str(&em->b, em->cwd);
+    if (strcmp(em->cwd, "/") != 0) sb_add(&em->b, "/", 1);
+  }
+  sb_str(&em->b, path);
+}
+
+/* "last = value   # where" for spec sp in section sec, if sp is the spec of that key. */
+static void emit_key(emitter *em, const mpm_key_spec *sp, const char *sec, size_t slen,
+                     int *header) {
+  const char *last = sp->key + section_len(sp->key) + 1;
+  sbuf k = {0};
+  sb_add(&k, sec, slen);
+  sb_add(&k, ".", 1);
+  sb_str(&k, last);
+  const entry *e = k.failed ? NULL : find_entry(em->cfg, k.s);
+  if (k.failed)
+    em->b.failed = 1;
+  else if (find_spec(em->cfg, k.s) == sp && (e || sp->def)) {
+    if (!*header) {
+      sb_str(&em->b, "\n[");
+      sb_add(&em->b, sec, slen);
+      sb_str(&em->b, "]\n");
+      *header = 1;
+    }
+    sb_printf(&em->b, "%s = ", last);
+    if (sp->type == MPM_KEY_PATH)
+      emit_path(em, e ? e->path : sp->def);
+    else
+      sb_str(&em->b, e ? e->value : sp->def);
+    sb_printf(&em->b, "   # %s\n", e ? show(e->where).s : "default");
+  }
+  free(k.s);
+}
+
+static int same_section(const char *a, const char *b) {
+  size_t n = section_len(a);
+  return n == section_len(b) && memcmp(a, b, n) == 0;
+}
+
+/* Section sec, an instance of the section of spec i: every key its specs declare. The
+ * header is written with the first key, so that no empty section appears. */
+static void emit_section(emitter *em, size_t i, const char *sec, size_t slen) {
+  const mpm_config *cfg = em->cfg;
+  int header = 0;
+  for (size_t k = i; k < cfg->nspecs; ++k)
+    if (same_section(cfg->specs[k]->key, cfg->specs[i]->key))
+      emit_key(em, cfg->specs[k], sec, slen, &header);
+}
+
+static int section_seen(const mpm_config *cfg, size_t i) {
+  for (size_t j = 0; j < i; ++j)
+    if (same_section(cfg->specs[j]->key, cfg->specs[i]->key)) return 1;
+  return 0;
+}
+
+static int section_used(const mpm_config *cfg, const char *pat, size_t plen) {
+  for (size_t j = 0; j < cfg->n; ++j)
+    if (section_in(cfg->entries[j].key, pat, plen)) return 1;
+  return 0;
+}
+
+static int section_requires(const mpm_config *cfg, size_t i) {
+  for (size_t k = i; k < cfg->nspecs; ++k)
+    if (is_required(cfg->specs[k]) && same_section(cfg->specs[k]->key, cfg->specs[i]->key))
+      return 1;
+  return 0;
+}
+
+/* Schema sections in declaration order; an instance section once per instance in use. An
+ * unused section with required keys is left out: its defaults would put it in use when the
+ * text is read back, and it would then lack those keys. */
+static void emit_all(emitter *em) {
+  const mpm_config *cfg = em->cfg;
+  for (size_t i = 0; i < cfg->nspecs; ++i) {
+    const char *pat = cfg->specs[i]->key;
+    size_t plen = section_len(pat);
+    if (section_seen(cfg, i)) continue;
+    if (!memchr(pat, '*', plen)) {
+      if (section_used(cfg, pat, plen) || !section_requires(cfg, i)) emit_section(em, i, pat, plen);
+    } else
+      for (size_t j = 0; j < cfg->n; ++j) {
+        size_t len = section_in(cfg->entries[j].key, pat, plen);
+        if (len && first_in_section(cfg, j, pat, plen))
+          emit_section(em, i, cfg->entries[j].key, len);
+      }
+  }
+}
+
+int mpm_config_resolved_text(const mpm_config *cfg, char **text) {
+  emitter em = {{0}, cfg, current_dir()};
+  sb_str(&em.b, "# Resolved configuration: every key of every section in use; the comment "
+                "says where each value came from.\n");
+  emit_all(&em);
+  free(em.cwd);
+  *text = sb_take(&em.b);
+  if (!*text) MPM_FAIL(MPM_ERR_MEMORY, "out of memory writing the resolved configuration");
+  return 0;
+}

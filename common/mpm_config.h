@@ -31,12 +31,14 @@ typedef enum {
 typedef struct mpm_key_spec {
   const char *key;     /* dotted, "*" matches one instance component */
   mpm_key_type type;
-  const char *def;     /* default as text, NULL if the key is required (when its section is used) */
+  const char *def;     /* default as text; NULL: no default (see optional) */
   double min, max;     /* inclusive range for REAL, INT and each of REALS (use -HUGE_VAL/HUGE_VAL) */
   int min_exclusive;   /* 1: value must be > min rather than >= min */
   int max_count;       /* REALS: most values allowed (0 = any) */
   const char *choices; /* ENUM: "a|b|c" */
   const char *help;    /* one line: meaning, unit, what a sensible value is */
+  int optional;        /* with def == NULL: 1 = may stay unset (its consumer checks
+                          mpm_config_has), 0 = required in every section in use */
 } mpm_key_spec;
 
 typedef struct mpm_config mpm_config;

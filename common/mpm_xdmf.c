@@ -1,0 +1,443 @@
+/* The XDMF index series.xmf (see mpm_xdmf.h for the layout). Invariants:
+ *
+ * - entry[k].xml is one complete <Grid CollectionType="Spatial"> ... </Grid> element,
+ *   starting at '<' and ending at '>', with no leading indentation; the writer places it.
+ * - Entries are kept in the order added; indices are whatever the caller gave (the output
+ *   layer numbers them 0, 1, 2, ... and continues after the largest kept one on a restart).
+ * - Times are printed with %.17g, so a time read back compares equal to the one written
+ *   and "time <= t_restart" on a restart keeps exactly the snapshots written up to then.
+ *
+ * Reading back is deliberately narrow: it finds the snapshot blocks of a file this module
+ * wrote (by element nesting, not by line layout) and keeps their text verbatim. */
+#define _POSIX_C_SOURCE 200809L /* strcasecmp */
+#include "mpm_xdmf.h"
+#include "mpm_error.h"
+#include "mpm_types.h"
+
+#include <errno.h>
+#include <inttypes.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+
+typedef struct xdmf_entry {
+  double time;
+  int index;
+  char *xml;
+} xdmf_entry;
+
+struct mpm_xdmf {
+  int dim;
+  int n, cap;
+  xdmf_entry *entry;
+};
+
+/* ---- a growing string ------------------------------------------------------------------ */
+
+typedef struct strbuf {
+  char *s;
+  size_t len, cap;
+  int failed; /* an allocation failed; later appends are ignored and the caller reports it */
+} strbuf;
+
+static void sb_reserve(strbuf *b, size_t extra) {
+  if (b->failed || b->len + extra + 1 <= b->cap) return;
+  size_t cap = b->cap ? b->cap : 1024;
+  while (cap < b->len + extra + 1) cap *= 2;
+  char *s = realloc(b->s, cap);
+  if (!s) {
+    b->failed = 1;
+    return;
+  }
+  b->s = s, b->cap = cap;
+}
+
+static void sb_printf(strbuf *b, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static void sb_printf(strbuf *b, const char *fmt, ...) {
+  va_list ap;
+  va_start(ap, fmt);
+  const int k = vsnprintf(NULL, 0, fmt, ap);
+  va_end(ap);
+  if (k < 0) {
+    b->failed = 1;
+    return;
+  }
+  sb_reserve(b, (size_t)k);
+  if (b->failed) return;
+  va_start(ap, fmt);
+  vsnprintf(b->s + b->len, b->cap - b->len, fmt, ap);
+  va_end(ap);
+  b->len += (size_t)k;
+}
+
+/* Names come from case files; escape them so that any name still gives well-formed XML. */
+static void sb_escaped(strbuf *b, const char *s) {
+  for (; *s; ++s) switch (*s) {
+    case '&':
+      sb_printf(b, "&amp;");
+      break;
+    case '<':
+      sb_printf(b, "&lt;");
+      break;
+    case '>':
+      sb_printf(b, "&gt;");
+      break;
+    case '"':
+      sb_printf(b, "&quot;");
+      break;
+    case '\'':
+      sb_printf(b, "&apos;");
+      break;
+    default:
+      sb_printf(b, "%c", *s);
+    }
+}
+
+/* ---- construction ---------------------------------------------------------------------- */
+
+int mpm_xdmf_new(mpm_xdmf **x, int dim) {
+  *x = NULL;
+  if (dim != 2 && dim != 3) MPM_FAIL(MPM_ERR_INPUT, "XDMF index: dimension %d is not 2 or 3", dim);
+  MPM_ALLOC(*x, 1);
+  (*x)->dim = dim;
+  return 0;
+}
+
+void mpm_xdmf_destroy(mpm_xdmf **x) {
+  if (!x || !*x) return;
+  for (int k = 0; k < (*x)->n; ++k) free((*x)->entry[k].xml);
+  free((*x)->entry);
+  free(*x);
+  *x = NULL;
+}
+
+int mpm_xdmf_count(const mpm_xdmf *x) {
+  return x->n;
+}
+
+int mpm_xdmf_next_index(const mpm_xdmf *x) {
+  int next = 0;
+  for (int k = 0; k < x->n; ++k) next = MPM_MAX(next, x->entry[k].index + 1);
+  return next;
+}
+
+/* Take ownership of xml. */
+static int push_entry(mpm_xdmf *x, double time, int index, char *xml) {
+  if (x->n == x->cap) {
+    const int cap = x->cap ? 2 * x->cap : 16;
+    xdmf_entry *e = realloc(x->entry, (size_t)cap * sizeof *e);
+    if (!e) {
+      free(xml);
+      MPM_FAIL(MPM_ERR_MEMORY, "XDMF index: cannot grow to %d entries", cap);
+    }
+    x->entry = e, x->cap = cap;
+  }
+  x->entry[x->n++] = (xdmf_entry){time, index, xml};
+  return 0;
+}
+
+/* ---- rendering one snapshot ------------------------------------------------------------ */
+
+static void data_item(strbuf *b, const char *indent, const char *dims, const char *type,
+                      const char *file, const char *group, const char *name) {
+  sb_printf(b, "%s<DataItem Dimensions=\"%s\" NumberType=\"%s\" Precision=\"8\" Format=\"HDF\">",
+            indent, dims, type);
+  sb_escaped(b, file);
+  sb_printf(b, ":/");
+  sb_escaped(b, group);
+  sb_printf(b, "/");
+  sb_escaped(b, name);
+  sb_printf(b, "</DataItem>\n");
+}
+
+/* ParaView reads Scalar, Vector (2 or 3 components) and Tensor (9) with their meaning, and
+ * any other count as a Matrix whose components it keeps in order. Tensor6 is avoided: its
+ * component order need not match a 6-component field's. */
+static const char *attribute_type(int ncomp, int dim) {
+  if (ncomp == 1) return "Scalar";
+  if (ncomp == dim) return "Vector";
+  if (ncomp == 9) return "Tensor";
+  return "Matrix";
+}
+
+static void render_phase(strbuf *b, const char *file, const mpm_xdmf_phase *ph, int dim) {
+  char dims[64];
+  sb_printf(b, "        <Grid Name=\"");
+  sb_escaped(b, ph->name);
+  sb_printf(b, "\" GridType=\"Uniform\">\n");
+  sb_printf(b,
+            "          <Topology TopologyType=\"Polyvertex\" NumberOfElements=\"%" PRId64
+            "\" NodesPerElement=\"1\"/>\n",
+            ph->n);
+  sb_printf(b, "          <Geometry GeometryType=\"%s\">\n", dim == 2 ? "XY" : "XYZ");
+  snprintf(dims, sizeof dims, "%" PRId64 " %d", ph->n, dim);
+  data_item(b, "            ", dims, "Float", file, ph->name, ph->field[0].name);
+  sb_printf(b, "          </Geometry>\n");
+  snprintf(dims, sizeof dims, "%" PRId64, ph->n);
+  sb_printf(b, "          <Attribute Name=\"id\" AttributeType=\"Scalar\" Center=\"Node\">\n");
+  data_item(b, "            ", dims, "Int", file, ph->name, "id");
+  sb_printf(b, "          </Attribute>\n");
+  for (int f = 1; f < ph->nfields; ++f) {
+    sb_printf(b, "          <Attribute Name=\"");
+    sb_escaped(b, ph->field[f].name);
+    sb_printf(b, "\" AttributeType=\"%s\" Center=\"Node\">\n",
+              attribute_type(ph->field[f].ncomp, dim));
+    snprintf(dims, sizeof dims, "%" PRId64 " %d", ph->n, ph->field[f].ncomp);
+    data_item(b, "            ", dims, "Float", file, ph->name, ph->field[f].name);
+    sb_printf(b, "          </Attribute>\n");
+  }
+  sb_printf(b, "        </Grid>\n");
+}
+
+/* XDMF lists structured extents, origins and spacings slowest axis first (z y x). */
+static void render_mesh(strbuf *b, const char *file, const mpm_xdmf_mesh *m, int dim) {
+  char dims[96], group[96];
+  const double dz = m->spacing; /* also for the single layer of a 2-D lattice */
+  snprintf(dims, sizeof dims, "%d %d %d", m->n[2], m->n[1], m->n[0]);
+  sb_printf(b, "        <Grid Name=\"");
+  sb_escaped(b, m->name);
+  sb_printf(b, "_grid\" GridType=\"Uniform\">\n");
+  sb_printf(b, "          <Topology TopologyType=\"3DCoRectMesh\" Dimensions=\"%s\"/>\n", dims);
+  sb_printf(b, "          <Geometry GeometryType=\"ORIGIN_DXDYDZ\">\n");
+  sb_printf(b,
+            "            <DataItem Name=\"Origin\" Dimensions=\"3\" NumberType=\"Float\" "
+            "Precision=\"8\" Format=\"XML\">%.17g %.17g %.17g</DataItem>\n",
+            dim == 3 ? m->origin[2] : 0.0, m->origin[1], m->origin[0]);
+  sb_printf(b,
+            "            <DataItem Name=\"Spacing\" Dimensions=\"3\" NumberType=\"Float\" "
+            "Precision=\"8\" Format=\"XML\">%.17g %.17g %.17g</DataItem>\n",
+            dz, m->spacing, m->spacing);
+  sb_printf(b, "          </Geometry>\n");
+  snprintf(group, sizeof group, "grid/%s", m->name); /* names are checked to fit */
+  sb_printf(b, "          <Attribute Name=\"m\" AttributeType=\"Scalar\" Center=\"Node\">\n");
+  data_item(b, "            ", dims, "Float", file, group, "m");
+  sb_printf(b, "          </Attribute>\n");
+  sb_printf(b, "          <Attribute Name=\"v\" AttributeType=\"Vector\" Center=\"Node\">\n");
+  snprintf(dims, sizeof dims, "%d %d %d %d", m->n[2], m->n[1], m->n[0], dim);
+  data_item(b, "            ", dims, "Float", file, group, "v");
+  sb_printf(b, "          </Attribute>\n");
+  sb_printf(b, "        </Grid>\n");
+}
+
+int mpm_xdmf_add(mpm_xdmf *x, double time, int index, const mpm_xdmf_phase *phase, int nphases,
+                 const mpm_xdmf_mesh *mesh, int nmeshes) {
+  char file[32];
+  strbuf b = {0};
+  snprintf(file, sizeof file, "snap_%06d.h5", index);
+  for (int k = 0; k < nmeshes; ++k)
+    if (strlen(mesh[k].name) > 64)
+      MPM_FAIL(MPM_ERR_INPUT, "XDMF index: grid phase name '%s' is too long", mesh[k].name);
+  sb_printf(&b,
+            "<Grid Name=\"snap_%06d\" GridType=\"Collection\" CollectionType=\"Spatial\">\n"
+            "        <Time Value=\"%.17g\"/>\n",
+            index, time);
+  for (int k = 0; k < nphases; ++k)
+    if (phase[k].n > 0) render_phase(&b, file, &phase[k], x->dim);
+  for (int k = 0; k < nmeshes; ++k) render_mesh(&b, file, &mesh[k], x->dim);
+  sb_printf(&b, "      </Grid>");
+  if (b.failed) {
+    free(b.s);
+    MPM_FAIL(MPM_ERR_MEMORY, "XDMF index: cannot render the entry of snapshot %d", index);
+  }
+  MPM_CALL(push_entry(x, time, index, b.s));
+  return 0;
+}
+
+/* ---- writing --------------------------------------------------------------------------- */
+
+static int write_all(const mpm_xdmf *x, FILE *f) {
+  fprintf(f, "<?xml version=\"1.0\" ?>\n"
+             "<!DOCTYPE Xdmf SYSTEM \"Xdmf.dtd\" []>\n"
+             "<Xdmf Version=\"2.0\">\n"
+             "  <Domain>\n"
+             "    <Grid Name=\"series\" GridType=\"Collection\" CollectionType=\"Temporal\">\n");
+  for (int k = 0; k < x->n; ++k) fprintf(f, "      %s\n", x->entry[k].xml);
+  fprintf(f, "    </Grid>\n"
+             "  </Domain>\n"
+             "</Xdmf>\n");
+  return ferror(f) ? -1 : 0;
+}
+
+int mpm_xdmf_write(const mpm_xdmf *x, const char *path) {
+  const size_t len = strlen(path) + 5;
+  char *tmp;
+  MPM_ALLOC(tmp, len);
+  snprintf(tmp, len, "%s.tmp", path);
+  FILE *f = fopen(tmp, "w");
+  if (!f) {
+    const int e = errno;
+    free(tmp);
+    MPM_FAIL(MPM_ERR_FILE, "cannot write the XDMF index %s.tmp: %s", path, strerror(e));
+  }
+  int bad = write_all(x, f);
+  bad |= fclose(f) != 0;
+  if (bad || rename(tmp, path) != 0) {
+    const int e = errno;
+    remove(tmp);
+    free(tmp);
+    MPM_FAIL(MPM_ERR_FILE, "cannot write the XDMF index %s: %s (is the disk full?)", path,
+             strerror(e));
+  }
+  free(tmp);
+  return 0;
+}
+
+/* ---- reading back ---------------------------------------------------------------------- */
+
+/* The end of the markup starting at p ('<'): one past its closing '>', skipping quoted
+ * attribute values; NULL if the text ends first. */
+static const char *markup_end(const char *p) {
+  if (strncmp(p, "<!--", 4) == 0) {
+    const char *e = strstr(p + 4, "-->");
+    return e ? e + 3 : NULL;
+  }
+  char quote = 0;
+  for (++p; *p; ++p) {
+    if (quote) {
+      if (*p == quote) quote = 0;
+    } else if (*p == '"' || *p == '\'') {
+      quote = *p;
+    } else if (*p == '>') {
+      return p + 1;
+    }
+  }
+  return NULL;
+}
+
+/* Is the tag [p, end) an element named name ("<name" followed by a space, '/' or '>')? */
+static int tag_is(const char *p, const char *end, const char *name) {
+  const size_t n = strlen(name);
+  return (size_t)(end - p) > n + 1 && strncmp(p + 1, name, n) == 0 &&
+         strchr(" \t\r\n/>", p[1 + n]) != NULL;
+}
+
+/* Copy the value of attribute key of the tag [p, end) into val; 0 if found. */
+static int tag_attr(const char *p, const char *end, const char *key, char *val, size_t size) {
+  const size_t n = strlen(key);
+  for (const char *q = p; q + n < end; ++q) {
+    if (!strchr(" \t\r\n", *q) || strncmp(q + 1, key, n) != 0) continue;
+    const char *r = q + 1 + n;
+    while (r < end && strchr(" \t\r\n", *r)) ++r;
+    if (r >= end || *r != '=') continue;
+    ++r;
+    while (r < end && strchr(" \t\r\n", *r)) ++r;
+    if (r >= end || (*r != '"' && *r != '\'')) continue;
+    const char quote = *r++;
+    const char *e = memchr(r, quote, (size_t)(end - r));
+    if (!e || (size_t)(e - r) >= size) return -1;
+    memcpy(val, r, (size_t)(e - r));
+    val[e - r] = 0;
+    return 0;
+  }
+  return -1;
+}
+
+/* The snapshot block being read: its start, time and index once seen. */
+typedef struct block_state {
+  const char *start;
+  int depth; /* Grid nesting depth at which the block opened */
+  int has_time, index;
+  double time;
+} block_state;
+
+static int block_open(block_state *s, const char *p, const char *end, int depth) {
+  char val[64];
+  s->start = p, s->depth = depth, s->has_time = 0, s->index = -1;
+  if (tag_attr(p, end, "Name", val, sizeof val) == 0) sscanf(val, "snap_%d", &s->index);
+  return 0;
+}
+
+static int block_close(mpm_xdmf *x, block_state *s, const char *end, const char *path,
+                       double t_max) {
+  if (!s->has_time || s->index < 0)
+    MPM_FAIL(MPM_ERR_INPUT,
+             "%s: a snapshot entry lacks its <Time> or its snap_NNNNNN name; this is not an "
+             "index mpmfsi wrote. Move the file away (or restart into a new output directory)",
+             path);
+  if (s->time <= t_max) {
+    const size_t len = (size_t)(end - s->start);
+    char *xml;
+    MPM_ALLOC(xml, len + 1);
+    memcpy(xml, s->start, len);
+    xml[len] = 0;
+    MPM_CALL(push_entry(x, s->time, s->index, xml));
+  }
+  s->start = NULL;
+  return 0;
+}
+
+static int parse_index(mpm_xdmf *x, const char *text, const char *path, double t_max) {
+  block_state s = {0};
+  int depth = 0, seen_xdmf = 0;
+  for (const char *p = strchr(text, '<'); p; p = strchr(p, '<')) {
+    const char *end = markup_end(p);
+    if (!end) break;
+    const int closing = p[1] == '/', empty = end[-2] == '/';
+    if (tag_is(p, end, "Xdmf")) seen_xdmf = 1;
+    if (closing && strncmp(p, "</Grid", 6) == 0) {
+      --depth;
+      if (s.start && depth == s.depth) MPM_CALL(block_close(x, &s, end, path, t_max));
+    } else if (!closing && tag_is(p, end, "Grid")) {
+      char type[32];
+      if (!empty && !s.start && tag_attr(p, end, "CollectionType", type, sizeof type) == 0 &&
+          strcasecmp(type, "Spatial") == 0)
+        block_open(&s, p, end, depth);
+      if (!empty) ++depth;
+    } else if (s.start && tag_is(p, end, "Time")) {
+      char val[64];
+      char *e;
+      if (tag_attr(p, end, "Value", val, sizeof val) == 0) {
+        s.time = strtod(val, &e);
+        s.has_time = e != val;
+      }
+    }
+    p = end;
+  }
+  if (!seen_xdmf || depth != 0 || s.start)
+    MPM_FAIL(MPM_ERR_INPUT,
+             "%s is not a complete XDMF index (truncated, or not written by mpmfsi). Move it "
+             "away to restart without the earlier snapshots in the index",
+             path);
+  return 0;
+}
+
+static int read_text(const char *path, char **text, int *found) {
+  *text = NULL;
+  FILE *f = fopen(path, "rb");
+  if (!f) {
+    if (errno == ENOENT) return *found = 0, 0;
+    MPM_FAIL(MPM_ERR_FILE, "cannot read the XDMF index %s: %s", path, strerror(errno));
+  }
+  *found = 1;
+  size_t len = 0, cap = 1 << 16;
+  char *s = malloc(cap);
+  while (s) {
+    len += fread(s + len, 1, cap - len - 1, f);
+    if (len < cap - 1) break;
+    char *t = realloc(s, cap *= 2);
+    if (!t) free(s);
+    s = t;
+  }
+  const int bad = ferror(f);
+  fclose(f);
+  if (!s) MPM_FAIL(MPM_ERR_MEMORY, "cannot hold the XDMF index %s in memory", path);
+  s[len] = 0;
+  if (bad) {
+    free(s);
+    MPM_FAIL(MPM_ERR_FILE, "error while reading the XDMF index %s", path);
+  }
+  *text = s;
+  return 0;
+}
+
+int mpm_xdmf_load(mpm_xdmf *x, const char *path, double t_max, int *found) {
+  char *text;
+  MPM_CALL(read_text(path, &text, found));
+  if (!*found) return 0;
+  const int rc = parse_index(x, text, path, t_max);
+  free(text);
+  MPM_CALL(rc);
+  return 0;
+}

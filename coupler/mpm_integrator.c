@@ -34,17 +34,17 @@ struct mpm_integrator {
 };
 
 const mpm_key_spec mpm_integrator_keys[] = {
-    {"time.t_end", MPM_KEY_REAL, NULL, 0, HUGE_VAL, 1, 0, NULL, "end time of the run, s"},
+    {"time.t_end", MPM_KEY_REAL, NULL, 0, HUGE_VAL, 1, 0, NULL, "end time of the run, s", 0},
     {"time.method", MPM_KEY_ENUM, "bs32", 0, 0, 0, 0, "usl|heun_euler|bs32|zonneveld43|dp54",
-     "time method: usl (classic MPM, fixed CFL step) or an adaptive embedded ERK pair"},
-    {"time.rtol", MPM_KEY_REAL, "1e-6", 0, 1, 1, 0, NULL, "relative tolerance (adaptive)"},
+     "time method: usl (classic MPM, fixed CFL step) or an adaptive embedded ERK pair", 0},
+    {"time.rtol", MPM_KEY_REAL, "1e-6", 0, 1, 1, 0, NULL, "relative tolerance (adaptive)", 0},
     {"time.atol", MPM_KEY_REAL, "1e-9", 0, HUGE_VAL, 1, 0, NULL,
-     "absolute tolerance (adaptive), in state units (m, m/s, 1)"},
-    {"time.cfl", MPM_KEY_REAL, "0.4", 0, 1, 1, 0, NULL,
-     "fraction of the stable step dx / (c + |v|) allowed"},
-    {"time.dt_max", MPM_KEY_REAL, "inf", 0, HUGE_VAL, 1, 0, NULL, "largest step, s"},
+     "absolute tolerance (adaptive), in state units (m, m/s, 1)", 0},
+    {"time.cfl", MPM_KEY_REAL, "0.4", 0, 0.999, 1, 0, NULL,
+     "fraction of the stable step dx / (c + |v|) allowed, below 1", 0},
+    {"time.dt_max", MPM_KEY_REAL, "0", 0, HUGE_VAL, 0, 0, NULL, "largest step, s (0: no limit)", 0},
     {"time.max_retries", MPM_KEY_INT, "8", 0, 100, 0, 0, NULL,
-     "restarts with a 4x smaller step after an unphysical stage before the run stops"},
+     "restarts with a 4x smaller step after an unphysical stage before the run stops", 0},
 };
 const int mpm_integrator_nkeys = (int)(sizeof mpm_integrator_keys / sizeof mpm_integrator_keys[0]);
 
@@ -123,17 +123,16 @@ static int rhs(mpm_sunreal t, N_Vector y, N_Vector ydot, void *user) {
   return 0;
 }
 
-/* Stable step: the CFL fraction of min over modules and ranks of dx / (c + |v|). */
+/* Stability limit: min over modules and ranks of dx / (c + |v|), before the CFL fraction. */
 static int stable_step(mpm_integrator *it, N_Vector y, double *hstab) {
   double h = HUGE_VAL;
   for (int k = 0; k < it->nmod; ++k)
     h = fmin(h, it->mod[k]->ops->stable_dt(it->mod[k], module_data(y, k)));
-  h *= it->cfl;
   MPM_CALL_MPI(MPI_Allreduce(&h, hstab, 1, MPI_DOUBLE, MPI_MIN, it->comm));
-  if (*hstab > it->dt_max) *hstab = it->dt_max;
   return 0;
 }
 
+/* For the adaptive pairs; ARKODE applies time.cfl as its CFL fraction. */
 static int estab(N_Vector y, mpm_sunreal t, mpm_sunreal *hstab, void *user) {
   (void)t;
   double h;
@@ -182,6 +181,7 @@ static int read_settings(mpm_integrator *it, const mpm_config *cfg) {
   MPM_CALL(mpm_config_get_real(cfg, "time.cfl", &it->cfl));
   MPM_CALL(mpm_config_get_real(cfg, "time.dt_max", &it->dt_max));
   MPM_CALL(mpm_config_get_int(cfg, "time.max_retries", &it->max_retries));
+  if (it->dt_max <= 0) it->dt_max = HUGE_VAL;
   return 0;
 }
 
@@ -237,7 +237,7 @@ static int configure(mpm_integrator *it, double h0) {
   MPM_CALL_SUN(ERKStepSetTableNum(it->ark, tables[it->method]));
   MPM_CALL_SUN(ERKStepSStolerances(it->ark, it->rtol, it->atol));
   MPM_CALL_SUN(ERKStepSetStabilityFn(it->ark, estab, it));
-  MPM_CALL_SUN(ERKStepSetCFLFraction(it->ark, 1.0)); /* time.cfl is applied in estab */
+  MPM_CALL_SUN(ERKStepSetCFLFraction(it->ark, it->cfl));
   if (isfinite(it->dt_max)) MPM_CALL_SUN(ERKStepSetMaxStep(it->ark, it->dt_max));
   if (h0 > 0) MPM_CALL_SUN(ERKStepSetInitStep(it->ark, h0));
   return 0;
@@ -291,6 +291,7 @@ static int attempt(mpm_integrator *it, double tstop, double scale, double *t, do
   if (it->method == MPM_METHOD_USL) {
     double hs;
     MPM_CALL(stable_step(it, it->y, &hs));
+    hs = fmin(it->cfl * hs, it->dt_max);
     if (!(hs > 0) || !isfinite(hs)) hs = tstop - it->t_last;
     it->h_classic = fmin(scale * hs, tstop - it->t_last);
     MPM_CALL_SUN(ERKStepSetFixedStep(it->ark, it->h_classic));

@@ -37,15 +37,16 @@ typedef struct {
 
 const mpm_key_spec solid_keys[] = {
     {"solid.*.geometry", MPM_KEY_STRING, NULL, 0, 0, 0, 0, NULL,
-     "name of the [geometry.NAME] region the body fills"},
+     "name of the [geometry.NAME] region the body fills", 0},
     {"solid.*.material", MPM_KEY_ENUM, NULL, 0, 0, 0, 0, "linear_elastic",
-     "material model of the body"},
-    {"solid.*.density", MPM_KEY_REAL, NULL, 0, HUGE_VAL, 1, 0, NULL, "mass density, kg/m^3"},
-    {"solid.*.E", MPM_KEY_REAL, NULL, 0, HUGE_VAL, 1, 0, NULL, "Young's modulus, Pa"},
-    {"solid.*.nu", MPM_KEY_REAL, "0.3", 0, 0.4999, 0, 0, NULL, "Poisson's ratio, [0, 0.5)"},
+     "material model of the body", 0},
+    {"solid.*.density", MPM_KEY_REAL, NULL, 0, HUGE_VAL, 1, 0, NULL, "mass density, kg/m^3", 0},
+    {"solid.*.E", MPM_KEY_REAL, NULL, 0, HUGE_VAL, 1, 0, NULL,
+     "Young's modulus, Pa (elastic models)", 1},
+    {"solid.*.nu", MPM_KEY_REAL, "0.3", 0, 0.4999, 0, 0, NULL, "Poisson's ratio, [0, 0.5)", 0},
     {"solid.*.velocity", MPM_KEY_REALS, "0 0 0", -HUGE_VAL, HUGE_VAL, 0, 3, NULL,
-     "initial velocity, m/s (dim values; extra values are ignored)"},
-    {"solid.*.ppc", MPM_KEY_INT, "2", 1, 8, 0, 0, NULL, "particles per cell per direction"},
+     "initial velocity, m/s (dim values; extra values are ignored)", 0},
+    {"solid.*.ppc", MPM_KEY_INT, "2", 1, 8, 0, 0, NULL, "particles per cell per direction", 0},
 };
 const int solid_nkeys = (int)(sizeof solid_keys / sizeof solid_keys[0]);
 
