@@ -75,7 +75,8 @@ static int run(const char *cmd, const char *path, int argc, char **argv) {
   mpm_config *cfg = NULL;
   mpm_sim *sim = NULL;
   int rc = mpm_config_new(&cfg, MPI_COMM_WORLD);
-  if (!rc) rc = load_config(cfg, cmd, path, argc, argv);
+  /* Whatever stops the case from loading (a missing file too) is bad input: exit 2. */
+  if (!rc && load_config(cfg, cmd, path, argc, argv) != 0) rc = MPM_ERR_INPUT;
   if (!rc)
     rc = strcmp(cmd, "restart") == 0 ? mpm_sim_restart(&sim, cfg, path) : mpm_sim_create(&sim, cfg);
   /* check builds everything a run needs (so every input error shows), then stops. */

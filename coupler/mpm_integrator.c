@@ -295,6 +295,10 @@ static int attempt(mpm_integrator *it, double tstop, double scale, double *t, do
     if (!(hs > 0) || !isfinite(hs)) hs = tstop - it->t_last;
     it->h_classic = fmin(scale * hs, tstop - it->t_last);
     MPM_CALL_SUN(ERKStepSetFixedStep(it->ark, it->h_classic));
+    /* ARKODE keeps f(t_n, y_n) from the end of the last step (for its interpolant) and would
+     * reuse it as this step's stage, but the classic update's f depends on h: evaluate it
+     * afresh with this step's h. */
+    MPM_CALL_SUN(ERKStepReset(it->ark, it->t_last, it->y));
   }
   MPM_CALL_SUN(ERKStepSetStopTime(it->ark, tstop));
   it->fault.set = 0;

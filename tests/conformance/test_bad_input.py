@@ -31,7 +31,7 @@ def line_of(text, needle):
 
 # (name, old text, new text, key expected in the message, extra words expected)
 CASES = [
-    ("unknown key", "dx = 0.1", "dxx = 0.1", "grid.dxx", "grid.dx"),
+    ("unknown key", "dx = 0.1", "dx = 0.1\nshpae = quadratic", "grid.shpae", "grid.shape"),
     ("wrong type", "dx = 0.1", "dx = abc", "grid.dx", None),
     ("integer expected", "dim = 2", "dim = 2.5", "domain.dim", None),
     ("negative modulus", "E = 1e6", "E = -5", "solid.block.E", None),
@@ -45,7 +45,7 @@ CASES = [
     ("domain not whole cells", "dx = 0.1", "dx = 0.3", "grid.dx", "whole number"),
     ("wrong vector length", "lo = 0 0\n", "lo = 0 0 0\n", "domain.lo", None),
     ("malformed line", "[physics]", "[physics]\nthis line has no equals sign", None, "syntax"),
-    ("missing required key", "density = 1000\n", "", "solid.block.density", "required"),
+    ("missing required key", "density = 1000\n", "", "[solid.block]", "'density'"),
     ("duplicate key", "dx = 0.1", "dx = 0.1\ndx = 0.2", "grid.dx", None),
 ]
 

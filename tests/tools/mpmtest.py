@@ -30,20 +30,16 @@ def run(args, ranks=1, check=True):
 
 
 def snapshots(outdir):
-    """(time, path) of every snapshot named in series.xmf, in order."""
+    """(time, path) of every snapshot named in series.xmf, in time order. Each snapshot is a
+    child grid of the temporal collection, with a <Time> and HDF data items."""
     root = ET.parse(os.path.join(outdir, "series.xmf")).getroot()
+    series = root.find("Domain/Grid")
     files = []
-    for grid in root.iter("Grid"):
-        if grid.get("GridType") == "Collection":
-            continue
+    for grid in series.findall("Grid"):
         t = grid.find("Time")
         item = grid.find(".//DataItem")
-        if t is None or item is None:
-            continue
         path = item.text.strip().split(":")[0]
-        entry = (float(t.get("Value")), os.path.join(outdir, path))
-        if entry not in files:
-            files.append(entry)
+        files.append((float(t.get("Value")), os.path.join(outdir, path)))
     return sorted(files)
 
 
