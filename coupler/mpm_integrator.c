@@ -338,5 +338,7 @@ int mpm_integrator_step(mpm_integrator *it, double tstop, double *t, double *h) 
     MPM_CALL(mpm_integrator_start(it, it->t_last, it->method == MPM_METHOD_USL
                                                        ? 0.0
                                                        : scale * fabs(h_tried)));
+    /* A fresh ERKStep may grow its first step 10^4-fold, straight back into the failure. */
+    if (it->method != MPM_METHOD_USL) MPM_CALL_SUN(ERKStepSetMaxFirstGrowth(it->ark, 2.0));
   }
 }

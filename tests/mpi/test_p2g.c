@@ -17,14 +17,14 @@
 #define NP 4000
 static int g_fail = 0, g_rank = 0;
 
-#define CHECK(cond, ...)                                                                       \
-  do {                                                                                         \
-    if (!(cond)) {                                                                             \
-      g_fail++;                                                                                \
-      fprintf(stderr, "[%d] FAIL %s:%d: ", g_rank, __FILE__, __LINE__);                        \
-      fprintf(stderr, __VA_ARGS__);                                                            \
-      fputc('\n', stderr);                                                                     \
-    }                                                                                          \
+#define CHECK(cond, ...)                                                                           \
+  do {                                                                                             \
+    if (!(cond)) {                                                                                 \
+      g_fail++;                                                                                    \
+      fprintf(stderr, "[%d] FAIL %s:%d: ", g_rank, __FILE__, __LINE__);                            \
+      fprintf(stderr, __VA_ARGS__);                                                                \
+      fputc('\n', stderr);                                                                         \
+    }                                                                                              \
   } while (0)
 
 static double rnd(unsigned long long *s) {
@@ -167,8 +167,7 @@ static void run_case(int dim, mpm_shape_kind shape) {
   for (mpm_lidx l = 0; l < g->nnodes; ++l) {
     int gi[3], inside = 1;
     global_of(g, l, gi);
-    for (int d = 0; d < dim; ++d)
-      inside &= gi[d] >= -g->pad && gi[d] <= g->ncells[d] + g->pad;
+    for (int d = 0; d < dim; ++d) inside &= gi[d] >= -g->pad && gi[d] <= g->ncells[d] + g->pad;
     if (inside)
       ferr = fmax(ferr, fabs(ph->m_i[l] - ref->phase[0].m_i[mpm_grid_local_index(ref, gi)]));
   }
