@@ -26,7 +26,10 @@ struct mpm_integrator {
   mpm_method method;
   double rtol, atol, cfl, dt_max;
   int max_retries;
-  double h_classic;  /* step of the classic update during its RHS call */
+  double h_classic;  /* step of the classic update, computed by its RHS (see classic_step) */
+  double tstop;      /* stop time of the current step */
+  double scale;      /* step reduction of the current retry (1 when not retrying) */
+  int fn_stale;      /* ERKStep's stored f(t_n, y_n) used another step size: re-evaluate */
   mpm_fault fault;   /* last unphysical state seen by the RHS (same on every rank) */
   int rhs_error;     /* a non-recoverable failure inside the RHS */
   long steps, rhs_evals, fails, retries;
@@ -109,10 +112,16 @@ static int mpm_cycle(mpm_integrator *it, double t, N_Vector y, N_Vector ydot) {
   return 0;
 }
 
+static int classic_step(mpm_integrator *it, double t, N_Vector y, double *h);
+
 static int rhs(mpm_sunreal t, N_Vector y, N_Vector ydot, void *user) {
   mpm_integrator *it = user;
   mpm_fault local = {0};
   it->rhs_evals++;
+  if (it->method == MPM_METHOD_USL && classic_step(it, t, y, &it->h_classic) != 0) {
+    it->rhs_error = 1;
+    return -1;
+  }
   for (int k = 0; k < it->nmod && !local.set; ++k)
     it->mod[k]->ops->check(it->mod[k], module_data(y, k), &local);
   if (share_fault(it, &local)) return 1;
@@ -138,6 +147,19 @@ static int estab(N_Vector y, mpm_sunreal t, mpm_sunreal *hstab, void *user) {
   double h;
   if (stable_step(user, y, &h) != 0) return -1;
   *hstab = isfinite(h) ? h : 0.0; /* 0: no limit */
+  return 0;
+}
+
+/* The step of the classic update from (t, y): the CFL fraction of the stability limit,
+ * capped by dt_max and the stop time, times the retry scale. ERKStep evaluates f at the end
+ * of each step and reuses it as the next step's only stage, so the RHS computes the step it
+ * will be used with from the same (t, y) the driver uses to set the fixed step. */
+static int classic_step(mpm_integrator *it, double t, N_Vector y, double *h) {
+  double hs;
+  MPM_CALL(stable_step(it, y, &hs));
+  hs = fmin(it->cfl * hs, it->dt_max);
+  if (!(hs > 0) || !isfinite(hs)) hs = it->tstop - t;
+  *h = fmin(it->scale * hs, it->tstop - t);
   return 0;
 }
 
@@ -249,6 +271,7 @@ int mpm_integrator_start(mpm_integrator *it, double t, double h0) {
   it->ark = ERKStepCreate(rhs, t, it->y, it->ctx);
   if (!it->ark) MPM_FAIL(MPM_ERR_SUNDIALS, "ERKStepCreate failed");
   it->t_last = t;
+  it->scale = 1.0, it->fn_stale = 0;
   return configure(it, h0);
 }
 
@@ -289,16 +312,13 @@ static int report_fault(const mpm_integrator *it, double t) {
 static int attempt(mpm_integrator *it, double tstop, double scale, double *t, double *h) {
   mpm_sunreal tret = it->t_last;
   if (it->method == MPM_METHOD_USL) {
-    double hs;
-    MPM_CALL(stable_step(it, it->y, &hs));
-    hs = fmin(it->cfl * hs, it->dt_max);
-    if (!(hs > 0) || !isfinite(hs)) hs = tstop - it->t_last;
-    it->h_classic = fmin(scale * hs, tstop - it->t_last);
+    /* A stored f computed for another stop time or scale would use the wrong step. */
+    if (tstop != it->tstop || scale != it->scale) it->fn_stale = 1;
+    it->tstop = tstop, it->scale = scale;
+    MPM_CALL(classic_step(it, it->t_last, it->y, &it->h_classic));
     MPM_CALL_SUN(ERKStepSetFixedStep(it->ark, it->h_classic));
-    /* ARKODE keeps f(t_n, y_n) from the end of the last step (for its interpolant) and would
-     * reuse it as this step's stage, but the classic update's f depends on h: evaluate it
-     * afresh with this step's h. */
-    MPM_CALL_SUN(ERKStepReset(it->ark, it->t_last, it->y));
+    if (it->fn_stale) MPM_CALL_SUN(ERKStepReset(it->ark, it->t_last, it->y));
+    it->fn_stale = 0;
   }
   MPM_CALL_SUN(ERKStepSetStopTime(it->ark, tstop));
   it->fault.set = 0;
