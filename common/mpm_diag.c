@@ -13,9 +13,12 @@ struct mpm_diag {
   int ncols;
 };
 
-/* Keep the header and the rows with time <= t_keep of an existing file. */
+/* Keep the header and the rows with time <= t_keep of an existing file (none if there is no
+ * file: a restart may write into a new folder). */
 static int truncate_after(const char *path, double t_keep, char **kept) {
   FILE *f = fopen(path, "r");
+  *kept = NULL;
+  if (!f && errno == ENOENT) return 0;
   if (!f) MPM_FAIL(MPM_ERR_FILE, "cannot reopen diagnostics '%s': %s", path, strerror(errno));
   size_t cap = 1 << 16, len = 0;
   char *buf, line[8192];

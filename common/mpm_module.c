@@ -4,6 +4,7 @@
 #include "mpm_error.h"
 
 #include <math.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 
@@ -14,11 +15,12 @@ void mpm_module_destroy(mpm_module **m) {
   *m = NULL;
 }
 
-void mpm_grid_phase_update(mpm_grid *grid, int phase, double h) {
+int mpm_grid_phase_update(mpm_grid *grid, int phase, double h) {
   mpm_grid_phase *ph = &grid->phase[phase];
   const int dim = grid->dim;
-  double mmax = 0.0;
-  for (mpm_lidx l = 0; l < grid->nnodes; ++l) mmax = fmax(mmax, ph->m_i[l]);
+  double local = 0.0, mmax;
+  for (mpm_lidx l = 0; l < grid->nnodes; ++l) local = fmax(local, ph->m_i[l]);
+  MPM_CALL_MPI(MPI_Allreduce(&local, &mmax, 1, MPI_DOUBLE, MPI_MAX, grid->comm));
   /* Nodes touched only by the far tail of a stencil carry roundoff-sized mass; dividing by it
    * would amplify noise, so they are treated as empty. */
   const double mmin = 1e-14 * mmax;
@@ -34,14 +36,18 @@ void mpm_grid_phase_update(mpm_grid *grid, int phase, double h) {
       }
     }
   }
+  return 0;
 }
 
-static int fault_at(const mpm_particles *p, const double *y, mpm_lidx i, mpm_fault *fault,
-                    const char *cause) {
+int mpm_fault_at(mpm_fault *fault, const mpm_particles *p, const double *y, mpm_lidx i,
+                 const char *fmt, ...) {
+  va_list ap;
   fault->set = 1;
   fault->id = p->id[i];
   for (int d = 0; d < p->dim; ++d) fault->x[d] = y[(size_t)d * p->n + i];
-  snprintf(fault->cause, sizeof fault->cause, "%s", cause);
+  va_start(ap, fmt);
+  vsnprintf(fault->cause, sizeof fault->cause, fmt, ap);
+  va_end(ap);
   return 1;
 }
 
@@ -50,18 +56,18 @@ int mpm_module_check_positions(const mpm_module *m, const double *y, mpm_fault *
   const mpm_grid *g = m->grid;
   const mpm_lidx n = p->n;
   for (size_t k = 0; k < (size_t)p->nstate * (size_t)n; ++k)
-    if (!isfinite(y[k])) return fault_at(p, y, (mpm_lidx)(k % (size_t)(n ? n : 1)), fault,
+    if (!isfinite(y[k])) return mpm_fault_at(fault, p, y, (mpm_lidx)(k % (size_t)(n ? n : 1)),
                                          "a state value is not finite (NaN or Inf)");
   for (mpm_lidx i = 0; i < n; ++i)
     for (int d = 0; d < p->dim; ++d) {
       const double x = y[(size_t)d * n + i];
       if (!(x >= g->lo[d] && x < g->hi[d]))
-        return fault_at(p, y, i, fault, "the particle left the domain");
+        return mpm_fault_at(fault, p, y, i, "the particle left the domain");
       const int cell = (int)floor((x - g->lo[d]) / g->dx);
       const int c = g->coord[d];
       if (cell < g->cell_split[d][c] - 1 || cell > g->cell_split[d][c + 1])
-        return fault_at(p, y, i, fault,
-                        "the particle moved more than one cell within one step");
+        return mpm_fault_at(fault, p, y, i,
+                            "the particle moved more than one cell within one step");
     }
   return 0;
 }

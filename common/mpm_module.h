@@ -57,8 +57,14 @@ struct mpm_module {
 void mpm_module_destroy(mpm_module **m);
 
 /* Nodal update of one phase on every box node: v = mv/m, a = f/m, then v += h a; nodes
- * with m below a tiny fraction of the largest nodal mass get v = a = 0. */
-void mpm_grid_phase_update(mpm_grid *grid, int phase, double h);
+ * with m below a tiny fraction of the largest nodal mass of the whole grid get v = a = 0.
+ * Collective (the largest mass is reduced over the ranks, so the result does not depend on
+ * the decomposition). */
+int mpm_grid_phase_update(mpm_grid *grid, int phase, double h);
+
+/* Record a fault at particle i of p (positions from y) with a printf-style cause; returns 1. */
+int mpm_fault_at(mpm_fault *fault, const mpm_particles *p, const double *y, mpm_lidx i,
+                 const char *fmt, ...) __attribute__((format(printf, 5, 6)));
 
 /* Shared particle checks: NaN in the state, a particle outside the domain, or one that has
  * drifted more than one cell beyond this rank's cells during a step. */

@@ -33,12 +33,13 @@ struct mpm_integrator {
   mpm_fault fault;   /* last unphysical state seen by the RHS (same on every rank) */
   int rhs_error;     /* a non-recoverable failure inside the RHS */
   long steps, rhs_evals, fails, retries;
+  long fails_seen; /* ERKStep's cumulative error-test failures already counted */
   double t_last;     /* time of the last accepted state */
 };
 
 const mpm_key_spec mpm_integrator_keys[] = {
     {"time.t_end", MPM_KEY_REAL, NULL, 0, HUGE_VAL, 1, 0, NULL, "end time of the run, s", 0},
-    {"time.method", MPM_KEY_ENUM, "bs32", 0, 0, 0, 0, "usl|heun_euler|bs32|zonneveld43|dp54",
+    {"time.method", MPM_KEY_ENUM, "bs32", 0, 0, 0, 0, "usl|ralston21|bs32|zonneveld43|dp54",
      "time method: usl (classic MPM, fixed CFL step) or an adaptive embedded ERK pair", 0},
     {"time.rtol", MPM_KEY_REAL, "1e-6", 0, 1, 1, 0, NULL, "relative tolerance (adaptive)", 0},
     {"time.atol", MPM_KEY_REAL, "1e-9", 0, HUGE_VAL, 1, 0, NULL,
@@ -51,7 +52,7 @@ const mpm_key_spec mpm_integrator_keys[] = {
 };
 const int mpm_integrator_nkeys = (int)(sizeof mpm_integrator_keys / sizeof mpm_integrator_keys[0]);
 
-static const char *const g_method_names[MPM_METHOD_COUNT] = {"usl", "heun_euler", "bs32",
+static const char *const g_method_names[MPM_METHOD_COUNT] = {"usl", "ralston21", "bs32",
                                                              "zonneveld43", "dp54"};
 const char *mpm_method_name(mpm_method m) { return g_method_names[m]; }
 
@@ -244,10 +245,27 @@ static int set_classic_table(mpm_integrator *it) {
   return 0;
 }
 
+/* Ralston's second-order method with an embedded Euler step. SUNDIALS before 6.7 treats
+ * every table whose last node is c = 1 as first-same-as-last, which breaks Heun-Euler
+ * (llnl/sundials#311); Ralston's nodes are 0 and 2/3. */
+static int set_ralston_table(mpm_integrator *it) {
+  ARKodeButcherTable B = ARKodeButcherTable_Alloc(2, SUNTRUE);
+  if (!B) MPM_FAIL(MPM_ERR_MEMORY, "cannot allocate a Butcher table");
+  B->A[1][0] = 2.0 / 3.0;
+  B->c[0] = 0.0, B->c[1] = 2.0 / 3.0;
+  B->b[0] = 0.25, B->b[1] = 0.75;
+  B->d[0] = 1.0, B->d[1] = 0.0;
+  B->q = 2, B->p = 1;
+  int flag = ERKStepSetTable(it->ark, B);
+  ARKodeButcherTable_Free(B);
+  MPM_CALL_SUN(flag);
+  return 0;
+}
+
 static int configure(mpm_integrator *it, double h0) {
   static const ARKODE_ERKTableID tables[MPM_METHOD_COUNT] = {
-      ARKODE_HEUN_EULER_2_1_2, ARKODE_HEUN_EULER_2_1_2, ARKODE_BOGACKI_SHAMPINE_4_2_3,
-      ARKODE_ZONNEVELD_5_3_4, ARKODE_DORMAND_PRINCE_7_4_5};
+      ARKODE_ERK_NONE, ARKODE_ERK_NONE, ARKODE_BOGACKI_SHAMPINE_4_2_3, ARKODE_ZONNEVELD_5_3_4,
+      ARKODE_DORMAND_PRINCE_7_4_5};
   MPM_CALL_SUN(ERKStepSetUserData(it->ark, it));
   MPM_CALL_SUN(ERKStepSetErrHandlerFn(it->ark, ark_errors, NULL));
   MPM_CALL_SUN(ERKStepSetMaxNumSteps(it->ark, -1));
@@ -256,7 +274,8 @@ static int configure(mpm_integrator *it, double h0) {
     MPM_CALL_SUN(ERKStepSetFixedStep(it->ark, h0 > 0 ? h0 : 1.0));
     return 0;
   }
-  MPM_CALL_SUN(ERKStepSetTableNum(it->ark, tables[it->method]));
+  if (it->method == MPM_METHOD_RALSTON21) MPM_CALL(set_ralston_table(it));
+  else MPM_CALL_SUN(ERKStepSetTableNum(it->ark, tables[it->method]));
   MPM_CALL_SUN(ERKStepSStolerances(it->ark, it->rtol, it->atol));
   MPM_CALL_SUN(ERKStepSetStabilityFn(it->ark, estab, it));
   MPM_CALL_SUN(ERKStepSetCFLFraction(it->ark, it->cfl));
@@ -271,7 +290,7 @@ int mpm_integrator_start(mpm_integrator *it, double t, double h0) {
   it->ark = ERKStepCreate(rhs, t, it->y, it->ctx);
   if (!it->ark) MPM_FAIL(MPM_ERR_SUNDIALS, "ERKStepCreate failed");
   it->t_last = t;
-  it->scale = 1.0, it->fn_stale = 0;
+  it->scale = 1.0, it->fn_stale = 0, it->fails_seen = 0;
   return configure(it, h0);
 }
 
@@ -292,16 +311,16 @@ void mpm_integrator_counts(const mpm_integrator *it, long *steps, long *rhs_eval
   *steps = it->steps, *rhs_evals = it->rhs_evals, *fails = it->fails, *retries = it->retries;
 }
 
-static int report_fault(const mpm_integrator *it, double t) {
+static int report_fault(const mpm_integrator *it, double t, int tries) {
   const mpm_fault *f = &it->fault;
   char where[96];
   if (it->grid->dim == 2) snprintf(where, sizeof where, "(%.6g, %.6g)", f->x[0], f->x[1]);
   else snprintf(where, sizeof where, "(%.6g, %.6g, %.6g)", f->x[0], f->x[1], f->x[2]);
   mpm_log(MPM_LOG_ERROR,
-          "the run stopped at t = %.6g after %d retries with smaller steps: particle %lld at %s: "
+          "the run stopped at t = %.6g after %d %s with smaller steps: particle %lld at %s: "
           "%s. Reduce time.cfl or time.rtol, refine the grid, or check the material "
           "parameters and boundary conditions near that point",
-          t, it->max_retries, (long long)f->id, where, f->cause);
+          t, tries, tries == 1 ? "retry" : "retries", (long long)f->id, where, f->cause);
   return MPM_ERR_UNPHYSICAL;
 }
 
@@ -335,29 +354,39 @@ static int attempt(mpm_integrator *it, double tstop, double scale, double *t, do
            "ERKStep failed at t = %.6g with flag %d", it->t_last, flag);
 }
 
+/* The smallest step a retry may try, relative to the CFL step: a stage that still fails
+ * below it meets a barrier (a wall, an inverted element) that no step size removes. */
+#define MPM_RETRY_FLOOR 1e-6
+
 int mpm_integrator_step(mpm_integrator *it, double tstop, double *t, double *h) {
-  double scale = 1.0;
-  const double h_tried = mpm_integrator_next_step(it);
+  double scale = 1.0, h_cfl, h_tried = 0.0;
   for (int tries = 0;; ++tries) {
+    const int rc = attempt(it, tstop, scale, t, h);
     long nfail = 0;
-    int rc = attempt(it, tstop, scale, t, h);
     ERKStepGetNumErrTestFails(it->ark, &nfail);
+    it->fails += nfail - it->fails_seen;
+    it->fails_seen = nfail;
     if (rc == 0) {
       it->steps++;
-      it->fails += nfail;
+      /* The end-of-step f of a retried classic step was computed with the reduced scale. */
+      if (scale != 1.0) it->fn_stale = 1;
       return 0;
     }
     if (rc != MPM_RETRY) return mpm_trace(__FILE__, __LINE__, __func__, rc);
-    if (tries >= it->max_retries) return report_fault(it, it->t_last);
-    it->retries++;
+    /* The step ERKStep tried (it keeps it as the next step after a failure). */
+    if (tries == 0) h_tried = fabs(mpm_integrator_next_step(it));
     scale *= 0.25;
-    mpm_log(MPM_LOG_DEBUG, "retrying from t = %.6g with a smaller step: particle %lld: %s",
-            it->t_last, (long long)it->fault.id, it->fault.cause);
+    MPM_CALL(stable_step(it, it->y, &h_cfl));
+    h_cfl = isfinite(h_cfl) ? it->cfl * h_cfl : h_tried; /* no stability limit: the step tried */
+    const double h_next = it->method == MPM_METHOD_USL ? scale * h_cfl : scale * h_tried;
+    if (tries >= it->max_retries || h_next < MPM_RETRY_FLOOR * h_cfl)
+      return report_fault(it, it->t_last, tries);
+    it->retries++;
+    mpm_log(MPM_LOG_DEBUG, "retrying from t = %.6g with step %.3g: particle %lld: %s", it->t_last,
+            h_next, (long long)it->fault.id, it->fault.cause);
     /* ERKStep cannot retry a recoverable explicit RHS failure itself: restart it from the
      * last accepted state (the particle data) with a quarter of the step it tried. */
-    MPM_CALL(mpm_integrator_start(it, it->t_last, it->method == MPM_METHOD_USL
-                                                       ? 0.0
-                                                       : scale * fabs(h_tried)));
+    MPM_CALL(mpm_integrator_start(it, it->t_last, it->method == MPM_METHOD_USL ? 0.0 : h_next));
     /* A fresh ERKStep may grow its first step 10^4-fold, straight back into the failure. */
     if (it->method != MPM_METHOD_USL) MPM_CALL_SUN(ERKStepSetMaxFirstGrowth(it->ark, 2.0));
   }

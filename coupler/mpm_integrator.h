@@ -12,7 +12,8 @@
  * Failures: an unphysical stage (NaN, J <= 0, a particle outside the domain or too far out
  * of its box) makes the RHS return a recoverable flag on every rank. ERKStep 6.4 cannot
  * retry after a recoverable explicit RHS failure, so the integrator restarts itself from the
- * last accepted state with a quarter of the step, up to max_retries times in a row, and then
+ * last accepted state with a quarter of the step, up to max_retries times for one step or
+ * until the step falls below 1e-6 of the CFL step (a barrier no step size removes), and then
  * fails with a message that names the particle, its position and the cause. */
 #ifndef MPM_INTEGRATOR_H
 #define MPM_INTEGRATOR_H
@@ -22,7 +23,7 @@
 
 typedef enum {
   MPM_METHOD_USL,         /* classic MPM update, fixed step from the CFL limit */
-  MPM_METHOD_HEUN_EULER,  /* ERK 2(1), unstable for undamped waves: for comparison */
+  MPM_METHOD_RALSTON21,   /* Ralston ERK 2(1): unstable for undamped waves, for comparison */
   MPM_METHOD_BS32,        /* Bogacki-Shampine 3(2) */
   MPM_METHOD_ZONNEVELD43, /* Zonneveld 4(3) */
   MPM_METHOD_DP54,        /* Dormand-Prince 5(4) */

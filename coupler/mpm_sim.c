@@ -72,7 +72,7 @@ int mpm_sim_add_schema(mpm_config *cfg) {
   MPM_CALL(mpm_config_add_schema(cfg, sim_keys, (int)(sizeof sim_keys / sizeof sim_keys[0])));
   MPM_CALL(mpm_config_add_schema(cfg, mpm_integrator_keys, mpm_integrator_nkeys));
   MPM_CALL(mpm_config_add_schema(cfg, mpm_geometry_keys, mpm_geometry_nkeys));
-  MPM_CALL(mpm_config_add_schema(cfg, solid_keys, solid_nkeys));
+  MPM_CALL(solid_add_schema(cfg));
   return 0;
 }
 
@@ -100,7 +100,11 @@ static int build_grid(mpm_sim *s) {
   MPM_CALL(mpm_config_get_real(s->cfg, "grid.dx", &dx));
   MPM_CALL(mpm_config_get_string(s->cfg, "grid.shape", &shape));
   MPM_CALL(mpm_config_get_reals(s->cfg, "grid.ranks", ranks, 3, &nr));
-  for (int d = 0; d < dim && d < nr; ++d) nproc[d] = (int)ranks[d];
+  for (int d = 0; d < dim && d < nr; ++d) {
+    if (ranks[d] != floor(ranks[d]))
+      return mpm_config_fail(s->cfg, "grid.ranks", "expected whole numbers, got %g", ranks[d]);
+    nproc[d] = (int)ranks[d];
+  }
   for (int d = 0; d < dim; ++d) {
     const double cells = (hi[d] - lo[d]) / dx;
     if (fabs(cells - round(cells)) > 1e-9 * cells)
@@ -175,29 +179,32 @@ int mpm_sim_create(mpm_sim **sp, mpm_config *cfg) {
   return mpm_integrator_new(&s->it, cfg, s->grid, s->mod, s->nmod);
 }
 
-static int ckpt_attr(const mpm_checkpoint *ck, const char *name, double *v) {
-  return mpm_checkpoint_attr(ck, name, v);
-}
-
 int mpm_sim_restart(mpm_sim **sp, mpm_config *cfg, const char *path) {
   MPM_CALL(sim_alloc(sp, cfg));
   mpm_sim *s = *sp;
   MPM_CALL(build_modules(s, 0));
   mpm_checkpoint *ck = NULL;
   MPM_CALL(mpm_checkpoint_open(&ck, s->comm, path));
-  double step, out_next, ckpt_next;
-  int rc = ckpt_attr(ck, "t", &s->t);
-  if (!rc) rc = ckpt_attr(ck, "step", &step);
-  if (!rc) rc = ckpt_attr(ck, "h_next", &s->h_next);
-  if (!rc) rc = ckpt_attr(ck, "out_next", &out_next);
-  if (!rc) rc = ckpt_attr(ck, "ckpt_next", &ckpt_next);
+  double step;
+  int rc = mpm_checkpoint_attr(ck, "t", &s->t);
+  if (!rc) rc = mpm_checkpoint_attr(ck, "step", &step);
+  if (!rc) rc = mpm_checkpoint_attr(ck, "h_next", &s->h_next);
   for (int k = 0; !rc && k < s->nmod; ++k)
     rc = mpm_checkpoint_read_particles(ck, s->mod[k]->name, s->mod[k]->particles);
   mpm_checkpoint_close(&ck);
   MPM_CALL(rc);
+  if (s->t_end <= s->t * (1 + 1e-14))
+    return mpm_config_fail(cfg, "time.t_end",
+                           "the checkpoint is at t = %.6g, so there is nothing to run until "
+                           "t_end = %.6g; restart with time.t_end=<a later time>",
+                           s->t, s->t_end);
   s->step = (long)step;
-  s->out_next = (long)out_next;
-  s->ckpt_next = (long)ckpt_next;
+  /* Outputs continue on the (possibly new) intervals: the next ones after t. Written at t
+   * already, so strictly after it. */
+  s->out_next = (long)floor(s->t / s->out_interval * (1 + 1e-12)) + 1;
+  s->ckpt_next = isfinite(s->ckpt_interval)
+                     ? (long)floor(s->t / s->ckpt_interval * (1 + 1e-12)) + 1
+                     : 1;
   for (int k = 0; k < s->nmod; ++k) MPM_CALL(mpm_particles_migrate(s->mod[k]->particles, s->grid, NULL));
   MPM_CALL(mpm_integrator_new(&s->it, cfg, s->grid, s->mod, s->nmod));
   s->restarted = 1;
@@ -235,11 +242,10 @@ static int write_checkpoint(mpm_sim *s, const char *path) {
   const mpm_particles *p[SIM_MAX_MODULES];
   const char *names[SIM_MAX_MODULES];
   for (int k = 0; k < s->nmod; ++k) p[k] = s->mod[k]->particles, names[k] = s->mod[k]->name;
-  const char *attr[] = {"t", "step", "h_next", "out_next", "ckpt_next"};
-  const double val[] = {s->t, (double)s->step, s->h_next, (double)s->out_next,
-                        (double)s->ckpt_next};
+  const char *attr[] = {"t", "step", "h_next"};
+  const double val[] = {s->t, (double)s->step, s->h_next};
   mpm_timer_start(MPM_T_IO);
-  int rc = mpm_checkpoint_write(s->comm, path, s->config_text, attr, val, 5, p, names, s->nmod);
+  int rc = mpm_checkpoint_write(s->comm, path, s->config_text, attr, val, 3, p, names, s->nmod);
   mpm_timer_stop(MPM_T_IO);
   MPM_CALL(rc);
   mpm_log(MPM_LOG_INFO, "checkpoint %s at t = %.6g", path, s->t);

@@ -14,7 +14,14 @@ static const solid_material_ops *const g_models[] = {
 };
 static const int g_nmodels = (int)(sizeof g_models / sizeof g_models[0]);
 
-const char *solid_material_names(void) { return "linear_elastic"; }
+const char *solid_material_names(void) {
+  static char names[256];
+  if (!names[0])
+    for (int k = 0; k < g_nmodels; ++k)
+      snprintf(names + strlen(names), sizeof names - strlen(names), "%s%s", k ? "|" : "",
+               g_models[k]->name);
+  return names;
+}
 
 int solid_material_create(solid_material **mat, const char *type, const mpm_config *cfg,
                           const char *section) {

@@ -35,10 +35,10 @@ typedef struct {
   mpm_lidx *idx, *count;  /* particle indices grouped by body; counts per body */
 } solid_content;
 
-const mpm_key_spec solid_keys[] = {
+static mpm_key_spec solid_keys[] = {
     {"solid.*.geometry", MPM_KEY_STRING, NULL, 0, 0, 0, 0, NULL,
      "name of the [geometry.NAME] region the body fills", 0},
-    {"solid.*.material", MPM_KEY_ENUM, NULL, 0, 0, 0, 0, "linear_elastic",
+    {"solid.*.material", MPM_KEY_ENUM, NULL, 0, 0, 0, 0, NULL, /* set from the registry */
      "material model of the body", 0},
     {"solid.*.density", MPM_KEY_REAL, NULL, 0, HUGE_VAL, 1, 0, NULL, "mass density, kg/m^3", 0},
     {"solid.*.E", MPM_KEY_REAL, NULL, 0, HUGE_VAL, 1, 0, NULL,
@@ -48,7 +48,12 @@ const mpm_key_spec solid_keys[] = {
      "initial velocity, m/s (dim values; extra values are ignored)", 0},
     {"solid.*.ppc", MPM_KEY_INT, "2", 1, 8, 0, 0, NULL, "particles per cell per direction", 0},
 };
-const int solid_nkeys = (int)(sizeof solid_keys / sizeof solid_keys[0]);
+
+int solid_add_schema(mpm_config *cfg) {
+  for (size_t k = 0; k < sizeof solid_keys / sizeof solid_keys[0]; ++k)
+    if (solid_keys[k].type == MPM_KEY_ENUM) solid_keys[k].choices = solid_material_names();
+  return mpm_config_add_schema(cfg, solid_keys, (int)(sizeof solid_keys / sizeof solid_keys[0]));
+}
 
 int solid_particles_new(mpm_particles **p, int dim) {
   const mpm_field_desc fields[F_COUNT] = {{"x", dim}, {"v", dim}, {"F", dim * dim},
@@ -56,9 +61,8 @@ int solid_particles_new(mpm_particles **p, int dim) {
   return mpm_particles_new(p, dim, fields, F_COUNT, 3);
 }
 
-static int key_of(char *key, size_t size, const char *section, const char *name) {
+static void key_of(char *key, size_t size, const char *section, const char *name) {
   snprintf(key, size, "%s.%s", section, name);
-  return 0;
 }
 
 /* Seed one body and append it to the particle set. */
@@ -77,6 +81,7 @@ static int seed_body(mpm_module *m, const mpm_config *cfg, int b, double *lp) {
   MPM_CALL(mpm_config_get_int(cfg, key, &ppc));
   key_of(key, sizeof key, sc->body[b].section, "velocity");
   MPM_CALL(mpm_config_get_reals(cfg, key, v0, 3, &nv));
+  if (nv < dim) return mpm_config_fail(cfg, key, "needs %d values, got %d", dim, nv);
   *lp = fmin(*lp, 0.5 / ppc);
 
   mpm_region *region = NULL;
@@ -95,7 +100,9 @@ static int seed_body(mpm_module *m, const mpm_config *cfg, int b, double *lp) {
   mpm_lidx n;
   double *x;
   mpm_gidx *id;
-  int rc = mpm_region_seed(region, g, ppc, b * mpm_region_seed_span(g, ppc), &n, &x, &id);
+  /* Each body takes a fresh block of ids as wide as its seeding lattice. */
+  const mpm_gidx id_base = p->id_next;
+  int rc = mpm_region_seed(region, g, ppc, id_base, &n, &x, &id);
   mpm_region_destroy(&region);
   MPM_CALL(rc);
 
@@ -117,14 +124,15 @@ static int seed_body(mpm_module *m, const mpm_config *cfg, int b, double *lp) {
   free(x);
   free(id);
   MPM_CALL(rc);
-  /* Ids of later injections start past every lattice id. */
-  p->id_next = MPM_MAX(p->id_next, (b + 1) * mpm_region_seed_span(g, ppc));
-  mpm_gidx total;
-  MPM_CALL(mpm_particles_global_count(p, g->comm, &total));
-  if (total == 0)
-    return mpm_config_fail(cfg, key, "body '%s' has no particles: its geometry '%s' lies "
-                                     "outside the domain or is thinner than a particle spacing",
-                           sc->body[b].section, geom);
+  p->id_next = id_base + mpm_region_seed_span(g, ppc);
+  mpm_gidx local = n, total;
+  MPM_CALL_MPI(MPI_Allreduce(&local, &total, 1, MPM_MPI_GIDX, MPI_SUM, g->comm));
+  if (total == 0) {
+    key_of(key, sizeof key, sc->body[b].section, "geometry");
+    return mpm_config_fail(cfg, key, "body '%s' has no particles: region '%s' is thinner than "
+                                     "the particle spacing %g; refine grid.dx or raise ppc",
+                           sc->body[b].section, geom, g->dx / ppc);
+  }
   mpm_log(MPM_LOG_INFO, "solid body %s: %lld particles, material %s", sc->body[b].section,
           (long long)total, sc->body[b].mat->ops->name);
   return 0;
@@ -190,8 +198,7 @@ static int solid_p2g(mpm_module *m, double t, const double *y) {
 
 static int solid_grid_update(mpm_module *m, double t, double h) {
   (void)t;
-  mpm_grid_phase_update(m->grid, m->phase, h);
-  return 0;
+  return mpm_grid_phase_update(m->grid, m->phase, h);
 }
 
 /* dx/dt = sum S v_i, dv/dt = sum S a_i, dF/dt = L F with L = sum v_i (x) grad S. */
@@ -258,14 +265,9 @@ static int solid_check(const mpm_module *m, const double *y, mpm_fault *fault) {
   const double *F = y + (size_t)p->offset[F_F] * p->n;
   for (mpm_lidx i = 0; i < p->n; ++i) {
     const double J = det(p->dim, F, p->n, i);
-    if (J <= 0.0) {
-      fault->set = 1;
-      fault->id = p->id[i];
-      for (int d = 0; d < p->dim; ++d) fault->x[d] = y[(size_t)d * p->n + i];
-      snprintf(fault->cause, sizeof fault->cause,
-               "the deformation gradient is inverted (J = %.3g <= 0)", J);
-      return 1;
-    }
+    if (J <= 0.0)
+      return mpm_fault_at(fault, p, y, i, "the deformation gradient is inverted (J = %.3g <= 0)",
+                          J);
   }
   return 0;
 }

@@ -9,9 +9,8 @@
 #include "mpm_config.h"
 #include "mpm_module.h"
 
-/* Keys of [solid.NAME] sections. */
-extern const mpm_key_spec solid_keys[];
-extern const int solid_nkeys;
+/* Add the keys of [solid.NAME] sections (material names from the registry) to cfg. */
+int solid_add_schema(mpm_config *cfg);
 
 /* Field layout of solid particles (for checkpoints). */
 int solid_particles_new(mpm_particles **p, int dim);

@@ -3,6 +3,7 @@ output. Run with Debian's /usr/bin/python3, which has h5py."""
 import os
 import subprocess
 import sys
+import tempfile
 import xml.etree.ElementTree as ET
 
 import h5py
@@ -15,6 +16,11 @@ SOURCE = os.environ.get("MPMFSI_SOURCE_DIR", os.path.join(os.path.dirname(__file
 
 def case(name):
     return os.path.join(SOURCE, "cases", name)
+
+
+def outdir(name):
+    """A fresh output folder for one run of a test (runs never share folders)."""
+    return tempfile.mkdtemp(prefix=name + "_", dir=".")
 
 
 def run(args, ranks=1, check=True):

@@ -42,7 +42,7 @@ def analytic_error(outdir, v0, g):
 
 for dim, name, v0, g in [(2, "ballistic2d.ini", [3, 2], [0, -9.81]),
                          (3, "ballistic3d.ini", [2, 1, 1], [0, 0, -9.81])]:
-    serial, par = f"out_{dim}d_np1", f"out_{dim}d_np2"
+    serial, par = mt.outdir(f"ballistic{dim}d_np1"), mt.outdir(f"ballistic{dim}d_np2")
     mt.run(["run", mt.case(name), f"output.dir={serial}", "run.progress=false"])
     err, snaps = analytic_error(serial, v0, g)
     check(len(snaps) >= 3, f"{dim}-D: {len(snaps)} snapshots written")

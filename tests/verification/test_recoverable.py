@@ -21,16 +21,16 @@ def check(cond, msg):
     print(("ok   " if cond else "FAIL ") + msg)
 
 
-for ranks in (1, 2):
-    out = f"out_wall_np{ranks}"
+for ranks, method in ((1, "bs32"), (2, "bs32"), (1, "usl"), (2, "usl")):
+    out = mt.outdir(f"wall_{method}_np{ranks}")
     p = mt.run(["run", mt.case("ballistic2d.ini"), f"output.dir={out}", "run.progress=false",
-                "solid.block.velocity=40 0", "time.t_end=0.2", "output.interval=0.02"],
-               ranks=ranks, check=False)
+                "solid.block.velocity=40 0", "time.t_end=0.2", "output.interval=0.02",
+                f"time.method={method}"], ranks=ranks, check=False)
     errors = [l for l in p.stderr.splitlines() if "error:" in l]
     msg = errors[0] if errors else p.stderr.strip()[-300:]
-    check(p.returncode != 0, f"np{ranks}: exit status {p.returncode} (non-zero)")
+    check(p.returncode != 0, f"{method} np{ranks}: exit status {p.returncode} (non-zero)")
     check(len(errors) == 1 and "particle" in msg and "left the domain" in msg and "(" in msg,
-          f"np{ranks}: one message with particle, position and cause: {msg}")
+          f"{method} np{ranks}: one message with particle, position and cause: {msg}")
     snaps = mt.snapshots(out)
     ok = len(snaps) >= 2
     for t, path in snaps:
@@ -39,6 +39,6 @@ for ranks in (1, 2):
         except Exception as e:  # noqa: BLE001
             ok = False
             print("unreadable", path, e)
-    check(ok, f"np{ranks}: {len(snaps)} snapshots written before the failure are readable")
+    check(ok, f"{method} np{ranks}: {len(snaps)} snapshots written before the failure are readable")
 
 sys.exit(mt.report("test_recoverable", passed, failed))

@@ -29,7 +29,8 @@ T = 0.6
 common = [f"time.t_end={T}", "output.interval=0.1", "run.progress=false", "grid.dx=0.04"]
 for ranks in (1, 2):
     for method in ("usl", "bs32"):
-        full, rest, plain = (f"{x}_{method}_np{ranks}" for x in ("full", "restarted", "plain"))
+        full, rest, plain = (mt.outdir(f"{x}_{method}_np{ranks}")
+                             for x in ("full", "restarted", "plain"))
         mt.run(["run", case, f"output.dir={full}", f"time.method={method}",
                 f"output.checkpoint_interval={T / 2}"] + common, ranks)
         ckpt = os.path.join(full, "checkpoint_000001.h5")
