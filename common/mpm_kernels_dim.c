@@ -14,31 +14,58 @@
 
 #define MPM_INLINE static inline __attribute__((always_inline))
 
-/* Stencil of one particle: box-local index of its first node, weights, gradients. */
+#if MPM_DIM == 3
+#define MAX_NODES (MPM_SHAPE_MAX_SUPPORT * MPM_SHAPE_MAX_SUPPORT * MPM_SHAPE_MAX_SUPPORT)
+#else
+#define MAX_NODES (MPM_SHAPE_MAX_SUPPORT * MPM_SHAPE_MAX_SUPPORT)
+#endif
+
+/* The nodes a particle touches: box index, weight and weight gradient of each. */
 typedef struct {
-  mpm_lidx first;
-  double w[MPM_DIM][MPM_SHAPE_MAX_SUPPORT];
-  double g[MPM_DIM][MPM_SHAPE_MAX_SUPPORT]; /* physical derivative, 1/dx applied */
+  int count;
+  mpm_lidx l[MAX_NODES];
+  double w[MAX_NODES];
+  double grad[MAX_NODES][MPM_DIM];
 } DIMFN(stencil);
 
+/* Expand the tensor-product stencil of a particle at x into its node list. */
 MPM_INLINE void DIMFN(stencil_eval)(const mpm_grid *g, mpm_shape_kind kind, const double *x,
                                     double lp, DIMFN(stencil) * s) {
+  const int S = mpm_shape_support(kind);
   const double inv_dx = 1.0 / g->dx;
+  double w[MPM_DIM][MPM_SHAPE_MAX_SUPPORT], dw[MPM_DIM][MPM_SHAPE_MAX_SUPPORT];
   int gi[MPM_DIM];
   for (int d = 0; d < MPM_DIM; ++d) {
-    gi[d] = mpm_shape_1d(kind, (x[d] - g->lo[d]) * inv_dx, lp, s->w[d], s->g[d]);
-    for (int k = 0; k < MPM_SHAPE_MAX_SUPPORT; ++k) s->g[d][k] *= inv_dx;
+    gi[d] = mpm_shape_1d(kind, (x[d] - g->lo[d]) * inv_dx, lp, w[d], dw[d]);
+    for (int k = 0; k < MPM_SHAPE_MAX_SUPPORT; ++k) dw[d][k] *= inv_dx;
   }
-  s->first = mpm_grid_local_index(g, gi);
+  const mpm_lidx first = mpm_grid_local_index(g, gi), sy = g->box_n[0];
+  int q = 0;
+#if MPM_DIM == 3
+  const mpm_lidx sz = (mpm_lidx)g->box_n[0] * g->box_n[1];
+  for (int k = 0; k < S; ++k)
+#endif
+    for (int j = 0; j < S; ++j)
+      for (int i = 0; i < S; ++i, ++q) {
+#if MPM_DIM == 3
+        const double wjk = w[1][j] * w[2][k];
+        s->grad[q][0] = dw[0][i] * wjk;
+        s->grad[q][1] = w[0][i] * dw[1][j] * w[2][k];
+        s->grad[q][2] = w[0][i] * w[1][j] * dw[2][k];
+        s->l[q] = first + i + j * sy + k * sz;
+#else
+      const double wjk = w[1][j];
+      s->grad[q][0] = dw[0][i] * wjk;
+      s->grad[q][1] = w[0][i] * dw[1][j];
+      s->l[q] = first + i + j * sy;
+#endif
+        s->w[q] = w[0][i] * wjk;
+      }
+  s->count = q;
 }
 
 MPM_INLINE void DIMFN(p2g_loop)(mpm_grid *g, mpm_grid_phase *ph, const mpm_p2g_args *a,
                                 mpm_shape_kind kind) {
-  const int S = mpm_shape_support(kind);
-  const mpm_lidx sy = g->box_n[0];
-#if MPM_DIM == 3
-  const mpm_lidx sz = (mpm_lidx)g->box_n[0] * g->box_n[1];
-#endif
   for (mpm_lidx p = 0; p < a->n; ++p) {
     double x[MPM_DIM], mv[MPM_DIM], sig[MPM_DIM][MPM_DIM];
     const double m = a->m[p];
@@ -48,83 +75,54 @@ MPM_INLINE void DIMFN(p2g_loop)(mpm_grid *g, mpm_grid_phase *ph, const mpm_p2g_a
         sig[r][c] = a->vsig ? a->vsig[(size_t)(r * MPM_DIM + c) * (size_t)a->n + p] : 0.0;
     DIMFN(stencil) s;
     DIMFN(stencil_eval)(g, kind, x, a->lp, &s);
-#if MPM_DIM == 3
-    for (int k = 0; k < S; ++k)
-#else
-    const int k = 0;
-#endif
-      for (int j = 0; j < S; ++j)
-        for (int i = 0; i < S; ++i) {
-#if MPM_DIM == 3
-          const double wjk = s.w[1][j] * s.w[2][k];
-          const double grad[3] = {s.g[0][i] * wjk, s.w[0][i] * s.g[1][j] * s.w[2][k],
-                                  s.w[0][i] * s.w[1][j] * s.g[2][k]};
-          const mpm_lidx l = s.first + i + j * sy + k * sz;
-#else
-        (void)k;
-        const double wjk = s.w[1][j];
-        const double grad[2] = {s.g[0][i] * wjk, s.w[0][i] * s.g[1][j]};
-        const mpm_lidx l = s.first + i + j * sy;
-#endif
-          const double w = s.w[0][i] * wjk;
-          ph->m_i[l] += w * m;
-          for (int d = 0; d < MPM_DIM; ++d) {
-            double f = w * m * a->gravity[d];
-            for (int c = 0; c < MPM_DIM; ++c) f -= sig[d][c] * grad[c];
-            ph->mv_i[d][l] += w * mv[d];
-            ph->f_i[d][l] += f;
-          }
-        }
+    for (int q = 0; q < s.count; ++q) {
+      const mpm_lidx l = s.l[q];
+      const double w = s.w[q];
+      ph->m_i[l] += w * m;
+      for (int d = 0; d < MPM_DIM; ++d) {
+        double f = w * m * a->gravity[d];
+        for (int c = 0; c < MPM_DIM; ++c) f -= sig[d][c] * s.grad[q][c];
+        ph->mv_i[d][l] += w * mv[d];
+        ph->f_i[d][l] += f;
+      }
+    }
   }
 }
 
 static void DIMFN(p2g)(mpm_grid *g, int phase, const mpm_p2g_args *a) {
   mpm_grid_phase *ph = &g->phase[phase];
   switch (g->shape) {
-  case MPM_SHAPE_LINEAR: DIMFN(p2g_loop)(g, ph, a, MPM_SHAPE_LINEAR); break;
-  case MPM_SHAPE_GIMP: DIMFN(p2g_loop)(g, ph, a, MPM_SHAPE_GIMP); break;
-  case MPM_SHAPE_QUADRATIC: DIMFN(p2g_loop)(g, ph, a, MPM_SHAPE_QUADRATIC); break;
-  default: DIMFN(p2g_loop)(g, ph, a, MPM_SHAPE_CUBIC); break;
+  case MPM_SHAPE_LINEAR:
+    DIMFN(p2g_loop)(g, ph, a, MPM_SHAPE_LINEAR);
+    break;
+  case MPM_SHAPE_GIMP:
+    DIMFN(p2g_loop)(g, ph, a, MPM_SHAPE_GIMP);
+    break;
+  case MPM_SHAPE_QUADRATIC:
+    DIMFN(p2g_loop)(g, ph, a, MPM_SHAPE_QUADRATIC);
+    break;
+  default:
+    DIMFN(p2g_loop)(g, ph, a, MPM_SHAPE_CUBIC);
+    break;
   }
 }
 
 MPM_INLINE void DIMFN(g2p_loop)(const mpm_grid *g, const mpm_g2p_args *a, mpm_shape_kind kind) {
-  const int S = mpm_shape_support(kind);
-  const mpm_lidx sy = g->box_n[0];
-#if MPM_DIM == 3
-  const mpm_lidx sz = (mpm_lidx)g->box_n[0] * g->box_n[1];
-#endif
   for (mpm_lidx p = 0; p < a->n; ++p) {
     double x[MPM_DIM], v[MPM_DIM] = {0}, acc[MPM_DIM] = {0}, L[MPM_DIM][MPM_DIM] = {{0}};
     for (int d = 0; d < MPM_DIM; ++d) x[d] = a->x[d][p];
     DIMFN(stencil) s;
     DIMFN(stencil_eval)(g, kind, x, a->lp, &s);
-#if MPM_DIM == 3
-    for (int k = 0; k < S; ++k)
-#else
-    const int k = 0;
-#endif
-      for (int j = 0; j < S; ++j)
-        for (int i = 0; i < S; ++i) {
-#if MPM_DIM == 3
-          const double wjk = s.w[1][j] * s.w[2][k];
-          const double grad[3] = {s.g[0][i] * wjk, s.w[0][i] * s.g[1][j] * s.w[2][k],
-                                  s.w[0][i] * s.w[1][j] * s.g[2][k]};
-          const mpm_lidx l = s.first + i + j * sy + k * sz;
-#else
-        (void)k;
-        const double wjk = s.w[1][j];
-        const double grad[2] = {s.g[0][i] * wjk, s.w[0][i] * s.g[1][j]};
-        const mpm_lidx l = s.first + i + j * sy;
-#endif
-          const double w = s.w[0][i] * wjk;
-          for (int d = 0; d < MPM_DIM; ++d) {
-            const double vi = a->v_i[d][l];
-            v[d] += w * vi;
-            acc[d] += w * a->a_i[d][l];
-            for (int c = 0; c < MPM_DIM; ++c) L[d][c] += vi * grad[c];
-          }
-        }
+    for (int q = 0; q < s.count; ++q) {
+      const mpm_lidx l = s.l[q];
+      const double w = s.w[q];
+      for (int d = 0; d < MPM_DIM; ++d) {
+        const double vi = a->v_i[d][l];
+        v[d] += w * vi;
+        acc[d] += w * a->a_i[d][l];
+        for (int c = 0; c < MPM_DIM; ++c) L[d][c] += vi * s.grad[q][c];
+      }
+    }
     for (int d = 0; d < MPM_DIM; ++d) {
       a->v_out[d][p] = v[d];
       a->a_out[d][p] = acc[d];
@@ -138,10 +136,18 @@ MPM_INLINE void DIMFN(g2p_loop)(const mpm_grid *g, const mpm_g2p_args *a, mpm_sh
 
 static void DIMFN(g2p)(const mpm_grid *g, const mpm_g2p_args *a) {
   switch (g->shape) {
-  case MPM_SHAPE_LINEAR: DIMFN(g2p_loop)(g, a, MPM_SHAPE_LINEAR); break;
-  case MPM_SHAPE_GIMP: DIMFN(g2p_loop)(g, a, MPM_SHAPE_GIMP); break;
-  case MPM_SHAPE_QUADRATIC: DIMFN(g2p_loop)(g, a, MPM_SHAPE_QUADRATIC); break;
-  default: DIMFN(g2p_loop)(g, a, MPM_SHAPE_CUBIC); break;
+  case MPM_SHAPE_LINEAR:
+    DIMFN(g2p_loop)(g, a, MPM_SHAPE_LINEAR);
+    break;
+  case MPM_SHAPE_GIMP:
+    DIMFN(g2p_loop)(g, a, MPM_SHAPE_GIMP);
+    break;
+  case MPM_SHAPE_QUADRATIC:
+    DIMFN(g2p_loop)(g, a, MPM_SHAPE_QUADRATIC);
+    break;
+  default:
+    DIMFN(g2p_loop)(g, a, MPM_SHAPE_CUBIC);
+    break;
   }
 }
 
@@ -149,3 +155,4 @@ const mpm_kernels DIMFN(mpm_kernels) = {MPM_DIM, DIMFN(p2g), DIMFN(g2p)};
 
 #undef DIMFN
 #undef MPM_INLINE
+#undef MAX_NODES
