@@ -6,3 +6,5 @@ mpm_add_script_test(test_bad_input SCRIPT conformance/test_bad_input.py
                     LABELS "conformance" TIMEOUT 600)
 mpm_add_script_test(test_recoverable SCRIPT verification/test_recoverable.py
                     LABELS "verification" TIMEOUT 600)
+mpm_add_script_test(test_decomposition SCRIPT verification/test_decomposition.py
+                    LABELS "verification;mpi" TIMEOUT 600)
