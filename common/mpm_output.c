@@ -7,8 +7,10 @@
  * - out->next, the index of the next snapshot, is equal on every rank. It advances once the
  *   file is in place, even if the index could not be rewritten, so no file is reused.
  * - Every rank takes part in every collective HDF5 call, with an empty selection when it
- *   has nothing to write. Local failures (allocations) are agreed on with an MPI_Allreduce
- *   before the next collective call, so all ranks return the same code instead of waiting.
+ *   has nothing to write. Local failures (checks, allocations) are agreed on with an
+ *   MPI_Allreduce before the next collective call, so all ranks return the same code
+ *   instead of waiting; the HDF5 helpers of mpm_h5.h do the same inside each write, so
+ *   every function below that writes returns the same code on every rank.
  * - Particle rows are in rank order: rank r holds rows [offset_r, offset_r + n_r) with
  *   offset_r = MPI_Exscan of the counts. Particle data is component-major in memory and
  *   row-major ([N][ncomp]) on disk, so each field is transposed through one buffer.
@@ -16,9 +18,8 @@
 #define _POSIX_C_SOURCE 200809L /* mkdir, stat, access */
 #include "mpm_output.h"
 #include "mpm_error.h"
+#include "mpm_h5.h"
 #include "mpm_xdmf.h"
-
-#include <hdf5.h>
 
 #include <errno.h>
 #include <stdio.h>
@@ -43,78 +44,11 @@ typedef struct phase_rows {
   int64_t n, offset, total;
 } phase_rows;
 
-/* A failure every rank meets at once (a collective call failed): rank 0 explains it and the
- * others only return the code, so the user reads the message once. */
-#define FAIL_ON_ROOT(rank, code, ...)                                                              \
-  do {                                                                                             \
-    if ((rank) == 0) MPM_FAIL(code, __VA_ARGS__);                                                  \
-    return mpm_trace(__FILE__, __LINE__, __func__, (code));                                        \
-  } while (0)
-
-/* The largest code over all ranks: every rank then returns the same result. */
-static int agree(MPI_Comm comm, int rc) {
-  int worst = rc;
-  if (MPI_Allreduce(&rc, &worst, 1, MPI_INT, MPI_MAX, comm) != MPI_SUCCESS) return MPM_ERR_MPI;
-  return worst;
-}
-
 static char *path_join(const char *dir, const char *name) {
   const size_t len = strlen(dir) + strlen(name) + 2;
   char *s = malloc(len);
   if (s) snprintf(s, len, "%s/%s", dir, name);
   return s;
-}
-
-/* ---- HDF5 helpers ---------------------------------------------------------------------- */
-
-static int attr_write(hid_t loc, const char *name, hid_t type, int n, const void *value) {
-  const hsize_t dims = (hsize_t)n;
-  const hid_t space = n == 1 ? H5Screate(H5S_SCALAR) : H5Screate_simple(1, &dims, NULL);
-  const hid_t a = H5Acreate2(loc, name, type, space, H5P_DEFAULT, H5P_DEFAULT);
-  const herr_t w = a >= 0 ? H5Awrite(a, type, value) : -1;
-  if (a >= 0) H5Aclose(a);
-  H5Sclose(space);
-  if (w < 0) MPM_FAIL(MPM_ERR_HDF5, "cannot write the HDF5 attribute '%s'", name);
-  return 0;
-}
-
-/* Variable-length strings: they live in the file's global heap, so a long case text does
- * not hit the 64 KiB limit of an object header, and h5py reads them as str. */
-static int attr_string(hid_t loc, const char *name, const char *value) {
-  const hid_t type = H5Tcopy(H5T_C_S1);
-  H5Tset_size(type, H5T_VARIABLE);
-  H5Tset_cset(type, H5T_CSET_UTF8);
-  const int rc = attr_write(loc, name, type, 1, &value);
-  H5Tclose(type);
-  return rc;
-}
-
-/* Create dataset `name` (extents fdims) under loc and write this rank's block [start,
- * start + count) from the contiguous buffer buf. A rank with an empty block still takes
- * part in the collective write, selecting nothing. */
-static int write_block(hid_t loc, const char *name, hid_t ftype, hid_t mtype, int rank,
-                       const hsize_t *fdims, const hsize_t *start, const hsize_t *count,
-                       const void *buf, hid_t dxpl) {
-  static const double dummy = 0; /* a valid pointer for an empty write */
-  hsize_t n = 1, one = 1, total = 1;
-  for (int d = 0; d < rank; ++d) n *= count[d], total *= fdims[d];
-  const hid_t fspace = H5Screate_simple(rank, fdims, NULL);
-  const hid_t mspace = n ? H5Screate_simple(rank, count, NULL) : H5Screate_simple(1, &one, NULL);
-  const hid_t dset = H5Dcreate2(loc, name, ftype, fspace, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
-  herr_t st = dset < 0 || fspace < 0 || mspace < 0 ? -1 : 0;
-  if (st >= 0 && n) st = H5Sselect_hyperslab(fspace, H5S_SELECT_SET, start, NULL, count, NULL);
-  if (st >= 0 && !n) st = H5Sselect_none(fspace) < 0 || H5Sselect_none(mspace) < 0 ? -1 : 0;
-  /* An empty dataset has no storage: even an empty collective write would fail on it. */
-  if (st >= 0 && total) st = H5Dwrite(dset, mtype, mspace, fspace, dxpl, n ? buf : &dummy);
-  if (dset >= 0) H5Dclose(dset);
-  if (mspace >= 0) H5Sclose(mspace);
-  if (fspace >= 0) H5Sclose(fspace);
-  if (st < 0) MPM_FAIL(MPM_ERR_HDF5, "cannot write the dataset '%s' of a snapshot", name);
-  return 0;
-}
-
-static hid_t create_group(hid_t loc, const char *name) {
-  return H5Gcreate2(loc, name, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
 }
 
 /* ---- particles ------------------------------------------------------------------------- */
@@ -128,26 +62,26 @@ static void transpose(const mpm_particles *p, int f, double *buf) {
   }
 }
 
-static int write_particle_fields(hid_t g, hid_t dxpl, const mpm_particles *p, const phase_rows *r,
-                                 double *buf) {
+static int write_particle_fields(const mpm_h5 *h, hid_t g, const mpm_particles *p,
+                                 const phase_rows *r, double *buf) {
   hsize_t fdims[2] = {(hsize_t)r->total, 0}, start[2] = {(hsize_t)r->offset, 0},
           count[2] = {(hsize_t)r->n, 0};
-  MPM_CALL(
-      write_block(g, "id", H5T_STD_I64LE, H5T_NATIVE_INT64, 1, fdims, start, count, p->id, dxpl));
+  MPM_CALL(mpm_h5_write_block(h, g, "id", H5T_STD_I64LE, H5T_NATIVE_INT64, 1, fdims, start, count,
+                              p->id));
   for (int f = 0; f < p->nfields; ++f) {
     transpose(p, f, buf);
     fdims[1] = count[1] = (hsize_t)p->field[f].ncomp;
-    MPM_CALL(write_block(g, p->field[f].name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 2, fdims, start,
-                         count, buf, dxpl));
+    MPM_CALL(mpm_h5_write_block(h, g, p->field[f].name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 2, fdims,
+                                start, count, buf));
   }
   return 0;
 }
 
-static int write_particles(hid_t file, hid_t dxpl, const mpm_particles *p, const char *name,
+static int write_particles(const mpm_h5 *h, hid_t file, const mpm_particles *p, const char *name,
                            const phase_rows *r, double *buf) {
-  const hid_t g = create_group(file, name);
-  if (g < 0) MPM_FAIL(MPM_ERR_HDF5, "cannot create the group /%s of a snapshot", name);
-  const int rc = write_particle_fields(g, dxpl, p, r, buf);
+  hid_t g;
+  MPM_CALL(mpm_h5_group(h, file, name, &g));
+  const int rc = write_particle_fields(h, g, p, r, buf);
   H5Gclose(g);
   MPM_CALL(rc);
   return 0;
@@ -200,7 +134,7 @@ static int check_grid(const mpm_grid *g, int dim) {
   return 0;
 }
 
-static int write_grid_phase(hid_t gg, hid_t dxpl, const mpm_grid *g, int k, double *buf) {
+static int write_grid_phase(const mpm_h5 *h, hid_t gg, const mpm_grid *g, int k, double *buf) {
   const int dim = g->dim;
   hsize_t fdims[4], start[4], count[4];
   for (int d = 0; d < dim; ++d) { /* slowest first: [Nz][Ny][Nx] */
@@ -210,16 +144,16 @@ static int write_grid_phase(hid_t gg, hid_t dxpl, const mpm_grid *g, int k, doub
   }
   fdims[dim] = count[dim] = (hsize_t)dim, start[dim] = 0;
   const mpm_grid_phase *ph = &g->phase[k];
-  const hid_t sub = create_group(gg, ph->name);
-  if (sub < 0) MPM_FAIL(MPM_ERR_HDF5, "cannot create the group /grid/%s of a snapshot", ph->name);
+  hid_t sub;
+  MPM_CALL(mpm_h5_group(h, gg, ph->name, &sub));
   double *m[1] = {ph->m_i};
   pack_owned(g, m, 1, buf);
-  int rc =
-      write_block(sub, "m", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, dim, fdims, start, count, buf, dxpl);
+  int rc = mpm_h5_write_block(h, sub, "m", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, dim, fdims, start,
+                              count, buf);
   if (!rc) {
     pack_owned(g, ph->v_i, dim, buf);
-    rc = write_block(sub, "v", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, dim + 1, fdims, start, count, buf,
-                     dxpl);
+    rc = mpm_h5_write_block(h, sub, "v", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, dim + 1, fdims, start,
+                            count, buf);
   }
   H5Gclose(sub);
   MPM_CALL(rc);
@@ -232,22 +166,22 @@ static int has_name(const char *const *names, int n, const char *name) {
   return 0;
 }
 
-static int write_grid_fields(hid_t gg, hid_t dxpl, const mpm_grid *g, const char *const *names,
+static int write_grid_fields(const mpm_h5 *h, hid_t gg, const mpm_grid *g, const char *const *names,
                              int nphases, double *buf) {
   double origin[MPM_MAX_DIM];
   for (int d = 0; d < g->dim; ++d) origin[d] = g->lo[d] - g->pad * g->dx;
-  MPM_CALL(attr_write(gg, "origin", H5T_NATIVE_DOUBLE, g->dim, origin));
-  MPM_CALL(attr_write(gg, "spacing", H5T_NATIVE_DOUBLE, 1, &g->dx));
+  MPM_CALL(mpm_h5_attr(h, gg, "origin", H5T_NATIVE_DOUBLE, g->dim, origin));
+  MPM_CALL(mpm_h5_attr(h, gg, "spacing", H5T_NATIVE_DOUBLE, 1, &g->dx));
   for (int k = 0; k < g->nphases; ++k)
-    if (has_name(names, nphases, g->phase[k].name)) MPM_CALL(write_grid_phase(gg, dxpl, g, k, buf));
+    if (has_name(names, nphases, g->phase[k].name)) MPM_CALL(write_grid_phase(h, gg, g, k, buf));
   return 0;
 }
 
-static int write_grid(hid_t file, hid_t dxpl, const mpm_grid *g, const char *const *names,
+static int write_grid(const mpm_h5 *h, hid_t file, const mpm_grid *g, const char *const *names,
                       int nphases, double *buf) {
-  const hid_t gg = create_group(file, "grid");
-  if (gg < 0) MPM_FAIL(MPM_ERR_HDF5, "cannot create the group /grid of a snapshot");
-  const int rc = write_grid_fields(gg, dxpl, g, names, nphases, buf);
+  hid_t gg;
+  MPM_CALL(mpm_h5_group(h, file, "grid", &gg));
+  const int rc = write_grid_fields(h, gg, g, names, nphases, buf);
   H5Gclose(gg);
   MPM_CALL(rc);
   return 0;
@@ -256,6 +190,7 @@ static int write_grid(hid_t file, hid_t dxpl, const mpm_grid *g, const char *con
 /* ---- one snapshot file ----------------------------------------------------------------- */
 
 typedef struct snapshot {
+  const mpm_output *out;
   double t;
   long step;
   const mpm_particles *const *phases;
@@ -266,53 +201,18 @@ typedef struct snapshot {
   double *buf;
 } snapshot;
 
-static int write_contents(const mpm_output *out, hid_t file, const snapshot *s) {
+/* Fills the snapshot file (an mpm_h5_fill; arg is the snapshot). */
+static int write_contents(const mpm_h5 *h, hid_t file, const void *arg) {
+  const snapshot *s = arg;
   const int64_t step = s->step;
-  MPM_CALL(attr_write(file, "time", H5T_NATIVE_DOUBLE, 1, &s->t));
-  MPM_CALL(attr_write(file, "step", H5T_NATIVE_INT64, 1, &step));
-  MPM_CALL(attr_write(file, "dim", H5T_NATIVE_INT, 1, &out->dim));
-  MPM_CALL(attr_string(file, "config", out->config));
-  MPM_CALL(attr_string(file, "version", OUTPUT_VERSION));
-  const hid_t dxpl = H5Pcreate(H5P_DATASET_XFER);
-  if (dxpl < 0 || H5Pset_dxpl_mpio(dxpl, H5FD_MPIO_COLLECTIVE) < 0)
-    MPM_FAIL(MPM_ERR_HDF5, "cannot set up collective HDF5 transfers");
-  int rc = 0;
-  for (int k = 0; k < s->nphases && !rc; ++k)
-    rc = write_particles(file, dxpl, s->phases[k], s->names[k], &s->rows[k], s->buf);
-  if (!rc && s->grid) rc = write_grid(file, dxpl, s->grid, s->names, s->nphases, s->buf);
-  H5Pclose(dxpl);
-  MPM_CALL(rc);
-  return 0;
-}
-
-/* Create path collectively; HDF5's own error stack is silenced so that the user sees one
- * message saying what to do rather than a page of library internals. */
-static hid_t create_file(MPI_Comm comm, const char *path) {
-  H5E_auto2_t func;
-  void *data;
-  const hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
-  if (fapl < 0 || H5Pset_fapl_mpio(fapl, comm, MPI_INFO_NULL) < 0) return -1;
-  H5Pset_coll_metadata_write(fapl, 1);
-  H5Eget_auto2(H5E_DEFAULT, &func, &data);
-  H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
-  const hid_t file = H5Fcreate(path, H5F_ACC_TRUNC, H5P_DEFAULT, fapl);
-  H5Eset_auto2(H5E_DEFAULT, func, data);
-  H5Pclose(fapl);
-  return file;
-}
-
-static int write_file(const mpm_output *out, const char *path, const snapshot *s) {
-  const hid_t file = create_file(out->comm, path);
-  if (file < 0)
-    FAIL_ON_ROOT(out->rank, MPM_ERR_FILE,
-                 "cannot create the snapshot %s: check that the output directory still exists, "
-                 "is writable and that the disk is not full",
-                 path);
-  int rc = write_contents(out, file, s);
-  if (H5Fclose(file) < 0 && !rc)
-    FAIL_ON_ROOT(out->rank, MPM_ERR_FILE, "cannot finish the snapshot %s (is the disk full?)",
-                 path);
-  MPM_CALL(rc);
+  MPM_CALL(mpm_h5_attr(h, file, "time", H5T_NATIVE_DOUBLE, 1, &s->t));
+  MPM_CALL(mpm_h5_attr(h, file, "step", H5T_NATIVE_INT64, 1, &step));
+  MPM_CALL(mpm_h5_attr(h, file, "dim", H5T_NATIVE_INT, 1, &s->out->dim));
+  MPM_CALL(mpm_h5_attr_string(h, file, "config", s->out->config));
+  MPM_CALL(mpm_h5_attr_string(h, file, "version", OUTPUT_VERSION));
+  for (int k = 0; k < s->nphases; ++k)
+    MPM_CALL(write_particles(h, file, s->phases[k], s->names[k], &s->rows[k], s->buf));
+  if (s->grid) MPM_CALL(write_grid(h, file, s->grid, s->names, s->nphases, s->buf));
   return 0;
 }
 
@@ -411,7 +311,7 @@ static int check_phases(const mpm_output *out, const mpm_particles *const *phase
 static int count_rows(const mpm_output *out, const mpm_particles *const *phases, int nphases,
                       phase_rows *rows) {
   int64_t *n = malloc(3 * (size_t)(nphases ? nphases : 1) * sizeof *n);
-  const int ok = agree(out->comm, n ? 0 : MPM_ERR_MEMORY);
+  const int ok = mpm_h5_agree(out->comm, n ? 0 : MPM_ERR_MEMORY);
   if (ok) free(n);
   MPM_CALL(ok);
   int64_t *before = n + nphases, *total = n + 2 * nphases;
@@ -450,9 +350,11 @@ static int snapshot_write(mpm_output *out, snapshot *s) {
   s->buf = rc ? NULL : malloc(buffer_size(s->phases, s->nphases, s->grid) * sizeof(double));
   if (!s->buf && !rc) rc = MPM_ERR_MEMORY;
   if (rc) mpm_log_all(MPM_LOG_ERROR, "output: cannot allocate the snapshot buffers");
-  rc = agree(out->comm, rc);
-  if (!rc) rc = agree(out->comm, write_file(out, tmp, s));
-  /* The MPI_Allreduce above is the barrier: every rank has closed the file. */
+  rc = mpm_h5_agree(out->comm, rc);
+  const mpm_h5 h = {out->comm, out->rank, "snapshot"};
+  if (!rc) rc = mpm_h5_write_file(&h, tmp, write_contents, s);
+  /* mpm_h5_write_file returns once every rank has closed the file (its agreement is the
+   * barrier), or the agreement above failed on every rank. */
   int state[2] = {rc, 0};
   if (out->rank == 0 && !rc) state[0] = publish(out, tmp, final, s, &state[1]);
   if (out->rank == 0 && rc && tmp) remove(tmp);
@@ -466,13 +368,13 @@ static int snapshot_write(mpm_output *out, snapshot *s) {
 
 int mpm_output_snapshot(mpm_output *out, double t, long step, const mpm_particles *const *phases,
                         const char *const *names, int nphases, const mpm_grid *grid) {
-  phase_rows *rows;
-  MPM_CALL(check_phases(out, phases, names, nphases));
-  if (grid) MPM_CALL(check_grid(grid, out->dim));
-  rows = malloc((size_t)(nphases ? nphases : 1) * sizeof *rows);
-  int rc = agree(out->comm, rows ? 0 : MPM_ERR_MEMORY);
+  /* The checks are local (each rank checks its own block): agreed on before any collective. */
+  int rc = check_phases(out, phases, names, nphases);
+  if (!rc && grid) rc = check_grid(grid, out->dim);
+  phase_rows *rows = rc ? NULL : malloc((size_t)(nphases ? nphases : 1) * sizeof *rows);
+  rc = mpm_h5_agree(out->comm, rc ? rc : rows ? 0 : MPM_ERR_MEMORY);
   if (!rc) rc = count_rows(out, phases, nphases, rows);
-  snapshot s = {t, step, phases, names, nphases, grid, rows, NULL};
+  snapshot s = {out, t, step, phases, names, nphases, grid, rows, NULL};
   if (!rc) rc = snapshot_write(out, &s);
   free(rows);
   MPM_CALL(rc);
@@ -544,7 +446,7 @@ static int bcast_string(MPI_Comm comm, int rank, const char *in, char **out) {
   if (len > (unsigned long long)INT32_MAX - 1)
     MPM_FAIL(MPM_ERR_INPUT, "output: the case text is too long (%llu bytes)", len);
   *out = calloc(len + 1, 1);
-  MPM_CALL(agree(comm, *out ? 0 : MPM_ERR_MEMORY));
+  MPM_CALL(mpm_h5_agree(comm, *out ? 0 : MPM_ERR_MEMORY));
   if (rank == 0 && len) memcpy(*out, in, len);
   MPM_CALL_MPI(MPI_Bcast(*out, (int)len, MPI_CHAR, 0, comm));
   return 0;
@@ -557,7 +459,7 @@ static int output_init(mpm_output *out, MPI_Comm comm, const char *dir, const ch
   MPM_CALL_MPI(MPI_Comm_size(out->comm, &out->size));
   MPM_CALL(bcast_string(out->comm, out->rank, config_text, &out->config));
   out->dir = malloc(strlen(dir) + 1);
-  MPM_CALL(agree(out->comm, out->dir ? 0 : MPM_ERR_MEMORY));
+  MPM_CALL(mpm_h5_agree(out->comm, out->dir ? 0 : MPM_ERR_MEMORY));
   memcpy(out->dir, dir, strlen(dir) + 1);
   int state[2] = {0, 0};
   if (out->rank == 0) state[0] = prepare_index(out, append, t_restart), state[1] = out->next;

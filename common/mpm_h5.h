@@ -1,0 +1,82 @@
+/* Parallel HDF5 helpers shared by snapshots (mpm_output.c) and checkpoints
+ * (mpm_checkpoint.c): one place for how both open and create their files, write attributes
+ * and move one rank's block of a dataset. Internal to common/.
+ *
+ * Invariants, which the callers rely on:
+ *
+ * - A helper that takes a communicator (directly or through an mpm_h5) is collective: every
+ *   rank of the communicator calls it, and it returns the same value on every rank. It agrees
+ *   on each rank's local status (mpm_h5_agree) before every collective HDF5 call, so a
+ *   failure on one rank (an allocation, a dataspace) makes all ranks skip the call together
+ *   instead of leaving the others waiting in it.
+ * - Callers keep the same discipline: a decision whether to call a collective helper is
+ *   taken on an agreed value, so the ranks stay on one path through every collective call.
+ * - A failure every rank meets at once is explained by rank 0 only (MPM_FAIL_ON_ROOT); a
+ *   purely local failure is explained by the rank that met it.
+ * - Files are opened through the MPI-IO driver with collective metadata writes, and with
+ *   HDF5's own error stack silenced while opening, so the caller's message is the one the
+ *   user reads. Metadata reads stay independent: reading attributes needs no agreement. */
+#ifndef MPM_H5_H
+#define MPM_H5_H
+
+#include "mpm_error.h"
+
+#include <hdf5.h>
+#include <mpi.h>
+
+/* A failure every rank meets at once: rank 0 explains it and the others only return the
+ * code, so the user reads the message once. */
+#define MPM_FAIL_ON_ROOT(rank, code, ...)                                                          \
+  do {                                                                                             \
+    if ((rank) == 0) MPM_FAIL(code, __VA_ARGS__);                                                  \
+    return mpm_trace(__FILE__, __LINE__, __func__, (code));                                        \
+  } while (0)
+
+/* The largest code over all ranks (MPM_ERR_MPI if the reduction fails): every rank then
+ * returns the same result. Collective. */
+int mpm_h5_agree(MPI_Comm comm, int rc);
+
+/* Who writes, for the collective helpers below. */
+typedef struct mpm_h5 {
+  MPI_Comm comm;
+  int rank;         /* in comm */
+  const char *what; /* the kind of file, for messages: "snapshot", "checkpoint" */
+} mpm_h5;
+
+/* Fills a freshly created file; returns an agreed code. */
+typedef int (*mpm_h5_fill)(const mpm_h5 *h, hid_t file, const void *arg);
+
+/* Create path (truncating it), fill it and close it. Returns once every rank has closed the
+ * file, so the agreement doubles as a barrier: rank 0 may then rename it. */
+int mpm_h5_write_file(const mpm_h5 *h, const char *path, mpm_h5_fill fill, const void *arg);
+
+/* Open path read-only; the same file on every rank, or -1 on every rank (without a
+ * message: the caller says what went wrong). */
+hid_t mpm_h5_open(MPI_Comm comm, const char *path);
+
+/* Attribute name of n values (a scalar if n == 1) of memory type type. */
+int mpm_h5_attr(const mpm_h5 *h, hid_t loc, const char *name, hid_t type, int n, const void *value);
+
+/* A variable-length UTF-8 string: it lives in the file's global heap, so a long case text
+ * does not hit the 64 KiB limit of an object header, and h5py reads it as str. */
+int mpm_h5_attr_string(const mpm_h5 *h, hid_t loc, const char *name, const char *value);
+
+/* The memory type of mpm_h5_attr_string; the caller closes it. */
+hid_t mpm_h5_string_type(void);
+
+/* Create the group name under loc into *group, or fail on every rank. */
+int mpm_h5_group(const mpm_h5 *h, hid_t loc, const char *name, hid_t *group);
+
+/* Create dataset name (extents fdims, file type ftype) under loc and write this rank's block
+ * [start, start + count) from the contiguous buffer buf (memory type mtype). A rank with an
+ * empty block still takes part, selecting nothing. */
+int mpm_h5_write_block(const mpm_h5 *h, hid_t loc, const char *name, hid_t ftype, hid_t mtype,
+                       int rank, const hsize_t *fdims, const hsize_t *start, const hsize_t *count,
+                       const void *buf);
+
+/* Read this rank's block [start, start + count) of dset into buf. 0, or MPM_ERR_HDF5 on
+ * every rank without a message. */
+int mpm_h5_read_block(MPI_Comm comm, hid_t dset, hid_t mtype, int rank, const hsize_t *start,
+                      const hsize_t *count, void *buf);
+
+#endif
