@@ -44,8 +44,7 @@ static int set_logging(const mpm_config *cfg) {
 }
 
 /* Read the case (or the checkpoint's stored case), apply overrides, validate. */
-static int load_config(mpm_config *cfg, const char *cmd, const char *path, int argc,
-                       char **argv) {
+static int load_config(mpm_config *cfg, const char *cmd, const char *path, int argc, char **argv) {
   MPM_CALL(mpm_sim_add_schema(cfg));
   if (strcmp(cmd, "restart") == 0) {
     mpm_checkpoint *ck = NULL;
@@ -80,8 +79,10 @@ static int run(const char *cmd, const char *path, int argc, char **argv) {
   if (!rc)
     rc = strcmp(cmd, "restart") == 0 ? mpm_sim_restart(&sim, cfg, path) : mpm_sim_create(&sim, cfg);
   /* check builds everything a run needs (so every input error shows), then stops. */
-  if (!rc && strcmp(cmd, "check") == 0) rc = print_resolved(cfg);
-  else if (!rc) rc = mpm_sim_run(sim);
+  if (!rc && strcmp(cmd, "check") == 0)
+    rc = print_resolved(cfg);
+  else if (!rc)
+    rc = mpm_sim_run(sim);
   mpm_sim_destroy(&sim);
   mpm_config_destroy(&cfg);
   return rc;

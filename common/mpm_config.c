@@ -990,7 +990,9 @@ static int section_has(const mpm_config *cfg, const char *sec, size_t len, const
 }
 
 /* A key without a default that is not marked optional must be set in every section used. */
-static int is_required(const mpm_key_spec *sp) { return !sp->def && !sp->optional; }
+static int is_required(const mpm_key_spec *sp) {
+  return !sp->def && !sp->optional;
+}
 
 /* Every used section that lacks the required key sp: one message each. */
 static int check_required(const mpm_config *cfg, const mpm_key_spec *sp) {

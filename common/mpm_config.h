@@ -29,12 +29,12 @@ typedef enum {
 } mpm_key_type;
 
 typedef struct mpm_key_spec {
-  const char *key;     /* dotted, "*" matches one instance component */
+  const char *key; /* dotted, "*" matches one instance component */
   mpm_key_type type;
-  const char *def;     /* default as text; NULL: no default (see optional) */
-  double min, max;     /* inclusive range for REAL, INT and each of REALS (use -HUGE_VAL/HUGE_VAL) */
-  int min_exclusive;   /* 1: value must be > min rather than >= min */
-  int max_count;       /* REALS: most values allowed (0 = any) */
+  const char *def;   /* default as text; NULL: no default (see optional) */
+  double min, max;   /* inclusive range for REAL, INT and each of REALS (use -HUGE_VAL/HUGE_VAL) */
+  int min_exclusive; /* 1: value must be > min rather than >= min */
+  int max_count;     /* REALS: most values allowed (0 = any) */
   const char *choices; /* ENUM: "a|b|c" */
   const char *help;    /* one line: meaning, unit, what a sensible value is */
   int optional;        /* with def == NULL: 1 = may stay unset (its consumer checks
@@ -53,8 +53,7 @@ int mpm_config_add_schema(mpm_config *cfg, const mpm_key_spec *specs, int n);
  * unreadable file, or a syntax error, is reported with the file (and line). */
 int mpm_config_read_file(mpm_config *cfg, const char *path);
 /* Parse case text; origin names it in messages ("case.ini"), dir resolves relative paths. */
-int mpm_config_read_string(mpm_config *cfg, const char *text, const char *origin,
-                           const char *dir);
+int mpm_config_read_string(mpm_config *cfg, const char *text, const char *origin, const char *dir);
 /* One "key=value" override from the command line; replaces an earlier value. */
 int mpm_config_override(mpm_config *cfg, const char *assignment);
 

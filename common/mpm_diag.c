@@ -54,7 +54,9 @@ int mpm_diag_open(mpm_diag **d, MPI_Comm comm, const char *path, int ncols,
     if (append && truncate_after(path, t_keep, &kept) != 0) kept = NULL;
     (*d)->f = fopen(path, "w");
     if (!(*d)->f) {
-      mpm_log_all(MPM_LOG_ERROR, "cannot write diagnostics '%s': %s; check that the output folder is writable", path, strerror(errno));
+      mpm_log_all(MPM_LOG_ERROR,
+                  "cannot write diagnostics '%s': %s; check that the output folder is writable",
+                  path, strerror(errno));
       status = MPM_ERR_FILE;
     } else if (kept && kept[0]) {
       fputs(kept, (*d)->f);
@@ -77,7 +79,8 @@ int mpm_diag_row(mpm_diag *d, const double *values) {
   if (!d->f) return 0;
   for (int c = 0; c < d->ncols; ++c) fprintf(d->f, "%s%.17g", c ? "," : "", values[c]);
   fputc('\n', d->f);
-  if (fflush(d->f) != 0) MPM_FAIL(MPM_ERR_FILE, "cannot write a diagnostics row: %s", strerror(errno));
+  if (fflush(d->f) != 0)
+    MPM_FAIL(MPM_ERR_FILE, "cannot write a diagnostics row: %s", strerror(errno));
   return 0;
 }
 

@@ -8,15 +8,15 @@
 #ifndef MPM_ERROR_H
 #define MPM_ERROR_H
 
-#define MPM_ERROR_LIST(X)                                                                      \
-  X(MPM_SUCCESS, "success")                                                                    \
-  X(MPM_ERR_MEMORY, "out of memory")                                                           \
-  X(MPM_ERR_INPUT, "invalid input")                                                            \
-  X(MPM_ERR_FILE, "file could not be read or written")                                         \
-  X(MPM_ERR_MPI, "MPI call failed")                                                            \
-  X(MPM_ERR_HDF5, "HDF5 call failed")                                                          \
-  X(MPM_ERR_SUNDIALS, "SUNDIALS call failed")                                                  \
-  X(MPM_ERR_UNPHYSICAL, "unphysical state")                                                    \
+#define MPM_ERROR_LIST(X)                                                                          \
+  X(MPM_SUCCESS, "success")                                                                        \
+  X(MPM_ERR_MEMORY, "out of memory")                                                               \
+  X(MPM_ERR_INPUT, "invalid input")                                                                \
+  X(MPM_ERR_FILE, "file could not be read or written")                                             \
+  X(MPM_ERR_MPI, "MPI call failed")                                                                \
+  X(MPM_ERR_HDF5, "HDF5 call failed")                                                              \
+  X(MPM_ERR_SUNDIALS, "SUNDIALS call failed")                                                      \
+  X(MPM_ERR_UNPHYSICAL, "unphysical state")                                                        \
   X(MPM_ERR_INTERNAL, "internal error")
 
 typedef enum {
@@ -31,45 +31,45 @@ const char *mpm_error_string(int code);
 /* Log one traceback frame; returns code so it can sit in an expression. */
 int mpm_trace(const char *file, int line, const char *func, int code);
 
-#define MPM_CALL(expr)                                                                         \
-  do {                                                                                         \
-    int mpm_rc_ = (expr);                                                                      \
-    if (mpm_rc_ != 0) return mpm_trace(__FILE__, __LINE__, __func__, mpm_rc_);                 \
+#define MPM_CALL(expr)                                                                             \
+  do {                                                                                             \
+    int mpm_rc_ = (expr);                                                                          \
+    if (mpm_rc_ != 0) return mpm_trace(__FILE__, __LINE__, __func__, mpm_rc_);                     \
   } while (0)
 
 /* Log a message at error level on this rank and return code. */
-#define MPM_FAIL(code, ...)                                                                    \
-  do {                                                                                         \
-    mpm_log_all(MPM_LOG_ERROR, __VA_ARGS__);                                                   \
-    return mpm_trace(__FILE__, __LINE__, __func__, (code));                                    \
+#define MPM_FAIL(code, ...)                                                                        \
+  do {                                                                                             \
+    mpm_log_all(MPM_LOG_ERROR, __VA_ARGS__);                                                       \
+    return mpm_trace(__FILE__, __LINE__, __func__, (code));                                        \
   } while (0)
 
-#define MPM_CALL_MPI(expr)                                                                     \
-  do {                                                                                         \
-    int mpm_rc_ = (expr);                                                                      \
-    if (mpm_rc_ != MPI_SUCCESS)                                                                \
-      MPM_FAIL(MPM_ERR_MPI, "%s failed with MPI error %d", #expr, mpm_rc_);                    \
+#define MPM_CALL_MPI(expr)                                                                         \
+  do {                                                                                             \
+    int mpm_rc_ = (expr);                                                                          \
+    if (mpm_rc_ != MPI_SUCCESS)                                                                    \
+      MPM_FAIL(MPM_ERR_MPI, "%s failed with MPI error %d", #expr, mpm_rc_);                        \
   } while (0)
 
 /* HDF5 calls return a negative value on failure. */
-#define MPM_CALL_H5(expr)                                                                      \
-  do {                                                                                         \
-    if ((expr) < 0) MPM_FAIL(MPM_ERR_HDF5, "%s failed", #expr);                                \
+#define MPM_CALL_H5(expr)                                                                          \
+  do {                                                                                             \
+    if ((expr) < 0) MPM_FAIL(MPM_ERR_HDF5, "%s failed", #expr);                                    \
   } while (0)
 
 /* SUNDIALS calls return a negative flag on failure. */
-#define MPM_CALL_SUN(expr)                                                                     \
-  do {                                                                                         \
-    int mpm_rc_ = (expr);                                                                      \
-    if (mpm_rc_ < 0) MPM_FAIL(MPM_ERR_SUNDIALS, "%s failed with flag %d", #expr, mpm_rc_);     \
+#define MPM_CALL_SUN(expr)                                                                         \
+  do {                                                                                             \
+    int mpm_rc_ = (expr);                                                                          \
+    if (mpm_rc_ < 0) MPM_FAIL(MPM_ERR_SUNDIALS, "%s failed with flag %d", #expr, mpm_rc_);         \
   } while (0)
 
 /* Allocation that fails with MPM_ERR_MEMORY. */
-#define MPM_ALLOC(ptr, count)                                                                  \
-  do {                                                                                         \
-    size_t mpm_n_ = (size_t)(count);                                                           \
-    (ptr) = calloc(mpm_n_ ? mpm_n_ : 1, sizeof(*(ptr)));                                       \
-    if (!(ptr)) MPM_FAIL(MPM_ERR_MEMORY, "cannot allocate %zu items for %s", mpm_n_, #ptr);    \
+#define MPM_ALLOC(ptr, count)                                                                      \
+  do {                                                                                             \
+    size_t mpm_n_ = (size_t)(count);                                                               \
+    (ptr) = calloc(mpm_n_ ? mpm_n_ : 1, sizeof(*(ptr)));                                           \
+    if (!(ptr)) MPM_FAIL(MPM_ERR_MEMORY, "cannot allocate %zu items for %s", mpm_n_, #ptr);        \
   } while (0)
 
 #include "mpm_log.h"

@@ -24,7 +24,8 @@ const mpm_key_spec mpm_geometry_keys[] = {
     {"geometry.*.type", MPM_KEY_ENUM, NULL, 0, 0, 0, 0,
      "box|disk|sphere|cylinder|polygon|union|difference",
      "region shape: box (lo, hi), disk (2-D: center, radius), sphere (3-D: center, radius), "
-     "cylinder (3-D: p0, p1, radius), polygon (file; z in 3-D), union or difference (of)", 0},
+     "cylinder (3-D: p0, p1, radius), polygon (file; z in 3-D), union or difference (of)",
+     0},
     {"geometry.*.lo", MPM_KEY_REALS, NULL, -HUGE_VAL, HUGE_VAL, 0, 3, NULL,
      "box: lower corner, one coordinate per dimension (m), each below hi", 1},
     {"geometry.*.hi", MPM_KEY_REALS, NULL, -HUGE_VAL, HUGE_VAL, 0, 3, NULL,
@@ -39,7 +40,8 @@ const mpm_key_spec mpm_geometry_keys[] = {
      "cylinder: centre of the other end face, x y z (m), different from p0", 1},
     {"geometry.*.file", MPM_KEY_PATH, NULL, 0, 0, 0, 0, NULL,
      "polygon: vertex file, one \"x y\" or \"x,y\" per line (m), '#' starts a comment; "
-     "closed implicitly, at least 3 vertices", 1},
+     "closed implicitly, at least 3 vertices",
+     1},
     {"geometry.*.z", MPM_KEY_REALS, NULL, -HUGE_VAL, HUGE_VAL, 0, 2, NULL,
      "polygon in 3-D: extrusion range z_lo z_hi (m), z_lo < z_hi", 1},
     {"geometry.*.of", MPM_KEY_NAMES, NULL, 0, 0, 0, 0, NULL,

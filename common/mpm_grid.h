@@ -35,12 +35,12 @@ typedef struct mpm_grid_phase {
 } mpm_grid_phase;
 
 typedef struct mpm_grid {
-  MPI_Comm comm;              /* Cartesian communicator (owned) */
+  MPI_Comm comm; /* Cartesian communicator (owned) */
   int rank, size;
   int dim;
-  int nproc[MPM_MAX_DIM];     /* ranks per direction */
-  int coord[MPM_MAX_DIM];     /* this rank's coordinates */
-  int nbr[MPM_MAX_DIM][2];    /* lower, upper neighbour (MPI_PROC_NULL at walls) */
+  int nproc[MPM_MAX_DIM];  /* ranks per direction */
+  int coord[MPM_MAX_DIM];  /* this rank's coordinates */
+  int nbr[MPM_MAX_DIM][2]; /* lower, upper neighbour (MPI_PROC_NULL at walls) */
   double lo[MPM_MAX_DIM], hi[MPM_MAX_DIM], dx;
   int ncells[MPM_MAX_DIM];
   mpm_shape_kind shape;

@@ -24,8 +24,12 @@ void mpm_log_init(MPI_Comm comm, mpm_log_level level, int all_ranks) {
   g_log.all_ranks = all_ranks;
 }
 
-void mpm_log_set_level(mpm_log_level level) { g_log.level = level; }
-mpm_log_level mpm_log_get_level(void) { return g_log.level; }
+void mpm_log_set_level(mpm_log_level level) {
+  g_log.level = level;
+}
+mpm_log_level mpm_log_get_level(void) {
+  return g_log.level;
+}
 
 int mpm_log_level_parse(const char *name) {
   for (int i = 0; i <= MPM_LOG_TRACE; ++i)

@@ -22,7 +22,6 @@ int mpm_log_level_parse(const char *name);
 /* Log on rank 0 only (or on every rank when all_ranks was set). */
 void mpm_log(mpm_log_level level, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 /* Log on the calling rank, whatever its number, with a [rank] prefix when size > 1. */
-void mpm_log_all(mpm_log_level level, const char *fmt, ...)
-    __attribute__((format(printf, 2, 3)));
+void mpm_log_all(mpm_log_level level, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 
 #endif

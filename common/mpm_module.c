@@ -56,8 +56,9 @@ int mpm_module_check_positions(const mpm_module *m, const double *y, mpm_fault *
   const mpm_grid *g = m->grid;
   const mpm_lidx n = p->n;
   for (size_t k = 0; k < (size_t)p->nstate * (size_t)n; ++k)
-    if (!isfinite(y[k])) return mpm_fault_at(fault, p, y, (mpm_lidx)(k % (size_t)(n ? n : 1)),
-                                         "a state value is not finite (NaN or Inf)");
+    if (!isfinite(y[k]))
+      return mpm_fault_at(fault, p, y, (mpm_lidx)(k % (size_t)(n ? n : 1)),
+                          "a state value is not finite (NaN or Inf)");
   for (mpm_lidx i = 0; i < n; ++i)
     for (int d = 0; d < p->dim; ++d) {
       const double x = y[(size_t)d * n + i];

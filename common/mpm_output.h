@@ -41,8 +41,7 @@ int mpm_output_count(const mpm_output *out);
 /* Write a checkpoint atomically. Collective. */
 int mpm_checkpoint_write(MPI_Comm comm, const char *path, const char *config_text,
                          const char *const *attr_names, const double *attr_values, int nattr,
-                         const mpm_particles *const *phases, const char *const *names,
-                         int nphases);
+                         const mpm_particles *const *phases, const char *const *names, int nphases);
 
 typedef struct mpm_checkpoint mpm_checkpoint;
 

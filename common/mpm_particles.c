@@ -220,7 +220,7 @@ static void format_point(char *buf, size_t len, const double *x, int dim) {
 
 static int report_outside(const mpm_particles *p, const mpm_grid *g, mpm_lidx i, mpm_lidx nout) {
   char at[128], lo[128], hi[128];
-  double x[MPM_MAX_DIM];
+  double x[MPM_MAX_DIM] = {0};
   for (int d = 0; d < p->dim; ++d) x[d] = mpm_particles_comp(p, 0, d)[i];
   format_point(at, sizeof at, x, p->dim);
   format_point(lo, sizeof lo, g->lo, g->dim);

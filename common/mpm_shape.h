@@ -62,8 +62,7 @@ static inline void mpm_shape_gimp_node(double r, double lp, double *w, double *d
 }
 
 static inline int mpm_shape_1d(mpm_shape_kind kind, double xi, double lp,
-                               double w[MPM_SHAPE_MAX_SUPPORT],
-                               double dw[MPM_SHAPE_MAX_SUPPORT]) {
+                               double w[MPM_SHAPE_MAX_SUPPORT], double dw[MPM_SHAPE_MAX_SUPPORT]) {
   int base;
   w[3] = dw[3] = 0.0;
   switch (kind) {

@@ -7,9 +7,7 @@
 #include <stdio.h>
 #include <string.h>
 
-static struct {
-  double total[MPM_T_COUNT], started[MPM_T_COUNT];
-} g_timer;
+static struct { double total[MPM_T_COUNT], started[MPM_T_COUNT]; } g_timer;
 
 static const char *const g_names[MPM_T_COUNT] = {
 #define MPM_X_NAME(id, name) name,
@@ -17,13 +15,21 @@ static const char *const g_names[MPM_T_COUNT] = {
 #undef MPM_X_NAME
 };
 
-void mpm_timer_reset(void) { memset(&g_timer, 0, sizeof g_timer); }
-void mpm_timer_start(mpm_timer_phase phase) { g_timer.started[phase] = MPI_Wtime(); }
+void mpm_timer_reset(void) {
+  memset(&g_timer, 0, sizeof g_timer);
+}
+void mpm_timer_start(mpm_timer_phase phase) {
+  g_timer.started[phase] = MPI_Wtime();
+}
 void mpm_timer_stop(mpm_timer_phase phase) {
   g_timer.total[phase] += MPI_Wtime() - g_timer.started[phase];
 }
-double mpm_timer_seconds(mpm_timer_phase phase) { return g_timer.total[phase]; }
-const char *mpm_timer_name(mpm_timer_phase phase) { return g_names[phase]; }
+double mpm_timer_seconds(mpm_timer_phase phase) {
+  return g_timer.total[phase];
+}
+const char *mpm_timer_name(mpm_timer_phase phase) {
+  return g_names[phase];
+}
 
 int mpm_timer_reduce(MPI_Comm comm, double *max, double *mean) {
   int size;

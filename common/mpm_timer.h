@@ -5,15 +5,15 @@
 
 #include <mpi.h>
 
-#define MPM_TIMER_LIST(X)                                                                      \
-  X(MPM_T_P2G, "p2g")                                                                          \
-  X(MPM_T_GRID, "grid")                                                                        \
-  X(MPM_T_G2P, "g2p")                                                                          \
-  X(MPM_T_HALO, "halo")                                                                        \
-  X(MPM_T_STRESS, "stress")                                                                    \
-  X(MPM_T_COUPLING, "coupling")                                                                \
-  X(MPM_T_MIGRATE, "migrate")                                                                  \
-  X(MPM_T_IO, "io")                                                                            \
+#define MPM_TIMER_LIST(X)                                                                          \
+  X(MPM_T_P2G, "p2g")                                                                              \
+  X(MPM_T_GRID, "grid")                                                                            \
+  X(MPM_T_G2P, "g2p")                                                                              \
+  X(MPM_T_HALO, "halo")                                                                            \
+  X(MPM_T_STRESS, "stress")                                                                        \
+  X(MPM_T_COUPLING, "coupling")                                                                    \
+  X(MPM_T_MIGRATE, "migrate")                                                                      \
+  X(MPM_T_IO, "io")                                                                                \
   X(MPM_T_TOTAL, "total")
 
 typedef enum {

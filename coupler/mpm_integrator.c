@@ -26,15 +26,15 @@ struct mpm_integrator {
   mpm_method method;
   double rtol, atol, cfl, dt_max;
   int max_retries;
-  double h_classic;  /* step of the classic update, computed by its RHS (see classic_step) */
-  double tstop;      /* stop time of the current step */
-  double scale;      /* step reduction of the current retry (1 when not retrying) */
-  int fn_stale;      /* ERKStep's stored f(t_n, y_n) used another step size: re-evaluate */
-  mpm_fault fault;   /* last unphysical state seen by the RHS (same on every rank) */
-  int rhs_error;     /* a non-recoverable failure inside the RHS */
+  double h_classic; /* step of the classic update, computed by its RHS (see classic_step) */
+  double tstop;     /* stop time of the current step */
+  double scale;     /* step reduction of the current retry (1 when not retrying) */
+  int fn_stale;     /* ERKStep's stored f(t_n, y_n) used another step size: re-evaluate */
+  mpm_fault fault;  /* last unphysical state seen by the RHS (same on every rank) */
+  int rhs_error;    /* a non-recoverable failure inside the RHS */
   long steps, rhs_evals, fails, retries;
   long fails_seen; /* ERKStep's cumulative error-test failures already counted */
-  double t_last;     /* time of the last accepted state */
+  double t_last;   /* time of the last accepted state */
 };
 
 const mpm_key_spec mpm_integrator_keys[] = {
@@ -54,7 +54,9 @@ const int mpm_integrator_nkeys = (int)(sizeof mpm_integrator_keys / sizeof mpm_i
 
 static const char *const g_method_names[MPM_METHOD_COUNT] = {"usl", "ralston21", "bs32",
                                                              "zonneveld43", "dp54"};
-const char *mpm_method_name(mpm_method m) { return g_method_names[m]; }
+const char *mpm_method_name(mpm_method m) {
+  return g_method_names[m];
+}
 
 /* ---- the right-hand side ---------------------------------------------------------------- */
 
@@ -88,7 +90,8 @@ static int halo(mpm_integrator *it, int reverse) {
     }
   }
   mpm_timer_start(MPM_T_HALO);
-  int rc = reverse ? mpm_grid_halo_reverse(it->grid, f, nf) : mpm_grid_halo_forward(it->grid, f, nf);
+  int rc =
+      reverse ? mpm_grid_halo_reverse(it->grid, f, nf) : mpm_grid_halo_forward(it->grid, f, nf);
   mpm_timer_stop(MPM_T_HALO);
   return rc;
 }
@@ -274,8 +277,10 @@ static int configure(mpm_integrator *it, double h0) {
     MPM_CALL_SUN(ERKStepSetFixedStep(it->ark, h0 > 0 ? h0 : 1.0));
     return 0;
   }
-  if (it->method == MPM_METHOD_RALSTON21) MPM_CALL(set_ralston_table(it));
-  else MPM_CALL_SUN(ERKStepSetTableNum(it->ark, tables[it->method]));
+  if (it->method == MPM_METHOD_RALSTON21)
+    MPM_CALL(set_ralston_table(it));
+  else
+    MPM_CALL_SUN(ERKStepSetTableNum(it->ark, tables[it->method]));
   MPM_CALL_SUN(ERKStepSStolerances(it->ark, it->rtol, it->atol));
   MPM_CALL_SUN(ERKStepSetStabilityFn(it->ark, estab, it));
   MPM_CALL_SUN(ERKStepSetCFLFraction(it->ark, it->cfl));
@@ -314,8 +319,10 @@ void mpm_integrator_counts(const mpm_integrator *it, long *steps, long *rhs_eval
 static int report_fault(const mpm_integrator *it, double t, int tries) {
   const mpm_fault *f = &it->fault;
   char where[96];
-  if (it->grid->dim == 2) snprintf(where, sizeof where, "(%.6g, %.6g)", f->x[0], f->x[1]);
-  else snprintf(where, sizeof where, "(%.6g, %.6g, %.6g)", f->x[0], f->x[1], f->x[2]);
+  if (it->grid->dim == 2)
+    snprintf(where, sizeof where, "(%.6g, %.6g)", f->x[0], f->x[1]);
+  else
+    snprintf(where, sizeof where, "(%.6g, %.6g, %.6g)", f->x[0], f->x[1], f->x[2]);
   mpm_log(MPM_LOG_ERROR,
           "the run stopped at t = %.6g after %d %s with smaller steps: particle %lld at %s: "
           "%s. Reduce time.cfl or time.rtol, refine the grid, or check the material "

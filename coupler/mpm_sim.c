@@ -144,9 +144,9 @@ static int build_modules(mpm_sim *s, int seed) {
   return 0;
 }
 
-static const char *const g_diag_cols[] = {
-    "t", "step", "dt", "particles", "mass", "px", "py", "pz", "kinetic", "internal", "total",
-    "rhs_evals"};
+static const char *const g_diag_cols[] = {"t",       "step",     "dt",    "particles",
+                                          "mass",    "px",       "py",    "pz",
+                                          "kinetic", "internal", "total", "rhs_evals"};
 enum { NDIAG = (int)(sizeof g_diag_cols / sizeof g_diag_cols[0]) };
 
 static int open_outputs(mpm_sim *s, int append) {
@@ -202,10 +202,10 @@ int mpm_sim_restart(mpm_sim **sp, mpm_config *cfg, const char *path) {
   /* Outputs continue on the (possibly new) intervals: the next ones after t. Written at t
    * already, so strictly after it. */
   s->out_next = (long)floor(s->t / s->out_interval * (1 + 1e-12)) + 1;
-  s->ckpt_next = isfinite(s->ckpt_interval)
-                     ? (long)floor(s->t / s->ckpt_interval * (1 + 1e-12)) + 1
-                     : 1;
-  for (int k = 0; k < s->nmod; ++k) MPM_CALL(mpm_particles_migrate(s->mod[k]->particles, s->grid, NULL));
+  s->ckpt_next =
+      isfinite(s->ckpt_interval) ? (long)floor(s->t / s->ckpt_interval * (1 + 1e-12)) + 1 : 1;
+  for (int k = 0; k < s->nmod; ++k)
+    MPM_CALL(mpm_particles_migrate(s->mod[k]->particles, s->grid, NULL));
   MPM_CALL(mpm_integrator_new(&s->it, cfg, s->grid, s->mod, s->nmod));
   s->restarted = 1;
   mpm_log(MPM_LOG_INFO, "restarted from %s at t = %.6g, step %ld", path, s->t, s->step);
@@ -298,8 +298,8 @@ static void progress(mpm_sim *s, double dt, double wall0, int final) {
   if (!final && now - last < 0.5) return;
   last = now;
   const double frac = s->t / s->t_end, eta = frac > 0 ? (now - wall0) * (1 - frac) / frac : 0;
-  fprintf(stderr, "\rstep %8ld  t = %-11.5g dt = %-10.3g %5.1f%%  ETA %6.0f s  ", s->step, s->t,
-          dt, 100 * frac, eta);
+  fprintf(stderr, "\rstep %8ld  t = %-11.5g dt = %-10.3g %5.1f%%  ETA %6.0f s  ", s->step, s->t, dt,
+          100 * frac, eta);
   if (final) fputc('\n', stderr);
   fflush(stderr);
 }

@@ -31,8 +31,8 @@ static int le_create(solid_material *mat, const mpm_config *cfg, const char *sec
 static void le_strain(int dim, const double *F, mpm_lidx n, mpm_lidx i, double eps[3][3]) {
   for (int r = 0; r < dim; ++r)
     for (int c = 0; c < dim; ++c)
-      eps[r][c] = 0.5 * (F[(size_t)(r * dim + c) * n + i] + F[(size_t)(c * dim + r) * n + i]) -
-                  (r == c);
+      eps[r][c] =
+          0.5 * (F[(size_t)(r * dim + c) * n + i] + F[(size_t)(c * dim + r) * n + i]) - (r == c);
 }
 
 static void le_stress(const solid_material *mat, const solid_stress_batch *b) {
@@ -68,7 +68,9 @@ static double le_energy_density(const solid_material *mat, int dim, const double
   return 0.5 * le->lambda * tr * tr + le->mu * ee;
 }
 
-static void le_destroy(solid_material *mat) { free(mat->content); }
+static void le_destroy(solid_material *mat) {
+  free(mat->content);
+}
 
 const solid_material_ops solid_linear_elastic_ops = {
     "linear_elastic", le_create, le_stress, le_wave_speed, le_energy_density, le_destroy,

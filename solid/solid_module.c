@@ -29,8 +29,8 @@ typedef struct {
   int nbodies;
   solid_body *body;
   double gravity[MPM_MAX_DIM];
-  double lp;             /* GIMP half-width in cells */
-  mpm_lidx cap;          /* capacity of the scratch arrays */
+  double lp;              /* GIMP half-width in cells */
+  mpm_lidx cap;           /* capacity of the scratch arrays */
   double *vsig, *scratch; /* V sigma (dim^2 n); G2P output v, a, L ((2 dim + dim^2) n) */
   mpm_lidx *idx, *count;  /* particle indices grouped by body; counts per body */
 } solid_content;
@@ -129,8 +129,9 @@ static int seed_body(mpm_module *m, const mpm_config *cfg, int b, double *lp) {
   MPM_CALL_MPI(MPI_Allreduce(&local, &total, 1, MPM_MPI_GIDX, MPI_SUM, g->comm));
   if (total == 0) {
     key_of(key, sizeof key, sc->body[b].section, "geometry");
-    return mpm_config_fail(cfg, key, "body '%s' has no particles: region '%s' is thinner than "
-                                     "the particle spacing %g; refine grid.dx or raise ppc",
+    return mpm_config_fail(cfg, key,
+                           "body '%s' has no particles: region '%s' is thinner than "
+                           "the particle spacing %g; refine grid.dx or raise ppc",
                            sc->body[b].section, geom, g->dx / ppc);
   }
   mpm_log(MPM_LOG_INFO, "solid body %s: %lld particles, material %s", sc->body[b].section,
@@ -177,8 +178,13 @@ static int solid_p2g(mpm_module *m, double t, const double *y) {
   group_by_body(m);
   const mpm_lidx *idx = sc->idx;
   for (int b = 0; b < sc->nbodies; ++b) {
-    const solid_stress_batch batch = {dim,    n, sc->count[b], idx, y + (size_t)p->offset[F_F] * n,
-                                      mpm_particles_comp(p, F_V0, 0), sc->vsig};
+    const solid_stress_batch batch = {dim,
+                                      n,
+                                      sc->count[b],
+                                      idx,
+                                      y + (size_t)p->offset[F_F] * n,
+                                      mpm_particles_comp(p, F_V0, 0),
+                                      sc->vsig};
     sc->body[b].mat->ops->stress(sc->body[b].mat, &batch);
     idx += sc->count[b];
   }
@@ -251,7 +257,7 @@ static double solid_stable_dt(const mpm_module *m, const double *y) {
 }
 
 static double det(int dim, const double *F, mpm_lidx n, mpm_lidx i) {
-#define A(r, c) F[(size_t)((r) * dim + (c)) * n + i]
+#define A(r, c) F[(size_t)((r)*dim + (c)) * n + i]
   if (dim == 2) return A(0, 0) * A(1, 1) - A(0, 1) * A(1, 0);
   return A(0, 0) * (A(1, 1) * A(2, 2) - A(1, 2) * A(2, 1)) -
          A(0, 1) * (A(1, 0) * A(2, 2) - A(1, 2) * A(2, 0)) +
@@ -308,8 +314,8 @@ static void solid_destroy(mpm_module *m) {
 }
 
 static const mpm_module_ops solid_ops = {
-    solid_p2g, solid_grid_update, solid_g2p, solid_stable_dt, solid_check, solid_sums, NULL,
-    solid_destroy,
+    solid_p2g,   solid_grid_update, solid_g2p, solid_stable_dt,
+    solid_check, solid_sums,        NULL,      solid_destroy,
 };
 
 /* Read the bodies' sections and build their materials. */
@@ -359,7 +365,8 @@ int solid_module_create(mpm_module **mp, const mpm_config *cfg, mpm_grid *grid, 
   if (!rc) rc = read_bodies(m, cfg);
   for (int b = 0; !rc && b < sc->nbodies; ++b) {
     double lp = sc->lp;
-    if (seed) rc = seed_body(m, cfg, b, &lp);
+    if (seed)
+      rc = seed_body(m, cfg, b, &lp);
     else {
       char key[160];
       int ppc;

@@ -13,13 +13,7 @@ sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "tools"))
 import mpmtest as mt  # noqa: E402
 
 BASE = open(mt.case("ballistic2d.ini")).read()
-passed = failed = 0
-
-
-def check(cond, msg):
-    global passed, failed
-    passed, failed = (passed + 1, failed) if cond else (passed, failed + 1)
-    print(("ok   " if cond else "FAIL ") + msg)
+check = mt.Checks("test_bad_input")
 
 
 def line_of(text, needle):
@@ -109,4 +103,4 @@ with tempfile.TemporaryDirectory() as tmp:
     check(strip(p.stdout) == strip(q.stdout) and "t_end = 0.3" in p.stdout,
           "check: the resolved configuration reads back to itself")
 
-sys.exit(mt.report("test_bad_input", passed, failed))
+sys.exit(check.finish())

@@ -12,21 +12,12 @@
 #include "mpm_grid.h"
 #include "mpm_error.h"
 
+#include "mpm_testing.h"
+
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
-static int g_rank, g_size, g_fail;
-
-#define CHECK(cond, ...)                                                                           \
-  do {                                                                                             \
-    if (!(cond) && g_fail++ < 20) {                                                                \
-      fprintf(stderr, "[%d] %s:%d: check failed: %s: ", g_rank, __FILE__, __LINE__, #cond);        \
-      fprintf(stderr, __VA_ARGS__);                                                                \
-      fputc('\n', stderr);                                                                         \
-    }                                                                                              \
-  } while (0)
 
 /* ---- the rules, recomputed from the header ------------------------------------------- */
 
@@ -309,9 +300,7 @@ static void check_input_errors(void) {
 }
 
 int main(int argc, char **argv) {
-  MPI_Init(&argc, &argv);
-  MPI_Comm_rank(MPI_COMM_WORLD, &g_rank);
-  MPI_Comm_size(MPI_COMM_WORLD, &g_size);
+  mpm_test_init(&argc, &argv);
   mpm_log_init(MPI_COMM_WORLD, MPM_LOG_INFO, 0);
   for (int dim = 2; dim <= 3; ++dim)
     for (int s = 0; s < MPM_SHAPE_COUNT; ++s) {
@@ -320,10 +309,7 @@ int main(int argc, char **argv) {
     }
   if (g_rank == 0) fprintf(stderr, "expected input errors follow:\n");
   check_input_errors();
-  MPI_Allreduce(MPI_IN_PLACE, &g_fail, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
-  if (g_rank == 0)
-    printf("test_halo on %d ranks: %s (%d failures)\n", g_size, g_fail ? "FAILED" : "passed",
-           g_fail);
+  mpm_test_finish("test_halo");
   MPI_Finalize();
   return g_fail != 0;
 }

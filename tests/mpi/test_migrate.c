@@ -13,21 +13,12 @@
 #include "mpm_particles.h"
 #include "mpm_error.h"
 
+#include "mpm_testing.h"
+
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
-static int g_rank, g_size, g_fail;
-
-#define CHECK(cond, ...)                                                                           \
-  do {                                                                                             \
-    if (!(cond) && g_fail++ < 20) {                                                                \
-      fprintf(stderr, "[%d] %s:%d: check failed: %s: ", g_rank, __FILE__, __LINE__, #cond);        \
-      fprintf(stderr, __VA_ARGS__);                                                                \
-      fputc('\n', stderr);                                                                         \
-    }                                                                                              \
-  } while (0)
 
 enum { NPART = 3000, NSTEPS = 50, NQ = 4 };
 
@@ -316,9 +307,7 @@ static void test_errors(int dim) {
 }
 
 int main(int argc, char **argv) {
-  MPI_Init(&argc, &argv);
-  MPI_Comm_rank(MPI_COMM_WORLD, &g_rank);
-  MPI_Comm_size(MPI_COMM_WORLD, &g_size);
+  mpm_test_init(&argc, &argv);
   mpm_log_init(MPI_COMM_WORLD, MPM_LOG_INFO, 0);
   for (int dim = 2; dim <= 3; ++dim) {
     test_edit(dim);
@@ -327,10 +316,7 @@ int main(int argc, char **argv) {
     test_migrate(dim);
     test_errors(dim);
   }
-  MPI_Allreduce(MPI_IN_PLACE, &g_fail, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
-  if (g_rank == 0)
-    printf("test_migrate on %d ranks: %s (%d failures)\n", g_size, g_fail ? "FAILED" : "passed",
-           g_fail);
+  mpm_test_finish("test_migrate");
   MPI_Finalize();
   return g_fail != 0;
 }

@@ -9,23 +9,14 @@
 #include "mpm_grid.h"
 #include "mpm_kernels.h"
 
+#include "mpm_testing.h"
+
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #define NP 4000
-static int g_fail = 0, g_rank = 0;
-
-#define CHECK(cond, ...)                                                                           \
-  do {                                                                                             \
-    if (!(cond)) {                                                                                 \
-      g_fail++;                                                                                    \
-      fprintf(stderr, "[%d] FAIL %s:%d: ", g_rank, __FILE__, __LINE__);                            \
-      fprintf(stderr, __VA_ARGS__);                                                                \
-      fputc('\n', stderr);                                                                         \
-    }                                                                                              \
-  } while (0)
 
 static double rnd(unsigned long long *s) {
   *s = *s * 6364136223846793005ULL + 1442695040888963407ULL;
@@ -181,13 +172,10 @@ static void run_case(int dim, mpm_shape_kind shape) {
 }
 
 int main(int argc, char **argv) {
-  MPI_Init(&argc, &argv);
-  MPI_Comm_rank(MPI_COMM_WORLD, &g_rank);
+  mpm_test_init(&argc, &argv);
   for (int dim = 2; dim <= 3; ++dim)
     for (int s = 0; s < MPM_SHAPE_COUNT; ++s) run_case(dim, (mpm_shape_kind)s);
-  int total;
-  MPI_Allreduce(&g_fail, &total, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
-  if (g_rank == 0) printf("%s: %d failed checks\n", total ? "FAILED" : "passed", total);
+  const int total = mpm_test_finish("test_p2g");
   MPI_Finalize();
   return total ? 1 : 0;
 }

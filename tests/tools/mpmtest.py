@@ -63,6 +63,20 @@ def particles(path, phase="solid"):
     return out
 
 
-def report(name, passed, failed):
-    print(f"{name}: {passed} passed, {failed} failed")
-    return 1 if failed else 0
+class Checks:
+    """Counts and prints checks; finish() prints the closing 'N passed, N failed' line and
+    returns the exit status."""
+
+    def __init__(self, name):
+        self.name, self.passed, self.failed = name, 0, 0
+
+    def __call__(self, cond, msg):
+        if cond:
+            self.passed += 1
+        else:
+            self.failed += 1
+        print(("ok   " if cond else "FAIL ") + msg)
+
+    def finish(self):
+        print(f"{self.name}: {self.passed} passed, {self.failed} failed")
+        return 1 if self.failed else 0

@@ -28,7 +28,8 @@ static const mpm_key_spec g_keys[] = {
     {"grid.periodic", MPM_KEY_BOOL, "false", 0, 0, 0, 0, NULL, "periodic boundaries", 0},
     {"grid.lo", MPM_KEY_REALS, "0 0 0", -HUGE_VAL, HUGE_VAL, 0, 3, NULL, "lower corner, m", 0},
     {"run.name", MPM_KEY_STRING, "case", 0, 0, 0, 0, NULL, "run name", 0},
-    {"run.log_level", MPM_KEY_ENUM, "info", 0, 0, 0, 0, "error|warn|info|debug|trace", "log level", 0},
+    {"run.log_level", MPM_KEY_ENUM, "info", 0, 0, 0, 0, "error|warn|info|debug|trace", "log level",
+     0},
     {"time.t_end", MPM_KEY_REAL, "1", 0, HUGE_VAL, 1, 0, NULL, "end time, s", 0},
     {"geometry.*.type", MPM_KEY_ENUM, NULL, 0, 0, 0, 0, "box|sphere", "region shape", 0},
     {"geometry.*.lo", MPM_KEY_REALS, "0 0", -HUGE_VAL, HUGE_VAL, 0, 3, NULL, "lower corner, m", 0},
@@ -630,7 +631,8 @@ static void test_getter_errors(void **state) {
 
 static void test_bad_schema(void **state) {
   (void)state;
-  static const mpm_key_spec bad_default[] = {{"a.x", MPM_KEY_REAL, "abc", 0, 1, 0, 0, NULL, "x", 0}};
+  static const mpm_key_spec bad_default[] = {
+      {"a.x", MPM_KEY_REAL, "abc", 0, 1, 0, 0, NULL, "x", 0}};
   static const mpm_key_spec no_section[] = {{"x", MPM_KEY_REAL, "1", 0, 1, 0, 0, NULL, "x", 0}};
   static const mpm_key_spec star_last[] = {{"a.*", MPM_KEY_REAL, "1", 0, 1, 0, 0, NULL, "x", 0}};
   static const mpm_key_spec no_choices[] = {{"a.e", MPM_KEY_ENUM, "x", 0, 0, 0, 0, NULL, "e", 0}};

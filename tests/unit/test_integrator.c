@@ -13,21 +13,12 @@
 #include "mpm_integrator.h"
 #include "mpm_module.h"
 
+#include "mpm_testing.h"
+
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
-static int g_fail = 0, g_rank = 0;
-#define CHECK(cond, ...)                                                                           \
-  do {                                                                                             \
-    if (!(cond)) {                                                                                 \
-      g_fail++;                                                                                    \
-      fprintf(stderr, "[%d] FAIL %s:%d: ", g_rank, __FILE__, __LINE__);                            \
-      fprintf(stderr, __VA_ARGS__);                                                                \
-      fputc('\n', stderr);                                                                         \
-    }                                                                                              \
-  } while (0)
 
 static const double G[2] = {0.0, -1.0};
 
@@ -256,16 +247,12 @@ static void run_hopeless(void) {
 }
 
 int main(int argc, char **argv) {
-  MPI_Init(&argc, &argv);
-  MPI_Comm_rank(MPI_COMM_WORLD, &g_rank);
+  mpm_test_init(&argc, &argv);
   mpm_log_init(MPI_COMM_WORLD, MPM_LOG_WARN, 0);
   run_two_modules(1e30, "two modules, no step limit");
   run_two_modules(0.02, "two modules, moves limited to 0.02 per step");
   run_hopeless();
-  int total;
-  MPI_Allreduce(&g_fail, &total, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
-  if (g_rank == 0)
-    printf("test_integrator: %s, %d failed checks\n", total ? "FAILED" : "passed", total);
+  const int total = mpm_test_finish("test_integrator");
   MPI_Finalize();
   return total ? 1 : 0;
 }

@@ -172,7 +172,7 @@ static void free_grid(mpm_grid **g) {
 /* ---- files ----------------------------------------------------------------------------- */
 
 static void path_of(char *buf, size_t size, const char *a, const char *b) {
-  snprintf(buf, size, "%s/%s", a, b);
+  if (snprintf(buf, size, "%s/%s", a, b) >= (int)size) fail_msg("path too long: %s/%s", a, b);
 }
 
 static int remove_entry(const char *path, const struct stat *st, int flag, struct FTW *ftw) {

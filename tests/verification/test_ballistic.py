@@ -16,16 +16,7 @@ import numpy as np
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "tools"))
 import mpmtest as mt  # noqa: E402
 
-passed = failed = 0
-
-
-def check(cond, msg):
-    global passed, failed
-    if cond:
-        passed += 1
-    else:
-        failed += 1
-    print(("ok   " if cond else "FAIL ") + msg)
+check = mt.Checks("test_ballistic")
 
 
 def analytic_error(outdir, v0, g):
@@ -59,4 +50,4 @@ for dim, name, v0, g in [(2, "ballistic2d.ini", [3, 2], [0, -9.81]),
     err2, _ = analytic_error(par, v0, g)
     check(err2 <= 1e-10, f"{dim}-D 2 ranks: max |x - x_exact| = {err2:.3e} m")
 
-sys.exit(mt.report("test_ballistic", passed, failed))
+sys.exit(check.finish())

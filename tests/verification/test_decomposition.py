@@ -20,13 +20,7 @@ import numpy as np
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "tools"))
 import mpmtest as mt  # noqa: E402
 
-passed = failed = 0
-
-
-def check(cond, msg):
-    global passed, failed
-    passed, failed = (passed + 1, failed) if cond else (passed, failed + 1)
-    print(("ok   " if cond else "FAIL ") + msg)
+check = mt.Checks("test_decomposition")
 
 
 args = ["time.t_end=0.8", "grid.dx=0.025", "output.interval=0.4", "run.progress=false"]
@@ -50,4 +44,4 @@ for method, extra, tol in (("usl", [], 1e-12),
                   f"{method} np{ranks} vs np1 at t = {p['time']:.3g}: max |dx| = {dx:.2e} m, "
                   f"max |dv| = {dv:.2e} m/s (tolerance {tol:g})")
 
-sys.exit(mt.report("test_decomposition", passed, failed))
+sys.exit(check.finish())

@@ -12,13 +12,7 @@ import sys
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "tools"))
 import mpmtest as mt  # noqa: E402
 
-passed = failed = 0
-
-
-def check(cond, msg):
-    global passed, failed
-    passed, failed = (passed + 1, failed) if cond else (passed, failed + 1)
-    print(("ok   " if cond else "FAIL ") + msg)
+check = mt.Checks("test_recoverable")
 
 
 for ranks, method in ((1, "bs32"), (2, "bs32"), (1, "usl"), (2, "usl")):
@@ -41,4 +35,4 @@ for ranks, method in ((1, "bs32"), (2, "bs32"), (1, "usl"), (2, "usl")):
             print("unreadable", path, e)
     check(ok, f"{method} np{ranks}: {len(snaps)} snapshots written before the failure are readable")
 
-sys.exit(mt.report("test_recoverable", passed, failed))
+sys.exit(check.finish())

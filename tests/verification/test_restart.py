@@ -15,13 +15,7 @@ import numpy as np
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "tools"))
 import mpmtest as mt  # noqa: E402
 
-passed = failed = 0
-
-
-def check(cond, msg):
-    global passed, failed
-    passed, failed = (passed + 1, failed) if cond else (passed, failed + 1)
-    print(("ok   " if cond else "FAIL ") + msg)
+check = mt.Checks("test_restart")
 
 
 case = mt.case("two_disks.ini")
@@ -55,4 +49,4 @@ for ranks in (1, 2):
             print(f"info {method} np{ranks}: run without the T/2 restart differs by "
                   f"{drift:.3e} m in x (step-size history differs; within rtol)")
 
-sys.exit(mt.report("test_restart", passed, failed))
+sys.exit(check.finish())
