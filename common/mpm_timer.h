@@ -12,6 +12,8 @@
   X(MPM_T_HALO, "halo")                                                                            \
   X(MPM_T_STRESS, "stress")                                                                        \
   X(MPM_T_COUPLING, "coupling")                                                                    \
+  X(MPM_T_CHECK, "check")                                                                          \
+  X(MPM_T_DIAG, "diagnostics")                                                                     \
   X(MPM_T_MIGRATE, "migrate")                                                                      \
   X(MPM_T_IO, "io")                                                                                \
   X(MPM_T_TOTAL, "total")

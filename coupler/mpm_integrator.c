@@ -122,13 +122,16 @@ static int rhs(mpm_sunreal t, N_Vector y, N_Vector ydot, void *user) {
   mpm_integrator *it = user;
   mpm_fault local = {0};
   it->rhs_evals++;
+  mpm_timer_start(MPM_T_CHECK);
   if (it->method == MPM_METHOD_USL && classic_step(it, t, y, &it->h_classic) != 0) {
     it->rhs_error = 1;
     return -1;
   }
   for (int k = 0; k < it->nmod && !local.set; ++k)
     it->mod[k]->ops->check(it->mod[k], module_data(y, k), &local);
-  if (share_fault(it, &local)) return 1;
+  const int faulty = share_fault(it, &local);
+  mpm_timer_stop(MPM_T_CHECK);
+  if (faulty) return 1;
   if (mpm_cycle(it, t, y, ydot) != 0) {
     it->rhs_error = 1;
     return -1;
@@ -149,7 +152,10 @@ static int stable_step(mpm_integrator *it, N_Vector y, double *hstab) {
 static int estab(N_Vector y, mpm_sunreal t, mpm_sunreal *hstab, void *user) {
   (void)t;
   double h;
-  if (stable_step(user, y, &h) != 0) return -1;
+  mpm_timer_start(MPM_T_CHECK);
+  const int rc = stable_step(user, y, &h);
+  mpm_timer_stop(MPM_T_CHECK);
+  if (rc != 0) return -1;
   *hstab = isfinite(h) ? h : 0.0; /* 0: no limit */
   return 0;
 }
