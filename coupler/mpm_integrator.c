@@ -173,11 +173,14 @@ static int classic_step(mpm_integrator *it, double t, N_Vector y, double *h) {
   return 0;
 }
 
-/* ARKODE's own messages become debug lines; the driver reports failures itself. */
+#if SUNDIALS_VERSION_MAJOR < 7
+/* ARKODE's own messages become debug lines; the driver reports failures itself. (SUNDIALS 7
+ * routes them through the context's logger instead.) */
 static void ark_errors(int code, const char *module, const char *func, char *msg, void *user) {
   (void)user;
   mpm_log(MPM_LOG_DEBUG, "ARKODE %s %s (%d): %s", module, func, code, msg);
 }
+#endif
 
 /* ---- state vector ------------------------------------------------------------------------ */
 
@@ -276,7 +279,9 @@ static int configure(mpm_integrator *it, double h0) {
       ARKODE_ERK_NONE, ARKODE_ERK_NONE, ARKODE_BOGACKI_SHAMPINE_4_2_3, ARKODE_ZONNEVELD_5_3_4,
       ARKODE_DORMAND_PRINCE_7_4_5};
   MPM_CALL_SUN(ERKStepSetUserData(it->ark, it));
+#if SUNDIALS_VERSION_MAJOR < 7
   MPM_CALL_SUN(ERKStepSetErrHandlerFn(it->ark, ark_errors, NULL));
+#endif
   MPM_CALL_SUN(ERKStepSetMaxNumSteps(it->ark, -1));
   if (it->method == MPM_METHOD_USL) {
     MPM_CALL(set_classic_table(it));
