@@ -1,33 +1,13 @@
 /* Small-strain linear elasticity: sigma = lambda tr(eps) I + 2 mu eps, eps = sym(F) - I.
- * Valid while rotations and strains stay small; it is not objective under large rotation
- * (use a finite-strain model for that). Parameters: E > 0, 0 <= nu < 0.5. */
-#include "solid_material.h"
+ * Valid while rotations and strains stay small: it is not objective under finite rotation
+ * (use stvk or neo_hookean for that). Parameters: E > 0, 0 <= nu < 0.5. */
+#include "solid_elastic.h"
 
 #include "mpm_error.h"
 
-#include <math.h>
-#include <stdio.h>
 #include <stdlib.h>
 
-typedef struct {
-  double E, nu, lambda, mu;
-} linear_elastic;
-
-static int le_create(solid_material *mat, const mpm_config *cfg, const char *section) {
-  char key[160];
-  linear_elastic *le;
-  MPM_ALLOC(le, 1);
-  mat->content = le;
-  snprintf(key, sizeof key, "%s.E", section);
-  MPM_CALL(mpm_config_get_real(cfg, key, &le->E));
-  snprintf(key, sizeof key, "%s.nu", section);
-  MPM_CALL(mpm_config_get_real(cfg, key, &le->nu));
-  le->lambda = le->E * le->nu / ((1 + le->nu) * (1 - 2 * le->nu));
-  le->mu = le->E / (2 * (1 + le->nu));
-  return 0;
-}
-
-/* Strain from F (component-major tensor at particle i). */
+/* Strain of particle i (component-major tensor with stride n). */
 static void le_strain(int dim, const double *F, mpm_lidx n, mpm_lidx i, double eps[3][3]) {
   for (int r = 0; r < dim; ++r)
     for (int c = 0; c < dim; ++c)
@@ -35,8 +15,8 @@ static void le_strain(int dim, const double *F, mpm_lidx n, mpm_lidx i, double e
           0.5 * (F[(size_t)(r * dim + c) * n + i] + F[(size_t)(c * dim + r) * n + i]) - (r == c);
 }
 
-static void le_stress(const solid_material *mat, const solid_stress_batch *b) {
-  const linear_elastic *le = mat->content;
+static void le_stress(const solid_material *mat, const solid_batch *b) {
+  const solid_elastic *el = mat->content;
   const int dim = b->dim;
   for (mpm_lidx k = 0; k < b->count; ++k) {
     const mpm_lidx i = b->idx[k];
@@ -47,31 +27,28 @@ static void le_stress(const solid_material *mat, const solid_stress_batch *b) {
     const double V = b->V0[i];
     for (int r = 0; r < dim; ++r)
       for (int c = 0; c < dim; ++c)
-        b->vsig[(size_t)(r * dim + c) * b->n + i] =
-            V * (2.0 * le->mu * eps[r][c] + (r == c ? le->lambda * tr : 0.0));
+        b->out[(size_t)(r * dim + c) * b->n + i] =
+            V * (2.0 * el->mu * eps[r][c] + (r == c ? el->lambda * tr : 0.0));
   }
 }
 
-static double le_wave_speed(const solid_material *mat, double rho) {
-  const linear_elastic *le = mat->content;
-  return sqrt((le->lambda + 2.0 * le->mu) / rho);
-}
-
-static double le_energy_density(const solid_material *mat, int dim, const double *F) {
-  const linear_elastic *le = mat->content;
+static double le_energy_density(const solid_material *mat, const solid_batch *b, mpm_lidx i) {
+  const solid_elastic *el = mat->content;
   double eps[3][3], tr = 0.0, ee = 0.0;
-  le_strain(dim, F, 1, 0, eps);
-  for (int r = 0; r < dim; ++r) {
+  le_strain(b->dim, b->F, b->n, i, eps);
+  for (int r = 0; r < b->dim; ++r) {
     tr += eps[r][r];
-    for (int c = 0; c < dim; ++c) ee += eps[r][c] * eps[r][c];
+    for (int c = 0; c < b->dim; ++c) ee += eps[r][c] * eps[r][c];
   }
-  return 0.5 * le->lambda * tr * tr + le->mu * ee;
-}
-
-static void le_destroy(solid_material *mat) {
-  free(mat->content);
+  return 0.5 * el->lambda * tr * tr + el->mu * ee;
 }
 
 const solid_material_ops solid_linear_elastic_ops = {
-    "linear_elastic", le_create, le_stress, le_wave_speed, le_energy_density, le_destroy,
+    .name = "linear_elastic",
+    .create = solid_elastic_create,
+    .stress = le_stress,
+    .wave_speed = solid_elastic_wave_speed,
+    .energy_density = le_energy_density,
+    .destroy = solid_elastic_destroy,
+    .small_strain = 1,
 };

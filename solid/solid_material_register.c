@@ -23,13 +23,21 @@ const char *solid_material_names(void) {
   return names;
 }
 
+int solid_material_count(void) {
+  return g_nmodels;
+}
+const solid_material_ops *solid_material_ops_at(int k) {
+  return g_models[k];
+}
+
 int solid_material_create(solid_material **mat, const char *type, const mpm_config *cfg,
-                          const char *section) {
+                          const char *section, int dim) {
   for (int k = 0; k < g_nmodels; ++k) {
     if (strcmp(g_models[k]->name, type) != 0) continue;
     MPM_ALLOC(*mat, 1);
     (*mat)->ops = g_models[k];
-    int rc = g_models[k]->create(*mat, cfg, section);
+    (*mat)->dim = dim;
+    int rc = g_models[k]->create(*mat, cfg, section, dim);
     if (rc) {
       solid_material_destroy(mat);
       return mpm_trace(__FILE__, __LINE__, __func__, rc);

@@ -1,6 +1,7 @@
 /* Solid module: seeding, and the module phases of an MPM right-hand side.
  *
- * Invariants: particle field order is x, v, F | m, V0, body (see solid_particles_new); body
+ * Invariants: particle field order is x, v, F, [sigma] | m, V0, body, [hist] (see
+ * solid_particles_new); body
  * holds a small integer stored as a double. The per-body index lists used for batched
  * stress evaluation are rebuilt at each P2G, so they never go stale after migration,
  * sorting or injection. */
@@ -17,7 +18,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-enum { F_X, F_V, F_F, F_M, F_V0, F_BODY, F_COUNT };
+/* Field indices: x, v, F are always fields 0-2; sigma (rate-form stress) and hist (material
+ * history) exist only when some body's model needs them (see solid_layout). */
+enum { F_X, F_V, F_F };
 
 typedef struct {
   char section[96];
@@ -26,8 +29,14 @@ typedef struct {
 } solid_body;
 
 typedef struct {
+  int f_sigma, f_m, f_V0, f_body, f_hist; /* field indices (f_sigma, f_hist: -1 if absent) */
+  int nhist;                              /* history components per particle */
+} solid_layout;
+
+typedef struct {
   int nbodies;
   solid_body *body;
+  solid_layout lay;
   double gravity[MPM_MAX_DIM];
   double lp;              /* GIMP half-width in cells */
   mpm_lidx cap;           /* capacity of the scratch arrays */
@@ -47,6 +56,10 @@ static mpm_key_spec solid_keys[] = {
     {"solid.*.velocity", MPM_KEY_REALS, "0 0 0", -HUGE_VAL, HUGE_VAL, 0, 3, NULL,
      "initial velocity, m/s (dim values; extra values are ignored)", 0},
     {"solid.*.ppc", MPM_KEY_INT, "2", 1, 8, 0, 0, NULL, "particles per cell per direction", 0},
+    {"solid.*.sigma_y", MPM_KEY_REAL, NULL, 0, HUGE_VAL, 1, 0, NULL,
+     "initial yield stress, Pa (plastic models)", 1},
+    {"solid.*.hardening", MPM_KEY_REAL, "0", 0, HUGE_VAL, 0, 0, NULL,
+     "linear isotropic hardening modulus H, Pa (plastic models)", 0},
 };
 
 int solid_add_schema(mpm_config *cfg) {
@@ -55,14 +68,56 @@ int solid_add_schema(mpm_config *cfg) {
   return mpm_config_add_schema(cfg, solid_keys, (int)(sizeof solid_keys / sizeof solid_keys[0]));
 }
 
-int solid_particles_new(mpm_particles **p, int dim) {
-  const mpm_field_desc fields[F_COUNT] = {{"x", dim}, {"v", dim}, {"F", dim * dim},
-                                          {"m", 1},   {"V0", 1},  {"body", 1}};
-  return mpm_particles_new(p, dim, fields, F_COUNT, 3);
+/* The particle fields the bodies' models need: sigma if any model is in rate form, hist
+ * sized for the model with the most history. */
+static int solid_particles_new(mpm_particles **p, int dim, solid_layout *lay, int has_rate,
+                               int nhist) {
+  mpm_field_desc fields[8] = {{"x", dim}, {"v", dim}, {"F", dim * dim}};
+  int nf = 3;
+  lay->f_sigma = has_rate ? nf : -1;
+  if (has_rate) fields[nf++] = (mpm_field_desc){"sigma", dim * dim};
+  const int nstate = nf;
+  lay->f_m = nf, fields[nf++] = (mpm_field_desc){"m", 1};
+  lay->f_V0 = nf, fields[nf++] = (mpm_field_desc){"V0", 1};
+  lay->f_body = nf, fields[nf++] = (mpm_field_desc){"body", 1};
+  lay->f_hist = nhist > 0 ? nf : -1;
+  lay->nhist = nhist;
+  if (nhist > 0) fields[nf++] = (mpm_field_desc){"hist", nhist};
+  return mpm_particles_new(p, dim, fields, nf, nstate);
 }
 
 static void key_of(char *key, size_t size, const char *section, const char *name) {
   snprintf(key, size, "%s.%s", section, name);
+}
+
+/* A batch over particles `idx` of component-major arrays with stride n (state from y). */
+static solid_batch batch_of(const solid_content *sc, const mpm_particles *p, const double *y,
+                            mpm_lidx count, const mpm_lidx *idx, double *out) {
+  const mpm_lidx n = p->n;
+  return (solid_batch){
+      .dim = p->dim,
+      .n = n,
+      .count = count,
+      .idx = idx,
+      .F = y + (size_t)p->offset[F_F] * n,
+      .V0 = mpm_particles_comp(p, sc->lay.f_V0, 0),
+      .sigma = sc->lay.f_sigma >= 0 ? y + (size_t)p->offset[sc->lay.f_sigma] * n : NULL,
+      .hist = sc->lay.f_hist >= 0 ? mpm_particles_comp(p, sc->lay.f_hist, 0) : NULL,
+      .out = out,
+  };
+}
+
+/* Initial history of n new particles of body b (arrays with stride n). */
+static void init_history(const solid_content *sc, int b, int dim, mpm_lidx n, const double *F,
+                         double *hist) {
+  const solid_material *mat = sc->body[b].mat;
+  if (!hist || !mat->ops->init_history || n == 0) return;
+  mpm_lidx *idx = malloc(sizeof *idx * (size_t)n);
+  if (!idx) return;
+  for (mpm_lidx i = 0; i < n; ++i) idx[i] = i;
+  const solid_batch batch = {.dim = dim, .n = n, .count = n, .idx = idx, .F = F, .hist = hist};
+  mat->ops->init_history(mat, &batch);
+  free(idx);
 }
 
 /* Seed one body and append it to the particle set. */
@@ -115,10 +170,12 @@ static int seed_body(mpm_module *m, const mpm_config *cfg, int b, double *lp) {
       data[(size_t)(p->offset[F_V] + d) * n + i] = v0[d];
       data[(size_t)(p->offset[F_F] + d * dim + d) * n + i] = 1.0;
     }
-    data[(size_t)p->offset[F_M] * n + i] = sc->body[b].rho * vol;
-    data[(size_t)p->offset[F_V0] * n + i] = vol;
-    data[(size_t)p->offset[F_BODY] * n + i] = b;
+    data[(size_t)p->offset[sc->lay.f_m] * n + i] = sc->body[b].rho * vol;
+    data[(size_t)p->offset[sc->lay.f_V0] * n + i] = vol;
+    data[(size_t)p->offset[sc->lay.f_body] * n + i] = b;
   }
+  init_history(sc, b, dim, n, data + (size_t)p->offset[F_F] * n,
+               sc->lay.f_hist >= 0 ? data + (size_t)p->offset[sc->lay.f_hist] * n : NULL);
   rc = mpm_particles_edit(p, NULL, n, id, data);
   free(data);
   free(x);
@@ -159,7 +216,7 @@ static int ensure_scratch(mpm_module *m) {
 static void group_by_body(mpm_module *m) {
   solid_content *sc = m->content;
   const mpm_particles *p = m->particles;
-  const double *body = mpm_particles_comp(p, F_BODY, 0);
+  const double *body = mpm_particles_comp(p, sc->lay.f_body, 0);
   mpm_lidx start[64] = {0};
   memset(sc->count, 0, sizeof(mpm_lidx) * (size_t)sc->nbodies);
   for (mpm_lidx i = 0; i < p->n; ++i) sc->count[(int)body[i]]++;
@@ -178,20 +235,15 @@ static int solid_p2g(mpm_module *m, double t, const double *y) {
   group_by_body(m);
   const mpm_lidx *idx = sc->idx;
   for (int b = 0; b < sc->nbodies; ++b) {
-    const solid_stress_batch batch = {dim,
-                                      n,
-                                      sc->count[b],
-                                      idx,
-                                      y + (size_t)p->offset[F_F] * n,
-                                      mpm_particles_comp(p, F_V0, 0),
-                                      sc->vsig};
+    const solid_batch batch = batch_of(sc, p, y, sc->count[b], idx, sc->vsig);
     sc->body[b].mat->ops->stress(sc->body[b].mat, &batch);
     idx += sc->count[b];
   }
   mpm_timer_stop(MPM_T_STRESS);
 
   mpm_timer_start(MPM_T_P2G);
-  mpm_p2g_args a = {.n = n, .m = mpm_particles_comp(p, F_M, 0), .vsig = sc->vsig, .lp = sc->lp};
+  mpm_p2g_args a = {
+      .n = n, .m = mpm_particles_comp(p, sc->lay.f_m, 0), .vsig = sc->vsig, .lp = sc->lp};
   for (int d = 0; d < dim; ++d) {
     a.x[d] = y + (size_t)(p->offset[F_X] + d) * n;
     a.v[d] = y + (size_t)(p->offset[F_V] + d) * n;
@@ -206,6 +258,8 @@ static int solid_grid_update(mpm_module *m, double t, double h) {
   (void)t;
   return mpm_grid_phase_update(m->grid, m->phase, h);
 }
+
+static void solid_stress_rates(mpm_module *m, const double *y, double *ydot, const double *L);
 
 /* dx/dt = sum S v_i, dv/dt = sum S a_i, dF/dt = L F with L = sum v_i (x) grad S. */
 static int solid_g2p(mpm_module *m, double t, const double *y, double *ydot, double h) {
@@ -236,13 +290,53 @@ static int solid_g2p(mpm_module *m, double t, const double *y, double *ydot, dou
         for (mpm_lidx i = 0; i < n; ++i) out[i] += Lrk[i] * Fkc[i];
       }
     }
+  if (sc->lay.f_sigma >= 0) solid_stress_rates(m, y, ydot, L);
+  return 0;
+}
+
+/* Rate-form models: d sigma/dt from L; the stress state of other bodies stays constant.
+ * Particles are grouped by body as in this RHS's P2G. */
+static void solid_stress_rates(mpm_module *m, const double *y, double *ydot, const double *L) {
+  solid_content *sc = m->content;
+  const mpm_particles *p = m->particles;
+  const mpm_lidx n = p->n;
+  double *sdot = ydot + (size_t)p->offset[sc->lay.f_sigma] * n;
+  memset(sdot, 0, sizeof(double) * (size_t)(p->dim * p->dim) * (size_t)n);
+  const mpm_lidx *idx = sc->idx;
+  for (int b = 0; b < sc->nbodies; ++b) {
+    const solid_material *mat = sc->body[b].mat;
+    if (mat->ops->rate) {
+      solid_batch batch = batch_of(sc, p, y, sc->count[b], idx, sdot);
+      batch.L = L;
+      mat->ops->rate(mat, &batch);
+    }
+    idx += sc->count[b];
+  }
+}
+
+/* After an accepted step (and migration): models with history store the returned state. */
+static int solid_post_step(mpm_module *m) {
+  solid_content *sc = m->content;
+  const mpm_particles *p = m->particles;
+  if (sc->lay.f_hist < 0) return 0;
+  MPM_CALL(ensure_scratch(m));
+  group_by_body(m);
+  const mpm_lidx *idx = sc->idx;
+  for (int b = 0; b < sc->nbodies; ++b) {
+    const solid_material *mat = sc->body[b].mat;
+    if (mat->ops->commit) {
+      const solid_batch batch = batch_of(sc, p, p->data, sc->count[b], idx, NULL);
+      mat->ops->commit(mat, &batch);
+    }
+    idx += sc->count[b];
+  }
   return 0;
 }
 
 static double solid_stable_dt(const mpm_module *m, const double *y) {
   const solid_content *sc = m->content;
   const mpm_particles *p = m->particles;
-  const double *body = mpm_particles_comp(p, F_BODY, 0);
+  const double *body = mpm_particles_comp(p, sc->lay.f_body, 0);
   double dt = HUGE_VAL;
   for (mpm_lidx i = 0; i < p->n; ++i) {
     double v2 = 0.0;
@@ -282,20 +376,20 @@ static void solid_sums(const mpm_module *m, mpm_module_sums *s) {
   const solid_content *sc = m->content;
   const mpm_particles *p = m->particles;
   const int dim = p->dim;
-  const double *mass = mpm_particles_comp(p, F_M, 0), *V0 = mpm_particles_comp(p, F_V0, 0);
-  const double *body = mpm_particles_comp(p, F_BODY, 0);
+  const double *mass = mpm_particles_comp(p, sc->lay.f_m, 0),
+               *V0 = mpm_particles_comp(p, sc->lay.f_V0, 0);
+  const double *body = mpm_particles_comp(p, sc->lay.f_body, 0);
   memset(s, 0, sizeof *s);
   for (mpm_lidx i = 0; i < p->n; ++i) {
-    double F[9];
     s->mass += mass[i];
     for (int d = 0; d < dim; ++d) {
       const double v = mpm_particles_comp(p, F_V, d)[i];
       s->momentum[d] += mass[i] * v;
       s->kinetic += 0.5 * mass[i] * v * v;
     }
-    for (int c = 0; c < dim * dim; ++c) F[c] = mpm_particles_comp(p, F_F, c)[i];
     const solid_body *b = &sc->body[(int)body[i]];
-    s->internal += V0[i] * b->mat->ops->energy_density(b->mat, dim, F);
+    const solid_batch batch = batch_of(sc, p, p->data, 0, NULL, NULL);
+    s->internal += V0[i] * b->mat->ops->energy_density(b->mat, &batch, i);
   }
 }
 
@@ -314,8 +408,8 @@ static void solid_destroy(mpm_module *m) {
 }
 
 static const mpm_module_ops solid_ops = {
-    solid_p2g,   solid_grid_update, solid_g2p, solid_stable_dt,
-    solid_check, solid_sums,        NULL,      solid_destroy,
+    solid_p2g,   solid_grid_update, solid_g2p,       solid_stable_dt,
+    solid_check, solid_sums,        solid_post_step, solid_destroy,
 };
 
 /* Read the bodies' sections and build their materials. */
@@ -336,7 +430,7 @@ static int read_bodies(mpm_module *m, const mpm_config *cfg) {
     MPM_CALL(mpm_config_get_real(cfg, key, &sc->body[b].rho));
     key_of(key, sizeof key, sc->body[b].section, "material");
     MPM_CALL(mpm_config_get_string(cfg, key, &type));
-    MPM_CALL(solid_material_create(&sc->body[b].mat, type, cfg, sc->body[b].section));
+    MPM_CALL(solid_material_create(&sc->body[b].mat, type, cfg, sc->body[b].section, m->grid->dim));
   }
   double g[3] = {0, 0, 0};
   MPM_CALL(mpm_config_get_reals(cfg, "physics.gravity", g, 3, &nv));
@@ -360,9 +454,17 @@ int solid_module_create(mpm_module **mp, const mpm_config *cfg, mpm_grid *grid, 
   MPM_ALLOC(sc, 1);
   m->content = sc;
   sc->lp = 0.5;
-  int rc = solid_particles_new(&m->particles, grid->dim);
-  if (!rc) rc = mpm_grid_add_phase(grid, "solid", &m->phase);
+  int rc = mpm_grid_add_phase(grid, "solid", &m->phase);
   if (!rc) rc = read_bodies(m, cfg);
+  if (!rc) {
+    int has_rate = 0, nhist = 0;
+    for (int b = 0; b < sc->nbodies; ++b) {
+      const solid_material_ops *ops = sc->body[b].mat->ops;
+      has_rate |= ops->rate != NULL;
+      if (ops->nhistory) nhist = MPM_MAX(nhist, ops->nhistory(grid->dim));
+    }
+    rc = solid_particles_new(&m->particles, grid->dim, &sc->lay, has_rate, nhist);
+  }
   for (int b = 0; !rc && b < sc->nbodies; ++b) {
     double lp = sc->lp;
     if (seed)

@@ -1,8 +1,9 @@
 /* The solid MPM module: elastic bodies seeded from case-file geometry, each with its own
  * material model, integrated as x, v and F on the particles.
  *
- * State fields: x (dim), v (dim), F (dim*dim). Other fields: m (mass), V0 (reference
- * volume), body (index of the [solid.NAME] section the particle came from). */
+ * State fields: x (dim), v (dim), F (dim*dim), and sigma (dim*dim) when a body's model is in
+ * rate form. Other fields: m (mass), V0 (reference volume), body (index of the [solid.NAME]
+ * section the particle came from), and hist when a body's model has history variables. */
 #ifndef SOLID_MODULE_H
 #define SOLID_MODULE_H
 
@@ -11,9 +12,6 @@
 
 /* Add the keys of [solid.NAME] sections (material names from the registry) to cfg. */
 int solid_add_schema(mpm_config *cfg);
-
-/* Field layout of solid particles (for checkpoints). */
-int solid_particles_new(mpm_particles **p, int dim);
 
 /* Build the module over grid with its own phase of nodal fields. With seed = 1 the bodies
  * are seeded from their geometry; with seed = 0 the particle set starts empty (a restart
