@@ -78,10 +78,11 @@ static int choose_nproc(int size, int dim, const int *nproc, int *dims) {
   return 0;
 }
 
-/* Every rank needs at least `ghost` cells per direction (see the file comment). */
+/* Along a split direction every rank needs at least `ghost` cells, so that a halo slab
+ * comes from the next rank only (see the file comment). An unsplit direction has no halo. */
 static int check_cells_per_rank(const mpm_grid *g) {
   for (int d = 0; d < g->dim; ++d)
-    if (g->ncells[d] / g->nproc[d] < g->ghost)
+    if (g->nproc[d] > 1 && g->ncells[d] / g->nproc[d] < g->ghost)
       FAIL_INPUT("grid: %d cells along %c over %d ranks leave %d cells on some rank, fewer than "
                  "the %d ghost layers of the %s shape; use fewer ranks or a finer grid",
                  g->ncells[d], g_axis[d], g->nproc[d], g->ncells[d] / g->nproc[d], g->ghost,

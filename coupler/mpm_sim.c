@@ -1,6 +1,7 @@
 /* The simulation object and its step loop (see mpm_sim.h). */
 #include "mpm_sim.h"
 
+#include "mpm_bc.h"
 #include "mpm_diag.h"
 #include "mpm_error.h"
 #include "mpm_geometry.h"
@@ -72,6 +73,7 @@ int mpm_sim_add_schema(mpm_config *cfg) {
   MPM_CALL(mpm_config_add_schema(cfg, sim_keys, (int)(sizeof sim_keys / sizeof sim_keys[0])));
   MPM_CALL(mpm_config_add_schema(cfg, mpm_integrator_keys, mpm_integrator_nkeys));
   MPM_CALL(mpm_config_add_schema(cfg, mpm_geometry_keys, mpm_geometry_nkeys));
+  MPM_CALL(mpm_config_add_schema(cfg, mpm_bc_keys, mpm_bc_nkeys));
   MPM_CALL(solid_add_schema(cfg));
   return 0;
 }

@@ -7,7 +7,9 @@
  * sorting or injection. */
 #include "solid_module.h"
 
+#include "mpm_bc.h"
 #include "mpm_error.h"
+#include "mpm_expr.h"
 #include "mpm_geometry.h"
 #include "mpm_kernels.h"
 #include "mpm_timer.h"
@@ -29,14 +31,17 @@ typedef struct {
 } solid_body;
 
 typedef struct {
-  int f_sigma, f_m, f_V0, f_body, f_hist; /* field indices (f_sigma, f_hist: -1 if absent) */
-  int nhist;                              /* history components per particle */
+  int f_sigma, f_m, f_V0, f_body, f_hist, f_fixed; /* field indices (-1 if absent) */
+  int nhist;                                       /* history components per particle */
 } solid_layout;
 
 typedef struct {
   int nbodies;
   solid_body *body;
   solid_layout lay;
+  mpm_node_constraints cons; /* wall and clamp nodes */
+  int nclamps;
+  mpm_region **clamp; /* clamped regions */
   double gravity[MPM_MAX_DIM];
   double lp;              /* GIMP half-width in cells */
   mpm_lidx cap;           /* capacity of the scratch arrays */
@@ -55,11 +60,17 @@ static mpm_key_spec solid_keys[] = {
     {"solid.*.nu", MPM_KEY_REAL, "0.3", 0, 0.4999, 0, 0, NULL, "Poisson's ratio, [0, 0.5)", 0},
     {"solid.*.velocity", MPM_KEY_REALS, "0 0 0", -HUGE_VAL, HUGE_VAL, 0, 3, NULL,
      "initial velocity, m/s (dim values; extra values are ignored)", 0},
+    {"solid.*.velocity_field", MPM_KEY_STRING, NULL, 0, 0, 0, 0, NULL,
+     "initial velocity as expressions in x, y, z, one per component separated by ';' "
+     "(e.g. 0.1*sin(pi*x/50); 0), instead of velocity",
+     1},
     {"solid.*.ppc", MPM_KEY_INT, "2", 1, 8, 0, 0, NULL, "particles per cell per direction", 0},
     {"solid.*.sigma_y", MPM_KEY_REAL, NULL, 0, HUGE_VAL, 1, 0, NULL,
      "initial yield stress, Pa (plastic models)", 1},
     {"solid.*.hardening", MPM_KEY_REAL, "0", 0, HUGE_VAL, 0, 0, NULL,
      "linear isotropic hardening modulus H, Pa (plastic models)", 0},
+    {"clamp.*.geometry", MPM_KEY_STRING, NULL, 0, 0, 0, 0, NULL,
+     "region whose nodes and particles are held fixed (a [geometry.NAME])", 0},
 };
 
 int solid_add_schema(mpm_config *cfg) {
@@ -71,8 +82,8 @@ int solid_add_schema(mpm_config *cfg) {
 /* The particle fields the bodies' models need: sigma if any model is in rate form, hist
  * sized for the model with the most history. */
 static int solid_particles_new(mpm_particles **p, int dim, solid_layout *lay, int has_rate,
-                               int nhist) {
-  mpm_field_desc fields[8] = {{"x", dim}, {"v", dim}, {"F", dim * dim}};
+                               int nhist, int fixed) {
+  mpm_field_desc fields[9] = {{"x", dim}, {"v", dim}, {"F", dim * dim}};
   int nf = 3;
   lay->f_sigma = has_rate ? nf : -1;
   if (has_rate) fields[nf++] = (mpm_field_desc){"sigma", dim * dim};
@@ -83,6 +94,8 @@ static int solid_particles_new(mpm_particles **p, int dim, solid_layout *lay, in
   lay->f_hist = nhist > 0 ? nf : -1;
   lay->nhist = nhist;
   if (nhist > 0) fields[nf++] = (mpm_field_desc){"hist", nhist};
+  lay->f_fixed = fixed ? nf : -1;
+  if (fixed) fields[nf++] = (mpm_field_desc){"fixed", 1};
   return mpm_particles_new(p, dim, fields, nf, nstate);
 }
 
@@ -120,6 +133,12 @@ static void init_history(const solid_content *sc, int b, int dim, mpm_lidx n, co
   free(idx);
 }
 
+static int in_clamp(const solid_content *sc, const double *x) {
+  for (int k = 0; k < sc->nclamps; ++k)
+    if (mpm_region_contains(sc->clamp[k], x)) return 1;
+  return 0;
+}
+
 /* Seed one body and append it to the particle set. */
 static int seed_body(mpm_module *m, const mpm_config *cfg, int b, double *lp) {
   solid_content *sc = m->content;
@@ -137,6 +156,14 @@ static int seed_body(mpm_module *m, const mpm_config *cfg, int b, double *lp) {
   key_of(key, sizeof key, sc->body[b].section, "velocity");
   MPM_CALL(mpm_config_get_reals(cfg, key, v0, 3, &nv));
   if (nv < dim) return mpm_config_fail(cfg, key, "needs %d values, got %d", dim, nv);
+  mpm_expr *vfield = NULL;
+  char vkey[160];
+  key_of(vkey, sizeof vkey, sc->body[b].section, "velocity_field");
+  if (mpm_config_has(cfg, vkey)) {
+    if (mpm_config_has(cfg, key))
+      return mpm_config_fail(cfg, vkey, "give either velocity or velocity_field, not both");
+    MPM_CALL(mpm_expr_from_config(&vfield, cfg, vkey, dim));
+  }
   *lp = fmin(*lp, 0.5 / ppc);
 
   mpm_region *region = NULL;
@@ -159,23 +186,28 @@ static int seed_body(mpm_module *m, const mpm_config *cfg, int b, double *lp) {
   const mpm_gidx id_base = p->id_next;
   int rc = mpm_region_seed(region, g, ppc, id_base, &n, &x, &id);
   mpm_region_destroy(&region);
+  if (rc) mpm_expr_destroy(&vfield);
   MPM_CALL(rc);
 
   double *data;
   MPM_ALLOC(data, (size_t)p->ncomp * (size_t)(n ? n : 1));
   const double vol = pow(g->dx / ppc, dim);
   for (mpm_lidx i = 0; i < n; ++i) {
+    double xp[3] = {0, 0, 0};
+    for (int d = 0; d < dim; ++d) xp[d] = x[(size_t)d * n + i];
     for (int d = 0; d < dim; ++d) {
-      data[(size_t)(p->offset[F_X] + d) * n + i] = x[(size_t)d * n + i];
-      data[(size_t)(p->offset[F_V] + d) * n + i] = v0[d];
+      data[(size_t)(p->offset[F_X] + d) * n + i] = xp[d];
+      data[(size_t)(p->offset[F_V] + d) * n + i] = vfield ? mpm_expr_eval(vfield, d, xp) : v0[d];
       data[(size_t)(p->offset[F_F] + d * dim + d) * n + i] = 1.0;
     }
     data[(size_t)p->offset[sc->lay.f_m] * n + i] = sc->body[b].rho * vol;
     data[(size_t)p->offset[sc->lay.f_V0] * n + i] = vol;
     data[(size_t)p->offset[sc->lay.f_body] * n + i] = b;
+    if (sc->lay.f_fixed >= 0) data[(size_t)p->offset[sc->lay.f_fixed] * n + i] = in_clamp(sc, xp);
   }
   init_history(sc, b, dim, n, data + (size_t)p->offset[F_F] * n,
                sc->lay.f_hist >= 0 ? data + (size_t)p->offset[sc->lay.f_hist] * n : NULL);
+  mpm_expr_destroy(&vfield);
   rc = mpm_particles_edit(p, NULL, n, id, data);
   free(data);
   free(x);
@@ -256,10 +288,14 @@ static int solid_p2g(mpm_module *m, double t, const double *y) {
 
 static int solid_grid_update(mpm_module *m, double t, double h) {
   (void)t;
-  return mpm_grid_phase_update(m->grid, m->phase, h);
+  const solid_content *sc = m->content;
+  MPM_CALL(mpm_grid_phase_update(m->grid, m->phase, h));
+  mpm_constraints_apply(&sc->cons, m->grid, m->phase);
+  return 0;
 }
 
 static void solid_stress_rates(mpm_module *m, const double *y, double *ydot, const double *L);
+static void hold_fixed(const mpm_particles *p, int f_fixed, double *ydot);
 
 /* dx/dt = sum S v_i, dv/dt = sum S a_i, dF/dt = L F with L = sum v_i (x) grad S. */
 static int solid_g2p(mpm_module *m, double t, const double *y, double *ydot, double h) {
@@ -291,7 +327,16 @@ static int solid_g2p(mpm_module *m, double t, const double *y, double *ydot, dou
       }
     }
   if (sc->lay.f_sigma >= 0) solid_stress_rates(m, y, ydot, L);
+  if (sc->lay.f_fixed >= 0) hold_fixed(p, sc->lay.f_fixed, ydot);
   return 0;
+}
+
+/* Clamped particles keep their state: zero every state derivative. */
+static void hold_fixed(const mpm_particles *p, int f_fixed, double *ydot) {
+  const double *fixed = mpm_particles_comp(p, f_fixed, 0);
+  for (int c = 0; c < p->nstate; ++c)
+    for (mpm_lidx i = 0; i < p->n; ++i)
+      if (fixed[i] != 0.0) ydot[(size_t)c * p->n + i] = 0.0;
 }
 
 /* Rate-form models: d sigma/dt from L; the stress state of other bodies stays constant.
@@ -397,6 +442,9 @@ static void solid_destroy(mpm_module *m) {
   solid_content *sc = m->content;
   if (sc) {
     for (int b = 0; b < sc->nbodies; ++b) solid_material_destroy(&sc->body[b].mat);
+    for (int k = 0; k < sc->nclamps; ++k) mpm_region_destroy(&sc->clamp[k]);
+    free(sc->clamp);
+    mpm_constraints_free(&sc->cons);
     free(sc->body);
     free(sc->vsig);
     free(sc->scratch);
@@ -411,6 +459,38 @@ static const mpm_module_ops solid_ops = {
     solid_p2g,   solid_grid_update, solid_g2p,       solid_stable_dt,
     solid_check, solid_sums,        solid_post_step, solid_destroy,
 };
+
+/* Walls on the domain faces and clamped regions ([clamp.NAME] geometry = ...): the nodes
+ * they hold, listed once. */
+static int read_constraints(mpm_module *m, const mpm_config *cfg) {
+  solid_content *sc = m->content;
+  const mpm_grid *g = m->grid;
+  mpm_walls walls;
+  MPM_CALL(mpm_walls_from_config(&walls, cfg, g->dim));
+  MPM_CALL(mpm_constraints_add_walls(&sc->cons, &walls, g));
+  const char *const *names;
+  int count;
+  MPM_CALL(mpm_config_instances(cfg, "clamp", &names, &count));
+  if (count == 0) return 0;
+  MPM_ALLOC(sc->clamp, count);
+  for (int k = 0; k < count; ++k) {
+    char key[160];
+    const char *geom;
+    snprintf(key, sizeof key, "clamp.%s.geometry", names[k]);
+    MPM_CALL(mpm_config_get_string(cfg, key, &geom));
+    MPM_CALL(mpm_region_from_config(&sc->clamp[k], cfg, g->dim, geom));
+    sc->nclamps = k + 1;
+  }
+  const unsigned char all = (unsigned char)((1u << g->dim) - 1);
+  for (mpm_lidx l = 0; l < g->nnodes; ++l) {
+    int gi[MPM_MAX_DIM];
+    double x[3] = {0, 0, 0};
+    mpm_grid_node_global(g, l, gi);
+    for (int d = 0; d < g->dim; ++d) x[d] = g->lo[d] + gi[d] * g->dx;
+    if (in_clamp(sc, x)) MPM_CALL(mpm_constraints_add(&sc->cons, l, all));
+  }
+  return 0;
+}
 
 /* Read the bodies' sections and build their materials. */
 static int read_bodies(mpm_module *m, const mpm_config *cfg) {
@@ -463,7 +543,10 @@ int solid_module_create(mpm_module **mp, const mpm_config *cfg, mpm_grid *grid, 
       has_rate |= ops->rate != NULL;
       if (ops->nhistory) nhist = MPM_MAX(nhist, ops->nhistory(grid->dim));
     }
-    rc = solid_particles_new(&m->particles, grid->dim, &sc->lay, has_rate, nhist);
+    if (!rc) rc = read_constraints(m, cfg);
+    if (!rc)
+      rc =
+          solid_particles_new(&m->particles, grid->dim, &sc->lay, has_rate, nhist, sc->nclamps > 0);
   }
   for (int b = 0; !rc && b < sc->nbodies; ++b) {
     double lp = sc->lp;

@@ -7,7 +7,7 @@ build=${1:-$src/build}
 shift || true
 
 packages=(build-essential cmake pkg-config libopenmpi-dev openmpi-bin libhdf5-openmpi-dev
-          hdf5-tools libsundials-dev libinih-dev libcmocka-dev python3-h5py python3-numpy
+          hdf5-tools libsundials-dev libinih-dev libmatheval-dev libcmocka-dev python3-h5py python3-numpy
           python3-matplotlib libxml2-utils)
 missing=()
 for p in "${packages[@]}"; do

@@ -1,0 +1,143 @@
+/* Wall conditions and node constraints (see mpm_bc.h). */
+#include "mpm_bc.h"
+
+#include "mpm_error.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define WALL_CHOICES "none|slip|no_slip"
+#define WALL_HELP    "wall on this face: none (open), slip or no_slip"
+
+const mpm_key_spec mpm_bc_keys[] = {
+    {"boundary.x_lo", MPM_KEY_ENUM, "none", 0, 0, 0, 0, WALL_CHOICES, WALL_HELP, 0},
+    {"boundary.x_hi", MPM_KEY_ENUM, "none", 0, 0, 0, 0, WALL_CHOICES, WALL_HELP, 0},
+    {"boundary.y_lo", MPM_KEY_ENUM, "none", 0, 0, 0, 0, WALL_CHOICES, WALL_HELP, 0},
+    {"boundary.y_hi", MPM_KEY_ENUM, "none", 0, 0, 0, 0, WALL_CHOICES, WALL_HELP, 0},
+    {"boundary.z_lo", MPM_KEY_ENUM, "none", 0, 0, 0, 0, WALL_CHOICES, WALL_HELP, 0},
+    {"boundary.z_hi", MPM_KEY_ENUM, "none", 0, 0, 0, 0, WALL_CHOICES, WALL_HELP, 0},
+};
+const int mpm_bc_nkeys = (int)(sizeof mpm_bc_keys / sizeof mpm_bc_keys[0]);
+
+int mpm_walls_from_config(mpm_walls *w, const mpm_config *cfg, int dim) {
+  static const char *const axes = "xyz", *const side[2] = {"lo", "hi"};
+  memset(w, 0, sizeof *w);
+  for (int d = 0; d < dim; ++d)
+    for (int s = 0; s < 2; ++s) {
+      char key[32];
+      const char *v;
+      snprintf(key, sizeof key, "boundary.%c_%s", axes[d], side[s]);
+      MPM_CALL(mpm_config_get_string(cfg, key, &v));
+      w->face[d][s] = strcmp(v, "slip") == 0      ? MPM_WALL_SLIP
+                      : strcmp(v, "no_slip") == 0 ? MPM_WALL_NO_SLIP
+                                                  : MPM_WALL_NONE;
+    }
+  for (int d = dim; d < MPM_MAX_DIM; ++d)
+    for (int s = 0; s < 2; ++s) {
+      char key[32];
+      const char *v;
+      snprintf(key, sizeof key, "boundary.%c_%s", axes[d], side[s]);
+      MPM_CALL(mpm_config_get_string(cfg, key, &v));
+      if (strcmp(v, "none") != 0)
+        return mpm_config_fail(cfg, key, "a %d-D domain has no %c axis; remove the key", dim,
+                               axes[d]);
+    }
+  return 0;
+}
+
+static int add_rule(mpm_node_constraints *c, mpm_lidx l, mpm_lidx source, unsigned char mask,
+                    int axis) {
+  if (c->count == c->cap) {
+    const mpm_lidx cap = c->cap ? 2 * c->cap : 256;
+    mpm_lidx *node = realloc(c->node, sizeof *node * (size_t)cap);
+    if (node) c->node = node;
+    mpm_lidx *src = realloc(c->source, sizeof *src * (size_t)cap);
+    if (src) c->source = src;
+    unsigned char *m = realloc(c->mask, (size_t)cap);
+    if (m) c->mask = m;
+    unsigned char *ax = realloc(c->axis, (size_t)cap);
+    if (ax) c->axis = ax;
+    if (!node || !src || !m || !ax) MPM_FAIL(MPM_ERR_MEMORY, "cannot grow the node constraints");
+    c->cap = cap;
+  }
+  c->node[c->count] = l;
+  c->source[c->count] = source;
+  c->mask[c->count] = mask;
+  c->axis[c->count++] = (unsigned char)axis;
+  return 0;
+}
+
+int mpm_constraints_add(mpm_node_constraints *c, mpm_lidx l, unsigned char mask) {
+  return add_rule(c, l, -1, mask, 0);
+}
+
+void mpm_grid_node_global(const mpm_grid *grid, mpm_lidx l, int *gi) {
+  for (int d = 0; d < grid->dim; ++d) {
+    gi[d] = grid->box_lo[d] + (int)(l % grid->box_n[d]);
+    l /= grid->box_n[d];
+  }
+}
+
+/* Components a wall of kind k on axis d constrains. */
+static unsigned char wall_components(mpm_wall k, int d, int dim) {
+  return k == MPM_WALL_NO_SLIP ? (unsigned char)((1u << dim) - 1) : (unsigned char)(1u << d);
+}
+
+/* Rules of one face: hold the face nodes, mirror the pad nodes beyond it. Nodes outside the
+ * box (other ranks' parts of the face) are skipped. */
+static int add_face(mpm_node_constraints *c, const mpm_grid *g, int d, int side,
+                    unsigned char mask) {
+  const int face = side == 0 ? 0 : g->ncells[d];
+  for (mpm_lidx l = 0; l < g->nnodes; ++l) {
+    int gi[MPM_MAX_DIM];
+    mpm_grid_node_global(g, l, gi);
+    const int k = side == 0 ? face - gi[d] : gi[d] - face; /* distance beyond the face */
+    if (k < 0) continue;
+    if (k == 0) {
+      MPM_CALL(add_rule(c, l, -1, mask, d));
+      continue;
+    }
+    int gm[MPM_MAX_DIM];
+    memcpy(gm, gi, sizeof gm);
+    gm[d] = side == 0 ? face + k : face - k;
+    if (gm[d] < g->box_lo[d] || gm[d] >= g->box_lo[d] + g->box_n[d]) continue;
+    MPM_CALL(add_rule(c, l, mpm_grid_local_index(g, gm), mask, d));
+  }
+  return 0;
+}
+
+int mpm_constraints_add_walls(mpm_node_constraints *c, const mpm_walls *w, const mpm_grid *grid) {
+  for (int d = 0; d < grid->dim; ++d)
+    for (int s = 0; s < 2; ++s)
+      if (w->face[d][s] != MPM_WALL_NONE)
+        MPM_CALL(add_face(c, grid, d, s, wall_components(w->face[d][s], d, grid->dim)));
+  return 0;
+}
+
+/* Rules in the order they were added: faces axis by axis (so corners see the first axis's
+ * mirrored values when the second axis mirrors them), then clamps. */
+void mpm_constraints_apply(const mpm_node_constraints *c, mpm_grid *grid, int phase) {
+  mpm_grid_phase *ph = &grid->phase[phase];
+  for (mpm_lidx k = 0; k < c->count; ++k) {
+    const mpm_lidx l = c->node[k], src = c->source[k];
+    for (int d = 0; d < grid->dim; ++d) {
+      const int flip = (c->mask[k] >> d) & 1;
+      if (src < 0) {
+        if (flip) ph->v_i[d][l] = ph->a_i[d][l] = 0.0;
+      } else {
+        const double sign = flip ? -1.0 : 1.0;
+        ph->v_i[d][l] = sign * ph->v_i[d][src];
+        ph->a_i[d][l] = sign * ph->a_i[d][src];
+      }
+    }
+  }
+}
+
+void mpm_constraints_free(mpm_node_constraints *c) {
+  free(c->node);
+  free(c->source);
+  free(c->mask);
+  free(c->axis);
+  memset(c, 0, sizeof *c);
+}

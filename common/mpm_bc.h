@@ -1,0 +1,53 @@
+/* Wall conditions on the faces of the domain, for any phase's nodal fields.
+ *
+ * A face is open (none: a particle crossing it is an error), a slip wall (the normal
+ * velocity and acceleration vanish on it) or a no-slip wall (all components vanish). Nodes
+ * on the face are held; the pad nodes beyond it mirror the nodes inside (see
+ * mpm_node_constraints). Rules are built once for a grid; clamps append held nodes. */
+#ifndef MPM_BC_H
+#define MPM_BC_H
+
+#include "mpm_config.h"
+#include "mpm_grid.h"
+
+typedef enum { MPM_WALL_NONE, MPM_WALL_SLIP, MPM_WALL_NO_SLIP } mpm_wall;
+
+typedef struct mpm_walls {
+  mpm_wall face[MPM_MAX_DIM][2]; /* [axis][lower, upper] */
+} mpm_walls;
+
+/* Keys of the [boundary] section: x_lo, x_hi, y_lo, y_hi, z_lo, z_hi. */
+extern const mpm_key_spec mpm_bc_keys[];
+extern const int mpm_bc_nkeys;
+
+int mpm_walls_from_config(mpm_walls *w, const mpm_config *cfg, int dim);
+
+/* Node constraints on a grid, applied after every nodal update:
+ *  - held nodes (clamps, wall faces): the masked velocity components are set to zero;
+ *  - mirrored nodes (pad nodes beyond a wall): the node copies its mirror image inside the
+ *    domain, with the sign flipped in the masked components (v_n(-k) = -v_n(k) at a slip
+ *    wall, v(-k) = -v(k) at a no-slip wall) and kept in the others. An odd reflection makes
+ *    the interpolated velocity vanish at the wall to second order, where zeroing the pad
+ *    nodes would shift the wall by a fraction of a cell.
+ * Mirror rules are applied axis by axis, so corner nodes mirror through both walls. Mask
+ * bit d selects velocity component d. */
+typedef struct mpm_node_constraints {
+  mpm_lidx count, cap;
+  mpm_lidx *node;
+  mpm_lidx *source; /* mirror node, or -1 for a held node */
+  unsigned char *mask;
+  unsigned char *axis; /* axis of a mirror rule (rules are applied in axis order) */
+} mpm_node_constraints;
+
+/* Hold the masked components of node l at zero. */
+int mpm_constraints_add(mpm_node_constraints *c, mpm_lidx l, unsigned char mask);
+/* Add the wall rules of every wall face of w on grid. */
+int mpm_constraints_add_walls(mpm_node_constraints *c, const mpm_walls *w, const mpm_grid *grid);
+/* Apply the rules to v and a of one phase. */
+void mpm_constraints_apply(const mpm_node_constraints *c, mpm_grid *grid, int phase);
+void mpm_constraints_free(mpm_node_constraints *c);
+
+/* Global node index of box node l, per axis. */
+void mpm_grid_node_global(const mpm_grid *grid, mpm_lidx l, int *gi);
+
+#endif
