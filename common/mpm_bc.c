@@ -107,6 +107,8 @@ static int add_face(mpm_node_constraints *c, const mpm_grid *g, int d, int side,
   return 0;
 }
 
+static void apply_pass(const mpm_node_constraints *c, mpm_grid *grid, int phase);
+
 int mpm_constraints_add_walls(mpm_node_constraints *c, const mpm_walls *w, const mpm_grid *grid) {
   for (int d = 0; d < grid->dim; ++d)
     for (int s = 0; s < 2; ++s)
@@ -115,9 +117,31 @@ int mpm_constraints_add_walls(mpm_node_constraints *c, const mpm_walls *w, const
   return 0;
 }
 
-/* Rules in the order they were added: faces axis by axis (so corners see the first axis's
- * mirrored values when the second axis mirrors them), then clamps. */
+/* Faces were added axis by axis, so a corner pad node folds through the first wall into a
+ * node that is still a pad node of the second wall, which then folds it inside. */
+void mpm_constraints_fold(const mpm_node_constraints *c, mpm_grid *grid, int phase) {
+  mpm_grid_phase *ph = &grid->phase[phase];
+  for (mpm_lidx k = 0; k < c->count; ++k) {
+    const mpm_lidx l = c->node[k], src = c->source[k];
+    if (src < 0) continue;
+    ph->m_i[src] += ph->m_i[l];
+    ph->m_i[l] = 0.0;
+    for (int d = 0; d < grid->dim; ++d) {
+      const double sign = (c->mask[k] >> d) & 1 ? -1.0 : 1.0;
+      ph->mv_i[d][src] += sign * ph->mv_i[d][l];
+      ph->f_i[d][src] += sign * ph->f_i[d][l];
+      ph->mv_i[d][l] = ph->f_i[d][l] = 0.0;
+    }
+  }
+}
+
+/* One pass per axis: a corner pad node mirrors a node that is itself a pad node of another
+ * wall, set in the previous pass. Clamps hold their nodes in every pass. */
 void mpm_constraints_apply(const mpm_node_constraints *c, mpm_grid *grid, int phase) {
+  for (int pass = 0; pass < grid->dim; ++pass) apply_pass(c, grid, phase);
+}
+
+static void apply_pass(const mpm_node_constraints *c, mpm_grid *grid, int phase) {
   mpm_grid_phase *ph = &grid->phase[phase];
   for (mpm_lidx k = 0; k < c->count; ++k) {
     const mpm_lidx l = c->node[k], src = c->source[k];

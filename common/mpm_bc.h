@@ -43,7 +43,13 @@ typedef struct mpm_node_constraints {
 int mpm_constraints_add(mpm_node_constraints *c, mpm_lidx l, unsigned char mask);
 /* Add the wall rules of every wall face of w on grid. */
 int mpm_constraints_add_walls(mpm_node_constraints *c, const mpm_walls *w, const mpm_grid *grid);
-/* Apply the rules to v and a of one phase. */
+/* Before the nodal update: fold what particles deposited on mirrored pad nodes into their
+ * mirror nodes, as the mirror images of those particles would have deposited it (mass with
+ * sign +1, momentum and force with -1 in the masked components and +1 in the others), and
+ * clear the pad nodes. Without this the nodes next to a wall miss part of their stencil and
+ * the wall costs a first-order error. */
+void mpm_constraints_fold(const mpm_node_constraints *c, mpm_grid *grid, int phase);
+/* After the nodal update: hold and mirror v and a of one phase. */
 void mpm_constraints_apply(const mpm_node_constraints *c, mpm_grid *grid, int phase);
 void mpm_constraints_free(mpm_node_constraints *c);
 

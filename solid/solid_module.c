@@ -289,6 +289,7 @@ static int solid_p2g(mpm_module *m, double t, const double *y) {
 static int solid_grid_update(mpm_module *m, double t, double h) {
   (void)t;
   const solid_content *sc = m->content;
+  mpm_constraints_fold(&sc->cons, m->grid, m->phase);
   MPM_CALL(mpm_grid_phase_update(m->grid, m->phase, h));
   mpm_constraints_apply(&sc->cons, m->grid, m->phase);
   return 0;
