@@ -332,10 +332,12 @@ static int solid_g2p(mpm_module *m, double t, const double *y, double *ydot, dou
   return 0;
 }
 
-/* Clamped particles keep their state: zero every state derivative. */
+/* Clamped particles keep their place and velocity. Their deformation gradient (and stress)
+ * still follows the grid: those at the edge of a clamp carry the reaction stress, which a
+ * frozen F would drop, turning the clamp's edge into a hinge. */
 static void hold_fixed(const mpm_particles *p, int f_fixed, double *ydot) {
   const double *fixed = mpm_particles_comp(p, f_fixed, 0);
-  for (int c = 0; c < p->nstate; ++c)
+  for (int c = 0; c < 2 * p->dim; ++c) /* the x and v fields */
     for (mpm_lidx i = 0; i < p->n; ++i)
       if (fixed[i] != 0.0) ydot[(size_t)c * p->n + i] = 0.0;
 }
