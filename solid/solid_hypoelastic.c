@@ -5,18 +5,10 @@
  * derives from no stored-energy function, and a closed strain cycle can leave a residual
  * stress. In 2-D plane strain sigma, D and W are the in-plane 2 x 2 blocks (sigma_zz is not
  * needed by the in-plane equations). Parameters: E > 0, 0 <= nu < 0.5 (solid_elastic). */
+#include "solid_tensor.h"
 #include "solid_elastic.h"
 
 #include <stddef.h>
-
-static double hypo_det(int dim, const double *F, mpm_lidx n, mpm_lidx i) {
-#define A(r, c) F[(size_t)((r)*dim + (c)) * n + i]
-  if (dim == 2) return A(0, 0) * A(1, 1) - A(0, 1) * A(1, 0);
-  return A(0, 0) * (A(1, 1) * A(2, 2) - A(1, 2) * A(2, 1)) -
-         A(0, 1) * (A(1, 0) * A(2, 2) - A(1, 2) * A(2, 0)) +
-         A(0, 2) * (A(1, 0) * A(2, 1) - A(1, 1) * A(2, 0));
-#undef A
-}
 
 /* V sigma with the current volume V = V0 det F. */
 static void hypo_stress(const solid_material *mat, const solid_batch *b) {
@@ -24,7 +16,7 @@ static void hypo_stress(const solid_material *mat, const solid_batch *b) {
   const int dim = b->dim;
   for (mpm_lidx k = 0; k < b->count; ++k) {
     const mpm_lidx i = b->idx[k];
-    const double V = b->V0[i] * hypo_det(dim, b->F, b->n, i);
+    const double V = b->V0[i] * solid_det(dim, b->F, b->n, i);
     for (int rc = 0; rc < dim * dim; ++rc) {
       const size_t at = (size_t)rc * b->n + i;
       b->out[at] = V * b->sigma[at];
@@ -75,7 +67,7 @@ static double hypo_energy_density(const solid_material *mat, const solid_batch *
     }
   }
   const double a = el->lambda / (dim * el->lambda + 2.0 * el->mu);
-  return hypo_det(dim, b->F, b->n, i) * (ss - a * tr * tr) / (4.0 * el->mu);
+  return solid_det(dim, b->F, b->n, i) * (ss - a * tr * tr) / (4.0 * el->mu);
 }
 
 const solid_material_ops solid_hypoelastic_ops = {

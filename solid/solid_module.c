@@ -5,6 +5,7 @@
  * holds a small integer stored as a double. The per-body index lists used for batched
  * stress evaluation are rebuilt at each P2G, so they never go stale after migration,
  * sorting or injection. */
+#include "solid_tensor.h"
 #include "solid_module.h"
 
 #include "mpm_bc.h"
@@ -398,21 +399,12 @@ static double solid_stable_dt(const mpm_module *m, const double *y) {
   return dt;
 }
 
-static double det(int dim, const double *F, mpm_lidx n, mpm_lidx i) {
-#define A(r, c) F[(size_t)((r)*dim + (c)) * n + i]
-  if (dim == 2) return A(0, 0) * A(1, 1) - A(0, 1) * A(1, 0);
-  return A(0, 0) * (A(1, 1) * A(2, 2) - A(1, 2) * A(2, 1)) -
-         A(0, 1) * (A(1, 0) * A(2, 2) - A(1, 2) * A(2, 0)) +
-         A(0, 2) * (A(1, 0) * A(2, 1) - A(1, 1) * A(2, 0));
-#undef A
-}
-
 static int solid_check(const mpm_module *m, const double *y, mpm_fault *fault) {
   if (mpm_module_check_positions(m, y, fault)) return 1;
   const mpm_particles *p = m->particles;
   const double *F = y + (size_t)p->offset[F_F] * p->n;
   for (mpm_lidx i = 0; i < p->n; ++i) {
-    const double J = det(p->dim, F, p->n, i);
+    const double J = solid_det(p->dim, F, p->n, i);
     if (J <= 0.0)
       return mpm_fault_at(fault, p, y, i, "the deformation gradient is inverted (J = %.3g <= 0)",
                           J);
