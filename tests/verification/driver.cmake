@@ -12,3 +12,4 @@ mpm_add_script_test(test_axial_bar SCRIPT verification/test_axial_bar.py
                     LABELS verification TIMEOUT 600)
 mpm_add_script_test(test_axial_bar_long SCRIPT verification/test_axial_bar.py ARGS long
                     LABELS "verification;long" TIMEOUT 1800)
+mpm_add_script_test(test_cases SCRIPT conformance/test_cases.py LABELS conformance TIMEOUT 300)
