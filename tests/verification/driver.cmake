@@ -7,7 +7,7 @@ mpm_add_script_test(test_bad_input SCRIPT conformance/test_bad_input.py
 mpm_add_script_test(test_recoverable SCRIPT verification/test_recoverable.py
                     LABELS "verification" TIMEOUT 600)
 mpm_add_script_test(test_decomposition SCRIPT verification/test_decomposition.py
-                    LABELS "verification;mpi" TIMEOUT 600)
+                    LABELS "verification;mpi" TIMEOUT 1500)
 mpm_add_script_test(test_axial_bar SCRIPT verification/test_axial_bar.py
                     LABELS verification TIMEOUT 600)
 mpm_add_script_test(test_axial_bar_long SCRIPT verification/test_axial_bar.py ARGS long
