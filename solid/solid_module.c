@@ -1,12 +1,13 @@
-/* Solid module: seeding, and the module phases of an MPM right-hand side.
+/* Solid module: seeding, constraints (walls, clamps), and the module phases of an MPM
+ * right-hand side.
  *
- * Invariants: particle field order is x, v, F, [sigma] | m, V0, body, [hist] (see
- * solid_particles_new); body
- * holds a small integer stored as a double. The per-body index lists used for batched
- * stress evaluation are rebuilt at each P2G, so they never go stale after migration,
+ * Invariants: particle field order is x, v, F, [sigma] | m, V0, body, [hist], [fixed] (see
+ * solid_particles_new; bracketed fields exist only when a body's model or a clamp needs
+ * them). body holds a small integer stored as a double. The per-body index lists used for
+ * batched stress evaluation are rebuilt at each P2G, so they never go stale after migration,
  * sorting or injection. */
-#include "solid_tensor.h"
 #include "solid_module.h"
+#include "solid_tensor.h"
 
 #include "mpm_bc.h"
 #include "mpm_error.h"

@@ -1,9 +1,10 @@
-/* The solid MPM module: elastic bodies seeded from case-file geometry, each with its own
- * material model, integrated as x, v and F on the particles.
+/* The solid MPM module: bodies seeded from case-file geometry, each with its own material
+ * model, integrated as x, v and F on the particles, held by walls and clamps.
  *
  * State fields: x (dim), v (dim), F (dim*dim), and sigma (dim*dim) when a body's model is in
  * rate form. Other fields: m (mass), V0 (reference volume), body (index of the [solid.NAME]
- * section the particle came from), and hist when a body's model has history variables. */
+ * section the particle came from), hist when a body's model has history variables, and fixed
+ * (1 inside a clamp) when the case has clamps. */
 #ifndef SOLID_MODULE_H
 #define SOLID_MODULE_H
 
