@@ -59,6 +59,10 @@ static const mpm_key_spec sim_keys[] = {
      "MPI ranks per direction (0: let MPI choose)", 0},
     {"physics.gravity", MPM_KEY_REALS, "0 0 0", -HUGE_VAL, HUGE_VAL, 0, 3, NULL,
      "body acceleration, m/s^2", 0},
+    {"physics.damping", MPM_KEY_REAL, "0", 0, HUGE_VAL, 0, 0, NULL,
+     "mass-proportional damping rate alpha, 1/s (amplitudes decay as exp(-alpha t / 2)); "
+     "for quasi-static problems",
+     0},
     {"output.dir", MPM_KEY_STRING, "out", 0, 0, 0, 0, NULL, "output folder", 0},
     {"output.interval", MPM_KEY_REAL, "0", 0, HUGE_VAL, 0, 0, NULL,
      "time between snapshots, s (0: t_end / 10)", 0},
@@ -270,7 +274,7 @@ static int diagnostics_row(mpm_sim *s, double dt) {
   mpm_integrator_counts(s->it, &steps, &rhs, &fails, &retries);
   const double row[NDIAG] = {s->t,   (double)s->step, dt,     sum[0], sum[1],          sum[2],
                              sum[3], sum[4],          sum[5], sum[6], sum[5] + sum[6], (double)rhs};
-  s->particle_steps += sum[0];
+  if (dt > 0) s->particle_steps += sum[0]; /* the row at t = 0 is not a step */
   return mpm_diag_row(s->diag, row);
 }
 

@@ -45,6 +45,7 @@ typedef struct {
   int nclamps;
   mpm_region **clamp; /* clamped regions */
   double gravity[MPM_MAX_DIM];
+  double damping; /* mass-proportional damping rate alpha, 1/s: f_i -= alpha (m v)_i */
   double lp;              /* GIMP half-width in cells */
   mpm_lidx cap;           /* capacity of the scratch arrays */
   double *vsig, *scratch; /* V sigma (dim^2 n); G2P output v, a, L ((2 dim + dim^2) n) */
@@ -288,10 +289,19 @@ static int solid_p2g(mpm_module *m, double t, const double *y) {
   return 0;
 }
 
+/* Mass-proportional damping, a force -alpha m v on every node: each mode's amplitude decays
+ * as exp(-alpha t / 2). For quasi-static problems; off by default. */
+static void damp(mpm_grid *grid, int phase, double alpha) {
+  mpm_grid_phase *ph = &grid->phase[phase];
+  for (int d = 0; d < grid->dim; ++d)
+    for (mpm_lidx l = 0; l < grid->nnodes; ++l) ph->f_i[d][l] -= alpha * ph->mv_i[d][l];
+}
+
 static int solid_grid_update(mpm_module *m, double t, double h) {
   (void)t;
   const solid_content *sc = m->content;
   mpm_constraints_fold(&sc->cons, m->grid, m->phase);
+  if (sc->damping > 0) damp(m->grid, m->phase, sc->damping);
   MPM_CALL(mpm_grid_phase_update(m->grid, m->phase, h));
   mpm_constraints_apply(&sc->cons, m->grid, m->phase);
   return 0;
@@ -511,6 +521,7 @@ static int read_bodies(mpm_module *m, const mpm_config *cfg) {
   double g[3] = {0, 0, 0};
   MPM_CALL(mpm_config_get_reals(cfg, "physics.gravity", g, 3, &nv));
   memcpy(sc->gravity, g, sizeof g);
+  MPM_CALL(mpm_config_get_real(cfg, "physics.damping", &sc->damping));
   return 0;
 }
 

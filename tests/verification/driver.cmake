@@ -24,3 +24,5 @@ mpm_add_script_test(test_cases SCRIPT conformance/test_cases.py LABELS conforman
 mpm_add_script_test(test_csm3 SCRIPT verification/test_csm3.py
                     LABELS "verification;long" TIMEOUT 1800)
 set_tests_properties(test_csm3 PROPERTIES WILL_FAIL TRUE)
+mpm_add_script_test(test_damping SCRIPT verification/test_damping.py LABELS verification
+                    TIMEOUT 300)
