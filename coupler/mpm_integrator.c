@@ -192,12 +192,22 @@ static void free_state(mpm_integrator *it) {
   memset(it->sub, 0, sizeof it->sub);
 }
 
+/* The classic update takes fixed steps, so no error norm is ever used; ARKODE 6.4 still
+ * computes one per step (a "too much accuracy" check read only for adaptive steps), a full
+ * pass over the state with a global reduction. For this method the state's vectors report
+ * a zero local sum instead: an ops-table specialisation, inherited by ARKODE's clones. */
+static mpm_sunreal no_wsqrsum(N_Vector x, N_Vector w) {
+  (void)x, (void)w;
+  return 0.0;
+}
+
 static int wrap_state(mpm_integrator *it) {
   free_state(it);
   for (int k = 0; k < it->nmod; ++k) {
     mpm_particles *p = it->mod[k]->particles;
     it->sub[k] = N_VMake_Serial((sunindextype)p->nstate * p->n, p->data, it->ctx);
     if (!it->sub[k]) MPM_FAIL(MPM_ERR_SUNDIALS, "cannot wrap the %s state", it->mod[k]->name);
+    if (it->method == MPM_METHOD_USL) it->sub[k]->ops->nvwsqrsumlocal = no_wsqrsum;
   }
   it->y = N_VMake_MPIManyVector(it->comm, it->nmod, it->sub, it->ctx);
   if (!it->y) MPM_FAIL(MPM_ERR_SUNDIALS, "cannot build the MPIManyVector state");
@@ -274,6 +284,15 @@ static int set_ralston_table(mpm_integrator *it) {
   return 0;
 }
 
+/* Error weights for the classic update. A fixed step never uses them, but ARKODE 6.4
+ * recomputes them every step (four passes over the state with the default function); one
+ * constant fill is all a fixed step needs. */
+static int unit_weights(N_Vector y, N_Vector ewt, void *user) {
+  (void)y, (void)user;
+  N_VConst(1.0, ewt);
+  return 0;
+}
+
 static int configure(mpm_integrator *it, double h0) {
   static const ARKODE_ERKTableID tables[MPM_METHOD_COUNT] = {
       ARKODE_ERK_NONE, ARKODE_ERK_NONE, ARKODE_BOGACKI_SHAMPINE_4_2_3, ARKODE_ZONNEVELD_5_3_4,
@@ -285,6 +304,7 @@ static int configure(mpm_integrator *it, double h0) {
   MPM_CALL_SUN(ERKStepSetMaxNumSteps(it->ark, -1));
   if (it->method == MPM_METHOD_USL) {
     MPM_CALL(set_classic_table(it));
+    MPM_CALL_SUN(ERKStepWFtolerances(it->ark, unit_weights));
     MPM_CALL_SUN(ERKStepSetFixedStep(it->ark, h0 > 0 ? h0 : 1.0));
     return 0;
   }
