@@ -45,7 +45,7 @@ typedef struct {
   int nclamps;
   mpm_region **clamp; /* clamped regions */
   double gravity[MPM_MAX_DIM];
-  double damping; /* mass-proportional damping rate alpha, 1/s: f_i -= alpha (m v)_i */
+  double damping;         /* mass-proportional damping rate alpha, 1/s: f_i -= alpha (m v)_i */
   double lp;              /* GIMP half-width in cells */
   mpm_lidx cap;           /* capacity of the scratch arrays */
   double *vsig, *scratch; /* V sigma (dim^2 n); G2P output v, a, L ((2 dim + dim^2) n) */
