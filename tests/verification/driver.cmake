@@ -26,3 +26,5 @@ mpm_add_script_test(test_csm3 SCRIPT verification/test_csm3.py
 set_tests_properties(test_csm3 PROPERTIES WILL_FAIL TRUE)
 mpm_add_script_test(test_damping SCRIPT verification/test_damping.py LABELS verification
                     TIMEOUT 300)
+mpm_add_script_test(test_model_swap SCRIPT verification/test_model_swap.py
+                    LABELS verification TIMEOUT 600)
