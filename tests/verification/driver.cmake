@@ -28,3 +28,5 @@ mpm_add_script_test(test_damping SCRIPT verification/test_damping.py LABELS veri
                     TIMEOUT 300)
 mpm_add_script_test(test_model_swap SCRIPT verification/test_model_swap.py
                     LABELS verification TIMEOUT 600)
+mpm_add_script_test(test_disks SCRIPT verification/test_disks.py LABELS verification
+                    TIMEOUT 600)
