@@ -30,3 +30,5 @@ mpm_add_script_test(test_model_swap SCRIPT verification/test_model_swap.py
                     LABELS verification TIMEOUT 600)
 mpm_add_script_test(test_disks SCRIPT verification/test_disks.py LABELS verification
                     TIMEOUT 600)
+mpm_add_script_test(test_ranks_solid SCRIPT verification/test_ranks_solid.py
+                    LABELS "verification;mpi" TIMEOUT 900)
