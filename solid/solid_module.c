@@ -46,6 +46,7 @@ typedef struct {
   mpm_region **clamp; /* clamped regions */
   double gravity[MPM_MAX_DIM];
   double damping;         /* mass-proportional damping rate alpha, 1/s: f_i -= alpha (m v)_i */
+  double pic;             /* PIC fraction of the velocity transfer (0: FLIP, 1: PIC) */
   double lp;              /* GIMP half-width in cells */
   mpm_lidx cap;           /* capacity of the scratch arrays */
   double *vsig, *scratch; /* V sigma (dim^2 n); G2P output v, a, L ((2 dim + dim^2) n) */
@@ -308,6 +309,17 @@ static int solid_grid_update(mpm_module *m, double t, double h) {
 }
 
 static void solid_stress_rates(mpm_module *m, const double *y, double *ydot, const double *L);
+
+/* FLIP/PIC blend of the classic update: v_p <- (1 - a)(v_p + h sum S a_i) + a sum S v_i^{n+1},
+ * written as a rate over the step h; sum S v_i^{n+1} is dx/dt, already in ydot. */
+static void blend_pic(const mpm_particles *p, const double *y, double *ydot, double a, double h) {
+  for (int d = 0; d < p->dim; ++d) {
+    const double *v = y + (size_t)(p->offset[F_V] + d) * p->n;
+    const double *xdot = ydot + (size_t)(p->offset[F_X] + d) * p->n;
+    double *vdot = ydot + (size_t)(p->offset[F_V] + d) * p->n;
+    for (mpm_lidx i = 0; i < p->n; ++i) vdot[i] = (1.0 - a) * vdot[i] + a / h * (xdot[i] - v[i]);
+  }
+}
 static void hold_fixed(const mpm_particles *p, int f_fixed, double *ydot);
 
 /* dx/dt = sum S v_i, dv/dt = sum S a_i, dF/dt = L F with L = sum v_i (x) grad S. */
@@ -339,6 +351,7 @@ static int solid_g2p(mpm_module *m, double t, const double *y, double *ydot, dou
         for (mpm_lidx i = 0; i < n; ++i) out[i] += Lrk[i] * Fkc[i];
       }
     }
+  if (sc->pic > 0 && h > 0) blend_pic(p, y, ydot, sc->pic, h);
   if (sc->lay.f_sigma >= 0) solid_stress_rates(m, y, ydot, L);
   if (sc->lay.f_fixed >= 0) hold_fixed(p, sc->lay.f_fixed, ydot);
   return 0;
@@ -522,6 +535,14 @@ static int read_bodies(mpm_module *m, const mpm_config *cfg) {
   MPM_CALL(mpm_config_get_reals(cfg, "physics.gravity", g, 3, &nv));
   memcpy(sc->gravity, g, sizeof g);
   MPM_CALL(mpm_config_get_real(cfg, "physics.damping", &sc->damping));
+  MPM_CALL(mpm_config_get_real(cfg, "transfer.pic_fraction", &sc->pic));
+  const char *method;
+  MPM_CALL(mpm_config_get_string(cfg, "time.method", &method));
+  if (sc->pic > 0 && strcmp(method, "usl") != 0)
+    return mpm_config_fail(cfg, "transfer.pic_fraction",
+                           "a PIC fraction is defined per step of the classic update; use "
+                           "time.method = usl, or pic_fraction = 0 with %s",
+                           method);
   return 0;
 }
 

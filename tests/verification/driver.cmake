@@ -32,3 +32,5 @@ mpm_add_script_test(test_disks SCRIPT verification/test_disks.py LABELS verifica
                     TIMEOUT 600)
 mpm_add_script_test(test_ranks_solid SCRIPT verification/test_ranks_solid.py
                     LABELS "verification;mpi" TIMEOUT 900)
+mpm_add_script_test(test_transfer SCRIPT verification/test_transfer.py LABELS verification
+                    TIMEOUT 600)
