@@ -46,8 +46,7 @@ int mpm_walls_from_config(mpm_walls *w, const mpm_config *cfg, int dim) {
   return 0;
 }
 
-static int add_rule(mpm_node_constraints *c, mpm_lidx l, mpm_lidx source, unsigned char mask,
-                    int axis) {
+static int add_rule(mpm_node_constraints *c, mpm_lidx l, mpm_lidx source, unsigned char mask) {
   if (c->count == c->cap) {
     const mpm_lidx cap = c->cap ? 2 * c->cap : 256;
     mpm_lidx *node = realloc(c->node, sizeof *node * (size_t)cap);
@@ -56,20 +55,17 @@ static int add_rule(mpm_node_constraints *c, mpm_lidx l, mpm_lidx source, unsign
     if (src) c->source = src;
     unsigned char *m = realloc(c->mask, (size_t)cap);
     if (m) c->mask = m;
-    unsigned char *ax = realloc(c->axis, (size_t)cap);
-    if (ax) c->axis = ax;
-    if (!node || !src || !m || !ax) MPM_FAIL(MPM_ERR_MEMORY, "cannot grow the node constraints");
+    if (!node || !src || !m) MPM_FAIL(MPM_ERR_MEMORY, "cannot grow the node constraints");
     c->cap = cap;
   }
   c->node[c->count] = l;
   c->source[c->count] = source;
-  c->mask[c->count] = mask;
-  c->axis[c->count++] = (unsigned char)axis;
+  c->mask[c->count++] = mask;
   return 0;
 }
 
 int mpm_constraints_add(mpm_node_constraints *c, mpm_lidx l, unsigned char mask) {
-  return add_rule(c, l, -1, mask, 0);
+  return add_rule(c, l, -1, mask);
 }
 
 void mpm_grid_node_global(const mpm_grid *grid, mpm_lidx l, int *gi) {
@@ -95,14 +91,14 @@ static int add_face(mpm_node_constraints *c, const mpm_grid *g, int d, int side,
     const int k = side == 0 ? face - gi[d] : gi[d] - face; /* distance beyond the face */
     if (k < 0) continue;
     if (k == 0) {
-      MPM_CALL(add_rule(c, l, -1, mask, d));
+      MPM_CALL(add_rule(c, l, -1, mask));
       continue;
     }
     int gm[MPM_MAX_DIM];
     memcpy(gm, gi, sizeof gm);
     gm[d] = side == 0 ? face + k : face - k;
     if (gm[d] < g->box_lo[d] || gm[d] >= g->box_lo[d] + g->box_n[d]) continue;
-    MPM_CALL(add_rule(c, l, mpm_grid_local_index(g, gm), mask, d));
+    MPM_CALL(add_rule(c, l, mpm_grid_local_index(g, gm), mask));
   }
   return 0;
 }
@@ -162,6 +158,5 @@ void mpm_constraints_free(mpm_node_constraints *c) {
   free(c->node);
   free(c->source);
   free(c->mask);
-  free(c->axis);
   memset(c, 0, sizeof *c);
 }

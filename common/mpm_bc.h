@@ -36,7 +36,6 @@ typedef struct mpm_node_constraints {
   mpm_lidx *node;
   mpm_lidx *source; /* mirror node, or -1 for a held node */
   unsigned char *mask;
-  unsigned char *axis; /* axis of a mirror rule (rules are applied in axis order) */
 } mpm_node_constraints;
 
 /* Hold the masked components of node l at zero. */
