@@ -30,6 +30,7 @@ typedef struct {
   char section[96];
   solid_material *mat;
   double rho;
+  double c; /* elastic wave speed of the model at rho (for the stable step) */
 } solid_body;
 
 typedef struct {
@@ -417,8 +418,7 @@ static double solid_stable_dt(const mpm_module *m, const double *y) {
       const double v = y[(size_t)(p->offset[F_V] + d) * p->n + i];
       v2 += v * v;
     }
-    const solid_body *b = &sc->body[(int)body[i]];
-    dt = fmin(dt, m->grid->dx / (b->mat->ops->wave_speed(b->mat, b->rho) + sqrt(v2)));
+    dt = fmin(dt, m->grid->dx / (sc->body[(int)body[i]].c + sqrt(v2)));
   }
   return dt;
 }
@@ -443,6 +443,7 @@ static void solid_sums(const mpm_module *m, mpm_module_sums *s) {
   const double *mass = mpm_particles_comp(p, sc->lay.f_m, 0),
                *V0 = mpm_particles_comp(p, sc->lay.f_V0, 0);
   const double *body = mpm_particles_comp(p, sc->lay.f_body, 0);
+  const solid_batch batch = batch_of(sc, p, p->data, 0, NULL, NULL);
   memset(s, 0, sizeof *s);
   for (mpm_lidx i = 0; i < p->n; ++i) {
     s->mass += mass[i];
@@ -452,7 +453,6 @@ static void solid_sums(const mpm_module *m, mpm_module_sums *s) {
       s->kinetic += 0.5 * mass[i] * v * v;
     }
     const solid_body *b = &sc->body[(int)body[i]];
-    const solid_batch batch = batch_of(sc, p, p->data, 0, NULL, NULL);
     s->internal += V0[i] * b->mat->ops->energy_density(b->mat, &batch, i);
   }
 }
@@ -530,6 +530,8 @@ static int read_bodies(mpm_module *m, const mpm_config *cfg) {
     key_of(key, sizeof key, sc->body[b].section, "material");
     MPM_CALL(mpm_config_get_string(cfg, key, &type));
     MPM_CALL(solid_material_create(&sc->body[b].mat, type, cfg, sc->body[b].section, m->grid->dim));
+    /* Constant per body: evaluated once, not per particle in every stable-step scan. */
+    sc->body[b].c = sc->body[b].mat->ops->wave_speed(sc->body[b].mat, sc->body[b].rho);
   }
   double g[3] = {0, 0, 0};
   MPM_CALL(mpm_config_get_reals(cfg, "physics.gravity", g, 3, &nv));
