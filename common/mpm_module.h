@@ -3,7 +3,7 @@
  * exposes the phases of an MPM right-hand side; the coupler decides their order:
  *
  *   zero grid phase -> p2g -> [halo reverse] -> [coupling] -> grid_update -> [halo forward]
- *   -> g2p
+ *   -> [MUSL: remap -> halo reverse -> grid_update -> halo forward] -> g2p
  *
  * y and ydot are the module's block of the ODE state, laid out like the state fields of its
  * particle set (component-major, stride n). h is the step size of the classic MPM update
@@ -42,6 +42,12 @@ typedef struct mpm_module_ops {
   /* After an accepted step and migration (history updates, regularisation). Optional. */
   int (*post_step)(mpm_module *m);
   void (*destroy)(mpm_module *m);
+  /* MUSL's second transfer, after the first grid update and forward halo: compute the
+   * particles' new velocities, zero this phase and deposit their mass and momentum again.
+   * The coupler then sums the halo and calls grid_update, which turns the new momenta into
+   * the nodal velocities (no force, no damping: the force acted in the first pass) before
+   * g2p. Optional: NULL if the module has no MUSL. */
+  int (*remap)(mpm_module *m, double t, const double *y, double h);
 } mpm_module_ops;
 
 struct mpm_module {

@@ -39,8 +39,8 @@ struct mpm_integrator {
 
 const mpm_key_spec mpm_integrator_keys[] = {
     {"time.t_end", MPM_KEY_REAL, NULL, 0, HUGE_VAL, 1, 0, NULL, "end time of the run, s", 0},
-    {"time.method", MPM_KEY_ENUM, "bs32", 0, 0, 0, 0, "usl|ralston21|bs32|zonneveld43|dp54",
-     "time method: usl (classic MPM, fixed CFL step) or an adaptive embedded ERK pair", 0},
+    {"time.method", MPM_KEY_ENUM, "bs32", 0, 0, 0, 0, "usl|musl|ralston21|bs32|zonneveld43|dp54",
+     "time method: usl or musl (classic MPM, fixed CFL step) or an adaptive embedded ERK pair", 0},
     {"time.rtol", MPM_KEY_REAL, "1e-6", 0, 1, 1, 0, NULL, "relative tolerance (adaptive)", 0},
     {"time.atol", MPM_KEY_REAL, "1e-9", 0, HUGE_VAL, 1, 0, NULL,
      "absolute tolerance (adaptive), in state units (m, m/s, 1)", 0},
@@ -52,8 +52,8 @@ const mpm_key_spec mpm_integrator_keys[] = {
 };
 const int mpm_integrator_nkeys = (int)(sizeof mpm_integrator_keys / sizeof mpm_integrator_keys[0]);
 
-static const char *const g_method_names[MPM_METHOD_COUNT] = {"usl", "ralston21", "bs32",
-                                                             "zonneveld43", "dp54"};
+static const char *const g_method_names[MPM_METHOD_COUNT] = {"usl",  "musl",        "ralston21",
+                                                             "bs32", "zonneveld43", "dp54"};
 const char *mpm_method_name(mpm_method m) {
   return g_method_names[m];
 }
@@ -96,18 +96,30 @@ static int halo(mpm_integrator *it, int reverse) {
   return rc;
 }
 
-/* P2G -> reverse halo -> grid update -> forward halo -> G2P, over every module. */
+/* Reverse halo -> grid update -> forward halo, over every module. */
+static int grid_pass(mpm_integrator *it, double t, double h) {
+  MPM_CALL(halo(it, 1));
+  mpm_timer_start(MPM_T_GRID);
+  for (int k = 0; k < it->nmod; ++k) MPM_CALL(it->mod[k]->ops->grid_update(it->mod[k], t, h));
+  mpm_timer_stop(MPM_T_GRID);
+  return halo(it, 0);
+}
+
+/* P2G -> grid pass -> [MUSL: remap -> grid pass] -> G2P, over every module. */
 static int mpm_cycle(mpm_integrator *it, double t, N_Vector y, N_Vector ydot) {
   for (int k = 0; k < it->nmod; ++k) {
     mpm_grid_phase_zero(it->grid, it->mod[k]->phase);
     MPM_CALL(it->mod[k]->ops->p2g(it->mod[k], t, module_data(y, k)));
   }
-  MPM_CALL(halo(it, 1));
-  mpm_timer_start(MPM_T_GRID);
-  for (int k = 0; k < it->nmod; ++k)
-    MPM_CALL(it->mod[k]->ops->grid_update(it->mod[k], t, it->h_classic));
-  mpm_timer_stop(MPM_T_GRID);
-  MPM_CALL(halo(it, 0));
+  MPM_CALL(grid_pass(it, t, it->h_classic));
+  if (it->method == MPM_METHOD_MUSL) {
+    mpm_timer_start(MPM_T_P2G);
+    for (int k = 0; k < it->nmod; ++k)
+      if (it->mod[k]->ops->remap)
+        MPM_CALL(it->mod[k]->ops->remap(it->mod[k], t, module_data(y, k), it->h_classic));
+    mpm_timer_stop(MPM_T_P2G);
+    MPM_CALL(grid_pass(it, t, 0.0));
+  }
   mpm_timer_start(MPM_T_G2P);
   for (int k = 0; k < it->nmod; ++k)
     MPM_CALL(it->mod[k]->ops->g2p(it->mod[k], t, module_data(y, k), module_data(ydot, k),
@@ -123,7 +135,7 @@ static int rhs(mpm_sunreal t, N_Vector y, N_Vector ydot, void *user) {
   mpm_fault local = {0};
   it->rhs_evals++;
   mpm_timer_start(MPM_T_CHECK);
-  if (it->method == MPM_METHOD_USL && classic_step(it, t, y, &it->h_classic) != 0) {
+  if (mpm_method_is_classic(it->method) && classic_step(it, t, y, &it->h_classic) != 0) {
     it->rhs_error = 1;
     return -1;
   }
@@ -207,7 +219,7 @@ static int wrap_state(mpm_integrator *it) {
     mpm_particles *p = it->mod[k]->particles;
     it->sub[k] = N_VMake_Serial((sunindextype)p->nstate * p->n, p->data, it->ctx);
     if (!it->sub[k]) MPM_FAIL(MPM_ERR_SUNDIALS, "cannot wrap the %s state", it->mod[k]->name);
-    if (it->method == MPM_METHOD_USL) it->sub[k]->ops->nvwsqrsumlocal = no_wsqrsum;
+    if (mpm_method_is_classic(it->method)) it->sub[k]->ops->nvwsqrsumlocal = no_wsqrsum;
   }
   it->y = N_VMake_MPIManyVector(it->comm, it->nmod, it->sub, it->ctx);
   if (!it->y) MPM_FAIL(MPM_ERR_SUNDIALS, "cannot build the MPIManyVector state");
@@ -295,14 +307,15 @@ static int unit_weights(N_Vector y, N_Vector ewt, void *user) {
 
 static int configure(mpm_integrator *it, double h0) {
   static const ARKODE_ERKTableID tables[MPM_METHOD_COUNT] = {
-      ARKODE_ERK_NONE, ARKODE_ERK_NONE, ARKODE_BOGACKI_SHAMPINE_4_2_3, ARKODE_ZONNEVELD_5_3_4,
-      ARKODE_DORMAND_PRINCE_7_4_5};
+      ARKODE_ERK_NONE,        ARKODE_ERK_NONE,
+      ARKODE_ERK_NONE,        ARKODE_BOGACKI_SHAMPINE_4_2_3,
+      ARKODE_ZONNEVELD_5_3_4, ARKODE_DORMAND_PRINCE_7_4_5};
   MPM_CALL_SUN(ERKStepSetUserData(it->ark, it));
 #if SUNDIALS_VERSION_MAJOR < 7
   MPM_CALL_SUN(ERKStepSetErrHandlerFn(it->ark, ark_errors, NULL));
 #endif
   MPM_CALL_SUN(ERKStepSetMaxNumSteps(it->ark, -1));
-  if (it->method == MPM_METHOD_USL) {
+  if (mpm_method_is_classic(it->method)) {
     MPM_CALL(set_classic_table(it));
     MPM_CALL_SUN(ERKStepWFtolerances(it->ark, unit_weights));
     MPM_CALL_SUN(ERKStepSetFixedStep(it->ark, h0 > 0 ? h0 : 1.0));
@@ -368,7 +381,7 @@ static int report_fault(const mpm_integrator *it, double t, int tries) {
  * unphysical stage (retry smaller), otherwise an error code. */
 static int attempt(mpm_integrator *it, double tstop, double scale, double *t, double *h) {
   mpm_sunreal tret = it->t_last;
-  if (it->method == MPM_METHOD_USL) {
+  if (mpm_method_is_classic(it->method)) {
     /* A stored f computed for another stop time or scale would use the wrong step. */
     if (tstop != it->tstop || scale != it->scale) it->fn_stale = 1;
     it->tstop = tstop, it->scale = scale;
@@ -416,7 +429,7 @@ int mpm_integrator_step(mpm_integrator *it, double tstop, double *t, double *h) 
     scale *= 0.25;
     MPM_CALL(stable_step(it, it->y, &h_cfl));
     h_cfl = isfinite(h_cfl) ? it->cfl * h_cfl : h_tried; /* no stability limit: the step tried */
-    const double h_next = it->method == MPM_METHOD_USL ? scale * h_cfl : scale * h_tried;
+    const double h_next = mpm_method_is_classic(it->method) ? scale * h_cfl : scale * h_tried;
     if (tries >= it->max_retries || h_next < MPM_RETRY_FLOOR * h_cfl)
       return report_fault(it, it->t_last, tries);
     it->retries++;
@@ -424,8 +437,9 @@ int mpm_integrator_step(mpm_integrator *it, double tstop, double *t, double *h) 
             h_next, (long long)it->fault.id, it->fault.cause);
     /* ERKStep cannot retry a recoverable explicit RHS failure itself: restart it from the
      * last accepted state (the particle data) with a quarter of the step it tried. */
-    MPM_CALL(mpm_integrator_start(it, it->t_last, it->method == MPM_METHOD_USL ? 0.0 : h_next));
+    MPM_CALL(
+        mpm_integrator_start(it, it->t_last, mpm_method_is_classic(it->method) ? 0.0 : h_next));
     /* A fresh ERKStep may grow its first step 10^4-fold, straight back into the failure. */
-    if (it->method != MPM_METHOD_USL) MPM_CALL_SUN(ERKStepSetMaxFirstGrowth(it->ark, 2.0));
+    if (!mpm_method_is_classic(it->method)) MPM_CALL_SUN(ERKStepSetMaxFirstGrowth(it->ark, 2.0));
   }
 }

@@ -4,10 +4,10 @@
  * state block of the module's particle set (no copy). The RHS is the MPM cycle owned by the
  * coupler: P2G of every module, reverse halo, grid update, forward halo, G2P.
  *
- * Methods: the classic MPM update (USL) is a one-stage explicit table taken with a fixed
- * step set before every step from the stability limit; the grid velocity is advanced by
- * that step before G2P, as the classic update needs. The adaptive methods are embedded ERK
- * pairs with error control and the same stability limit.
+ * Methods: the classic MPM update (USL, and MUSL with its second transfer) is a one-stage
+ * explicit table taken with a fixed step set before every step from the stability limit;
+ * the grid velocity is advanced by that step before G2P, as the classic update needs. The adaptive
+ * methods are embedded ERK pairs with error control and the same stability limit.
  *
  * Failures: an unphysical stage (NaN, J <= 0, a particle outside the domain or too far out
  * of its box) makes the RHS return a recoverable flag on every rank. ERKStep 6.4 cannot
@@ -23,6 +23,8 @@
 
 typedef enum {
   MPM_METHOD_USL,         /* classic MPM update, fixed step from the CFL limit */
+  MPM_METHOD_MUSL,        /* the same with MUSL's second transfer (nodal velocities from the
+                             updated particle momenta) before positions and F are moved */
   MPM_METHOD_RALSTON21,   /* Ralston ERK 2(1): unstable for undamped waves, for comparison */
   MPM_METHOD_BS32,        /* Bogacki-Shampine 3(2) */
   MPM_METHOD_ZONNEVELD43, /* Zonneveld 4(3) */
@@ -58,5 +60,10 @@ void mpm_integrator_counts(const mpm_integrator *it, long *steps, long *rhs, lon
                            long *retries);
 
 const char *mpm_method_name(mpm_method m);
+
+/* Is m a classic MPM update (fixed CFL step known to the RHS)? */
+static inline int mpm_method_is_classic(mpm_method m) {
+  return m == MPM_METHOD_USL || m == MPM_METHOD_MUSL;
+}
 
 #endif

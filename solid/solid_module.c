@@ -48,6 +48,9 @@ typedef struct {
   double gravity[MPM_MAX_DIM];
   double damping;         /* mass-proportional damping rate alpha, 1/s: f_i -= alpha (m v)_i */
   double pic;             /* PIC fraction of the velocity transfer (0: FLIP, 1: PIC) */
+  int musl;               /* MUSL: nodal velocities from the updated particle momenta */
+  int remapped;           /* the phase holds MUSL's second deposit (see solid_remap) */
+  double *vnew;           /* MUSL: the particles' new velocities (dim n) */
   double lp;              /* GIMP half-width in cells */
   mpm_lidx cap;           /* capacity of the scratch arrays */
   double *vsig, *scratch; /* V sigma (dim^2 n); G2P output v, a, L ((2 dim + dim^2) n) */
@@ -242,10 +245,13 @@ static int ensure_scratch(mpm_module *m) {
   free(sc->vsig);
   free(sc->scratch);
   free(sc->idx);
+  free(sc->vnew);
+  sc->vnew = NULL;
   sc->cap = n + n / 4 + 16;
   MPM_ALLOC(sc->vsig, (size_t)dim * dim * sc->cap);
   MPM_ALLOC(sc->scratch, (size_t)(2 * dim + dim * dim) * sc->cap);
   MPM_ALLOC(sc->idx, sc->cap);
+  if (sc->musl) MPM_ALLOC(sc->vnew, (size_t)dim * sc->cap);
   return 0;
 }
 
@@ -299,12 +305,16 @@ static void damp(mpm_grid *grid, int phase, double alpha) {
     for (mpm_lidx l = 0; l < grid->nnodes; ++l) ph->f_i[d][l] -= alpha * ph->mv_i[d][l];
 }
 
+/* The nodal update. After MUSL's second deposit the phase holds mass and momentum only: the
+ * update just turns them into velocities (h = 0, no damping; the force acted already). */
 static int solid_grid_update(mpm_module *m, double t, double h) {
   (void)t;
-  const solid_content *sc = m->content;
+  solid_content *sc = m->content;
+  const int second = sc->remapped;
+  sc->remapped = 0;
   mpm_constraints_fold(&sc->cons, m->grid, m->phase);
-  if (sc->damping > 0) damp(m->grid, m->phase, sc->damping);
-  MPM_CALL(mpm_grid_phase_update(m->grid, m->phase, h));
+  if (sc->damping > 0 && !second) damp(m->grid, m->phase, sc->damping);
+  MPM_CALL(mpm_grid_phase_update(m->grid, m->phase, second ? 0.0 : h));
   mpm_constraints_apply(&sc->cons, m->grid, m->phase);
   return 0;
 }
@@ -323,24 +333,68 @@ static void blend_pic(const mpm_particles *p, const double *y, double *ydot, dou
 }
 static void hold_fixed(const mpm_particles *p, int f_fixed, double *ydot);
 
-/* dx/dt = sum S v_i, dv/dt = sum S a_i, dF/dt = L F with L = sum v_i (x) grad S. */
-static int solid_g2p(mpm_module *m, double t, const double *y, double *ydot, double h) {
-  (void)t, (void)h;
-  solid_content *sc = m->content;
+/* G2P of velocity and acceleration only (no L): v_out = sum S v_i, a_out = sum S a_i. */
+static void g2p_velocity(mpm_module *m, const double *y, double *const *v_out, double *const *a_out,
+                         double *L_out) {
+  const solid_content *sc = m->content;
   const mpm_particles *p = m->particles;
   const mpm_grid_phase *ph = &m->grid->phase[m->phase];
+  mpm_g2p_args a = {.n = p->n, .lp = sc->lp, .L_out = L_out};
+  for (int d = 0; d < p->dim; ++d) {
+    a.x[d] = y + (size_t)(p->offset[F_X] + d) * p->n;
+    a.v_i[d] = ph->v_i[d];
+    a.a_i[d] = ph->a_i[d];
+    a.v_out[d] = v_out[d];
+    a.a_out[d] = a_out[d];
+  }
+  mpm_kernels_get(p->dim)->g2p(m->grid, &a);
+}
+
+/* MUSL's second transfer (Sulsky, Zhou and Schreyer 1995): the particles take their new
+ * velocities, v_p^+ = (1 - a)(v_p + h sum S a_i) + a sum S v_i^{n+1} (a = PIC fraction), and
+ * deposit their mass and momentum again; the positions and F then move with the nodal
+ * velocities of these momenta. Stress and gravity are not deposited again. */
+static int solid_remap(mpm_module *m, double t, const double *y, double h) {
+  (void)t;
+  solid_content *sc = m->content;
+  const mpm_particles *p = m->particles;
+  const int dim = p->dim;
+  const mpm_lidx n = p->n;
+  double *vg[MPM_MAX_DIM] = {NULL}, *ag[MPM_MAX_DIM] = {NULL};
+  for (int d = 0; d < dim; ++d)
+    vg[d] = sc->scratch + (size_t)d * n, ag[d] = sc->scratch + (size_t)(dim + d) * n;
+  g2p_velocity(m, y, vg, ag, NULL);
+  for (int d = 0; d < dim; ++d) {
+    const double *v = y + (size_t)(p->offset[F_V] + d) * n;
+    double *vn = sc->vnew + (size_t)d * n;
+    for (mpm_lidx i = 0; i < n; ++i)
+      vn[i] = (1.0 - sc->pic) * (v[i] + h * ag[d][i]) + sc->pic * vg[d][i];
+  }
+  mpm_grid_phase_zero(m->grid, m->phase);
+  mpm_p2g_args a = {.n = n, .m = mpm_particles_comp(p, sc->lay.f_m, 0), .lp = sc->lp};
+  for (int d = 0; d < dim; ++d) {
+    a.x[d] = y + (size_t)(p->offset[F_X] + d) * n;
+    a.v[d] = sc->vnew + (size_t)d * n;
+  }
+  mpm_kernels_get(dim)->p2g(m->grid, m->phase, &a);
+  sc->remapped = 1;
+  return 0;
+}
+
+/* dx/dt = sum S v_i, dv/dt = sum S a_i, dF/dt = L F with L = sum v_i (x) grad S. */
+static int solid_g2p(mpm_module *m, double t, const double *y, double *ydot, double h) {
+  (void)t;
+  solid_content *sc = m->content;
+  const mpm_particles *p = m->particles;
   const int dim = p->dim;
   const mpm_lidx n = p->n;
   double *L = sc->scratch + (size_t)2 * dim * n;
-  mpm_g2p_args a = {.n = n, .lp = sc->lp, .L_out = L};
+  double *xdot[MPM_MAX_DIM] = {NULL}, *vdot[MPM_MAX_DIM] = {NULL};
   for (int d = 0; d < dim; ++d) {
-    a.x[d] = y + (size_t)(p->offset[F_X] + d) * n;
-    a.v_i[d] = ph->v_i[d];
-    a.a_i[d] = ph->a_i[d];
-    a.v_out[d] = ydot + (size_t)(p->offset[F_X] + d) * n;
-    a.a_out[d] = ydot + (size_t)(p->offset[F_V] + d) * n;
+    xdot[d] = ydot + (size_t)(p->offset[F_X] + d) * n;
+    vdot[d] = ydot + (size_t)(p->offset[F_V] + d) * n;
   }
-  mpm_kernels_get(dim)->g2p(m->grid, &a);
+  g2p_velocity(m, y, xdot, vdot, L);
   const double *F = y + (size_t)p->offset[F_F] * n;
   double *Fdot = ydot + (size_t)p->offset[F_F] * n;
   for (int r = 0; r < dim; ++r)
@@ -352,7 +406,13 @@ static int solid_g2p(mpm_module *m, double t, const double *y, double *ydot, dou
         for (mpm_lidx i = 0; i < n; ++i) out[i] += Lrk[i] * Fkc[i];
       }
     }
-  if (sc->pic > 0 && h > 0) blend_pic(p, y, ydot, sc->pic, h);
+  if (sc->musl && h > 0)
+    for (int d = 0; d < dim; ++d) { /* the velocity solid_remap gave the particles */
+      const double *v = y + (size_t)(p->offset[F_V] + d) * n, *vn = sc->vnew + (size_t)d * n;
+      for (mpm_lidx i = 0; i < n; ++i) vdot[d][i] = (vn[i] - v[i]) / h;
+    }
+  else if (sc->pic > 0 && h > 0)
+    blend_pic(p, y, ydot, sc->pic, h);
   if (sc->lay.f_sigma >= 0) solid_stress_rates(m, y, ydot, L);
   if (sc->lay.f_fixed >= 0) hold_fixed(p, sc->lay.f_fixed, ydot);
   return 0;
@@ -468,6 +528,7 @@ static void solid_destroy(mpm_module *m) {
     free(sc->vsig);
     free(sc->scratch);
     free(sc->idx);
+    free(sc->vnew);
     free(sc->count);
     free(sc);
   }
@@ -475,8 +536,15 @@ static void solid_destroy(mpm_module *m) {
 }
 
 static const mpm_module_ops solid_ops = {
-    solid_p2g,   solid_grid_update, solid_g2p,       solid_stable_dt,
-    solid_check, solid_sums,        solid_post_step, solid_destroy,
+    .p2g = solid_p2g,
+    .grid_update = solid_grid_update,
+    .g2p = solid_g2p,
+    .stable_dt = solid_stable_dt,
+    .check = solid_check,
+    .sums = solid_sums,
+    .post_step = solid_post_step,
+    .destroy = solid_destroy,
+    .remap = solid_remap,
 };
 
 /* Walls on the domain faces and clamped regions ([clamp.NAME] geometry = ...): the nodes
@@ -540,10 +608,11 @@ static int read_bodies(mpm_module *m, const mpm_config *cfg) {
   MPM_CALL(mpm_config_get_real(cfg, "transfer.pic_fraction", &sc->pic));
   const char *method;
   MPM_CALL(mpm_config_get_string(cfg, "time.method", &method));
-  if (sc->pic > 0 && strcmp(method, "usl") != 0)
+  sc->musl = strcmp(method, "musl") == 0;
+  if (sc->pic > 0 && !sc->musl && strcmp(method, "usl") != 0)
     return mpm_config_fail(cfg, "transfer.pic_fraction",
                            "a PIC fraction is defined per step of the classic update; use "
-                           "time.method = usl, or pic_fraction = 0 with %s",
+                           "time.method = usl or musl, or pic_fraction = 0 with %s",
                            method);
   return 0;
 }

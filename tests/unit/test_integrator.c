@@ -76,8 +76,13 @@ static void fl_destroy(mpm_module *m) {
   mpm_particles_destroy(&m->particles);
 }
 
-static const mpm_module_ops flight_ops = {fl_nop_p2g, fl_nop_grid, fl_g2p, fl_stable,
-                                          fl_check,   fl_sums,     NULL,   fl_destroy};
+static const mpm_module_ops flight_ops = {.p2g = fl_nop_p2g,
+                                          .grid_update = fl_nop_grid,
+                                          .g2p = fl_g2p,
+                                          .stable_dt = fl_stable,
+                                          .check = fl_check,
+                                          .sums = fl_sums,
+                                          .destroy = fl_destroy};
 
 static void accept_positions(mpm_module *m) {
   flight *fl = m->content;

@@ -20,7 +20,7 @@ import mpmtest as mt  # noqa: E402
 check = mt.Checks("test_disks")
 png = sys.argv[1] if len(sys.argv) > 1 else os.path.abspath("disks_energy.png")
 runs = []
-for method in ("usl", "bs32", "zonneveld43", "dp54"):
+for method in ("usl", "musl", "bs32", "zonneveld43", "dp54"):
     out = mt.outdir(f"disks_{method}")
     mt.run(["run", mt.case("two_disks.ini"), f"output.dir={out}", f"time.method={method}",
             "time.t_end=1.5", "output.snapshots=false", "run.progress=false"])
