@@ -24,6 +24,7 @@ struct mpm_integrator {
   mpm_module *mod[MPM_MAX_MODULES];
   int nmod;
   mpm_method method;
+  int fixed; /* fixed CFL steps without error control (classic, euler, time.adaptive = false) */
   double rtol, atol, cfl, dt_max;
   int max_retries;
   double h_classic; /* step of the classic update, computed by its RHS (see classic_step) */
@@ -39,7 +40,8 @@ struct mpm_integrator {
 
 const mpm_key_spec mpm_integrator_keys[] = {
     {"time.t_end", MPM_KEY_REAL, NULL, 0, HUGE_VAL, 1, 0, NULL, "end time of the run, s", 0},
-    {"time.method", MPM_KEY_ENUM, "bs32", 0, 0, 0, 0, "usl|musl|ralston21|bs32|zonneveld43|dp54",
+    {"time.method", MPM_KEY_ENUM, "bs32", 0, 0, 0, 0,
+     "usl|musl|euler|ralston21|bs32|zonneveld43|dp54",
      "time method: usl or musl (classic MPM, fixed CFL step) or an adaptive embedded ERK pair", 0},
     {"time.rtol", MPM_KEY_REAL, "1e-6", 0, 1, 1, 0, NULL, "relative tolerance (adaptive)", 0},
     {"time.atol", MPM_KEY_REAL, "1e-9", 0, HUGE_VAL, 1, 0, NULL,
@@ -47,13 +49,17 @@ const mpm_key_spec mpm_integrator_keys[] = {
     {"time.cfl", MPM_KEY_REAL, "0.4", 0, 0.999, 1, 0, NULL,
      "fraction of the stable step dx / (c + |v|) allowed, below 1", 0},
     {"time.dt_max", MPM_KEY_REAL, "0", 0, HUGE_VAL, 0, 0, NULL, "largest step, s (0: no limit)", 0},
+    {"time.adaptive", MPM_KEY_BOOL, "true", 0, 0, 0, 0, NULL,
+     "false: the ERK pairs take a fixed step, time.cfl of the stability limit, without error "
+     "control (for stability studies; usl, musl and euler always do)",
+     0},
     {"time.max_retries", MPM_KEY_INT, "8", 0, 100, 0, 0, NULL,
      "restarts with a 4x smaller step after an unphysical stage before the run stops", 0},
 };
 const int mpm_integrator_nkeys = (int)(sizeof mpm_integrator_keys / sizeof mpm_integrator_keys[0]);
 
-static const char *const g_method_names[MPM_METHOD_COUNT] = {"usl",  "musl",        "ralston21",
-                                                             "bs32", "zonneveld43", "dp54"};
+static const char *const g_method_names[MPM_METHOD_COUNT] = {
+    "usl", "musl", "euler", "ralston21", "bs32", "zonneveld43", "dp54"};
 const char *mpm_method_name(mpm_method m) {
   return g_method_names[m];
 }
@@ -172,10 +178,10 @@ static int estab(N_Vector y, mpm_sunreal t, mpm_sunreal *hstab, void *user) {
   return 0;
 }
 
-/* The step of the classic update from (t, y): the CFL fraction of the stability limit,
- * capped by dt_max and the stop time, times the retry scale. ERKStep evaluates f at the end
- * of each step and reuses it as the next step's only stage, so the RHS computes the step it
- * will be used with from the same (t, y) the driver uses to set the fixed step. */
+/* The fixed step (classic update, euler, non-adaptive pairs) from (t, y): the CFL fraction of the
+ * stability limit, capped by dt_max and the stop time, times the retry scale. ERKStep evaluates f
+ * at the end of each step and reuses it as the next step's only stage, so the RHS computes the step
+ * it will be used with from the same (t, y) the driver uses to set the fixed step. */
 static int classic_step(mpm_integrator *it, double t, N_Vector y, double *h) {
   double hs;
   MPM_CALL(stable_step(it, y, &hs));
@@ -204,10 +210,10 @@ static void free_state(mpm_integrator *it) {
   memset(it->sub, 0, sizeof it->sub);
 }
 
-/* The classic update takes fixed steps, so no error norm is ever used; ARKODE 6.4 still
- * computes one per step (a "too much accuracy" check read only for adaptive steps), a full
- * pass over the state with a global reduction. For this method the state's vectors report
- * a zero local sum instead: an ops-table specialisation, inherited by ARKODE's clones. */
+/* Fixed steps (the classic update, euler, time.adaptive = false) never use an error norm;
+ * ARKODE 6.4 still computes one per step (a "too much accuracy" check read only for adaptive
+ * steps), a full pass over the state with a global reduction. For this method the state's vectors
+ * report a zero local sum instead: an ops-table specialisation, inherited by ARKODE's clones. */
 static mpm_sunreal no_wsqrsum(N_Vector x, N_Vector w) {
   (void)x, (void)w;
   return 0.0;
@@ -219,7 +225,7 @@ static int wrap_state(mpm_integrator *it) {
     mpm_particles *p = it->mod[k]->particles;
     it->sub[k] = N_VMake_Serial((sunindextype)p->nstate * p->n, p->data, it->ctx);
     if (!it->sub[k]) MPM_FAIL(MPM_ERR_SUNDIALS, "cannot wrap the %s state", it->mod[k]->name);
-    if (mpm_method_is_classic(it->method)) it->sub[k]->ops->nvwsqrsumlocal = no_wsqrsum;
+    if (it->fixed) it->sub[k]->ops->nvwsqrsumlocal = no_wsqrsum;
   }
   it->y = N_VMake_MPIManyVector(it->comm, it->nmod, it->sub, it->ctx);
   if (!it->y) MPM_FAIL(MPM_ERR_SUNDIALS, "cannot build the MPIManyVector state");
@@ -238,6 +244,9 @@ static int read_settings(mpm_integrator *it, const mpm_config *cfg) {
   MPM_CALL(mpm_config_get_real(cfg, "time.cfl", &it->cfl));
   MPM_CALL(mpm_config_get_real(cfg, "time.dt_max", &it->dt_max));
   MPM_CALL(mpm_config_get_int(cfg, "time.max_retries", &it->max_retries));
+  int adaptive;
+  MPM_CALL(mpm_config_get_bool(cfg, "time.adaptive", &adaptive));
+  it->fixed = !adaptive || mpm_method_is_classic(it->method) || it->method == MPM_METHOD_EULER;
   if (it->dt_max <= 0) it->dt_max = HUGE_VAL;
   return 0;
 }
@@ -307,24 +316,25 @@ static int unit_weights(N_Vector y, N_Vector ewt, void *user) {
 
 static int configure(mpm_integrator *it, double h0) {
   static const ARKODE_ERKTableID tables[MPM_METHOD_COUNT] = {
-      ARKODE_ERK_NONE,        ARKODE_ERK_NONE,
-      ARKODE_ERK_NONE,        ARKODE_BOGACKI_SHAMPINE_4_2_3,
-      ARKODE_ZONNEVELD_5_3_4, ARKODE_DORMAND_PRINCE_7_4_5};
+      [MPM_METHOD_BS32] = ARKODE_BOGACKI_SHAMPINE_4_2_3,
+      [MPM_METHOD_ZONNEVELD43] = ARKODE_ZONNEVELD_5_3_4,
+      [MPM_METHOD_DP54] = ARKODE_DORMAND_PRINCE_7_4_5};
   MPM_CALL_SUN(ERKStepSetUserData(it->ark, it));
 #if SUNDIALS_VERSION_MAJOR < 7
   MPM_CALL_SUN(ERKStepSetErrHandlerFn(it->ark, ark_errors, NULL));
 #endif
   MPM_CALL_SUN(ERKStepSetMaxNumSteps(it->ark, -1));
-  if (mpm_method_is_classic(it->method)) {
+  if (mpm_method_is_classic(it->method) || it->method == MPM_METHOD_EULER)
     MPM_CALL(set_classic_table(it));
+  else if (it->method == MPM_METHOD_RALSTON21)
+    MPM_CALL(set_ralston_table(it));
+  else
+    MPM_CALL_SUN(ERKStepSetTableNum(it->ark, tables[it->method]));
+  if (it->fixed) {
     MPM_CALL_SUN(ERKStepWFtolerances(it->ark, unit_weights));
     MPM_CALL_SUN(ERKStepSetFixedStep(it->ark, h0 > 0 ? h0 : 1.0));
     return 0;
   }
-  if (it->method == MPM_METHOD_RALSTON21)
-    MPM_CALL(set_ralston_table(it));
-  else
-    MPM_CALL_SUN(ERKStepSetTableNum(it->ark, tables[it->method]));
   MPM_CALL_SUN(ERKStepSStolerances(it->ark, it->rtol, it->atol));
   MPM_CALL_SUN(ERKStepSetStabilityFn(it->ark, estab, it));
   MPM_CALL_SUN(ERKStepSetCFLFraction(it->ark, it->cfl));
@@ -381,12 +391,16 @@ static int report_fault(const mpm_integrator *it, double t, int tries) {
  * unphysical stage (retry smaller), otherwise an error code. */
 static int attempt(mpm_integrator *it, double tstop, double scale, double *t, double *h) {
   mpm_sunreal tret = it->t_last;
-  if (mpm_method_is_classic(it->method)) {
-    /* A stored f computed for another stop time or scale would use the wrong step. */
-    if (tstop != it->tstop || scale != it->scale) it->fn_stale = 1;
+  if (it->fixed) {
+    /* A stored f computed for another stop time or scale would use the wrong step (only the
+     * classic update's f depends on the step). */
+    const int classic = mpm_method_is_classic(it->method);
+    if (classic && (tstop != it->tstop || scale != it->scale)) it->fn_stale = 1;
     it->tstop = tstop, it->scale = scale;
-    MPM_CALL(classic_step(it, it->t_last, it->y, &it->h_classic));
-    MPM_CALL_SUN(ERKStepSetFixedStep(it->ark, it->h_classic));
+    double hf;
+    MPM_CALL(classic_step(it, it->t_last, it->y, &hf));
+    if (classic) it->h_classic = hf;
+    MPM_CALL_SUN(ERKStepSetFixedStep(it->ark, hf));
     if (it->fn_stale) MPM_CALL_SUN(ERKStepReset(it->ark, it->t_last, it->y));
     it->fn_stale = 0;
   }
@@ -429,7 +443,7 @@ int mpm_integrator_step(mpm_integrator *it, double tstop, double *t, double *h) 
     scale *= 0.25;
     MPM_CALL(stable_step(it, it->y, &h_cfl));
     h_cfl = isfinite(h_cfl) ? it->cfl * h_cfl : h_tried; /* no stability limit: the step tried */
-    const double h_next = mpm_method_is_classic(it->method) ? scale * h_cfl : scale * h_tried;
+    const double h_next = it->fixed ? scale * h_cfl : scale * h_tried;
     if (tries >= it->max_retries || h_next < MPM_RETRY_FLOOR * h_cfl)
       return report_fault(it, it->t_last, tries);
     it->retries++;
@@ -437,9 +451,8 @@ int mpm_integrator_step(mpm_integrator *it, double tstop, double *t, double *h) 
             h_next, (long long)it->fault.id, it->fault.cause);
     /* ERKStep cannot retry a recoverable explicit RHS failure itself: restart it from the
      * last accepted state (the particle data) with a quarter of the step it tried. */
-    MPM_CALL(
-        mpm_integrator_start(it, it->t_last, mpm_method_is_classic(it->method) ? 0.0 : h_next));
+    MPM_CALL(mpm_integrator_start(it, it->t_last, it->fixed ? 0.0 : h_next));
     /* A fresh ERKStep may grow its first step 10^4-fold, straight back into the failure. */
-    if (!mpm_method_is_classic(it->method)) MPM_CALL_SUN(ERKStepSetMaxFirstGrowth(it->ark, 2.0));
+    if (!it->fixed) MPM_CALL_SUN(ERKStepSetMaxFirstGrowth(it->ark, 2.0));
   }
 }

@@ -25,6 +25,8 @@ typedef enum {
   MPM_METHOD_USL,         /* classic MPM update, fixed step from the CFL limit */
   MPM_METHOD_MUSL,        /* the same with MUSL's second transfer (nodal velocities from the
                              updated particle momenta) before positions and F are moved */
+  MPM_METHOD_EULER,       /* forward Euler, fixed CFL step: unstable for undamped waves, for
+                             stability studies */
   MPM_METHOD_RALSTON21,   /* Ralston ERK 2(1): unstable for undamped waves, for comparison */
   MPM_METHOD_BS32,        /* Bogacki-Shampine 3(2) */
   MPM_METHOD_ZONNEVELD43, /* Zonneveld 4(3) */

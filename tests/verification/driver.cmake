@@ -34,3 +34,5 @@ mpm_add_script_test(test_ranks_solid SCRIPT verification/test_ranks_solid.py
                     LABELS "verification;mpi" TIMEOUT 900)
 mpm_add_script_test(test_transfer SCRIPT verification/test_transfer.py LABELS verification
                     TIMEOUT 600)
+mpm_add_script_test(test_stability SCRIPT verification/test_stability.py LABELS verification
+                    TIMEOUT 300)
