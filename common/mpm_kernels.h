@@ -12,14 +12,21 @@
 
 #include "mpm_grid.h"
 
+/* Optional fields are NULL when unused and then cost nothing. */
 typedef struct mpm_p2g_args {
   mpm_lidx n;
   const double *x[MPM_MAX_DIM]; /* positions */
   const double *v[MPM_MAX_DIM]; /* velocities */
   const double *m;              /* masses */
   const double *vsig;           /* V_p sigma_p, dim*dim components of n, or NULL */
-  double gravity[MPM_MAX_DIM];  /* body acceleration */
-  double lp;                    /* GIMP particle half-width in cells */
+  /* APIC affine velocity C_p, dim*dim components of n (entry (r, c) at C[(r*dim + c)*n + p]),
+   * or NULL. When set the momentum deposited at node i is S m (v_p + C_p (x_i - x_p)). */
+  const double *C;
+  /* External force on each particle, N (e.g. a surface traction times its area): component
+   * d is an array of n; off when fext[0] is NULL. Adds S fext_p to f_i. */
+  const double *fext[MPM_MAX_DIM];
+  double gravity[MPM_MAX_DIM]; /* body acceleration */
+  double lp;                   /* GIMP particle half-width in cells */
 } mpm_p2g_args;
 
 typedef struct mpm_g2p_args {
@@ -31,6 +38,11 @@ typedef struct mpm_g2p_args {
   double *v_out[MPM_MAX_DIM]; /* sum_i S_ip v_i */
   double *a_out[MPM_MAX_DIM]; /* sum_i S_ip a_i */
   double *L_out;              /* sum_i v_i (x) grad S_ip, dim*dim components, or NULL */
+  /* APIC affine velocity (layout of L_out), or NULL. Quadratic and cubic B-splines:
+   * C_p = D^-1 sum_i S_ip v_i (x_i - x_p)^T with D = dx^2/4 and dx^2/3 (Jiang et al. 2015);
+   * linear and GIMP: C_p = sum_i v_i (x) grad S_ip, the exact APIC form for multilinear
+   * weights. Either way an affine nodal velocity v0 + A x gives C_p = A. */
+  double *C_out;
 } mpm_g2p_args;
 
 typedef struct mpm_kernels {

@@ -1,0 +1,4 @@
+# P2G/G2P kernels: the APIC affine transfer and the external-force deposit, every shape in
+# 2-D and 3-D (one rank: the grid needs MPI).
+mpm_add_test(test_kernels_apic SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/unit/test_kernels_apic.c
+             LABELS unit RANKS 1)
