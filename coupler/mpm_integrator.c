@@ -404,7 +404,11 @@ static int attempt(mpm_integrator *it, double tstop, double scale, double *t, do
     if (it->fn_stale) MPM_CALL_SUN(ERKStepReset(it->ark, it->t_last, it->y));
     it->fn_stale = 0;
   }
-  MPM_CALL_SUN(ERKStepSetStopTime(it->ark, tstop));
+  /* A fixed step already lands on tstop (see classic_step). ARKODE's own stop time would
+   * replace the state it reaches by its interpolant at tstop, built with the end-of-step f,
+   * which the classic update evaluates for a step that does not exist (h = 0): that
+   * interpolated state breaks the update's conservation properties at every output time. */
+  if (!it->fixed) MPM_CALL_SUN(ERKStepSetStopTime(it->ark, tstop));
   it->fault.set = 0;
   it->rhs_error = 0;
   int flag = ERKStepEvolve(it->ark, tstop, it->y, &tret, ARK_ONE_STEP);

@@ -59,6 +59,10 @@ static const mpm_key_spec sim_keys[] = {
      "MPI ranks per direction (0: let MPI choose)", 0},
     {"physics.gravity", MPM_KEY_REALS, "0 0 0", -HUGE_VAL, HUGE_VAL, 0, 3, NULL,
      "body acceleration, m/s^2", 0},
+    {"transfer.velocity", MPM_KEY_ENUM, "flip", 0, 0, 0, 0, "flip|apic",
+     "particle velocity transfer: flip (FLIP/PIC blend, see pic_fraction) or apic (affine "
+     "particle-in-cell: PIC with an affine velocity per particle; classic update only)",
+     0},
     {"transfer.pic_fraction", MPM_KEY_REAL, "0", 0, 1, 0, 0, NULL,
      "PIC share of the particle velocity update: 0 = FLIP (no numerical dissipation), 1 = "
      "PIC (smooth, dissipative); classic update only",

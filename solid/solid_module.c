@@ -1,11 +1,11 @@
 /* Solid module: seeding, constraints (walls, clamps), and the module phases of an MPM
  * right-hand side.
  *
- * Invariants: particle field order is x, v, F, [sigma] | m, V0, body, [hist], [fixed] (see
- * solid_particles_new; bracketed fields exist only when a body's model or a clamp needs
- * them). body holds a small integer stored as a double. The per-body index lists used for
- * batched stress evaluation are rebuilt at each P2G, so they never go stale after migration,
- * sorting or injection. */
+ * Invariants: particle field order is x, v, F, [sigma], [C] | m, V0, body, [hist], [fixed]
+ * (see solid_particles_new; bracketed fields exist only when a body's model, the APIC
+ * transfer or a clamp needs them). body holds a small integer stored as a double. The per-body
+ * index lists used for batched stress evaluation are rebuilt at each P2G, so they never go stale
+ * after migration, sorting or injection. */
 #include "solid_module.h"
 #include "solid_tensor.h"
 
@@ -34,8 +34,8 @@ typedef struct {
 } solid_body;
 
 typedef struct {
-  int f_sigma, f_m, f_V0, f_body, f_hist, f_fixed; /* field indices (-1 if absent) */
-  int nhist;                                       /* history components per particle */
+  int f_sigma, f_C, f_m, f_V0, f_body, f_hist, f_fixed; /* field indices (-1 if absent) */
+  int nhist;                                            /* history components per particle */
 } solid_layout;
 
 typedef struct {
@@ -49,6 +49,7 @@ typedef struct {
   double damping;         /* mass-proportional damping rate alpha, 1/s: f_i -= alpha (m v)_i */
   double pic;             /* PIC fraction of the velocity transfer (0: FLIP, 1: PIC) */
   int musl;               /* MUSL: nodal velocities from the updated particle momenta */
+  int apic;               /* APIC transfer: affine velocity C per particle (state field) */
   int remapped;           /* the phase holds MUSL's second deposit (see solid_remap) */
   double *vnew;           /* MUSL: the particles' new velocities (dim n) */
   double lp;              /* GIMP half-width in cells */
@@ -90,11 +91,13 @@ int solid_add_schema(mpm_config *cfg) {
 /* The particle fields the bodies' models need: sigma if any model is in rate form, hist
  * sized for the model with the most history. */
 static int solid_particles_new(mpm_particles **p, int dim, solid_layout *lay, int has_rate,
-                               int nhist, int fixed) {
-  mpm_field_desc fields[9] = {{"x", dim}, {"v", dim}, {"F", dim * dim}};
+                               int apic, int nhist, int fixed) {
+  mpm_field_desc fields[10] = {{"x", dim}, {"v", dim}, {"F", dim * dim}};
   int nf = 3;
   lay->f_sigma = has_rate ? nf : -1;
   if (has_rate) fields[nf++] = (mpm_field_desc){"sigma", dim * dim};
+  lay->f_C = apic ? nf : -1;
+  if (apic) fields[nf++] = (mpm_field_desc){"C", dim * dim};
   const int nstate = nf;
   lay->f_m = nf, fields[nf++] = (mpm_field_desc){"m", 1};
   lay->f_V0 = nf, fields[nf++] = (mpm_field_desc){"V0", 1};
@@ -267,6 +270,11 @@ static void group_by_body(mpm_module *m) {
   for (mpm_lidx i = 0; i < p->n; ++i) sc->idx[start[(int)body[i]]++] = i;
 }
 
+/* The APIC affine velocities in state y, or NULL without APIC. */
+static const double *state_C(const solid_content *sc, const mpm_particles *p, const double *y) {
+  return sc->lay.f_C >= 0 ? y + (size_t)p->offset[sc->lay.f_C] * p->n : NULL;
+}
+
 static int solid_p2g(mpm_module *m, double t, const double *y) {
   (void)t;
   solid_content *sc = m->content;
@@ -285,8 +293,11 @@ static int solid_p2g(mpm_module *m, double t, const double *y) {
   mpm_timer_stop(MPM_T_STRESS);
 
   mpm_timer_start(MPM_T_P2G);
-  mpm_p2g_args a = {
-      .n = n, .m = mpm_particles_comp(p, sc->lay.f_m, 0), .vsig = sc->vsig, .lp = sc->lp};
+  mpm_p2g_args a = {.n = n,
+                    .m = mpm_particles_comp(p, sc->lay.f_m, 0),
+                    .vsig = sc->vsig,
+                    .C = state_C(sc, p, y),
+                    .lp = sc->lp};
   for (int d = 0; d < dim; ++d) {
     a.x[d] = y + (size_t)(p->offset[F_X] + d) * n;
     a.v[d] = y + (size_t)(p->offset[F_V] + d) * n;
@@ -333,13 +344,14 @@ static void blend_pic(const mpm_particles *p, const double *y, double *ydot, dou
 }
 static void hold_fixed(const mpm_particles *p, int f_fixed, double *ydot);
 
-/* G2P of velocity and acceleration only (no L): v_out = sum S v_i, a_out = sum S a_i. */
+/* G2P: v_out = sum S v_i, a_out = sum S a_i, and optionally L and the APIC C (NULL: not
+ * wanted). */
 static void g2p_velocity(mpm_module *m, const double *y, double *const *v_out, double *const *a_out,
-                         double *L_out) {
+                         double *L_out, double *C_out) {
   const solid_content *sc = m->content;
   const mpm_particles *p = m->particles;
   const mpm_grid_phase *ph = &m->grid->phase[m->phase];
-  mpm_g2p_args a = {.n = p->n, .lp = sc->lp, .L_out = L_out};
+  mpm_g2p_args a = {.n = p->n, .lp = sc->lp, .L_out = L_out, .C_out = C_out};
   for (int d = 0; d < p->dim; ++d) {
     a.x[d] = y + (size_t)(p->offset[F_X] + d) * p->n;
     a.v_i[d] = ph->v_i[d];
@@ -351,9 +363,10 @@ static void g2p_velocity(mpm_module *m, const double *y, double *const *v_out, d
 }
 
 /* MUSL's second transfer (Sulsky, Zhou and Schreyer 1995): the particles take their new
- * velocities, v_p^+ = (1 - a)(v_p + h sum S a_i) + a sum S v_i^{n+1} (a = PIC fraction), and
- * deposit their mass and momentum again; the positions and F then move with the nodal
- * velocities of these momenta. Stress and gravity are not deposited again. */
+ * velocities, v_p^+ = (1 - a)(v_p + h sum S a_i) + a sum S v_i^{n+1} (a = PIC fraction; APIC:
+ * a = 1 with the new affine velocities), and deposit their mass and momentum again; the
+ * positions and F then move with the nodal velocities of these momenta. Stress and gravity
+ * are not deposited again. */
 static int solid_remap(mpm_module *m, double t, const double *y, double h) {
   (void)t;
   solid_content *sc = m->content;
@@ -363,15 +376,16 @@ static int solid_remap(mpm_module *m, double t, const double *y, double h) {
   double *vg[MPM_MAX_DIM] = {NULL}, *ag[MPM_MAX_DIM] = {NULL};
   for (int d = 0; d < dim; ++d)
     vg[d] = sc->scratch + (size_t)d * n, ag[d] = sc->scratch + (size_t)(dim + d) * n;
-  g2p_velocity(m, y, vg, ag, NULL);
+  double *C = sc->apic ? sc->scratch + (size_t)2 * dim * n : NULL; /* the L slot */
+  g2p_velocity(m, y, vg, ag, NULL, C);
+  const double pic = sc->apic ? 1.0 : sc->pic;
   for (int d = 0; d < dim; ++d) {
     const double *v = y + (size_t)(p->offset[F_V] + d) * n;
     double *vn = sc->vnew + (size_t)d * n;
-    for (mpm_lidx i = 0; i < n; ++i)
-      vn[i] = (1.0 - sc->pic) * (v[i] + h * ag[d][i]) + sc->pic * vg[d][i];
+    for (mpm_lidx i = 0; i < n; ++i) vn[i] = (1.0 - pic) * (v[i] + h * ag[d][i]) + pic * vg[d][i];
   }
   mpm_grid_phase_zero(m->grid, m->phase);
-  mpm_p2g_args a = {.n = n, .m = mpm_particles_comp(p, sc->lay.f_m, 0), .lp = sc->lp};
+  mpm_p2g_args a = {.n = n, .m = mpm_particles_comp(p, sc->lay.f_m, 0), .C = C, .lp = sc->lp};
   for (int d = 0; d < dim; ++d) {
     a.x[d] = y + (size_t)(p->offset[F_X] + d) * n;
     a.v[d] = sc->vnew + (size_t)d * n;
@@ -394,7 +408,8 @@ static int solid_g2p(mpm_module *m, double t, const double *y, double *ydot, dou
     xdot[d] = ydot + (size_t)(p->offset[F_X] + d) * n;
     vdot[d] = ydot + (size_t)(p->offset[F_V] + d) * n;
   }
-  g2p_velocity(m, y, xdot, vdot, L);
+  double *Cdot = sc->apic ? ydot + (size_t)p->offset[sc->lay.f_C] * n : NULL;
+  g2p_velocity(m, y, xdot, vdot, L, Cdot);
   const double *F = y + (size_t)p->offset[F_F] * n;
   double *Fdot = ydot + (size_t)p->offset[F_F] * n;
   for (int r = 0; r < dim; ++r)
@@ -406,13 +421,17 @@ static int solid_g2p(mpm_module *m, double t, const double *y, double *ydot, dou
         for (mpm_lidx i = 0; i < n; ++i) out[i] += Lrk[i] * Fkc[i];
       }
     }
-  if (sc->musl && h > 0)
+  if (sc->musl && !sc->apic && h > 0)
     for (int d = 0; d < dim; ++d) { /* the velocity solid_remap gave the particles */
       const double *v = y + (size_t)(p->offset[F_V] + d) * n, *vn = sc->vnew + (size_t)d * n;
       for (mpm_lidx i = 0; i < n; ++i) vdot[d][i] = (vn[i] - v[i]) / h;
     }
-  else if (sc->pic > 0 && h > 0)
-    blend_pic(p, y, ydot, sc->pic, h);
+  else if ((sc->apic || sc->pic > 0) && h > 0) /* APIC (also under MUSL): the final grid's */
+    blend_pic(p, y, ydot, sc->apic ? 1.0 : sc->pic, h);
+  if (sc->apic && h > 0) { /* C takes the new affine velocity over the step */
+    const double *C = state_C(sc, p, y);
+    for (size_t k = 0; k < (size_t)dim * dim * (size_t)n; ++k) Cdot[k] = (Cdot[k] - C[k]) / h;
+  }
   if (sc->lay.f_sigma >= 0) solid_stress_rates(m, y, ydot, L);
   if (sc->lay.f_fixed >= 0) hold_fixed(p, sc->lay.f_fixed, ydot);
   return 0;
@@ -609,7 +628,19 @@ static int read_bodies(mpm_module *m, const mpm_config *cfg) {
   const char *method;
   MPM_CALL(mpm_config_get_string(cfg, "time.method", &method));
   sc->musl = strcmp(method, "musl") == 0;
-  if (sc->pic > 0 && !sc->musl && strcmp(method, "usl") != 0)
+  const int classic = sc->musl || strcmp(method, "usl") == 0;
+  const char *transfer;
+  MPM_CALL(mpm_config_get_string(cfg, "transfer.velocity", &transfer));
+  sc->apic = strcmp(transfer, "apic") == 0;
+  if (sc->apic && !classic)
+    return mpm_config_fail(cfg, "transfer.velocity",
+                           "APIC replaces the particle velocity once per step of the classic "
+                           "update; use time.method = usl or musl, or velocity = flip with %s",
+                           method);
+  if (sc->apic && sc->pic > 0)
+    return mpm_config_fail(cfg, "transfer.pic_fraction",
+                           "APIC has no PIC fraction; set pic_fraction = 0 or velocity = flip");
+  if (sc->pic > 0 && !classic)
     return mpm_config_fail(cfg, "transfer.pic_fraction",
                            "a PIC fraction is defined per step of the classic update; use "
                            "time.method = usl or musl, or pic_fraction = 0 with %s",
@@ -644,8 +675,8 @@ int solid_module_create(mpm_module **mp, const mpm_config *cfg, mpm_grid *grid, 
     }
     if (!rc) rc = read_constraints(m, cfg);
     if (!rc)
-      rc =
-          solid_particles_new(&m->particles, grid->dim, &sc->lay, has_rate, nhist, sc->nclamps > 0);
+      rc = solid_particles_new(&m->particles, grid->dim, &sc->lay, has_rate, sc->apic, nhist,
+                               sc->nclamps > 0);
   }
   for (int b = 0; !rc && b < sc->nbodies; ++b) {
     double lp = sc->lp;
