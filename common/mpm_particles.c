@@ -236,6 +236,9 @@ static int report_outside(const mpm_particles *p, const mpm_grid *g, mpm_lidx i,
 /* Wrap positions across periodic faces; returns how many particles moved. */
 static mpm_lidx wrap_positions(mpm_particles *p, const mpm_grid *g) {
   mpm_lidx nwrap = 0;
+  int any = 0;
+  for (int d = 0; d < g->dim; ++d) any |= g->periodic[d];
+  if (!any) return 0; /* no pass over the particles when nothing can wrap */
   for (mpm_lidx i = 0; i < p->n; ++i) {
     double x[MPM_MAX_DIM];
     for (int d = 0; d < p->dim; ++d) x[d] = mpm_particles_comp(p, 0, d)[i];
