@@ -7,8 +7,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define WALL_CHOICES "none|slip|no_slip"
-#define WALL_HELP    "wall on this face: none (open), slip or no_slip"
+#define WALL_CHOICES "none|slip|no_slip|periodic"
+#define WALL_HELP                                                                                  \
+  "wall on this face: none (open), slip, no_slip or periodic (with the opposite face)"
 
 const mpm_key_spec mpm_bc_keys[] = {
     {"boundary.x_lo", MPM_KEY_ENUM, "none", 0, 0, 0, 0, WALL_CHOICES, WALL_HELP, 0},
@@ -20,30 +21,53 @@ const mpm_key_spec mpm_bc_keys[] = {
 };
 const int mpm_bc_nkeys = (int)(sizeof mpm_bc_keys / sizeof mpm_bc_keys[0]);
 
+static const char *const g_axes = "xyz", *const g_side[2] = {"lo", "hi"};
+
+/* A periodic face wraps onto the opposite face, so that face must wrap back. */
+static int check_periodic_pairs(const mpm_walls *w, const mpm_config *cfg, int dim) {
+  for (int d = 0; d < dim; ++d)
+    for (int s = 0; s < 2; ++s)
+      if (w->face[d][s] == MPM_WALL_PERIODIC && w->face[d][1 - s] != MPM_WALL_PERIODIC) {
+        char key[32];
+        snprintf(key, sizeof key, "boundary.%c_%s", g_axes[d], g_side[s]);
+        return mpm_config_fail(cfg, key,
+                               "a periodic face needs its opposite face %c_%s periodic too; set "
+                               "both %c_lo and %c_hi to periodic",
+                               g_axes[d], g_side[1 - s], g_axes[d], g_axes[d]);
+      }
+  return 0;
+}
+
 int mpm_walls_from_config(mpm_walls *w, const mpm_config *cfg, int dim) {
-  static const char *const axes = "xyz", *const side[2] = {"lo", "hi"};
   memset(w, 0, sizeof *w);
   for (int d = 0; d < dim; ++d)
     for (int s = 0; s < 2; ++s) {
       char key[32];
       const char *v;
-      snprintf(key, sizeof key, "boundary.%c_%s", axes[d], side[s]);
+      snprintf(key, sizeof key, "boundary.%c_%s", g_axes[d], g_side[s]);
       MPM_CALL(mpm_config_get_string(cfg, key, &v));
-      w->face[d][s] = strcmp(v, "slip") == 0      ? MPM_WALL_SLIP
-                      : strcmp(v, "no_slip") == 0 ? MPM_WALL_NO_SLIP
-                                                  : MPM_WALL_NONE;
+      w->face[d][s] = strcmp(v, "slip") == 0       ? MPM_WALL_SLIP
+                      : strcmp(v, "no_slip") == 0  ? MPM_WALL_NO_SLIP
+                      : strcmp(v, "periodic") == 0 ? MPM_WALL_PERIODIC
+                                                   : MPM_WALL_NONE;
     }
+  MPM_CALL(check_periodic_pairs(w, cfg, dim));
   for (int d = dim; d < MPM_MAX_DIM; ++d)
     for (int s = 0; s < 2; ++s) {
       char key[32];
       const char *v;
-      snprintf(key, sizeof key, "boundary.%c_%s", axes[d], side[s]);
+      snprintf(key, sizeof key, "boundary.%c_%s", g_axes[d], g_side[s]);
       MPM_CALL(mpm_config_get_string(cfg, key, &v));
       if (strcmp(v, "none") != 0)
         return mpm_config_fail(cfg, key, "a %d-D domain has no %c axis; remove the key", dim,
-                               axes[d]);
+                               g_axes[d]);
     }
   return 0;
+}
+
+void mpm_walls_periodic(const mpm_walls *w, int *periodic) {
+  for (int d = 0; d < MPM_MAX_DIM; ++d)
+    periodic[d] = w->face[d][0] == MPM_WALL_PERIODIC && w->face[d][1] == MPM_WALL_PERIODIC;
 }
 
 static int add_rule(mpm_node_constraints *c, mpm_lidx l, mpm_lidx source, unsigned char mask) {
@@ -108,7 +132,7 @@ static void apply_pass(const mpm_node_constraints *c, mpm_grid *grid, int phase)
 int mpm_constraints_add_walls(mpm_node_constraints *c, const mpm_walls *w, const mpm_grid *grid) {
   for (int d = 0; d < grid->dim; ++d)
     for (int s = 0; s < 2; ++s)
-      if (w->face[d][s] != MPM_WALL_NONE)
+      if (w->face[d][s] != MPM_WALL_NONE && w->face[d][s] != MPM_WALL_PERIODIC)
         MPM_CALL(add_face(c, grid, d, s, wall_components(w->face[d][s], d, grid->dim)));
   return 0;
 }

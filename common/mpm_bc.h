@@ -1,16 +1,18 @@
 /* Wall conditions on the faces of the domain, for any phase's nodal fields.
  *
  * A face is open (none: a particle crossing it is an error), a slip wall (the normal
- * velocity and acceleration vanish on it) or a no-slip wall (all components vanish). Nodes
- * on the face are held; the pad nodes beyond it mirror the nodes inside (see
- * mpm_node_constraints). Rules are built once for a grid; clamps append held nodes. */
+ * velocity and acceleration vanish on it), a no-slip wall (all components vanish) or
+ * periodic (the lattice wraps to the opposite face, which must be periodic too; the grid
+ * handles it, so it has no rules here). Nodes on a wall face are held; the pad nodes beyond
+ * it mirror the nodes inside (see mpm_node_constraints). Rules are built once for a grid;
+ * clamps append held nodes. */
 #ifndef MPM_BC_H
 #define MPM_BC_H
 
 #include "mpm_config.h"
 #include "mpm_grid.h"
 
-typedef enum { MPM_WALL_NONE, MPM_WALL_SLIP, MPM_WALL_NO_SLIP } mpm_wall;
+typedef enum { MPM_WALL_NONE, MPM_WALL_SLIP, MPM_WALL_NO_SLIP, MPM_WALL_PERIODIC } mpm_wall;
 
 typedef struct mpm_walls {
   mpm_wall face[MPM_MAX_DIM][2]; /* [axis][lower, upper] */
@@ -20,7 +22,10 @@ typedef struct mpm_walls {
 extern const mpm_key_spec mpm_bc_keys[];
 extern const int mpm_bc_nkeys;
 
+/* Read the faces; a periodic face whose opposite face is not periodic is an input error. */
 int mpm_walls_from_config(mpm_walls *w, const mpm_config *cfg, int dim);
+/* periodic[d] = 1 where both faces of axis d are periodic, for d < MPM_MAX_DIM. */
+void mpm_walls_periodic(const mpm_walls *w, int *periodic);
 
 /* Node constraints on a grid, applied after every nodal update:
  *  - held nodes (clamps, wall faces): the masked velocity components are set to zero;
@@ -40,7 +45,7 @@ typedef struct mpm_node_constraints {
 
 /* Hold the masked components of node l at zero. */
 int mpm_constraints_add(mpm_node_constraints *c, mpm_lidx l, unsigned char mask);
-/* Add the wall rules of every wall face of w on grid. */
+/* Add the wall rules of every wall face of w on grid (none and periodic faces have none). */
 int mpm_constraints_add_walls(mpm_node_constraints *c, const mpm_walls *w, const mpm_grid *grid);
 /* Before the nodal update: fold what particles deposited on mirrored pad nodes into their
  * mirror nodes, as the mirror images of those particles would have deposited it (mass with

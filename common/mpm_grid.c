@@ -2,11 +2,13 @@
  * the halo exchanges. mpm_grid.h states the contract (ownership, box layout); this file
  * keeps these invariants:
  *
- * - grid->comm is a non-periodic Cartesian communicator made with reorder = 0, so a rank
- *   number means the same in grid->comm as in the communicator the caller passed.
+ * - grid->comm is a Cartesian communicator, periodic along the periodic axes, made with
+ *   reorder = 0, so a rank number means the same in grid->comm as in the communicator the
+ *   caller passed.
  * - Along d, coordinate c owns cells [cell_split[d][c], cell_split[d][c+1]) with
  *   cell_split[d][c] = (ncells * c) / nproc, so every rank owns at least
- *   floor(ncells / nproc) >= ghost cells: a ghost layer only ever reaches the next rank.
+ *   floor(ncells / nproc) >= ghost cells: a ghost layer only ever reaches the next rank
+ *   (along a periodic axis the next rank may be across the face, or this rank itself).
  * - The box is [own_lo - ghost, own_hi + ghost) per direction. Directions d >= dim are
  *   degenerate (box_lo = own_lo = 0, box_n = own_hi = 1) so that loops can always run over
  *   three indices.
@@ -15,7 +17,11 @@
  * - The halo exchanges go one direction at a time over slabs that span the whole box in
  *   the other directions, ghosts included. What moved along direction 0 is then carried
  *   along direction 1, and so on, so edge and corner values reach diagonal neighbours in
- *   dim steps with face neighbours only. */
+ *   dim steps with face neighbours only.
+ * - Periodic axes need nothing special in the exchanges: the box is still own ± ghost, a
+ *   slab is addressed in box-local indices, and rank 0's lower ghosts [-ghost, 0) are the
+ *   images of the last rank's top owned layers [ncells - ghost, ncells), which is exactly
+ *   where a box-local slab sent to the lower (wrapped) neighbour lands. */
 #include "mpm_grid.h"
 #include "mpm_error.h"
 
@@ -79,19 +85,28 @@ static int choose_nproc(int size, int dim, const int *nproc, int *dims) {
 }
 
 /* Along a split direction every rank needs at least `ghost` cells, so that a halo slab
- * comes from the next rank only (see the file comment). An unsplit direction has no halo. */
+ * comes from the next rank only (see the file comment). An unsplit direction has no halo,
+ * unless it is periodic: then the one rank's ghosts are images of its own owned layers,
+ * which must exist. */
 static int check_cells_per_rank(const mpm_grid *g) {
-  for (int d = 0; d < g->dim; ++d)
-    if (g->nproc[d] > 1 && g->ncells[d] / g->nproc[d] < g->ghost)
-      FAIL_INPUT("grid: %d cells along %c over %d ranks leave %d cells on some rank, fewer than "
-                 "the %d ghost layers of the %s shape; use fewer ranks or a finer grid",
-                 g->ncells[d], g_axis[d], g->nproc[d], g->ncells[d] / g->nproc[d], g->ghost,
-                 mpm_shape_name(g->shape));
+  for (int d = 0; d < g->dim; ++d) {
+    if (!(g->nproc[d] > 1 || g->periodic[d]) || g->ncells[d] / g->nproc[d] >= g->ghost) continue;
+    if (g->nproc[d] == 1)
+      FAIL_INPUT("grid: the periodic axis %c has %d cells, fewer than the %d ghost layers of the "
+                 "%s shape; a periodic axis needs at least %d cells: use a finer grid, a longer "
+                 "domain or a narrower shape",
+                 g_axis[d], g->ncells[d], g->ghost, mpm_shape_name(g->shape), g->ghost);
+    FAIL_INPUT("grid: %d cells along %c over %d ranks leave %d cells on some rank, fewer than "
+               "the %d ghost layers of the %s shape; use fewer ranks or a finer grid",
+               g->ncells[d], g_axis[d], g->nproc[d], g->ncells[d] / g->nproc[d], g->ghost,
+               mpm_shape_name(g->shape));
+  }
   return 0;
 }
 
 static int make_comm(mpm_grid *g, MPI_Comm comm) {
   int periods[MPM_MAX_DIM] = {0, 0, 0};
+  for (int d = 0; d < g->dim; ++d) periods[d] = g->periodic[d];
   /* reorder = 0: rank numbers stay those of comm, which callers rely on. */
   MPM_CALL_MPI(MPI_Cart_create(comm, g->dim, g->nproc, periods, 0, &g->comm));
   MPM_CALL_MPI(MPI_Comm_rank(g->comm, &g->rank));
@@ -102,15 +117,18 @@ static int make_comm(mpm_grid *g, MPI_Comm comm) {
   return 0;
 }
 
-/* cell_split, owned range and box of this rank, per the header's ownership rule. */
+/* cell_split, owned range and box of this rank, per the header's ownership rule: the ends
+ * of a non-periodic axis own the pad layers (and node ncells), those of a periodic one
+ * do not. */
 static int make_layout(mpm_grid *g) {
   long long nnodes = 1;
   for (int d = 0; d < g->dim; ++d) {
     const int np = g->nproc[d], c = g->coord[d];
     MPM_ALLOC(g->cell_split[d], np + 1);
     for (int k = 0; k <= np; ++k) g->cell_split[d][k] = (int)((long long)g->ncells[d] * k / np);
-    g->own_lo[d] = c == 0 ? -g->pad : g->cell_split[d][c];
-    g->own_hi[d] = c == np - 1 ? g->ncells[d] + 1 + g->pad : g->cell_split[d][c + 1];
+    const int ends = !g->periodic[d];
+    g->own_lo[d] = ends && c == 0 ? -g->pad : g->cell_split[d][c];
+    g->own_hi[d] = ends && c == np - 1 ? g->ncells[d] + 1 + g->pad : g->cell_split[d][c + 1];
     g->box_lo[d] = g->own_lo[d] - g->ghost;
     g->box_n[d] = g->own_hi[d] - g->own_lo[d] + 2 * g->ghost;
     nnodes *= g->box_n[d];
@@ -152,8 +170,9 @@ static int grid_setup(mpm_grid *g, MPI_Comm comm, const double *lo, const double
   return 0;
 }
 
-int mpm_grid_new(mpm_grid **grid, MPI_Comm comm, int dim, const double *lo, const double *hi,
-                 double dx, mpm_shape_kind shape, const int *nproc) {
+int mpm_grid_new_periodic(mpm_grid **grid, MPI_Comm comm, int dim, const double *lo,
+                          const double *hi, double dx, mpm_shape_kind shape, const int *nproc,
+                          const int *periodic) {
   mpm_grid *g;
   *grid = NULL;
   if ((unsigned)shape >= MPM_SHAPE_COUNT)
@@ -162,6 +181,7 @@ int mpm_grid_new(mpm_grid **grid, MPI_Comm comm, int dim, const double *lo, cons
   g->comm = MPI_COMM_NULL;
   set_unused_dims(g);
   g->dim = dim;
+  for (int d = 0; periodic && d < dim && d < MPM_MAX_DIM; ++d) g->periodic[d] = periodic[d] != 0;
   g->shape = shape;
   g->ghost = g->pad = mpm_shape_ghost_width(shape);
   const int rc = grid_setup(g, comm, lo, hi, dx, nproc);
@@ -171,6 +191,11 @@ int mpm_grid_new(mpm_grid **grid, MPI_Comm comm, int dim, const double *lo, cons
   }
   *grid = g;
   return 0;
+}
+
+int mpm_grid_new(mpm_grid **grid, MPI_Comm comm, int dim, const double *lo, const double *hi,
+                 double dx, mpm_shape_kind shape, const int *nproc) {
+  return mpm_grid_new_periodic(grid, comm, dim, lo, hi, dx, shape, nproc, NULL);
 }
 
 static void phase_free(mpm_grid_phase *ph) {
@@ -267,6 +292,27 @@ int mpm_grid_owner_of(const mpm_grid *g, const double *x) {
   return rank;
 }
 
+/* One period at most: a point farther out is a runaway particle, for migration to report
+ * rather than to hide. Roundoff may land a wrapped point on the excluded face hi, which
+ * is the same point as lo; or just below lo, which is lo up to roundoff. */
+static int wrap_coord(double *x, double lo, double hi) {
+  const double len = hi - lo, x0 = *x;
+  if (x0 >= hi && x0 < hi + len)
+    *x = fmax(x0 - len, lo);
+  else if (x0 < lo && x0 >= lo - len)
+    *x = x0 + len < hi ? x0 + len : lo;
+  else
+    return 0;
+  return 1;
+}
+
+int mpm_grid_wrap(const mpm_grid *g, double *x) {
+  int n = 0;
+  for (int d = 0; d < g->dim; ++d)
+    if (g->periodic[d]) n += wrap_coord(&x[d], g->lo[d], g->hi[d]);
+  return n;
+}
+
 /* ---- halo exchange --------------------------------------------------------------------- */
 
 /* Box-local index ranges of a slab: [start, start + ghost) along d, the whole box across. */
@@ -337,7 +383,9 @@ static int scratch_reserve(mpm_grid *g, int nfields) {
 
 /* One direction of an exchange, both ways. For side 0 the slab at send_at[0] goes to the
  * lower neighbour while the upper neighbour's message lands in the slab at recv_at[0];
- * side 1 mirrors it. A wall neighbour is MPI_PROC_NULL and Sendrecv does nothing there. */
+ * side 1 mirrors it. Beyond a non-periodic face the neighbour is MPI_PROC_NULL and Sendrecv
+ * does nothing there; across a periodic face it may be this rank, which Sendrecv handles
+ * (the send and receive buffers are distinct). */
 static int exchange_dir(mpm_grid *g, int d, double *const *fields, int nfields,
                         const int send_at[2], const int recv_at[2], int add) {
   halo_scratch *s = g->scratch;

@@ -10,6 +10,15 @@
  * those cells' lower faces; the last rank along d also owns node ncells, and the first and
  * last ranks own the pad layers on their side. Every node has exactly one owner.
  *
+ * Periodic axes. Along a periodic axis the lattice wraps: node i and node i + ncells are
+ * the same node, so there are ncells distinct nodes, owned as above except that nobody
+ * owns node ncells or pad layers (they are images of nodes near the other face). The
+ * ghosts beyond either face are such images: the halo exchanges treat the two faces like a
+ * boundary between ranks (with one rank along the axis, a rank exchanges with itself), so
+ * a particle near or slightly beyond a periodic face deposits and reads as it would on an
+ * unbounded lattice. Positions stay in [lo, hi): mpm_grid_wrap() maps a point that left
+ * through a periodic face back in, which migration does before it decides ownership.
+ *
  * Box. A rank stores its owned nodes plus `ghost` layers on every side (as wide as the
  * shape function reaches); the local array of one field spans global nodes
  * [box_lo[d], box_lo[d] + box_n[d]) with x fastest. P2G adds into ghost nodes;
@@ -40,9 +49,10 @@ typedef struct mpm_grid {
   int dim;
   int nproc[MPM_MAX_DIM];  /* ranks per direction */
   int coord[MPM_MAX_DIM];  /* this rank's coordinates */
-  int nbr[MPM_MAX_DIM][2]; /* lower, upper neighbour (MPI_PROC_NULL at walls) */
+  int nbr[MPM_MAX_DIM][2]; /* lower, upper neighbour (MPI_PROC_NULL at non-periodic faces) */
   double lo[MPM_MAX_DIM], hi[MPM_MAX_DIM], dx;
   int ncells[MPM_MAX_DIM];
+  int periodic[MPM_MAX_DIM]; /* 1 if the lattice wraps along d (0 beyond dim) */
   mpm_shape_kind shape;
   int ghost, pad;
   int *cell_split[MPM_MAX_DIM]; /* nproc[d]+1 cell offsets: rank c owns [split[c], split[c+1]) */
@@ -56,7 +66,12 @@ typedef struct mpm_grid {
 
 /* Build the grid over comm. nproc[d] = 0 lets MPI choose the split. The domain [lo, hi] must
  * be a whole number of cells of size dx (to 1e-9 relative); each rank needs at least `ghost`
- * cells per direction. Collective. */
+ * cells along a split direction, and along a periodic one even when it is not split.
+ * periodic[d] != 0 makes axis d periodic; NULL means no periodic axis. Collective. */
+int mpm_grid_new_periodic(mpm_grid **grid, MPI_Comm comm, int dim, const double *lo,
+                          const double *hi, double dx, mpm_shape_kind shape, const int *nproc,
+                          const int *periodic);
+/* mpm_grid_new_periodic() with no periodic axis. */
 int mpm_grid_new(mpm_grid **grid, MPI_Comm comm, int dim, const double *lo, const double *hi,
                  double dx, mpm_shape_kind shape, const int *nproc);
 void mpm_grid_destroy(mpm_grid **grid);
@@ -79,6 +94,11 @@ int mpm_grid_node_is_owned(const mpm_grid *g, mpm_lidx l);
 
 /* Rank (in grid->comm) that owns the cell containing x; -1 if x is outside [lo, hi). */
 int mpm_grid_owner_of(const mpm_grid *g, const double *x);
+
+/* Map x back into [lo, hi) along every periodic axis where it lies at most one period
+ * outside (a farther point is left alone, for the caller to report). Returns the number of
+ * coordinates changed. */
+int mpm_grid_wrap(const mpm_grid *g, double *x);
 
 /* Sum ghost contributions into their owners, for nfields box arrays (collective). */
 int mpm_grid_halo_reverse(mpm_grid *grid, double *const *fields, int nfields);

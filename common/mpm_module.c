@@ -59,12 +59,14 @@ int mpm_module_check_positions(const mpm_module *m, const double *y, mpm_fault *
     if (!isfinite(y[k]))
       return mpm_fault_at(fault, p, y, (mpm_lidx)(k % (size_t)(n ? n : 1)),
                           "a state value is not finite (NaN or Inf)");
+  /* Beyond a periodic face a particle is fine until migration wraps it; only the drift
+   * check (cells as doubles: a far particle's cell may not fit an int) limits it there. */
   for (mpm_lidx i = 0; i < n; ++i)
     for (int d = 0; d < p->dim; ++d) {
       const double x = y[(size_t)d * n + i];
-      if (!(x >= g->lo[d] && x < g->hi[d]))
+      if (!g->periodic[d] && !(x >= g->lo[d] && x < g->hi[d]))
         return mpm_fault_at(fault, p, y, i, "the particle left the domain");
-      const int cell = (int)floor((x - g->lo[d]) / g->dx);
+      const double cell = floor((x - g->lo[d]) / g->dx);
       const int c = g->coord[d];
       if (cell < g->cell_split[d][c] - 1 || cell > g->cell_split[d][c + 1])
         return mpm_fault_at(fault, p, y, i,

@@ -72,8 +72,9 @@ int mpm_grid_phase_update(mpm_grid *grid, int phase, double h);
 int mpm_fault_at(mpm_fault *fault, const mpm_particles *p, const double *y, mpm_lidx i,
                  const char *fmt, ...) __attribute__((format(printf, 5, 6)));
 
-/* Shared particle checks: NaN in the state, a particle outside the domain, or one that has
- * drifted more than one cell beyond this rank's cells during a step. */
+/* Shared particle checks: NaN in the state, a particle outside the domain (beyond a
+ * non-periodic face; beyond a periodic one it stays until migration wraps it), or one that
+ * has drifted more than one cell beyond this rank's cells during a step. */
 int mpm_module_check_positions(const mpm_module *m, const double *y, mpm_fault *fault);
 
 #endif

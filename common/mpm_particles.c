@@ -7,6 +7,8 @@
  *   id and data always change together.
  * - Ids are unique over all ranks and never reused: id_next exceeds every id handed out
  *   and is equal on every rank (inject() advances it by the global count on every rank).
+ * - Migration first wraps positions that left through a periodic face back into [lo, hi)
+ *   (mpm_grid_wrap), so ownership and every later use see a position inside the domain.
  * - Migration keeps the order of the particles that stay and appends arrivals in source
  *   rank order; sorting is stable. A run is therefore reproducible for a given rank count.
  * - Collective operations never leave a rank behind: every local failure (a particle out of
@@ -231,6 +233,22 @@ static int report_outside(const mpm_particles *p, const mpm_grid *g, mpm_lidx i,
            p->id[i], at, lo, hi, (int)nout);
 }
 
+/* Wrap positions across periodic faces; returns how many particles moved. */
+static mpm_lidx wrap_positions(mpm_particles *p, const mpm_grid *g) {
+  mpm_lidx nwrap = 0;
+  int any = 0;
+  for (int d = 0; d < g->dim; ++d) any |= g->periodic[d];
+  if (!any) return 0; /* no pass over the particles when nothing can wrap */
+  for (mpm_lidx i = 0; i < p->n; ++i) {
+    double x[MPM_MAX_DIM];
+    for (int d = 0; d < p->dim; ++d) x[d] = mpm_particles_comp(p, 0, d)[i];
+    if (!mpm_grid_wrap(g, x)) continue;
+    for (int d = 0; d < p->dim; ++d) mpm_particles_comp(p, 0, d)[i] = x[d];
+    nwrap++;
+  }
+  return nwrap;
+}
+
 /* Owner of every particle; fails naming the first particle outside the domain. */
 static int find_owners(const mpm_particles *p, const mpm_grid *g, migration *m) {
   mpm_lidx nout = 0, first = -1;
@@ -337,11 +355,13 @@ static int exchange(mpm_particles *p, const mpm_grid *g, migration *m) {
 
 int mpm_particles_migrate(mpm_particles *p, const mpm_grid *grid, int *changed) {
   migration m = {0};
-  int status[2]; /* error code, whether anything moves; agreed on by every rank */
+  /* error code, whether anything moves, whether a position wrapped; agreed on by every rank */
+  int status[3];
   if (changed) *changed = 0;
+  status[2] = wrap_positions(p, grid) > 0;
   status[0] = plan_sends(p, grid, &m);
   status[1] = m.nmove > 0;
-  int rc = MPI_Allreduce(MPI_IN_PLACE, status, 2, MPI_INT, MPI_MAX, grid->comm);
+  int rc = MPI_Allreduce(MPI_IN_PLACE, status, 3, MPI_INT, MPI_MAX, grid->comm);
   if (rc != MPI_SUCCESS) {
     migration_free(&m);
     MPM_FAIL(MPM_ERR_MPI, "MPI_Allreduce failed with MPI error %d", rc);
@@ -350,6 +370,8 @@ int mpm_particles_migrate(mpm_particles *p, const mpm_grid *grid, int *changed) 
   if (!rc && status[1]) {
     rc = exchange(p, grid, &m);
     if (changed) *changed = !rc;
+  } else if (!rc && changed) {
+    *changed = status[2]; /* the state changed in place: an integrator must hear of it */
   }
   migration_free(&m);
   MPM_CALL(rc);

@@ -59,8 +59,10 @@ int mpm_particles_edit(mpm_particles *p, const unsigned char *keep, mpm_lidx nad
  * order from id_next). */
 int mpm_particles_inject(mpm_particles *p, MPI_Comm comm, mpm_lidx nadd, const double *add_data);
 
-/* Send every particle to the rank owning its cell. *changed (may be NULL) is set to 1 on
- * every rank if any rank's set changed. A particle outside the domain is an error naming
+/* Send every particle to the rank owning its cell, after wrapping positions that left
+ * through a periodic face back into the domain. *changed (may be NULL) is set to 1 on every
+ * rank if any rank's set changed, a wrapped position included. A particle outside the
+ * domain (beyond a non-periodic face, or more than a period away) is an error naming
  * its id and position. Collective over grid->comm. */
 int mpm_particles_migrate(mpm_particles *p, const mpm_grid *grid, int *changed);
 

@@ -107,10 +107,13 @@ static int read_domain(const mpm_config *cfg, int *dim, double *lo, double *hi) 
 }
 
 static int build_grid(mpm_sim *s) {
-  int dim, nr, nproc[3] = {0, 0, 0};
+  int dim, nr, nproc[3] = {0, 0, 0}, periodic[MPM_MAX_DIM];
   double lo[3], hi[3], dx, ranks[3] = {0, 0, 0};
   const char *shape;
+  mpm_walls walls;
   MPM_CALL(read_domain(s->cfg, &dim, lo, hi));
+  MPM_CALL(mpm_walls_from_config(&walls, s->cfg, dim));
+  mpm_walls_periodic(&walls, periodic);
   MPM_CALL(mpm_config_get_real(s->cfg, "grid.dx", &dx));
   MPM_CALL(mpm_config_get_string(s->cfg, "grid.shape", &shape));
   MPM_CALL(mpm_config_get_reals(s->cfg, "grid.ranks", ranks, 3, &nr));
@@ -126,8 +129,19 @@ static int build_grid(mpm_sim *s) {
                              "the domain length %g along axis %d is not a whole number of cells "
                              "of %g (%.6g cells); adjust grid.dx or the domain",
                              hi[d] - lo[d], d, dx, cells);
+    const int ghost = mpm_shape_ghost_width(mpm_shape_parse(shape));
+    if (periodic[d] && round(cells) < ghost) {
+      char key[32];
+      snprintf(key, sizeof key, "boundary.%c_lo", "xyz"[d]);
+      return mpm_config_fail(s->cfg, key,
+                             "a periodic axis needs at least %d cells for the %s shape, but the "
+                             "domain holds %.0f along %c; lengthen the domain, refine grid.dx or "
+                             "use a narrower shape",
+                             ghost, shape, round(cells), "xyz"[d]);
+    }
   }
-  MPM_CALL(mpm_grid_new(&s->grid, s->comm, dim, lo, hi, dx, mpm_shape_parse(shape), nproc));
+  MPM_CALL(mpm_grid_new_periodic(&s->grid, s->comm, dim, lo, hi, dx, mpm_shape_parse(shape), nproc,
+                                 periodic));
   mpm_log(MPM_LOG_INFO, "grid: %d-D, %d x %d%s cells of %g, %s, %d ranks (%d x %d%s)", dim,
           s->grid->ncells[0], s->grid->ncells[1], dim == 3 ? " x ..." : "", dx, shape, s->size,
           s->grid->nproc[0], s->grid->nproc[1], dim == 3 ? " x ..." : "");

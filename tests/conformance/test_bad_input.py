@@ -41,6 +41,9 @@ CASES = [
     ("malformed line", "[physics]", "[physics]\nthis line has no equals sign", None, "syntax"),
     ("missing required key", "density = 1000\n", "", "[solid.block]", "'density'"),
     ("duplicate key", "dx = 0.1", "dx = 0.1\ndx = 0.2", "grid.dx", None),
+    ("periodic on one face only", "velocity = 3 2",
+     "velocity = 3 2\n\n[boundary]\nx_lo = periodic", "boundary.x_lo",
+     "set both x_lo and x_hi to periodic"),
 ]
 
 

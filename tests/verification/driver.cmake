@@ -36,3 +36,5 @@ mpm_add_script_test(test_transfer SCRIPT verification/test_transfer.py LABELS ve
                     TIMEOUT 600)
 mpm_add_script_test(test_stability SCRIPT verification/test_stability.py LABELS verification
                     TIMEOUT 300)
+mpm_add_script_test(test_periodic SCRIPT verification/test_periodic.py
+                    LABELS "verification;mpi" TIMEOUT 300)
