@@ -2,14 +2,15 @@
  * XXXSetType pattern). A model file exports only its ops table; solid_material_register.c
  * lists the built-ins, so a new model is one file plus one line there.
  *
- * Three kinds of model fit the one interface:
+ * Four kinds of model fit the one interface:
  *  - total (hyperelastic, small-strain elastic): Cauchy stress from F alone;
  *  - rate form (hypoelastic): the stress is part of the ODE state (field "sigma", nrate
  *    components) and the model gives its rate from the velocity gradient L;
  *  - with history (J2 plasticity): per-particle history values (field "hist", nhistory
  *    components) that stay fixed during a step; stress() performs the return mapping from the
  *    stage's F and the committed history without changing it, and commit() stores the
- *    returned state once a step is accepted.
+ *    returned state once a step is accepted;
+ *  - rigid (flag `rigid`): no stress; the solid module prescribes the body's motion.
  * Everything is evaluated over a batch of particles (an index list into component-major
  * arrays), never one call per particle.
  *
@@ -61,6 +62,10 @@ typedef struct solid_material_ops {
   /* 1 if the model is only valid for small strains and rotations (it is then checked for
    * objectivity to first order only). */
   int small_strain;
+  /* 1 for a rigid body: no stress, F = I, its particles move with the body's constant
+   * velocity and the grid nodes inside its region (moving with it) take that velocity; the
+   * solid module does the motion (the model gives zero stress and a wave speed of 0). */
+  int rigid;
 } solid_material_ops;
 
 struct solid_material {

@@ -12,10 +12,11 @@ extern const solid_material_ops solid_stvk_ops;
 extern const solid_material_ops solid_neo_hookean_ops;
 extern const solid_material_ops solid_hypoelastic_ops;
 extern const solid_material_ops solid_j2_ops;
+extern const solid_material_ops solid_rigid_ops;
 
 static const solid_material_ops *const g_models[] = {
     &solid_linear_elastic_ops, &solid_stvk_ops, &solid_neo_hookean_ops,
-    &solid_hypoelastic_ops,    &solid_j2_ops,
+    &solid_hypoelastic_ops,    &solid_j2_ops,   &solid_rigid_ops,
 };
 static const int g_nmodels = (int)(sizeof g_models / sizeof g_models[0]);
 

@@ -21,6 +21,11 @@
  *  h      history models: the yield surface (perfect plasticity, H = 0), the hardening
  *         law (H > 0) along isochoric pure shear with a commit per increment, consistency
  *         of commit, and init_history resetting the state.
+ *  r      rigid models (ops->rigid): zero stress and energy at any F, a wave speed of exactly
+ *         0 (only the body's velocity may limit the step), no history and no rate. Checks
+ *         b-f concern an elastic response and are skipped for them, each with its reason;
+ *         batch and a apply unchanged. A rigid model is created without E, nu, sigma_y and
+ *         hardening, which it must refuse.
  *
  * Cauchy stress is read back from stress() as out / V with V = V0 det F (the contract:
  * out = V sigma); the small-strain model takes V = V0, which these checks see as an O(e)
@@ -730,6 +735,60 @@ static void check_spin(const model *m) {
   report(m, "g: pure spin |sigma - Q s0 Q^T| / |s0|", worst, 1e-8);
 }
 
+/* ---- rigid models ------------------------------------------------------------------------ */
+
+/* r: at 20 random F = Q (I + H) (det(I + H) in [0.7, 1.3], Q a random rotation of up to 2 pi)
+ * the model must write exact zeros: tolerance 0, since nothing is computed. */
+static void check_rigid(const model *m) {
+  const int dim = m->dim;
+  double smax = 0.0, wmax = 0.0;
+  for (int k = 0; k < 20; ++k) {
+    double H[3][3], F[3][3], L[3][3], sig[3][3], hist[MAXH];
+    random_H(dim, H);
+    path p = straight(H);
+    random_generator(dim, p.K);
+    p.theta = 3.141592653589793 * (rnd() + 1.0);
+    path_at(dim, &p, 1.0, F, L);
+    fresh_history(m, hist);
+    stress_at(m, F, NULL, hist, sig);
+    smax = fmax(smax, m_maxabs(dim, sig));
+    wmax = fmax(wmax, fabs(energy_at(m, F, NULL, hist)));
+  }
+  const double c = m->ops->wave_speed(m->mat, g_rho);
+  report(m, "r: |sigma(F)|, 20 random F with rotation", smax, 0.0);
+  report(m, "r: |W(F)|, the same F", wmax, 0.0);
+  report(m, "r: |wave speed| (must be 0)", isfinite(c) ? fabs(c) : 1.0, 0.0);
+  report(m, "r: no history and no rate (0/1)", m->nh || m->ops->rate ? 1.0 : 0.0, 0.0);
+  /* each constant alone must be refused as bad input (the error line it prints is expected) */
+  static const char *const keys[] = {"E = 1e7", "nu = 0.3", "sigma_y = 1e5", "hardening = 1e6"};
+  int accepted = 0;
+  for (int k = 0; k < 4; ++k) {
+    char text[256];
+    mpm_config *cfg = NULL;
+    solid_material *mat = NULL;
+    snprintf(text, sizeof text, "[solid.t]\nmaterial = %s\ndensity = %g\n%s\n", m->ops->name, g_rho,
+             keys[k]);
+    int rc = mpm_config_new(&cfg, MPI_COMM_WORLD);
+    if (!rc) rc = solid_add_schema(cfg);
+    if (!rc) rc = mpm_config_read_string(cfg, text, "test_materials", ".");
+    if (!rc) accepted += solid_material_create(&mat, m->ops->name, cfg, "solid.t", dim) == 0;
+    solid_material_destroy(&mat);
+    mpm_config_destroy(&cfg);
+  }
+  report(m, "r: constants accepted (E, nu, sigma_y, H)", accepted, 0.0);
+}
+
+/* The elastic checks b-f with the reason each does not apply to a rigid model. */
+static void skip_elastic_checks(const model *m) {
+  skip(m, "b: symmetry", "rigid: zero stress at any F (r) is symmetric");
+  skip(m, "c: objectivity", "rigid: zero stress at any F with rotation (r) is objective");
+  skip(m, "d: small-strain limit", "rigid: no elastic tangent (C = 0, not the suite's E, nu)");
+  skip(m, "e: wave speed > 0",
+       "rigid: its wave speed is 0 by design (r), so that only its "
+       "velocity enters the stable step");
+  skip(m, "f: energy", "rigid: no stored energy (W = 0 checked in r)");
+}
+
 /* ---- history models ---------------------------------------------------------------------- */
 
 /* von Mises stress. In 2-D sigma_zz is not reported (plane strain keeps it inside the
@@ -875,10 +934,13 @@ static int create_model(model *m, const solid_material_ops *ops, int dim, double
   m->dim = dim;
   m->lambda = g_E * g_nu / ((1 + g_nu) * (1 - 2 * g_nu));
   m->mu = g_E / (2 * (1 + g_nu));
-  snprintf(text, sizeof text,
-           "[solid.t]\nmaterial = %s\ndensity = %g\nE = %g\nnu = %g\nsigma_y = %g\n"
-           "hardening = %g\n",
-           ops->name, g_rho, g_E, g_nu, g_sy, hardening);
+  if (ops->rigid) /* a rigid model refuses material constants */
+    snprintf(text, sizeof text, "[solid.t]\nmaterial = %s\ndensity = %g\n", ops->name, g_rho);
+  else
+    snprintf(text, sizeof text,
+             "[solid.t]\nmaterial = %s\ndensity = %g\nE = %g\nnu = %g\nsigma_y = %g\n"
+             "hardening = %g\n",
+             ops->name, g_rho, g_E, g_nu, g_sy, hardening);
   MPM_CALL(mpm_config_new(&cfg, MPI_COMM_WORLD));
   int rc = solid_add_schema(cfg);
   if (!rc) rc = mpm_config_read_string(cfg, text, "test_materials", ".");
@@ -912,10 +974,21 @@ int main(int argc, char **argv) {
             "%s: a required op is missing", ops->name);
       CHECK(!m.nh || ops->commit, "%s: a model with history needs commit", ops->name);
       if (g_rank == 0)
-        printf("%s %dD (%s%s%s):\n", ops->name, dim, ops->rate ? "rate form" : "total",
+        printf("%s %dD (%s%s%s):\n", ops->name, dim,
+               ops->rigid  ? "rigid"
+               : ops->rate ? "rate form"
+                           : "total",
                m.nh ? ", history" : "", ops->small_strain ? ", small strain" : "");
       check_batch(&m);
       check_zero(&m);
+      if (ops->rigid) {
+        check_rigid(&m);
+        skip_elastic_checks(&m);
+        skip(&m, "g: rate form", "total model");
+        skip(&m, "h: plasticity", "no history");
+        solid_material_destroy(&m.mat);
+        continue;
+      }
       check_symmetry(&m);
       check_objectivity(&m);
       check_small_strain(&m);
