@@ -1,10 +1,13 @@
 /* The solid MPM module: bodies seeded from case-file geometry, each with its own material
- * model, integrated as x, v and F on the particles, held by walls and clamps.
+ * model, integrated as x, v and F on the particles, held by walls, clamps and rigid bodies
+ * (material rigid: a prescribed constant velocity, holding the grid nodes inside the body),
+ * and loaded by surface tractions ([traction.NAME]).
  *
  * State fields: x (dim), v (dim), F (dim*dim), and sigma (dim*dim) when a body's model is in
  * rate form. Other fields: m (mass), V0 (reference volume), body (index of the [solid.NAME]
- * section the particle came from), hist when a body's model has history variables, and fixed
- * (1 inside a clamp) when the case has clamps. */
+ * section the particle came from), hist when a body's model has history variables, fixed
+ * (1 inside a clamp) when the case has clamps, and fext (dim: the constant external force
+ * of a particle tagged by a traction, N) when the case has tractions. */
 #ifndef SOLID_MODULE_H
 #define SOLID_MODULE_H
 

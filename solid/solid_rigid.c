@@ -3,8 +3,10 @@
  * inside its region (translated with it) at that velocity. The motion and the node rule
  * live in the solid module (solid_module.c), which reads the `rigid` flag; this file gives
  * the model's side: zero stress and energy, and a wave speed of 0 so that only the body's
- * velocity enters the stable step. Parameters: density only (it gives the particle mass);
- * an elastic or plastic constant given to a rigid body is an input error. */
+ * velocity enters the stable step. Parameters: density only (it gives the particle mass).
+ * E and sigma_y given to a rigid body are input errors. nu and hardening have defaults, so a
+ * resolved case (the text a checkpoint stores) always holds them: they are ignored, as every
+ * model ignores the keys it does not use. */
 #include "solid_material.h"
 
 #include <stdio.h>
@@ -12,7 +14,7 @@
 
 static int rigid_create(solid_material *mat, const mpm_config *cfg, const char *section, int dim) {
   (void)dim;
-  static const char *const unused[] = {"E", "nu", "sigma_y", "hardening"};
+  static const char *const unused[] = {"E", "sigma_y"};
   mat->content = NULL;
   for (size_t k = 0; k < sizeof unused / sizeof unused[0]; ++k) {
     char key[160];

@@ -80,3 +80,45 @@ class Checks:
     def finish(self):
         print(f"{self.name}: {self.passed} passed, {self.failed} failed")
         return 1 if self.failed else 0
+
+
+def worst_difference(a, b):
+    """Largest difference over the fields of two particle sets with the same ids (from
+    particles()), each relative to the field's largest magnitude; and the fields compared."""
+    fields = [k for k in a if k not in ("id", "time")]
+    worst = max(float(np.abs(a[k] - b[k]).max()) / max(float(np.abs(a[k]).max()), 1e-300)
+                for k in fields)
+    return worst, fields
+
+
+def expect_input_error(check, name, text, key, line, words=""):
+    """Run `mpmfsi run` on case text that must be rejected: exit status 2, one `error:` line
+    that names case.ini:LINE and the key (and holds `words`), and no output folder."""
+    with tempfile.TemporaryDirectory() as tmp:
+        path = os.path.join(tmp, "case.ini")
+        with open(path, "w") as f:
+            f.write(text)
+        out = os.path.join(tmp, "out")
+        p = run(["run", path, f"output.dir={out}", "run.progress=false"], check=False)
+        errors = [l for l in p.stderr.splitlines() if l.startswith("error:")]
+        ok = (p.returncode == 2 and len(errors) == 1 and f"case.ini:{line}:" in errors[0]
+              and key in errors[0] and words in errors[0] and not os.path.exists(out))
+        check(ok, f"{name}: exit {p.returncode}: {errors[0] if errors else p.stderr[-300:]}")
+
+
+def line_starting(text, prefix):
+    """Number of the last line of text that starts with prefix."""
+    return [k for k, l in enumerate(text.splitlines(), 1) if l.startswith(prefix)][-1]
+
+
+def restart_difference(case_path, args, T, name):
+    """Run a case to T with a checkpoint at T/2, restart from that checkpoint to T, and
+    compare the two final states by particle id: (ids equal, worst_difference, fields)."""
+    full, rest = outdir(f"{name}_full"), outdir(f"{name}_restarted")
+    common = [f"time.t_end={T}", "run.progress=false"] + list(args)
+    run(["run", case_path, f"output.dir={full}", f"output.checkpoint_interval={T / 2}"] + common)
+    run(["restart", os.path.join(full, "checkpoint_000001.h5"), f"output.dir={rest}"] + common)
+    a, b = (particles(snapshots(d)[-1][1]) for d in (full, rest))
+    if not np.array_equal(a["id"], b["id"]):
+        return False, float("inf"), []
+    return (True,) + worst_difference(a, b)

@@ -38,3 +38,7 @@ mpm_add_script_test(test_stability SCRIPT verification/test_stability.py LABELS 
                     TIMEOUT 300)
 mpm_add_script_test(test_periodic SCRIPT verification/test_periodic.py
                     LABELS "verification;mpi" TIMEOUT 300)
+mpm_add_script_test(test_rigid SCRIPT verification/test_rigid.py LABELS "verification;mpi"
+                    TIMEOUT 300)
+mpm_add_script_test(test_traction SCRIPT verification/test_traction.py
+                    LABELS "verification;mpi" TIMEOUT 300)
