@@ -24,7 +24,8 @@ inside the region at seeding carries the force t h^(dim-1), h = dx / ppc.
     ranks, and in 3-D (a free block's top face, 1 x 0.5, traction (1, 2, 3)). For free blocks
     in 2-D and 3-D (no walls, no gravity) the momentum of diagnostics.csv grows at exactly the
     total force: |p(t) - F t| <= 1e-12 |F t| (P2G's weights sum to one and the internal
-    forces to zero; only roundoff remains).
+    forces to zero; only roundoff remains); the 3-D block with bs32, the 2-D one with the
+    classic update.
 A restart at t = 2 continued to 4 ends bitwise where a straight run does.
 (iii) Bad input, one error line naming file:line and the key, exit 2: a traction region that
     holds no particle; one two particle layers deep; one on a rigid body only; a value with
@@ -133,7 +134,7 @@ hi = 2 2
 dx = 0.25
 [time]
 t_end = 0.02
-method = bs32
+method = usl
 [output]
 interval = 0.02
 [geometry.block]
