@@ -17,6 +17,9 @@ pushing into an elastic bar (E = 100, rho = 1, nu = 0, c = 10, height A = 2), bs
 - On 2 ranks as on 1, by particle id, every field (classic update, a faster piston
   straddling the rank boundary at x = 16 and crossing it): equal to 1e-13 relative
   (only the order of P2G additions differs; measured 4e-15).
+- Through a periodic face (x wraps at 8, cases/rigid_push.ini with overrides, v = 0.25,
+  3 s): the nodes inside the piston's wrapped region move at v exactly, the bar on the far
+  side is pushed (positive momentum), and 2 ranks agree with 1 to 1e-13 (classic update).
 - A restart at t = 0.5 continued to 1 ends bitwise where a straight run does (the held
   nodes follow from the restored time).
 - Bad input: E or sigma_y given to a rigid body, velocity_field for a rigid body: one error
@@ -60,24 +63,35 @@ def piston_exact(out, check, label):
     return snaps
 
 
+def held_nodes(snaps, lo, hi, v, period=None):
+    """Nodes of the owned lattice inside the box [lo, hi] translated by v t (wrapped along x
+    with `period` = (x0, length) if given) in each snapshot after the first: the largest
+    count per snapshot and the largest |v_i - v| over them."""
+    worst, held = 0.0, 0
+    for t, path in snaps[1:]:
+        with h5py.File(path, "r") as f:
+            origin, dx = f["grid"].attrs["origin"], f["grid"].attrs["spacing"]
+            vi = f["grid/solid/v"][()]  # [ny][nx][2]
+        xs = origin[0] + np.ravel(dx)[0] * np.arange(vi.shape[1])
+        ys = origin[1] + np.ravel(dx)[-1] * np.arange(vi.shape[0])
+        XX, YY = np.meshgrid(xs, ys)
+        rx = XX - lo[0] - v[0] * t
+        if period:
+            inside_domain = (XX >= period[0]) & (XX < period[0] + period[1])
+            rx = np.where(inside_domain, np.mod(rx, period[1]), -1.0)
+        inside = ((rx >= 0) & (rx <= hi[0] - lo[0]) &
+                  (YY >= lo[1] + v[1] * t) & (YY <= hi[1] + v[1] * t))
+        held = max(held, int(inside.sum()))
+        worst = max(worst, float(np.abs(vi[inside] - v).max()))
+    return held, worst
+
+
 def main_push(check):
     out = mt.outdir("rigid_push")
     mt.run(["run", mt.case("rigid_push.ini"), f"output.dir={out}", "run.progress=false"])
     snaps = piston_exact(out, check, "bs32")
 
-    # nodes inside the translated piston take v exactly
-    worst, held = 0.0, 0
-    for t, path in snaps[1:]:
-        with h5py.File(path, "r") as f:
-            origin, dx = f["grid"].attrs["origin"], f["grid"].attrs["spacing"]
-            v = f["grid/solid/v"][()]  # [ny][nx][2]
-        xs = origin[0] + np.ravel(dx)[0] * np.arange(v.shape[1])
-        ys = origin[1] + np.ravel(dx)[-1] * np.arange(v.shape[0])
-        XX, YY = np.meshgrid(xs, ys)
-        inside = ((XX >= PISTON_LO[0] + V * t) & (XX <= PISTON_HI[0] + V * t) &
-                  (YY >= PISTON_LO[1]) & (YY <= PISTON_HI[1]))
-        held = max(held, int(inside.sum()))
-        worst = max(worst, float(np.abs(v[inside] - np.array([V, 0.0])).max()))
+    held, worst = held_nodes(snaps, PISTON_LO, PISTON_HI, np.array([V, 0.0]))
     check(held > 0 and worst == 0.0, f"nodes inside the moving piston ({held} per snapshot): "
           f"|v_i - v| = {worst:.1e} (exactly 0)")
 
@@ -103,6 +117,35 @@ def main_push(check):
     ratio = first[-1] / (V * ts[-1])
     check(abs(ratio - 1) < 0.05, f"contact column (X = {X[col, 0][0]:.3f}) moved {ratio:.4f} v t "
           "at t = 2 (tolerance 5 %)")
+
+
+def main_periodic(check):
+    """A piston crossing a periodic face (x in [0, 8) wraps) into the bar on the far side."""
+    args = ["domain.hi=8 2", "boundary.x_lo=periodic", "boundary.x_hi=periodic",
+            "geometry.piston.lo=6 0", "geometry.piston.hi=8 2", "geometry.bar.lo=0.5 0",
+            "geometry.bar.hi=5 2", "solid.piston.velocity=0.25 0", "time.t_end=3",
+            "output.interval=0.5", "run.progress=false"]
+    out = mt.outdir("rigid_periodic")
+    mt.run(["run", mt.case("rigid_push.ini"), f"output.dir={out}"] + args)
+    snaps = mt.snapshots(out)
+    held, worst = held_nodes(snaps, [6.0, 0.0], [8.0, 2.0], np.array([0.25, 0.0]), (0.0, 8.0))
+    check(held > 0 and worst == 0.0, f"periodic: nodes inside the wrapped piston ({held} per "
+          f"snapshot): |v_i - v| = {worst:.1e} (exactly 0)")
+    p = mt.particles(snaps[-1][1])
+    bar = p["body"][:, 0] == 1
+    P = float((p["m"][bar, 0] * p["v"][bar, 0]).sum())
+    check(P > 0, f"periodic: the bar, pushed through the face from t = 2 s, has momentum {P:.4f} "
+          "> 0 at t = 3 s")
+    finals = []
+    for ranks, split in ((1, "1 1"), (2, "2 1")):
+        out = mt.outdir(f"rigid_periodic_np{ranks}")
+        mt.run(["run", mt.case("rigid_push.ini"), f"output.dir={out}", f"grid.ranks={split}",
+                "time.method=usl", "output.grid_fields=false"] + args, ranks)
+        finals.append(mt.particles(mt.snapshots(out)[-1][1]))
+    same = np.array_equal(finals[0]["id"], finals[1]["id"])
+    worst = mt.worst_difference(*finals)[0] if same else float("inf")
+    check(worst <= 1e-13, f"periodic, 2 ranks vs 1 (usl): same ids {same}, fields agree to "
+          f"{worst:.1e} relative (tolerance 1e-13)")
 
 
 def main_ranks(check):
@@ -165,6 +208,7 @@ check = mt.Checks("test_rigid")
 main_push(check)
 main_classic(check)
 main_ranks(check)
+main_periodic(check)
 main_restart(check)
 main_bad_input(check)
 sys.exit(check.finish())
