@@ -4,8 +4,17 @@ Tip A displacement over the first five periods: frequency within 2 % of 1.0995 H
 amplitude within 5 % of 65.160 mm (tolerances from the issue). The tip response is measured
 by tools/tip_response.py (mean of the particles at the free end's mid-line; extrema by a
 parabola through three snapshots, taken every 0.02 s).
-Optional arguments: the cell size (default 0.005 m, 4 cells through the thickness), then
-extra key=value overrides (e.g. time.method=musl).
+The full test (label long) runs musl at dx = 2.5 mm (8 cells through the thickness), which
+meets both (measured -1.91 % and -0.62 %, about 15 minutes on one loaded core). usl is
+dissipative here: at 2.5 mm its amplitude is -10 % (the maxima sink period by period), while
+musl's and bs32's are within 1 %; the frequency error is spatial (-4.0 % at 5 mm for every
+method). Arguments: the cell size, then extra key=value overrides (e.g. time.method=musl).
+
+`fast` instead runs the first period at dx = 5 mm (4 cells through the thickness) with musl
+(about 25 s) and checks the first minimum of uy against the reference's, mean - amplitude =
+-128.77 mm at half a period, 0.4548 s: a regression guard for the default selection. Its
+tolerances come from this grid's measured spatial error (-137.0 mm, +6.4 %, at 0.474 s,
++4.3 %; at 2.5 mm the error halves): 8 % in value and 6 % in time.
 """
 import os
 import sys
@@ -17,6 +26,20 @@ sys.path.insert(0, os.path.join(mt.SOURCE, "tools"))
 import tip_response  # noqa: E402
 
 check = mt.Checks("test_csm3")
+if len(sys.argv) > 1 and sys.argv[1] == "fast":
+    out = mt.outdir("csm3_fast")
+    mt.run(["run", mt.case("csm3.ini"), f"output.dir={out}", "grid.dx=0.005", "time.method=musl",
+            "time.t_end=0.7", "run.progress=false"])
+    t, uy = tip_response.tip_uy(out)
+    lows = tip_response.extrema(t, uy, 1)
+    check(len(lows) == 1, f"one minimum in the first 0.7 s (found {len(lows)})")
+    tmin, umin = lows[0]
+    check(abs(umin + 128.77) / 128.77 < 0.08,
+          f"first minimum {umin:.2f} mm vs -128.77 ({100 * (umin + 128.77) / -128.77:+.2f} %, "
+          "tolerance 8 %)")
+    check(abs(tmin - 0.4548) / 0.4548 < 0.06,
+          f"at t = {tmin:.4f} s vs 0.4548 ({100 * (tmin - 0.4548) / 0.4548:+.2f} %, tolerance 6 %)")
+    sys.exit(check.finish())
 dx = sys.argv[1] if len(sys.argv) > 1 else "0.005"
 out = mt.outdir(f"csm3_dx{dx}")
 mt.run(["run", mt.case("csm3.ini"), f"output.dir={out}", f"grid.dx={dx}", "run.progress=false"]
