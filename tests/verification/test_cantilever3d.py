@@ -27,14 +27,8 @@ a zero crossing would pick up their local value. The second zero crossing (one p
 linear interpolation) is printed as a cross-check; so is the frequency from the zero
 crossings of the total momentum p_y in diagnostics.csv (every step).
 
-Snapshots perturb usl runs slightly: each snapshot time is an ARKODE stop time, and
-SUNDIALS 6.4.1 returns there a state interpolated by ARKODE rather than the classic update's
-own step (about half of that step's increment is lost). With snapshots every 0.2 s this
-lowers f1 by 0.05 % at h/dx = 2 (measured against a private build that does not set the stop
-time for usl), and less on finer grids (more steps between snapshots).
-
 Default (fast) selection, h / dx = 2 (2 cells through the thickness):
-1. f1 within 10 % of f_EB. Coarse: measured -7.1 % (-6.3 % from f_T); the accuracy check is
+1. f1 within 10 % of f_EB. Coarse: measured -7.0 % (-6.3 % from f_T); the accuracy check is
    the long test. This catches a clamp that does not hold, a modulus or density off by a
    factor, a start that is not bending; not a few per cent.
 2. Mode purity: the RMS residual of the one-frequency fit below 2 % of the amplitude
@@ -45,9 +39,9 @@ Default (fast) selection, h / dx = 2 (2 cells through the thickness):
 Long (`long [n ...]`, default n = h / dx = 2 4 6): f1 within 3 % of f_EB at the finest n
 (the issue's acceptance), and the observed order of |f - f_T| at least 1 between successive
 resolutions. Measured (usl; f_EB = 0.51083 Hz, f_T = 0.50687 Hz):
-  n = 2: 0.47472 Hz, -7.07 % vs EB (-6.34 % vs f_T)
-  n = 4: 0.49791 Hz, -2.53 % (-1.77 %)
-  n = 6: 0.50280 Hz, -1.57 % (-0.80 %); observed orders 1.84 and 1.95.
+  n = 2: 0.47499 Hz, -7.02 % vs EB (-6.29 % vs f_T)
+  n = 4: 0.49799 Hz, -2.51 % (-1.75 %)
+  n = 6: 0.50287 Hz, -1.56 % (-0.79 %); observed orders 1.84 and 1.96.
 Second order, unlike CSM1's first: here the clamp's face lies on a grid plane and its nodes
 are held. h/dx = 8 would take about 3 times as long as n = 6 and is left out of the label.
 """
