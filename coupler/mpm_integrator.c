@@ -2,6 +2,7 @@
 #include "mpm_integrator.h"
 
 #include "mpm_error.h"
+#include "mpm_nvector.h"
 #include "mpm_sundials.h"
 #include "mpm_timer.h"
 
@@ -34,8 +35,9 @@ struct mpm_integrator {
   mpm_fault fault;  /* last unphysical state seen by the RHS (same on every rank) */
   int rhs_error;    /* a non-recoverable failure inside the RHS */
   long steps, rhs_evals, fails, retries;
-  long fails_seen; /* ERKStep's cumulative error-test failures already counted */
-  double t_last;   /* time of the last accepted state */
+  long fails_seen;     /* ERKStep's cumulative error-test failures already counted */
+  double t_last;       /* time of the last accepted state */
+  N_Vector ewt_filled; /* the error-weight vector unit_weights last filled (fixed steps) */
 };
 
 const mpm_key_spec mpm_integrator_keys[] = {
@@ -212,9 +214,9 @@ static void free_state(mpm_integrator *it) {
 
 /* Fixed steps (the classic update, euler, time.adaptive = false) never use an error norm;
  * ARKODE 6.4 still computes one per step (a "too much accuracy" check read only for adaptive
- * steps), a full pass over the state with a global reduction. For this method the state's vectors
- * report a zero local sum instead: an ops-table specialisation, inherited by ARKODE's clones. */
-static mpm_sunreal no_wsqrsum(N_Vector x, N_Vector w) {
+ * steps), a full pass over the state with a global reduction. For them the state vector
+ * reports a zero norm instead: an ops-table specialisation, inherited by ARKODE's clones. */
+static mpm_sunreal no_wrmsnorm(N_Vector x, N_Vector w) {
   (void)x, (void)w;
   return 0.0;
 }
@@ -225,10 +227,15 @@ static int wrap_state(mpm_integrator *it) {
     mpm_particles *p = it->mod[k]->particles;
     it->sub[k] = N_VMake_Serial((sunindextype)p->nstate * p->n, p->data, it->ctx);
     if (!it->sub[k]) MPM_FAIL(MPM_ERR_SUNDIALS, "cannot wrap the %s state", it->mod[k]->name);
-    if (it->fixed) it->sub[k]->ops->nvwsqrsumlocal = no_wsqrsum;
+    mpm_nvector_fast_ops(it->sub[k]);
   }
   it->y = N_VMake_MPIManyVector(it->comm, it->nmod, it->sub, it->ctx);
   if (!it->y) MPM_FAIL(MPM_ERR_SUNDIALS, "cannot build the MPIManyVector state");
+  /* One pass per subvector for ARKODE's stage and solution combinations. */
+  MPM_CALL_SUN(N_VEnableLinearCombination_MPIManyVector(it->y, SUNTRUE));
+  MPM_CALL_SUN(N_VEnableScaleAddMulti_MPIManyVector(it->y, SUNTRUE));
+  if (it->fixed) it->y->ops->nvwrmsnorm = no_wrmsnorm;
+  it->ewt_filled = NULL;
   return 0;
 }
 
@@ -305,12 +312,14 @@ static int set_ralston_table(mpm_integrator *it) {
   return 0;
 }
 
-/* Error weights for the classic update. A fixed step never uses them, but ARKODE 6.4
+/* Error weights for fixed steps, which never use them, but ARKODE 6.4
  * recomputes them every step (four passes over the state with the default function); one
- * constant fill is all a fixed step needs. */
+ * constant fill of each weight vector ARKODE allocates is all a fixed step needs. */
 static int unit_weights(N_Vector y, N_Vector ewt, void *user) {
-  (void)y, (void)user;
-  N_VConst(1.0, ewt);
+  mpm_integrator *it = user;
+  (void)y;
+  if (ewt != it->ewt_filled) N_VConst(1.0, ewt);
+  it->ewt_filled = ewt;
   return 0;
 }
 
@@ -332,6 +341,7 @@ static int configure(mpm_integrator *it, double h0) {
     MPM_CALL_SUN(ERKStepSetTableNum(it->ark, tables[it->method]));
   if (it->fixed) {
     MPM_CALL_SUN(ERKStepWFtolerances(it->ark, unit_weights));
+    it->ewt_filled = NULL;
     MPM_CALL_SUN(ERKStepSetFixedStep(it->ark, h0 > 0 ? h0 : 1.0));
     return 0;
   }
