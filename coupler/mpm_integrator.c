@@ -7,6 +7,7 @@
 #include "mpm_timer.h"
 
 #include <arkode/arkode_erkstep.h>
+#include <float.h>
 #include <math.h>
 #include <nvector/nvector_mpimanyvector.h>
 #include <nvector/nvector_serial.h>
@@ -29,6 +30,8 @@ struct mpm_integrator {
   double rtol, atol, cfl, dt_max;
   int max_retries;
   double h_classic; /* step of the classic update, computed by its RHS (see classic_step) */
+  double h_limit;   /* its stability-limited step at ERKStep's current state (0: no limit) */
+  int h_limit_set;  /* h_limit belongs to the current state (set by the RHS at a step's end) */
   double tstop;     /* stop time of the current step */
   double scale;     /* step reduction of the current retry (1 when not retrying) */
   int fn_stale;     /* ERKStep's stored f(t_n, y_n) used another step size: re-evaluate */
@@ -136,16 +139,22 @@ static int mpm_cycle(mpm_integrator *it, double t, N_Vector y, N_Vector ydot) {
   return 0;
 }
 
-static int classic_step(mpm_integrator *it, double t, N_Vector y, double *h);
+static int classic_limit(mpm_integrator *it, N_Vector y, double *h);
+static double classic_step(const mpm_integrator *it, double t, double h_limit, int at_end);
 
 static int rhs(mpm_sunreal t, N_Vector y, N_Vector ydot, void *user) {
   mpm_integrator *it = user;
   mpm_fault local = {0};
   it->rhs_evals++;
   mpm_timer_start(MPM_T_CHECK);
-  if (mpm_method_is_classic(it->method) && classic_step(it, t, y, &it->h_classic) != 0) {
-    it->rhs_error = 1;
-    return -1;
+  if (mpm_method_is_classic(it->method)) {
+    if (classic_limit(it, y, &it->h_limit) != 0) {
+      it->rhs_error = 1;
+      return -1;
+    }
+    it->h_limit_set = 1;
+    /* Not at t_last: at the end of a step, where the next one starts. */
+    it->h_classic = classic_step(it, t, it->h_limit, t != it->t_last);
   }
   for (int k = 0; k < it->nmod && !local.set; ++k)
     it->mod[k]->ops->check(it->mod[k], module_data(y, k), &local);
@@ -180,17 +189,31 @@ static int estab(N_Vector y, mpm_sunreal t, mpm_sunreal *hstab, void *user) {
   return 0;
 }
 
-/* The fixed step (classic update, euler, non-adaptive pairs) from (t, y): the CFL fraction of the
- * stability limit, capped by dt_max and the stop time, times the retry scale. ERKStep evaluates f
- * at the end of each step and reuses it as the next step's only stage, so the RHS computes the step
- * it will be used with from the same (t, y) the driver uses to set the fixed step. */
-static int classic_step(mpm_integrator *it, double t, N_Vector y, double *h) {
+/* The stability-limited fixed step (classic update, euler, non-adaptive pairs) at y: the CFL
+ * fraction of the limit, capped by dt_max; 0 when nothing limits it. */
+static int classic_limit(mpm_integrator *it, N_Vector y, double *h) {
   double hs;
   MPM_CALL(stable_step(it, y, &hs));
   hs = fmin(it->cfl * hs, it->dt_max);
-  if (!(hs > 0) || !isfinite(hs)) hs = it->tstop - t;
-  *h = fmin(it->scale * hs, it->tstop - t);
+  *h = hs > 0 && isfinite(hs) ? hs : 0.0;
   return 0;
+}
+
+/* The fixed step from t: the limit (or, without one, the rest of the way to the stop time)
+ * times the retry scale, capped by the stop time so that a step lands on it. ERKStep
+ * evaluates f at the end of each step and reuses it as the next step's only stage, so the
+ * classic update's RHS computes the step it will be used with from the same (t, y) the
+ * driver uses to set the fixed step.
+ *
+ * At the end of a step that reached the stop time (at_end, within a few ulps) the next stop
+ * time is not known yet. The step is then the one a stop time at least a step away allows,
+ * as the next one usually is, so the driver can keep this f rather than evaluate it again
+ * (see attempt). */
+static double classic_step(const mpm_integrator *it, double t, double h_limit, int at_end) {
+  const double rest = it->tstop - t;
+  if (at_end && h_limit > 0 && rest <= 4 * DBL_EPSILON * fabs(it->tstop))
+    return it->scale * h_limit;
+  return fmin(it->scale * (h_limit > 0 ? h_limit : rest), rest);
 }
 
 #if SUNDIALS_VERSION_MAJOR < 7
@@ -340,6 +363,11 @@ static int configure(mpm_integrator *it, double h0) {
   else
     MPM_CALL_SUN(ERKStepSetTableNum(it->ark, tables[it->method]));
   if (it->fixed) {
+    /* Fixed steps never read ARKODE's dense output (no stop time, see attempt), but the
+     * default Hermite interpolant still copies the state and f at every step; a degree-0
+     * Lagrange one copies the state only. */
+    MPM_CALL_SUN(ERKStepSetInterpolantType(it->ark, ARK_INTERP_LAGRANGE));
+    MPM_CALL_SUN(ERKStepSetInterpolantDegree(it->ark, 0));
     MPM_CALL_SUN(ERKStepWFtolerances(it->ark, unit_weights));
     it->ewt_filled = NULL;
     MPM_CALL_SUN(ERKStepSetFixedStep(it->ark, h0 > 0 ? h0 : 1.0));
@@ -359,12 +387,13 @@ int mpm_integrator_start(mpm_integrator *it, double t, double h0) {
   it->ark = ERKStepCreate(rhs, t, it->y, it->ctx);
   if (!it->ark) MPM_FAIL(MPM_ERR_SUNDIALS, "ERKStepCreate failed");
   it->t_last = t;
-  it->scale = 1.0, it->fn_stale = 0, it->fails_seen = 0;
+  it->scale = 1.0, it->fn_stale = 0, it->fails_seen = 0, it->h_limit_set = 0;
   return configure(it, h0);
 }
 
 int mpm_integrator_resize(mpm_integrator *it, double t) {
   MPM_CALL(wrap_state(it));
+  it->h_limit_set = 0; /* particles moved between ranks, or were added or removed */
   MPM_CALL_SUN(ERKStepResize(it->ark, it->y, 1.0, t, NULL, NULL));
   return 0;
 }
@@ -402,13 +431,16 @@ static int report_fault(const mpm_integrator *it, double t, int tries) {
 static int attempt(mpm_integrator *it, double tstop, double scale, double *t, double *h) {
   mpm_sunreal tret = it->t_last;
   if (it->fixed) {
-    /* A stored f computed for another stop time or scale would use the wrong step (only the
-     * classic update's f depends on the step). */
+    /* The classic update's stored f (from the end of the last step) holds for the step it
+     * was computed with; another stop time or retry scale may change the step (the f of
+     * the other fixed-step methods does not depend on it). Its RHS left the stability limit
+     * of this state, unless the particles changed since. */
     const int classic = mpm_method_is_classic(it->method);
-    if (classic && (tstop != it->tstop || scale != it->scale)) it->fn_stale = 1;
+    const double h_stored = it->h_classic;
     it->tstop = tstop, it->scale = scale;
-    double hf;
-    MPM_CALL(classic_step(it, it->t_last, it->y, &hf));
+    if (!it->h_limit_set) MPM_CALL(classic_limit(it, it->y, &it->h_limit));
+    const double hf = classic_step(it, it->t_last, it->h_limit, 0);
+    if (classic && hf != h_stored) it->fn_stale = 1;
     if (classic) it->h_classic = hf;
     MPM_CALL_SUN(ERKStepSetFixedStep(it->ark, hf));
     if (it->fn_stale) MPM_CALL_SUN(ERKStepReset(it->ark, it->t_last, it->y));
