@@ -335,9 +335,9 @@ static int set_ralston_table(mpm_integrator *it) {
   return 0;
 }
 
-/* Error weights for fixed steps, which never use them, but ARKODE 6.4
- * recomputes them every step (four passes over the state with the default function); one
- * constant fill of each weight vector ARKODE allocates is all a fixed step needs. */
+/* Error weights for fixed steps. These never use them, but ARKODE 6.4 recomputes them every
+ * step (four passes over the state with the default function); one constant fill of each
+ * weight vector ARKODE allocates is all a fixed step needs. */
 static int unit_weights(N_Vector y, N_Vector ewt, void *user) {
   mpm_integrator *it = user;
   (void)y;
