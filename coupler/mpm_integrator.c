@@ -346,6 +346,15 @@ static int unit_weights(N_Vector y, N_Vector ewt, void *user) {
   return 0;
 }
 
+/* Error weights of the adaptive pairs: ARKODE's scalar-tolerance weights 1 / (rtol |y| +
+ * atol), bit for bit, in one pass (time.atol > 0 keeps them finite, so ARKODE's positivity
+ * check has nothing to find). */
+static int tolerance_weights(N_Vector y, N_Vector ewt, void *user) {
+  const mpm_integrator *it = user;
+  mpm_nvector_weights(y, ewt, it->rtol, it->atol);
+  return 0;
+}
+
 static int configure(mpm_integrator *it, double h0) {
   static const ARKODE_ERKTableID tables[MPM_METHOD_COUNT] = {
       [MPM_METHOD_BS32] = ARKODE_BOGACKI_SHAMPINE_4_2_3,
@@ -373,7 +382,7 @@ static int configure(mpm_integrator *it, double h0) {
     MPM_CALL_SUN(ERKStepSetFixedStep(it->ark, h0 > 0 ? h0 : 1.0));
     return 0;
   }
-  MPM_CALL_SUN(ERKStepSStolerances(it->ark, it->rtol, it->atol));
+  MPM_CALL_SUN(ERKStepWFtolerances(it->ark, tolerance_weights));
   MPM_CALL_SUN(ERKStepSetStabilityFn(it->ark, estab, it));
   MPM_CALL_SUN(ERKStepSetCFLFraction(it->ark, it->cfl));
   if (isfinite(it->dt_max)) MPM_CALL_SUN(ERKStepSetMaxStep(it->ark, it->dt_max));

@@ -6,6 +6,7 @@
 #include "mpm_sundials.h"
 
 #include <float.h>
+#include <nvector/nvector_mpimanyvector.h>
 #include <math.h>
 #include <string.h>
 
@@ -222,4 +223,13 @@ void mpm_nvector_fast_ops(N_Vector v) {
   ops->nvmaxnormlocal = v_max_norm_local;
   ops->nvlinearcombination = v_linear_combination;
   ops->nvscaleaddmulti = v_scale_add_multi;
+}
+
+void mpm_nvector_weights(N_Vector y, N_Vector w, double rtol, double atol) {
+  for (sunindextype k = 0; k < N_VGetNumSubvectors_MPIManyVector(y); ++k) {
+    N_Vector ys = N_VGetSubvector_MPIManyVector(y, k), ws = N_VGetSubvector_MPIManyVector(w, k);
+    const double *yd = DATA(ys);
+    double *wd = DATA(ws);
+    for (idx_t i = 0; i < LEN(ys); ++i) wd[i] = 1.0 / (fabs(yd[i]) * rtol + atol);
+  }
 }

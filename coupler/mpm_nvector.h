@@ -18,4 +18,9 @@
  * additions) on a serial vector. */
 void mpm_nvector_fast_ops(N_Vector v);
 
+/* w = 1 / (rtol |y| + atol) over every serial subvector of the MPIManyVectors y and w: ARKODE's
+ * scalar-tolerance error weights (the same operations in the same order), in one pass
+ * instead of four. */
+void mpm_nvector_weights(N_Vector y, N_Vector w, double rtol, double atol);
+
 #endif
