@@ -1,8 +1,9 @@
 /* The compiled serial vector operations (coupler/mpm_nvector.c) against SUNDIALS' own serial
  * operations, bit for bit: every special case of each operation (coefficients 1, -1, equal,
  * opposite, general; output aliasing an input; one to seven vectors in the fused
- * combinations), on vectors of odd length and on empty ones. Exact equality is the point:
- * the state of a run must not depend on which implementation did the vector work. */
+ * combinations), on vectors of odd length and on empty ones; and the one-pass error weights
+ * against ARKODE's four-operation sequence. Exact equality is the point: the state of a run
+ * must not depend on which implementation did the vector work. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -16,6 +17,8 @@
 #include <mpi.h>
 
 #include "mpm_nvector.h"
+
+#include <nvector/nvector_mpimanyvector.h>
 #include "mpm_sundials.h"
 
 #define N    1001
@@ -163,6 +166,29 @@ static void test_scale_add_multi(void **state) {
     }
 }
 
+/* 1 / (rtol |y| + atol) in one pass against ARKODE's arkEwtSetSS sequence of SUNDIALS
+ * operations (abs, scale, add constant, inverse), on a two-block MPIManyVector. */
+static void test_weights(void **state) {
+  (void)state;
+  const double rtol = 1e-6, atol = 1e-9;
+  pair y[2] = {pair_new(N, 50), pair_new(7, 51)}, w[2] = {pair_new(N, 52), pair_new(7, 53)};
+  N_Vector ys[2] = {y[0].ref, y[1].ref}, ws[2] = {w[0].fast, w[1].fast};
+  N_Vector ym = N_VMake_MPIManyVector(MPI_COMM_SELF, 2, ys, g_ctx);
+  N_Vector wm = N_VMake_MPIManyVector(MPI_COMM_SELF, 2, ws, g_ctx);
+  mpm_nvector_weights(ym, wm, rtol, atol);
+  for (int k = 0; k < 2; ++k) {
+    N_Vector t = N_VClone(y[k].ref);
+    N_VAbs(y[k].ref, t);
+    N_VScale(rtol, t, t);
+    N_VAddConst(t, atol, t);
+    N_VInv(t, w[k].ref);
+    assert_same(&w[k]);
+    N_VDestroy(t);
+  }
+  N_VDestroy(ym), N_VDestroy(wm);
+  for (int k = 0; k < 2; ++k) pair_free(&y[k]), pair_free(&w[k]);
+}
+
 int main(int argc, char **argv) {
   MPI_Init(&argc, &argv);
   MPI_Comm comm = MPI_COMM_SELF;
@@ -170,7 +196,7 @@ int main(int argc, char **argv) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_linear_sum),      cmocka_unit_test(test_elementwise),
       cmocka_unit_test(test_reductions),      cmocka_unit_test(test_linear_combination),
-      cmocka_unit_test(test_scale_add_multi),
+      cmocka_unit_test(test_scale_add_multi), cmocka_unit_test(test_weights),
   };
   const int rc = cmocka_run_group_tests(tests, NULL, NULL);
   SUNContext_Free(&g_ctx);
