@@ -43,6 +43,10 @@ typedef struct mpm_g2p_args {
    * linear and GIMP: C_p = sum_i v_i (x) grad S_ip, the exact APIC form for multilinear
    * weights. Either way an affine nodal velocity v0 + A x gives C_p = A. */
   double *C_out;
+  /* With both set: LF_out = L F, where F is a particle tensor (layout of L_out), computed
+   * from L in registers (L_out may stay NULL). The rate of a deformation gradient. */
+  const double *F;
+  double *LF_out;
 } mpm_g2p_args;
 
 typedef struct mpm_kernels {

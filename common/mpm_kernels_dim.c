@@ -1,9 +1,19 @@
 /* Dimension-specific P2G and G2P; included by mpm_kernels2.c and mpm_kernels3.c with
  * MPM_DIM set to 2 or 3 (the p4est way: one source, two compilations). Not compiled alone.
  *
- * A stencil is the tensor product of 1-D weights: S = w0[i] w1[j] (w2[k]) and
- * dS/dx_d = dw_d / dx times the other weights. The kind is a compile-time constant inside
- * each specialised loop (the always-inline helpers are called with a literal). */
+ * A stencil is the tensor product of 1-D weights: S = wx[i] wy[j] (wz[k]) and
+ * grad S = (dwx wy wz, wx dwy wz, wx wy dwz). Both kernels factor these products by axis
+ * instead of forming every node's weight and gradient: P2G builds, per particle, the
+ * contribution to each node of one x-y layer of its stencil from per-axis factors, and in
+ * 3-D scales that layer by wz[k] and dwz[k]; G2P first sums each x-row of nodes with the
+ * x-weights and then combines the row sums with the y (and z) weights. The sums are the
+ * node-by-node ones with fewer multiplications; only the rounding differs.
+ *
+ * The shape kind and the optional terms (APIC) are compile-time constants inside each
+ * specialised loop (the always-inline helpers are called with literals), so the stencil
+ * loops are fully unrolled and an option that is off costs nothing. The lattice constants
+ * are copied to locals first: the compiler must otherwise assume that every store into a
+ * nodal array could change them and load them again. */
 #include <math.h>
 
 #if MPM_DIM == 2
@@ -13,193 +23,280 @@
 #endif
 
 #define MPM_INLINE static inline __attribute__((always_inline))
+#define SMAX       MPM_SHAPE_MAX_SUPPORT
+/* Nodes per direction of a kind: a constant expression once the kind is a literal. */
+#define SUPPORT(kind) ((kind) == MPM_SHAPE_LINEAR ? 2 : (kind) == MPM_SHAPE_CUBIC ? 4 : 3)
 
-#if MPM_DIM == 3
-#define MAX_NODES (MPM_SHAPE_MAX_SUPPORT * MPM_SHAPE_MAX_SUPPORT * MPM_SHAPE_MAX_SUPPORT)
-#else
-#define MAX_NODES (MPM_SHAPE_MAX_SUPPORT * MPM_SHAPE_MAX_SUPPORT)
-#endif
-
-/* The nodes a particle touches: box index, weight, weight gradient and offset x_i - x_p
- * of each. */
+/* The lattice as the kernels need it, read once per call. */
 typedef struct {
-  int count;
-  mpm_lidx l[MAX_NODES];
-  double w[MAX_NODES];
-  double grad[MAX_NODES][MPM_DIM];
-  double r[MAX_NODES][MPM_DIM];
-} DIMFN(stencil);
+  double lo[MPM_DIM], dx, inv_dx, lp;
+  int box_lo[MPM_DIM];
+  mpm_lidx sy, sz; /* index strides of y and z in the box */
+} DIMFN(lattice);
 
-/* Expand the tensor-product stencil of a particle at x into its node list. */
-MPM_INLINE void DIMFN(stencil_eval)(const mpm_grid *g, mpm_shape_kind kind, const double *x,
-                                    double lp, DIMFN(stencil) * s) {
-  const int S = mpm_shape_support(kind);
-  const double inv_dx = 1.0 / g->dx;
-  double w[MPM_DIM][MPM_SHAPE_MAX_SUPPORT], dw[MPM_DIM][MPM_SHAPE_MAX_SUPPORT];
-  double r[MPM_DIM][MPM_SHAPE_MAX_SUPPORT];
-  int gi[MPM_DIM];
-  for (int d = 0; d < MPM_DIM; ++d) {
-    const double xi = (x[d] - g->lo[d]) * inv_dx;
-    gi[d] = mpm_shape_1d(kind, xi, lp, w[d], dw[d]);
-    for (int k = 0; k < MPM_SHAPE_MAX_SUPPORT; ++k) {
-      dw[d][k] *= inv_dx;
-      r[d][k] = (gi[d] + k - xi) * g->dx;
-    }
-  }
-  const mpm_lidx first = mpm_grid_local_index(g, gi), sy = g->box_n[0];
-  int q = 0;
-#if MPM_DIM == 3
-  const mpm_lidx sz = (mpm_lidx)g->box_n[0] * g->box_n[1];
-  for (int k = 0; k < S; ++k)
-#endif
-    for (int j = 0; j < S; ++j)
-      for (int i = 0; i < S; ++i, ++q) {
-#if MPM_DIM == 3
-        const double wjk = w[1][j] * w[2][k];
-        s->grad[q][0] = dw[0][i] * wjk;
-        s->grad[q][1] = w[0][i] * dw[1][j] * w[2][k];
-        s->grad[q][2] = w[0][i] * w[1][j] * dw[2][k];
-        s->r[q][2] = r[2][k];
-        s->l[q] = first + i + j * sy + k * sz;
-#else
-      const double wjk = w[1][j];
-      s->grad[q][0] = dw[0][i] * wjk;
-      s->grad[q][1] = w[0][i] * dw[1][j];
-      s->l[q] = first + i + j * sy;
-#endif
-        s->r[q][0] = r[0][i];
-        s->r[q][1] = r[1][j];
-        s->w[q] = w[0][i] * wjk;
-      }
-  s->count = q;
+static DIMFN(lattice) DIMFN(lattice_of)(const mpm_grid *g, double lp) {
+  DIMFN(lattice) L = {.dx = g->dx, .inv_dx = 1.0 / g->dx, .lp = lp};
+  for (int d = 0; d < MPM_DIM; ++d) L.lo[d] = g->lo[d], L.box_lo[d] = g->box_lo[d];
+  L.sy = g->box_n[0];
+  L.sz = (mpm_lidx)g->box_n[0] * g->box_n[1];
+  return L;
 }
 
-/* apic (a literal) selects the affine momentum term at compile time. */
-MPM_INLINE void DIMFN(p2g_loop)(mpm_grid *g, mpm_grid_phase *ph, const mpm_p2g_args *a,
+/* The 1-D weights of one particle along each axis. */
+typedef struct {
+  mpm_lidx first;           /* box index of the stencil's first node */
+  double w[MPM_DIM][SMAX];  /* weights */
+  double dw[MPM_DIM][SMAX]; /* their derivatives, 1/m */
+  double r[MPM_DIM][SMAX];  /* node minus particle position, m (only when asked) */
+} DIMFN(weights);
+
+MPM_INLINE void DIMFN(weights_eval)(const DIMFN(lattice) * L, mpm_shape_kind kind, const double *x,
+                                    int with_r, DIMFN(weights) * s) {
+  int gi[MPM_DIM];
+  for (int d = 0; d < MPM_DIM; ++d) {
+    const double xi = (x[d] - L->lo[d]) * L->inv_dx;
+    gi[d] = mpm_shape_1d(kind, xi, L->lp, s->w[d], s->dw[d]);
+    for (int k = 0; k < SUPPORT(kind); ++k) {
+      s->dw[d][k] *= L->inv_dx;
+      if (with_r) s->r[d][k] = (gi[d] + k - xi) * L->dx;
+    }
+  }
+  s->first = (gi[0] - L->box_lo[0]) + L->sy * (gi[1] - L->box_lo[1]);
+#if MPM_DIM == 3
+  s->first += L->sz * (gi[2] - L->box_lo[2]);
+#endif
+}
+
+/* ---- P2G ---------------------------------------------------------------------------------- */
+
+/* With apic (a literal) the momentum carries the affine term S m C_p (x_i - x_p). */
+MPM_INLINE void DIMFN(p2g_loop)(const DIMFN(lattice) * L, mpm_grid_phase *ph, const mpm_p2g_args *a,
                                 mpm_shape_kind kind, int apic) {
+  enum { D = MPM_DIM };
+  const int S = SUPPORT(kind);
   const size_t n = (size_t)a->n;
-  for (mpm_lidx p = 0; p < a->n; ++p) {
-    double x[MPM_DIM], mv[MPM_DIM], b[MPM_DIM], sig[MPM_DIM][MPM_DIM], mC[MPM_DIM][MPM_DIM];
-    const double m = a->m[p];
-    for (int d = 0; d < MPM_DIM; ++d) {
-      x[d] = a->x[d][p], mv[d] = m * a->v[d][p];
-      b[d] = m * a->gravity[d] + (a->fext[0] ? a->fext[d][p] : 0.0);
+  double *restrict mi = ph->m_i;
+  double *restrict mvi[D], *restrict fi[D];
+  const double *restrict xp[D], *restrict vp[D], *restrict fext[D];
+  const double *restrict mp = a->m, *restrict vsig = a->vsig, *restrict C = a->C;
+  double grav[D];
+  for (int d = 0; d < D; ++d) {
+    mvi[d] = ph->mv_i[d], fi[d] = ph->f_i[d];
+    xp[d] = a->x[d], vp[d] = a->v[d], fext[d] = a->fext[0] ? a->fext[d] : NULL;
+    grav[d] = a->gravity[d];
+  }
+  for (size_t p = 0; p < n; ++p) {
+    double x[D], mv[D], b[D], sig[D][D], mC[D][D];
+    const double m = mp[p];
+    for (int d = 0; d < D; ++d) {
+      x[d] = xp[d][p], mv[d] = m * vp[d][p];
+      b[d] = m * grav[d] + (fext[0] ? fext[d][p] : 0.0); /* body force S b, N per unit S */
     }
-    for (int r = 0; r < MPM_DIM; ++r)
-      for (int c = 0; c < MPM_DIM; ++c) {
-        sig[r][c] = a->vsig ? a->vsig[(size_t)(r * MPM_DIM + c) * n + p] : 0.0;
-        mC[r][c] = apic ? m * a->C[(size_t)(r * MPM_DIM + c) * n + p] : 0.0;
+    for (int r = 0; r < D; ++r)
+      for (int c = 0; c < D; ++c) {
+        sig[r][c] = vsig ? vsig[(size_t)(r * D + c) * n + p] : 0.0;
+        if (apic) mC[r][c] = m * C[(size_t)(r * D + c) * n + p];
       }
-    DIMFN(stencil) s;
-    DIMFN(stencil_eval)(g, kind, x, a->lp, &s);
-    for (int q = 0; q < s.count; ++q) {
-      const mpm_lidx l = s.l[q];
-      const double w = s.w[q];
-      ph->m_i[l] += w * m;
-      for (int d = 0; d < MPM_DIM; ++d) {
-        double f = w * b[d], mvq = mv[d];
-        for (int c = 0; c < MPM_DIM; ++c) {
-          f -= sig[d][c] * s.grad[q][c];
-          if (apic) mvq += mC[d][c] * s.r[q][c];
+    DIMFN(weights) s;
+    DIMFN(weights_eval)(L, kind, x, apic, &s);
+    const double *wx = s.w[0], *dwx = s.dw[0], *wy = s.w[1], *dwy = s.dw[1];
+
+    /* x factors: f_d = wy (wx b_d - sig_d0 dwx) - dwy (sig_d1 wx) [- dwz wy (sig_d2 wx)],
+     * times wz in 3-D; momentum wx (m v_d + m C_d0 rx) + wx ry (m C_d1) [+ ...]. */
+    double mwx[SMAX], P[D][SMAX], Q[D][SMAX], MX[D][SMAX], CY[D][SMAX];
+#if MPM_DIM == 3
+    double R[D][SMAX], CZ[D][SMAX];
+#endif
+    for (int i = 0; i < S; ++i) {
+      mwx[i] = m * wx[i];
+      for (int d = 0; d < D; ++d) {
+        P[d][i] = wx[i] * b[d] - sig[d][0] * dwx[i];
+        Q[d][i] = sig[d][1] * wx[i];
+        MX[d][i] = wx[i] * (apic ? mv[d] + mC[d][0] * s.r[0][i] : mv[d]);
+        if (apic) CY[d][i] = wx[i] * mC[d][1];
+#if MPM_DIM == 3
+        R[d][i] = sig[d][2] * wx[i];
+        if (apic) CZ[d][i] = wx[i] * mC[d][2];
+#endif
+      }
+    }
+#if MPM_DIM == 2
+    for (int j = 0; j < S; ++j) {
+      const mpm_lidx row = s.first + j * L->sy;
+      const double ry = apic ? s.r[1][j] : 0.0;
+      for (int i = 0; i < S; ++i) {
+        mi[row + i] += wy[j] * mwx[i];
+        for (int d = 0; d < D; ++d) {
+          mvi[d][row + i] += wy[j] * (apic ? MX[d][i] + ry * CY[d][i] : MX[d][i]);
+          fi[d][row + i] += wy[j] * P[d][i] - dwy[j] * Q[d][i];
         }
-        ph->mv_i[d][l] += w * mvq;
-        ph->f_i[d][l] += f;
       }
     }
+#else
+    /* One x-y layer of the stencil: mass, momentum, force and their z parts; each is used
+     * for every z-layer. */
+    double lm[SMAX][SMAX], lmv[D][SMAX][SMAX], lf[D][SMAX][SMAX];
+    double lmvz[D][SMAX][SMAX], lfz[D][SMAX][SMAX];
+    for (int j = 0; j < S; ++j)
+      for (int i = 0; i < S; ++i) {
+        lm[j][i] = wy[j] * mwx[i];
+        for (int d = 0; d < D; ++d) {
+          lmv[d][j][i] = wy[j] * (apic ? MX[d][i] + s.r[1][j] * CY[d][i] : MX[d][i]);
+          lf[d][j][i] = wy[j] * P[d][i] - dwy[j] * Q[d][i];
+          lfz[d][j][i] = wy[j] * R[d][i];
+          if (apic) lmvz[d][j][i] = wy[j] * CZ[d][i];
+        }
+      }
+    for (int k = 0; k < S; ++k) {
+      const double wz = s.w[2][k], dwz = s.dw[2][k], rz = apic ? s.r[2][k] : 0.0;
+      for (int j = 0; j < S; ++j) {
+        const mpm_lidx row = s.first + j * L->sy + k * L->sz;
+        for (int i = 0; i < S; ++i) {
+          mi[row + i] += wz * lm[j][i];
+          for (int d = 0; d < D; ++d) {
+            mvi[d][row + i] += wz * (apic ? lmv[d][j][i] + rz * lmvz[d][j][i] : lmv[d][j][i]);
+            fi[d][row + i] += wz * lf[d][j][i] - dwz * lfz[d][j][i];
+          }
+        }
+      }
+    }
+#endif
   }
 }
 
 static void DIMFN(p2g)(mpm_grid *g, int phase, const mpm_p2g_args *a) {
   mpm_grid_phase *ph = &g->phase[phase];
+  const DIMFN(lattice) L = DIMFN(lattice_of)(g, a->lp);
   const int apic = a->C != NULL;
+#define P2G_CASE(kind)                                                                             \
+  case kind:                                                                                       \
+    if (apic)                                                                                      \
+      DIMFN(p2g_loop)(&L, ph, a, kind, 1);                                                         \
+    else                                                                                           \
+      DIMFN(p2g_loop)(&L, ph, a, kind, 0);                                                         \
+    break;
   switch (g->shape) {
-  case MPM_SHAPE_LINEAR:
-    if (apic)
-      DIMFN(p2g_loop)(g, ph, a, MPM_SHAPE_LINEAR, 1);
-    else
-      DIMFN(p2g_loop)(g, ph, a, MPM_SHAPE_LINEAR, 0);
-    break;
-  case MPM_SHAPE_GIMP:
-    if (apic)
-      DIMFN(p2g_loop)(g, ph, a, MPM_SHAPE_GIMP, 1);
-    else
-      DIMFN(p2g_loop)(g, ph, a, MPM_SHAPE_GIMP, 0);
-    break;
-  case MPM_SHAPE_QUADRATIC:
-    if (apic)
-      DIMFN(p2g_loop)(g, ph, a, MPM_SHAPE_QUADRATIC, 1);
-    else
-      DIMFN(p2g_loop)(g, ph, a, MPM_SHAPE_QUADRATIC, 0);
-    break;
+    P2G_CASE(MPM_SHAPE_LINEAR)
+    P2G_CASE(MPM_SHAPE_GIMP)
+    P2G_CASE(MPM_SHAPE_QUADRATIC)
   default:
-    if (apic)
-      DIMFN(p2g_loop)(g, ph, a, MPM_SHAPE_CUBIC, 1);
-    else
-      DIMFN(p2g_loop)(g, ph, a, MPM_SHAPE_CUBIC, 0);
-    break;
+    P2G_CASE(MPM_SHAPE_CUBIC)
   }
+#undef P2G_CASE
 }
 
-/* The B-spline APIC moment: with apic_b (a literal) the loop also sums S v_i (x_i - x_p)^T,
- * which C_p = D^-1 (that sum) needs for quadratic and cubic weights. */
-MPM_INLINE void DIMFN(g2p_loop)(const mpm_grid *g, const mpm_g2p_args *a, mpm_shape_kind kind,
-                                int apic_b) {
+/* ---- G2P ---------------------------------------------------------------------------------- */
+
+/* With apic_b (a literal) the loop also sums S v_i (x_i - x_p)^T, the B-spline APIC moment:
+ * C_p = D^-1 times that sum, from sum_i S (x_i - x_p)(x_i - x_p)^T = D I. */
+MPM_INLINE void DIMFN(g2p_loop)(const DIMFN(lattice) * L, const mpm_g2p_args *a,
+                                mpm_shape_kind kind, int apic_b) {
+  enum { D = MPM_DIM };
+  const int S = SUPPORT(kind);
   const size_t n = (size_t)a->n;
-  /* D^-1 of the B-spline moment sum_i S_ip (x_i - x_p)(x_i - x_p)^T = D I. */
-  const double Dinv = (kind == MPM_SHAPE_CUBIC ? 3.0 : 4.0) / (g->dx * g->dx);
-  for (mpm_lidx p = 0; p < a->n; ++p) {
-    double x[MPM_DIM], v[MPM_DIM] = {0}, acc[MPM_DIM] = {0}, L[MPM_DIM][MPM_DIM] = {{0}};
-    double B[MPM_DIM][MPM_DIM] = {{0}};
-    for (int d = 0; d < MPM_DIM; ++d) x[d] = a->x[d][p];
-    DIMFN(stencil) s;
-    DIMFN(stencil_eval)(g, kind, x, a->lp, &s);
-    for (int q = 0; q < s.count; ++q) {
-      const mpm_lidx l = s.l[q];
-      const double w = s.w[q];
-      for (int d = 0; d < MPM_DIM; ++d) {
-        const double vi = a->v_i[d][l], wv = w * vi;
-        v[d] += wv;
-        acc[d] += w * a->a_i[d][l];
-        for (int c = 0; c < MPM_DIM; ++c) {
-          L[d][c] += vi * s.grad[q][c];
-          if (apic_b) B[d][c] += wv * s.r[q][c];
+  const double Dinv = (kind == MPM_SHAPE_CUBIC ? 3.0 : 4.0) * L->inv_dx * L->inv_dx;
+  const double *restrict xp[D], *restrict vi[D], *restrict ai[D];
+  double *restrict vout[D], *restrict aout[D];
+  const double *restrict F = a->LF_out ? a->F : NULL;
+  double *restrict Lout = a->L_out, *restrict Cout = a->C_out, *restrict LF = a->LF_out;
+  for (int d = 0; d < D; ++d) {
+    xp[d] = a->x[d], vi[d] = a->v_i[d], ai[d] = a->a_i[d];
+    vout[d] = a->v_out[d], aout[d] = a->a_out[d];
+  }
+  for (size_t p = 0; p < n; ++p) {
+    double x[D], v[D] = {0}, acc[D] = {0}, Lg[D][D] = {{0}}, B[D][D] = {{0}};
+    for (int d = 0; d < D; ++d) x[d] = xp[d][p];
+    DIMFN(weights) s;
+    DIMFN(weights_eval)(L, kind, x, apic_b, &s);
+    const double *wx = s.w[0], *dwx = s.dw[0], *wy = s.w[1], *dwy = s.dw[1];
+    double wrx[SMAX];
+    if (apic_b)
+      for (int i = 0; i < S; ++i) wrx[i] = wx[i] * s.r[0][i];
+#if MPM_DIM == 3
+    for (int k = 0; k < S; ++k) {
+      const double wz = s.w[2][k], dwz = s.dw[2][k];
+#else
+    {
+      const double wz = 1.0;
+#endif
+      for (int j = 0; j < S; ++j) {
+#if MPM_DIM == 3
+        const mpm_lidx row = s.first + j * L->sy + k * L->sz;
+#else
+        const mpm_lidx row = s.first + j * L->sy;
+#endif
+        /* Row sums with the x weights: S wx v, S dwx v, S wx a (and S wx rx v). */
+        double sv[D] = {0}, sd[D] = {0}, sa[D] = {0}, sr[D] = {0};
+        for (int i = 0; i < S; ++i)
+          for (int d = 0; d < D; ++d) {
+            const double vn = vi[d][row + i];
+            sv[d] += wx[i] * vn;
+            sd[d] += dwx[i] * vn;
+            sa[d] += wx[i] * ai[d][row + i];
+            if (apic_b) sr[d] += wrx[i] * vn;
+          }
+        const double wyz = wy[j] * wz, dwyz = dwy[j] * wz;
+        for (int d = 0; d < D; ++d) {
+          v[d] += wyz * sv[d];
+          acc[d] += wyz * sa[d];
+          Lg[d][0] += wyz * sd[d];
+          Lg[d][1] += dwyz * sv[d];
+#if MPM_DIM == 3
+          Lg[d][2] += wy[j] * dwz * sv[d];
+#endif
+          if (apic_b) {
+            B[d][0] += wyz * sr[d];
+            B[d][1] += wyz * s.r[1][j] * sv[d];
+#if MPM_DIM == 3
+            B[d][2] += wyz * s.r[2][k] * sv[d];
+#endif
+          }
         }
       }
     }
-    for (int d = 0; d < MPM_DIM; ++d) {
-      a->v_out[d][p] = v[d];
-      a->a_out[d][p] = acc[d];
+    for (int d = 0; d < D; ++d) vout[d][p] = v[d], aout[d][p] = acc[d];
+    if (Lout)
+      for (int r = 0; r < D; ++r)
+        for (int c = 0; c < D; ++c) Lout[(size_t)(r * D + c) * n + p] = Lg[r][c];
+    if (Cout)
+      for (int r = 0; r < D; ++r)
+        for (int c = 0; c < D; ++c)
+          Cout[(size_t)(r * D + c) * n + p] = apic_b ? Dinv * B[r][c] : Lg[r][c];
+    if (LF) {
+      double f[D][D];
+      for (int r = 0; r < D; ++r)
+        for (int c = 0; c < D; ++c) f[r][c] = F[(size_t)(r * D + c) * n + p];
+      for (int r = 0; r < D; ++r)
+        for (int c = 0; c < D; ++c) {
+          double sum = 0.0;
+          for (int k = 0; k < D; ++k) sum += Lg[r][k] * f[k][c];
+          LF[(size_t)(r * D + c) * n + p] = sum;
+        }
     }
-    if (a->L_out)
-      for (int r = 0; r < MPM_DIM; ++r)
-        for (int c = 0; c < MPM_DIM; ++c) a->L_out[(size_t)(r * MPM_DIM + c) * n + p] = L[r][c];
-    if (a->C_out)
-      for (int r = 0; r < MPM_DIM; ++r)
-        for (int c = 0; c < MPM_DIM; ++c)
-          a->C_out[(size_t)(r * MPM_DIM + c) * n + p] = apic_b ? Dinv * B[r][c] : L[r][c];
   }
 }
 
 static void DIMFN(g2p)(const mpm_grid *g, const mpm_g2p_args *a) {
+  const DIMFN(lattice) L = DIMFN(lattice_of)(g, a->lp);
   const int apic_b = a->C_out != NULL;
   switch (g->shape) {
   case MPM_SHAPE_LINEAR:
-    DIMFN(g2p_loop)(g, a, MPM_SHAPE_LINEAR, 0);
+    DIMFN(g2p_loop)(&L, a, MPM_SHAPE_LINEAR, 0);
     break;
   case MPM_SHAPE_GIMP:
-    DIMFN(g2p_loop)(g, a, MPM_SHAPE_GIMP, 0);
+    DIMFN(g2p_loop)(&L, a, MPM_SHAPE_GIMP, 0);
     break;
   case MPM_SHAPE_QUADRATIC:
     if (apic_b)
-      DIMFN(g2p_loop)(g, a, MPM_SHAPE_QUADRATIC, 1);
+      DIMFN(g2p_loop)(&L, a, MPM_SHAPE_QUADRATIC, 1);
     else
-      DIMFN(g2p_loop)(g, a, MPM_SHAPE_QUADRATIC, 0);
+      DIMFN(g2p_loop)(&L, a, MPM_SHAPE_QUADRATIC, 0);
     break;
   default:
     if (apic_b)
-      DIMFN(g2p_loop)(g, a, MPM_SHAPE_CUBIC, 1);
+      DIMFN(g2p_loop)(&L, a, MPM_SHAPE_CUBIC, 1);
     else
-      DIMFN(g2p_loop)(g, a, MPM_SHAPE_CUBIC, 0);
+      DIMFN(g2p_loop)(&L, a, MPM_SHAPE_CUBIC, 0);
     break;
   }
 }
@@ -208,4 +305,5 @@ const mpm_kernels DIMFN(mpm_kernels) = {MPM_DIM, DIMFN(p2g), DIMFN(g2p)};
 
 #undef DIMFN
 #undef MPM_INLINE
-#undef MAX_NODES
+#undef SMAX
+#undef SUPPORT

@@ -15,27 +15,30 @@ void mpm_module_destroy(mpm_module **m) {
   *m = NULL;
 }
 
+/* v = mv/m + h a, a = f/m on the nodes of one velocity component (zero where m <= mmin).
+ * Both branches are formed and one is selected, so the loop has no unpredictable jump. */
+static void node_update(mpm_lidx nn, const double *restrict m, const double *restrict mv,
+                        const double *restrict f, double *restrict v, double *restrict a,
+                        double mmin, double h) {
+  for (mpm_lidx l = 0; l < nn; ++l) {
+    const int full = m[l] > mmin;
+    const double q = full ? m[l] : 1.0, al = f[l] / q, vl = mv[l] / q + h * al;
+    a[l] = full ? al : 0.0;
+    v[l] = full ? vl : 0.0;
+  }
+}
+
 int mpm_grid_phase_update(mpm_grid *grid, int phase, double h) {
   mpm_grid_phase *ph = &grid->phase[phase];
-  const int dim = grid->dim;
   double local = 0.0, mmax;
-  for (mpm_lidx l = 0; l < grid->nnodes; ++l) local = fmax(local, ph->m_i[l]);
+  for (mpm_lidx l = 0; l < grid->nnodes; ++l) /* fmax without the call (NaN is skipped too) */
+    if (ph->m_i[l] > local) local = ph->m_i[l];
   MPM_CALL_MPI(MPI_Allreduce(&local, &mmax, 1, MPI_DOUBLE, MPI_MAX, grid->comm));
   /* Nodes touched only by the far tail of a stencil carry roundoff-sized mass; dividing by it
    * would amplify noise, so they are treated as empty. */
   const double mmin = 1e-14 * mmax;
-  for (mpm_lidx l = 0; l < grid->nnodes; ++l) {
-    const double m = ph->m_i[l];
-    for (int d = 0; d < dim; ++d) {
-      if (m > mmin) {
-        const double a = ph->f_i[d][l] / m;
-        ph->a_i[d][l] = a;
-        ph->v_i[d][l] = ph->mv_i[d][l] / m + h * a;
-      } else {
-        ph->a_i[d][l] = ph->v_i[d][l] = 0.0;
-      }
-    }
-  }
+  for (int d = 0; d < grid->dim; ++d)
+    node_update(grid->nnodes, ph->m_i, ph->mv_i[d], ph->f_i[d], ph->v_i[d], ph->a_i[d], mmin, h);
   return 0;
 }
 

@@ -2,10 +2,12 @@
 #include "mpm_integrator.h"
 
 #include "mpm_error.h"
+#include "mpm_nvector.h"
 #include "mpm_sundials.h"
 #include "mpm_timer.h"
 
 #include <arkode/arkode_erkstep.h>
+#include <float.h>
 #include <math.h>
 #include <nvector/nvector_mpimanyvector.h>
 #include <nvector/nvector_serial.h>
@@ -28,14 +30,17 @@ struct mpm_integrator {
   double rtol, atol, cfl, dt_max;
   int max_retries;
   double h_classic; /* step of the classic update, computed by its RHS (see classic_step) */
+  double h_limit;   /* its stability-limited step at ERKStep's current state (0: no limit) */
+  int h_limit_set;  /* h_limit belongs to the current state (set by the RHS at a step's end) */
   double tstop;     /* stop time of the current step */
   double scale;     /* step reduction of the current retry (1 when not retrying) */
   int fn_stale;     /* ERKStep's stored f(t_n, y_n) used another step size: re-evaluate */
   mpm_fault fault;  /* last unphysical state seen by the RHS (same on every rank) */
   int rhs_error;    /* a non-recoverable failure inside the RHS */
   long steps, rhs_evals, fails, retries;
-  long fails_seen; /* ERKStep's cumulative error-test failures already counted */
-  double t_last;   /* time of the last accepted state */
+  long fails_seen;     /* ERKStep's cumulative error-test failures already counted */
+  double t_last;       /* time of the last accepted state */
+  N_Vector ewt_filled; /* the error-weight vector unit_weights last filled (fixed steps) */
 };
 
 const mpm_key_spec mpm_integrator_keys[] = {
@@ -134,16 +139,22 @@ static int mpm_cycle(mpm_integrator *it, double t, N_Vector y, N_Vector ydot) {
   return 0;
 }
 
-static int classic_step(mpm_integrator *it, double t, N_Vector y, double *h);
+static int classic_limit(mpm_integrator *it, N_Vector y, double *h);
+static double classic_step(const mpm_integrator *it, double t, double h_limit, int at_end);
 
 static int rhs(mpm_sunreal t, N_Vector y, N_Vector ydot, void *user) {
   mpm_integrator *it = user;
   mpm_fault local = {0};
   it->rhs_evals++;
   mpm_timer_start(MPM_T_CHECK);
-  if (mpm_method_is_classic(it->method) && classic_step(it, t, y, &it->h_classic) != 0) {
-    it->rhs_error = 1;
-    return -1;
+  if (mpm_method_is_classic(it->method)) {
+    if (classic_limit(it, y, &it->h_limit) != 0) {
+      it->rhs_error = 1;
+      return -1;
+    }
+    it->h_limit_set = 1;
+    /* Not at t_last: at the end of a step, where the next one starts. */
+    it->h_classic = classic_step(it, t, it->h_limit, t != it->t_last);
   }
   for (int k = 0; k < it->nmod && !local.set; ++k)
     it->mod[k]->ops->check(it->mod[k], module_data(y, k), &local);
@@ -178,17 +189,31 @@ static int estab(N_Vector y, mpm_sunreal t, mpm_sunreal *hstab, void *user) {
   return 0;
 }
 
-/* The fixed step (classic update, euler, non-adaptive pairs) from (t, y): the CFL fraction of the
- * stability limit, capped by dt_max and the stop time, times the retry scale. ERKStep evaluates f
- * at the end of each step and reuses it as the next step's only stage, so the RHS computes the step
- * it will be used with from the same (t, y) the driver uses to set the fixed step. */
-static int classic_step(mpm_integrator *it, double t, N_Vector y, double *h) {
+/* The stability-limited fixed step (classic update, euler, non-adaptive pairs) at y: the CFL
+ * fraction of the limit, capped by dt_max; 0 when nothing limits it. */
+static int classic_limit(mpm_integrator *it, N_Vector y, double *h) {
   double hs;
   MPM_CALL(stable_step(it, y, &hs));
   hs = fmin(it->cfl * hs, it->dt_max);
-  if (!(hs > 0) || !isfinite(hs)) hs = it->tstop - t;
-  *h = fmin(it->scale * hs, it->tstop - t);
+  *h = hs > 0 && isfinite(hs) ? hs : 0.0;
   return 0;
+}
+
+/* The fixed step from t: the limit (or, without one, the rest of the way to the stop time)
+ * times the retry scale, capped by the stop time so that a step lands on it. ERKStep
+ * evaluates f at the end of each step and reuses it as the next step's only stage, so the
+ * classic update's RHS computes the step it will be used with from the same (t, y) the
+ * driver uses to set the fixed step.
+ *
+ * At the end of a step that reached the stop time (at_end, within a few ulps) the next stop
+ * time is not known yet. The step is then the one a stop time at least a step away allows,
+ * as the next one usually is, so the driver can keep this f rather than evaluate it again
+ * (see attempt). */
+static double classic_step(const mpm_integrator *it, double t, double h_limit, int at_end) {
+  const double rest = it->tstop - t;
+  if (at_end && h_limit > 0 && rest <= 4 * DBL_EPSILON * fabs(it->tstop))
+    return it->scale * h_limit;
+  return fmin(it->scale * (h_limit > 0 ? h_limit : rest), rest);
 }
 
 #if SUNDIALS_VERSION_MAJOR < 7
@@ -212,9 +237,9 @@ static void free_state(mpm_integrator *it) {
 
 /* Fixed steps (the classic update, euler, time.adaptive = false) never use an error norm;
  * ARKODE 6.4 still computes one per step (a "too much accuracy" check read only for adaptive
- * steps), a full pass over the state with a global reduction. For this method the state's vectors
- * report a zero local sum instead: an ops-table specialisation, inherited by ARKODE's clones. */
-static mpm_sunreal no_wsqrsum(N_Vector x, N_Vector w) {
+ * steps), a full pass over the state with a global reduction. For them the state vector
+ * reports a zero norm instead: an ops-table specialisation, inherited by ARKODE's clones. */
+static mpm_sunreal no_wrmsnorm(N_Vector x, N_Vector w) {
   (void)x, (void)w;
   return 0.0;
 }
@@ -225,10 +250,15 @@ static int wrap_state(mpm_integrator *it) {
     mpm_particles *p = it->mod[k]->particles;
     it->sub[k] = N_VMake_Serial((sunindextype)p->nstate * p->n, p->data, it->ctx);
     if (!it->sub[k]) MPM_FAIL(MPM_ERR_SUNDIALS, "cannot wrap the %s state", it->mod[k]->name);
-    if (it->fixed) it->sub[k]->ops->nvwsqrsumlocal = no_wsqrsum;
+    mpm_nvector_fast_ops(it->sub[k]);
   }
   it->y = N_VMake_MPIManyVector(it->comm, it->nmod, it->sub, it->ctx);
   if (!it->y) MPM_FAIL(MPM_ERR_SUNDIALS, "cannot build the MPIManyVector state");
+  /* One pass per subvector for ARKODE's stage and solution combinations. */
+  MPM_CALL_SUN(N_VEnableLinearCombination_MPIManyVector(it->y, SUNTRUE));
+  MPM_CALL_SUN(N_VEnableScaleAddMulti_MPIManyVector(it->y, SUNTRUE));
+  if (it->fixed) it->y->ops->nvwrmsnorm = no_wrmsnorm;
+  it->ewt_filled = NULL;
   return 0;
 }
 
@@ -305,12 +335,23 @@ static int set_ralston_table(mpm_integrator *it) {
   return 0;
 }
 
-/* Error weights for the classic update. A fixed step never uses them, but ARKODE 6.4
- * recomputes them every step (four passes over the state with the default function); one
- * constant fill is all a fixed step needs. */
+/* Error weights for fixed steps. These never use them, but ARKODE 6.4 recomputes them every
+ * step (four passes over the state with the default function); one constant fill of each
+ * weight vector ARKODE allocates is all a fixed step needs. */
 static int unit_weights(N_Vector y, N_Vector ewt, void *user) {
-  (void)y, (void)user;
-  N_VConst(1.0, ewt);
+  mpm_integrator *it = user;
+  (void)y;
+  if (ewt != it->ewt_filled) N_VConst(1.0, ewt);
+  it->ewt_filled = ewt;
+  return 0;
+}
+
+/* Error weights of the adaptive pairs: ARKODE's scalar-tolerance weights 1 / (rtol |y| +
+ * atol), bit for bit, in one pass (time.atol > 0 keeps them finite, so ARKODE's positivity
+ * check has nothing to find). */
+static int tolerance_weights(N_Vector y, N_Vector ewt, void *user) {
+  const mpm_integrator *it = user;
+  mpm_nvector_weights(y, ewt, it->rtol, it->atol);
   return 0;
 }
 
@@ -331,11 +372,17 @@ static int configure(mpm_integrator *it, double h0) {
   else
     MPM_CALL_SUN(ERKStepSetTableNum(it->ark, tables[it->method]));
   if (it->fixed) {
+    /* Fixed steps never read ARKODE's dense output (no stop time, see attempt), but the
+     * default Hermite interpolant still copies the state and f at every step; a degree-0
+     * Lagrange one copies the state only. */
+    MPM_CALL_SUN(ERKStepSetInterpolantType(it->ark, ARK_INTERP_LAGRANGE));
+    MPM_CALL_SUN(ERKStepSetInterpolantDegree(it->ark, 0));
     MPM_CALL_SUN(ERKStepWFtolerances(it->ark, unit_weights));
+    it->ewt_filled = NULL;
     MPM_CALL_SUN(ERKStepSetFixedStep(it->ark, h0 > 0 ? h0 : 1.0));
     return 0;
   }
-  MPM_CALL_SUN(ERKStepSStolerances(it->ark, it->rtol, it->atol));
+  MPM_CALL_SUN(ERKStepWFtolerances(it->ark, tolerance_weights));
   MPM_CALL_SUN(ERKStepSetStabilityFn(it->ark, estab, it));
   MPM_CALL_SUN(ERKStepSetCFLFraction(it->ark, it->cfl));
   if (isfinite(it->dt_max)) MPM_CALL_SUN(ERKStepSetMaxStep(it->ark, it->dt_max));
@@ -349,12 +396,13 @@ int mpm_integrator_start(mpm_integrator *it, double t, double h0) {
   it->ark = ERKStepCreate(rhs, t, it->y, it->ctx);
   if (!it->ark) MPM_FAIL(MPM_ERR_SUNDIALS, "ERKStepCreate failed");
   it->t_last = t;
-  it->scale = 1.0, it->fn_stale = 0, it->fails_seen = 0;
+  it->scale = 1.0, it->fn_stale = 0, it->fails_seen = 0, it->h_limit_set = 0;
   return configure(it, h0);
 }
 
 int mpm_integrator_resize(mpm_integrator *it, double t) {
   MPM_CALL(wrap_state(it));
+  it->h_limit_set = 0; /* particles moved between ranks, or were added or removed */
   MPM_CALL_SUN(ERKStepResize(it->ark, it->y, 1.0, t, NULL, NULL));
   return 0;
 }
@@ -392,13 +440,16 @@ static int report_fault(const mpm_integrator *it, double t, int tries) {
 static int attempt(mpm_integrator *it, double tstop, double scale, double *t, double *h) {
   mpm_sunreal tret = it->t_last;
   if (it->fixed) {
-    /* A stored f computed for another stop time or scale would use the wrong step (only the
-     * classic update's f depends on the step). */
+    /* The classic update's stored f (from the end of the last step) holds for the step it
+     * was computed with; another stop time or retry scale may change the step (the f of
+     * the other fixed-step methods does not depend on it). Its RHS left the stability limit
+     * of this state, unless the particles changed since. */
     const int classic = mpm_method_is_classic(it->method);
-    if (classic && (tstop != it->tstop || scale != it->scale)) it->fn_stale = 1;
+    const double h_stored = it->h_classic;
     it->tstop = tstop, it->scale = scale;
-    double hf;
-    MPM_CALL(classic_step(it, it->t_last, it->y, &hf));
+    if (!it->h_limit_set) MPM_CALL(classic_limit(it, it->y, &it->h_limit));
+    const double hf = classic_step(it, it->t_last, it->h_limit, 0);
+    if (classic && hf != h_stored) it->fn_stale = 1;
     if (classic) it->h_classic = hf;
     MPM_CALL_SUN(ERKStepSetFixedStep(it->ark, hf));
     if (it->fn_stale) MPM_CALL_SUN(ERKStepReset(it->ark, it->t_last, it->y));

@@ -483,14 +483,19 @@ static void hold_fixed(const mpm_particles *p, int f_fixed, double *ydot);
 static void move_rigid(const solid_content *sc, const mpm_particles *p, double *ydot);
 static void rigid_velocity(const solid_content *sc, int dim, mpm_lidx n, double *v);
 
-/* G2P: v_out = sum S v_i, a_out = sum S a_i, and optionally L and the APIC C (NULL: not
- * wanted). */
+/* G2P: v_out = sum S v_i, a_out = sum S a_i, and optionally L, the APIC C and dF/dt = L F
+ * (NULL: not wanted). */
 static void g2p_velocity(mpm_module *m, const double *y, double *const *v_out, double *const *a_out,
-                         double *L_out, double *C_out) {
+                         double *L_out, double *C_out, double *Fdot) {
   const solid_content *sc = m->content;
   const mpm_particles *p = m->particles;
   const mpm_grid_phase *ph = &m->grid->phase[m->phase];
-  mpm_g2p_args a = {.n = p->n, .lp = sc->lp, .L_out = L_out, .C_out = C_out};
+  mpm_g2p_args a = {.n = p->n,
+                    .lp = sc->lp,
+                    .L_out = L_out,
+                    .C_out = C_out,
+                    .F = y + (size_t)p->offset[F_F] * p->n,
+                    .LF_out = Fdot};
   for (int d = 0; d < p->dim; ++d) {
     a.x[d] = y + (size_t)(p->offset[F_X] + d) * p->n;
     a.v_i[d] = ph->v_i[d];
@@ -516,7 +521,7 @@ static int solid_remap(mpm_module *m, double t, const double *y, double h) {
   for (int d = 0; d < dim; ++d)
     vg[d] = sc->scratch + (size_t)d * n, ag[d] = sc->scratch + (size_t)(dim + d) * n;
   double *C = sc->apic ? sc->scratch + (size_t)2 * dim * n : NULL; /* the L slot */
-  g2p_velocity(m, y, vg, ag, NULL, C);
+  g2p_velocity(m, y, vg, ag, NULL, C, NULL);
   const double pic = sc->apic ? 1.0 : sc->pic;
   for (int d = 0; d < dim; ++d) {
     const double *v = y + (size_t)(p->offset[F_V] + d) * n;
@@ -542,25 +547,16 @@ static int solid_g2p(mpm_module *m, double t, const double *y, double *ydot, dou
   const mpm_particles *p = m->particles;
   const int dim = p->dim;
   const mpm_lidx n = p->n;
-  double *L = sc->scratch + (size_t)2 * dim * n;
+  /* dF/dt = L F comes out of the kernel directly; L itself is kept only for rate-form
+   * models. */
+  double *L = sc->lay.f_sigma >= 0 ? sc->scratch + (size_t)2 * dim * n : NULL;
   double *xdot[MPM_MAX_DIM] = {NULL}, *vdot[MPM_MAX_DIM] = {NULL};
   for (int d = 0; d < dim; ++d) {
     xdot[d] = ydot + (size_t)(p->offset[F_X] + d) * n;
     vdot[d] = ydot + (size_t)(p->offset[F_V] + d) * n;
   }
   double *Cdot = sc->apic ? ydot + (size_t)p->offset[sc->lay.f_C] * n : NULL;
-  g2p_velocity(m, y, xdot, vdot, L, Cdot);
-  const double *F = y + (size_t)p->offset[F_F] * n;
-  double *Fdot = ydot + (size_t)p->offset[F_F] * n;
-  for (int r = 0; r < dim; ++r)
-    for (int c = 0; c < dim; ++c) {
-      double *out = Fdot + (size_t)(r * dim + c) * n;
-      for (mpm_lidx i = 0; i < n; ++i) out[i] = 0.0;
-      for (int k = 0; k < dim; ++k) {
-        const double *Lrk = L + (size_t)(r * dim + k) * n, *Fkc = F + (size_t)(k * dim + c) * n;
-        for (mpm_lidx i = 0; i < n; ++i) out[i] += Lrk[i] * Fkc[i];
-      }
-    }
+  g2p_velocity(m, y, xdot, vdot, L, Cdot, ydot + (size_t)p->offset[F_F] * n);
   if (sc->musl && !sc->apic && h > 0)
     for (int d = 0; d < dim; ++d) { /* the velocity solid_remap gave the particles */
       const double *v = y + (size_t)(p->offset[F_V] + d) * n, *vn = sc->vnew + (size_t)d * n;

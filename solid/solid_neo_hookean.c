@@ -9,47 +9,63 @@
 #include <math.h>
 #include <stddef.h>
 
+/* Every loop below runs over a compile-time dimension D: the helpers are always inlined
+ * and called with a literal 2 or 3, so the tensor loops unroll completely. */
+#define NH_INLINE static inline __attribute__((always_inline))
+
 /* b = F F^T of particle i; returns J = det F. */
-static double nh_left_cauchy_green(int dim, const double *F, mpm_lidx n, mpm_lidx i,
-                                   double bl[3][3]) {
+NH_INLINE double nh_left_cauchy_green(const int D, const double *F, mpm_lidx n, mpm_lidx i,
+                                      double bl[3][3]) {
   double f[3][3];
-  for (int r = 0; r < dim; ++r)
-    for (int c = 0; c < dim; ++c) f[r][c] = F[(size_t)(r * dim + c) * n + i];
-  for (int r = 0; r < dim; ++r)
-    for (int c = 0; c < dim; ++c) {
+  for (int r = 0; r < D; ++r)
+    for (int c = 0; c < D; ++c) f[r][c] = F[(size_t)(r * D + c) * n + i];
+  for (int r = 0; r < D; ++r)
+    for (int c = 0; c < D; ++c) {
       double s = 0.0;
-      for (int k = 0; k < dim; ++k) s += f[r][k] * f[c][k];
+      for (int k = 0; k < D; ++k) s += f[r][k] * f[c][k];
       bl[r][c] = s;
     }
-  if (dim == 2) return f[0][0] * f[1][1] - f[0][1] * f[1][0];
+  if (D == 2) return f[0][0] * f[1][1] - f[0][1] * f[1][0];
   return f[0][0] * (f[1][1] * f[2][2] - f[1][2] * f[2][1]) -
          f[0][1] * (f[1][0] * f[2][2] - f[1][2] * f[2][0]) +
          f[0][2] * (f[1][0] * f[2][1] - f[1][1] * f[2][0]);
 }
 
 /* V sigma = V0 J sigma = V0 (mu (b - I) + lambda ln J I). */
-static void nh_stress(const solid_material *mat, const solid_batch *b) {
-  const solid_elastic *el = mat->content;
-  const int dim = b->dim;
+NH_INLINE void nh_stress_dim(const int D, const solid_elastic *el, const solid_batch *b) {
+  const double mu = el->mu, lambda = el->lambda;
+  const mpm_lidx n = b->n;
+  double *out = b->out;
   for (mpm_lidx k = 0; k < b->count; ++k) {
     const mpm_lidx i = b->idx[k];
     double bl[3][3];
-    const double lnJ = log(nh_left_cauchy_green(dim, b->F, b->n, i, bl));
-    for (int r = 0; r < dim; ++r)
-      for (int c = 0; c < dim; ++c)
-        b->out[(size_t)(r * dim + c) * b->n + i] =
-            b->V0[i] * (el->mu * (bl[r][c] - (r == c)) + (r == c ? el->lambda * lnJ : 0.0));
+    const double lnJ = log(nh_left_cauchy_green(D, b->F, n, i, bl)), V0 = b->V0[i];
+    for (int r = 0; r < D; ++r)
+      for (int c = 0; c < D; ++c)
+        out[(size_t)(r * D + c) * n + i] =
+            V0 * (mu * (bl[r][c] - (r == c)) + (r == c ? lambda * lnJ : 0.0));
   }
+}
+
+static void nh_stress(const solid_material *mat, const solid_batch *b) {
+  if (b->dim == 2)
+    nh_stress_dim(2, mat->content, b);
+  else
+    nh_stress_dim(3, mat->content, b);
 }
 
 /* W per reference volume; I1 - 3 = tr b - dim (plane strain adds the unit out-of-plane
  * stretch to both). */
-static double nh_energy_density(const solid_material *mat, const solid_batch *b, mpm_lidx i) {
-  const solid_elastic *el = mat->content;
+NH_INLINE double nh_energy_dim(const int D, const solid_elastic *el, const solid_batch *b,
+                               mpm_lidx i) {
   double bl[3][3], trb = 0.0;
-  const double lnJ = log(nh_left_cauchy_green(b->dim, b->F, b->n, i, bl));
-  for (int d = 0; d < b->dim; ++d) trb += bl[d][d];
-  return 0.5 * el->mu * (trb - b->dim) - el->mu * lnJ + 0.5 * el->lambda * lnJ * lnJ;
+  const double lnJ = log(nh_left_cauchy_green(D, b->F, b->n, i, bl));
+  for (int d = 0; d < D; ++d) trb += bl[d][d];
+  return 0.5 * el->mu * (trb - D) - el->mu * lnJ + 0.5 * el->lambda * lnJ * lnJ;
+}
+
+static double nh_energy_density(const solid_material *mat, const solid_batch *b, mpm_lidx i) {
+  return b->dim == 2 ? nh_energy_dim(2, mat->content, b, i) : nh_energy_dim(3, mat->content, b, i);
 }
 
 const solid_material_ops solid_neo_hookean_ops = {

@@ -7,7 +7,8 @@
  *    than `limit` from its last accepted position, so large steps fail and the driver must
  *    retry with smaller ones and still reach the exact answer;
  *  - the final failure: with limit = 0 no step can succeed, and the driver stops with
- *    MPM_ERR_UNPHYSICAL on every rank after time.max_retries retries. */
+ *    MPM_ERR_UNPHYSICAL on every rank after time.max_retries retries;
+ *  - the classic update at output stops (run_classic). */
 #include "mpm_config.h"
 #include "mpm_error.h"
 #include "mpm_integrator.h"
@@ -146,11 +147,11 @@ static double error_of(const mpm_module *m, double t, mpm_gidx first_injected, d
   return err;
 }
 
-static mpm_config *make_config(const char *extra) {
+static mpm_config *make_config(const char *method, const char *extra) {
   mpm_config *cfg = NULL;
   char text[512];
-  snprintf(text, sizeof text, "[time]\nt_end = 1\nmethod = bs32\nrtol = 1e-10\natol = 1e-12\n%s",
-           extra);
+  snprintf(text, sizeof text, "[time]\nt_end = 1\nmethod = %s\nrtol = 1e-10\natol = 1e-12\n%s",
+           method, extra);
   mpm_config_new(&cfg, MPI_COMM_WORLD);
   mpm_config_add_schema(cfg, mpm_integrator_keys, mpm_integrator_nkeys);
   if (mpm_config_read_string(cfg, text, "test", ".") || mpm_config_validate(cfg))
@@ -183,7 +184,7 @@ static void run_two_modules(double limit, const char *label) {
   mpm_grid_new(&grid, MPI_COMM_WORLD, 2, lo, hi, 0.5, MPM_SHAPE_LINEAR, nproc);
   mpm_module *mods[2] = {flight_new(grid, "a", 0, 40, limit),
                          flight_new(grid, "b", 1000, 25, limit)};
-  mpm_config *cfg = make_config("max_retries = 12\n");
+  mpm_config *cfg = make_config("bs32", "max_retries = 12\n");
   mpm_integrator *it = NULL;
   CHECK(mpm_integrator_new(&it, cfg, grid, mods, 2) == 0, "integrator_new");
   mpm_integrator_start(it, 0.0, 0.0);
@@ -235,7 +236,7 @@ static void run_hopeless(void) {
   mpm_grid *grid = NULL;
   mpm_grid_new(&grid, MPI_COMM_WORLD, 2, lo, hi, 0.5, MPM_SHAPE_LINEAR, nproc);
   mpm_module *m = flight_new(grid, "a", 0, 10, 0.0);
-  mpm_config *cfg = make_config("max_retries = 3\n");
+  mpm_config *cfg = make_config("bs32", "max_retries = 3\n");
   mpm_integrator *it = NULL;
   mpm_integrator_new(&it, cfg, grid, &m, 1);
   mpm_integrator_start(it, 0.0, 0.0);
@@ -251,12 +252,70 @@ static void run_hopeless(void) {
   mpm_grid_destroy(&grid);
 }
 
+/* The classic update (usl) is forward Euler with the driver's fixed steps: here h = 1/32
+ * from time.dt_max (the flight module has no stability limit), with stops at 0.25, 0.3, 0.5,
+ * 0.75 and 1 (0.3 is not on the step lattice). Checks:
+ *  - the state returned at each stop is the state the steps reached, against forward Euler
+ *    recomputed here with the returned steps (tolerance 1e-12: rounding over 32 steps of
+ *    O(1) values; returning ARKODE's degree-0 dense output instead, the mean of the last two
+ *    states, misses by h |v| / 2 ~ 1e-2);
+ *  - f from the end of a step is reused when the next stop is a step away: one RHS
+ *    evaluation per step, plus one at the start and at most one after each Resize. */
+static void run_classic(void) {
+  enum { NP = 30 };
+  const double lo[2] = {0, 0}, hi[2] = {10, 10}, stops[] = {0.25, 0.3, 0.5, 0.75, 1.0};
+  const int nproc[3] = {0, 0, 0};
+  mpm_grid *grid = NULL;
+  mpm_grid_new(&grid, MPI_COMM_WORLD, 2, lo, hi, 0.5, MPM_SHAPE_LINEAR, nproc);
+  mpm_module *m = flight_new(grid, "a", 0, NP, 1e30);
+  mpm_config *cfg = make_config("usl", "dt_max = 0.03125\n");
+  mpm_integrator *it = NULL;
+  CHECK(mpm_integrator_new(&it, cfg, grid, &m, 1) == 0, "integrator_new");
+  mpm_integrator_start(it, 0.0, 0.0);
+  double xr[NP][2], vr[NP][2], t = 0.0, h;
+  for (int i = 0; i < NP; ++i) initial(i, xr[i], vr[i]);
+  long resizes = 0;
+  int rc = 0;
+  for (size_t k = 0; k < sizeof stops / sizeof stops[0] && rc == 0; ++k)
+    while (t < stops[k] - 1e-14 && rc == 0) {
+      rc = mpm_integrator_step(it, stops[k], &t, &h);
+      for (int i = 0; i < NP; ++i)
+        for (int d = 0; d < 2; ++d) xr[i][d] += h * vr[i][d], vr[i][d] += h * G[d];
+      int changed;
+      mpm_particles_migrate(m->particles, grid, &changed);
+      if (changed) mpm_integrator_resize(it, t), resizes++;
+    }
+  CHECK(rc == 0, "classic update: integration failed (%d)", rc);
+  const mpm_particles *p = m->particles;
+  double err = 0.0, gerr;
+  for (mpm_lidx i = 0; i < p->n; ++i)
+    for (int d = 0; d < 2; ++d) {
+      err = fmax(err, fabs(p->data[(size_t)d * p->n + i] - xr[p->id[i]][d]));
+      err = fmax(err, fabs(p->data[(size_t)(2 + d) * p->n + i] - vr[p->id[i]][d]));
+    }
+  MPI_Allreduce(&err, &gerr, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+  long steps, rhs, fails, retries;
+  mpm_integrator_counts(it, &steps, &rhs, &fails, &retries);
+  CHECK(gerr <= 1e-12, "classic update: max deviation from forward Euler %.3e", gerr);
+  CHECK(rhs <= steps + 1 + resizes, "classic update: %ld rhs for %ld steps and %ld resizes", rhs,
+        steps, resizes);
+  if (g_rank == 0)
+    printf("classic update: t = %.3g, max deviation from forward Euler %.2e, %ld steps, %ld rhs, "
+           "%ld resizes on rank 0\n",
+           t, gerr, steps, rhs, resizes);
+  mpm_integrator_destroy(&it);
+  mpm_module_destroy(&m);
+  mpm_config_destroy(&cfg);
+  mpm_grid_destroy(&grid);
+}
+
 int main(int argc, char **argv) {
   mpm_test_init(&argc, &argv);
   mpm_log_init(MPI_COMM_WORLD, MPM_LOG_WARN, 0);
   run_two_modules(1e30, "two modules, no step limit");
   run_two_modules(0.02, "two modules, moves limited to 0.02 per step");
   run_hopeless();
+  run_classic();
   const int total = mpm_test_finish("test_integrator");
   MPI_Finalize();
   return total ? 1 : 0;

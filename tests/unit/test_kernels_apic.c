@@ -9,7 +9,8 @@
  *        same momenta as P2G without C, bit for bit.
  *  (ii)  G2P of an affine nodal velocity v_i = v0 + A x_i returns v_p = v0 + A x_p and
  *        C_p = A (for B-splines through the moment sum_i S (x_i - x_p)(x_i - x_p)^T = D I,
- *        for linear and GIMP through sum_i x_i (x) grad S = I), with L_out = A as well.
+ *        for linear and GIMP through sum_i x_i (x) grad S = I), with L_out = A as well, and
+ *        the fused product LF_out = L F = A F for a particle tensor F.
  *  (iii) P2G with only fext deposits a total nodal force sum_i f_i = sum_p fext_p
  *        (partition of unity); with gravity too, sum_p (m_p g + fext_p).
  *
@@ -198,9 +199,12 @@ static void check_g2p_affine(int dim, mpm_shape_kind shape) {
   }
   pset p;
   pset_make(&p, dim, 91u + (uint64_t)(10 * dim + shape));
-  double *vout[3], *aout[3], *C = malloc(sizeof(double) * (size_t)(dim * dim) * NP),
-                             *L = malloc(sizeof(double) * (size_t)(dim * dim) * NP);
-  mpm_g2p_args a = {.n = p.n, .lp = 0.25, .L_out = L, .C_out = C};
+  const size_t nt = (size_t)(dim * dim) * NP;
+  double *vout[3], *aout[3], *C = malloc(sizeof(double) * nt), *L = malloc(sizeof(double) * nt),
+                             *F = malloc(sizeof(double) * nt), *LF = malloc(sizeof(double) * nt);
+  uint64_t seed = 7u;
+  for (size_t k = 0; k < nt; ++k) F[k] = 2.0 * uniform(&seed) - 1.0;
+  mpm_g2p_args a = {.n = p.n, .lp = 0.25, .L_out = L, .C_out = C, .F = F, .LF_out = LF};
   for (int d = 0; d < dim; ++d) {
     vout[d] = malloc(sizeof(double) * NP), aout[d] = malloc(sizeof(double) * NP);
     a.x[d] = p.x[d], a.v_i[d] = ph->v_i[d], a.a_i[d] = ph->a_i[d];
@@ -208,7 +212,7 @@ static void check_g2p_affine(int dim, mpm_shape_kind shape) {
   }
   mpm_kernels_get(dim)->g2p(g, &a);
   const double V = velocity_scale(dim);
-  double ev = 0, eC = 0, eL = 0, amax = 0;
+  double ev = 0, eC = 0, eL = 0, eF = 0, amax = 0;
   for (int r = 0; r < dim; ++r)
     for (int c = 0; c < dim; ++c) amax = fmax(amax, fabs(g_A[r][c]));
   for (mpm_lidx i = 0; i < p.n; ++i) {
@@ -220,17 +224,20 @@ static void check_g2p_affine(int dim, mpm_shape_kind shape) {
       for (int c = 0; c < dim; ++c) {
         eC = fmax(eC, fabs(C[(size_t)(r * dim + c) * NP + i] - g_A[r][c]) / amax);
         eL = fmax(eL, fabs(L[(size_t)(r * dim + c) * NP + i] - g_A[r][c]) / amax);
+        double af = 0; /* (A F)_rc; |F| <= 1, so amax * dim bounds it */
+        for (int k = 0; k < dim; ++k) af += g_A[r][k] * F[(size_t)(k * dim + c) * NP + i];
+        eF = fmax(eF, fabs(LF[(size_t)(r * dim + c) * NP + i] - af) / (amax * dim));
       }
   }
   printf("  %d-D %-9s G2P of v0 + A x: max |v_p - (v0 + A x_p)| / V = %.2e, |C_p - A| / |A| = "
-         "%.2e, |L_p - A| / |A| = %.2e\n",
-         dim, mpm_shape_name(shape), ev, eC, eL);
+         "%.2e, |L_p - A| / |A| = %.2e, |L F - A F| / (|A| dim) = %.2e\n",
+         dim, mpm_shape_name(shape), ev, eC, eL, eF);
   assert_true(ev <= TOL);
   assert_true(eC <= TOL);
   assert_true(eL <= TOL);
+  assert_true(eF <= TOL);
   for (int d = 0; d < dim; ++d) free(vout[d]), free(aout[d]);
-  free(C);
-  free(L);
+  free(C), free(L), free(F), free(LF);
   pset_free(&p);
   mpm_grid_destroy(&g);
 }
