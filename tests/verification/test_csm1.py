@@ -40,10 +40,15 @@ the effective clamp edge lies about a cell behind the true one (with the nodes o
 line x = 0.25 also held, the 5 mm error drops from +8.7 % to +2.8 %). Measured (usl):
   cubic      dx = 5 mm: uy -71.38 (+8.0 %), ux -8.262 (+14.9 %)
              dx = 2.5 mm: uy -68.20 (+3.2 %), ux -7.602 (+5.8 %); orders 1.33, 1.37
+             dx = 1.25 mm: uy -67.00 (+1.35 %), ux -7.362 (+2.43 %); orders 1.24, 1.24
   quadratic  dx = 5 mm: uy -71.88 (+8.7 %), ux -8.419 (+17.1 %)
              dx = 2.5 mm: uy -69.19 (+4.7 %), ux -7.857 (+9.3 %); orders 0.90, 0.88
-The targets are not met at 2.5 mm, the finest resolution this label affords (the long test
-is an expected failure; see driver.cmake and the README for dx = 1.25 mm).
+The targets are met at dx = 1.25 mm with cubic B-splines, but that run takes 45 to 60 minutes
+on one core (20480 particles, 330 000 steps; it was measured in 0.3 s restart segments with
+this file's tip measure, since mpmtest.run stops a run after 20 minutes). At 2.5 mm, the
+finest resolution this label affords, they are not met: the long test is an expected
+failure (driver.cmake). musl instead of usl changes little here (cubic, 2.5 mm: uy +3.10 %,
+ux +5.60 %): the clamp's edge, not the time update, sets the error.
 """
 import os
 import sys
