@@ -744,6 +744,22 @@ static const mpm_module_ops solid_ops = {
     .remap = solid_remap,
 };
 
+/* A clamp holds the nodes nearest its boundary: a node is held if the region contains it or
+ * a point half a cell from it along an axis. Holding only the nodes strictly inside puts
+ * the effective root of a clamped bar up to a cell inside the clamp (B-splines do not
+ * interpolate), a first-order error that dominated CSM1 (tip uy +8.7 % at dx = 5 mm, against
+ * +2.8 % when the node line at the clamp's face is held). */
+static int clamps_node(const solid_content *sc, const double *x, double half, int dim) {
+  if (in_clamp(sc, x)) return 1;
+  for (int d = 0; d < dim; ++d)
+    for (int s = -1; s <= 1; s += 2) {
+      double y[3] = {x[0], x[1], x[2]};
+      y[d] += s * half;
+      if (in_clamp(sc, y)) return 1;
+    }
+  return 0;
+}
+
 /* Walls on the domain faces and clamped regions ([clamp.NAME] geometry = ...): the nodes
  * they hold, listed once. */
 static int read_constraints(mpm_module *m, const mpm_config *cfg) {
@@ -771,7 +787,7 @@ static int read_constraints(mpm_module *m, const mpm_config *cfg) {
     double x[3] = {0, 0, 0};
     mpm_grid_node_global(g, l, gi);
     for (int d = 0; d < g->dim; ++d) x[d] = g->lo[d] + gi[d] * g->dx;
-    if (in_clamp(sc, x)) MPM_CALL(mpm_constraints_add(&sc->cons, l, all));
+    if (clamps_node(sc, x, 0.5 * g->dx, g->dim)) MPM_CALL(mpm_constraints_add(&sc->cons, l, all));
   }
   return 0;
 }

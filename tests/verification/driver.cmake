@@ -39,16 +39,11 @@ mpm_add_script_test(test_traction SCRIPT verification/test_traction.py
                     LABELS "verification;mpi" TIMEOUT 300)
 # Turek & Hron CSM1, static deflection by damping: the fast test checks the settling, a coarse
 # (10 mm) deflection and 2 ranks vs 1; the long one is the issue's acceptance at dx = 5 and
-# 2.5 mm (cubic, the more accurate shape here). Not met yet (measured, usl, 5 % PIC): tip uy
-# +8.0 % (5 mm), +3.2 % (2.5 mm), ux +14.9 %, +5.8 % (quadratic: uy +8.7 %, +4.7 %); first
-# order in dx (the clamp's effective edge). Met at 1.25 mm, cubic (uy +1.35 %, ux +2.43 %),
-# which takes 45 minutes or more on one core, beyond this label's budget (2.5 mm: about 5 CPU
-# minutes); see test_csm1.py and the README.
+# 2.5 mm (cubic). Met at 2.5 mm: tip uy +1.07 %, ux +1.99 % (tolerances 2 %, 5 %).
 mpm_add_script_test(test_csm1 SCRIPT verification/test_csm1.py LABELS "verification;mpi"
                     TIMEOUT 600)
 mpm_add_script_test(test_csm1_long SCRIPT verification/test_csm1.py ARGS long
                     LABELS "verification;long" TIMEOUT 1800)
-set_tests_properties(test_csm1_long PROPERTIES WILL_FAIL TRUE)
 # 3-D cantilever, first bending frequency vs Euler-Bernoulli: fast at h/dx = 2 with 2 ranks
 # vs 1; long at h/dx = 2, 4, 6 (acceptance 3 % at 6).
 mpm_add_script_test(test_cantilever3d SCRIPT verification/test_cantilever3d.py
