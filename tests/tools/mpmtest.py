@@ -91,6 +91,23 @@ def worst_difference(a, b):
     return worst, fields
 
 
+def check_ranks_agree(check, case_path, args, name, tol=1e-12):
+    """Run case_path with args on 1 and 2 ranks and check that the final snapshots hold the
+    same particle ids and agree in every field to tol relative (worst_difference)."""
+    finals = []
+    for ranks in (1, 2):
+        out = outdir(f"{name}_np{ranks}")
+        run(["run", case_path, f"output.dir={out}", "run.progress=false"] + list(args), ranks)
+        finals.append(particles(snapshots(out)[-1][1]))
+    a, b = finals
+    same = np.array_equal(a["id"], b["id"])
+    check(same, f"2 ranks vs 1: the same {len(a['id'])} particle ids")
+    if same:
+        worst, fields = worst_difference(a, b)
+        check(worst <= tol, f"2 ranks vs 1 at t = {float(a['time']):g} s: fields "
+              f"{', '.join(fields)} agree to {worst:.1e} relative (tolerance {tol:g})")
+
+
 def expect_input_error(check, name, text, key, line, words=""):
     """Run `mpmfsi run` on case text that must be rejected: exit status 2, one `error:` line
     that names case.ini:LINE and the key (and holds `words`), and no output folder."""

@@ -154,19 +154,7 @@ else:
           "tolerance 10 % on this coarse grid)")
     check(purity < 0.02, f"h/dx = 2: RMS residual of the one-mode fit {100 * purity:.2f} % of "
           "the amplitude (< 2 %)")
-    finals = []
-    for ranks in (1, 2):
-        out = mt.outdir(f"cantilever_np{ranks}")
-        mt.run(["run", mt.case("cantilever3d.ini"), f"output.dir={out}", f"grid.dx={H / 2!r}",
-                "time.t_end=0.1", "output.interval=0.1", "run.progress=false"], ranks)
-        finals.append(mt.particles(mt.snapshots(out)[-1][1]))
-    a, b = finals
-    same = np.array_equal(a["id"], b["id"])
-    check(same, f"2 ranks vs 1: the same {len(a['id'])} particle ids")
-    if same:
-        fields = [k for k in a if k not in ("id", "time")]
-        worst = max(float(np.abs(a[k] - b[k]).max()) / max(float(np.abs(a[k]).max()), 1e-300)
-                    for k in fields)
-        check(worst <= 1e-12, f"2 ranks vs 1 at t = 0.1 s: fields {', '.join(fields)} agree "
-              f"to {worst:.1e} relative (tolerance 1e-12)")
+    mt.check_ranks_agree(check, mt.case("cantilever3d.ini"),
+                         [f"grid.dx={H / 2!r}", "time.t_end=0.1", "output.interval=0.1"],
+                         "cantilever")
 sys.exit(check.finish())

@@ -96,21 +96,8 @@ def static_tip(dx, shape="quadratic", extra=()):
 
 
 def ranks_agree():
-    finals = []
-    for ranks in (1, 2):
-        out = mt.outdir(f"csm1_np{ranks}")
-        mt.run(["run", mt.case("csm1.ini"), f"output.dir={out}", "time.t_end=0.02",
-                "output.interval=0.02", "run.progress=false"], ranks)
-        finals.append(mt.particles(mt.snapshots(out)[-1][1]))
-    a, b = finals
-    same = np.array_equal(a["id"], b["id"])
-    check(same, f"2 ranks vs 1: the same {len(a['id'])} particle ids")
-    if same:
-        fields = [k for k in a if k not in ("id", "time")]
-        worst = max(float(np.abs(a[k] - b[k]).max()) / max(float(np.abs(a[k]).max()), 1e-300)
-                    for k in fields)
-        check(worst <= 1e-12, f"2 ranks vs 1 at t = 0.02 s: fields {', '.join(fields)} agree "
-              f"to {worst:.1e} relative (tolerance 1e-12)")
+    mt.check_ranks_agree(check, mt.case("csm1.ini"), ["time.t_end=0.02", "output.interval=0.02"],
+                         "csm1")
 
 
 if len(sys.argv) > 1 and sys.argv[1] == "long":
