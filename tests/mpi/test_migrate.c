@@ -13,6 +13,7 @@
 #include "mpm_particles.h"
 #include "mpm_error.h"
 
+#include "mpm_random.h"
 #include "mpm_testing.h"
 
 #include <math.h>
@@ -26,16 +27,12 @@ static const mpm_field_desc g_fields[4] = {{"x", 0}, {"v", 0}, {"q", NQ}, {"s", 
 
 /* ---- deterministic functions of the id ------------------------------------------------- */
 
-static uint64_t mix(uint64_t z) { /* splitmix64 */
-  z += 0x9e3779b97f4a7c15ULL;
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-  return z ^ (z >> 31);
-}
-
 /* Uniform in [0, 1) from (id, step, d). */
 static double uniform(mpm_gidx id, int step, int d) {
-  return (double)(mix(mix(mix((uint64_t)id) + (uint64_t)step) + (uint64_t)d) >> 11) * 0x1.0p-53;
+  return (double)(mpm_test_mix(mpm_test_mix(mpm_test_mix((uint64_t)id) + (uint64_t)step) +
+                               (uint64_t)d) >>
+                  11) *
+         0x1.0p-53;
 }
 
 /* Value of component c of field f (not x) for particle id. */

@@ -19,6 +19,7 @@
 #include "mpm_error.h"
 #include "mpm_particles.h"
 
+#include "mpm_random.h"
 #include "mpm_testing.h"
 
 #include <math.h>
@@ -39,15 +40,11 @@ static const config g_configs[] = {
 
 /* ---- deterministic functions of the id ------------------------------------------------- */
 
-static uint64_t mix(uint64_t z) { /* splitmix64 */
-  z += 0x9e3779b97f4a7c15ULL;
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-  return z ^ (z >> 31);
-}
-
 static double uniform(mpm_gidx id, int step, int d) {
-  return (double)(mix(mix(mix((uint64_t)id) + (uint64_t)step) + (uint64_t)d) >> 11) * 0x1.0p-53;
+  return (double)(mpm_test_mix(mpm_test_mix(mpm_test_mix((uint64_t)id) + (uint64_t)step) +
+                               (uint64_t)d) >>
+                  11) *
+         0x1.0p-53;
 }
 
 static double value_of(mpm_gidx id, int f, int c) {

@@ -19,6 +19,7 @@
  * only rounding in sums of a few hundred terms of size O(scale) remains (about 1e-15
  * relative); 1e-12 leaves a wide margin for that and still catches any wrong term, which
  * is O(dx) = O(0.1) relative. */
+#include "mpm_random.h"
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -50,13 +51,8 @@ typedef struct {
   double *x[3], *v[3], *m, *C, *fext[3];
 } pset;
 
-/* splitmix64: a fixed seed makes every run test the same particles. */
 static double uniform(uint64_t *state) {
-  uint64_t z = (*state += 0x9e3779b97f4a7c15ull);
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-  z ^= z >> 31;
-  return (double)(z >> 11) * 0x1.0p-53;
+  return mpm_test_uniform(state);
 }
 
 static void affine(int dim, const double *x, double *v) {

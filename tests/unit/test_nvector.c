@@ -4,6 +4,7 @@
  * combinations), on vectors of odd length and on empty ones; and the one-pass error weights
  * against ARKODE's four-operation sequence. Exact equality is the point: the state of a run
  * must not depend on which implementation did the vector work. */
+#include "mpm_random.h"
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -32,11 +33,7 @@ typedef struct {
 } pair;
 
 static double uniform(uint64_t *state) {
-  uint64_t z = (*state += 0x9e3779b97f4a7c15ull);
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-  z ^= z >> 31;
-  return (double)(z >> 11) * 0x1.0p-53;
+  return mpm_test_uniform(state);
 }
 
 static pair pair_new(sunindextype n, uint64_t seed) {

@@ -8,6 +8,7 @@
  *   linear completeness    sum S_i x_i = x
  *   gradient sums          sum grad S_i = 0,  sum x_i (x) grad S_i = I
  * all to 1e-13 absolute, with x = O(10) so that rounding is the only error source. */
+#include "mpm_random.h"
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -38,13 +39,8 @@ static const shape_case g_cases[] = {
 
 /* ------------------------------------------------------------------------ helpers --- */
 
-/* splitmix64: a fixed seed makes every run test the same points. */
 static double next_uniform(uint64_t *state) {
-  uint64_t z = (*state += 0x9e3779b97f4a7c15ull);
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-  z ^= z >> 31;
-  return (double)(z >> 11) * 0x1.0p-53;
+  return mpm_test_uniform(state);
 }
 
 /* Uniform in [4, 12): the stencil stays well inside a lattice of nodes 0..16. */
