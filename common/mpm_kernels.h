@@ -49,11 +49,17 @@ typedef struct mpm_g2p_args {
   double *LF_out;
 } mpm_g2p_args;
 
+#define MPM_KERNELS_MAX_SCALARS 4
+
 typedef struct mpm_kernels {
   int dim;
   /* Add m_i, (m v)_i and f_i = sum S m g - sum V sigma grad S into phase fields. */
   void (*p2g)(mpm_grid *grid, int phase, const mpm_p2g_args *a);
   void (*g2p)(const mpm_grid *grid, const mpm_g2p_args *a);
+  /* G2P of k <= MPM_KERNELS_MAX_SCALARS nodal scalars: s_out[j][p] = sum_i S_ip s_i[j][i] for
+   * the n particles at x (a separate pass, for quantities only some modules need). */
+  void (*g2p_scalars)(const mpm_grid *grid, mpm_lidx n, const double *const *x, double lp, int k,
+                      const double *const *s_i, double *const *s_out);
 } mpm_kernels;
 
 const mpm_kernels *mpm_kernels_get(int dim);

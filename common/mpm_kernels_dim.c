@@ -301,7 +301,39 @@ static void DIMFN(g2p)(const mpm_grid *g, const mpm_g2p_args *a) {
   }
 }
 
-const mpm_kernels DIMFN(mpm_kernels) = {MPM_DIM, DIMFN(p2g), DIMFN(g2p)};
+MPM_INLINE void DIMFN(g2p_scalars_loop)(const mpm_grid *g, mpm_lidx n, const double *const *x,
+                                        double lp, int k, const double *const *s_i,
+                                        double *const *s_out, mpm_shape_kind kind) {
+  for (mpm_lidx p = 0; p < n; ++p) {
+    double xp[MPM_DIM], sum[MPM_KERNELS_MAX_SCALARS] = {0};
+    for (int d = 0; d < MPM_DIM; ++d) xp[d] = x[d][p];
+    DIMFN(stencil) s;
+    DIMFN(stencil_eval)(g, kind, xp, lp, &s);
+    for (int q = 0; q < s.count; ++q)
+      for (int j = 0; j < k; ++j) sum[j] += s.w[q] * s_i[j][s.l[q]];
+    for (int j = 0; j < k; ++j) s_out[j][p] = sum[j];
+  }
+}
+
+static void DIMFN(g2p_scalars)(const mpm_grid *g, mpm_lidx n, const double *const *x, double lp,
+                               int k, const double *const *s_i, double *const *s_out) {
+  switch (g->shape) {
+  case MPM_SHAPE_LINEAR:
+    DIMFN(g2p_scalars_loop)(g, n, x, lp, k, s_i, s_out, MPM_SHAPE_LINEAR);
+    break;
+  case MPM_SHAPE_GIMP:
+    DIMFN(g2p_scalars_loop)(g, n, x, lp, k, s_i, s_out, MPM_SHAPE_GIMP);
+    break;
+  case MPM_SHAPE_QUADRATIC:
+    DIMFN(g2p_scalars_loop)(g, n, x, lp, k, s_i, s_out, MPM_SHAPE_QUADRATIC);
+    break;
+  default:
+    DIMFN(g2p_scalars_loop)(g, n, x, lp, k, s_i, s_out, MPM_SHAPE_CUBIC);
+    break;
+  }
+}
+
+const mpm_kernels DIMFN(mpm_kernels) = {MPM_DIM, DIMFN(p2g), DIMFN(g2p), DIMFN(g2p_scalars)};
 
 #undef DIMFN
 #undef MPM_INLINE
