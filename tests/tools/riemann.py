@@ -121,15 +121,18 @@ class Riemann:
         return tuple(q.reshape(n, sub).mean(axis=1) for q in out)
 
 
-def cell_profile(x, q, lo, hi, ncells, weights=None):
-    """Average of the particle values q in each of ncells equal cells of [lo, hi] along x
-    (weighted by `weights` if given); NaN in a cell without particles."""
-    k = np.clip(((x - lo) / (hi - lo) * ncells).astype(int), 0, ncells - 1)
-    w = np.ones_like(q) if weights is None else weights
-    s = np.bincount(k, weights=w * q, minlength=ncells)
-    n = np.bincount(k, weights=w, minlength=ncells)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        return s / n
+def cell_profile(x, q, edges, sub=64):
+    """Cell averages of a particle quantity q along x: the piecewise-linear interpolant
+    through the particle values (ordered by x; constant beyond the outermost particles)
+    averaged over each cell [edges[k], edges[k+1]] on `sub` midpoints, as in
+    Riemann.cell_averages. Interpolating between particles rather than binning them keeps
+    cells that hold no particle (where the gas has expanded past one particle per cell) in the
+    measure."""
+    order = np.argsort(x, kind="stable")
+    n = len(edges) - 1
+    h = np.diff(edges)
+    xs = (edges[:-1, None] + h[:, None] * (np.arange(sub)[None, :] + 0.5) / sub).ravel()
+    return np.interp(xs, x[order], q[order]).reshape(n, sub).mean(axis=1)
 
 
 def shock_front(xc, rho, rho_pre, rho_post, x_from):

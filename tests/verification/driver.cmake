@@ -50,3 +50,7 @@ mpm_add_script_test(test_cantilever3d SCRIPT verification/test_cantilever3d.py
                     LABELS "verification;mpi" TIMEOUT 600)
 mpm_add_script_test(test_cantilever3d_long SCRIPT verification/test_cantilever3d.py ARGS long
                     LABELS "verification;long" TIMEOUT 1800)
+mpm_add_script_test(test_sod SCRIPT verification/test_sod.py LABELS "verification;mpi"
+                    TIMEOUT 600)
+mpm_add_script_test(test_sod_long SCRIPT verification/test_sod.py ARGS long
+                    LABELS "verification;long" TIMEOUT 1800)
