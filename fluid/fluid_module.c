@@ -47,7 +47,7 @@ static const mpm_key_spec fluid_keys[] = {
      "linear artificial viscosity coefficient c_lin: q = rho l |tr D| (c_lin c + c_quad l "
      "|tr D|) in compression, l = grid.dx",
      0},
-    {"fluid.av_quadratic", MPM_KEY_REAL, "1.5", 0, HUGE_VAL, 0, 0, NULL,
+    {"fluid.av_quadratic", MPM_KEY_REAL, "2", 0, HUGE_VAL, 0, 0, NULL,
      "quadratic artificial viscosity coefficient c_quad (see av_linear)", 0},
     {"fluid.ppc", MPM_KEY_INT, "2", 1, 8, 0, 0, NULL,
      "gas particles per cell per direction at seeding", 0},

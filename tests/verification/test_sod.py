@@ -6,15 +6,8 @@ them). Reference: the exact Riemann solver of tests/tools/riemann.py, itself che
 against the star state and wave positions of the validation CSV (to 2e-6 relative: the CSV
 gives six significant digits).
 
-Density measure: the particle densities m / (V0 J) (the `rho` output field), joined along x by
-linear interpolation between particles and averaged over each cell, against the exact
-solution averaged over the cell. The particle density is what the method computes; binning
-particle mass per cell instead would add sampling noise of +-1 particle per cell row (4 or 5
-particles across a cell behind the shock, +-11 %) that is no error of the solution, and
-averaging the particles inside each cell would leave out the cells the expanded gas leaves
-empty (left of the contact a particle row has one particle per 1.17 cells at t = 0.2).
-L1 = sum over cells |rho_cell - rho_exact| dx. The shock position is where the cell profile
-right of the contact crosses the mid-value of the pre- and post-shock densities.
+Density measure and shock position: see tests/tools/shocktube.py (particle densities joined
+by linear interpolation, averaged per cell, against the exact cell averages).
 
 Acceptance (issue 4), checked for the default method bs32:
   - L1 <= 8e-3 at 400 cells, observed order >= 0.8 from 100 to 800 cells (log2 of the L1
@@ -43,7 +36,8 @@ import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "tools"))
 import mpmtest as mt  # noqa: E402
-from riemann import Riemann, cell_profile, shock_front  # noqa: E402
+import shocktube  # noqa: E402
+from riemann import Riemann  # noqa: E402
 
 check = mt.Checks("test_sod")
 LONG = len(sys.argv) > 1 and sys.argv[1] == "long"
@@ -63,24 +57,11 @@ check(worst <= 2e-6, f"exact solver vs the validation CSV: largest relative diff
 
 
 def run(N, method, ranks=1, extra=()):
-    h = 3.0 / N
-    out = mt.outdir(f"sod_{method}_N{N}_np{ranks}")
-    mt.run(["run", mt.case("sod.ini"), f"output.dir={out}", f"grid.dx={1.0 / N}",
-            f"domain.hi=1 {h}", f"geometry.left.hi=0.5 {h}", f"geometry.right.hi=1 {h}",
-            f"time.method={method}", f"output.interval={T}", "run.progress=false"] + list(extra),
-           ranks)
-    return out
+    return shocktube.run("sod.ini", N, method, T, ranks, ["output.interval=0.2"] + list(extra))
 
 
 def measure(out, N):
-    P = mt.particles(mt.snapshots(out)[-1][1], "fluid")
-    edges = np.linspace(0.0, 1.0, N + 1)
-    xc = 0.5 * (edges[1:] + edges[:-1])
-    prof = cell_profile(P["x"][:, 0], P["rho"][:, 0], edges)
-    exact = EXACT.cell_averages(edges, T)[0]
-    l1 = float(np.sum(np.abs(prof - exact)) / N)
-    xs = shock_front(xc, prof, RIGHT[0], EXACT.r_star_r, EXACT.contact_position(T) + 0.02)
-    return l1, xs, P
+    return shocktube.measure(out, N, EXACT, T)
 
 
 def conservation(out, method):
