@@ -29,6 +29,8 @@ typedef struct mpm_p2g_args {
   double lp;                   /* GIMP particle half-width in cells */
 } mpm_p2g_args;
 
+#define MPM_KERNELS_MAX_SCALARS 4
+
 typedef struct mpm_g2p_args {
   mpm_lidx n;
   const double *x[MPM_MAX_DIM];
@@ -47,19 +49,18 @@ typedef struct mpm_g2p_args {
    * from L in registers (L_out may stay NULL). The rate of a deformation gradient. */
   const double *F;
   double *LF_out;
+  /* nscalar <= MPM_KERNELS_MAX_SCALARS nodal scalars to interpolate in the same pass:
+   * s_out[j][p] = sum_i S_ip s_i[j][i] (e.g. a nodal power for an energy balance). */
+  int nscalar;
+  const double *s_i[MPM_KERNELS_MAX_SCALARS];
+  double *s_out[MPM_KERNELS_MAX_SCALARS];
 } mpm_g2p_args;
-
-#define MPM_KERNELS_MAX_SCALARS 4
 
 typedef struct mpm_kernels {
   int dim;
   /* Add m_i, (m v)_i and f_i = sum S m g - sum V sigma grad S into phase fields. */
   void (*p2g)(mpm_grid *grid, int phase, const mpm_p2g_args *a);
   void (*g2p)(const mpm_grid *grid, const mpm_g2p_args *a);
-  /* G2P of k <= MPM_KERNELS_MAX_SCALARS nodal scalars: s_out[j][p] = sum_i S_ip s_i[j][i] for
-   * the n particles at x (a separate pass, for quantities only some modules need). */
-  void (*g2p_scalars)(const mpm_grid *grid, mpm_lidx n, const double *const *x, double lp, int k,
-                      const double *const *s_i, double *const *s_out);
 } mpm_kernels;
 
 const mpm_kernels *mpm_kernels_get(int dim);

@@ -260,8 +260,16 @@ void mpm_sim_destroy(mpm_sim **sp) {
 
 /* ---- the step loop --------------------------------------------------------------------- */
 
+/* Derived output fields are refreshed only when they are written. */
+static int prepare_output(mpm_sim *s) {
+  for (int k = 0; k < s->nmod; ++k)
+    if (s->mod[k]->ops->output) MPM_CALL(s->mod[k]->ops->output(s->mod[k]));
+  return 0;
+}
+
 static int write_snapshot(mpm_sim *s) {
   const mpm_particles *p[SIM_MAX_MODULES];
+  MPM_CALL(prepare_output(s));
   const char *names[SIM_MAX_MODULES];
   for (int k = 0; k < s->nmod; ++k) p[k] = s->mod[k]->particles, names[k] = s->mod[k]->name;
   mpm_timer_start(MPM_T_IO);
@@ -273,6 +281,7 @@ static int write_snapshot(mpm_sim *s) {
 
 static int write_checkpoint(mpm_sim *s, const char *path) {
   const mpm_particles *p[SIM_MAX_MODULES];
+  MPM_CALL(prepare_output(s));
   const char *names[SIM_MAX_MODULES];
   for (int k = 0; k < s->nmod; ++k) p[k] = s->mod[k]->particles, names[k] = s->mod[k]->name;
   const char *attr[] = {"t", "step", "h_next"};

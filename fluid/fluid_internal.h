@@ -49,12 +49,12 @@ typedef struct fluid_step_out {
 } fluid_step_out;
 
 /* G2P of the classic step h after the grid update (fluid_transfer.c). */
-int fluid_classic_transfer(mpm_module *m, const double *y, double h, const fluid_step_out *o);
+void fluid_classic_transfer(mpm_module *m, const double *y, double h, const fluid_step_out *o);
 
 /* Seed every [gas.NAME] region into the (empty) particle set (fluid_seed.c). */
 int fluid_seed(mpm_module *m, const mpm_config *cfg);
 
-/* Refresh the output fields rho, p, mach, T, s from the particle data. */
+/* Refresh the output fields rho, p, mach, T, s from the particle data (before output). */
 void fluid_output_fields(mpm_module *m);
 
 #endif

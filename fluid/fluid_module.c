@@ -169,14 +169,15 @@ static void energy_rate(mpm_module *m, const double *L, const double *heat, doub
   const mpm_lidx n = p->n;
   const double *mass = mpm_particles_comp(p, fc->lay.f_m, 0);
   double *pw = fc->power;
-  if (heat)
-    for (mpm_lidx i = 0; i < n; ++i) pw[i] = heat[i] / h;
-  else
-    memset(pw, 0, sizeof *pw * (size_t)n);
+  memset(pw, 0, sizeof *pw * (size_t)n);
   for (int k = 0; k < p->dim * p->dim; ++k) {
     const double *s = fc->vsig + (size_t)k * n, *Lk = L + (size_t)k * n;
-    for (mpm_lidx i = 0; i < n; ++i) pw[i] += s[i] * Lk[i] / mass[i];
+    for (mpm_lidx i = 0; i < n; ++i) pw[i] += s[i] * Lk[i];
   }
+  if (heat)
+    for (mpm_lidx i = 0; i < n; ++i) pw[i] = pw[i] / mass[i] + heat[i] / h;
+  else
+    for (mpm_lidx i = 0; i < n; ++i) pw[i] /= mass[i];
 }
 
 /* The classic step's transfer into the arrays o points to, and the energy rate. */
@@ -184,7 +185,7 @@ static int classic_transfer(mpm_module *m, const double *y, double h, fluid_step
   fluid_content *fc = m->content;
   o->L = fc->scratch + (size_t)2 * m->grid->dim * m->particles->n;
   o->heat = fc->power;
-  MPM_CALL(fluid_classic_transfer(m, y, h, o));
+  fluid_classic_transfer(m, y, h, o);
   energy_rate(m, o->L, o->heat, h);
   return 0;
 }
@@ -296,6 +297,10 @@ static int fluid_post_step(mpm_module *m) {
     memcpy(mpm_particles_comp(p, fc->lay.f_divv, 0), mpm_particles_comp(p, fc->lay.f_pending, 0),
            sizeof(double) * count);
   }
+  return 0;
+}
+
+static int fluid_output(mpm_module *m) {
   fluid_output_fields(m);
   return 0;
 }
@@ -309,19 +314,20 @@ static double fluid_stable_dt(const mpm_module *m, const double *y) {
   const double *V0 = mpm_particles_comp(p, fc->lay.f_V0, 0);
   const double *divv = field(p, y, fc->lay.f_divv);
   const double *J = state(p, y, FLUID_J), *e = state(p, y, FLUID_E);
-  double dt = HUGE_VAL;
+  const int viscous = fc->gas.mu > 0.0;
+  double smax = 0.0; /* the fastest signal: dt = dx / smax */
   for (mpm_lidx i = 0; i < n; ++i) {
     double v2 = 0.0;
     for (int d = 0; d < p->dim; ++d) {
       const double v = state(p, y, FLUID_V)[(size_t)d * n + i];
       v2 += v * v;
     }
-    const double rho = mass[i] / (V0[i] * J[i]);
-    const double c = fluid_sound_speed(gamma, rho, fluid_pressure(gamma, rho, e[i]));
+    const double rho = viscous ? mass[i] / (V0[i] * J[i]) : 1.0; /* only viscosity needs it */
+    const double c = sqrt(gamma * (gamma - 1.0) * fabs(e[i]));   /* sqrt(gamma p / rho) */
     const double s = c + sqrt(v2) + fluid_viscous_speed(&fc->gas, rho, c, divv[i], dx);
-    dt = fmin(dt, dx / s);
+    if (s > smax) smax = s; /* (fmax is a call: its NaN rules block inlining) */
   }
-  return dt;
+  return smax > 0.0 ? dx / smax : HUGE_VAL;
 }
 
 static int fluid_check(const mpm_module *m, const double *y, mpm_fault *fault) {
@@ -379,6 +385,7 @@ static const mpm_module_ops fluid_ops = {
     .post_step = fluid_post_step,
     .destroy = fluid_destroy,
     .remap = fluid_remap,
+    .output = fluid_output,
 };
 
 /* ---- construction -------------------------------------------------------------------------- */

@@ -4,7 +4,8 @@
  * (dim*dim), the APIC affine velocity, when transfer.velocity = apic. Other fields: m (mass),
  * V0 (reference volume), divv (tr D of the last RHS evaluation), D (dim*dim, the strain rate of
  * the last RHS, only with viscosity), and the output fields rho, p, mach, T and s (density,
- * pressure, Mach number, temperature and specific entropy), refreshed after every step. */
+ * pressure, Mach number, temperature and specific entropy), refreshed before every snapshot
+ * and checkpoint. */
 #ifndef FLUID_MODULE_H
 #define FLUID_MODULE_H
 

@@ -1,6 +1,7 @@
-/* The gas output fields, derived from the state after each accepted step (and at seeding),
- * so that snapshots carry them without any work at output time: density, pressure, Mach
- * number |v| / c, temperature p / (rho R) and specific entropy c_v ln(p / rho^gamma). */
+/* The gas output fields, derived from the state just before a snapshot or checkpoint is
+ * written (the module's output op), so that steps between outputs do not pay for them:
+ * density, pressure, Mach number |v| / c, temperature p / (rho R) and specific entropy
+ * c_v ln(p / rho^gamma). */
 #include "fluid_eos.h"
 #include "fluid_internal.h"
 

@@ -209,6 +209,5 @@ int fluid_seed(mpm_module *m, const mpm_config *cfg) {
   for (int k = 0; s && k < count; ++k) state_free(&s[k]);
   free(s);
   free(sections);
-  if (!rc) fluid_output_fields(m);
   return rc ? mpm_trace(__FILE__, __LINE__, __func__, rc) : 0;
 }

@@ -25,7 +25,6 @@
  * their deposits into their images), so a closed box conserves total energy to roundoff. */
 #include "fluid_internal.h"
 
-#include "mpm_error.h"
 #include "mpm_kernels.h"
 
 #include <string.h>
@@ -50,20 +49,18 @@ static void apic_half_step(mpm_module *m, const double *y, double h, double *C) 
   for (size_t k = 0; k < (size_t)dim * dim * (size_t)n; ++k) C[k] += 0.5 * h * Ca[k];
 }
 
-/* Nodal |a|^2, |v^{n+1}|^2 and |v^n|^2 (those the transfer needs) at the particles. */
-static int read_scalars(mpm_module *m, const double *y, const double *const *vbar, double h,
-                        double **out) {
+/* The nodal scalars the heat shares need, |a|^2, |v^{n+1}|^2 and |v^n|^2 (FLIP needs the first,
+ * a PIC share or APIC the other two), set up for interpolation in the G2P pass a: out[j]
+ * receives scalar j at the particles. */
+static void nodal_scalars(mpm_module *m, const double *const *vbar, double h, double **out,
+                          mpm_g2p_args *a) {
   fluid_content *fc = m->content;
-  const mpm_particles *p = m->particles;
   const mpm_grid *g = m->grid;
   const mpm_grid_phase *ph = &g->phase[m->phase];
-  const int dim = p->dim, flip = !fc->tr.apic, pic = fc->tr.apic || fc->tr.pic > 0;
-  const double *s_i[MPM_KERNELS_MAX_SCALARS];
-  double *s_out[MPM_KERNELS_MAX_SCALARS];
-  int k = 0;
+  const int dim = g->dim, flip = !fc->tr.apic, pic = fc->tr.apic || fc->tr.pic > 0;
   for (int j = 0; j < 3; ++j) {
     if ((j == 0 && !flip) || (j > 0 && !pic)) continue;
-    double *s = fc->node + (size_t)(dim + k) * g->nnodes;
+    double *s = fc->node + (size_t)(dim + a->nscalar) * g->nnodes;
     const double half = j == 1 ? 0.5 * h : -0.5 * h; /* v^{n+1} or v^n from vbar */
     for (mpm_lidx l = 0; l < g->nnodes; ++l) {
       double sum = 0.0;
@@ -73,14 +70,9 @@ static int read_scalars(mpm_module *m, const double *y, const double *const *vba
       }
       s[l] = sum;
     }
-    s_i[k] = s;
-    s_out[k] = out[j];
-    ++k;
+    a->s_i[a->nscalar] = s;
+    a->s_out[a->nscalar++] = out[j];
   }
-  const double *x[MPM_MAX_DIM] = {NULL};
-  for (int d = 0; d < dim; ++d) x[d] = y + (size_t)(p->offset[FLUID_X] + d) * p->n;
-  mpm_kernels_get(dim)->g2p_scalars(g, p->n, x, fc->lp, k, s_i, s_out);
-  return 0;
 }
 
 /* The new velocity and the heat share of particle i (see the file comment). */
@@ -104,7 +96,7 @@ static double new_velocity(const fluid_content *fc, int dim, double h, const dou
   return heat;
 }
 
-int fluid_classic_transfer(mpm_module *m, const double *y, double h, const fluid_step_out *o) {
+void fluid_classic_transfer(mpm_module *m, const double *y, double h, const fluid_step_out *o) {
   fluid_content *fc = m->content;
   const mpm_particles *p = m->particles;
   const mpm_grid *g = m->grid;
@@ -126,11 +118,11 @@ int fluid_classic_transfer(mpm_module *m, const double *y, double h, const fluid
     a.v_out[d] = o->vhat[d];
     a.a_out[d] = ap[d];
   }
+  nodal_scalars(m, (const double *const *)vbar, h, sc, &a);
   mpm_kernels_get(dim)->g2p(g, &a);
   for (int d = 0; d < dim; ++d)
     for (mpm_lidx i = 0; i < n; ++i) o->vhat[d][i] += 0.5 * h * ap[d][i];
   if (o->C) apic_half_step(m, y, h, o->C);
-  MPM_CALL(read_scalars(m, y, (const double *const *)vbar, h, sc));
   for (mpm_lidx i = 0; i < n; ++i) {
     double v[MPM_MAX_DIM], acc[MPM_MAX_DIM], vh[MPM_MAX_DIM], vn[MPM_MAX_DIM];
     for (int d = 0; d < dim; ++d) {
@@ -140,5 +132,4 @@ int fluid_classic_transfer(mpm_module *m, const double *y, double h, const fluid
     o->heat[i] = new_velocity(fc, dim, h, v, acc, vh, sc, i, vn);
     for (int d = 0; d < dim; ++d) o->vnew[d][i] = vn[d];
   }
-  return 0;
 }

@@ -60,3 +60,5 @@ mpm_add_script_test(test_strong_shock_long SCRIPT verification/test_strong_shock
                     LABELS "verification;long" TIMEOUT 1800)
 mpm_add_script_test(test_gas_conservation SCRIPT verification/test_gas_conservation.py
                     LABELS verification TIMEOUT 600)
+mpm_add_script_test(test_gas_output SCRIPT verification/test_gas_output.py
+                    LABELS "verification;mpi" TIMEOUT 600)
