@@ -167,17 +167,14 @@ static void energy_rate(mpm_module *m, const double *L, const double *heat, doub
   fluid_content *fc = m->content;
   const mpm_particles *p = m->particles;
   const mpm_lidx n = p->n;
+  const int nk = p->dim * p->dim;
   const double *mass = mpm_particles_comp(p, fc->lay.f_m, 0);
-  double *pw = fc->power;
-  memset(pw, 0, sizeof *pw * (size_t)n);
-  for (int k = 0; k < p->dim * p->dim; ++k) {
-    const double *s = fc->vsig + (size_t)k * n, *Lk = L + (size_t)k * n;
-    for (mpm_lidx i = 0; i < n; ++i) pw[i] += s[i] * Lk[i];
+  double *pw = fc->power; /* heat may be this array: read each entry before writing it */
+  for (mpm_lidx i = 0; i < n; ++i) {
+    double work = 0.0;
+    for (int k = 0; k < nk; ++k) work += fc->vsig[(size_t)k * n + i] * L[(size_t)k * n + i];
+    pw[i] = work / mass[i] + (heat ? heat[i] / h : 0.0);
   }
-  if (heat)
-    for (mpm_lidx i = 0; i < n; ++i) pw[i] = pw[i] / mass[i] + heat[i] / h;
-  else
-    for (mpm_lidx i = 0; i < n; ++i) pw[i] /= mass[i];
 }
 
 /* The classic step's transfer into the arrays o points to, and the energy rate. */
