@@ -23,7 +23,8 @@ so the shock and the contact cross the rank boundary) vs 1: usl and musl take th
 steps, so every particle field must agree to 1e-12 relative (sums in another order); bs32's
 adaptive steps depend on the order of the global error-norm sum, and the artificial viscosity
 uses the strain rate of the previous accepted step, so a different step sequence changes the
-solution at first order in the step: the particles differ by about 3e-4 (velocity, relative),
+solution at first order in the step: the particles differ by about 3e-4 (velocity, relative;
+6e-4 over every field),
 and the check is on the measured result: L1 within 2 % and the shock within 0.1 cell.
 `long` adds 400 and 800 cells for every method and checks the acceptance for bs32; for usl
 and musl it checks L1 at 400 and the shock position, and prints their orders (see README:
@@ -116,14 +117,14 @@ for method in ("usl", "musl", "bs32"):
     if not np.array_equal(pa["id"], pb["id"]):
         check(False, f"{method} 2 ranks: particle ids differ from 1 rank")
         continue
-    diff = max(float(np.abs(pa[k] - pb[k]).max() / np.abs(pa[k]).max()) for k in ("x", "v", "J", "e"))
+    diff, _ = mt.worst_difference(pa, pb)
     if method == "bs32":
         dl1, dxs = abs(b[0] - a[0]) / a[0], abs(b[1] - a[1]) * 200
         check(dl1 <= 0.02 and dxs <= 0.1,
               f"bs32 2 ranks vs 1: L1 {b[0]:.4e} vs {a[0]:.4e} ({100 * dl1:.2f} %, <= 2 %), shock "
               f"{dxs:.3f} cells apart (<= 0.1); particles differ by {diff:.1e} (step sequence)")
     else:
-        check(diff <= 1e-12, f"{method} 2 ranks vs 1, by id: largest relative difference {diff:.1e} "
-              "(<= 1e-12)")
+        check(diff <= 1e-12, f"{method} 2 ranks vs 1, by id, every field: largest relative "
+              f"difference {diff:.1e} (<= 1e-12)")
 
 sys.exit(check.finish())
