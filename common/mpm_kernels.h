@@ -29,6 +29,8 @@ typedef struct mpm_p2g_args {
   double lp;                   /* GIMP particle half-width in cells */
 } mpm_p2g_args;
 
+#define MPM_KERNELS_MAX_SCALARS 4
+
 typedef struct mpm_g2p_args {
   mpm_lidx n;
   const double *x[MPM_MAX_DIM];
@@ -47,6 +49,11 @@ typedef struct mpm_g2p_args {
    * from L in registers (L_out may stay NULL). The rate of a deformation gradient. */
   const double *F;
   double *LF_out;
+  /* nscalar <= MPM_KERNELS_MAX_SCALARS nodal scalars to interpolate in the same pass:
+   * s_out[j][p] = sum_i S_ip s_i[j][i] (e.g. a nodal power for an energy balance). */
+  int nscalar;
+  const double *s_i[MPM_KERNELS_MAX_SCALARS];
+  double *s_out[MPM_KERNELS_MAX_SCALARS];
 } mpm_g2p_args;
 
 typedef struct mpm_kernels {

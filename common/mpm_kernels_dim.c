@@ -205,6 +205,7 @@ MPM_INLINE void DIMFN(g2p_loop)(const DIMFN(lattice) * L, const mpm_g2p_args *a,
   }
   for (size_t p = 0; p < n; ++p) {
     double x[D], v[D] = {0}, acc[D] = {0}, Lg[D][D] = {{0}}, B[D][D] = {{0}};
+    double sc[MPM_KERNELS_MAX_SCALARS] = {0};
     for (int d = 0; d < D; ++d) x[d] = xp[d][p];
     DIMFN(weights) s;
     DIMFN(weights_eval)(L, kind, x, apic_b, &s);
@@ -236,6 +237,11 @@ MPM_INLINE void DIMFN(g2p_loop)(const DIMFN(lattice) * L, const mpm_g2p_args *a,
             if (apic_b) sr[d] += wrx[i] * vn;
           }
         const double wyz = wy[j] * wz, dwyz = dwy[j] * wz;
+        for (int q = 0; q < a->nscalar; ++q) { /* extra nodal scalars (rare: a runtime count) */
+          double ss = 0.0;
+          for (int i = 0; i < S; ++i) ss += wx[i] * a->s_i[q][row + i];
+          sc[q] += wyz * ss;
+        }
         for (int d = 0; d < D; ++d) {
           v[d] += wyz * sv[d];
           acc[d] += wyz * sa[d];
@@ -255,6 +261,7 @@ MPM_INLINE void DIMFN(g2p_loop)(const DIMFN(lattice) * L, const mpm_g2p_args *a,
       }
     }
     for (int d = 0; d < D; ++d) vout[d][p] = v[d], aout[d][p] = acc[d];
+    for (int q = 0; q < a->nscalar; ++q) a->s_out[q][p] = sc[q];
     if (Lout)
       for (int r = 0; r < D; ++r)
         for (int c = 0; c < D; ++c) Lout[(size_t)(r * D + c) * n + p] = Lg[r][c];

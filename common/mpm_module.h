@@ -48,6 +48,9 @@ typedef struct mpm_module_ops {
    * the nodal velocities (no force, no damping: the force acted in the first pass) before
    * g2p. Optional: NULL if the module has no MUSL. */
   int (*remap)(mpm_module *m, double t, const double *y, double h);
+  /* Refresh fields derived for output only (a gas's pressure, Mach number, ...) before a
+   * snapshot or checkpoint is written. Optional. */
+  int (*output)(mpm_module *m);
 } mpm_module_ops;
 
 struct mpm_module {

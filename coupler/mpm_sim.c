@@ -8,6 +8,7 @@
 #include "mpm_integrator.h"
 #include "mpm_output.h"
 #include "mpm_timer.h"
+#include "fluid_module.h"
 #include "solid_module.h"
 
 #include <math.h>
@@ -87,6 +88,7 @@ int mpm_sim_add_schema(mpm_config *cfg) {
   MPM_CALL(mpm_config_add_schema(cfg, mpm_geometry_keys, mpm_geometry_nkeys));
   MPM_CALL(mpm_config_add_schema(cfg, mpm_bc_keys, mpm_bc_nkeys));
   MPM_CALL(solid_add_schema(cfg));
+  MPM_CALL(fluid_add_schema(cfg));
   return 0;
 }
 
@@ -163,12 +165,15 @@ static int read_run_settings(mpm_sim *s) {
 }
 
 static int build_modules(mpm_sim *s, int seed) {
-  mpm_module *solid = NULL;
+  mpm_module *solid = NULL, *fluid = NULL;
   MPM_CALL(solid_module_create(&solid, s->cfg, s->grid, seed));
   if (solid) s->mod[s->nmod++] = solid;
+  MPM_CALL(fluid_module_create(&fluid, s->cfg, s->grid, seed));
+  if (fluid) s->mod[s->nmod++] = fluid;
   if (s->nmod == 0)
     return mpm_config_fail(s->cfg, "solid",
-                           "the case defines no bodies: add a [solid.NAME] section");
+                           "the case defines neither bodies nor gas: add a [solid.NAME] or a "
+                           "[gas.NAME] section");
   return 0;
 }
 
@@ -255,8 +260,16 @@ void mpm_sim_destroy(mpm_sim **sp) {
 
 /* ---- the step loop --------------------------------------------------------------------- */
 
+/* Derived output fields are refreshed only when they are written. */
+static int prepare_output(mpm_sim *s) {
+  for (int k = 0; k < s->nmod; ++k)
+    if (s->mod[k]->ops->output) MPM_CALL(s->mod[k]->ops->output(s->mod[k]));
+  return 0;
+}
+
 static int write_snapshot(mpm_sim *s) {
   const mpm_particles *p[SIM_MAX_MODULES];
+  MPM_CALL(prepare_output(s));
   const char *names[SIM_MAX_MODULES];
   for (int k = 0; k < s->nmod; ++k) p[k] = s->mod[k]->particles, names[k] = s->mod[k]->name;
   mpm_timer_start(MPM_T_IO);
@@ -268,6 +281,7 @@ static int write_snapshot(mpm_sim *s) {
 
 static int write_checkpoint(mpm_sim *s, const char *path) {
   const mpm_particles *p[SIM_MAX_MODULES];
+  MPM_CALL(prepare_output(s));
   const char *names[SIM_MAX_MODULES];
   for (int k = 0; k < s->nmod; ++k) p[k] = s->mod[k]->particles, names[k] = s->mod[k]->name;
   const char *attr[] = {"t", "step", "h_next"};

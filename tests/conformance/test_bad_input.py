@@ -79,6 +79,43 @@ for name, old, new, key, words in CASES:
         line = line_of(text, "geometry = block")
     expect_error(name, text, key, words, line)
 
+# Gas keys, on the valid cases/sod.ini (same form: one error with file:line and key, exit 2).
+GAS = open(mt.case("sod.ini")).read()
+GAS_CASES = [
+    ("gamma not above 1", "\ngamma = 1.4", "\ngamma = 1.0", "fluid.gamma", "> 1"),
+    ("negative gas density", "density = 0.125", "density = -0.125", "gas.right.density", "> 0"),
+    ("zero gas pressure", "pressure = 0.1", "pressure = 0", "gas.right.pressure", "> 0"),
+    ("negative artificial viscosity", "\ngamma = 1.4", "\ngamma = 1.4\nav_linear = -0.5",
+     "fluid.av_linear", ">= 0"),
+    ("unknown fluid key", "\ngamma = 1.4", "\ngamma = 1.4\ngama = 1.3", "fluid.gama",
+     "fluid.gamma"),
+    ("unknown gas key", "pressure = 0.1", "pressure = 0.1\npresure = 0.2", "gas.right.presure",
+     "gas.right.pressure"),
+    ("density and density_field", "density = 0.125", "density = 0.125\ndensity_field = 0.125",
+     "gas.right.density_field", "not both"),
+    ("density field not positive", "density = 0.125", "density_field = x - 0.75",
+     "gas.right.density_field", "must be positive"),
+    ("gas region outside the domain", "lo = 0.5 0\nhi = 1 0.0075", "lo = 0.5 0\nhi = 1.5 0.0075",
+     "gas.right.geometry",
+     "outside the domain"),
+    ("APIC with an ERK pair", "pressure = 0.1", "pressure = 0.1\n\n[transfer]\nvelocity = apic",
+     "transfer.velocity", "classic update"),
+]
+for name, old, new, key, words in GAS_CASES:
+    assert old in GAS, old
+    text = GAS.replace(old, new, 1) if old != "pressure = 0.1" or "[transfer]" not in new else \
+        GAS.rstrip("\n").rsplit(old, 1)[0] + new + "\n"
+    line = line_of(text, new.splitlines()[-1])
+    if name == "gas region outside the domain":
+        line = line_of(text, "geometry = right")
+    expect_error(name, text, key, words, line)
+# A gas section without its density (reported within the section), and a scene with neither
+# bodies nor gas (naming the sections to add).
+expect_error("gas without density", GAS.replace("density = 0.125\n", ""), "gas.right.density",
+             "density_field", None)
+expect_error("empty scene", GAS[:GAS.index("[gas.left]")], None, "add a [solid.NAME] or a "
+             "[gas.NAME] section", None)
+
 # Overrides on the command line are named as such.
 expect_error("bad override", BASE, "grid.dx", "command line", None, ["grid.dx=-1"])
 expect_error("malformed override", BASE, None, "command line", None, ["grid.dx"])

@@ -2,3 +2,6 @@
 # 2-D and 3-D (one rank: the grid needs MPI).
 mpm_add_test(test_kernels_apic SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/unit/test_kernels_apic.c
              LABELS unit RANKS 1)
+# G2P of nodal scalars with the velocity (the gas energy balance), every shape, 2-D and 3-D.
+mpm_add_test(test_kernels_scalars SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/unit/test_kernels_scalars.c
+             LABELS unit RANKS 1)

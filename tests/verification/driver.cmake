@@ -50,3 +50,24 @@ mpm_add_script_test(test_cantilever3d SCRIPT verification/test_cantilever3d.py
                     LABELS "verification;mpi" TIMEOUT 600)
 mpm_add_script_test(test_cantilever3d_long SCRIPT verification/test_cantilever3d.py ARGS long
                     LABELS "verification;long" TIMEOUT 1800)
+mpm_add_script_test(test_sod SCRIPT verification/test_sod.py LABELS "verification;mpi"
+                    TIMEOUT 600)
+mpm_add_script_test(test_sod_long SCRIPT verification/test_sod.py ARGS long
+                    LABELS "verification;long" TIMEOUT 1800)
+mpm_add_script_test(test_strong_shock SCRIPT verification/test_strong_shock.py
+                    LABELS verification TIMEOUT 600)
+mpm_add_script_test(test_strong_shock_long SCRIPT verification/test_strong_shock.py ARGS long
+                    LABELS "verification;long" TIMEOUT 1800)
+mpm_add_script_test(test_gas_conservation SCRIPT verification/test_gas_conservation.py
+                    LABELS verification TIMEOUT 600)
+mpm_add_script_test(test_gas_output SCRIPT verification/test_gas_output.py
+                    LABELS "verification;mpi" TIMEOUT 600)
+mpm_add_script_test(test_gas_shear SCRIPT verification/test_gas_shear.py LABELS verification
+                    TIMEOUT 600)
+# The inviscid shear wave at 64 cells goes unstable under FLIP (usl, musl, bs32: kinetic energy
+# x1e6 by t = 1, onset t = 0.43; Brackbill's ringing instability once the particle columns have
+# slid a quarter cell past each other). APIC is stable; particle regularisation should fix FLIP.
+# Kept honest as an expected failure; see the test's header for the figures.
+mpm_add_script_test(test_gas_shear_long SCRIPT verification/test_gas_shear.py ARGS long
+                    LABELS "verification;long" TIMEOUT 1800)
+set_tests_properties(test_gas_shear_long PROPERTIES WILL_FAIL TRUE)

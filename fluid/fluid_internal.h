@@ -1,0 +1,60 @@
+/* What the fluid module's files share: the module content and the field layout. Private to
+ * fluid/. */
+#ifndef FLUID_INTERNAL_H
+#define FLUID_INTERNAL_H
+
+#include "fluid_stress.h"
+
+#include "mpm_bc.h"
+#include "mpm_config.h"
+#include "mpm_module.h"
+#include "mpm_transfer.h"
+
+/* The state fields x, v, J, e are fields 0-3; C follows when APIC is on. */
+enum { FLUID_X, FLUID_V, FLUID_J, FLUID_E };
+
+typedef struct fluid_layout {
+  int f_C, f_m, f_V0, f_divv, f_D;  /* field indices; -1 if absent */
+  int f_pending;                    /* method of lines: this RHS's tr D (and D) */
+  int f_rho, f_p, f_mach, f_T, f_s; /* output fields */
+} fluid_layout;
+
+typedef struct fluid_content {
+  fluid_gas gas;
+  double R; /* specific gas constant, J/(kg K) */
+  int ppc;
+  double lp; /* GIMP half-width in cells */
+  fluid_layout lay;
+  mpm_transfer tr;
+  double gravity[MPM_MAX_DIM];
+  mpm_node_constraints cons; /* wall nodes */
+  int remapped;              /* the phase holds MUSL's second deposit */
+  mpm_lidx cap;              /* capacity of the particle scratch arrays */
+  double *vsig;              /* V sigma deposited by this RHS (dim^2 cap) */
+  double *scratch;           /* G2P output v, a, L ((2 dim + dim^2) cap) */
+  double *vnew;              /* MUSL: the particles' new velocities (dim cap) */
+  double *Cnew;              /* MUSL with APIC: their new affine velocities (dim^2 cap) */
+  double *power;             /* de/dt of each particle (cap) */
+  double *tscratch; /* the classic transfer's a_p, scalars and APIC terms (see ensure_scratch) */
+  double *node;     /* nodal scratch: time-centred velocity and scalars ((dim + 3) nnodes) */
+} fluid_content;
+
+/* What the classic step's transfer gives each particle (component-major, stride n). */
+typedef struct fluid_step_out {
+  double *vhat[MPM_MAX_DIM]; /* sum S v_i^{n+1} (the velocity that moves it) */
+  double *vnew[MPM_MAX_DIM]; /* its new velocity (FLIP/PIC blend or APIC) */
+  double *C;                 /* APIC: its new affine velocity (dim^2), else NULL */
+  double *L;                 /* gradient of the time-centred nodal velocity (dim^2) */
+  double *heat; /* its share of the transfer's energy defect, J/kg (fluid_transfer.c) */
+} fluid_step_out;
+
+/* G2P of the classic step h after the grid update (fluid_transfer.c). */
+void fluid_classic_transfer(mpm_module *m, const double *y, double h, const fluid_step_out *o);
+
+/* Seed every [gas.NAME] region into the (empty) particle set (fluid_seed.c). */
+int fluid_seed(mpm_module *m, const mpm_config *cfg);
+
+/* Refresh the output fields rho, p, mach, T, s from the particle data (before output). */
+void fluid_output_fields(mpm_module *m);
+
+#endif

@@ -1,0 +1,477 @@
+/* Fluid module: the phases of an MPM right-hand side for a compressible ideal gas, its case
+ * keys and its construction.
+ *
+ * Per particle: dx/dt = sum S v_i, dv/dt = sum S a_i (or the FLIP/PIC/APIC update of the
+ * classic step), dJ/dt = J tr L, de/dt = grid power per unit mass (below). The stress
+ * deposited at P2G is the ideal-gas pressure plus the viscous and artificial viscous terms
+ * of the strain rate D of the previous RHS evaluation, stored in the fields divv and D: in the
+ * classic update that is the previous step's rate, i.e. the stress is updated last, as in
+ * USL; the ERK pairs see the rate of the previous stage.
+ *
+ * Energy. Each particle's internal energy takes the work its stress does on the grid,
+ * (V sigma : L) / m per unit mass, with L the gradient of the same nodal velocity that moves
+ * the particles. Summed over the particles that is minus the power of the internal nodal
+ * forces, sum_i f_i . v_i. In the method-of-lines RHS the particles' kinetic energy gains
+ * exactly sum_i f_i . v_i (sum_p m_p v_p . sum_i S a_i = sum_i a_i . (m v)_i), so the semi-
+ * discrete system conserves mass, momentum and total energy, with or without walls (a wall
+ * node has no normal velocity and no normal acceleration; mirrored pad nodes fold back
+ * symmetrically). The classic update replaces v by v_new over the step h; its kinetic energy
+ * then changes by m (|v_new|^2 - |v|^2) / 2, which the grid work does not match: the
+ * transfer loses (PIC, APIC) or moves (FLIP) energy. Each particle therefore also takes
+ *   h sum_i S_ip (a_i . v_i^{n+1}) - (|v_new|^2 - |v|^2) / 2,
+ * whose sum over the particles (weighted by m_p) closes the budget exactly: total energy is
+ * conserved to roundoff by usl and musl with any transfer, and the kinetic energy the
+ * transfer removes becomes heat in the particles it was taken from. */
+#include "fluid_module.h"
+
+#include "fluid_eos.h"
+#include "fluid_internal.h"
+
+#include "mpm_error.h"
+#include "mpm_kernels.h"
+#include "mpm_timer.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static const mpm_key_spec fluid_keys[] = {
+    {"fluid.gamma", MPM_KEY_REAL, "1.4", 1, HUGE_VAL, 1, 0, NULL,
+     "ratio of specific heats c_p / c_v of the ideal gas, > 1 (air: 1.4)", 0},
+    {"fluid.R", MPM_KEY_REAL, "287.05", 0, HUGE_VAL, 1, 0, NULL,
+     "specific gas constant, J/(kg K), for the temperature and entropy output (air: 287.05)", 0},
+    {"fluid.viscosity", MPM_KEY_REAL, "0", 0, HUGE_VAL, 0, 0, NULL,
+     "dynamic viscosity mu, Pa s (0: inviscid; air: 1.8e-5)", 0},
+    {"fluid.av_linear", MPM_KEY_REAL, "0.5", 0, HUGE_VAL, 0, 0, NULL,
+     "linear artificial viscosity coefficient c_lin: q = rho l |tr D| (c_lin c + c_quad l "
+     "|tr D|) in compression, l = grid.dx",
+     0},
+    {"fluid.av_quadratic", MPM_KEY_REAL, "2", 0, HUGE_VAL, 0, 0, NULL,
+     "quadratic artificial viscosity coefficient c_quad (see av_linear)", 0},
+    {"fluid.ppc", MPM_KEY_INT, "2", 1, 8, 0, 0, NULL,
+     "gas particles per cell per direction at seeding", 0},
+    {"gas.*.geometry", MPM_KEY_STRING, NULL, 0, 0, 0, 0, NULL,
+     "name of the [geometry.NAME] region the gas fills (where regions overlap, the first "
+     "[gas] section in the file wins)",
+     0},
+    {"gas.*.density", MPM_KEY_REAL, NULL, 0, HUGE_VAL, 1, 0, NULL,
+     "initial density, kg/m^3 (or density_field)", 1},
+    {"gas.*.pressure", MPM_KEY_REAL, NULL, 0, HUGE_VAL, 1, 0, NULL,
+     "initial pressure, Pa (or pressure_field)", 1},
+    {"gas.*.velocity", MPM_KEY_REALS, "0 0 0", -HUGE_VAL, HUGE_VAL, 0, 3, NULL,
+     "initial velocity, m/s (dim values; extra values are ignored)", 0},
+    {"gas.*.density_field", MPM_KEY_STRING, NULL, 0, 0, 0, 0, NULL,
+     "initial density as an expression in x, y, z (e.g. 1 + 0.1*exp(-x^2/0.01)), instead of "
+     "density",
+     1},
+    {"gas.*.pressure_field", MPM_KEY_STRING, NULL, 0, 0, 0, 0, NULL,
+     "initial pressure as an expression in x, y, z, instead of pressure", 1},
+    {"gas.*.velocity_field", MPM_KEY_STRING, NULL, 0, 0, 0, 0, NULL,
+     "initial velocity as expressions in x, y, z, one per component separated by ';', "
+     "instead of velocity",
+     1},
+};
+
+int fluid_add_schema(mpm_config *cfg) {
+  return mpm_config_add_schema(cfg, fluid_keys, (int)(sizeof fluid_keys / sizeof fluid_keys[0]));
+}
+
+/* ---- helpers ----------------------------------------------------------------------------- */
+
+static const double *state(const mpm_particles *p, const double *y, int f) {
+  return y + (size_t)p->offset[f] * p->n;
+}
+
+/* Field f from the state y if it is a state field, else from the particle data. */
+static double *field(const mpm_particles *p, const double *y, int f) {
+  return (f < p->nstate_fields ? (double *)y : p->data) + (size_t)p->offset[f] * p->n;
+}
+
+/* Grow the particle scratch arrays to the current count. tscratch holds the classic
+ * transfer's a_p (dim), three interpolated scalars, and with APIC C(a) (dim^2) and two
+ * discarded G2P outputs (2 dim). */
+static int ensure_scratch(mpm_module *m) {
+  fluid_content *fc = m->content;
+  const mpm_lidx n = m->particles->n;
+  const int dim = m->grid->dim;
+  if (n <= fc->cap && fc->vsig) return 0;
+  free(fc->vsig), free(fc->scratch), free(fc->vnew), free(fc->Cnew), free(fc->power);
+  free(fc->tscratch);
+  fc->vnew = fc->Cnew = fc->tscratch = NULL;
+  fc->cap = n + n / 4 + 16;
+  MPM_ALLOC(fc->vsig, (size_t)dim * dim * fc->cap);
+  MPM_ALLOC(fc->scratch, (size_t)(2 * dim + dim * dim) * fc->cap);
+  MPM_ALLOC(fc->power, fc->cap);
+  if (fc->tr.classic)
+    MPM_ALLOC(fc->tscratch, (size_t)(dim + 3 + (fc->tr.apic ? dim * dim + 2 * dim : 0)) * fc->cap);
+  if (fc->tr.musl) MPM_ALLOC(fc->vnew, (size_t)dim * fc->cap);
+  if (fc->tr.musl && fc->tr.apic) MPM_ALLOC(fc->Cnew, (size_t)dim * dim * fc->cap);
+  return 0;
+}
+
+/* ---- the RHS phases ------------------------------------------------------------------------ */
+
+static int fluid_p2g(mpm_module *m, double t, const double *y) {
+  (void)t;
+  fluid_content *fc = m->content;
+  const mpm_particles *p = m->particles;
+  const int dim = p->dim;
+  const mpm_lidx n = p->n;
+  MPM_CALL(ensure_scratch(m));
+  mpm_timer_start(MPM_T_STRESS);
+  const fluid_batch b = {.dim = dim,
+                         .n = n,
+                         .m = mpm_particles_comp(p, fc->lay.f_m, 0),
+                         .V0 = mpm_particles_comp(p, fc->lay.f_V0, 0),
+                         .J = state(p, y, FLUID_J),
+                         .e = state(p, y, FLUID_E),
+                         .divv = field(p, y, fc->lay.f_divv),
+                         .D = fc->lay.f_D >= 0 ? field(p, y, fc->lay.f_D) : NULL,
+                         .vsig = fc->vsig};
+  fluid_stress(&fc->gas, &b);
+  mpm_timer_stop(MPM_T_STRESS);
+
+  mpm_timer_start(MPM_T_P2G);
+  mpm_p2g_args a = {.n = n,
+                    .m = b.m,
+                    .vsig = fc->vsig,
+                    .C = fc->tr.apic ? state(p, y, fc->lay.f_C) : NULL,
+                    .lp = fc->lp};
+  for (int d = 0; d < dim; ++d) {
+    a.x[d] = state(p, y, FLUID_X) + (size_t)d * n;
+    a.v[d] = state(p, y, FLUID_V) + (size_t)d * n;
+    a.gravity[d] = fc->gravity[d];
+  }
+  mpm_kernels_get(dim)->p2g(m->grid, m->phase, &a);
+  mpm_timer_stop(MPM_T_P2G);
+  return 0;
+}
+
+/* After MUSL's second deposit the phase holds mass and momentum only: the update turns them
+ * into velocities (h = 0; the force acted in the first pass). */
+static int fluid_grid_update(mpm_module *m, double t, double h) {
+  (void)t;
+  fluid_content *fc = m->content;
+  const int second = fc->remapped;
+  fc->remapped = 0;
+  mpm_constraints_fold(&fc->cons, m->grid, m->phase);
+  MPM_CALL(mpm_grid_phase_update(m->grid, m->phase, second ? 0.0 : h));
+  mpm_constraints_apply(&fc->cons, m->grid, m->phase);
+  return 0;
+}
+
+/* de/dt = (V sigma : L) / m + heat / h: the work of the stress on the grid per unit mass, and
+ * in the classic step the particle's share of the transfer's energy defect (fluid_transfer.c). */
+static void energy_rate(mpm_module *m, const double *L, const double *heat, double h) {
+  fluid_content *fc = m->content;
+  const mpm_particles *p = m->particles;
+  const mpm_lidx n = p->n;
+  const int nk = p->dim * p->dim;
+  const double *mass = mpm_particles_comp(p, fc->lay.f_m, 0);
+  double *pw = fc->power; /* heat may be this array: read each entry before writing it */
+  for (mpm_lidx i = 0; i < n; ++i) {
+    double work = 0.0;
+    for (int k = 0; k < nk; ++k) work += fc->vsig[(size_t)k * n + i] * L[(size_t)k * n + i];
+    pw[i] = work / mass[i] + (heat ? heat[i] / h : 0.0);
+  }
+}
+
+/* The classic step's transfer into the arrays o points to, and the energy rate. */
+static int classic_transfer(mpm_module *m, const double *y, double h, fluid_step_out *o) {
+  fluid_content *fc = m->content;
+  o->L = fc->scratch + (size_t)2 * m->grid->dim * m->particles->n;
+  o->heat = fc->power;
+  fluid_classic_transfer(m, y, h, o);
+  energy_rate(m, o->L, o->heat, h);
+  return 0;
+}
+
+/* MUSL's second transfer (Sulsky, Zhou and Schreyer 1995): the particles take their new
+ * velocities (and APIC affine velocities) from the first grid update and deposit mass and
+ * momentum again; positions and J then move with the nodal velocities of that deposit. The
+ * energy rate is set here, from the first pass, whose nodal velocities the deposit replaces. */
+static int fluid_remap(mpm_module *m, double t, const double *y, double h) {
+  (void)t;
+  fluid_content *fc = m->content;
+  const mpm_particles *p = m->particles;
+  const int dim = p->dim;
+  const mpm_lidx n = p->n;
+  fluid_step_out o = {.C = fc->Cnew};
+  for (int d = 0; d < dim; ++d)
+    o.vhat[d] = fc->scratch + (size_t)d * n, o.vnew[d] = fc->vnew + (size_t)d * n;
+  MPM_CALL(classic_transfer(m, y, h, &o));
+  mpm_grid_phase_zero(m->grid, m->phase);
+  mpm_p2g_args a = {
+      .n = n, .m = mpm_particles_comp(p, fc->lay.f_m, 0), .C = fc->Cnew, .lp = fc->lp};
+  for (int d = 0; d < dim; ++d) {
+    a.x[d] = state(p, y, FLUID_X) + (size_t)d * n;
+    a.v[d] = o.vnew[d];
+  }
+  mpm_kernels_get(dim)->p2g(m->grid, m->phase, &a);
+  fc->remapped = 1;
+  return 0;
+}
+
+/* A replaced state field as a rate over the step: out = (out - y) / h, or (src - y) / h. */
+static void as_rate(double *out, const double *src, const double *y, size_t count, double h) {
+  for (size_t k = 0; k < count; ++k) out[k] = ((src ? src[k] : out[k]) - y[k]) / h;
+}
+
+/* dJ/dt = J tr L. The strain rate is kept for the next stress evaluation and stable step:
+ * in the classic update as the state's rate (new - old) / h; in the method-of-lines RHS in the
+ * field `pending`, which fluid_post_step commits after an accepted step (the RHS must not
+ * change what it reads: ARKODE also probes it at trial states). */
+static void volume_rate(mpm_module *m, const double *y, double *ydot, const double *L, double h) {
+  const fluid_content *fc = m->content;
+  const mpm_particles *p = m->particles;
+  const int dim = p->dim;
+  const mpm_lidx n = p->n;
+  const int in_state = fc->lay.f_pending < 0;
+  const double *J = state(p, y, FLUID_J);
+  double *Jdot = ydot + (size_t)p->offset[FLUID_J] * n;
+  double *tr = in_state ? fc->scratch : mpm_particles_comp(p, fc->lay.f_pending, 0);
+  for (mpm_lidx i = 0; i < n; ++i) tr[i] = L[i];
+  for (int d = 1; d < dim; ++d)
+    for (mpm_lidx i = 0; i < n; ++i) tr[i] += L[(size_t)(d * dim + d) * n + i];
+  for (mpm_lidx i = 0; i < n; ++i) Jdot[i] = J[i] * tr[i];
+  if (in_state)
+    as_rate(ydot + (size_t)p->offset[fc->lay.f_divv] * n, tr, field(p, y, fc->lay.f_divv), n, h);
+  if (fc->lay.f_D < 0) return;
+  double *D = in_state ? ydot + (size_t)p->offset[fc->lay.f_D] * n : tr + n;
+  for (int r = 0; r < dim; ++r)
+    for (int c = 0; c < dim; ++c)
+      for (mpm_lidx i = 0; i < n; ++i)
+        D[(size_t)(r * dim + c) * n + i] =
+            0.5 * (L[(size_t)(r * dim + c) * n + i] + L[(size_t)(c * dim + r) * n + i]);
+  if (in_state) as_rate(D, NULL, field(p, y, fc->lay.f_D), (size_t)dim * dim * n, h);
+}
+
+/* Three forms of G2P: the method-of-lines RHS (h = 0): dx/dt = sum S v_i, dv/dt = sum S a_i;
+ * the classic USL step: the transfer of fluid_transfer.c as rates over h; MUSL after its
+ * second deposit: positions and J move with the new nodal velocities, v, C and e take what
+ * fluid_remap computed. */
+static int fluid_g2p(mpm_module *m, double t, const double *y, double *ydot, double h) {
+  (void)t;
+  fluid_content *fc = m->content;
+  const mpm_particles *p = m->particles;
+  const int dim = p->dim;
+  const mpm_lidx n = p->n;
+  double *L = fc->scratch + (size_t)2 * dim * n;
+  double *xdot[MPM_MAX_DIM] = {NULL}, *vdot[MPM_MAX_DIM] = {NULL}, *a_p[MPM_MAX_DIM] = {NULL};
+  for (int d = 0; d < dim; ++d) {
+    xdot[d] = ydot + (size_t)(p->offset[FLUID_X] + d) * n;
+    vdot[d] = ydot + (size_t)(p->offset[FLUID_V] + d) * n;
+    a_p[d] = fc->scratch + (size_t)(dim + d) * n;
+  }
+  const size_t nv = (size_t)dim * n, nC = (size_t)dim * dim * n;
+  double *Cdot = fc->tr.apic ? ydot + (size_t)p->offset[fc->lay.f_C] * n : NULL;
+  const double *v = state(p, y, FLUID_V), *C = fc->tr.apic ? state(p, y, fc->lay.f_C) : NULL;
+  if (!(h > 0)) {
+    mpm_transfer_g2p(m->grid, m->phase, p, y, fc->lp, xdot, vdot, L, NULL);
+    energy_rate(m, L, NULL, h);
+  } else if (!fc->tr.musl) {
+    fluid_step_out o = {.C = Cdot};
+    for (int d = 0; d < dim; ++d) o.vhat[d] = xdot[d], o.vnew[d] = vdot[d];
+    MPM_CALL(classic_transfer(m, y, h, &o));
+    as_rate(vdot[0], NULL, v, nv, h);
+    if (Cdot) as_rate(Cdot, NULL, C, nC, h);
+  } else {
+    mpm_transfer_g2p(m->grid, m->phase, p, y, fc->lp, xdot, a_p, L, NULL);
+    as_rate(vdot[0], fc->vnew, v, nv, h);
+    if (Cdot) as_rate(Cdot, fc->Cnew, C, nC, h);
+  }
+  volume_rate(m, y, ydot, L, h);
+  memcpy(ydot + (size_t)p->offset[FLUID_E] * n, fc->power, sizeof(double) * (size_t)n);
+  return 0;
+}
+
+static int fluid_post_step(mpm_module *m) {
+  const fluid_content *fc = m->content;
+  const mpm_particles *p = m->particles;
+  if (fc->lay.f_pending >= 0) { /* divv and D follow pending in the particle data */
+    const size_t count = (size_t)p->n * (1 + (fc->lay.f_D >= 0 ? p->dim * p->dim : 0));
+    memcpy(mpm_particles_comp(p, fc->lay.f_divv, 0), mpm_particles_comp(p, fc->lay.f_pending, 0),
+           sizeof(double) * count);
+  }
+  return 0;
+}
+
+static int fluid_output(mpm_module *m) {
+  fluid_output_fields(m);
+  return 0;
+}
+
+static double fluid_stable_dt(const mpm_module *m, const double *y) {
+  const fluid_content *fc = m->content;
+  const mpm_particles *p = m->particles;
+  const mpm_lidx n = p->n;
+  const double dx = m->grid->dx, gamma = fc->gas.gamma;
+  const double *mass = mpm_particles_comp(p, fc->lay.f_m, 0);
+  const double *V0 = mpm_particles_comp(p, fc->lay.f_V0, 0);
+  const double *divv = field(p, y, fc->lay.f_divv);
+  const double *J = state(p, y, FLUID_J), *e = state(p, y, FLUID_E);
+  const int viscous = fc->gas.mu > 0.0;
+  double smax = 0.0; /* the fastest signal: dt = dx / smax */
+  for (mpm_lidx i = 0; i < n; ++i) {
+    double v2 = 0.0;
+    for (int d = 0; d < p->dim; ++d) {
+      const double v = state(p, y, FLUID_V)[(size_t)d * n + i];
+      v2 += v * v;
+    }
+    const double rho = viscous ? mass[i] / (V0[i] * J[i]) : 1.0; /* only viscosity needs it */
+    const double c = sqrt(gamma * (gamma - 1.0) * fabs(e[i]));   /* sqrt(gamma p / rho) */
+    const double s = c + sqrt(v2) + fluid_viscous_speed(&fc->gas, rho, c, divv[i], dx);
+    if (s > smax) smax = s; /* (fmax is a call: its NaN rules block inlining) */
+  }
+  return smax > 0.0 ? dx / smax : HUGE_VAL;
+}
+
+static int fluid_check(const mpm_module *m, const double *y, mpm_fault *fault) {
+  if (mpm_module_check_positions(m, y, fault)) return 1;
+  const mpm_particles *p = m->particles;
+  const double *J = state(p, y, FLUID_J), *e = state(p, y, FLUID_E);
+  for (mpm_lidx i = 0; i < p->n; ++i) {
+    if (J[i] <= 0.0)
+      return mpm_fault_at(fault, p, y, i, "the gas volume collapsed (J = %.3g <= 0)", J[i]);
+    if (e[i] <= 0.0)
+      return mpm_fault_at(fault, p, y, i,
+                          "the gas internal energy is not positive (e = %.3g J/kg, so p <= 0)",
+                          e[i]);
+  }
+  return 0;
+}
+
+static void fluid_sums(const mpm_module *m, mpm_module_sums *s) {
+  const fluid_content *fc = m->content;
+  const mpm_particles *p = m->particles;
+  const double *mass = mpm_particles_comp(p, fc->lay.f_m, 0);
+  const double *e = mpm_particles_comp(p, FLUID_E, 0);
+  memset(s, 0, sizeof *s);
+  for (mpm_lidx i = 0; i < p->n; ++i) {
+    s->mass += mass[i];
+    s->internal += mass[i] * e[i];
+  }
+  for (int d = 0; d < p->dim; ++d) {
+    const double *v = mpm_particles_comp(p, FLUID_V, d);
+    for (mpm_lidx i = 0; i < p->n; ++i) {
+      s->momentum[d] += mass[i] * v[i];
+      s->kinetic += 0.5 * mass[i] * v[i] * v[i];
+    }
+  }
+}
+
+static void fluid_destroy(mpm_module *m) {
+  fluid_content *fc = m->content;
+  if (fc) {
+    mpm_constraints_free(&fc->cons);
+    free(fc->vsig), free(fc->scratch), free(fc->vnew), free(fc->Cnew), free(fc->power);
+    free(fc->tscratch), free(fc->node);
+    free(fc);
+  }
+  mpm_particles_destroy(&m->particles);
+}
+
+static const mpm_module_ops fluid_ops = {
+    .p2g = fluid_p2g,
+    .grid_update = fluid_grid_update,
+    .g2p = fluid_g2p,
+    .stable_dt = fluid_stable_dt,
+    .check = fluid_check,
+    .sums = fluid_sums,
+    .post_step = fluid_post_step,
+    .destroy = fluid_destroy,
+    .remap = fluid_remap,
+    .output = fluid_output,
+};
+
+/* ---- construction -------------------------------------------------------------------------- */
+
+static int read_settings(fluid_content *fc, const mpm_config *cfg, const mpm_grid *g) {
+  int nv;
+  double grav[3] = {0, 0, 0};
+  MPM_CALL(mpm_config_get_real(cfg, "fluid.gamma", &fc->gas.gamma));
+  MPM_CALL(mpm_config_get_real(cfg, "fluid.viscosity", &fc->gas.mu));
+  MPM_CALL(mpm_config_get_real(cfg, "fluid.av_linear", &fc->gas.av_lin));
+  MPM_CALL(mpm_config_get_real(cfg, "fluid.av_quadratic", &fc->gas.av_quad));
+  MPM_CALL(mpm_config_get_real(cfg, "fluid.R", &fc->R));
+  MPM_CALL(mpm_config_get_int(cfg, "fluid.ppc", &fc->ppc));
+  MPM_CALL(mpm_config_get_reals(cfg, "physics.gravity", grav, 3, &nv));
+  memcpy(fc->gravity, grav, sizeof grav);
+  MPM_CALL(mpm_transfer_from_config(&fc->tr, cfg));
+  fc->gas.l = g->dx;
+  fc->lp = 0.5 / fc->ppc;
+  return 0;
+}
+
+/* The lagged strain rate (divv, D) is part of the state in the classic update: the step's
+ * rate is (new - old) / h, so the stress and the stable step of the next step read it from
+ * y_{n+1}. The step size the driver sets and the one the RHS computed for the same state are
+ * then the same, which the exact energy balance needs; a restart also gets it bit for bit. In
+ * the method-of-lines RHS it is an ordinary field the RHS overwrites (the previous stage's). */
+static void lag_fields(mpm_field_desc *f, int *nf, fluid_layout *lay, int dim, int viscous) {
+  lay->f_divv = *nf, f[(*nf)++] = (mpm_field_desc){"divv", 1};
+  lay->f_D = viscous ? *nf : -1;
+  if (viscous) f[(*nf)++] = (mpm_field_desc){"D", dim * dim};
+}
+
+static int particles_new(mpm_particles **p, int dim, fluid_layout *lay, int apic, int viscous,
+                         int lag_in_state) {
+  mpm_field_desc f[MPM_PARTICLES_MAX_FIELDS] = {{"x", dim}, {"v", dim}, {"J", 1}, {"e", 1}};
+  int nf = 4;
+  lay->f_C = apic ? nf : -1;
+  if (apic) f[nf++] = (mpm_field_desc){"C", dim * dim};
+  if (lag_in_state) lag_fields(f, &nf, lay, dim, viscous);
+  const int nstate = nf;
+  lay->f_m = nf, f[nf++] = (mpm_field_desc){"m", 1};
+  lay->f_V0 = nf, f[nf++] = (mpm_field_desc){"V0", 1};
+  lay->f_pending = -1;
+  if (!lag_in_state) { /* pending directly before divv and D: post_step copies one block */
+    lay->f_pending = nf, f[nf++] = (mpm_field_desc){"pending", 1 + (viscous ? dim * dim : 0)};
+    lag_fields(f, &nf, lay, dim, viscous);
+  }
+  lay->f_rho = nf, f[nf++] = (mpm_field_desc){"rho", 1};
+  lay->f_p = nf, f[nf++] = (mpm_field_desc){"p", 1};
+  lay->f_mach = nf, f[nf++] = (mpm_field_desc){"mach", 1};
+  lay->f_T = nf, f[nf++] = (mpm_field_desc){"T", 1};
+  lay->f_s = nf, f[nf++] = (mpm_field_desc){"s", 1};
+  return mpm_particles_new(p, dim, f, nf, nstate);
+}
+
+static int build(mpm_module *m, const mpm_config *cfg, int seed) {
+  fluid_content *fc = m->content;
+  mpm_grid *g = m->grid;
+  mpm_walls walls;
+  MPM_CALL(mpm_grid_add_phase(g, "fluid", &m->phase));
+  MPM_CALL(read_settings(fc, cfg, g));
+  MPM_CALL(mpm_walls_from_config(&walls, cfg, g->dim));
+  MPM_CALL(mpm_constraints_add_walls(&fc->cons, &walls, g));
+  MPM_ALLOC(fc->node, (size_t)(g->dim + 3) * g->nnodes);
+  MPM_CALL(
+      particles_new(&m->particles, g->dim, &fc->lay, fc->tr.apic, fc->gas.mu > 0, fc->tr.classic));
+  if (seed) MPM_CALL(fluid_seed(m, cfg));
+  return 0;
+}
+
+int fluid_module_create(mpm_module **mp, const mpm_config *cfg, mpm_grid *grid, int seed) {
+  const char *const *names;
+  int count;
+  *mp = NULL;
+  MPM_CALL(mpm_config_instances(cfg, "gas", &names, &count));
+  if (count == 0) return 0;
+  mpm_module *m;
+  MPM_ALLOC(m, 1);
+  *mp = m;
+  snprintf(m->name, sizeof m->name, "fluid");
+  m->ops = &fluid_ops;
+  m->grid = grid;
+  fluid_content *fc;
+  MPM_ALLOC(fc, 1);
+  m->content = fc;
+  const int rc = build(m, cfg, seed);
+  if (rc) {
+    mpm_module_destroy(mp);
+    return mpm_trace(__FILE__, __LINE__, __func__, rc);
+  }
+  return 0;
+}

@@ -1,0 +1,23 @@
+/* The gas MPM module: compressible ideal gas as particles on the shared grid.
+ *
+ * State fields: x (dim), v (dim), J = V / V0 (1), e, the specific internal energy (1), and C
+ * (dim*dim), the APIC affine velocity, when transfer.velocity = apic. Other fields: m (mass),
+ * V0 (reference volume), divv (tr D of the last RHS evaluation), D (dim*dim, the strain rate of
+ * the last RHS, only with viscosity), and the output fields rho, p, mach, T and s (density,
+ * pressure, Mach number, temperature and specific entropy), refreshed before every snapshot
+ * and checkpoint. */
+#ifndef FLUID_MODULE_H
+#define FLUID_MODULE_H
+
+#include "mpm_config.h"
+#include "mpm_module.h"
+
+/* Add the keys of the [fluid] and [gas.NAME] sections to cfg. */
+int fluid_add_schema(mpm_config *cfg);
+
+/* Build the module over grid with its own phase of nodal fields. With seed = 1 the gas
+ * regions are seeded; with seed = 0 the particle set starts empty (a restart fills it). *m
+ * is NULL if the case has no [gas.*] section. Collective. */
+int fluid_module_create(mpm_module **m, const mpm_config *cfg, mpm_grid *grid, int seed);
+
+#endif

@@ -1,0 +1,45 @@
+/* Gas stress over a batch of particles (see fluid_stress.h). */
+#include "fluid_stress.h"
+
+#include "fluid_eos.h"
+
+/* -V (p + q) on the diagonal; the viscous part, if any, is added by viscous_stress. */
+static void pressure_stress(const fluid_gas *g, const fluid_batch *b) {
+  const int dim = b->dim;
+  const mpm_lidx n = b->n;
+  for (int r = 0; r < dim; ++r)
+    for (int c = 0; c < dim; ++c)
+      if (r != c)
+        for (mpm_lidx i = 0; i < n; ++i) b->vsig[(size_t)(r * dim + c) * n + i] = 0.0;
+  double *s00 = b->vsig;
+  for (mpm_lidx i = 0; i < n; ++i) {
+    const double V = b->V0[i] * b->J[i], rho = b->m[i] / V;
+    const double p = fluid_pressure(g->gamma, rho, b->e[i]);
+    const double q = fluid_av_pressure(g, rho, fluid_sound_speed(g->gamma, rho, p), b->divv[i]);
+    s00[i] = -V * (p + q);
+  }
+  for (int d = 1; d < dim; ++d) {
+    double *sdd = b->vsig + (size_t)(d * dim + d) * n;
+    for (mpm_lidx i = 0; i < n; ++i) sdd[i] = s00[i];
+  }
+}
+
+/* V 2 mu (D - tr D / 3 I). */
+static void viscous_stress(const fluid_gas *g, const fluid_batch *b) {
+  const int dim = b->dim;
+  const mpm_lidx n = b->n;
+  for (int r = 0; r < dim; ++r)
+    for (int c = 0; c < dim; ++c) {
+      const double *D = b->D + (size_t)(r * dim + c) * n;
+      double *s = b->vsig + (size_t)(r * dim + c) * n;
+      for (mpm_lidx i = 0; i < n; ++i) {
+        const double dev = r == c ? D[i] - b->divv[i] / 3.0 : D[i];
+        s[i] += 2.0 * g->mu * b->V0[i] * b->J[i] * dev;
+      }
+    }
+}
+
+void fluid_stress(const fluid_gas *g, const fluid_batch *b) {
+  pressure_stress(g, b);
+  if (g->mu > 0.0 && b->D) viscous_stress(g, b);
+}

@@ -1,0 +1,135 @@
+/* The classic step's grid-to-particle transfer for the gas, with its energy balance.
+ *
+ * Over a step h the grid velocity goes from v_i^n to v_i^{n+1} = v_i^n + h a_i. The stress
+ * works on the time-centred nodal velocity vbar_i = v_i^n + h a_i / 2: the particles' internal
+ * energy takes h (V sigma : grad vbar) / m, and summed over the particles that is exactly
+ * minus the change of the grid's kinetic energy, sum_i m_i (|v^{n+1}|^2 - |v^n|^2) / 2 (less
+ * the work of gravity). The particles' own kinetic energy changes by a different amount,
+ * because the transfer is not the grid's: FLIP adds h sum S a_i to v_p, PIC replaces v_p by
+ * sum S v_i^{n+1}, APIC by that and an affine velocity. The difference (grid minus particles)
+ * is split over the particles as heat, each share non-negative for FLIP/PIC blends:
+ *
+ *   FLIP: h^2 / 2 (sum S |a_i|^2 - |sum S a_i|^2), the spread of the nodal accelerations
+ *         a particle reads (sums to the difference because sum_p m_p a_p . v_p =
+ *         sum_i a_i . (m v)_i);
+ *   PIC:  (sum S |v_i^{n+1}|^2 - |sum S v_i^{n+1}|^2) / 2, the spread of the velocities it
+ *         reads, plus sum S |v_p - v_i^n|^2 / 2, the spread of its velocity about the nodal
+ *         velocities it deposited into;
+ *   blend a: (1 - a) FLIP + a PIC + a (1 - a) |v_FLIP - v_PIC|^2 / 2 (the convexity of |v|^2).
+ *
+ * APIC deposits an affine velocity the particle's |v|^2 does not count, so its share is the
+ * plain difference sum S (|v_i^{n+1}|^2 - |v_i^n|^2) / 2 - (|v_new|^2 - |v_p|^2) / 2: exact in
+ * sum, but not of one sign per particle.
+ *
+ * Every identity holds with walls (held components have v = a = 0; mirrored pad nodes fold
+ * their deposits into their images), so a closed box conserves total energy to roundoff. */
+#include "fluid_internal.h"
+
+#include "mpm_kernels.h"
+
+#include <string.h>
+
+/* APIC's new affine velocity is that of v^{n+1} = vbar + h a / 2: add h/2 C(a). */
+static void apic_half_step(mpm_module *m, const double *y, double h, double *C) {
+  fluid_content *fc = m->content;
+  const mpm_particles *p = m->particles;
+  const mpm_grid_phase *ph = &m->grid->phase[m->phase];
+  const int dim = p->dim;
+  const mpm_lidx n = p->n;
+  double *Ca = fc->tscratch + (size_t)(dim + 3) * n, *dummy = Ca + (size_t)dim * dim * n;
+  mpm_g2p_args a = {.n = n, .lp = fc->lp, .C_out = Ca};
+  for (int d = 0; d < dim; ++d) {
+    a.x[d] = y + (size_t)(p->offset[FLUID_X] + d) * n;
+    a.v_i[d] = ph->a_i[d];
+    a.a_i[d] = ph->a_i[d];
+    a.v_out[d] = dummy + (size_t)d * n;
+    a.a_out[d] = dummy + (size_t)(dim + d) * n;
+  }
+  mpm_kernels_get(dim)->g2p(m->grid, &a);
+  for (size_t k = 0; k < (size_t)dim * dim * (size_t)n; ++k) C[k] += 0.5 * h * Ca[k];
+}
+
+/* The nodal scalars the heat shares need, |a|^2, |v^{n+1}|^2 and |v^n|^2 (FLIP needs the first,
+ * a PIC share or APIC the other two), set up for interpolation in the G2P pass a: out[j]
+ * receives scalar j at the particles. */
+static void nodal_scalars(mpm_module *m, const double *const *vbar, double h, double **out,
+                          mpm_g2p_args *a) {
+  fluid_content *fc = m->content;
+  const mpm_grid *g = m->grid;
+  const mpm_grid_phase *ph = &g->phase[m->phase];
+  const int dim = g->dim, flip = !fc->tr.apic, pic = fc->tr.apic || fc->tr.pic > 0;
+  for (int j = 0; j < 3; ++j) {
+    if ((j == 0 && !flip) || (j > 0 && !pic)) continue;
+    double *s = fc->node + (size_t)(dim + a->nscalar) * g->nnodes;
+    const double half = j == 1 ? 0.5 * h : -0.5 * h; /* v^{n+1} or v^n from vbar */
+    for (mpm_lidx l = 0; l < g->nnodes; ++l) {
+      double sum = 0.0;
+      for (int d = 0; d < dim; ++d) {
+        const double q = j == 0 ? ph->a_i[d][l] : vbar[d][l] + half * ph->a_i[d][l];
+        sum += q * q;
+      }
+      s[l] = sum;
+    }
+    a->s_i[a->nscalar] = s;
+    a->s_out[a->nscalar++] = out[j];
+  }
+}
+
+/* The new velocity and the heat share of particle i (see the file comment). */
+static double new_velocity(const fluid_content *fc, int dim, double h, const double *v,
+                           const double *a, const double *vhat, double *const *sc, mpm_lidx i,
+                           double *vnew) {
+  const double al = fc->tr.apic ? 1.0 : fc->tr.pic;
+  double v2 = 0, a2 = 0, vP2 = 0, vvn = 0, dFP2 = 0;
+  for (int d = 0; d < dim; ++d) {
+    const double vF = v[d] + h * a[d], vP = vhat[d];
+    vnew[d] = (1.0 - al) * vF + al * vP;
+    v2 += v[d] * v[d], a2 += a[d] * a[d], vP2 += vP * vP;
+    vvn += v[d] * (vP - h * a[d]); /* v_p . sum S v_i^n */
+    dFP2 += (vF - vP) * (vF - vP);
+  }
+  if (fc->tr.apic) return 0.5 * (sc[1][i] - sc[2][i]) - 0.5 * (vP2 - v2);
+  double heat = (1.0 - al) * 0.5 * h * h * (sc[0][i] - a2);
+  if (al > 0)
+    heat += al * (0.5 * (sc[1][i] - vP2) + 0.5 * (v2 - 2.0 * vvn + sc[2][i])) +
+            0.5 * al * (1.0 - al) * dFP2;
+  return heat;
+}
+
+void fluid_classic_transfer(mpm_module *m, const double *y, double h, const fluid_step_out *o) {
+  fluid_content *fc = m->content;
+  const mpm_particles *p = m->particles;
+  const mpm_grid *g = m->grid;
+  const mpm_grid_phase *ph = &g->phase[m->phase];
+  const int dim = p->dim;
+  const mpm_lidx n = p->n;
+  double *vbar[MPM_MAX_DIM] = {NULL}, *ap[MPM_MAX_DIM] = {NULL}, *sc[3];
+  for (int d = 0; d < dim; ++d) {
+    vbar[d] = fc->node + (size_t)d * g->nnodes;
+    for (mpm_lidx l = 0; l < g->nnodes; ++l) vbar[d][l] = ph->v_i[d][l] - 0.5 * h * ph->a_i[d][l];
+    ap[d] = fc->tscratch + (size_t)d * n;
+  }
+  for (int j = 0; j < 3; ++j) sc[j] = fc->tscratch + (size_t)(dim + j) * n;
+  mpm_g2p_args a = {.n = n, .lp = fc->lp, .L_out = o->L, .C_out = o->C};
+  for (int d = 0; d < dim; ++d) {
+    a.x[d] = y + (size_t)(p->offset[FLUID_X] + d) * n;
+    a.v_i[d] = vbar[d];
+    a.a_i[d] = ph->a_i[d];
+    a.v_out[d] = o->vhat[d];
+    a.a_out[d] = ap[d];
+  }
+  nodal_scalars(m, (const double *const *)vbar, h, sc, &a);
+  mpm_kernels_get(dim)->g2p(g, &a);
+  for (int d = 0; d < dim; ++d)
+    for (mpm_lidx i = 0; i < n; ++i) o->vhat[d][i] += 0.5 * h * ap[d][i];
+  if (o->C) apic_half_step(m, y, h, o->C);
+  for (mpm_lidx i = 0; i < n; ++i) {
+    double v[MPM_MAX_DIM], acc[MPM_MAX_DIM], vh[MPM_MAX_DIM], vn[MPM_MAX_DIM];
+    for (int d = 0; d < dim; ++d) {
+      v[d] = y[(size_t)(p->offset[FLUID_V] + d) * n + i];
+      acc[d] = ap[d][i], vh[d] = o->vhat[d][i];
+    }
+    o->heat[i] = new_velocity(fc, dim, h, v, acc, vh, sc, i, vn);
+    for (int d = 0; d < dim; ++d) o->vnew[d][i] = vn[d];
+  }
+}

@@ -1,0 +1,67 @@
+"""A shear wave in a periodic box of gas (cases/gas_box.ini with a velocity field):
+v = (0, U sin(2 pi x)), U = 0.01, p = 100, rho = 1 (c = 11.8: Mach 1e-3, nearly incompressible).
+
+Default: viscous decay. With viscosity mu = 0.01 (nu = 0.01) the wave decays as
+exp(-nu k^2 t), so the kinetic energy as exp(-2 nu k^2 t), rate 0.7896 /s. The rate is
+fitted to ln K over t in [0.05, 1] from diagnostics.csv. At 16 and 32 cells per wavelength,
+usl and bs32: the error at 32 cells within 3 % (measured -2.0 % for both: the spatial error of
+the quadratic B-spline viscous operator; the time error is far smaller) and an observed order
+>= 1.5 from 16 to 32 cells (measured 1.95; the operator is second order).
+
+`long`: the inviscid wave (mu = 0) at 64 cells must keep its kinetic energy: it is a steady
+solution, its physical (Kelvin-Helmholtz type) instability grows on a time scale of 1/(U k)
+= 16 s, so K may not grow by more than 1 % by t = 0.7. **This fails with FLIP (registered as an
+expected failure):** measured, the kinetic energy grows by 1e6 by t = 1, starting at t = 0.43
+for usl, musl and bs32 alike (0.52 with PIC share 0.01, 0.86 with 0.05), once the columns of
+particles have slid about a quarter cell past each other: a particle-scale mode (Brackbill's
+ringing instability of FLIP), independent of the step size (the same onset at CFL 0.2) and of
+the energy balance (bs32 has none). A PIC share of 0.1 suppresses it but dissipates 84 % of the
+wave's energy by t = 1; APIC keeps 97.8 % and stays stable. Particle regularisation (the next
+gas task) or an APIC fix for sparse regions should close it; remove WILL_FAIL then.
+"""
+import os
+import sys
+
+import numpy as np
+
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "tools"))
+import mpmtest as mt  # noqa: E402
+
+check = mt.Checks("test_gas_shear")
+LONG = len(sys.argv) > 1 and sys.argv[1] == "long"
+K2 = (2 * np.pi) ** 2
+
+
+def run(N, method, mu, t_end):
+    out = mt.outdir(f"shear_{method}_N{N}_mu{mu:g}")
+    mt.run(["run", mt.case("gas_box.ini"), f"output.dir={out}", "run.progress=false",
+            "output.snapshots=false", f"grid.dx={1.0 / N}", "gas.air.pressure_field=100",
+            "gas.air.velocity_field=0; 0.01*sin(2*pi*x)", f"fluid.viscosity={mu}",
+            f"time.method={method}", f"time.t_end={t_end}"])
+    d = np.genfromtxt(os.path.join(out, "diagnostics.csv"), delimiter=",", names=True)
+    return d["t"], d["kinetic"]
+
+
+if not LONG:
+    exact = 2 * 0.01 * K2
+    for method in ("usl", "bs32"):
+        errs = []
+        for N in (16, 32):
+            t, K = run(N, method, 0.01, 1.0)
+            sel = t >= 0.05
+            rate = -np.polyfit(t[sel], np.log(K[sel]), 1)[0]
+            errs.append(rate / exact - 1)
+            print(f"info {method} N={N}: kinetic energy decay rate {rate:.5f} /s "
+                  f"(exact {exact:.5f}), error {100 * errs[-1]:+.2f} %")
+        check(abs(errs[1]) <= 0.03, f"{method} N=32: decay rate error {100 * errs[1]:+.2f} % "
+              "(within 3 %)")
+        order = np.log2(abs(errs[0] / errs[1]))
+        check(order >= 1.5, f"{method}: observed order {order:.2f} from 16 to 32 cells (>= 1.5)")
+else:
+    for method in ("bs32", "usl"):
+        t, K = run(64, method, 0.0, 0.7)
+        growth = float(K.max() / K[0])
+        check(growth <= 1.01, f"{method} N=64, inviscid: largest K / K0 = {growth:.3g} by t = 0.7 "
+              "(<= 1.01)")
+
+sys.exit(check.finish())
