@@ -39,8 +39,13 @@ typedef struct mpm_module_ops {
   /* Local check of a state: fills *fault and returns 1 if it is unphysical. */
   int (*check)(const mpm_module *m, const double *y, mpm_fault *fault);
   void (*sums)(const mpm_module *m, mpm_module_sums *s);
-  /* After an accepted step and migration (history updates, regularisation). Optional. */
-  int (*post_step)(mpm_module *m);
+  /* Between accepted steps, before migration: particles leave through outflow faces and
+   * enter through inflow faces. t is the time reached and h the step just taken. Sets
+   * *changed to 1 if the particle set changed (count or order). Optional. */
+  int (*boundary)(mpm_module *m, double t, double h, int *changed);
+  /* After an accepted step and migration (history updates, regularisation, reports); every
+   * particle sits on the rank that owns its cell. Same arguments as boundary. Optional. */
+  int (*post_step)(mpm_module *m, double t, double h, int *changed);
   void (*destroy)(mpm_module *m);
   /* MUSL's second transfer, after the first grid update and forward halo: compute the
    * particles' new velocities, zero this phase and deposit their mass and momentum again.

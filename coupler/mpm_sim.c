@@ -321,20 +321,26 @@ static int diagnostics(mpm_sim *s, double dt) {
   return rc;
 }
 
-/* Move particles to their owners and sort them now and then; tell the integrator. */
-static int after_step(mpm_sim *s) {
+/* Between steps: particles enter and leave through the boundary, move to their owners and
+ * are sorted now and then; the modules do their post-step work; the integrator is told. */
+static int after_step(mpm_sim *s, double h) {
   int changed_any = 0;
   mpm_timer_start(MPM_T_MIGRATE);
   for (int k = 0; k < s->nmod; ++k) {
-    int changed = 0;
-    MPM_CALL(mpm_particles_migrate(s->mod[k]->particles, s->grid, &changed));
+    mpm_module *m = s->mod[k];
+    int changed = 0, migrated = 0;
+    if (m->ops->boundary) MPM_CALL(m->ops->boundary(m, s->t, h, &changed));
+    MPM_CALL(mpm_particles_migrate(m->particles, s->grid, &migrated));
+    changed |= migrated;
     if (s->sort_every > 0 && s->step % s->sort_every == 0) {
-      MPM_CALL(mpm_particles_sort(s->mod[k]->particles, s->grid));
+      MPM_CALL(mpm_particles_sort(m->particles, s->grid));
       changed = 1;
     }
+    if (m->ops->post_step) MPM_CALL(m->ops->post_step(m, s->t, h, &changed));
     changed_any |= changed;
-    if (s->mod[k]->ops->post_step) MPM_CALL(s->mod[k]->ops->post_step(s->mod[k]));
   }
+  /* A module's own changes may be local to a rank; the resize is collective. */
+  MPM_CALL_MPI(MPI_Allreduce(MPI_IN_PLACE, &changed_any, 1, MPI_INT, MPI_LOR, s->comm));
   if (changed_any) MPM_CALL(mpm_integrator_resize(s->it, s->t));
   mpm_timer_stop(MPM_T_MIGRATE);
   return 0;
@@ -396,7 +402,7 @@ int mpm_sim_run(mpm_sim *s) {
     const double t_ckpt = s->ckpt_next * s->ckpt_interval;
     MPM_CALL(mpm_integrator_step(s->it, fmin(t_out, t_ckpt), &s->t, &dt));
     s->step++;
-    MPM_CALL(after_step(s));
+    MPM_CALL(after_step(s, dt));
     MPM_CALL(diagnostics(s, dt));
     progress(s, dt, wall0, 0);
     if (s->t >= t_out * (1 - 1e-14)) {

@@ -286,7 +286,8 @@ static int fluid_g2p(mpm_module *m, double t, const double *y, double *ydot, dou
   return 0;
 }
 
-static int fluid_post_step(mpm_module *m) {
+static int fluid_post_step(mpm_module *m, double t, double h, int *changed) {
+  (void)t, (void)h, (void)changed;
   const fluid_content *fc = m->content;
   const mpm_particles *p = m->particles;
   if (fc->lay.f_pending >= 0) { /* divv and D follow pending in the particle data */

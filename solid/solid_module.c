@@ -641,7 +641,8 @@ static void solid_stress_rates(mpm_module *m, const double *y, double *ydot, con
 }
 
 /* After an accepted step (and migration): models with history store the returned state. */
-static int solid_post_step(mpm_module *m) {
+static int solid_post_step(mpm_module *m, double t, double h, int *changed) {
+  (void)t, (void)h, (void)changed;
   solid_content *sc = m->content;
   const mpm_particles *p = m->particles;
   if (sc->lay.f_hist < 0) return 0;
