@@ -7,9 +7,12 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define WALL_CHOICES "none|slip|no_slip|periodic"
+#define WALL_CHOICES                                                                               \
+  "none|slip|no_slip|periodic|inflow|outflow|subsonic_inflow|subsonic_outflow|farfield"
 #define WALL_HELP                                                                                  \
-  "wall on this face: none (open), slip, no_slip or periodic (with the opposite face)"
+  "condition on this face: none (closed to particles), slip, no_slip, periodic (with the "         \
+  "opposite face), or for gas inflow, outflow (supersonic), subsonic_inflow, subsonic_outflow, "   \
+  "farfield (non-reflecting; all with the [freestream] state)"
 
 const mpm_key_spec mpm_bc_keys[] = {
     {"boundary.x_lo", MPM_KEY_ENUM, "none", 0, 0, 0, 0, WALL_CHOICES, WALL_HELP, 0},
@@ -22,6 +25,15 @@ const mpm_key_spec mpm_bc_keys[] = {
 const int mpm_bc_nkeys = (int)(sizeof mpm_bc_keys / sizeof mpm_bc_keys[0]);
 
 static const char *const g_axes = "xyz", *const g_side[2] = {"lo", "hi"};
+
+static const char *const g_wall_names[MPM_WALL_COUNT] = {
+    "none",    "slip",    "no_slip",         "periodic",
+    "inflow",  "outflow", "subsonic_inflow", "subsonic_outflow",
+    "farfield"};
+
+const char *mpm_wall_name(mpm_wall k) {
+  return k >= 0 && k < MPM_WALL_COUNT ? g_wall_names[k] : "?";
+}
 
 /* A periodic face wraps onto the opposite face, so that face must wrap back. */
 static int check_periodic_pairs(const mpm_walls *w, const mpm_config *cfg, int dim) {
@@ -46,10 +58,9 @@ int mpm_walls_from_config(mpm_walls *w, const mpm_config *cfg, int dim) {
       const char *v;
       snprintf(key, sizeof key, "boundary.%c_%s", g_axes[d], g_side[s]);
       MPM_CALL(mpm_config_get_string(cfg, key, &v));
-      w->face[d][s] = strcmp(v, "slip") == 0       ? MPM_WALL_SLIP
-                      : strcmp(v, "no_slip") == 0  ? MPM_WALL_NO_SLIP
-                      : strcmp(v, "periodic") == 0 ? MPM_WALL_PERIODIC
-                                                   : MPM_WALL_NONE;
+      w->face[d][s] = MPM_WALL_NONE;
+      for (int k = 0; k < MPM_WALL_COUNT; ++k)
+        if (strcmp(v, g_wall_names[k]) == 0) w->face[d][s] = (mpm_wall)k;
     }
   MPM_CALL(check_periodic_pairs(w, cfg, dim));
   for (int d = dim; d < MPM_MAX_DIM; ++d)
@@ -132,7 +143,7 @@ static void apply_pass(const mpm_node_constraints *c, mpm_grid *grid, int phase)
 int mpm_constraints_add_walls(mpm_node_constraints *c, const mpm_walls *w, const mpm_grid *grid) {
   for (int d = 0; d < grid->dim; ++d)
     for (int s = 0; s < 2; ++s)
-      if (w->face[d][s] != MPM_WALL_NONE && w->face[d][s] != MPM_WALL_PERIODIC)
+      if (w->face[d][s] == MPM_WALL_SLIP || w->face[d][s] == MPM_WALL_NO_SLIP)
         MPM_CALL(add_face(c, grid, d, s, wall_components(w->face[d][s], d, grid->dim)));
   return 0;
 }

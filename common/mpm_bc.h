@@ -1,18 +1,39 @@
 /* Wall conditions on the faces of the domain, for any phase's nodal fields.
  *
  * A face is open (none: a particle crossing it is an error), a slip wall (the normal
- * velocity and acceleration vanish on it), a no-slip wall (all components vanish) or
+ * velocity and acceleration vanish on it), a no-slip wall (all components vanish),
  * periodic (the lattice wraps to the opposite face, which must be periodic too; the grid
- * handles it, so it has no rules here). Nodes on a wall face are held; the pad nodes beyond
- * it mirror the nodes inside (see mpm_node_constraints). Rules are built once for a grid;
- * clamps append held nodes. */
+ * handles it, so it has no rules here), or one of the gas's open faces (inflow, outflow,
+ * subsonic_inflow, subsonic_outflow, farfield; the fluid module applies them). Nodes on a wall face
+ * are held; the pad nodes beyond it mirror the nodes inside (see mpm_node_constraints). Rules are
+ * built once for a grid; clamps append held nodes. */
 #ifndef MPM_BC_H
 #define MPM_BC_H
 
 #include "mpm_config.h"
 #include "mpm_grid.h"
 
-typedef enum { MPM_WALL_NONE, MPM_WALL_SLIP, MPM_WALL_NO_SLIP, MPM_WALL_PERIODIC } mpm_wall;
+typedef enum {
+  MPM_WALL_NONE,
+  MPM_WALL_SLIP,
+  MPM_WALL_NO_SLIP,
+  MPM_WALL_PERIODIC,
+  /* Open faces of the gas (fluid/fluid_boundary.c); for every other phase they are open
+   * (none): no node rules here. */
+  MPM_WALL_INFLOW,           /* supersonic inflow: the free stream enters */
+  MPM_WALL_OUTFLOW,          /* supersonic outflow: the gas leaves */
+  MPM_WALL_SUBSONIC_INFLOW,  /* characteristic subsonic inflow */
+  MPM_WALL_SUBSONIC_OUTFLOW, /* characteristic subsonic outflow at a back pressure */
+  MPM_WALL_FARFIELD,         /* non-reflecting far field */
+  MPM_WALL_COUNT
+} mpm_wall;
+
+/* The case-file name of a face kind ("slip", "farfield", ...). */
+const char *mpm_wall_name(mpm_wall k);
+/* Is k one of the gas's open faces (inflow ... farfield)? */
+static inline int mpm_wall_is_open_gas(mpm_wall k) {
+  return k >= MPM_WALL_INFLOW && k < MPM_WALL_COUNT;
+}
 
 typedef struct mpm_walls {
   mpm_wall face[MPM_MAX_DIM][2]; /* [axis][lower, upper] */

@@ -65,6 +65,9 @@ struct mpm_module {
   mpm_particles *particles;
   mpm_grid *grid;
   int phase; /* index of this module's nodal fields on grid */
+  /* Faces [axis][lo, hi] a particle may cross during a step: the module removes it between
+   * steps (the gas's open faces). Elsewhere a particle outside the domain is a fault. */
+  unsigned char open[MPM_MAX_DIM][2];
 };
 
 /* Call ops->destroy and free the module; accepts NULL. */
@@ -81,7 +84,8 @@ int mpm_fault_at(mpm_fault *fault, const mpm_particles *p, const double *y, mpm_
                  const char *fmt, ...) __attribute__((format(printf, 5, 6)));
 
 /* Shared particle checks: NaN in the state, a particle outside the domain (beyond a
- * non-periodic face; beyond a periodic one it stays until migration wraps it), or one that
+ * non-periodic face, or more than a cell beyond an open one; beyond a periodic face it stays
+ * until migration wraps it), or one that
  * has drifted more than one cell beyond this rank's cells during a step. */
 int mpm_module_check_positions(const mpm_module *m, const double *y, mpm_fault *fault);
 

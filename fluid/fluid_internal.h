@@ -3,6 +3,7 @@
 #ifndef FLUID_INTERNAL_H
 #define FLUID_INTERNAL_H
 
+#include "fluid_boundary.h"
 #include "fluid_stress.h"
 
 #include "mpm_bc.h"
@@ -28,6 +29,7 @@ typedef struct fluid_content {
   mpm_transfer tr;
   double gravity[MPM_MAX_DIM];
   mpm_node_constraints cons; /* wall nodes */
+  fluid_open *open;          /* open faces (inflow, outflow, far field), or NULL */
   int remapped;              /* the phase holds MUSL's second deposit */
   mpm_lidx cap;              /* capacity of the particle scratch arrays */
   double *vsig;              /* V sigma deposited by this RHS (dim^2 cap) */

@@ -74,6 +74,7 @@ static const mpm_key_spec fluid_keys[] = {
 };
 
 int fluid_add_schema(mpm_config *cfg) {
+  MPM_CALL(mpm_config_add_schema(cfg, fluid_boundary_keys, fluid_boundary_nkeys));
   return mpm_config_add_schema(cfg, fluid_keys, (int)(sizeof fluid_keys / sizeof fluid_keys[0]));
 }
 
@@ -144,6 +145,7 @@ static int fluid_p2g(mpm_module *m, double t, const double *y) {
     a.gravity[d] = fc->gravity[d];
   }
   mpm_kernels_get(dim)->p2g(m->grid, m->phase, &a);
+  MPM_CALL(fluid_open_p2g(fc->open, m, y));
   mpm_timer_stop(MPM_T_P2G);
   return 0;
 }
@@ -156,8 +158,10 @@ static int fluid_grid_update(mpm_module *m, double t, double h) {
   const int second = fc->remapped;
   fc->remapped = 0;
   mpm_constraints_fold(&fc->cons, m->grid, m->phase);
+  if (!second) MPM_CALL(fluid_open_forces(fc->open, m, t));
   MPM_CALL(mpm_grid_phase_update(m->grid, m->phase, second ? 0.0 : h));
   mpm_constraints_apply(&fc->cons, m->grid, m->phase);
+  fluid_open_hold(fc->open, m);
   return 0;
 }
 
@@ -298,6 +302,11 @@ static int fluid_post_step(mpm_module *m, double t, double h, int *changed) {
   return 0;
 }
 
+static int fluid_boundary(mpm_module *m, double t, double h, int *changed) {
+  fluid_content *fc = m->content;
+  return fluid_open_exchange(fc->open, m, t, h, changed);
+}
+
 static int fluid_output(mpm_module *m) {
   fluid_output_fields(m);
   return 0;
@@ -366,6 +375,7 @@ static void fluid_destroy(mpm_module *m) {
   fluid_content *fc = m->content;
   if (fc) {
     mpm_constraints_free(&fc->cons);
+    fluid_open_destroy(&fc->open);
     free(fc->vsig), free(fc->scratch), free(fc->vnew), free(fc->Cnew), free(fc->power);
     free(fc->tscratch), free(fc->node);
     free(fc);
@@ -380,6 +390,7 @@ static const mpm_module_ops fluid_ops = {
     .stable_dt = fluid_stable_dt,
     .check = fluid_check,
     .sums = fluid_sums,
+    .boundary = fluid_boundary,
     .post_step = fluid_post_step,
     .destroy = fluid_destroy,
     .remap = fluid_remap,
@@ -447,6 +458,7 @@ static int build(mpm_module *m, const mpm_config *cfg, int seed) {
   MPM_CALL(read_settings(fc, cfg, g));
   MPM_CALL(mpm_walls_from_config(&walls, cfg, g->dim));
   MPM_CALL(mpm_constraints_add_walls(&fc->cons, &walls, g));
+  MPM_CALL(fluid_open_new(&fc->open, m, cfg, &walls, fc->gas.gamma, fc->ppc));
   MPM_ALLOC(fc->node, (size_t)(g->dim + 3) * g->nnodes);
   MPM_CALL(
       particles_new(&m->particles, g->dim, &fc->lay, fc->tr.apic, fc->gas.mu > 0, fc->tr.classic));

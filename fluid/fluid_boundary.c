@@ -1,0 +1,559 @@
+/* Open faces of the gas (see fluid_boundary.h).
+ *
+ * The missing exterior gas. A particle near a face has no neighbours beyond it, so the nodes
+ * there miss the force the exterior gas would exert: at uniform pressure the internal force
+ * of a full lattice of particles vanishes at every node, and with the exterior half removed a
+ * face node is pushed outwards by about p per unit area. Each open face therefore adds the
+ * force of an exterior lattice of particles (the seeding lattice, continued beyond the face)
+ * at a boundary pressure p_b:
+ *     f_i += p_b W_i,   W_i = sum over exterior lattice points q of V_q dS_i/dx_n (x_q),
+ * computed once per node as a product of 1-D sums (the shape functions are tensor products).
+ * On the undisturbed seeding lattice at uniform pressure p_b = p this cancels the one-sided
+ * force exactly. The face kind chooses p_b:
+ *   inflow            the free-stream pressure; the nodes on and beyond the face are also held
+ *                     at the free-stream velocity (all characteristics enter);
+ *   outflow           the gas's own pressure at the node (all characteristics leave: zero
+ *                     gradient), from a mass-weighted deposit of the particles' pressure;
+ *   subsonic_outflow  the back pressure freestream.back_pressure (the one entering
+ *                     characteristic);
+ *   subsonic_inflow,  the linearised characteristic state between the gas at the node
+ *   farfield          (p_i, u_i) and the free stream (p_inf, u_inf):
+ *                         p_b = (p_i + p_inf) / 2 + Z (u_i - u_inf) . n / 2,  Z = rho_inf c_inf,
+ *                     which passes an outgoing acoustic wave (p' = Z u'.n) without reflection
+ *                     and holds the free stream; where the free stream crosses the face
+ *                     supersonically, p_b is p_inf (entering) or p_i (leaving).
+ * The normal n points out of the domain.
+ *
+ * Particles. A particle beyond an open face is removed between steps (it may sit up to a cell
+ * beyond the face during a step: the pad nodes carry its stencil). Where the free stream
+ * enters (inflow, subsonic_inflow, and a farfield face with u_inf . n < 0) the seeding
+ * lattice continues outside the domain and moves in with the free stream: layer k (k = 0, 1,
+ * ...) of the exterior lattice sits at a depth (k + 1/2) delta - U t beyond the face, with
+ * delta = dx / ppc the lattice spacing and U = -u_inf . n. A layer that has crossed the face
+ * is injected at its exact position, in the free-stream state. The count of layers in by time
+ * t is floor(U t / delta + 1/2): a function of t alone, so a restart needs no extra state.
+ * Injected ids are (face + 1) 2^48 + layer * (lattice points across the face) + the point's
+ * index across the face: they do not depend on the decomposition. */
+#include "fluid_boundary.h"
+
+#include "fluid_eos.h"
+#include "fluid_internal.h"
+
+#include "mpm_error.h"
+#include "mpm_kernels.h"
+#include "mpm_log.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+const mpm_key_spec fluid_boundary_keys[] = {
+    {"freestream.density", MPM_KEY_REAL, NULL, 0, HUGE_VAL, 1, 0, NULL,
+     "free-stream density, kg/m^3, for inflow, subsonic_inflow and farfield faces", 1},
+    {"freestream.pressure", MPM_KEY_REAL, NULL, 0, HUGE_VAL, 1, 0, NULL,
+     "free-stream pressure, Pa, for the open gas faces", 1},
+    {"freestream.velocity", MPM_KEY_REALS, "0 0 0", -HUGE_VAL, HUGE_VAL, 0, 3, NULL,
+     "free-stream velocity, m/s (dim values)", 0},
+    {"freestream.back_pressure", MPM_KEY_REAL, NULL, 0, HUGE_VAL, 1, 0, NULL,
+     "exit pressure of subsonic_outflow faces, Pa (default: freestream.pressure)", 1},
+};
+const int fluid_boundary_nkeys = (int)(sizeof fluid_boundary_keys / sizeof fluid_boundary_keys[0]);
+
+#define ID_FACE_SHIFT 48
+#define NORMAL_REACH  3 /* nodes this many cells inside a face feel the exterior lattice */
+
+typedef struct open_face {
+  int axis, side; /* side 0: the lo face, 1: the hi face */
+  mpm_wall kind;
+  double sign;      /* the outward normal is sign e_axis */
+  int inject;       /* the free stream enters here */
+  double speed;     /* its inward normal speed U */
+  long long layers; /* exterior layers injected so far; -1: not yet counted */
+  mpm_lidx count;   /* box nodes with an exterior force weight */
+  mpm_lidx *node;
+  int *r;                      /* their distance inside the face, cells (0 .. NORMAL_REACH) */
+  double *wt;                  /* the product of their tangential weights, m^(dim-1) */
+  double wn[NORMAL_REACH + 1]; /* normal weights by distance, for the current lattice phase */
+} open_face;
+
+struct fluid_open {
+  int nfaces;
+  open_face face[2 * MPM_MAX_DIM];
+  double rho, p, v[MPM_MAX_DIM], e, c, Z, p_back; /* free stream */
+  int ppc;
+  int phase; /* grid phase of the virtual particles' forces, -1 if unused */
+  mpm_lidx cand_cap, virt_cap;
+  struct column_entry *cand; /* near-face particles of one face, by column */
+  double *virt;              /* virtual particles: x (dim), V sigma (dim^2), m and v (zeros) */
+};
+
+/* ---- exterior force weights ---------------------------------------------------------------- */
+
+/* sum over the exterior lattice points along the normal of dS_i/dxi / ppc, for the node `r`
+ * cells inside the face; the points sit (k + 1/2) / ppc + shift cells beyond the face. */
+static double normal_weight(const mpm_grid *g, const open_face *f, int ppc, double lp, int r,
+                            double shift) {
+  const int F = f->side ? g->ncells[f->axis] : 0, i = F - (int)f->sign * r;
+  double sum = 0.0, w[MPM_SHAPE_MAX_SUPPORT], dw[MPM_SHAPE_MAX_SUPPORT];
+  for (int k = 0; k < 4 * ppc; ++k) { /* 4 cells: beyond every stencil */
+    const double beyond = (k + 0.5) / ppc + shift;
+    const int s = i - mpm_shape_1d(g->shape, F + f->sign * beyond, lp, w, dw);
+    if (s >= 0 && s < MPM_SHAPE_MAX_SUPPORT) sum += dw[s];
+  }
+  return sum / ppc;
+}
+
+/* The integral of S_i along a tangential axis t over the lattice inside the domain (all of it
+ * along a periodic axis), m. */
+static double tangential_weight(const mpm_grid *g, int t, int ppc, double lp, int i) {
+  if (g->periodic[t]) return g->dx;
+  double sum = 0.0, w[MPM_SHAPE_MAX_SUPPORT], dw[MPM_SHAPE_MAX_SUPPORT];
+  for (int j = (i - 3) * ppc; j < (i + 3) * ppc; ++j) {
+    if (j < 0 || j >= g->ncells[t] * ppc) continue;
+    const int s = i - mpm_shape_1d(g->shape, (j + 0.5) / ppc, lp, w, dw);
+    if (s >= 0 && s < MPM_SHAPE_MAX_SUPPORT) sum += w[s];
+  }
+  return sum * g->dx / ppc;
+}
+
+/* Nodes of this box with a weight: on or inside the face within the stencil reach (the nodes
+ * beyond it take the face node's velocity, see fluid_open_hold) and, along a wall's axis,
+ * inside the domain, where the wall's mirror rules do not act. */
+static int build_weights(open_face *f, const mpm_grid *g, int ppc, double lp) {
+  const int F = f->side ? g->ncells[f->axis] : 0;
+  MPM_ALLOC(f->node, (size_t)g->nnodes);
+  MPM_ALLOC(f->r, (size_t)g->nnodes);
+  MPM_ALLOC(f->wt, (size_t)g->nnodes);
+  f->count = 0;
+  for (mpm_lidx l = 0; l < g->nnodes; ++l) {
+    int gi[MPM_MAX_DIM];
+    mpm_grid_node_global(g, l, gi);
+    const int r = (int)f->sign * (F - gi[f->axis]);
+    if (r < 0 || r > NORMAL_REACH) continue;
+    double W = 1.0;
+    for (int t = 0; t < g->dim && W != 0.0; ++t)
+      if (t != f->axis) {
+        if (!g->periodic[t] && (gi[t] < 0 || gi[t] > g->ncells[t])) W = 0.0;
+        W *= tangential_weight(g, t, ppc, lp, gi[t]);
+      }
+    if (W == 0.0) continue;
+    f->node[f->count] = l;
+    f->r[f->count] = r;
+    f->wt[f->count++] = W;
+  }
+  for (int r = 0; r <= NORMAL_REACH; ++r) f->wn[r] = normal_weight(g, f, ppc, lp, r, 0.0);
+  return 0;
+}
+
+/* ---- construction ---------------------------------------------------------------------------- */
+
+static const char *const g_axes = "xyz", *const g_side[2] = {"lo", "hi"};
+
+static int read_freestream(fluid_open *o, const mpm_config *cfg, const mpm_walls *walls, int dim,
+                           double gamma) {
+  const char *needs = NULL;
+  for (int d = 0; d < dim; ++d)
+    for (int s = 0; s < 2; ++s)
+      if (mpm_wall_is_open_gas(walls->face[d][s])) needs = mpm_wall_name(walls->face[d][s]);
+  static const char *const keys[] = {"freestream.density", "freestream.pressure"};
+  for (int k = 0; k < 2; ++k)
+    if (!mpm_config_has(cfg, keys[k]))
+      return mpm_config_fail(cfg, keys[k],
+                             "a %s face needs the free-stream state: set [freestream] density, "
+                             "pressure and velocity",
+                             needs);
+  int count;
+  double v[3] = {0, 0, 0};
+  MPM_CALL(mpm_config_get_real(cfg, "freestream.density", &o->rho));
+  MPM_CALL(mpm_config_get_real(cfg, "freestream.pressure", &o->p));
+  MPM_CALL(mpm_config_get_reals(cfg, "freestream.velocity", v, 3, &count));
+  memcpy(o->v, v, sizeof o->v);
+  o->p_back = o->p;
+  if (mpm_config_has(cfg, "freestream.back_pressure"))
+    MPM_CALL(mpm_config_get_real(cfg, "freestream.back_pressure", &o->p_back));
+  o->e = fluid_energy(gamma, o->rho, o->p);
+  o->c = fluid_sound_speed(gamma, o->rho, o->p);
+  o->Z = o->rho * o->c;
+  return 0;
+}
+
+/* Face kinds against the free stream: an inflow face needs gas that enters. */
+static int check_face(const fluid_open *o, const open_face *f, const mpm_config *cfg) {
+  const double un = f->sign * o->v[f->axis];
+  char key[32];
+  snprintf(key, sizeof key, "boundary.%c_%s", g_axes[f->axis], g_side[f->side]);
+  if ((f->kind == MPM_WALL_INFLOW || f->kind == MPM_WALL_SUBSONIC_INFLOW) && !(un < 0))
+    return mpm_config_fail(cfg, key,
+                           "is %s but the free stream does not enter through it (u . n = %g "
+                           "m/s with n pointing out of the domain); fix freestream.velocity or "
+                           "the face kind",
+                           mpm_wall_name(f->kind), un);
+  if (f->kind == MPM_WALL_INFLOW && -un < o->c)
+    mpm_log(MPM_LOG_WARN,
+            "%s = inflow holds the free-stream velocity, but the inflow is subsonic (Mach %.3g): "
+            "waves reaching the face reflect; subsonic_inflow or farfield lets them out",
+            key, -un / o->c);
+  return 0;
+}
+
+int fluid_open_new(fluid_open **openp, mpm_module *m, const mpm_config *cfg, const mpm_walls *walls,
+                   double gamma, int ppc) {
+  *openp = NULL;
+  const mpm_grid *g = m->grid;
+  int any = 0;
+  for (int d = 0; d < g->dim; ++d)
+    for (int s = 0; s < 2; ++s) any |= mpm_wall_is_open_gas(walls->face[d][s]);
+  if (!any) return 0;
+  fluid_open *o;
+  MPM_ALLOC(o, 1);
+  *openp = o;
+  o->ppc = ppc;
+  o->phase = -1;
+  MPM_CALL(read_freestream(o, cfg, walls, g->dim, gamma));
+  const double lp = 0.5 / ppc;
+  for (int d = 0; d < g->dim; ++d)
+    for (int s = 0; s < 2; ++s) {
+      const mpm_wall k = walls->face[d][s];
+      if (!mpm_wall_is_open_gas(k)) continue;
+      open_face *f = &o->face[o->nfaces++];
+      *f = (open_face){.axis = d, .side = s, .kind = k, .sign = s ? 1.0 : -1.0, .layers = -1};
+      MPM_CALL(check_face(o, f, cfg));
+      f->speed = -f->sign * o->v[d];
+      f->inject = k != MPM_WALL_OUTFLOW && k != MPM_WALL_SUBSONIC_OUTFLOW && f->speed > 0;
+      m->open[d][s] = 1;
+      if (k == MPM_WALL_INFLOW) MPM_CALL(build_weights(f, g, ppc, lp));
+      if (k != MPM_WALL_INFLOW && o->phase < 0)
+        MPM_CALL(mpm_grid_add_phase(m->grid, "fluid_open", &o->phase));
+    }
+  return 0;
+}
+
+void fluid_open_destroy(fluid_open **openp) {
+  fluid_open *o = *openp;
+  if (!o) return;
+  for (int k = 0; k < o->nfaces; ++k)
+    free(o->face[k].node), free(o->face[k].r), free(o->face[k].wt);
+  free(o->cand), free(o->virt);
+  free(o);
+  *openp = NULL;
+}
+
+/* ---- forces ---------------------------------------------------------------------------------- */
+
+/* Distance of x inside the face (negative beyond it). */
+static double depth(const mpm_grid *g, const open_face *f, const double *x) {
+  return f->side ? g->hi[f->axis] - x[f->axis] : x[f->axis] - g->lo[f->axis];
+}
+
+/* The exterior lattice of an inflow face moves in with the free stream: its first layer not
+ * yet injected is (layers + 1/2) delta - U t beyond the face (inside it during the stages of
+ * the step in which it enters, until the step ends and the layer becomes particles). */
+static void inflow_phase(open_face *f, const fluid_open *o, const mpm_grid *g, double t) {
+  const double delta = g->dx / o->ppc, lp = 0.5 / o->ppc;
+  const long long layers =
+      f->layers >= 0 ? f->layers : (long long)floor(f->speed * t / delta + 0.5);
+  const double shift = (layers * delta - f->speed * t) / g->dx;
+  for (int r = 0; r <= NORMAL_REACH; ++r) f->wn[r] = normal_weight(g, f, o->ppc, lp, r, shift);
+}
+
+#define MAX_COPIES 16 /* virtual particles per column, at most */
+
+/* One candidate for the outermost particles of a column across face f. */
+typedef struct column_entry {
+  long long key; /* the column: lattice index across the face */
+  double depth;  /* inside the face, m (negative beyond it) */
+  mpm_lidx i;
+} column_entry;
+
+static int by_column(const void *a, const void *b) {
+  const column_entry *p = a, *q = b;
+  if (p->key != q->key) return p->key < q->key ? -1 : 1;
+  return (p->depth > q->depth) - (p->depth < q->depth);
+}
+
+/* The boundary pressure for a column of face f whose outermost particle has pressure pp and
+ * velocity v. */
+static double boundary_pressure(const fluid_open *o, const open_face *f, double pp,
+                                const double *v) {
+  if (f->kind == MPM_WALL_OUTFLOW) return pp;
+  if (f->kind == MPM_WALL_SUBSONIC_OUTFLOW) return o->p_back;
+  const double un_inf = f->sign * o->v[f->axis], un = f->sign * v[f->axis];
+  if (un_inf >= o->c) return pp;
+  if (un_inf <= -o->c) return o->p;
+  return fmax(0.0, 0.5 * (pp + o->p) + 0.5 * o->Z * (un - un_inf));
+}
+
+/* Scratch for ncand column entries and nvirt virtual particles (contents are not kept). */
+static int grow(fluid_open *o, mpm_lidx ncand, mpm_lidx nvirt, int dim) {
+  if (ncand > o->cand_cap) {
+    free(o->cand);
+    o->cand_cap = ncand + ncand / 4 + 16;
+    MPM_ALLOC(o->cand, (size_t)o->cand_cap);
+  }
+  if (nvirt > o->virt_cap) {
+    free(o->virt);
+    o->virt_cap = nvirt + nvirt / 4 + 16;
+    MPM_ALLOC(o->virt, (size_t)(dim + dim * dim + 2) * o->virt_cap);
+  }
+  return 0;
+}
+
+/* The columns of face f into col: the particles within two cells of it, sorted by column and
+ * depth. Returns their count. */
+static mpm_lidx columns(const fluid_open *o, const open_face *f, const mpm_module *m,
+                        const double *x, column_entry *col) {
+  const mpm_grid *g = m->grid;
+  const mpm_lidx n = m->particles->n;
+  const double delta = g->dx / o->ppc;
+  mpm_lidx k = 0;
+  for (mpm_lidx i = 0; i < n; ++i) {
+    double xp[MPM_MAX_DIM] = {0};
+    for (int d = 0; d < g->dim; ++d) xp[d] = x[(size_t)d * n + i];
+    const double dep = depth(g, f, xp);
+    if (dep >= 2.0 * g->dx) continue;
+    long long key = 0;
+    for (int t = 0; t < g->dim; ++t)
+      if (t != f->axis)
+        key = key * ((long long)g->ncells[t] * o->ppc + 2) +
+              (long long)floor((xp[t] - g->lo[t]) / delta) + 1;
+    col[k++] = (column_entry){key, dep, i};
+  }
+  qsort(col, (size_t)k, sizeof *col, by_column);
+  return k;
+}
+
+/* Virtual particles beyond face f, appended from index *nv: each column continues outwards
+ * with its outermost particle's volume and spacing (the distance to the next particle in, or
+ * for a lone particle the lattice spacing scaled by J^(1/dim)), at the boundary pressure. */
+static void continue_columns(fluid_open *o, const open_face *f, const mpm_module *m,
+                             const double *y, const column_entry *col, mpm_lidx ncol,
+                             mpm_lidx *nv) {
+  const fluid_content *fc = m->content;
+  const mpm_particles *p = m->particles;
+  const mpm_grid *g = m->grid;
+  const int dim = g->dim;
+  const mpm_lidx n = p->n, cap = o->virt_cap;
+  const double *x = y + (size_t)p->offset[FLUID_X] * n, *v = y + (size_t)p->offset[FLUID_V] * n;
+  const double *J = y + (size_t)p->offset[FLUID_J] * n, *e = y + (size_t)p->offset[FLUID_E] * n;
+  const double *mass = mpm_particles_comp(p, fc->lay.f_m, 0);
+  const double *V0 = mpm_particles_comp(p, fc->lay.f_V0, 0);
+  const double reach = 0.5 * mpm_shape_support(g->shape) * g->dx; /* of a node's stencil */
+  double *vx = o->virt, *vsig = vx + (size_t)dim * cap;
+  for (mpm_lidx a = 0; a < ncol;) {
+    mpm_lidx b = a + 1;
+    while (b < ncol && col[b].key == col[a].key) ++b;
+    const mpm_lidx i = col[a].i;
+    const double V = V0[i] * J[i];
+    double spacing = pow(V, 1.0 / dim);
+    if (b > a + 1) {
+      const double gap = col[a + 1].depth - col[a].depth;
+      if (gap > 0.25 * spacing && gap < 4.0 * spacing) spacing = gap;
+    }
+    double vi[MPM_MAX_DIM] = {0};
+    for (int d = 0; d < dim; ++d) vi[d] = v[(size_t)d * n + i];
+    const double pb = boundary_pressure(o, f, fluid_pressure(fc->gas.gamma, mass[i] / V, e[i]), vi);
+    for (int j = 1; j <= MAX_COPIES && col[a].depth - j * spacing > -reach; ++j) {
+      const mpm_lidx q = (*nv)++;
+      for (int d = 0; d < dim; ++d)
+        vx[(size_t)d * cap + q] = x[(size_t)d * n + i] + (d == f->axis ? f->sign * j * spacing : 0);
+      for (int r = 0; r < dim; ++r)
+        for (int c = 0; c < dim; ++c) vsig[(size_t)(r * dim + c) * cap + q] = r == c ? -V * pb : 0;
+    }
+    a = b;
+  }
+}
+
+int fluid_open_p2g(fluid_open *o, mpm_module *m, const double *y) {
+  if (!o || o->phase < 0) return 0;
+  const fluid_content *fc = m->content;
+  const mpm_particles *p = m->particles;
+  const int dim = p->dim;
+  mpm_lidx start[2 * MPM_MAX_DIM + 1] = {0}, nv = 0;
+  MPM_CALL(grow(o, o->nfaces * p->n, 0, dim));
+  for (int k = 0; k < o->nfaces; ++k) {
+    const open_face *f = &o->face[k];
+    start[k + 1] = start[k];
+    if (f->kind != MPM_WALL_INFLOW)
+      start[k + 1] += columns(o, f, m, y + (size_t)p->offset[FLUID_X] * p->n, o->cand + start[k]);
+  }
+  MPM_CALL(grow(o, 0, MAX_COPIES * start[o->nfaces] + 1, dim));
+  for (int k = 0; k < o->nfaces; ++k)
+    continue_columns(o, &o->face[k], m, y, o->cand + start[k], start[k + 1] - start[k], &nv);
+  const mpm_lidx cap = o->virt_cap;
+  double *vm = o->virt + (size_t)(dim + dim * dim) * cap, *vv = vm + cap;
+  for (mpm_lidx q = 0; q < nv; ++q) vm[q] = vv[q] = 0.0;
+  mpm_grid_phase_zero(m->grid, o->phase);
+  mpm_p2g_args a = {.n = nv, .m = vm, .vsig = o->virt + (size_t)dim * cap, .lp = fc->lp};
+  for (int d = 0; d < dim; ++d) a.x[d] = o->virt + (size_t)d * cap, a.v[d] = vv;
+  mpm_kernels_get(dim)->p2g(m->grid, o->phase, &a);
+  return 0;
+}
+
+int fluid_open_forces(fluid_open *o, mpm_module *m, double t) {
+  if (!o) return 0;
+  mpm_grid *g = m->grid;
+  const int dim = g->dim;
+  mpm_grid_phase *ph = &g->phase[m->phase];
+  if (o->phase >= 0) {
+    mpm_grid_phase *bc = &g->phase[o->phase];
+    MPM_CALL(mpm_grid_halo_reverse(g, bc->f_i, dim));
+    for (int d = 0; d < dim; ++d)
+      for (mpm_lidx l = 0; l < g->nnodes; ++l) ph->f_i[d][l] += bc->f_i[d][l];
+  }
+  for (int k = 0; k < o->nfaces; ++k) {
+    open_face *f = &o->face[k];
+    if (f->kind != MPM_WALL_INFLOW) continue;
+    inflow_phase(f, o, g, t);
+    for (mpm_lidx j = 0; j < f->count; ++j)
+      ph->f_i[f->axis][f->node[j]] += o->p * f->wn[f->r[j]] * f->wt[j];
+  }
+  return 0;
+}
+
+void fluid_open_hold(const fluid_open *o, mpm_module *m) {
+  if (!o) return;
+  mpm_grid *g = m->grid;
+  mpm_grid_phase *ph = &g->phase[m->phase];
+  for (int k = 0; k < o->nfaces; ++k) {
+    const open_face *f = &o->face[k];
+    const int F = f->side ? g->ncells[f->axis] : 0, inflow = f->kind == MPM_WALL_INFLOW;
+    for (mpm_lidx l = 0; l < g->nnodes; ++l) {
+      int gi[MPM_MAX_DIM];
+      mpm_grid_node_global(g, l, gi);
+      const int beyond = f->sign * (gi[f->axis] - F);
+      if (beyond < 0 || (beyond == 0 && !inflow)) continue;
+      if (inflow) {
+        for (int d = 0; d < g->dim; ++d) ph->v_i[d][l] = o->v[d], ph->a_i[d][l] = 0.0;
+        continue;
+      }
+      gi[f->axis] = F;
+      const mpm_lidx src = mpm_grid_local_index(g, gi);
+      gi[f->axis] = F - (int)f->sign;
+      const mpm_lidx in = mpm_grid_local_index(g, gi);
+      for (int d = 0; d < g->dim; ++d) {
+        ph->v_i[d][l] = ph->v_i[d][src] + beyond * (ph->v_i[d][src] - ph->v_i[d][in]);
+        ph->a_i[d][l] = ph->a_i[d][src] + beyond * (ph->a_i[d][src] - ph->a_i[d][in]);
+      }
+    }
+  }
+}
+
+/* ---- removal and injection ------------------------------------------------------------------- */
+
+/* Lattice points across face f in this rank's cells, and their global indices. */
+static mpm_lidx across_points(const mpm_grid *g, const open_face *f, int ppc, int *lo, int *cnt,
+                              mpm_gidx *total) {
+  mpm_lidx n = 1;
+  *total = 1;
+  for (int t = 0; t < g->dim; ++t) {
+    if (t == f->axis) {
+      lo[t] = 0, cnt[t] = 1;
+      continue;
+    }
+    lo[t] = g->cell_split[t][g->coord[t]] * ppc;
+    cnt[t] = (g->cell_split[t][g->coord[t] + 1] - g->cell_split[t][g->coord[t]]) * ppc;
+    n *= cnt[t];
+    *total *= (mpm_gidx)g->ncells[t] * ppc;
+  }
+  return n;
+}
+
+/* Append the layers k0 .. k1-1 of face f at time t to the arrays (component-major, stride
+ * cap) from index *nadd on. */
+static void layers(const fluid_open *o, const open_face *f, const mpm_module *m, long long k0,
+                   long long k1, double t, mpm_lidx cap, double *data, mpm_gidx *id,
+                   mpm_lidx *nadd) {
+  const fluid_content *fc = m->content;
+  const mpm_particles *p = m->particles;
+  const mpm_grid *g = m->grid;
+  const int dim = g->dim, ppc = o->ppc;
+  const double delta = g->dx / ppc, vol = pow(delta, dim);
+  int lo[MPM_MAX_DIM], cnt[MPM_MAX_DIM];
+  mpm_gidx total;
+  const mpm_lidx nacross = across_points(g, f, ppc, lo, cnt, &total);
+  const mpm_gidx base = (mpm_gidx)(2 * f->axis + f->side + 1) << ID_FACE_SHIFT;
+  for (long long k = k0; k < k1; ++k) {
+    const double d = f->speed * t - (k + 0.5) * delta; /* depth inside the face */
+    double xn = f->side ? g->hi[f->axis] - d : g->lo[f->axis] + d;
+    if (xn >= g->hi[f->axis]) xn = nextafter(g->hi[f->axis], g->lo[f->axis]);
+    for (mpm_lidx a = 0; a < nacross; ++a) {
+      mpm_lidx rest = a, q = *nadd;
+      mpm_gidx gidx = 0, stride = 1;
+      for (int t2 = 0; t2 < dim; ++t2) {
+        double xt = xn;
+        if (t2 != f->axis) {
+          const int j = lo[t2] + (int)(rest % cnt[t2]);
+          rest /= cnt[t2];
+          xt = g->lo[t2] + (j + 0.5) * delta;
+          gidx += stride * j;
+          stride *= (mpm_gidx)g->ncells[t2] * ppc;
+        }
+        data[(size_t)(p->offset[FLUID_X] + t2) * cap + q] = xt;
+        data[(size_t)(p->offset[FLUID_V] + t2) * cap + q] = o->v[t2];
+      }
+      data[(size_t)p->offset[FLUID_J] * cap + q] = 1.0;
+      data[(size_t)p->offset[FLUID_E] * cap + q] = o->e;
+      data[(size_t)p->offset[fc->lay.f_m] * cap + q] = o->rho * vol;
+      data[(size_t)p->offset[fc->lay.f_V0] * cap + q] = vol;
+      id[q] = base + (mpm_gidx)k * total + gidx;
+      ++*nadd;
+    }
+  }
+}
+
+/* Does this rank own the cells along face f? */
+static int owns_face(const mpm_grid *g, const open_face *f) {
+  return f->side ? g->coord[f->axis] == g->nproc[f->axis] - 1 : g->coord[f->axis] == 0;
+}
+
+int fluid_open_exchange(fluid_open *o, mpm_module *m, double t, double h, int *changed) {
+  if (!o) return 0;
+  mpm_particles *p = m->particles;
+  const mpm_grid *g = m->grid;
+  const mpm_lidx n = p->n;
+  /* Removal. */
+  unsigned char *keep = malloc((size_t)(n ? n : 1));
+  if (!keep) MPM_FAIL(MPM_ERR_MEMORY, "cannot allocate the removal mask");
+  mpm_lidx removed = 0;
+  for (mpm_lidx i = 0; i < n; ++i) {
+    keep[i] = 1;
+    for (int k = 0; k < o->nfaces && keep[i]; ++k) {
+      const open_face *f = &o->face[k];
+      const double x = p->data[(size_t)(p->offset[FLUID_X] + f->axis) * n + i];
+      keep[i] = f->side ? x < g->hi[f->axis] : x >= g->lo[f->axis];
+    }
+    removed += !keep[i];
+  }
+  /* Injection: the layers that crossed the face by t. */
+  const double delta = g->dx / o->ppc;
+  long long k0[2 * MPM_MAX_DIM], k1[2 * MPM_MAX_DIM];
+  mpm_lidx nadd = 0;
+  for (int k = 0; k < o->nfaces; ++k) {
+    open_face *f = &o->face[k];
+    k0[k] = k1[k] = 0;
+    if (!f->inject) continue;
+    if (f->layers < 0) f->layers = (long long)floor(f->speed * (t - h) / delta + 0.5);
+    k0[k] = f->layers;
+    k1[k] = f->layers = (long long)floor(f->speed * t / delta + 0.5);
+    if (owns_face(g, f)) {
+      int lo[MPM_MAX_DIM], cnt[MPM_MAX_DIM];
+      mpm_gidx total;
+      nadd += (mpm_lidx)(k1[k] - k0[k]) * across_points(g, f, o->ppc, lo, cnt, &total);
+    }
+  }
+  int rc = 0;
+  if (removed || nadd) {
+    double *data = calloc((size_t)p->ncomp * (size_t)(nadd ? nadd : 1), sizeof *data);
+    mpm_gidx *id = malloc(sizeof *id * (size_t)(nadd ? nadd : 1));
+    rc = data && id ? 0 : MPM_ERR_MEMORY;
+    mpm_lidx q = 0;
+    for (int k = 0; !rc && k < o->nfaces; ++k)
+      if (o->face[k].inject && owns_face(g, &o->face[k]))
+        layers(o, &o->face[k], m, k0[k], k1[k], t, nadd, data, id, &q);
+    if (!rc) rc = mpm_particles_edit(p, keep, nadd, id, data);
+    free(data), free(id);
+    *changed = 1;
+  }
+  free(keep);
+  return rc ? mpm_trace(__FILE__, __LINE__, __func__, rc) : 0;
+}

@@ -1,0 +1,36 @@
+/* Open faces of the gas: supersonic inflow and outflow, characteristic subsonic inflow and
+ * outflow, and a non-reflecting far field (the [boundary] kinds inflow, outflow,
+ * subsonic_inflow, subsonic_outflow, farfield), with the free-stream state of [freestream].
+ * Private to fluid/; see fluid_boundary.c for the method. */
+#ifndef FLUID_BOUNDARY_H
+#define FLUID_BOUNDARY_H
+
+#include "mpm_bc.h"
+#include "mpm_config.h"
+#include "mpm_module.h"
+
+extern const mpm_key_spec fluid_boundary_keys[];
+extern const int fluid_boundary_nkeys;
+
+typedef struct fluid_open fluid_open;
+
+/* Build the open faces of walls on the module's grid (NULL *open if there is none); marks
+ * them in m->open. The gas constants come from gamma; ppc is the seeding lattice. */
+int fluid_open_new(fluid_open **open, mpm_module *m, const mpm_config *cfg, const mpm_walls *walls,
+                   double gamma, int ppc);
+void fluid_open_destroy(fluid_open **open);
+
+/* In P2G, after the gas deposit: the pressure of the particles near the faces that need it,
+ * into the open faces' own grid phase. y is the module's state. */
+int fluid_open_p2g(fluid_open *open, mpm_module *m, const double *y);
+/* Before the nodal update (first pass only) at time t: add the pressure of the missing
+ * exterior gas to the nodal forces. Collective. */
+int fluid_open_forces(fluid_open *open, mpm_module *m, double t);
+/* After the nodal update: hold the nodes on and beyond an inflow face at the free-stream
+ * velocity; beyond the other open faces, copy the face node (zero gradient). */
+void fluid_open_hold(const fluid_open *open, mpm_module *m);
+/* Between steps (the boundary op): remove particles that left through an open face and inject
+ * the free-stream layers that entered during the step h that ended at t. Local. */
+int fluid_open_exchange(fluid_open *open, mpm_module *m, double t, double h, int *changed);
+
+#endif
