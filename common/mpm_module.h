@@ -65,6 +65,8 @@ struct mpm_module {
   mpm_particles *particles;
   mpm_grid *grid;
   int phase; /* index of this module's nodal fields on grid */
+  long step; /* accepted steps of the run (a restart continues the count); set by the sim
+              * before boundary and post_step */
 };
 
 /* Call ops->destroy and free the module; accepts NULL. */
