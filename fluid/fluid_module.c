@@ -51,15 +51,15 @@ static const mpm_key_spec fluid_keys[] = {
      "quadratic artificial viscosity coefficient c_quad (see av_linear)", 0},
     {"fluid.ppc", MPM_KEY_INT, "2", 1, 8, 0, 0, NULL,
      "gas particles per cell per direction at seeding", 0},
-    {"fluid.regularise_every", MPM_KEY_INT, "0", 0, INT32_MAX, 0, 0, NULL,
+    {"fluid.regularise_every", MPM_KEY_INT, "0", 0, HUGE_VAL, 0, 0, NULL,
      "merge and split gas particles every N accepted steps, conserving mass, momentum and "
      "total energy (0: never; the seed paper uses 30)",
      0},
-    {"fluid.regularise_min", MPM_KEY_INT, NULL, 1, INT32_MAX, 0, 0, NULL,
+    {"fluid.regularise_min", MPM_KEY_INT, NULL, 1, HUGE_VAL, 0, 0, NULL,
      "split particles in a non-empty cell holding fewer than this (default ceil(ppc^dim / 2): "
      "refill where the gas has expanded to twice its seeding volume; 1 never splits)",
      1},
-    {"fluid.regularise_max", MPM_KEY_INT, NULL, 2, INT32_MAX, 0, 0, NULL,
+    {"fluid.regularise_max", MPM_KEY_INT, NULL, 2, HUGE_VAL, 0, 0, NULL,
      "merge particles in a cell holding more than this (default 4 ppc^dim: only where the "
      "gas is compressed fourfold, beyond the 2-3x of the usual shocks); > regularise_min",
      1},

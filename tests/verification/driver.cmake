@@ -71,3 +71,6 @@ mpm_add_script_test(test_gas_shear SCRIPT verification/test_gas_shear.py LABELS 
 mpm_add_script_test(test_gas_shear_long SCRIPT verification/test_gas_shear.py ARGS long
                     LABELS "verification;long" TIMEOUT 1800)
 set_tests_properties(test_gas_shear_long PROPERTIES WILL_FAIL TRUE)
+# Particle regularisation of the gas: conservation per event, thresholds, ranks, restart.
+mpm_add_script_test(test_regularise SCRIPT verification/test_regularise.py
+                    LABELS "verification;mpi" TIMEOUT 600)
