@@ -68,6 +68,8 @@ struct mpm_module {
   /* Faces [axis][lo, hi] a particle may cross during a step: the module removes it between
    * steps (the gas's open faces). Elsewhere a particle outside the domain is a fault. */
   unsigned char open[MPM_MAX_DIM][2];
+  long step; /* accepted steps of the run (a restart continues the count); set by the sim
+              * before boundary and post_step */
 };
 
 /* Call ops->destroy and free the module; accepts NULL. */

@@ -329,6 +329,7 @@ static int after_step(mpm_sim *s, double h) {
   for (int k = 0; k < s->nmod; ++k) {
     mpm_module *m = s->mod[k];
     int changed = 0, migrated = 0;
+    m->step = s->step;
     if (m->ops->boundary) MPM_CALL(m->ops->boundary(m, s->t, h, &changed));
     MPM_CALL(mpm_particles_migrate(m->particles, s->grid, &migrated));
     changed |= migrated;

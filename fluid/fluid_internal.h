@@ -31,6 +31,8 @@ typedef struct fluid_content {
   mpm_node_constraints cons; /* wall nodes */
   fluid_open *open;          /* open faces (inflow, outflow, far field), or NULL */
   int remapped;              /* the phase holds MUSL's second deposit */
+  int reg_every;             /* regularise every reg_every steps (0: never) */
+  int reg_min, reg_max;      /* particles per non-empty cell after regularisation */
   mpm_lidx cap;              /* capacity of the particle scratch arrays */
   double *vsig;              /* V sigma deposited by this RHS (dim^2 cap) */
   double *scratch;           /* G2P output v, a, L ((2 dim + dim^2) cap) */
@@ -55,6 +57,11 @@ void fluid_classic_transfer(mpm_module *m, const double *y, double h, const flui
 
 /* Seed every [gas.NAME] region into the (empty) particle set (fluid_seed.c). */
 int fluid_seed(mpm_module *m, const mpm_config *cfg);
+
+/* Merge and split particles so that every non-empty cell holds reg_min to reg_max of them,
+ * conserving mass, momentum and total energy, when step is a multiple of reg_every. Sets
+ * *changed if this rank's set changed (fluid_regularise.c). Collective. */
+int fluid_regularise(mpm_module *m, long step, int *changed);
 
 /* Refresh the output fields rho, p, mach, T, s from the particle data (before output). */
 void fluid_output_fields(mpm_module *m);

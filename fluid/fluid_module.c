@@ -51,6 +51,18 @@ static const mpm_key_spec fluid_keys[] = {
      "quadratic artificial viscosity coefficient c_quad (see av_linear)", 0},
     {"fluid.ppc", MPM_KEY_INT, "2", 1, 8, 0, 0, NULL,
      "gas particles per cell per direction at seeding", 0},
+    {"fluid.regularise_every", MPM_KEY_INT, "0", 0, HUGE_VAL, 0, 0, NULL,
+     "merge and split gas particles every N accepted steps, conserving mass, momentum and "
+     "total energy (0: never; the seed paper uses 30)",
+     0},
+    {"fluid.regularise_min", MPM_KEY_INT, NULL, 1, HUGE_VAL, 0, 0, NULL,
+     "split particles in a non-empty cell holding fewer than this (default ceil(ppc^dim / 2): "
+     "refill where the gas has expanded to twice its seeding volume; 1 never splits)",
+     1},
+    {"fluid.regularise_max", MPM_KEY_INT, NULL, 2, HUGE_VAL, 0, 0, NULL,
+     "merge particles in a cell holding more than this (default 4 ppc^dim: only where the "
+     "gas is compressed fourfold, beyond the 2-3x of the usual shocks); > regularise_min",
+     1},
     {"gas.*.geometry", MPM_KEY_STRING, NULL, 0, 0, 0, 0, NULL,
      "name of the [geometry.NAME] region the gas fills (where regions overlap, the first "
      "[gas] section in the file wins)",
@@ -290,8 +302,9 @@ static int fluid_g2p(mpm_module *m, double t, const double *y, double *ydot, dou
   return 0;
 }
 
+/* After an accepted step: commit the ERK pairs' pending strain rate, then regularise. */
 static int fluid_post_step(mpm_module *m, double t, double h, int *changed) {
-  (void)t, (void)h, (void)changed;
+  (void)t, (void)h;
   const fluid_content *fc = m->content;
   const mpm_particles *p = m->particles;
   if (fc->lay.f_pending >= 0) { /* divv and D follow pending in the particle data */
@@ -299,7 +312,7 @@ static int fluid_post_step(mpm_module *m, double t, double h, int *changed) {
     memcpy(mpm_particles_comp(p, fc->lay.f_divv, 0), mpm_particles_comp(p, fc->lay.f_pending, 0),
            sizeof(double) * count);
   }
-  return 0;
+  return fluid_regularise(m, m->step, changed);
 }
 
 static int fluid_boundary(mpm_module *m, double t, double h, int *changed) {
@@ -399,6 +412,23 @@ static const mpm_module_ops fluid_ops = {
 
 /* ---- construction -------------------------------------------------------------------------- */
 
+/* The regularisation thresholds; the defaults follow the seeding count ppc^dim. */
+static int read_regularise(fluid_content *fc, const mpm_config *cfg, int dim) {
+  const char *kmin = "fluid.regularise_min", *kmax = "fluid.regularise_max";
+  int seeded = 1;
+  for (int d = 0; d < dim; ++d) seeded *= fc->ppc;
+  fc->reg_min = (seeded + 1) / 2, fc->reg_max = 4 * seeded;
+  MPM_CALL(mpm_config_get_int(cfg, "fluid.regularise_every", &fc->reg_every));
+  if (mpm_config_has(cfg, kmin)) MPM_CALL(mpm_config_get_int(cfg, kmin, &fc->reg_min));
+  if (mpm_config_has(cfg, kmax)) MPM_CALL(mpm_config_get_int(cfg, kmax, &fc->reg_max));
+  if (fc->reg_min < fc->reg_max) return 0;
+  return mpm_config_fail(cfg, mpm_config_has(cfg, kmax) ? kmax : kmin,
+                         "regularise_min = %d must be below regularise_max = %d (a cell would "
+                         "be split and merged at once); lower regularise_min or raise "
+                         "regularise_max",
+                         fc->reg_min, fc->reg_max);
+}
+
 static int read_settings(fluid_content *fc, const mpm_config *cfg, const mpm_grid *g) {
   int nv;
   double grav[3] = {0, 0, 0};
@@ -408,6 +438,7 @@ static int read_settings(fluid_content *fc, const mpm_config *cfg, const mpm_gri
   MPM_CALL(mpm_config_get_real(cfg, "fluid.av_quadratic", &fc->gas.av_quad));
   MPM_CALL(mpm_config_get_real(cfg, "fluid.R", &fc->R));
   MPM_CALL(mpm_config_get_int(cfg, "fluid.ppc", &fc->ppc));
+  MPM_CALL(read_regularise(fc, cfg, g->dim));
   MPM_CALL(mpm_config_get_reals(cfg, "physics.gravity", grav, 3, &nv));
   memcpy(fc->gravity, grav, sizeof grav);
   MPM_CALL(mpm_transfer_from_config(&fc->tr, cfg));

@@ -98,6 +98,13 @@ GAS_CASES = [
     ("gas region outside the domain", "lo = 0.5 0\nhi = 1 0.0075", "lo = 0.5 0\nhi = 1.5 0.0075",
      "gas.right.geometry",
      "outside the domain"),
+    ("negative regularise_every", "\ngamma = 1.4", "\ngamma = 1.4\nregularise_every = -30",
+     "fluid.regularise_every", ">= 0"),
+    ("regularise_min not below regularise_max", "\ngamma = 1.4",
+     "\ngamma = 1.4\nregularise_min = 8\nregularise_max = 8", "fluid.regularise_max",
+     "must be below"),
+    ("regularise_min above the default max", "\ngamma = 1.4", "\ngamma = 1.4\nregularise_min = 20",
+     "fluid.regularise_min", "regularise_max = 16"),
     ("APIC with an ERK pair", "pressure = 0.1", "pressure = 0.1\n\n[transfer]\nvelocity = apic",
      "transfer.velocity", "classic update"),
 ]

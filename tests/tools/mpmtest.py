@@ -91,14 +91,14 @@ def worst_difference(a, b):
     return worst, fields
 
 
-def check_ranks_agree(check, case_path, args, name, tol=1e-12):
+def check_ranks_agree(check, case_path, args, name, tol=1e-12, phase="solid"):
     """Run case_path with args on 1 and 2 ranks and check that the final snapshots hold the
-    same particle ids and agree in every field to tol relative (worst_difference)."""
+    same particle ids of `phase` and agree in every field to tol relative (worst_difference)."""
     finals = []
     for ranks in (1, 2):
         out = outdir(f"{name}_np{ranks}")
         run(["run", case_path, f"output.dir={out}", "run.progress=false"] + list(args), ranks)
-        finals.append(particles(snapshots(out)[-1][1]))
+        finals.append(particles(snapshots(out)[-1][1], phase))
     a, b = finals
     same = np.array_equal(a["id"], b["id"])
     check(same, f"2 ranks vs 1: the same {len(a['id'])} particle ids")
@@ -128,14 +128,15 @@ def line_starting(text, prefix):
     return [k for k, l in enumerate(text.splitlines(), 1) if l.startswith(prefix)][-1]
 
 
-def restart_difference(case_path, args, T, name):
+def restart_difference(case_path, args, T, name, phase="solid"):
     """Run a case to T with a checkpoint at T/2, restart from that checkpoint to T, and
-    compare the two final states by particle id: (ids equal, worst_difference, fields)."""
+    compare the two final states of `phase` by particle id: (ids equal, worst_difference,
+    fields)."""
     full, rest = outdir(f"{name}_full"), outdir(f"{name}_restarted")
     common = [f"time.t_end={T}", "run.progress=false"] + list(args)
     run(["run", case_path, f"output.dir={full}", f"output.checkpoint_interval={T / 2}"] + common)
     run(["restart", os.path.join(full, "checkpoint_000001.h5"), f"output.dir={rest}"] + common)
-    a, b = (particles(snapshots(d)[-1][1]) for d in (full, rest))
+    a, b = (particles(snapshots(d)[-1][1], phase) for d in (full, rest))
     if not np.array_equal(a["id"], b["id"]):
         return False, float("inf"), []
     return (True,) + worst_difference(a, b)

@@ -1,0 +1,337 @@
+/* Conservative particle regularisation of the gas: every fluid.regularise_every accepted
+ * steps, cells holding more than regularise_max particles merge pairs and cells holding fewer
+ * than regularise_min (but at least one) split particles, until every non-empty cell holds
+ * between the two. Empty cells stay empty: there is no state to seed them from.
+ *
+ * Merge: in an overcrowded cell the two closest particles (ties: the first pair in id order)
+ * become one, which keeps the lower id:
+ *   m = m_a + m_b, m v = m_a v_a + m_b v_b, x = the centre of mass, V0 = V0_a + V0_b,
+ *   J = (J_a V0_a + J_b V0_b) / V0 (so the volume J V0 is the sum), and
+ *   m e = m_a e_a + m_b e_b + (m_a m_b / 2 m) |v_a - v_b|^2:
+ * the kinetic energy the averaging of the velocities removes (never negative) becomes heat,
+ * so m e + m |v|^2 / 2 is the sum of the two. Every other field (the APIC matrix C, the lagged
+ * strain rate divv and D, the pending rate of the ERK pairs) is mass-weighted. The output-only
+ * fields (rho, p, mach, T, s) are refreshed before every write, so their merged values do not
+ * matter.
+ * Split: in a depleted cell the heaviest particle (ties: the lowest id) becomes two halves
+ * with half its mass and V0 and its v, e, J, C, divv and D, displaced by -delta and +delta
+ * along one axis, so the centre of mass stays. The axis is the one along which the cell's
+ * particles leave the widest gap (counted cyclically across the cell, ties: the lowest axis,
+ * so a lone particle splits along x); delta is a quarter of the parent's size (J V0)^(1/dim),
+ * at most half its distance to the cell faces along the axis, so both halves stay in the
+ * cell and no migration is needed. The first half keeps the parent's id.
+ * Mass, momentum and total energy are thus unchanged up to roundoff in every event.
+ *
+ * Decomposition independence: the post-step hook runs after migration, so each cell's
+ * particles are all on one rank. A cell's particles are processed in id order, and the j-th
+ * particle a split creates in global cell c gets the id id_next + c (min - 1) + j (at most
+ * min - 1 splits per cell); every rank then advances id_next by ncells (min - 1) when any
+ * rank split. The result, new ids included, does not depend on the rank layout. Nothing is
+ * kept between events: the sim's step count (restored by a restart) decides when to act. */
+#include "fluid_internal.h"
+
+#include "mpm_error.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* The particles of one cell, as rows of ncomp values, sorted by id. */
+typedef struct reg_cell {
+  int k, cap;
+  double *row;
+  mpm_gidx *id;
+  mpm_lidx *slot; /* local indices of the cell's original particles, by id */
+} reg_cell;
+
+/* The cells this rank owns: [c0, c0 + nc) along each axis, and the global lattice. */
+typedef struct reg_box {
+  int dim, c0[MPM_MAX_DIM], nc[MPM_MAX_DIM], ncells[MPM_MAX_DIM];
+  double lo[MPM_MAX_DIM], dx;
+} reg_box;
+
+static void box_of(reg_box *b, const mpm_grid *g) {
+  b->dim = g->dim, b->dx = g->dx;
+  for (int d = 0; d < g->dim; ++d) {
+    b->c0[d] = g->cell_split[d][g->coord[d]];
+    b->nc[d] = g->cell_split[d][g->coord[d] + 1] - b->c0[d];
+    b->ncells[d] = g->ncells[d], b->lo[d] = g->lo[d];
+  }
+}
+
+/* Global cell coordinate of x along d, as mpm_grid_owner_of computes it. */
+static int cell_coord(const reg_box *b, int d, double x) {
+  const int c = (int)floor((x - b->lo[d]) / b->dx);
+  return c < 0 ? 0 : c >= b->ncells[d] ? b->ncells[d] - 1 : c;
+}
+
+/* Local cell index of particle i (clamped into the box: after migration it is inside). */
+static mpm_lidx local_cell(const reg_box *b, const mpm_particles *p, mpm_lidx i) {
+  mpm_lidx l = 0;
+  for (int d = b->dim - 1; d >= 0; --d) {
+    int c = cell_coord(b, d, mpm_particles_comp(p, 0, d)[i]) - b->c0[d];
+    c = c < 0 ? 0 : c >= b->nc[d] ? b->nc[d] - 1 : c;
+    l = l * b->nc[d] + c;
+  }
+  return l;
+}
+
+static mpm_gidx global_cell(const reg_box *b, const double *x) {
+  mpm_gidx c = 0;
+  for (int d = b->dim - 1; d >= 0; --d) c = c * b->ncells[d] + cell_coord(b, d, x[d]);
+  return c;
+}
+
+/* Particle indices grouped by local cell: cell l holds perm[start[l] .. start[l + 1]). */
+static int group_by_cell(const reg_box *b, const mpm_particles *p, mpm_lidx **start,
+                         mpm_lidx **perm, mpm_lidx *ncell) {
+  mpm_lidx nc = 1;
+  for (int d = 0; d < b->dim; ++d) nc *= b->nc[d];
+  *ncell = nc;
+  mpm_lidx *cell;
+  MPM_ALLOC(cell, p->n);
+  *start = calloc((size_t)nc + 2, sizeof **start);
+  *perm = malloc(sizeof **perm * (size_t)(p->n ? p->n : 1));
+  if (!*start || !*perm) {
+    free(cell);
+    MPM_FAIL(MPM_ERR_MEMORY, "regularise: cannot group %d particles by cell", (int)p->n);
+  }
+  for (mpm_lidx i = 0; i < p->n; ++i) cell[i] = local_cell(b, p, i), (*start)[cell[i] + 2]++;
+  for (mpm_lidx l = 0; l < nc; ++l) (*start)[l + 2] += (*start)[l + 1];
+  for (mpm_lidx i = 0; i < p->n; ++i) (*perm)[(*start)[cell[i] + 1]++] = i;
+  free(cell);
+  return 0;
+}
+
+/* ---- one cell ---------------------------------------------------------------------------- */
+
+static int cell_reserve(reg_cell *c, int k, int ncomp) {
+  if (k <= c->cap) return 0;
+  const int cap = 2 * k;
+  double *row = realloc(c->row, sizeof *row * (size_t)cap * (size_t)ncomp);
+  if (row) c->row = row;
+  mpm_gidx *id = realloc(c->id, sizeof *id * (size_t)cap);
+  if (id) c->id = id;
+  mpm_lidx *slot = realloc(c->slot, sizeof *slot * (size_t)cap);
+  if (slot) c->slot = slot;
+  if (!row || !id || !slot) MPM_FAIL(MPM_ERR_MEMORY, "regularise: a cell of %d particles", k);
+  c->cap = cap;
+  return 0;
+}
+
+/* Gather the k particles perm[0 .. k) into rows, in id order. */
+static int cell_gather(reg_cell *c, const mpm_particles *p, const mpm_lidx *perm, int k) {
+  MPM_CALL(cell_reserve(c, k, p->ncomp));
+  for (int a = 0; a < k; ++a) { /* insertion sort by id: a cell holds a few particles */
+    int b = a;
+    for (; b > 0 && p->id[c->slot[b - 1]] > p->id[perm[a]]; --b) c->slot[b] = c->slot[b - 1];
+    c->slot[b] = perm[a];
+  }
+  for (int a = 0; a < k; ++a) {
+    c->id[a] = p->id[c->slot[a]];
+    for (int q = 0; q < p->ncomp; ++q)
+      c->row[(size_t)a * p->ncomp + q] = p->data[(size_t)q * p->n + c->slot[a]];
+  }
+  c->k = k;
+  return 0;
+}
+
+/* Row b merged into row a (see the header for the rules). */
+static void merge_rows(const fluid_layout *lay, const mpm_particles *p, double *a,
+                       const double *b) {
+  const int om = p->offset[lay->f_m], oV = p->offset[lay->f_V0], ov = p->offset[FLUID_V];
+  const int oJ = p->offset[FLUID_J], oe = p->offset[FLUID_E];
+  const double ma = a[om], mb = b[om], m = ma + mb, V0 = a[oV] + b[oV];
+  double dv2 = 0.0;
+  for (int d = 0; d < p->dim; ++d) dv2 += (a[ov + d] - b[ov + d]) * (a[ov + d] - b[ov + d]);
+  const double J = (a[oJ] * a[oV] + b[oJ] * b[oV]) / V0;
+  const double e = (ma * a[oe] + mb * b[oe] + 0.5 * ma * mb / m * dv2) / m;
+  for (int q = 0; q < p->ncomp; ++q) a[q] = (ma * a[q] + mb * b[q]) / m;
+  a[om] = m, a[oV] = V0, a[oJ] = J, a[oe] = e;
+}
+
+static double dist2(const double *a, const double *b, int dim) {
+  double s = 0.0;
+  for (int d = 0; d < dim; ++d) s += (a[d] - b[d]) * (a[d] - b[d]);
+  return s;
+}
+
+/* Merge the closest pair of rows; the later row (higher id) goes. */
+static void merge_closest(reg_cell *c, const fluid_layout *lay, const mpm_particles *p) {
+  const int nc = p->ncomp;
+  int ia = 0, ib = 1;
+  double best = HUGE_VAL;
+  for (int a = 0; a < c->k; ++a)
+    for (int b = a + 1; b < c->k; ++b) {
+      const double s = dist2(c->row + (size_t)a * nc, c->row + (size_t)b * nc, p->dim);
+      if (s < best) best = s, ia = a, ib = b;
+    }
+  merge_rows(lay, p, c->row + (size_t)ia * nc, c->row + (size_t)ib * nc);
+  memmove(c->row + (size_t)ib * nc, c->row + (size_t)(ib + 1) * nc,
+          sizeof *c->row * (size_t)(c->k - ib - 1) * nc);
+  memmove(c->id + ib, c->id + ib + 1, sizeof *c->id * (size_t)(c->k - ib - 1));
+  c->k--;
+}
+
+/* The axis along which the rows leave the widest gap, cyclically across the cell. */
+static int widest_gap_axis(const reg_cell *c, const reg_box *b, int nc) {
+  int axis = 0;
+  double widest = -1.0;
+  for (int d = 0; d < b->dim; ++d) {
+    double gap = 0.0;
+    for (int a = 0; a < c->k; ++a) { /* the gap above row a: to the next coordinate up */
+      const double u = c->row[(size_t)a * nc + d];
+      double next = HUGE_VAL;
+      for (int q = 0; q < c->k; ++q) {
+        double w = c->row[(size_t)q * nc + d];
+        if (!(w > u) && q != a) w += b->dx; /* at or below: its image in the next cell */
+        if (q != a && w < next) next = w;
+      }
+      gap = fmax(gap, c->k > 1 ? next - u : b->dx);
+    }
+    if (gap > widest) widest = gap, axis = d;
+  }
+  return axis;
+}
+
+/* Split the heaviest row into two halves; the new half gets id `id`. */
+static int split_heaviest(reg_cell *c, const fluid_layout *lay, const mpm_particles *p,
+                          const reg_box *b, mpm_gidx id) {
+  const int nc = p->ncomp, om = p->offset[lay->f_m];
+  MPM_CALL(cell_reserve(c, c->k + 1, nc));
+  int h = 0;
+  for (int a = 1; a < c->k; ++a)
+    if (c->row[(size_t)a * nc + om] > c->row[(size_t)h * nc + om]) h = a;
+  const int axis = widest_gap_axis(c, b, nc);
+  double *par = c->row + (size_t)h * nc, *kid = c->row + (size_t)c->k * nc;
+  const double x = par[axis];
+  const double face = b->lo[axis] + cell_coord(b, axis, x) * b->dx;
+  const double room = fmin(x - face, face + b->dx - x);
+  const double size = pow(par[p->offset[FLUID_J]] * par[p->offset[lay->f_V0]], 1.0 / p->dim);
+  const double delta = fmin(0.25 * size, 0.5 * room);
+  par[om] *= 0.5, par[p->offset[lay->f_V0]] *= 0.5;
+  memcpy(kid, par, sizeof *kid * (size_t)nc);
+  par[axis] = x - delta, kid[axis] = x + delta;
+  c->id[c->k++] = id;
+  return 0;
+}
+
+/* ---- the event --------------------------------------------------------------------------- */
+
+/* Changes made on this rank: rows written back, particles dropped or appended. */
+typedef struct reg_edit {
+  unsigned char *keep;
+  mpm_lidx nadd, cap;
+  double *add; /* rows (row-major) of the appended particles */
+  mpm_gidx *add_id;
+  long splits, merges;
+} reg_edit;
+
+static int edit_append(reg_edit *e, const double *row, mpm_gidx id, int nc) {
+  if (e->nadd == e->cap) {
+    const mpm_lidx cap = 2 * e->cap + 16;
+    double *add = realloc(e->add, sizeof *add * (size_t)cap * (size_t)nc);
+    if (add) e->add = add;
+    mpm_gidx *ids = realloc(e->add_id, sizeof *ids * (size_t)cap);
+    if (ids) e->add_id = ids;
+    if (!add || !ids) MPM_FAIL(MPM_ERR_MEMORY, "regularise: cannot append %d particles", cap);
+    e->cap = cap;
+  }
+  memcpy(e->add + (size_t)e->nadd * nc, row, sizeof *row * (size_t)nc);
+  e->add_id[e->nadd++] = id;
+  return 0;
+}
+
+/* Write the cell's rows back: into its original slots first, the rest appended; slots
+ * left over are dropped. */
+static int cell_scatter(const reg_cell *c, int k0, mpm_particles *p, reg_edit *e) {
+  const int nc = p->ncomp;
+  for (int a = 0; a < c->k && a < k0; ++a) {
+    p->id[c->slot[a]] = c->id[a];
+    for (int q = 0; q < nc; ++q)
+      p->data[(size_t)q * p->n + c->slot[a]] = c->row[(size_t)a * nc + q];
+  }
+  for (int a = c->k; a < k0; ++a) e->keep[c->slot[a]] = 0;
+  for (int a = k0; a < c->k; ++a) MPM_CALL(edit_append(e, c->row + (size_t)a * nc, c->id[a], nc));
+  return 0;
+}
+
+/* Bring one cell's count into [min, max]. */
+static int regularise_cell(const fluid_content *fc, mpm_particles *p, const reg_box *b,
+                           const mpm_lidx *perm, int k, mpm_gidx id_base, reg_cell *c,
+                           reg_edit *e) {
+  if (k == 0 || (k >= fc->reg_min && k <= fc->reg_max)) return 0;
+  MPM_CALL(cell_gather(c, p, perm, k));
+  const mpm_gidx first = id_base + global_cell(b, c->row) * (mpm_gidx)(fc->reg_min - 1);
+  for (int j = 0; c->k < fc->reg_min; ++j, e->splits++)
+    MPM_CALL(split_heaviest(c, &fc->lay, p, b, first + j));
+  for (; c->k > fc->reg_max; e->merges++) merge_closest(c, &fc->lay, p);
+  return cell_scatter(c, k, p, e);
+}
+
+/* Apply the edit: drop and append (component-major add data). */
+static int edit_apply(mpm_particles *p, const reg_edit *e) {
+  const int nc = p->ncomp;
+  double *data;
+  MPM_ALLOC(data, (size_t)nc * e->nadd);
+  for (mpm_lidx a = 0; a < e->nadd; ++a)
+    for (int q = 0; q < nc; ++q) data[(size_t)q * e->nadd + a] = e->add[(size_t)a * nc + q];
+  const int rc = mpm_particles_edit(p, e->keep, e->nadd, e->add_id, data);
+  free(data);
+  return rc;
+}
+
+static int regularise_local(mpm_module *m, reg_edit *e, mpm_gidx id_base) {
+  const fluid_content *fc = m->content;
+  mpm_particles *p = m->particles;
+  reg_box b;
+  box_of(&b, m->grid);
+  mpm_lidx *start = NULL, *perm = NULL, ncell = 0;
+  reg_cell c = {0};
+  MPM_ALLOC(e->keep, p->n);
+  memset(e->keep, 1, (size_t)p->n);
+  int rc = group_by_cell(&b, p, &start, &perm, &ncell);
+  for (mpm_lidx l = 0; !rc && l < ncell; ++l)
+    rc =
+        regularise_cell(fc, p, &b, perm + start[l], (int)(start[l + 1] - start[l]), id_base, &c, e);
+  if (!rc && (e->splits || e->merges)) rc = edit_apply(p, e);
+  free(start), free(perm), free(c.row), free(c.id), free(c.slot);
+  return rc;
+}
+
+/* Global totals: mass, momentum (3), total energy. */
+static void totals(const mpm_module *m, double *t) {
+  mpm_module_sums s;
+  m->ops->sums(m, &s);
+  t[0] = s.mass, t[4] = s.kinetic + s.internal;
+  for (int d = 0; d < 3; ++d) t[1 + d] = s.momentum[d];
+}
+
+int fluid_regularise(mpm_module *m, long step, int *changed) {
+  const fluid_content *fc = m->content;
+  if (fc->reg_every <= 0 || step % fc->reg_every != 0) return 0;
+  mpm_particles *p = m->particles;
+  reg_edit e = {0};
+  double sum[13] = {0}; /* failures, splits, merges, totals before (5) and after (5) */
+  totals(m, sum + 3);
+  const int rc = regularise_local(m, &e, p->id_next);
+  sum[0] = rc != 0, sum[1] = (double)e.splits, sum[2] = (double)e.merges;
+  totals(m, sum + 8);
+  free(e.keep), free(e.add), free(e.add_id);
+  /* One reduction: every rank learns of a failure anywhere before it goes on. */
+  MPM_CALL_MPI(MPI_Allreduce(MPI_IN_PLACE, sum, 13, MPI_DOUBLE, MPI_SUM, m->grid->comm));
+  MPM_CALL(rc);
+  if (sum[0] > 0) MPM_FAIL(MPM_ERR_MEMORY, "regularise: failed on another rank");
+  if (sum[1] > 0) {
+    mpm_gidx cells = 1;
+    for (int d = 0; d < m->grid->dim; ++d) cells *= m->grid->ncells[d];
+    p->id_next += cells * (mpm_gidx)(fc->reg_min - 1);
+  }
+  if (e.splits || e.merges) *changed = 1;
+  mpm_log(MPM_LOG_DEBUG,
+          "regularise step %ld: %.0f splits, %.0f merges; mass %.17g -> %.17g, momentum "
+          "(%.17g, %.17g, %.17g) -> (%.17g, %.17g, %.17g), energy %.17g -> %.17g",
+          step, sum[1], sum[2], sum[3], sum[8], sum[4], sum[5], sum[6], sum[9], sum[10], sum[11],
+          sum[7], sum[12]);
+  return 0;
+}
