@@ -151,17 +151,15 @@ static const char *const g_axes = "xyz", *const g_side[2] = {"lo", "hi"};
 
 static int read_freestream(fluid_open *o, const mpm_config *cfg, const mpm_walls *walls, int dim,
                            double gamma) {
-  const char *needs = NULL;
+  char face[32] = "";
   for (int d = 0; d < dim; ++d)
     for (int s = 0; s < 2; ++s)
-      if (mpm_wall_is_open_gas(walls->face[d][s])) needs = mpm_wall_name(walls->face[d][s]);
-  static const char *const keys[] = {"freestream.density", "freestream.pressure"};
-  for (int k = 0; k < 2; ++k)
-    if (!mpm_config_has(cfg, keys[k]))
-      return mpm_config_fail(cfg, keys[k],
-                             "a %s face needs the free-stream state: set [freestream] density, "
-                             "pressure and velocity",
-                             needs);
+      if (mpm_wall_is_open_gas(walls->face[d][s]) && !face[0])
+        snprintf(face, sizeof face, "boundary.%c_%s", g_axes[d], g_side[s]);
+  if (!mpm_config_has(cfg, "freestream.density") || !mpm_config_has(cfg, "freestream.pressure"))
+    return mpm_config_fail(cfg, face,
+                           "an open gas face needs the free-stream state: add a [freestream] "
+                           "section with density, pressure and velocity");
   int count;
   double v[3] = {0, 0, 0};
   MPM_CALL(mpm_config_get_real(cfg, "freestream.density", &o->rho));
@@ -382,8 +380,12 @@ int fluid_open_p2g(fluid_open *o, mpm_module *m, const double *y) {
   const mpm_lidx cap = o->virt_cap;
   double *vm = o->virt + (size_t)(dim + dim * dim) * cap, *vv = vm + cap;
   for (mpm_lidx q = 0; q < nv; ++q) vm[q] = vv[q] = 0.0;
+  /* The kernel reads V sigma component-major with stride nv. */
+  double *vsig = o->virt + (size_t)dim * cap;
+  for (int c = 1; c < dim * dim; ++c)
+    memmove(vsig + (size_t)c * nv, vsig + (size_t)c * cap, sizeof(double) * (size_t)nv);
   mpm_grid_phase_zero(m->grid, o->phase);
-  mpm_p2g_args a = {.n = nv, .m = vm, .vsig = o->virt + (size_t)dim * cap, .lp = fc->lp};
+  mpm_p2g_args a = {.n = nv, .m = vm, .vsig = vsig, .lp = fc->lp};
   for (int d = 0; d < dim; ++d) a.x[d] = o->virt + (size_t)d * cap, a.v[d] = vv;
   mpm_kernels_get(dim)->p2g(m->grid, o->phase, &a);
   return 0;

@@ -105,6 +105,8 @@ GAS_CASES = [
      "must be below"),
     ("regularise_min above the default max", "\ngamma = 1.4", "\ngamma = 1.4\nregularise_min = 20",
      "fluid.regularise_min", "regularise_max = 16"),
+    ("open face without [freestream]", "x_hi = slip", "x_hi = outflow", "boundary.x_hi",
+     "[freestream]"),
     ("APIC with an ERK pair", "pressure = 0.1", "pressure = 0.1\n\n[transfer]\nvelocity = apic",
      "transfer.velocity", "classic update"),
 ]
@@ -116,6 +118,11 @@ for name, old, new, key, words in GAS_CASES:
     if name == "gas region outside the domain":
         line = line_of(text, "geometry = right")
     expect_error(name, text, key, words, line)
+# An inflow face through which the free stream leaves.
+inflow = GAS.replace("x_hi = slip", "x_hi = inflow") + \
+    "\n[freestream]\ndensity = 1\npressure = 1\nvelocity = 1 0\n"
+expect_error("inflow face the free stream leaves", inflow, "boundary.x_hi", "does not enter",
+             line_of(inflow, "x_hi = inflow"))
 # A gas section without its density (reported within the section), and a scene with neither
 # bodies nor gas (naming the sections to add).
 expect_error("gas without density", GAS.replace("density = 0.125\n", ""), "gas.right.density",

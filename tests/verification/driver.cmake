@@ -75,3 +75,5 @@ set_tests_properties(test_gas_shear_long PROPERTIES WILL_FAIL TRUE)
 # Particle regularisation of the gas: conservation per event, thresholds, ranks, restart.
 mpm_add_script_test(test_regularise SCRIPT verification/test_regularise.py
                     LABELS "verification;mpi" TIMEOUT 600)
+mpm_add_script_test(test_gas_boundaries SCRIPT verification/test_gas_boundaries.py
+                    LABELS "verification;mpi" TIMEOUT 600)
