@@ -50,7 +50,8 @@ void mpm_sdf_ball(mpm_sdf *s, int dim, const double *c, double r) {
 
 double mpm_polygon_area(const double *xy, int nv) {
   double a = 0.0;
-  for (int i = 0, j = nv - 1; i < nv; j = i++) a += xy[2 * j] * xy[2 * i + 1] - xy[2 * i] * xy[2 * j + 1];
+  for (int i = 0, j = nv - 1; i < nv; j = i++)
+    a += xy[2 * j] * xy[2 * i + 1] - xy[2 * i] * xy[2 * j + 1];
   return 0.5 * a;
 }
 
@@ -75,8 +76,8 @@ int mpm_sdf_polygon(mpm_sdf *s, int dim, const double *xy, int nv, const double 
 int mpm_sdf_wedge(mpm_sdf *s, int dim, const double *foot, double length, double angle_deg,
                   const double *z) {
   const double rise = length * tan(angle_deg * PI / 180.0);
-  const double xy[6] = {foot[0], foot[1], foot[0] + length, foot[1], foot[0] + length,
-                        foot[1] + rise};
+  const double xy[6] = {foot[0], foot[1],          foot[0] + length,
+                        foot[1], foot[0] + length, foot[1] + rise};
   return mpm_sdf_polygon(s, dim, xy, 3, z);
 }
 

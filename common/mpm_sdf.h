@@ -22,9 +22,9 @@ typedef struct mpm_sdf {
   double lo[3], hi[3]; /* bounding box (the box itself for a box) */
   double c[3], r;      /* ball */
   int nv;
-  double *v;      /* polygon vertices (x, y) pairs, no repeated closing vertex */
-  double orient;  /* +1 counter-clockwise, -1 clockwise */
-  int extruded;   /* 3-D polygon with a finite z range lo[2]..hi[2] */
+  double *v;     /* polygon vertices (x, y) pairs, no repeated closing vertex */
+  double orient; /* +1 counter-clockwise, -1 clockwise */
+  int extruded;  /* 3-D polygon with a finite z range lo[2]..hi[2] */
 } mpm_sdf;
 
 void mpm_sdf_box(mpm_sdf *s, int dim, const double *lo, const double *hi);

@@ -32,8 +32,7 @@ const mpm_key_spec fluid_obstacle_keys[] = {
     {"obstacle.*.radius", MPM_KEY_REAL, NULL, 0, HUGE_VAL, 1, 0, NULL,
      "circle, sphere: radius, m, > 0", 1},
     {"obstacle.*.vertices", MPM_KEY_REALS, NULL, -HUGE_VAL, HUGE_VAL, 0, 0, NULL,
-     "polygon: x1 y1 x2 y2 ... (m), at least 3 vertices, closed implicitly, not self-crossing",
-     1},
+     "polygon: x1 y1 x2 y2 ... (m), at least 3 vertices, closed implicitly, not self-crossing", 1},
     {"obstacle.*.z", MPM_KEY_REALS, NULL, -HUGE_VAL, HUGE_VAL, 0, 2, NULL,
      "polygon, wedge, airfoil in 3-D: extrusion range z_lo z_hi, m (default: endless)", 1},
     {"obstacle.*.foot", MPM_KEY_REALS, NULL, -HUGE_VAL, HUGE_VAL, 0, 2, NULL,
@@ -73,10 +72,9 @@ static const char *const g_shapes[][2] = {
     {"wedge", "foot length angle z"},
     {"airfoil", "file chord leading_edge angle_of_attack z"},
 };
-static const char *const g_shape_keys[] = {"lo",     "hi",   "center", "radius",
-                                           "vertices", "z",  "foot",   "length",
-                                           "angle",  "file", "chord",  "leading_edge",
-                                           "angle_of_attack"};
+static const char *const g_shape_keys[] = {
+    "lo",    "hi",   "center", "radius",       "vertices",       "z", "foot", "length",
+    "angle", "file", "chord",  "leading_edge", "angle_of_attack"};
 
 typedef struct reader {
   const mpm_config *cfg;
@@ -104,8 +102,7 @@ static int get_vec(const reader *r, const char *field, int n, double *v, int max
     return mpm_config_fail(r->cfg, r->shape_key, "this shape needs `%s = ...` in [obstacle.%s]",
                            field, r->name);
   MPM_CALL(mpm_config_get_reals(r->cfg, key, v, max, &got));
-  if (n > 0 && got != n)
-    return mpm_config_fail(r->cfg, key, "needs %d values, got %d", n, got);
+  if (n > 0 && got != n) return mpm_config_fail(r->cfg, key, "needs %d values, got %d", n, got);
   for (int i = 0; i < got; ++i)
     if (!isfinite(v[i])) return mpm_config_fail(r->cfg, key, "values must be finite");
   if (count) *count = got;
@@ -328,8 +325,8 @@ static int find_nodes(fluid_obstacle *ob, const mpm_grid *g, double band) {
   return 0;
 }
 
-static int build_one(fluid_obstacle *ob, const mpm_config *cfg, const mpm_grid *g,
-                     const char *name, double band) {
+static int build_one(fluid_obstacle *ob, const mpm_config *cfg, const mpm_grid *g, const char *name,
+                     double band) {
   reader r = {cfg, name, g->dim, ""};
   const char *shape, *cond;
   char key[KEY_LEN];
@@ -346,7 +343,6 @@ static int build_one(fluid_obstacle *ob, const mpm_config *cfg, const mpm_grid *
   MPM_CALL(check_overlap(ob, &r, g));
   return find_nodes(ob, g, band);
 }
-
 
 /* A particle in cell c reaches nodes c - 1 .. c + 2 at most: flag cells gi - 2 .. gi + 1. */
 static void flag_near(fluid_obstacles *o, const mpm_grid *g, const int *gi) {
@@ -378,8 +374,7 @@ static void stencil_at(stencil *st, const mpm_grid *g, const double *x, double l
 }
 
 /* Stencil slot k (x fastest) as a box index, or -1 outside the box; w and grad S there. */
-static mpm_lidx stencil_node(const stencil *st, const mpm_grid *g, int k, double *w,
-                             double *grad) {
+static mpm_lidx stencil_node(const stencil *st, const mpm_grid *g, int k, double *w, double *grad) {
   int gi[MPM_MAX_DIM], kd[MPM_MAX_DIM];
   for (int d = 0; d < g->dim; ++d) {
     kd[d] = k % st->support, k /= st->support;
@@ -506,7 +501,6 @@ int fluid_obstacles_inside(const fluid_obstacles *o, const double *x) {
   return 0;
 }
 
-
 void fluid_obstacles_deposit(fluid_obstacles *o, const mpm_grid *grid, mpm_lidx n,
                              const double *const *x, const double *m, const double *V0,
                              const double *J, const double *vsig) {
@@ -564,8 +558,8 @@ int fluid_obstacles_begin(fluid_obstacles *o, mpm_grid *grid, int phase, double 
 }
 
 /* Constrain one obstacle's nodes; adds this rank's owned share of the force to f. */
-static void apply_one(const fluid_obstacle *ob, mpm_grid_phase *ph, int dim, double h,
-                      double share, double *f) {
+static void apply_one(const fluid_obstacle *ob, mpm_grid_phase *ph, int dim, double h, double share,
+                      double *f) {
   for (mpm_lidx k = 0; k < ob->count; ++k) {
     const mpm_lidx l = ob->node[k];
     const double m = ph->m_i[l];

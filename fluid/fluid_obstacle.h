@@ -44,13 +44,13 @@ typedef struct fluid_obstacle {
   char name[64];
   mpm_sdf sdf;
   int no_slip;
-  int has_ref;                 /* reference area given: write Cd and Cl */
-  double q_ref_area;           /* 1/2 rho U^2 A */
-  double flow[3], lift[3];     /* unit drag and lift directions */
-  mpm_lidx count;              /* constrained nodes */
-  mpm_lidx *node;              /* box index */
-  double *normal;              /* dim per node */
-  unsigned char *owned;        /* counted in the force */
+  int has_ref;             /* reference area given: write Cd and Cl */
+  double q_ref_area;       /* 1/2 rho U^2 A */
+  double flow[3], lift[3]; /* unit drag and lift directions */
+  mpm_lidx count;          /* constrained nodes */
+  mpm_lidx *node;          /* box index */
+  double *normal;          /* dim per node */
+  unsigned char *owned;    /* counted in the force */
 } fluid_obstacle;
 
 /* The forces of one RHS evaluation on this rank (dim per obstacle). */
@@ -63,20 +63,20 @@ typedef struct fluid_force_record {
 typedef struct fluid_obstacles {
   int count;
   fluid_obstacle *ob;
-  double pic_share; /* s above */
+  double pic_share;          /* s above */
   fluid_force_record rec[2]; /* the latest RHS and the one before (at another time) */
   int latest;
   int ppc;
-  double lp;            /* GIMP half-width of the particles and ghosts, cells */
-  mpm_lidx gcount;      /* nodes with a ghost force */
-  mpm_lidx *gnode;      /* box index */
-  double *G;            /* sum V grad S of the ghosts (dim per node) */
+  double lp;       /* GIMP half-width of the particles and ghosts, cells */
+  mpm_lidx gcount; /* nodes with a ghost force */
+  mpm_lidx *gnode; /* box index */
+  double *G;       /* sum V grad S of the ghosts (dim per node) */
   unsigned char *gowned;
-  int *gob;             /* the obstacle each ghost force belongs to (the nearest) */
-  unsigned char *near;  /* per box node as a cell's lower corner: a particle in it reaches a
-                           ghost node */
-  double *sm;           /* nodal m and m p of the particles near a body (2 nnodes) */
-  char path[4096]; /* obstacles.csv */
+  int *gob;            /* the obstacle each ghost force belongs to (the nearest) */
+  unsigned char *near; /* per box node as a cell's lower corner: a particle in it reaches a
+                          ghost node */
+  double *sm;          /* nodal m and m p of the particles near a body (2 nnodes) */
+  char path[4096];     /* obstacles.csv */
   mpm_diag *csv;
 } fluid_obstacles;
 
@@ -100,7 +100,8 @@ int fluid_obstacles_begin(fluid_obstacles *o, mpm_grid *grid, int phase, double 
 /* 1 if x lies inside an obstacle (phi < 0): no gas particle is seeded there. */
 int fluid_obstacles_inside(const fluid_obstacles *o, const double *x);
 /* Constrain the obstacle nodes of phase after a nodal update with step h (0: method of lines);
- * add the removed momentum to the force record begun by fluid_obstacles_begin when record is set. */
+ * add the removed momentum to the force record begun by fluid_obstacles_begin when record is set.
+ */
 void fluid_obstacles_apply(fluid_obstacles *o, mpm_grid *grid, int phase, double h, int record);
 /* After an accepted step from t - h to t: reduce the recorded forces and write one row per
  * obstacle to obstacles.csv (opened at the first call; appended after a restart). Collective. */

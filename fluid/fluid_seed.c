@@ -185,11 +185,12 @@ static int seed_one(mpm_module *m, const mpm_config *cfg, gas_state *s, int k) {
   if (total == 0) {
     char key[160];
     key_of(key, sizeof key, s[k].section, "geometry");
-    return mpm_config_fail(cfg, key,
-                           "[%s] has no particles: its region is thinner than the particle "
-                           "spacing %g or lies inside earlier gas regions or obstacles; refine grid.dx, raise "
-                           "fluid.ppc or change the region",
-                           s[k].section, g->dx / fc->ppc);
+    return mpm_config_fail(
+        cfg, key,
+        "[%s] has no particles: its region is thinner than the particle "
+        "spacing %g or lies inside earlier gas regions or obstacles; refine grid.dx, raise "
+        "fluid.ppc or change the region",
+        s[k].section, g->dx / fc->ppc);
   }
   mpm_log(MPM_LOG_INFO, "gas %s: %lld particles", s[k].section, (long long)total);
   return 0;
