@@ -156,13 +156,13 @@ static int polygon_from(mpm_sdf *s, const reader *r, const char *key, const doub
   int i, j;
   if (nv < 3)
     return mpm_config_fail(r->cfg, key, "a polygon needs at least 3 vertices, got %d", nv);
-  if (mpm_polygon_area(xy, nv) == 0.0)
-    return mpm_config_fail(r->cfg, key, "the vertices enclose no area (all collinear?)");
   if (mpm_polygon_self_intersects(xy, nv, &i, &j))
     return mpm_config_fail(r->cfg, key,
                            "the outline crosses itself: edge %d (from vertex %d) meets edge %d; "
                            "list the vertices in order around the shape",
                            i + 1, i + 1, j + 1);
+  if (mpm_polygon_area(xy, nv) == 0.0)
+    return mpm_config_fail(r->cfg, key, "the vertices enclose no area (all collinear?)");
   return mpm_sdf_polygon(s, r->dim, xy, nv, z);
 }
 
