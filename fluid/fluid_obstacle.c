@@ -296,6 +296,29 @@ static int check_overlap(const fluid_obstacle *ob, const reader *r, const mpm_gr
   return 0;
 }
 
+/* phi (and the normal) at x, nearest over the periodic images of x: a body near a periodic face
+ * is also near the nodes beyond the opposite face. */
+static double phi_images(const mpm_sdf *sdf, const mpm_grid *g, const double *x, double *normal) {
+  double best = HUGE_VAL;
+  const int nimg = g->dim == 2 ? 9 : 27;
+  for (int k = 0; k < nimg; ++k) {
+    double y[3] = {0, 0, 0}, n[3];
+    int skip = 0;
+    for (int d = 0, r = k; d < g->dim; ++d, r /= 3) {
+      const int shift = r % 3 - 1;
+      skip |= shift && !g->periodic[d];
+      y[d] = x[d] + shift * (g->hi[d] - g->lo[d]);
+    }
+    if (skip) continue;
+    const double phi = mpm_sdf_eval(sdf, y, normal ? n : NULL);
+    if (phi < best) {
+      best = phi;
+      if (normal) memcpy(normal, n, sizeof n);
+    }
+  }
+  return best;
+}
+
 /* The nodes with phi < band, their normals and whether this rank owns them. */
 static int find_nodes(fluid_obstacle *ob, const mpm_grid *g, double band) {
   const int dim = g->dim;
@@ -307,7 +330,7 @@ static int find_nodes(fluid_obstacle *ob, const mpm_grid *g, double band) {
       double x[3] = {0, 0, 0}, nrm[3];
       mpm_grid_node_global(g, l, gi);
       for (int d = 0; d < dim; ++d) x[d] = g->lo[d] + gi[d] * g->dx;
-      if (!(mpm_sdf_eval(&ob->sdf, x, nrm) < band)) continue;
+      if (!(phi_images(&ob->sdf, g, x, nrm) < band)) continue;
       if (pass) {
         ob->node[n] = l;
         memcpy(ob->normal + (size_t)dim * n, nrm, sizeof *nrm * (size_t)dim);
@@ -429,7 +452,7 @@ static int nearest(const fluid_obstacles *o, const mpm_grid *g, const int *gi) {
   int k_best = 0;
   for (int d = 0; d < g->dim; ++d) x[d] = g->lo[d] + gi[d] * g->dx;
   for (int k = 0; k < o->count; ++k) {
-    const double phi = mpm_sdf_eval(&o->ob[k].sdf, x, NULL);
+    const double phi = phi_images(&o->ob[k].sdf, g, x, NULL);
     if (phi < best) best = phi, k_best = k;
   }
   return k_best;
