@@ -75,13 +75,28 @@ int mpm_diag_open(mpm_diag **d, MPI_Comm comm, const char *path, int ncols,
   return 0;
 }
 
-int mpm_diag_row(mpm_diag *d, const double *values) {
+/* Columns [0, ncols) of a row; the column `at` is the label (none if label is NULL). */
+static int write_row(mpm_diag *d, const char *label, int at, const double *values) {
   if (!d->f) return 0;
-  for (int c = 0; c < d->ncols; ++c) fprintf(d->f, "%s%.17g", c ? "," : "", values[c]);
+  for (int c = 0, k = 0; c < d->ncols; ++c) {
+    if (c) fputc(',', d->f);
+    if (label && c == at)
+      fputs(label, d->f);
+    else
+      fprintf(d->f, "%.17g", values[k++]);
+  }
   fputc('\n', d->f);
   if (fflush(d->f) != 0)
     MPM_FAIL(MPM_ERR_FILE, "cannot write a diagnostics row: %s", strerror(errno));
   return 0;
+}
+
+int mpm_diag_row(mpm_diag *d, const double *values) {
+  return write_row(d, NULL, -1, values);
+}
+
+int mpm_diag_row_label(mpm_diag *d, const char *label, const double *values) {
+  return write_row(d, label, 1, values);
 }
 
 void mpm_diag_close(mpm_diag **d) {

@@ -13,6 +13,9 @@ int mpm_diag_open(mpm_diag **d, MPI_Comm comm, const char *path, int ncols,
                   const char *const *names, int append, double t_keep);
 /* Write one row (rank 0 writes; the values must be the same on every rank). */
 int mpm_diag_row(mpm_diag *d, const double *values);
+/* Write one row whose second column is text: values[0], label, values[1 .. ncols - 2]
+ * (several rows of one time, one per named object). */
+int mpm_diag_row_label(mpm_diag *d, const char *label, const double *values);
 void mpm_diag_close(mpm_diag **d);
 
 #endif

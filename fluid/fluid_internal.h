@@ -4,6 +4,7 @@
 #define FLUID_INTERNAL_H
 
 #include "fluid_boundary.h"
+#include "fluid_obstacle.h"
 #include "fluid_stress.h"
 
 #include "mpm_bc.h"
@@ -30,6 +31,7 @@ typedef struct fluid_content {
   double gravity[MPM_MAX_DIM];
   mpm_node_constraints cons; /* wall nodes */
   fluid_open *open;          /* open faces (inflow, outflow, far field), or NULL */
+  fluid_obstacles obs;       /* static obstacles (fluid_obstacle.h) */
   int remapped;              /* the phase holds MUSL's second deposit */
   int reg_every;             /* regularise every reg_every steps (0: never) */
   int reg_min, reg_max;      /* particles per non-empty cell after regularisation */

@@ -87,6 +87,7 @@ static const mpm_key_spec fluid_keys[] = {
 
 int fluid_add_schema(mpm_config *cfg) {
   MPM_CALL(mpm_config_add_schema(cfg, fluid_boundary_keys, fluid_boundary_nkeys));
+  MPM_CALL(mpm_config_add_schema(cfg, fluid_obstacle_keys, fluid_obstacle_nkeys));
   return mpm_config_add_schema(cfg, fluid_keys, (int)(sizeof fluid_keys / sizeof fluid_keys[0]));
 }
 
@@ -158,22 +159,29 @@ static int fluid_p2g(mpm_module *m, double t, const double *y) {
   }
   mpm_kernels_get(dim)->p2g(m->grid, m->phase, &a);
   MPM_CALL(fluid_open_p2g(fc->open, m, y));
+  fluid_obstacles_deposit(&fc->obs, m->grid, n, a.x, b.m, b.V0, b.J, fc->vsig);
   mpm_timer_stop(MPM_T_P2G);
   return 0;
 }
 
 /* After MUSL's second deposit the phase holds mass and momentum only: the update turns them
- * into velocities (h = 0; the force acted in the first pass). */
+ * into velocities (h = 0; the force acted in the first pass, so only that one is recorded as
+ * the obstacles' force). Walls and open faces, then obstacles (their force excludes what a wall
+ * holds), then the walls again, so that mirrored pad nodes copy the obstacle-constrained nodes. */
 static int fluid_grid_update(mpm_module *m, double t, double h) {
-  (void)t;
   fluid_content *fc = m->content;
   const int second = fc->remapped;
   fc->remapped = 0;
+  if (!second) MPM_CALL(fluid_obstacles_begin(&fc->obs, m->grid, m->phase, t, h, 1));
   mpm_constraints_fold(&fc->cons, m->grid, m->phase);
   if (!second) MPM_CALL(fluid_open_forces(fc->open, m, t));
   MPM_CALL(mpm_grid_phase_update(m->grid, m->phase, second ? 0.0 : h));
   mpm_constraints_apply(&fc->cons, m->grid, m->phase);
   fluid_open_hold(fc->open, m);
+  if (fc->obs.count) {
+    fluid_obstacles_apply(&fc->obs, m->grid, m->phase, second ? 0.0 : h, !second);
+    mpm_constraints_apply(&fc->cons, m->grid, m->phase);
+  }
   return 0;
 }
 
@@ -304,14 +312,14 @@ static int fluid_g2p(mpm_module *m, double t, const double *y, double *ydot, dou
 
 /* After an accepted step: commit the ERK pairs' pending strain rate, then regularise. */
 static int fluid_post_step(mpm_module *m, double t, double h, int *changed) {
-  (void)t, (void)h;
-  const fluid_content *fc = m->content;
+  fluid_content *fc = m->content;
   const mpm_particles *p = m->particles;
   if (fc->lay.f_pending >= 0) { /* divv and D follow pending in the particle data */
     const size_t count = (size_t)p->n * (1 + (fc->lay.f_D >= 0 ? p->dim * p->dim : 0));
     memcpy(mpm_particles_comp(p, fc->lay.f_divv, 0), mpm_particles_comp(p, fc->lay.f_pending, 0),
            sizeof(double) * count);
   }
+  MPM_CALL(fluid_obstacles_report(&fc->obs, m->grid, t, h));
   return fluid_regularise(m, m->step, changed);
 }
 
@@ -389,6 +397,7 @@ static void fluid_destroy(mpm_module *m) {
   if (fc) {
     mpm_constraints_free(&fc->cons);
     fluid_open_destroy(&fc->open);
+    fluid_obstacles_free(&fc->obs);
     free(fc->vsig), free(fc->scratch), free(fc->vnew), free(fc->Cnew), free(fc->power);
     free(fc->tscratch), free(fc->node);
     free(fc);
@@ -490,6 +499,7 @@ static int build(mpm_module *m, const mpm_config *cfg, int seed) {
   MPM_CALL(mpm_walls_from_config(&walls, cfg, g->dim));
   MPM_CALL(mpm_constraints_add_walls(&fc->cons, &walls, g));
   MPM_CALL(fluid_open_new(&fc->open, m, cfg, &walls, fc->gas.gamma, fc->ppc));
+  MPM_CALL(fluid_obstacles_build(&fc->obs, cfg, g, fc->tr.apic ? 1.0 : fc->tr.pic, fc->ppc));
   MPM_ALLOC(fc->node, (size_t)(g->dim + 3) * g->nnodes);
   MPM_CALL(
       particles_new(&m->particles, g->dim, &fc->lay, fc->tr.apic, fc->gas.mu > 0, fc->tr.classic));

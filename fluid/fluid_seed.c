@@ -5,7 +5,8 @@
  * Overlaps: a lattice point belongs to the first section, in case-file order, whose region
  * contains it; later sections skip it. So a uniform background region listed last fills
  * whatever the others leave. Each section takes a fresh block of ids as wide as the seeding
- * lattice, so an id does not depend on the number of ranks. */
+ * lattice, so an id does not depend on the number of ranks. No particle is seeded inside an
+ * obstacle (phi < 0). */
 #include "fluid_eos.h"
 #include "fluid_internal.h"
 
@@ -103,14 +104,15 @@ static int check_positive(const mpm_config *cfg, const mpm_grid *g, const char *
                          name, worst.v, at[0], at[1], at[2]);
 }
 
-/* The lattice points of section k not claimed by an earlier section: keep[i] = 1. */
-static mpm_lidx claim(const gas_state *s, int k, int dim, mpm_lidx n, const double *x,
-                      unsigned char *keep) {
+/* The lattice points of section k not claimed by an earlier section and outside every
+ * obstacle: keep[i] = 1. */
+static mpm_lidx claim(const gas_state *s, int k, const fluid_obstacles *obs, int dim, mpm_lidx n,
+                      const double *x, unsigned char *keep) {
   mpm_lidx kept = 0;
   for (mpm_lidx i = 0; i < n; ++i) {
     double xp[3] = {0, 0, 0};
     for (int d = 0; d < dim; ++d) xp[d] = x[(size_t)d * n + i];
-    keep[i] = 1;
+    keep[i] = !fluid_obstacles_inside(obs, xp);
     for (int j = 0; j < k && keep[i]; ++j) keep[i] = !mpm_region_contains(s[j].region, xp);
     kept += keep[i];
   }
@@ -166,7 +168,7 @@ static int seed_one(mpm_module *m, const mpm_config *cfg, gas_state *s, int k) {
   double minv[2] = {HUGE_VAL, HUGE_VAL}, where[2][3] = {{0}};
   mpm_lidx nk = 0;
   if (!rc) {
-    nk = claim(s, k, g->dim, n, x, keep);
+    nk = claim(s, k, &fc->obs, g->dim, n, x, keep);
     for (mpm_lidx i = 0, j = 0; i < n; ++i)
       if (keep[i]) kid[j++] = id[i];
     fill(fc, p, &s[k], pow(g->dx / fc->ppc, g->dim), n, x, keep, nk, data, minv, where);
@@ -183,11 +185,12 @@ static int seed_one(mpm_module *m, const mpm_config *cfg, gas_state *s, int k) {
   if (total == 0) {
     char key[160];
     key_of(key, sizeof key, s[k].section, "geometry");
-    return mpm_config_fail(cfg, key,
-                           "[%s] has no particles: its region is thinner than the particle "
-                           "spacing %g or lies inside earlier gas regions; refine grid.dx, raise "
-                           "fluid.ppc or change the region",
-                           s[k].section, g->dx / fc->ppc);
+    return mpm_config_fail(
+        cfg, key,
+        "[%s] has no particles: its region is thinner than the particle "
+        "spacing %g or lies inside earlier gas regions or obstacles; refine grid.dx, raise "
+        "fluid.ppc or change the region",
+        s[k].section, g->dx / fc->ppc);
   }
   mpm_log(MPM_LOG_INFO, "gas %s: %lld particles", s[k].section, (long long)total);
   return 0;

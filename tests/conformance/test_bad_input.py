@@ -157,4 +157,33 @@ with tempfile.TemporaryDirectory() as tmp:
     check(strip(p.stdout) == strip(q.stdout) and "t_end = 0.3" in p.stdout,
           "check: the resolved configuration reads back to itself")
 
+
+# Obstacles: the same rules on cases/gas_obstacles.ini (their keys are read with the gas).
+OBST = open(mt.case("gas_obstacles.ini")).read()
+OBST_CASES = [
+    ("unknown obstacle shape", "shape = circle", "shape = blob", "obstacle.cylinder.shape",
+     "circle"),
+    ("negative radius", "radius = 0.12", "radius = -0.12", "obstacle.cylinder.radius", None),
+    ("polygon with 2 vertices", "shape = box\nlo = 0.8 0.15\nhi = 0.9 0.35",
+     "shape = polygon\nvertices = 0.8 0.15 0.9 0.15", "obstacle.block.vertices", "3 vertices"),
+    ("self-crossing polygon", "shape = box\nlo = 0.8 0.15\nhi = 0.9 0.35",
+     "shape = polygon\nvertices = 0.8 0.15 0.9 0.35 0.9 0.15 0.8 0.35",
+     "obstacle.block.vertices", "crosses itself"),
+    ("missing aerofoil file", "shape = box\nlo = 0.8 0.15\nhi = 0.9 0.35",
+     "shape = airfoil\nchord = 0.1\nleading_edge = 0.7 0.2\nfile = no_such_file.csv",
+     "obstacle.block.file", None),
+    ("obstacle outside the domain", "center = 0.55 0.5", "center = 1.55 0.5",
+     "obstacle.cylinder.shape", "outside the domain"),
+    ("reference area without speed", "reference_speed = 1\n", "", "obstacle.cylinder.reference_area",
+     "reference_speed"),
+    ("key the shape does not use", "radius = 0.12", "radius = 0.12\nlo = 0.01 0.01",
+     "obstacle.cylinder.lo", "not used"),
+]
+for name, old, new, key, words in OBST_CASES:
+    assert old in OBST, old
+    text = OBST.replace(old, new, 1)
+    needle = {"obstacle outside the domain": "shape = circle",
+              "reference area without speed": "reference_area"}.get(name) or new.splitlines()[-1]
+    expect_error(name, text, key, words, line_of(text, needle))
+
 sys.exit(check.finish())

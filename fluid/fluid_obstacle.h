@@ -1,0 +1,111 @@
+/* Static rigid obstacles for the gas: [obstacle.NAME] sections, each a signed-distance shape
+ * (common/mpm_sdf.h) that acts as a boundary condition on the gas's nodal velocities, with no
+ * particles. Private to fluid/.
+ *
+ * Nodes. Every box node with phi(x_i) < band (fluid.obstacle_band cells) is constrained after
+ * each nodal update: slip removes the components of v_i and a_i along the outward normal of
+ * the nearest surface point (bilateral: the gas can neither enter the body nor pull away
+ * from it), no_slip sets v_i = a_i = 0. phi and the normals are evaluated once, at build.
+ * Nodes deep inside carry no mass (no particle is seeded inside, and the stencil of a
+ * particle outside reaches at most two cells in), so they cost one comparison.
+ *
+ * Ghost pressure. Held nodes alone leave the nodes next to the surface with an incomplete
+ * stencil: the gas pressure pushes them towards the body (a force of order p / dx per unit
+ * volume), so gas at rest does not stay at rest and slips into the body at corners. Like the
+ * mirrored pad nodes of a wall, the missing neighbours are supplied: every point of the
+ * seeding lattice inside an obstacle is a ghost of volume (dx / ppc)^dim that adds
+ * p_i V grad S_i to each node i near it, with p_i the mass-weighted nodal pressure of the gas
+ * (-tr sigma / dim, deposited by the particles near a body). With the gas's own stencil that
+ * completes the lattice, so a uniform pressure gives no nodal force anywhere: gas at rest stays
+ * exactly at rest. G_i = sum_ghosts V grad S_i is computed once, at build.
+ *
+ * Force. The force the gas exerts on an obstacle is minus the rate at which the obstacle
+ * changes the gas's momentum, summed over the nodes each rank owns and reduced over the ranks:
+ *   method of lines (h = 0):  F = sum_i m_i (a_i - a_i') - sum_i p_i G_i,
+ *   classic update (h > 0):   F = sum_i m_i [(1 - s) (a_i - a_i') + s (v_i - v_i') / h]
+ *                                 - sum_i p_i G_i,
+ * where ' marks the constrained values (a_i includes the ghost force) and s is the PIC share
+ * of the particle velocity update (1 for APIC, transfer.pic_fraction for the FLIP/PIC blend):
+ * FLIP moves the particles' momentum by h sum S a_i', PIC replaces it by sum m_i v_i'. So over
+ * a classic step P(t + h) - P(t) = -h F exactly, with P the gas momentum. F points the way the
+ * gas pushes the body (+x: downstream for a flow along +x). The report uses the RHS that made
+ * the step (classic) or the last RHS of the step (ERK pairs: the end of the step for the FSAL
+ * pairs bs32 and dp54). */
+#ifndef FLUID_OBSTACLE_H
+#define FLUID_OBSTACLE_H
+
+#include "mpm_config.h"
+#include "mpm_diag.h"
+#include "mpm_grid.h"
+#include "mpm_sdf.h"
+#include "mpm_shape.h"
+
+typedef struct fluid_obstacle {
+  char name[64];
+  mpm_sdf sdf;
+  int no_slip;
+  int has_ref;             /* reference area given: write Cd and Cl */
+  double q_ref_area;       /* 1/2 rho U^2 A */
+  double flow[3], lift[3]; /* unit drag and lift directions */
+  mpm_lidx count;          /* constrained nodes */
+  mpm_lidx *node;          /* box index */
+  double *normal;          /* dim per node */
+  unsigned char *owned;    /* counted in the force */
+} fluid_obstacle;
+
+/* The forces of one RHS evaluation on this rank (dim per obstacle). */
+typedef struct fluid_force_record {
+  double t;
+  int set, classic; /* classic: made with a step h > 0 */
+  double *f;
+} fluid_force_record;
+
+typedef struct fluid_obstacles {
+  int count;
+  fluid_obstacle *ob;
+  double pic_share;          /* s above */
+  fluid_force_record rec[2]; /* the latest RHS and the one before (at another time) */
+  int latest;
+  int ppc;
+  double lp;       /* GIMP half-width of the particles and ghosts, cells */
+  mpm_lidx gcount; /* nodes with a ghost force */
+  mpm_lidx *gnode; /* box index */
+  double *G;       /* sum V grad S of the ghosts (dim per node) */
+  unsigned char *gowned;
+  int *gob;            /* the obstacle each ghost force belongs to (the nearest) */
+  unsigned char *near; /* per box node as a cell's lower corner: a particle in it reaches a
+                          ghost node */
+  double *sm;          /* nodal m and m p of the particles near a body (2 nnodes) */
+  char path[4096];     /* obstacles.csv */
+  mpm_diag *csv;
+} fluid_obstacles;
+
+/* Keys of [obstacle.NAME] and fluid.obstacle_band. */
+extern const mpm_key_spec fluid_obstacle_keys[];
+extern const int fluid_obstacle_nkeys;
+
+/* Read every [obstacle.NAME] and find its nodes on grid; pic_share is s above. */
+int fluid_obstacles_build(fluid_obstacles *o, const mpm_config *cfg, const mpm_grid *grid,
+                          double pic_share, int ppc);
+/* In P2G: deposit m and m p of the n particles near a body (positions per component, masses, V0
+ * and J, and the V sigma of the stress phase, dim^2 components of n). */
+void fluid_obstacles_deposit(fluid_obstacles *o, const mpm_grid *grid, mpm_lidx n,
+                             const double *const *x, const double *m, const double *V0,
+                             const double *J, const double *vsig);
+/* Before the nodal update (after the reverse halo): sum the nodal pressures over the ranks,
+ * add the ghost forces to f_i and, with record, start the force record of this RHS at time t.
+ * Collective. */
+int fluid_obstacles_begin(fluid_obstacles *o, mpm_grid *grid, int phase, double t, double h,
+                          int record);
+/* 1 if x lies inside an obstacle (phi < 0): no gas particle is seeded there. */
+int fluid_obstacles_inside(const fluid_obstacles *o, const double *x);
+/* Constrain the obstacle nodes of phase after a nodal update with step h (0: method of lines);
+ * add the removed momentum to the force record begun by fluid_obstacles_begin when record is set.
+ */
+void fluid_obstacles_apply(fluid_obstacles *o, mpm_grid *grid, int phase, double h, int record);
+/* After an accepted step from t - h to t: reduce the recorded forces and write one row per
+ * obstacle to obstacles.csv (opened at the first call; appended after a restart). Collective. */
+int fluid_obstacles_report(fluid_obstacles *o, const mpm_grid *grid, double t, double h);
+void fluid_obstacles_free(fluid_obstacles *o);
+
+#endif
