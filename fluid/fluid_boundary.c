@@ -24,6 +24,9 @@
  *                     supersonically, p_b is p_inf (entering) or p_i (leaving).
  * The normal n points out of the domain.
  *
+ * Where an obstacle crosses the face, the body continues beyond it (fluid_obstacle.c puts its
+ * ghost points there) and the columns stop at its surface.
+ *
  * Particles. A particle beyond an open face is removed between steps (it may sit up to a cell
  * beyond the face during a step: the pad nodes carry its stencil). Where the free stream
  * enters (inflow, subsonic_inflow, and a farfield face with u_inf . n < 0) the seeding
@@ -81,10 +84,9 @@ struct fluid_open {
   open_face face[2 * MPM_MAX_DIM];
   double rho, p, v[MPM_MAX_DIM], e, c, Z, p_back; /* free stream */
   int ppc;
-  int phase; /* grid phase of the virtual particles' forces, -1 if unused */
-  mpm_lidx cand_cap, virt_cap;
-  struct column_entry *cand; /* near-face particles of one face, by column */
-  double *virt;              /* virtual particles: x (dim), V sigma (dim^2), m and v (zeros) */
+  int columns; /* a face continues the particle columns (all but inflow) */
+  mpm_lidx cand_cap;
+  struct column_entry *cand; /* near-face particles of the faces, by face and column */
 };
 
 /* ---- exterior force weights ---------------------------------------------------------------- */
@@ -206,7 +208,6 @@ int fluid_open_new(fluid_open **openp, mpm_module *m, const mpm_config *cfg, con
   MPM_ALLOC(o, 1);
   *openp = o;
   o->ppc = ppc;
-  o->phase = -1;
   MPM_CALL(read_freestream(o, cfg, walls, g->dim, gamma));
   const double lp = 0.5 / ppc;
   for (int d = 0; d < g->dim; ++d)
@@ -220,10 +221,13 @@ int fluid_open_new(fluid_open **openp, mpm_module *m, const mpm_config *cfg, con
       f->inject = k != MPM_WALL_OUTFLOW && k != MPM_WALL_SUBSONIC_OUTFLOW && f->speed > 0;
       m->open[d][s] = 1;
       if (k == MPM_WALL_INFLOW) MPM_CALL(build_weights(f, g, ppc, lp));
-      if (k != MPM_WALL_INFLOW && o->phase < 0)
-        MPM_CALL(mpm_grid_add_phase(m->grid, "fluid_open", &o->phase));
+      o->columns |= k != MPM_WALL_INFLOW;
     }
   return 0;
+}
+
+int fluid_open_uses_virtual(const fluid_open *o) {
+  return o && o->columns;
 }
 
 void fluid_open_destroy(fluid_open **openp) {
@@ -231,7 +235,7 @@ void fluid_open_destroy(fluid_open **openp) {
   if (!o) return;
   for (int k = 0; k < o->nfaces; ++k)
     free(o->face[k].node), free(o->face[k].r), free(o->face[k].wt);
-  free(o->cand), free(o->virt);
+  free(o->cand);
   free(o);
   *openp = NULL;
 }
@@ -281,21 +285,6 @@ static double boundary_pressure(const fluid_open *o, const open_face *f, double 
   return fmax(0.0, 0.5 * (pp + o->p) + 0.5 * o->Z * (un - un_inf));
 }
 
-/* Scratch for ncand column entries and nvirt virtual particles (contents are not kept). */
-static int grow(fluid_open *o, mpm_lidx ncand, mpm_lidx nvirt, int dim) {
-  if (ncand > o->cand_cap) {
-    free(o->cand);
-    o->cand_cap = ncand + ncand / 4 + 16;
-    MPM_ALLOC(o->cand, (size_t)o->cand_cap);
-  }
-  if (nvirt > o->virt_cap) {
-    free(o->virt);
-    o->virt_cap = nvirt + nvirt / 4 + 16;
-    MPM_ALLOC(o->virt, (size_t)(dim + dim * dim + 2) * o->virt_cap);
-  }
-  return 0;
-}
-
 /* The columns of face f into col: the particles within two cells of it, sorted by column and
  * depth. Returns their count. */
 static mpm_lidx columns(const fluid_open *o, const open_face *f, const mpm_module *m,
@@ -320,23 +309,23 @@ static mpm_lidx columns(const fluid_open *o, const open_face *f, const mpm_modul
   return k;
 }
 
-/* Virtual particles beyond face f, appended from index *nv: each column continues outwards
- * with its outermost particle's volume and spacing (the distance to the next particle in, or
- * for a lone particle the lattice spacing scaled by J^(1/dim)), at the boundary pressure. */
-static void continue_columns(fluid_open *o, const open_face *f, const mpm_module *m,
-                             const double *y, const column_entry *col, mpm_lidx ncol,
-                             mpm_lidx *nv) {
-  const fluid_content *fc = m->content;
+/* Virtual particles beyond face f: each column continues outwards with
+ * its outermost particle's volume and spacing (the distance to the next particle in, or for a
+ * lone particle the lattice spacing scaled by J^(1/dim)), at the boundary pressure; not inside
+ * an obstacle, whose mirrors act there. */
+static int continue_columns(const fluid_open *o, const open_face *f, const mpm_module *m,
+                            const double *y, const column_entry *col, mpm_lidx ncol,
+                            fluid_virtual *virt) {
+  fluid_content *fc = m->content;
   const mpm_particles *p = m->particles;
   const mpm_grid *g = m->grid;
   const int dim = g->dim;
-  const mpm_lidx n = p->n, cap = o->virt_cap;
+  const mpm_lidx n = p->n;
   const double *x = y + (size_t)p->offset[FLUID_X] * n, *v = y + (size_t)p->offset[FLUID_V] * n;
   const double *J = y + (size_t)p->offset[FLUID_J] * n, *e = y + (size_t)p->offset[FLUID_E] * n;
   const double *mass = mpm_particles_comp(p, fc->lay.f_m, 0);
   const double *V0 = mpm_particles_comp(p, fc->lay.f_V0, 0);
   const double reach = 0.5 * mpm_shape_support(g->shape) * g->dx; /* of a node's stencil */
-  double *vx = o->virt, *vsig = vx + (size_t)dim * cap;
   for (mpm_lidx a = 0; a < ncol;) {
     mpm_lidx b = a + 1;
     while (b < ncol && col[b].key == col[a].key) ++b;
@@ -351,57 +340,41 @@ static void continue_columns(fluid_open *o, const open_face *f, const mpm_module
     for (int d = 0; d < dim; ++d) vi[d] = v[(size_t)d * n + i];
     const double pb = boundary_pressure(o, f, fluid_pressure(fc->gas.gamma, mass[i] / V, e[i]), vi);
     for (int j = 1; j <= MAX_COPIES && col[a].depth - j * spacing > -reach; ++j) {
-      const mpm_lidx q = (*nv)++;
+      double xq[3] = {0, 0, 0};
       for (int d = 0; d < dim; ++d)
-        vx[(size_t)d * cap + q] = x[(size_t)d * n + i] + (d == f->axis ? f->sign * j * spacing : 0);
-      for (int r = 0; r < dim; ++r)
-        for (int c = 0; c < dim; ++c) vsig[(size_t)(r * dim + c) * cap + q] = r == c ? -V * pb : 0;
+        xq[d] = x[(size_t)d * n + i] + (d == f->axis ? f->sign * j * spacing : 0);
+      if (!fluid_obstacles_inside(&fc->obs, xq)) MPM_CALL(fluid_virtual_add(virt, dim, xq, V, pb));
     }
     a = b;
   }
+  return 0;
 }
 
-int fluid_open_p2g(fluid_open *o, mpm_module *m, const double *y) {
-  if (!o || o->phase < 0) return 0;
-  const fluid_content *fc = m->content;
+int fluid_open_p2g(fluid_open *o, mpm_module *m, const double *y, fluid_virtual *virt) {
+  if (!o || !o->columns) return 0;
   const mpm_particles *p = m->particles;
-  const int dim = p->dim;
-  mpm_lidx start[2 * MPM_MAX_DIM + 1] = {0}, nv = 0;
-  MPM_CALL(grow(o, o->nfaces * p->n, 0, dim));
+  const mpm_lidx need = o->nfaces * p->n;
+  if (need > o->cand_cap || !o->cand) {
+    free(o->cand);
+    o->cand_cap = need + need / 4 + 16;
+    MPM_ALLOC(o->cand, (size_t)o->cand_cap);
+  }
+  mpm_lidx start = 0;
   for (int k = 0; k < o->nfaces; ++k) {
     const open_face *f = &o->face[k];
-    start[k + 1] = start[k];
-    if (f->kind != MPM_WALL_INFLOW)
-      start[k + 1] += columns(o, f, m, y + (size_t)p->offset[FLUID_X] * p->n, o->cand + start[k]);
+    if (f->kind == MPM_WALL_INFLOW) continue;
+    column_entry *col = o->cand + start;
+    const mpm_lidx ncol = columns(o, f, m, y + (size_t)p->offset[FLUID_X] * p->n, col);
+    MPM_CALL(continue_columns(o, f, m, y, col, ncol, virt));
+    start += ncol;
   }
-  MPM_CALL(grow(o, 0, MAX_COPIES * start[o->nfaces] + 1, dim));
-  for (int k = 0; k < o->nfaces; ++k)
-    continue_columns(o, &o->face[k], m, y, o->cand + start[k], start[k + 1] - start[k], &nv);
-  const mpm_lidx cap = o->virt_cap;
-  double *vm = o->virt + (size_t)(dim + dim * dim) * cap, *vv = vm + cap;
-  for (mpm_lidx q = 0; q < nv; ++q) vm[q] = vv[q] = 0.0;
-  /* The kernel reads V sigma component-major with stride nv. */
-  double *vsig = o->virt + (size_t)dim * cap;
-  for (int c = 1; c < dim * dim; ++c)
-    memmove(vsig + (size_t)c * nv, vsig + (size_t)c * cap, sizeof(double) * (size_t)nv);
-  mpm_grid_phase_zero(m->grid, o->phase);
-  mpm_p2g_args a = {.n = nv, .m = vm, .vsig = vsig, .lp = fc->lp};
-  for (int d = 0; d < dim; ++d) a.x[d] = o->virt + (size_t)d * cap, a.v[d] = vv;
-  mpm_kernels_get(dim)->p2g(m->grid, o->phase, &a);
   return 0;
 }
 
 int fluid_open_forces(fluid_open *o, mpm_module *m, double t) {
   if (!o) return 0;
   mpm_grid *g = m->grid;
-  const int dim = g->dim;
   mpm_grid_phase *ph = &g->phase[m->phase];
-  if (o->phase >= 0) {
-    mpm_grid_phase *bc = &g->phase[o->phase];
-    MPM_CALL(mpm_grid_halo_reverse(g, bc->f_i, dim));
-    for (int d = 0; d < dim; ++d)
-      for (mpm_lidx l = 0; l < g->nnodes; ++l) ph->f_i[d][l] += bc->f_i[d][l];
-  }
   for (int k = 0; k < o->nfaces; ++k) {
     open_face *f = &o->face[k];
     if (f->kind != MPM_WALL_INFLOW) continue;
@@ -498,7 +471,9 @@ static void layers(const fluid_open *o, const open_face *f, const mpm_module *m,
       data[(size_t)p->offset[fc->lay.f_m] * cap + q] = o->rho * vol;
       data[(size_t)p->offset[fc->lay.f_V0] * cap + q] = vol;
       id[q] = base + (mpm_gidx)k * total + gidx;
-      ++*nadd;
+      double xq[3] = {0, 0, 0};
+      for (int d = 0; d < dim; ++d) xq[d] = data[(size_t)(p->offset[FLUID_X] + d) * cap + q];
+      if (!fluid_obstacles_inside(&fc->obs, xq)) ++*nadd; /* else overwritten by the next */
     }
   }
 }
@@ -552,7 +527,9 @@ int fluid_open_exchange(fluid_open *o, mpm_module *m, double t, double h, int *c
     for (int k = 0; !rc && k < o->nfaces; ++k)
       if (o->face[k].inject && owns_face(g, &o->face[k]))
         layers(o, &o->face[k], m, k0[k], k1[k], t, nadd, data, id, &q);
-    if (!rc) rc = mpm_particles_edit(p, keep, nadd, id, data);
+    for (int c = 1; !rc && c < p->ncomp && q < nadd; ++c) /* to stride q: points in bodies */
+      memmove(data + (size_t)c * q, data + (size_t)c * nadd, sizeof(double) * (size_t)q);
+    if (!rc) rc = mpm_particles_edit(p, keep, q, id, data);
     free(data), free(id);
     *changed = 1;
   }

@@ -9,6 +9,8 @@
 #include "mpm_config.h"
 #include "mpm_module.h"
 
+#include "fluid_virtual.h"
+
 extern const mpm_key_spec fluid_boundary_keys[];
 extern const int fluid_boundary_nkeys;
 
@@ -20,9 +22,11 @@ int fluid_open_new(fluid_open **open, mpm_module *m, const mpm_config *cfg, cons
                    double gamma, int ppc);
 void fluid_open_destroy(fluid_open **open);
 
-/* In P2G, after the gas deposit: the pressure of the particles near the faces that need it,
- * into the open faces' own grid phase. y is the module's state. */
-int fluid_open_p2g(fluid_open *open, mpm_module *m, const double *y);
+/* In P2G: the virtual particles beyond the faces that continue the particle columns (all
+ * but inflow), appended to virt. y is the module's state. */
+int fluid_open_p2g(fluid_open *open, mpm_module *m, const double *y, fluid_virtual *virt);
+/* Does a face continue the particle columns (so the module needs virtual particles)? */
+int fluid_open_uses_virtual(const fluid_open *open);
 /* Before the nodal update (first pass only) at time t: add the pressure of the missing
  * exterior gas to the nodal forces. Collective. */
 int fluid_open_forces(fluid_open *open, mpm_module *m, double t);

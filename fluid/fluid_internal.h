@@ -31,6 +31,7 @@ typedef struct fluid_content {
   double gravity[MPM_MAX_DIM];
   mpm_node_constraints cons; /* wall nodes */
   fluid_open *open;          /* open faces (inflow, outflow, far field), or NULL */
+  fluid_virtual virt;        /* virtual particles of the open faces and obstacles */
   fluid_obstacles obs;       /* static obstacles (fluid_obstacle.h) */
   int remapped;              /* the phase holds MUSL's second deposit */
   int reg_every;             /* regularise every reg_every steps (0: never) */

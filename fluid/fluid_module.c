@@ -158,7 +158,9 @@ static int fluid_p2g(mpm_module *m, double t, const double *y) {
     a.gravity[d] = fc->gravity[d];
   }
   mpm_kernels_get(dim)->p2g(m->grid, m->phase, &a);
-  MPM_CALL(fluid_open_p2g(fc->open, m, y));
+  fluid_virtual_clear(&fc->virt);
+  MPM_CALL(fluid_open_p2g(fc->open, m, y, &fc->virt));
+  MPM_CALL(fluid_virtual_deposit(&fc->virt, m->grid, fc->lp));
   fluid_obstacles_deposit(&fc->obs, m->grid, n, a.x, b.m, b.V0, b.J, fc->vsig);
   mpm_timer_stop(MPM_T_P2G);
   return 0;
@@ -172,14 +174,17 @@ static int fluid_grid_update(mpm_module *m, double t, double h) {
   fluid_content *fc = m->content;
   const int second = fc->remapped;
   fc->remapped = 0;
-  if (!second) MPM_CALL(fluid_obstacles_begin(&fc->obs, m->grid, m->phase, t, h, 1));
+  if (!second) {
+    MPM_CALL(fluid_obstacles_begin(&fc->obs, m->grid, m->phase, t, h, 1));
+    MPM_CALL(fluid_virtual_forces(&fc->virt, m->grid, m->phase, NULL, 0));
+  }
   mpm_constraints_fold(&fc->cons, m->grid, m->phase);
   if (!second) MPM_CALL(fluid_open_forces(fc->open, m, t));
   MPM_CALL(mpm_grid_phase_update(m->grid, m->phase, second ? 0.0 : h));
   mpm_constraints_apply(&fc->cons, m->grid, m->phase);
   fluid_open_hold(fc->open, m);
   if (fc->obs.count) {
-    fluid_obstacles_apply(&fc->obs, m->grid, m->phase, second ? 0.0 : h, !second);
+    MPM_CALL(fluid_obstacles_apply(&fc->obs, m->grid, m->phase, second ? 0.0 : h, !second));
     mpm_constraints_apply(&fc->cons, m->grid, m->phase);
   }
   return 0;
@@ -398,6 +403,7 @@ static void fluid_destroy(mpm_module *m) {
     mpm_constraints_free(&fc->cons);
     fluid_open_destroy(&fc->open);
     fluid_obstacles_free(&fc->obs);
+    fluid_virtual_free(&fc->virt);
     free(fc->vsig), free(fc->scratch), free(fc->vnew), free(fc->Cnew), free(fc->power);
     free(fc->tscratch), free(fc->node);
     free(fc);
@@ -499,7 +505,9 @@ static int build(mpm_module *m, const mpm_config *cfg, int seed) {
   MPM_CALL(mpm_walls_from_config(&walls, cfg, g->dim));
   MPM_CALL(mpm_constraints_add_walls(&fc->cons, &walls, g));
   MPM_CALL(fluid_open_new(&fc->open, m, cfg, &walls, fc->gas.gamma, fc->ppc));
-  MPM_CALL(fluid_obstacles_build(&fc->obs, cfg, g, fc->tr.apic ? 1.0 : fc->tr.pic, fc->ppc));
+  MPM_CALL(fluid_obstacles_build(&fc->obs, cfg, g, fc->ppc, (const unsigned char(*)[2])m->open));
+  fc->virt.phase = -1;
+  if (fluid_open_uses_virtual(fc->open)) MPM_CALL(fluid_virtual_init(&fc->virt, g));
   MPM_ALLOC(fc->node, (size_t)(g->dim + 3) * g->nnodes);
   MPM_CALL(
       particles_new(&m->particles, g->dim, &fc->lay, fc->tr.apic, fc->gas.mu > 0, fc->tr.classic));

@@ -419,7 +419,8 @@ static int stencil_count(const stencil *st, int dim) {
 }
 
 /* Add V grad S_i of every seeding-lattice point inside an obstacle, in the cells of the box, to
- * G (dim arrays of nnodes). A point beyond a periodic face is tested at its image. */
+ * G (dim arrays of nnodes). A point beyond a periodic face is tested at its image; beyond an
+ * open face the body continues; beyond a wall there is none (the wall's mirror rules act). */
 static void ghost_sums(const fluid_obstacles *o, const mpm_grid *g, double *const *G) {
   const int dim = g->dim, ppc = o->ppc;
   const double V = pow(g->dx / ppc, dim);
@@ -434,7 +435,8 @@ static void ghost_sums(const fluid_obstacles *o, const mpm_grid *g, double *cons
     }
     memcpy(xw, x, sizeof x);
     mpm_grid_wrap(g, xw);
-    for (int d = 0; d < dim; ++d) in_domain &= xw[d] > g->lo[d] && xw[d] < g->hi[d];
+    for (int d = 0; d < dim; ++d)
+      in_domain &= (o->open[d][0] || xw[d] > g->lo[d]) && (o->open[d][1] || xw[d] < g->hi[d]);
     if (!in_domain || !fluid_obstacles_inside(o, xw)) continue;
     stencil st;
     stencil_at(&st, g, x, o->lp);
@@ -497,14 +499,15 @@ static int build_ghosts(fluid_obstacles *o, const mpm_grid *g) {
   return 0;
 }
 
-int fluid_obstacles_build(fluid_obstacles *o, const mpm_config *cfg, const mpm_grid *grid,
-                          double pic_share, int ppc) {
+int fluid_obstacles_build(fluid_obstacles *o, const mpm_config *cfg, const mpm_grid *grid, int ppc,
+                          const unsigned char (*open)[2]) {
   const char *const *names;
   const char *dir;
   int count;
   double band;
   memset(o, 0, sizeof *o);
-  o->pic_share = pic_share, o->ppc = ppc, o->lp = 0.5 / ppc;
+  o->ppc = ppc, o->lp = 0.5 / ppc;
+  memcpy(o->open, open, sizeof o->open);
   MPM_CALL(mpm_config_get_real(cfg, "fluid.obstacle_band", &band));
   MPM_CALL(mpm_config_get_string(cfg, "output.dir", &dir));
   snprintf(o->path, sizeof o->path, "%s/obstacles.csv", dir);
@@ -580,33 +583,46 @@ int fluid_obstacles_begin(fluid_obstacles *o, mpm_grid *grid, int phase, double 
   return 0;
 }
 
-/* Constrain one obstacle's nodes; adds this rank's owned share of the force to f. */
-static void apply_one(const fluid_obstacle *ob, mpm_grid_phase *ph, int dim, double h, double share,
-                      double *f) {
+/* Constrain one obstacle's nodes; adds this rank's owned share of the force to f. Nodes with
+ * less mass than hold_below are held entirely (see the header). In the classic update the
+ * velocity change is an impulse over the step: the acceleration takes it too, so that
+ * v_i^n = v_i - h a_i is unchanged (the transfer reads the time-centred velocity from it) and a
+ * FLIP particle loses the removed velocity as the grid does. */
+static void apply_one(const fluid_obstacle *ob, mpm_grid_phase *ph, int dim, double h,
+                      double hold_below, double *f) {
   for (mpm_lidx k = 0; k < ob->count; ++k) {
     const mpm_lidx l = ob->node[k];
     const double m = ph->m_i[l];
     if (!(m > 0.0)) continue; /* empty: the nodal update left v = a = 0 */
     const double *n = ob->normal + (size_t)dim * k;
+    const int hold = ob->no_slip || m < hold_below;
     double vn = 0.0, an = 0.0;
     for (int d = 0; d < dim; ++d) vn += ph->v_i[d][l] * n[d], an += ph->a_i[d][l] * n[d];
     for (int d = 0; d < dim; ++d) {
-      const double dv = ob->no_slip ? ph->v_i[d][l] : vn * n[d];
-      const double da = ob->no_slip ? ph->a_i[d][l] : an * n[d];
+      const double dv = hold ? ph->v_i[d][l] : vn * n[d];
+      const double da = h > 0 ? dv / h : hold ? ph->a_i[d][l] : an * n[d];
       ph->v_i[d][l] -= dv, ph->a_i[d][l] -= da;
-      if (ob->owned[k]) f[d] += h > 0 ? m * ((1.0 - share) * da + share * dv / h) : m * da;
+      if (ob->owned[k]) f[d] += m * da;
     }
   }
 }
 
-void fluid_obstacles_apply(fluid_obstacles *o, mpm_grid *grid, int phase, double h, int record) {
+int fluid_obstacles_apply(fluid_obstacles *o, mpm_grid *grid, int phase, double h, int record) {
+  if (o->count == 0) return 0;
   const int dim = grid->dim;
-  double scratch[3];
+  const mpm_grid_phase *ph = &grid->phase[phase];
+  double scratch[3], mmax = 0.0;
+  for (int k = 0; k < o->count; ++k)
+    for (mpm_lidx j = 0; j < o->ob[k].count; ++j)
+      if (ph->m_i[o->ob[k].node[j]] > mmax) mmax = ph->m_i[o->ob[k].node[j]];
+  MPM_CALL_MPI(MPI_Allreduce(MPI_IN_PLACE, &mmax, 1, MPI_DOUBLE, MPI_MAX, grid->comm));
   for (int k = 0; k < o->count; ++k) {
     double *f = record ? o->rec[o->latest].f + (size_t)dim * k : scratch;
-    apply_one(&o->ob[k], &grid->phase[phase], dim, h, o->pic_share, f);
+    apply_one(&o->ob[k], &grid->phase[phase], dim, h, FLUID_OBSTACLE_HOLD * mmax, f);
   }
+  return 0;
 }
+
 static int open_csv(fluid_obstacles *o, const mpm_grid *g, double t0) {
   const char *names[] = {"t", "name", "Fx", "Fy", "Fz", "Cd", "Cl"};
   const char *cols[7];
