@@ -333,8 +333,12 @@ static int continue_columns(const fluid_open *o, const open_face *f, const mpm_m
     const double V = V0[i] * J[i];
     double spacing = pow(V, 1.0 / dim);
     if (b > a + 1) {
+      const mpm_lidx i2 = col[a + 1].i;
+      double off = 0.0; /* how far the next particle in sits off the column's line */
+      for (int d = 0; d < dim; ++d)
+        if (d != f->axis) off = fmax(off, fabs(x[(size_t)d * n + i2] - x[(size_t)d * n + i]));
       const double gap = col[a + 1].depth - col[a].depth;
-      if (gap > 0.25 * spacing && gap < 4.0 * spacing) spacing = gap;
+      if (off < 0.1 * spacing && gap > 0.25 * spacing && gap < 4.0 * spacing) spacing = gap;
     }
     double vi[MPM_MAX_DIM] = {0};
     for (int d = 0; d < dim; ++d) vi[d] = v[(size_t)d * n + i];

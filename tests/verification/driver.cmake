@@ -80,3 +80,9 @@ mpm_add_script_test(test_gas_boundaries SCRIPT verification/test_gas_boundaries.
 # Field images: tools/plot_fields.py on a short Sod run and a 3-D box (binning, PNG size).
 mpm_add_script_test(test_plot_fields SCRIPT conformance/test_plot_fields.py LABELS conformance
                     TIMEOUT 300)
+# Mach 2.5 wedge: the acceptance at dx = 0.005 under long (3 minutes); a guard at dx = 0.01 with
+# 2 ranks vs 1 in the default selection (tolerances and reasons in test_wedge.py).
+mpm_add_script_test(test_wedge SCRIPT verification/test_wedge.py ARGS fast
+                    LABELS "verification;mpi" TIMEOUT 900)
+mpm_add_script_test(test_wedge_long SCRIPT verification/test_wedge.py ARGS long
+                    LABELS "verification;long" TIMEOUT 1800)
