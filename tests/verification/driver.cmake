@@ -86,3 +86,9 @@ mpm_add_script_test(test_wedge SCRIPT verification/test_wedge.py ARGS fast
                     LABELS "verification;mpi" TIMEOUT 900)
 mpm_add_script_test(test_wedge_long SCRIPT verification/test_wedge.py ARGS long
                     LABELS "verification;long" TIMEOUT 1800)
+# Woodward-Colella forward step: to t = 4 at dx = 1/80 under long; the first unit of time at
+# dx = 1/40 in the default selection.
+mpm_add_script_test(test_forward_step SCRIPT verification/test_forward_step.py
+                    LABELS verification TIMEOUT 900)
+mpm_add_script_test(test_forward_step_long SCRIPT verification/test_forward_step.py ARGS long
+                    LABELS "verification;long" TIMEOUT 3600)
