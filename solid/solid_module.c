@@ -17,6 +17,7 @@
 #include "mpm_geometry.h"
 #include "mpm_kernels.h"
 #include "mpm_timer.h"
+#include "mpm_transfer.h"
 #include "solid_material.h"
 
 #include <math.h>
@@ -67,9 +68,7 @@ typedef struct {
   solid_traction *traction;
   double gravity[MPM_MAX_DIM];
   double damping;         /* mass-proportional damping rate alpha, 1/s: f_i -= alpha (m v)_i */
-  double pic;             /* PIC fraction of the velocity transfer (0: FLIP, 1: PIC) */
-  int musl;               /* MUSL: nodal velocities from the updated particle momenta */
-  int apic;               /* APIC transfer: affine velocity C per particle (state field) */
+  mpm_transfer tr;        /* [transfer] settings and the time method's kind */
   int remapped;           /* the phase holds MUSL's second deposit (see solid_remap) */
   double *vnew;           /* MUSL: the particles' new velocities (dim n) */
   double lp;              /* GIMP half-width in cells */
@@ -332,7 +331,7 @@ static int ensure_scratch(mpm_module *m) {
   MPM_ALLOC(sc->vsig, (size_t)dim * dim * sc->cap);
   MPM_ALLOC(sc->scratch, (size_t)(2 * dim + dim * dim) * sc->cap);
   MPM_ALLOC(sc->idx, sc->cap);
-  if (sc->musl) MPM_ALLOC(sc->vnew, (size_t)dim * sc->cap);
+  if (sc->tr.musl) MPM_ALLOC(sc->vnew, (size_t)dim * sc->cap);
   return 0;
 }
 
@@ -469,16 +468,6 @@ static int solid_grid_update(mpm_module *m, double t, double h) {
 
 static void solid_stress_rates(mpm_module *m, const double *y, double *ydot, const double *L);
 
-/* FLIP/PIC blend of the classic update: v_p <- (1 - a)(v_p + h sum S a_i) + a sum S v_i^{n+1},
- * written as a rate over the step h; sum S v_i^{n+1} is dx/dt, already in ydot. */
-static void blend_pic(const mpm_particles *p, const double *y, double *ydot, double a, double h) {
-  for (int d = 0; d < p->dim; ++d) {
-    const double *v = y + (size_t)(p->offset[F_V] + d) * p->n;
-    const double *xdot = ydot + (size_t)(p->offset[F_X] + d) * p->n;
-    double *vdot = ydot + (size_t)(p->offset[F_V] + d) * p->n;
-    for (mpm_lidx i = 0; i < p->n; ++i) vdot[i] = (1.0 - a) * vdot[i] + a / h * (xdot[i] - v[i]);
-  }
-}
 static void hold_fixed(const mpm_particles *p, int f_fixed, double *ydot);
 static void move_rigid(const solid_content *sc, const mpm_particles *p, double *ydot);
 static void rigid_velocity(const solid_content *sc, int dim, mpm_lidx n, double *v);
@@ -520,9 +509,9 @@ static int solid_remap(mpm_module *m, double t, const double *y, double h) {
   double *vg[MPM_MAX_DIM] = {NULL}, *ag[MPM_MAX_DIM] = {NULL};
   for (int d = 0; d < dim; ++d)
     vg[d] = sc->scratch + (size_t)d * n, ag[d] = sc->scratch + (size_t)(dim + d) * n;
-  double *C = sc->apic ? sc->scratch + (size_t)2 * dim * n : NULL; /* the L slot */
+  double *C = sc->tr.apic ? sc->scratch + (size_t)2 * dim * n : NULL; /* the L slot */
   g2p_velocity(m, y, vg, ag, NULL, C, NULL);
-  const double pic = sc->apic ? 1.0 : sc->pic;
+  const double pic = sc->tr.apic ? 1.0 : sc->tr.pic;
   for (int d = 0; d < dim; ++d) {
     const double *v = y + (size_t)(p->offset[F_V] + d) * n;
     double *vn = sc->vnew + (size_t)d * n;
@@ -555,16 +544,16 @@ static int solid_g2p(mpm_module *m, double t, const double *y, double *ydot, dou
     xdot[d] = ydot + (size_t)(p->offset[F_X] + d) * n;
     vdot[d] = ydot + (size_t)(p->offset[F_V] + d) * n;
   }
-  double *Cdot = sc->apic ? ydot + (size_t)p->offset[sc->lay.f_C] * n : NULL;
+  double *Cdot = sc->tr.apic ? ydot + (size_t)p->offset[sc->lay.f_C] * n : NULL;
   g2p_velocity(m, y, xdot, vdot, L, Cdot, ydot + (size_t)p->offset[F_F] * n);
-  if (sc->musl && !sc->apic && h > 0)
+  if (sc->tr.musl && !sc->tr.apic && h > 0)
     for (int d = 0; d < dim; ++d) { /* the velocity solid_remap gave the particles */
       const double *v = y + (size_t)(p->offset[F_V] + d) * n, *vn = sc->vnew + (size_t)d * n;
       for (mpm_lidx i = 0; i < n; ++i) vdot[d][i] = (vn[i] - v[i]) / h;
     }
-  else if ((sc->apic || sc->pic > 0) && h > 0) /* APIC (also under MUSL): the final grid's */
-    blend_pic(p, y, ydot, sc->apic ? 1.0 : sc->pic, h);
-  if (sc->apic && h > 0) { /* C takes the new affine velocity over the step */
+  else if ((sc->tr.apic || sc->tr.pic > 0) && h > 0) /* APIC (also under MUSL): the final grid's */
+    mpm_transfer_blend(p, y, ydot, sc->tr.apic ? 1.0 : sc->tr.pic, h);
+  if (sc->tr.apic && h > 0) { /* C takes the new affine velocity over the step */
     const double *C = state_C(sc, p, y);
     for (size_t k = 0; k < (size_t)dim * dim * (size_t)n; ++k) Cdot[k] = (Cdot[k] - C[k]) / h;
   }
@@ -918,27 +907,7 @@ static int read_bodies(mpm_module *m, const mpm_config *cfg) {
   MPM_CALL(mpm_config_get_reals(cfg, "physics.gravity", g, 3, &nv));
   memcpy(sc->gravity, g, sizeof g);
   MPM_CALL(mpm_config_get_real(cfg, "physics.damping", &sc->damping));
-  MPM_CALL(mpm_config_get_real(cfg, "transfer.pic_fraction", &sc->pic));
-  const char *method;
-  MPM_CALL(mpm_config_get_string(cfg, "time.method", &method));
-  sc->musl = strcmp(method, "musl") == 0;
-  const int classic = sc->musl || strcmp(method, "usl") == 0;
-  const char *transfer;
-  MPM_CALL(mpm_config_get_string(cfg, "transfer.velocity", &transfer));
-  sc->apic = strcmp(transfer, "apic") == 0;
-  if (sc->apic && !classic)
-    return mpm_config_fail(cfg, "transfer.velocity",
-                           "APIC replaces the particle velocity once per step of the classic "
-                           "update; use time.method = usl or musl, or velocity = flip with %s",
-                           method);
-  if (sc->apic && sc->pic > 0)
-    return mpm_config_fail(cfg, "transfer.pic_fraction",
-                           "APIC has no PIC fraction; set pic_fraction = 0 or velocity = flip");
-  if (sc->pic > 0 && !classic)
-    return mpm_config_fail(cfg, "transfer.pic_fraction",
-                           "a PIC fraction is defined per step of the classic update; use "
-                           "time.method = usl or musl, or pic_fraction = 0 with %s",
-                           method);
+  MPM_CALL(mpm_transfer_from_config(&sc->tr, cfg));
   return 0;
 }
 
@@ -970,7 +939,7 @@ int solid_module_create(mpm_module **mp, const mpm_config *cfg, mpm_grid *grid, 
     if (!rc) rc = read_constraints(m, cfg);
     if (!rc) rc = read_tractions(m, cfg);
     if (!rc)
-      rc = solid_particles_new(&m->particles, grid->dim, &sc->lay, has_rate, sc->apic, nhist,
+      rc = solid_particles_new(&m->particles, grid->dim, &sc->lay, has_rate, sc->tr.apic, nhist,
                                sc->nclamps > 0, sc->ntractions > 0);
   }
   for (int b = 0; !rc && b < sc->nbodies; ++b) {
