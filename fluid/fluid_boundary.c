@@ -3,29 +3,37 @@
  * The missing exterior gas. A particle near a face has no neighbours beyond it, so the nodes
  * there miss the force the exterior gas would exert: at uniform pressure the internal force
  * of a full lattice of particles vanishes at every node, and with the exterior half removed a
- * face node is pushed outwards by about p per unit area. Each open face therefore adds the
- * force of an exterior lattice of particles (the seeding lattice, continued beyond the face)
- * at a boundary pressure p_b:
- *     f_i += p_b W_i,   W_i = sum over exterior lattice points q of V_q dS_i/dx_n (x_q),
- * computed once per node as a product of 1-D sums (the shape functions are tensor products).
- * On the undisturbed seeding lattice at uniform pressure p_b = p this cancels the one-sided
- * force exactly. The face kind chooses p_b:
- *   inflow            the free-stream pressure; the nodes on and beyond the face are also held
- *                     at the free-stream velocity (all characteristics enter);
- *   outflow           the gas's own pressure at the node (all characteristics leave: zero
- *                     gradient), from a mass-weighted deposit of the particles' pressure;
- *   subsonic_outflow  the back pressure freestream.back_pressure (the one entering
- *                     characteristic);
- *   subsonic_inflow,  the linearised characteristic state between the gas at the node
- *   farfield          (p_i, u_i) and the free stream (p_inf, u_inf):
- *                         p_b = (p_i + p_inf) / 2 + Z (u_i - u_inf) . n / 2,  Z = rho_inf c_inf,
- *                     which passes an outgoing acoustic wave (p' = Z u'.n) without reflection
- *                     and holds the free stream; where the free stream crosses the face
- *                     supersonically, p_b is p_inf (entering) or p_i (leaving).
- * The normal n points out of the domain.
- *
- * Where an obstacle crosses the face, the body continues beyond it (fluid_obstacle.c puts its
- * ghost points there) and the columns stop at its surface.
+ * face node is pushed outwards by about p per unit area. Each open face adds the force of the
+ * exterior gas, as pressure-only particles beyond it:
+ *   inflow            the exterior part of the seeding lattice, which moves in with the free
+ *                     stream (below), at the free-stream pressure: W_i = sum over its points q
+ *                     of V_q dS_i/dx_n (x_q), a product of 1-D sums (the shape functions are
+ *                     tensor products), recomputed for the lattice's position at each RHS. The
+ *                     nodes on and beyond the face are also held at the free-stream velocity
+ *                     (every characteristic enters). Exact: the free stream stays uniform.
+ *   the other kinds   virtual particles (fluid_virtual.h) that continue every column of
+ *                     particles across the face: the particles within two cells of the face,
+ *                     keyed by their lattice index across it, and from each column's outermost
+ *                     particle copies outwards at its volume and spacing (the distance to the
+ *                     next particle in the column when that one sits on the column's line,
+ *                     else the particle's size V^(1/dim)), until beyond a node's stencil. A
+ *                     fixed exterior lattice would not do: as the gas flows through the face
+ *                     its particles drift against that lattice, which then pins them to its
+ *                     spacing (slow flow through such a face stopped). The copies carry a
+ *                     boundary pressure p_b that the face kind chooses from the outermost
+ *                     particle's pressure p and velocity u:
+ *     outflow           p (every characteristic leaves: zero gradient);
+ *     subsonic_outflow  the back pressure freestream.back_pressure (the one entering
+ *                       characteristic);
+ *     subsonic_inflow,  the linearised characteristic state between the gas and the free
+ *     farfield          stream, p_b = (p + p_inf) / 2 + Z (u - u_inf) . n / 2, Z = rho_inf
+ *                       c_inf, which passes an outgoing acoustic wave (p' = Z u'.n) without
+ *                       reflection and holds the free stream; where the free stream crosses
+ *                       the face supersonically, p_b is p_inf (entering) or p (leaving).
+ *                     The nodes beyond these faces extrapolate the face node linearly.
+ * The normal n points out of the domain. Where an obstacle crosses the face, the body
+ * continues beyond it (fluid_obstacle.c puts its ghost points there) and the copies stop at
+ * its surface.
  *
  * Particles. A particle beyond an open face is removed between steps (it may sit up to a cell
  * beyond the face during a step: the pad nodes carry its stencil). Where the free stream

@@ -27,11 +27,11 @@ void fluid_open_destroy(fluid_open **open);
 int fluid_open_p2g(fluid_open *open, mpm_module *m, const double *y, fluid_virtual *virt);
 /* Does a face continue the particle columns (so the module needs virtual particles)? */
 int fluid_open_uses_virtual(const fluid_open *open);
-/* Before the nodal update (first pass only) at time t: add the pressure of the missing
- * exterior gas to the nodal forces. Collective. */
+/* Before the nodal update (first pass only) at time t: add the force of the exterior
+ * lattice of the inflow faces to the nodal forces. */
 int fluid_open_forces(fluid_open *open, mpm_module *m, double t);
 /* After the nodal update: hold the nodes on and beyond an inflow face at the free-stream
- * velocity; beyond the other open faces, copy the face node (zero gradient). */
+ * velocity; beyond the other open faces, extrapolate the face node linearly. */
 void fluid_open_hold(const fluid_open *open, mpm_module *m);
 /* Between steps (the boundary op): remove particles that left through an open face and inject
  * the free-stream layers that entered during the step h that ended at t. Local. */
