@@ -1,10 +1,14 @@
 #!/usr/bin/env bash
 # Install, build and run the default test selection (everything but the `long` and
 # `benchmark` labels), then the same selection again in a build with AddressSanitizer,
-# LeakSanitizer and UBSan. Idempotent.
+# LeakSanitizer and UBSan, less the two gas flow cases (test_wedge, test_forward_step: 7 minutes
+# under the sanitizers, 33 s without). The code they run is the open faces', the obstacles' and
+# the gas module's, which test_gas_boundaries, test_obstacles, test_sod and the other gas tests
+# run under the sanitizers in a few seconds each. Idempotent.
 set -euo pipefail
 src=$(cd "$(dirname "$0")/.." && pwd)
 bash "$src/tools/setup.sh" "$src/build"
 (cd "$src/build" && ctest -LE "long|benchmark" --output-on-failure -j 2 --timeout 900)
 bash "$src/tools/setup.sh" "$src/build-asan" -DMPMFSI_SANITIZE=ON -DCMAKE_BUILD_TYPE=Debug
-(cd "$src/build-asan" && ctest -LE "long|benchmark" --output-on-failure -j 2 --timeout 1800)
+(cd "$src/build-asan" &&
+  ctest -LE "long|benchmark" -E "^test_(wedge|forward_step)$" --output-on-failure -j 2 --timeout 1800)
