@@ -520,7 +520,18 @@ int fluid_module_create(mpm_module **mp, const mpm_config *cfg, mpm_grid *grid, 
   int count;
   *mp = NULL;
   MPM_CALL(mpm_config_instances(cfg, "gas", &names, &count));
-  if (count == 0) return 0;
+  if (count == 0) {
+    const char *const *obstacles;
+    int nobs;
+    MPM_CALL(mpm_config_instances(cfg, "obstacle", &obstacles, &nobs));
+    if (nobs == 0) return 0;
+    char key[160];
+    snprintf(key, sizeof key, "obstacle.%s.shape", obstacles[0]);
+    return mpm_config_fail(cfg, key,
+                           "an obstacle is a boundary condition for the gas, and the scene has no "
+                           "[gas.NAME] section: add the gas, or make the body a [solid.NAME] with "
+                           "material = rigid");
+  }
   mpm_module *m;
   MPM_ALLOC(m, 1);
   *mp = m;

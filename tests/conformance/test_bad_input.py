@@ -118,6 +118,10 @@ for name, old, new, key, words in GAS_CASES:
     if name == "gas region outside the domain":
         line = line_of(text, "geometry = right")
     expect_error(name, text, key, words, line)
+# An obstacle in a scene without gas (it would do nothing).
+lone = BASE + "\n[obstacle.post]\nshape = box\nlo = 0.2 0.2\nhi = 0.4 0.4\n"
+expect_error("obstacle without gas", lone, "obstacle.post.shape", "no [gas.NAME]",
+             line_of(lone, "shape = box"))
 # An inflow face through which the free stream leaves.
 inflow = GAS.replace("x_hi = slip", "x_hi = inflow") + \
     "\n[freestream]\ndensity = 1\npressure = 1\nvelocity = 1 0\n"
