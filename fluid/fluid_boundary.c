@@ -85,6 +85,9 @@ typedef struct open_face {
   int *r;                      /* their distance inside the face, cells (0 .. NORMAL_REACH) */
   double *wt;                  /* the product of their tangential weights, m^(dim-1) */
   double wn[NORMAL_REACH + 1]; /* normal weights by distance, for the current lattice phase */
+  mpm_lidx nout;               /* box nodes beyond the face (and on it, for inflow) */
+  mpm_lidx *out;               /* per node: its index, the face node and the one inside it */
+  int *beyond;                 /* cells beyond the face */
 } open_face;
 
 struct fluid_open {
@@ -152,6 +155,31 @@ static int build_weights(open_face *f, const mpm_grid *g, int ppc, double lp) {
     f->wt[f->count++] = W;
   }
   for (int r = 0; r <= NORMAL_REACH; ++r) f->wn[r] = normal_weight(g, f, ppc, lp, r, 0.0);
+  return 0;
+}
+
+/* The nodes fluid_open_hold sets: beyond the face (and on it, for an inflow face), each with
+ * the face node and the node inside it that a linear extrapolation reads. */
+static int build_outer(open_face *f, const mpm_grid *g) {
+  const int F = f->side ? g->ncells[f->axis] : 0, inflow = f->kind == MPM_WALL_INFLOW;
+  MPM_ALLOC(f->out, 3 * (size_t)g->nnodes);
+  MPM_ALLOC(f->beyond, (size_t)g->nnodes);
+  f->nout = 0;
+  for (mpm_lidx l = 0; l < g->nnodes; ++l) {
+    int gi[MPM_MAX_DIM];
+    mpm_grid_node_global(g, l, gi);
+    const int beyond = (int)f->sign * (gi[f->axis] - F);
+    if (beyond < 0 || (beyond == 0 && !inflow)) continue;
+    mpm_lidx *e = f->out + 3 * (size_t)f->nout;
+    e[0] = e[1] = e[2] = l;
+    if (!inflow) {
+      gi[f->axis] = F;
+      e[1] = mpm_grid_local_index(g, gi);
+      gi[f->axis] = F - (int)f->sign;
+      e[2] = mpm_grid_local_index(g, gi);
+    }
+    f->beyond[f->nout++] = beyond;
+  }
   return 0;
 }
 
@@ -229,6 +257,7 @@ int fluid_open_new(fluid_open **openp, mpm_module *m, const mpm_config *cfg, con
       f->inject = k != MPM_WALL_OUTFLOW && k != MPM_WALL_SUBSONIC_OUTFLOW && f->speed > 0;
       m->open[d][s] = 1;
       if (k == MPM_WALL_INFLOW) MPM_CALL(build_weights(f, g, ppc, lp));
+      MPM_CALL(build_outer(f, g));
       o->columns |= k != MPM_WALL_INFLOW;
     }
   return 0;
@@ -242,7 +271,8 @@ void fluid_open_destroy(fluid_open **openp) {
   fluid_open *o = *openp;
   if (!o) return;
   for (int k = 0; k < o->nfaces; ++k)
-    free(o->face[k].node), free(o->face[k].r), free(o->face[k].wt);
+    free(o->face[k].node), free(o->face[k].r), free(o->face[k].wt), free(o->face[k].out),
+        free(o->face[k].beyond);
   free(o->cand);
   free(o);
   *openp = NULL;
@@ -399,27 +429,20 @@ int fluid_open_forces(fluid_open *o, mpm_module *m, double t) {
 
 void fluid_open_hold(const fluid_open *o, mpm_module *m) {
   if (!o) return;
-  mpm_grid *g = m->grid;
-  mpm_grid_phase *ph = &g->phase[m->phase];
+  mpm_grid_phase *ph = &m->grid->phase[m->phase];
+  const int dim = m->grid->dim;
   for (int k = 0; k < o->nfaces; ++k) {
     const open_face *f = &o->face[k];
-    const int F = f->side ? g->ncells[f->axis] : 0, inflow = f->kind == MPM_WALL_INFLOW;
-    for (mpm_lidx l = 0; l < g->nnodes; ++l) {
-      int gi[MPM_MAX_DIM];
-      mpm_grid_node_global(g, l, gi);
-      const int beyond = f->sign * (gi[f->axis] - F);
-      if (beyond < 0 || (beyond == 0 && !inflow)) continue;
-      if (inflow) {
-        for (int d = 0; d < g->dim; ++d) ph->v_i[d][l] = o->v[d], ph->a_i[d][l] = 0.0;
-        continue;
-      }
-      gi[f->axis] = F;
-      const mpm_lidx src = mpm_grid_local_index(g, gi);
-      gi[f->axis] = F - (int)f->sign;
-      const mpm_lidx in = mpm_grid_local_index(g, gi);
-      for (int d = 0; d < g->dim; ++d) {
-        ph->v_i[d][l] = ph->v_i[d][src] + beyond * (ph->v_i[d][src] - ph->v_i[d][in]);
-        ph->a_i[d][l] = ph->a_i[d][src] + beyond * (ph->a_i[d][src] - ph->a_i[d][in]);
+    for (mpm_lidx j = 0; j < f->nout; ++j) {
+      const mpm_lidx l = f->out[3 * j], src = f->out[3 * j + 1], in = f->out[3 * j + 2];
+      const double b = f->beyond[j];
+      for (int d = 0; d < dim; ++d) {
+        if (f->kind == MPM_WALL_INFLOW) {
+          ph->v_i[d][l] = o->v[d], ph->a_i[d][l] = 0.0;
+          continue;
+        }
+        ph->v_i[d][l] = ph->v_i[d][src] + b * (ph->v_i[d][src] - ph->v_i[d][in]);
+        ph->a_i[d][l] = ph->a_i[d][src] + b * (ph->a_i[d][src] - ph->a_i[d][in]);
       }
     }
   }
