@@ -12,14 +12,11 @@ import csv
 import json
 import math
 import os
-import subprocess
 import sys
-import tempfile
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+from benchrun import ROOT, run_case  # noqa: E402
+
 BIN = os.path.join(ROOT, "build", "app", "mpmfsi")
-ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
-           OMPI_MCA_btl_vader_single_copy_mechanism="none", OMPI_MCA_mpi_yield_when_idle="1")
 quick = "--quick" in sys.argv
 
 # dim, cells per side: 2-D 256^2 x 4 = 262 144 particles, 3-D 24^3 x 8 = 110 592 (--quick:
@@ -31,20 +28,14 @@ C0 = math.sqrt(1.4)  # sound speed of the undisturbed gas
 
 def run(dim, cells, method, ranks):
     dx = 1.0 / cells
-    with tempfile.TemporaryDirectory() as out:
-        extra = [] if dim == 2 else [
-            "domain.lo=0 0 0", "domain.hi=1 1 1", "geometry.box.lo=0 0 0",
-            "geometry.box.hi=1 1 1", "boundary.z_lo=periodic", "boundary.z_hi=periodic",
-            "gas.air.pressure_field=1 + 0.5*exp(-((x-0.5)^2 + (y-0.5)^2 + (z-0.5)^2)/0.01)"]
-        args = [BIN, "run", os.path.join(ROOT, "bench", "bench_fluid.ini"), f"output.dir={out}",
-                f"domain.dim={dim}", f"grid.dx={dx}", f"time.method={method}",
-                f"time.t_end={40 * 0.4 * dx / C0}"] + extra
-        if ranks > 1:
-            args = ["mpiexec", "-n", str(ranks)] + args
-        subprocess.run(args, check=True, env=ENV, capture_output=True)
-        summary = json.load(open(os.path.join(out, "summary.json")))
-        with open(os.path.join(out, "timers.csv")) as f:
-            timers = {r["phase"]: float(r["mean_s"]) for r in csv.DictReader(f)}
+    extra = [] if dim == 2 else [
+        "domain.lo=0 0 0", "domain.hi=1 1 1", "geometry.box.lo=0 0 0",
+        "geometry.box.hi=1 1 1", "boundary.z_lo=periodic", "boundary.z_hi=periodic",
+        "gas.air.pressure_field=1 + 0.5*exp(-((x-0.5)^2 + (y-0.5)^2 + (z-0.5)^2)/0.01)"]
+    summary, timers = run_case(
+        BIN, os.path.join(ROOT, "bench", "bench_fluid.ini"),
+        [f"domain.dim={dim}", f"grid.dx={dx}", f"time.method={method}",
+         f"time.t_end={40 * 0.4 * dx / C0}"] + extra, ranks)
     steps = summary["steps"]
     n = summary["particle_steps"] / max(steps, 1)
     return {"dim": dim, "particles": int(round(n)), "method": method, "ranks": ranks,

@@ -22,13 +22,10 @@ import csv
 import json
 import os
 import statistics
-import subprocess
 import sys
-import tempfile
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
-           OMPI_MCA_btl_vader_single_copy_mechanism="none", OMPI_MCA_mpi_yield_when_idle="1")
+from benchrun import ROOT, run_case  # noqa: E402
+
 PHASES = ["p2g", "stress", "grid", "g2p", "halo", "check", "migrate", "diagnostics", "io"]
 
 
@@ -61,22 +58,16 @@ CASES = [(2, 0.0025 if not quick else 0.005), (3, 0.025 if not quick else 0.05)]
 
 
 def run_once(binary, dim, dx, method, ranks):
-    with tempfile.TemporaryDirectory() as out:
-        lo, hi = ("0 0", "1 1") if dim == 2 else ("0 0 0", "1 1 1")
-        blo, bhi = ("0.2 0.2", "0.8 0.8") if dim == 2 else ("0.2 0.2 0.2", "0.8 0.8 0.8")
-        vf = ("0.1*sin(pi*(x-0.2)/0.6); 0.05*sin(pi*(y-0.2)/0.6)" if dim == 2 else
-              "0.1*sin(pi*(x-0.2)/0.6); 0.05*sin(pi*(y-0.2)/0.6); 0")
-        args = [binary, "run", os.path.join(ROOT, "bench", "bench_solid.ini"), f"output.dir={out}",
-                f"domain.dim={dim}", f"domain.lo={lo}", f"domain.hi={hi}", f"grid.dx={dx}",
-                f"geometry.block.lo={blo}", f"geometry.block.hi={bhi}",
-                f"solid.block.velocity_field={vf}", f"time.method={method}",
-                "time.rtol=1e-6", "time.atol=1e-9", f"time.t_end={20 * dx / 60}"]
-        if ranks > 1:
-            args = ["mpiexec", "-n", str(ranks)] + args
-        subprocess.run(args, check=True, env=ENV, capture_output=True)
-        summary = json.load(open(os.path.join(out, "summary.json")))
-        with open(os.path.join(out, "timers.csv")) as f:
-            timers = {r["phase"]: float(r["mean_s"]) for r in csv.DictReader(f)}
+    lo, hi = ("0 0", "1 1") if dim == 2 else ("0 0 0", "1 1 1")
+    blo, bhi = ("0.2 0.2", "0.8 0.8") if dim == 2 else ("0.2 0.2 0.2", "0.8 0.8 0.8")
+    vf = ("0.1*sin(pi*(x-0.2)/0.6); 0.05*sin(pi*(y-0.2)/0.6)" if dim == 2 else
+          "0.1*sin(pi*(x-0.2)/0.6); 0.05*sin(pi*(y-0.2)/0.6); 0")
+    summary, timers = run_case(
+        binary, os.path.join(ROOT, "bench", "bench_solid.ini"),
+        [f"domain.dim={dim}", f"domain.lo={lo}", f"domain.hi={hi}", f"grid.dx={dx}",
+         f"geometry.block.lo={blo}", f"geometry.block.hi={bhi}",
+         f"solid.block.velocity_field={vf}", f"time.method={method}", "time.rtol=1e-6",
+         "time.atol=1e-9", f"time.t_end={20 * dx / 60}"], ranks)
     steps = summary["steps"]
     n = summary["particle_steps"] / max(steps, 1)
     total = timers.get("total", summary["wall_s"])
