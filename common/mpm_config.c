@@ -417,15 +417,27 @@ static int check_int(const item *it) {
   return 0;
 }
 
+static size_t edit_distance(const char *a, const char *b, size_t limit);
+
+/* A wrong choice names the nearest one when it is a likely typo (a third of the word away at
+ * most, at least 2). */
 static int check_enum(const item *it) {
   const char *c = it->sp->choices ? it->sp->choices : "";
-  size_t n = strlen(it->value);
+  size_t n = strlen(it->value), limit = n / 3 < 2 ? 2 : n / 3, best = limit + 1;
+  char near[64] = "";
   for (;;) {
     size_t len = strcspn(c, "|");
     if (len == n && memcmp(c, it->value, n) == 0) return 0;
+    if (len < sizeof near) {
+      char cand[64];
+      memcpy(cand, c, len), cand[len] = '\0';
+      const size_t d = edit_distance(it->value, cand, limit);
+      if (d < best) best = d, memcpy(near, cand, len + 1);
+    }
     if (!c[len]) break;
     c += len + 1;
   }
+  if (*near) return bad(it, "did you mean '%s'? Expected one of %s", near, it->sp->choices);
   return bad(it, "expected one of %s", it->sp->choices ? it->sp->choices : "(none)");
 }
 

@@ -254,6 +254,7 @@ void mpm_grid_phase_zero(mpm_grid *grid, int phase) {
   const size_t bytes = (size_t)grid->nnodes * sizeof(double);
   memset(ph->m_i, 0, bytes);
   for (int d = 0; d < grid->dim; ++d) memset(ph->mv_i[d], 0, bytes), memset(ph->f_i[d], 0, bytes);
+  for (int d = 0; ph->normals && d < grid->dim; ++d) memset(ph->normal_i[d], 0, bytes);
 }
 
 /* ---- ownership ------------------------------------------------------------------------- */

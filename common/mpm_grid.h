@@ -35,12 +35,16 @@
 /* Nodal fields of one phase (one module), each an array of box nodes. */
 typedef struct mpm_grid_phase {
   char name[32];
-  double *m_i;                   /* mass */
-  double *mv_i[MPM_MAX_DIM];     /* momentum */
-  double *f_i[MPM_MAX_DIM];      /* force (internal + external) */
-  double *v_i[MPM_MAX_DIM];      /* velocity */
-  double *a_i[MPM_MAX_DIM];      /* acceleration */
-  double *normal_i[MPM_MAX_DIM]; /* mass-gradient normal, for contact */
+  double *m_i;               /* mass */
+  double *mv_i[MPM_MAX_DIM]; /* momentum */
+  double *f_i[MPM_MAX_DIM];  /* force (internal + external) */
+  double *v_i[MPM_MAX_DIM];  /* velocity */
+  double *a_i[MPM_MAX_DIM];  /* acceleration */
+  /* Mass gradient sum_p m_p grad S_ip, deposited by P2G only when `normals` is set (a
+   * coupling scheme asks for it); it points into the phase's material. */
+  double *normal_i[MPM_MAX_DIM];
+  int normals;
+  double m_empty; /* the last nodal solve treated nodes with m_i <= m_empty as empty */
 } mpm_grid_phase;
 
 typedef struct mpm_grid {
@@ -79,7 +83,8 @@ void mpm_grid_destroy(mpm_grid **grid);
 /* Add a set of nodal fields for a phase; returns its index in *index. */
 int mpm_grid_add_phase(mpm_grid *grid, const char *name, int *index);
 
-/* Zero m, mv and f of one phase on every box node. */
+/* Zero m, mv and f (and the mass gradient, if the phase deposits it) of one phase on every box
+ * node. */
 void mpm_grid_phase_zero(mpm_grid *grid, int phase);
 
 /* Local (box) index of global node (i, j, k); the caller guarantees it is in the box. */

@@ -58,7 +58,8 @@ typedef struct mpm_g2p_args {
 
 typedef struct mpm_kernels {
   int dim;
-  /* Add m_i, (m v)_i and f_i = sum S m g - sum V sigma grad S into phase fields. */
+  /* Add m_i, (m v)_i and f_i = sum S m g - sum V sigma grad S into phase fields, and the mass
+   * gradient sum m grad S into normal_i when the phase asks for it (phase->normals). */
   void (*p2g)(mpm_grid *grid, int phase, const mpm_p2g_args *a);
   void (*g2p)(const mpm_grid *grid, const mpm_g2p_args *a);
 } mpm_kernels;

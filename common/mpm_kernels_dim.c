@@ -69,19 +69,20 @@ MPM_INLINE void DIMFN(weights_eval)(const DIMFN(lattice) * L, mpm_shape_kind kin
 
 /* ---- P2G ---------------------------------------------------------------------------------- */
 
-/* With apic (a literal) the momentum carries the affine term S m C_p (x_i - x_p). */
+/* With apic (a literal) the momentum carries the affine term S m C_p (x_i - x_p); with grad (a
+ * literal) the mass gradient m grad S goes to normal_i. */
 MPM_INLINE void DIMFN(p2g_loop)(const DIMFN(lattice) * L, mpm_grid_phase *ph, const mpm_p2g_args *a,
-                                mpm_shape_kind kind, int apic) {
+                                mpm_shape_kind kind, int apic, int grad) {
   enum { D = MPM_DIM };
   const int S = SUPPORT(kind);
   const size_t n = (size_t)a->n;
   double *restrict mi = ph->m_i;
-  double *restrict mvi[D], *restrict fi[D];
+  double *restrict mvi[D], *restrict fi[D], *restrict ni[D];
   const double *restrict xp[D], *restrict vp[D], *restrict fext[D];
   const double *restrict mp = a->m, *restrict vsig = a->vsig, *restrict C = a->C;
   double grav[D];
   for (int d = 0; d < D; ++d) {
-    mvi[d] = ph->mv_i[d], fi[d] = ph->f_i[d];
+    mvi[d] = ph->mv_i[d], fi[d] = ph->f_i[d], ni[d] = ph->normal_i[d];
     xp[d] = a->x[d], vp[d] = a->v[d], fext[d] = a->fext[0] ? a->fext[d] : NULL;
     grav[d] = a->gravity[d];
   }
@@ -130,6 +131,10 @@ MPM_INLINE void DIMFN(p2g_loop)(const DIMFN(lattice) * L, mpm_grid_phase *ph, co
           mvi[d][row + i] += wy[j] * (apic ? MX[d][i] + ry * CY[d][i] : MX[d][i]);
           fi[d][row + i] += wy[j] * P[d][i] - dwy[j] * Q[d][i];
         }
+        if (grad) {
+          ni[0][row + i] += wy[j] * m * dwx[i];
+          ni[1][row + i] += dwy[j] * mwx[i];
+        }
       }
     }
 #else
@@ -157,6 +162,11 @@ MPM_INLINE void DIMFN(p2g_loop)(const DIMFN(lattice) * L, mpm_grid_phase *ph, co
             mvi[d][row + i] += wz * (apic ? lmv[d][j][i] + rz * lmvz[d][j][i] : lmv[d][j][i]);
             fi[d][row + i] += wz * lf[d][j][i] - dwz * lfz[d][j][i];
           }
+          if (grad) {
+            ni[0][row + i] += wz * wy[j] * m * dwx[i];
+            ni[1][row + i] += wz * dwy[j] * mwx[i];
+            ni[2][row + i] += dwz * lm[j][i];
+          }
         }
       }
     }
@@ -167,13 +177,17 @@ MPM_INLINE void DIMFN(p2g_loop)(const DIMFN(lattice) * L, mpm_grid_phase *ph, co
 static void DIMFN(p2g)(mpm_grid *g, int phase, const mpm_p2g_args *a) {
   mpm_grid_phase *ph = &g->phase[phase];
   const DIMFN(lattice) L = DIMFN(lattice_of)(g, a->lp);
-  const int apic = a->C != NULL;
+  const int apic = a->C != NULL, grad = ph->normals;
 #define P2G_CASE(kind)                                                                             \
   case kind:                                                                                       \
-    if (apic)                                                                                      \
-      DIMFN(p2g_loop)(&L, ph, a, kind, 1);                                                         \
+    if (apic && grad)                                                                              \
+      DIMFN(p2g_loop)(&L, ph, a, kind, 1, 1);                                                      \
+    else if (apic)                                                                                 \
+      DIMFN(p2g_loop)(&L, ph, a, kind, 1, 0);                                                      \
+    else if (grad)                                                                                 \
+      DIMFN(p2g_loop)(&L, ph, a, kind, 0, 1);                                                      \
     else                                                                                           \
-      DIMFN(p2g_loop)(&L, ph, a, kind, 0);                                                         \
+      DIMFN(p2g_loop)(&L, ph, a, kind, 0, 0);                                                      \
     break;
   switch (g->shape) {
     P2G_CASE(MPM_SHAPE_LINEAR)

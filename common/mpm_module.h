@@ -1,9 +1,14 @@
 /* A physics module (solid, fluid): an object with an ops table, in the SUNDIALS N_Vector
  * shape. A module owns its particles and a phase of nodal fields on the shared grid, and
- * exposes the phases of an MPM right-hand side; the coupler decides their order:
+ * exposes the phases of an MPM right-hand side; the coupler decides their order and owns the
+ * nodal solve between a module's forces and its constraints (coupler/mpm_cycle.c):
  *
- *   zero grid phase -> p2g -> [halo reverse] -> [coupling] -> grid_update -> [halo forward]
- *   -> [MUSL: remap -> halo reverse -> grid_update -> halo forward] -> g2p
+ *   zero grid phase -> p2g -> halo reverse -> forces -> [coupling: before_solve] -> solve
+ *   -> [coupling: after_solve] -> constrain -> [coupling: after_constrain] -> halo forward
+ *   -> [MUSL: remap -> the same grid pass with pass = MPM_PASS_REMAP] -> g2p
+ *
+ * A module knows nothing of the other modules: what the phases exchange on shared nodes is
+ * the coupling scheme's business. It announces what it is through its role.
  *
  * y and ydot are the module's block of the ODE state, laid out like the state fields of its
  * particle set (component-major, stride n). h is the step size of the classic MPM update
@@ -30,9 +35,22 @@ typedef struct mpm_module_sums {
 
 typedef struct mpm_module mpm_module;
 
+/* Which transfer a grid pass follows: the first (particles with their stress, gravity and
+ * external forces) or MUSL's remap (mass and momentum only, after the first solve: no force
+ * acts, the solve just turns momenta into velocities). */
+typedef enum { MPM_PASS_FIRST, MPM_PASS_REMAP } mpm_pass;
+
+/* What a module models, so that a coupling scheme finds its phases without knowing names. */
+typedef enum { MPM_ROLE_SOLID, MPM_ROLE_FLUID, MPM_ROLE_COUNT } mpm_role;
+
 typedef struct mpm_module_ops {
   int (*p2g)(mpm_module *m, double t, const double *y);
-  int (*grid_update)(mpm_module *m, double t, double h);
+  /* After the reverse halo: complete this phase's nodal forces (fold mirrored pad nodes into
+   * walls, damping, ghost and boundary forces). h is the classic step (0: method of lines). */
+  int (*forces)(mpm_module *m, double t, double h, mpm_pass pass);
+  /* After the nodal solve (mpm_grid_phase_update): the kinematic constraints of this phase
+   * (walls, clamps, rigid bodies, obstacles, open faces), on v_i and a_i. */
+  int (*constrain)(mpm_module *m, double t, double h, mpm_pass pass);
   int (*g2p)(mpm_module *m, double t, const double *y, double *ydot, double h);
   /* Largest stable step on this rank (before the CFL factor). */
   double (*stable_dt)(const mpm_module *m, const double *y);
@@ -47,11 +65,11 @@ typedef struct mpm_module_ops {
    * particle sits on the rank that owns its cell. Same arguments as boundary. Optional. */
   int (*post_step)(mpm_module *m, double t, double h, int *changed);
   void (*destroy)(mpm_module *m);
-  /* MUSL's second transfer, after the first grid update and forward halo: compute the
+  /* MUSL's second transfer, after the first grid pass and forward halo: compute the
    * particles' new velocities, zero this phase and deposit their mass and momentum again.
-   * The coupler then sums the halo and calls grid_update, which turns the new momenta into
-   * the nodal velocities (no force, no damping: the force acted in the first pass) before
-   * g2p. Optional: NULL if the module has no MUSL. */
+   * The coupler then runs the grid pass with MPM_PASS_REMAP, which turns the new momenta
+   * into the nodal velocities (no force, no damping: the force acted in the first pass)
+   * before g2p. Optional: NULL if the module has no MUSL. */
   int (*remap)(mpm_module *m, double t, const double *y, double h);
   /* Refresh fields derived for output only (a gas's pressure, Mach number, ...) before a
    * snapshot or checkpoint is written. Optional. */
@@ -61,6 +79,7 @@ typedef struct mpm_module_ops {
 struct mpm_module {
   char name[32];
   const mpm_module_ops *ops;
+  mpm_role role;
   void *content;
   mpm_particles *particles;
   mpm_grid *grid;

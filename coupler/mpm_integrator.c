@@ -1,6 +1,7 @@
 /* ERKStep driver of the coupled MPM system (see mpm_integrator.h). */
 #include "mpm_integrator.h"
 
+#include "mpm_cycle.h"
 #include "mpm_error.h"
 #include "mpm_nvector.h"
 #include "mpm_sundials.h"
@@ -25,6 +26,7 @@ struct mpm_integrator {
   mpm_grid *grid;
   mpm_module *mod[MPM_MAX_MODULES];
   int nmod;
+  mpm_cycle cycle; /* the RHS over mod[] */
   mpm_method method;
   int fixed; /* fixed CFL steps without error control (classic, euler, time.adaptive = false) */
   double rtol, atol, cfl, dt_max;
@@ -88,55 +90,11 @@ static int share_fault(mpm_integrator *it, mpm_fault *local) {
   return 1;
 }
 
-static int halo(mpm_integrator *it, int reverse) {
-  double *f[MPM_MAX_MODULES * (1 + 2 * MPM_MAX_DIM)];
-  int nf = 0;
-  const int dim = it->grid->dim;
-  for (int k = 0; k < it->nmod; ++k) {
-    mpm_grid_phase *ph = &it->grid->phase[it->mod[k]->phase];
-    if (reverse) f[nf++] = ph->m_i;
-    for (int d = 0; d < dim; ++d) {
-      f[nf++] = reverse ? ph->mv_i[d] : ph->v_i[d];
-      f[nf++] = reverse ? ph->f_i[d] : ph->a_i[d];
-    }
-  }
-  mpm_timer_start(MPM_T_HALO);
-  int rc =
-      reverse ? mpm_grid_halo_reverse(it->grid, f, nf) : mpm_grid_halo_forward(it->grid, f, nf);
-  mpm_timer_stop(MPM_T_HALO);
-  return rc;
-}
-
-/* Reverse halo -> grid update -> forward halo, over every module. */
-static int grid_pass(mpm_integrator *it, double t, double h) {
-  MPM_CALL(halo(it, 1));
-  mpm_timer_start(MPM_T_GRID);
-  for (int k = 0; k < it->nmod; ++k) MPM_CALL(it->mod[k]->ops->grid_update(it->mod[k], t, h));
-  mpm_timer_stop(MPM_T_GRID);
-  return halo(it, 0);
-}
-
-/* P2G -> grid pass -> [MUSL: remap -> grid pass] -> G2P, over every module. */
-static int mpm_cycle(mpm_integrator *it, double t, N_Vector y, N_Vector ydot) {
-  for (int k = 0; k < it->nmod; ++k) {
-    mpm_grid_phase_zero(it->grid, it->mod[k]->phase);
-    MPM_CALL(it->mod[k]->ops->p2g(it->mod[k], t, module_data(y, k)));
-  }
-  MPM_CALL(grid_pass(it, t, it->h_classic));
-  if (it->method == MPM_METHOD_MUSL) {
-    mpm_timer_start(MPM_T_P2G);
-    for (int k = 0; k < it->nmod; ++k)
-      if (it->mod[k]->ops->remap)
-        MPM_CALL(it->mod[k]->ops->remap(it->mod[k], t, module_data(y, k), it->h_classic));
-    mpm_timer_stop(MPM_T_P2G);
-    MPM_CALL(grid_pass(it, t, 0.0));
-  }
-  mpm_timer_start(MPM_T_G2P);
-  for (int k = 0; k < it->nmod; ++k)
-    MPM_CALL(it->mod[k]->ops->g2p(it->mod[k], t, module_data(y, k), module_data(ydot, k),
-                                  it->h_classic));
-  mpm_timer_stop(MPM_T_G2P);
-  return 0;
+/* One RHS of the MPM cycle over every module's block of y. */
+static int cycle_rhs(mpm_integrator *it, N_Vector y, N_Vector ydot, double t) {
+  double *yk[MPM_MAX_MODULES], *ydk[MPM_MAX_MODULES];
+  for (int k = 0; k < it->nmod; ++k) yk[k] = module_data(y, k), ydk[k] = module_data(ydot, k);
+  return mpm_cycle_rhs(&it->cycle, t, yk, ydk, it->h_classic);
 }
 
 static int classic_limit(mpm_integrator *it, N_Vector y, double *h);
@@ -161,7 +119,7 @@ static int rhs(mpm_sunreal t, N_Vector y, N_Vector ydot, void *user) {
   const int faulty = share_fault(it, &local);
   mpm_timer_stop(MPM_T_CHECK);
   if (faulty) return 1;
-  if (mpm_cycle(it, t, y, ydot) != 0) {
+  if (cycle_rhs(it, y, ydot, t) != 0) {
     it->rhs_error = 1;
     return -1;
   }
@@ -282,7 +240,7 @@ static int read_settings(mpm_integrator *it, const mpm_config *cfg) {
 }
 
 int mpm_integrator_new(mpm_integrator **itp, const mpm_config *cfg, mpm_grid *grid,
-                       mpm_module **modules, int nmodules) {
+                       mpm_module **modules, int nmodules, mpm_coupling *coupling) {
   if (nmodules < 1 || nmodules > MPM_MAX_MODULES)
     MPM_FAIL(MPM_ERR_INPUT, "a run needs 1 to %d modules, got %d", MPM_MAX_MODULES, nmodules);
   mpm_integrator *it;
@@ -293,6 +251,11 @@ int mpm_integrator_new(mpm_integrator **itp, const mpm_config *cfg, mpm_grid *gr
   it->nmod = nmodules;
   for (int k = 0; k < nmodules; ++k) it->mod[k] = modules[k];
   MPM_CALL(read_settings(it, cfg));
+  it->cycle = (mpm_cycle){.grid = grid,
+                          .mod = it->mod,
+                          .nmod = nmodules,
+                          .coupling = coupling,
+                          .musl = it->method == MPM_METHOD_MUSL};
   if (mpm_sun_context_create(&it->comm, &it->ctx) != 0)
     MPM_FAIL(MPM_ERR_SUNDIALS, "SUNContext_Create failed");
   return wrap_state(it);

@@ -19,6 +19,7 @@
 #define MPM_INTEGRATOR_H
 
 #include "mpm_config.h"
+#include "mpm_coupling.h"
 #include "mpm_module.h"
 
 typedef enum {
@@ -39,8 +40,10 @@ extern const int mpm_integrator_nkeys;
 
 typedef struct mpm_integrator mpm_integrator;
 
+/* coupling: the spatial scheme the cycle runs (NULL: the modules do not interact); the caller
+ * keeps it alive and destroys it. */
 int mpm_integrator_new(mpm_integrator **it, const mpm_config *cfg, mpm_grid *grid,
-                       mpm_module **modules, int nmodules);
+                       mpm_module **modules, int nmodules, mpm_coupling *coupling);
 void mpm_integrator_destroy(mpm_integrator **it);
 
 /* (Re)start the integration at (t, current particle state) with first step h0 (0: let

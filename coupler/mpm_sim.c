@@ -2,6 +2,7 @@
 #include "mpm_sim.h"
 
 #include "mpm_bc.h"
+#include "mpm_coupling.h"
 #include "mpm_diag.h"
 #include "mpm_error.h"
 #include "mpm_geometry.h"
@@ -27,6 +28,7 @@ struct mpm_sim {
   mpm_grid *grid;
   mpm_module *mod[SIM_MAX_MODULES];
   int nmod;
+  mpm_coupling *coupling; /* NULL: one phase, or scheme = none */
   mpm_integrator *it;
   mpm_output *out;
   mpm_diag *diag;
@@ -87,6 +89,7 @@ int mpm_sim_add_schema(mpm_config *cfg) {
   MPM_CALL(mpm_config_add_schema(cfg, mpm_integrator_keys, mpm_integrator_nkeys));
   MPM_CALL(mpm_config_add_schema(cfg, mpm_geometry_keys, mpm_geometry_nkeys));
   MPM_CALL(mpm_config_add_schema(cfg, mpm_bc_keys, mpm_bc_nkeys));
+  MPM_CALL(mpm_coupling_add_schema(cfg));
   MPM_CALL(solid_add_schema(cfg));
   MPM_CALL(fluid_add_schema(cfg));
   return 0;
@@ -174,7 +177,7 @@ static int build_modules(mpm_sim *s, int seed) {
     return mpm_config_fail(s->cfg, "solid",
                            "the case defines neither bodies nor gas: add a [solid.NAME] or a "
                            "[gas.NAME] section");
-  return 0;
+  return mpm_coupling_new(&s->coupling, s->cfg, s->grid, s->mod, s->nmod);
 }
 
 static const char *const g_diag_cols[] = {"t",       "step",     "dt",    "particles",
@@ -209,7 +212,7 @@ int mpm_sim_create(mpm_sim **sp, mpm_config *cfg) {
   MPM_CALL(build_modules(s, 1));
   s->out_next = 0;
   s->ckpt_next = 1;
-  return mpm_integrator_new(&s->it, cfg, s->grid, s->mod, s->nmod);
+  return mpm_integrator_new(&s->it, cfg, s->grid, s->mod, s->nmod, s->coupling);
 }
 
 int mpm_sim_restart(mpm_sim **sp, mpm_config *cfg, const char *path) {
@@ -239,7 +242,7 @@ int mpm_sim_restart(mpm_sim **sp, mpm_config *cfg, const char *path) {
       isfinite(s->ckpt_interval) ? (long)floor(s->t / s->ckpt_interval * (1 + 1e-12)) + 1 : 1;
   for (int k = 0; k < s->nmod; ++k)
     MPM_CALL(mpm_particles_migrate(s->mod[k]->particles, s->grid, NULL));
-  MPM_CALL(mpm_integrator_new(&s->it, cfg, s->grid, s->mod, s->nmod));
+  MPM_CALL(mpm_integrator_new(&s->it, cfg, s->grid, s->mod, s->nmod, s->coupling));
   s->restarted = 1;
   mpm_log(MPM_LOG_INFO, "restarted from %s at t = %.6g, step %ld", path, s->t, s->step);
   return 0;
@@ -249,6 +252,7 @@ void mpm_sim_destroy(mpm_sim **sp) {
   if (!sp || !*sp) return;
   mpm_sim *s = *sp;
   mpm_integrator_destroy(&s->it);
+  mpm_coupling_destroy(&s->coupling);
   for (int k = 0; k < s->nmod; ++k) mpm_module_destroy(&s->mod[k]);
   mpm_output_destroy(&s->out);
   mpm_diag_close(&s->diag);

@@ -33,7 +33,6 @@ typedef struct fluid_content {
   fluid_open *open;          /* open faces (inflow, outflow, far field), or NULL */
   fluid_virtual virt;        /* virtual particles of the open faces and obstacles */
   fluid_obstacles obs;       /* static obstacles (fluid_obstacle.h) */
-  int remapped;              /* the phase holds MUSL's second deposit */
   int reg_every;             /* regularise every reg_every steps (0: never) */
   int reg_min, reg_max;      /* particles per non-empty cell after regularisation */
   mpm_lidx cap;              /* capacity of the particle scratch arrays */

@@ -166,25 +166,31 @@ static int fluid_p2g(mpm_module *m, double t, const double *y) {
   return 0;
 }
 
-/* After MUSL's second deposit the phase holds mass and momentum only: the update turns them
- * into velocities (h = 0; the force acted in the first pass, so only that one is recorded as
- * the obstacles' force). Walls and open faces, then obstacles (their force excludes what a wall
- * holds), then the walls again, so that mirrored pad nodes copy the obstacle-constrained nodes. */
-static int fluid_grid_update(mpm_module *m, double t, double h) {
+/* Before the nodal solve: the ghost pressure of the obstacles and the virtual particles' forces
+ * (first pass only: in MUSL's remap no force acts, and only the first pass's obstacle force is
+ * recorded), the mirrored pad nodes folded into the walls, and the open faces' forces. */
+static int fluid_forces(mpm_module *m, double t, double h, mpm_pass pass) {
   fluid_content *fc = m->content;
-  const int second = fc->remapped;
-  fc->remapped = 0;
-  if (!second) {
+  const int first = pass == MPM_PASS_FIRST;
+  if (first) {
     MPM_CALL(fluid_obstacles_begin(&fc->obs, m->grid, m->phase, t, h, 1));
     MPM_CALL(fluid_virtual_forces(&fc->virt, m->grid, m->phase, NULL, 0));
   }
   mpm_constraints_fold(&fc->cons, m->grid, m->phase);
-  if (!second) MPM_CALL(fluid_open_forces(fc->open, m, t));
-  MPM_CALL(mpm_grid_phase_update(m->grid, m->phase, second ? 0.0 : h));
+  if (first) MPM_CALL(fluid_open_forces(fc->open, m, t));
+  return 0;
+}
+
+/* After the nodal solve: walls and open faces, then obstacles (their force excludes what a wall
+ * holds), then the walls again, so that mirrored pad nodes copy the obstacle-constrained nodes. */
+static int fluid_constrain(mpm_module *m, double t, double h, mpm_pass pass) {
+  (void)t;
+  fluid_content *fc = m->content;
+  const int first = pass == MPM_PASS_FIRST;
   mpm_constraints_apply(&fc->cons, m->grid, m->phase);
   fluid_open_hold(fc->open, m);
   if (fc->obs.count) {
-    MPM_CALL(fluid_obstacles_apply(&fc->obs, m->grid, m->phase, second ? 0.0 : h, !second));
+    MPM_CALL(fluid_obstacles_apply(&fc->obs, m->grid, m->phase, first ? h : 0.0, first));
     mpm_constraints_apply(&fc->cons, m->grid, m->phase);
   }
   return 0;
@@ -238,7 +244,6 @@ static int fluid_remap(mpm_module *m, double t, const double *y, double h) {
     a.v[d] = o.vnew[d];
   }
   mpm_kernels_get(dim)->p2g(m->grid, m->phase, &a);
-  fc->remapped = 1;
   return 0;
 }
 
@@ -413,7 +418,8 @@ static void fluid_destroy(mpm_module *m) {
 
 static const mpm_module_ops fluid_ops = {
     .p2g = fluid_p2g,
-    .grid_update = fluid_grid_update,
+    .forces = fluid_forces,
+    .constrain = fluid_constrain,
     .g2p = fluid_g2p,
     .stable_dt = fluid_stable_dt,
     .check = fluid_check,
@@ -537,6 +543,7 @@ int fluid_module_create(mpm_module **mp, const mpm_config *cfg, mpm_grid *grid, 
   *mp = m;
   snprintf(m->name, sizeof m->name, "fluid");
   m->ops = &fluid_ops;
+  m->role = MPM_ROLE_FLUID;
   m->grid = grid;
   fluid_content *fc;
   MPM_ALLOC(fc, 1);

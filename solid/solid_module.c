@@ -69,7 +69,6 @@ typedef struct {
   double gravity[MPM_MAX_DIM];
   double damping;         /* mass-proportional damping rate alpha, 1/s: f_i -= alpha (m v)_i */
   mpm_transfer tr;        /* [transfer] settings and the time method's kind */
-  int remapped;           /* the phase holds MUSL's second deposit (see solid_remap) */
   double *vnew;           /* MUSL: the particles' new velocities (dim n) */
   double lp;              /* GIMP half-width in cells */
   mpm_lidx cap;           /* capacity of the scratch arrays */
@@ -449,17 +448,21 @@ static void hold_rigid_nodes(const solid_body *body, mpm_grid *g, int phase, dou
       }
 }
 
-/* The nodal update. After MUSL's second deposit the phase holds mass and momentum only: the
- * update just turns them into velocities (h = 0, no damping; the force acted already). Rigid
- * bodies act before the walls and clamps: the pad nodes beyond a wall mirror what a rigid
- * body set inside, and a wall or clamp keeps its own nodes. */
-static int solid_grid_update(mpm_module *m, double t, double h) {
+/* Before the nodal solve: mirrored pad nodes folded into the walls, and damping (first pass
+ * only: after MUSL's remap no force acts). */
+static int solid_forces(mpm_module *m, double t, double h, mpm_pass pass) {
+  (void)t, (void)h;
   solid_content *sc = m->content;
-  const int second = sc->remapped;
-  sc->remapped = 0;
   mpm_constraints_fold(&sc->cons, m->grid, m->phase);
-  if (sc->damping > 0 && !second) damp(m->grid, m->phase, sc->damping);
-  MPM_CALL(mpm_grid_phase_update(m->grid, m->phase, second ? 0.0 : h));
+  if (sc->damping > 0 && pass == MPM_PASS_FIRST) damp(m->grid, m->phase, sc->damping);
+  return 0;
+}
+
+/* After the nodal solve. Rigid bodies act before the walls and clamps: the pad nodes beyond a
+ * wall mirror what a rigid body set inside, and a wall or clamp keeps its own nodes. */
+static int solid_constrain(mpm_module *m, double t, double h, mpm_pass pass) {
+  (void)h, (void)pass;
+  solid_content *sc = m->content;
   for (int b = 0; b < sc->nbodies; ++b)
     if (sc->body[b].region) hold_rigid_nodes(&sc->body[b], m->grid, m->phase, t);
   mpm_constraints_apply(&sc->cons, m->grid, m->phase);
@@ -525,7 +528,6 @@ static int solid_remap(mpm_module *m, double t, const double *y, double h) {
     a.v[d] = sc->vnew + (size_t)d * n;
   }
   mpm_kernels_get(dim)->p2g(m->grid, m->phase, &a);
-  sc->remapped = 1;
   return 0;
 }
 
@@ -724,7 +726,8 @@ static void solid_destroy(mpm_module *m) {
 
 static const mpm_module_ops solid_ops = {
     .p2g = solid_p2g,
-    .grid_update = solid_grid_update,
+    .forces = solid_forces,
+    .constrain = solid_constrain,
     .g2p = solid_g2p,
     .stable_dt = solid_stable_dt,
     .check = solid_check,
@@ -922,6 +925,7 @@ int solid_module_create(mpm_module **mp, const mpm_config *cfg, mpm_grid *grid, 
   *mp = m;
   snprintf(m->name, sizeof m->name, "solid");
   m->ops = &solid_ops;
+  m->role = MPM_ROLE_SOLID;
   m->grid = grid;
   solid_content *sc;
   MPM_ALLOC(sc, 1);

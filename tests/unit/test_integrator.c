@@ -32,8 +32,8 @@ typedef struct {
 static int fl_nop_p2g(mpm_module *m, double t, const double *y) {
   return (void)m, (void)t, (void)y, 0;
 }
-static int fl_nop_grid(mpm_module *m, double t, double h) {
-  return (void)m, (void)t, (void)h, 0;
+static int fl_nop_grid(mpm_module *m, double t, double h, mpm_pass pass) {
+  return (void)m, (void)t, (void)h, (void)pass, 0;
 }
 
 static int fl_g2p(mpm_module *m, double t, const double *y, double *ydot, double h) {
@@ -78,7 +78,8 @@ static void fl_destroy(mpm_module *m) {
 }
 
 static const mpm_module_ops flight_ops = {.p2g = fl_nop_p2g,
-                                          .grid_update = fl_nop_grid,
+                                          .forces = fl_nop_grid,
+                                          .constrain = fl_nop_grid,
                                           .g2p = fl_g2p,
                                           .stable_dt = fl_stable,
                                           .check = fl_check,
@@ -186,7 +187,7 @@ static void run_two_modules(double limit, const char *label) {
                          flight_new(grid, "b", 1000, 25, limit)};
   mpm_config *cfg = make_config("bs32", "max_retries = 12\n");
   mpm_integrator *it = NULL;
-  CHECK(mpm_integrator_new(&it, cfg, grid, mods, 2) == 0, "integrator_new");
+  CHECK(mpm_integrator_new(&it, cfg, grid, mods, 2, NULL) == 0, "integrator_new");
   mpm_integrator_start(it, 0.0, 0.0);
   double t = 0.0, h;
   mpm_gidx first = 1 << 30;
@@ -238,7 +239,7 @@ static void run_hopeless(void) {
   mpm_module *m = flight_new(grid, "a", 0, 10, 0.0);
   mpm_config *cfg = make_config("bs32", "max_retries = 3\n");
   mpm_integrator *it = NULL;
-  mpm_integrator_new(&it, cfg, grid, &m, 1);
+  mpm_integrator_new(&it, cfg, grid, &m, 1, NULL);
   mpm_integrator_start(it, 0.0, 0.0);
   double t, h;
   const int rc = mpm_integrator_step(it, 1.0, &t, &h);
@@ -270,7 +271,7 @@ static void run_classic(void) {
   mpm_module *m = flight_new(grid, "a", 0, NP, 1e30);
   mpm_config *cfg = make_config("usl", "dt_max = 0.03125\n");
   mpm_integrator *it = NULL;
-  CHECK(mpm_integrator_new(&it, cfg, grid, &m, 1) == 0, "integrator_new");
+  CHECK(mpm_integrator_new(&it, cfg, grid, &m, 1, NULL) == 0, "integrator_new");
   mpm_integrator_start(it, 0.0, 0.0);
   double xr[NP][2], vr[NP][2], t = 0.0, h;
   for (int i = 0; i < NP; ++i) initial(i, xr[i], vr[i]);

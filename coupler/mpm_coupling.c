@@ -1,0 +1,266 @@
+/* The coupling scheme object: keys, construction, hook dispatch and the interface balance (see
+ * mpm_coupling.h). */
+#include "mpm_coupling.h"
+
+#include "mpm_error.h"
+#include "mpm_timer.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* "none|velocity|...", built from the register when the schema is added. */
+static char g_choices[256];
+static char g_help[1024];
+
+static mpm_key_spec g_scheme_key[] = {
+    {"coupling.scheme", MPM_KEY_ENUM, "none", 0, 0, 0, 0, g_choices, g_help, 0},
+};
+
+int mpm_coupling_add_schema(mpm_config *cfg) {
+  int n;
+  const mpm_coupling_type *const *types = mpm_coupling_types(&n);
+  size_t used = 0, hused = 0;
+  hused += (size_t)snprintf(g_help, sizeof g_help,
+                            "how the solid and the gas interact where both have mass:");
+  for (int k = 0; k < n; ++k) {
+    used += (size_t)snprintf(g_choices + used, sizeof g_choices - used, "%s%s", k ? "|" : "",
+                             types[k]->name);
+    hused += (size_t)snprintf(g_help + hused, sizeof g_help - hused, " %s (%s)%s", types[k]->name,
+                              types[k]->help, k + 1 < n ? ";" : "");
+  }
+  MPM_CALL(mpm_config_add_schema(cfg, g_scheme_key, 1));
+  for (int k = 0; k < n; ++k)
+    if (types[k]->nkeys) MPM_CALL(mpm_config_add_schema(cfg, types[k]->keys, types[k]->nkeys));
+  return 0;
+}
+
+/* Is the key set to something other than its default? (A checkpoint's resolved case lists the
+ * defaults too, so a restart of a one-phase run must not count them as set.) */
+static int set_off_default(const mpm_config *cfg, const mpm_key_spec *sp) {
+  if (!mpm_config_has(cfg, sp->key)) return 0;
+  if (!sp->def) return 1;
+  if (sp->type == MPM_KEY_REAL) {
+    double v;
+    return mpm_config_get_real(cfg, sp->key, &v) != 0 || v != strtod(sp->def, NULL);
+  }
+  const char *v;
+  return mpm_config_get_string(cfg, sp->key, &v) != 0 || strcmp(v, sp->def) != 0;
+}
+
+/* Does type t declare key? */
+static int declares(const mpm_coupling_type *t, const char *key) {
+  for (int k = 0; k < t->nkeys; ++k)
+    if (strcmp(t->keys[k].key, key) == 0) return 1;
+  return 0;
+}
+
+/* A key of another scheme (not also the chosen one's) is a mistake worth naming. */
+static int check_foreign_keys(const mpm_config *cfg, const mpm_coupling_type *chosen) {
+  int n;
+  const mpm_coupling_type *const *types = mpm_coupling_types(&n);
+  for (int k = 0; k < n; ++k)
+    for (int j = 0; j < types[k]->nkeys; ++j) {
+      const char *key = types[k]->keys[j].key;
+      if (types[k] != chosen && !declares(chosen, key) && set_off_default(cfg, &types[k]->keys[j]))
+        return mpm_config_fail(cfg, key,
+                               "is a key of the %s scheme, and coupling.scheme = %s does not read "
+                               "it; remove it or choose coupling.scheme = %s",
+                               types[k]->name, chosen->name, types[k]->name);
+    }
+  return 0;
+}
+
+/* The first coupling key set away from its default, or NULL. */
+static const char *first_coupling_key(const mpm_config *cfg) {
+  int n;
+  const mpm_coupling_type *const *types = mpm_coupling_types(&n);
+  if (set_off_default(cfg, &g_scheme_key[0])) return g_scheme_key[0].key;
+  for (int k = 0; k < n; ++k)
+    for (int j = 0; j < types[k]->nkeys; ++j)
+      if (set_off_default(cfg, &types[k]->keys[j])) return types[k]->keys[j].key;
+  return NULL;
+}
+
+static const mpm_coupling_type *find_type(const char *name) {
+  int n;
+  const mpm_coupling_type *const *types = mpm_coupling_types(&n);
+  for (int k = 0; k < n; ++k)
+    if (strcmp(types[k]->name, name) == 0) return types[k];
+  return NULL;
+}
+
+/* The modules by role; two of one role cannot be coupled by these schemes. */
+static int find_roles(mpm_coupling *c, const mpm_config *cfg, mpm_module **mods, int nmod) {
+  for (int k = 0; k < nmod; ++k) {
+    const mpm_role r = mods[k]->role;
+    if (c->module[r])
+      return mpm_config_fail(cfg, "coupling.scheme",
+                             "the scene has two %s modules; a coupling scheme joins one solid "
+                             "and one gas",
+                             r == MPM_ROLE_SOLID ? "solid" : "fluid");
+    c->module[r] = mods[k];
+    c->phase[r] = mods[k]->phase;
+  }
+  return 0;
+}
+
+static int build(mpm_coupling *c, const mpm_config *cfg, mpm_module **mods, int nmod) {
+  mpm_grid *g = c->grid;
+  MPM_CALL(find_roles(c, cfg, mods, nmod));
+  MPM_ALLOC(c->owned, g->nnodes);
+  for (mpm_lidx l = 0; l < g->nnodes; ++l)
+    c->owned[l] = (unsigned char)mpm_grid_node_is_owned(g, l);
+  if (c->type->needs & MPM_COUPLING_NORMALS)
+    for (int r = 0; r < MPM_ROLE_COUNT; ++r) g->phase[c->phase[r]].normals = 1;
+  if (c->type->ops->create) MPM_CALL(c->type->ops->create(c, cfg));
+  if (c->type->ops->setup) MPM_CALL(c->type->ops->setup(c));
+  return 0;
+}
+
+int mpm_coupling_new(mpm_coupling **cp, const mpm_config *cfg, mpm_grid *grid, mpm_module **mods,
+                     int nmod) {
+  const char *name;
+  *cp = NULL;
+  MPM_CALL(mpm_config_get_string(cfg, "coupling.scheme", &name));
+  const mpm_coupling_type *type = find_type(name);
+  if (!type) return mpm_config_fail(cfg, "coupling.scheme", "unknown scheme '%s'", name);
+  if (nmod < 2) {
+    const char *key = first_coupling_key(cfg);
+    if (key)
+      return mpm_config_fail(cfg, key,
+                             "the scene has only %s, so there is nothing to couple; remove the "
+                             "[coupling] keys",
+                             nmod == 1 && mods[0]->role == MPM_ROLE_SOLID ? "solid bodies" : "gas");
+    return 0;
+  }
+  MPM_CALL(check_foreign_keys(cfg, type));
+  if (strcmp(type->name, "none") == 0) return 0;
+  mpm_coupling *c;
+  MPM_ALLOC(c, 1);
+  *cp = c;
+  c->type = type, c->grid = grid;
+  const int rc = build(c, cfg, mods, nmod);
+  if (rc) {
+    mpm_coupling_destroy(cp);
+    return mpm_trace(__FILE__, __LINE__, __func__, rc);
+  }
+  mpm_log(MPM_LOG_INFO, "coupling: %s", type->name);
+  return 0;
+}
+
+void mpm_coupling_destroy(mpm_coupling **cp) {
+  if (!cp || !*cp) return;
+  mpm_coupling *c = *cp;
+  if (c->type->ops->destroy) c->type->ops->destroy(c);
+  free(c->owned);
+  free(c);
+  *cp = NULL;
+}
+
+/* ---- hooks ------------------------------------------------------------------------------ */
+
+/* A first pass starts a record: a new time a new one, the same time (a re-evaluation) replaces
+ * the latest. */
+static void begin_record(mpm_coupling *c, double t, double h) {
+  mpm_coupling_record *cur = &c->rec[c->latest];
+  if (cur->set && cur->t != t) c->latest ^= 1, cur = &c->rec[c->latest];
+  memset(cur, 0, sizeof *cur);
+  cur->t = t, cur->set = 1, cur->classic = h > 0;
+}
+
+typedef int (*hook_fn)(mpm_coupling *c, double t, double h, mpm_pass pass);
+
+static int run_hook(mpm_coupling *c, hook_fn fn, double t, double h, mpm_pass pass) {
+  if (!fn) return 0;
+  mpm_timer_start(MPM_T_COUPLING);
+  c->recording = pass == MPM_PASS_FIRST;
+  const int rc = fn(c, t, h, pass);
+  c->recording = 0;
+  mpm_timer_stop(MPM_T_COUPLING);
+  return rc;
+}
+
+int mpm_coupling_before_solve(mpm_coupling *c, double t, double h, mpm_pass pass) {
+  if (!c) return 0;
+  if (pass == MPM_PASS_FIRST) begin_record(c, t, h);
+  return run_hook(c, c->type->ops->before_solve, t, h, pass);
+}
+
+int mpm_coupling_after_solve(mpm_coupling *c, double t, double h, mpm_pass pass) {
+  return c ? run_hook(c, c->type->ops->after_solve, t, h, pass) : 0;
+}
+
+int mpm_coupling_after_constrain(mpm_coupling *c, double t, double h, mpm_pass pass) {
+  if (!c) return 0;
+  MPM_CALL(run_hook(c, c->type->ops->after_constrain, t, h, pass));
+  if (pass != MPM_PASS_FIRST) return 0;
+  /* Interpenetration: gas mass on the owned nodes inside the solid, those with at least 90 %
+   * of the largest solid nodal mass on this rank (full support: the stencil is covered). */
+  mpm_timer_start(MPM_T_COUPLING);
+  const mpm_grid *g = c->grid;
+  const double *ms = g->phase[c->phase[MPM_ROLE_SOLID]].m_i;
+  const double *mf = g->phase[c->phase[MPM_ROLE_FLUID]].m_i;
+  double mmax = 0.0, inside = 0.0;
+  for (mpm_lidx l = 0; l < g->nnodes; ++l) mmax = ms[l] > mmax ? ms[l] : mmax;
+  for (mpm_lidx l = 0; l < g->nnodes; ++l)
+    if (c->owned[l] && ms[l] >= 0.9 * mmax && mmax > 0) inside += mf[l];
+  c->rec[c->latest].gas_inside = inside;
+  mpm_timer_stop(MPM_T_COUPLING);
+  return 0;
+}
+
+/* ---- for the schemes ---------------------------------------------------------------------- */
+
+void mpm_coupling_exchange(mpm_coupling *c, mpm_role role, mpm_lidx l, const double *v,
+                           const double *a, double h) {
+  mpm_grid_phase *ph = &c->grid->phase[c->phase[role]];
+  const int dim = c->grid->dim;
+  const double m = ph->m_i[l];
+  double power = 0.0, force[MPM_MAX_DIM] = {0};
+  for (int d = 0; d < dim; ++d) {
+    const double v0 = ph->v_i[d][l], v1 = v ? v[d] : v0;
+    const double da = h > 0 ? (v1 - v0) / h : (a ? a[d] - ph->a_i[d][l] : 0.0);
+    ph->v_i[d][l] = v1;
+    ph->a_i[d][l] += da;
+    force[d] = m * da;
+    power += force[d] * 0.5 * (v0 + v1);
+  }
+  if (!c->recording || !c->owned[l]) return;
+  mpm_coupling_record *r = &c->rec[c->latest];
+  for (int d = 0; d < dim; ++d) r->force[role][d] += force[d];
+  r->power[role] += power;
+}
+
+int mpm_coupling_solid_normal(const mpm_coupling *c, mpm_lidx l, double *n) {
+  const mpm_grid_phase *ph = &c->grid->phase[c->phase[MPM_ROLE_SOLID]];
+  const int dim = c->grid->dim;
+  double len = 0.0;
+  for (int d = 0; d < dim; ++d) len += ph->normal_i[d][l] * ph->normal_i[d][l];
+  len = sqrt(len);
+  /* A gradient below roundoff of m / dx: the node is deep inside or alone. */
+  if (!(len > 1e-12 * ph->m_i[l] / c->grid->dx)) return 0;
+  for (int d = 0; d < dim; ++d) n[d] = -ph->normal_i[d][l] / len;
+  return 1;
+}
+
+int mpm_coupling_step_record(mpm_coupling *c, double t, mpm_coupling_record *out) {
+  memset(out, 0, sizeof *out);
+  out->t = t;
+  if (!c) return 0;
+  /* The classic update's step used the RHS before the one at the end of the step. */
+  const mpm_coupling_record *cur = &c->rec[c->latest], *prev = &c->rec[c->latest ^ 1];
+  const mpm_coupling_record *use = cur->classic && cur->t >= t && prev->set ? prev : cur;
+  enum { N = 2 * MPM_MAX_DIM + 3 };
+  double local[N], sum[N];
+  memcpy(local, use->force, sizeof use->force);
+  local[2 * MPM_MAX_DIM] = use->power[0], local[2 * MPM_MAX_DIM + 1] = use->power[1];
+  local[2 * MPM_MAX_DIM + 2] = use->gas_inside;
+  MPM_CALL_MPI(MPI_Allreduce(local, sum, N, MPI_DOUBLE, MPI_SUM, c->grid->comm));
+  memcpy(out->force, sum, sizeof out->force);
+  out->power[0] = sum[2 * MPM_MAX_DIM], out->power[1] = sum[2 * MPM_MAX_DIM + 1];
+  out->gas_inside = sum[2 * MPM_MAX_DIM + 2];
+  out->set = use->set, out->classic = use->classic;
+  return 0;
+}

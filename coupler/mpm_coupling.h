@@ -1,0 +1,120 @@
+/* Spatial coupling schemes: what happens on the nodes where the solid and the gas both have
+ * mass, between the modules' forces and their constraints (see mpm_cycle.h). An object with an
+ * ops table, registered by name (mpm_coupling_register.c) and chosen with
+ * `[coupling] scheme = NAME`: a new scheme is one file that exports its type plus one line in
+ * the register. The modules never see each other; only a scheme touches both phases.
+ *
+ * Hooks, in the order the cycle calls them, once per grid pass (pass tells which: the first
+ * transfer, or MUSL's remap where no force acts):
+ *   before_solve     the phases' m_i, mv_i, f_i (and normal_i, if asked) are summed over the
+ *                    ranks (optional);
+ *   after_solve      v_i and a_i are set on every node (v = mv/m + h a, a = f/m); a scheme
+ *                    may correct them where the phases meet;
+ *   after_constrain  each module has applied its walls, clamps, obstacles; a scheme may
+ *                    reconcile the phases there (optional).
+ * Every hook acts on all box nodes (owners hold the summed values; ghosts are overwritten by
+ * the forward halo that follows, so what a scheme writes there does not matter).
+ *
+ * The balance. Whatever a scheme changes goes through mpm_coupling_exchange(), which records,
+ * per phase on the nodes this rank owns, the momentum rate the interface gives that phase,
+ * F = sum m (a' - a) (in the classic update a' - a = (v' - v) / h, the impulse over the step),
+ * and the power of that force on the nodal velocities, sum m (a' - a) . (v + v') / 2: the rate
+ * of change of the nodal kinetic energy the exchange makes. F_solid + F_fluid = 0 to roundoff
+ * for every scheme; P_solid + P_fluid is the energy the coupling creates (> 0) or destroys. */
+#ifndef MPM_COUPLING_H
+#define MPM_COUPLING_H
+
+#include "mpm_config.h"
+#include "mpm_module.h"
+
+typedef struct mpm_coupling mpm_coupling;
+
+/* What a scheme needs deposited: the phases' mass gradients (for interface normals). */
+enum { MPM_COUPLING_NORMALS = 1 };
+
+typedef struct mpm_coupling_ops {
+  /* Read the scheme's own keys, allocate its content. Optional. */
+  int (*create)(mpm_coupling *c, const mpm_config *cfg);
+  /* The grid and the phases by role are known. Optional. */
+  int (*setup)(mpm_coupling *c);
+  int (*before_solve)(mpm_coupling *c, double t, double h, mpm_pass pass);
+  int (*after_solve)(mpm_coupling *c, double t, double h, mpm_pass pass);
+  int (*after_constrain)(mpm_coupling *c, double t, double h, mpm_pass pass);
+  void (*destroy)(mpm_coupling *c);
+} mpm_coupling_ops;
+
+typedef struct mpm_coupling_type {
+  const char *name;
+  const char *help;         /* one line for the key's documentation */
+  unsigned needs;           /* MPM_COUPLING_* flags */
+  const mpm_key_spec *keys; /* the scheme's own [coupling] keys (may be NULL) */
+  int nkeys;
+  const mpm_coupling_ops *ops;
+} mpm_coupling_type;
+
+/* The interface record of one RHS evaluation on this rank (first pass only). */
+typedef struct mpm_coupling_record {
+  double t;
+  int set, classic;
+  double force[MPM_ROLE_COUNT][MPM_MAX_DIM]; /* momentum rate into each phase, N */
+  double power[MPM_ROLE_COUNT];              /* its power on that phase's nodes, W */
+  double gas_inside;                         /* gas mass on nodes inside the solid, kg */
+} mpm_coupling_record;
+
+struct mpm_coupling {
+  const mpm_coupling_type *type;
+  void *content;
+  mpm_grid *grid;
+  mpm_module *module[MPM_ROLE_COUNT]; /* by role; NULL if absent */
+  int phase[MPM_ROLE_COUNT];          /* their grid phases */
+  unsigned char *owned;               /* per box node: counted in the balance */
+  mpm_coupling_record rec[2];         /* the latest RHS and the one before (another time) */
+  int latest;
+  int recording; /* inside a first pass: exchanges are recorded */
+};
+
+/* The registered types, `none` first; count in *n. */
+const mpm_coupling_type *const *mpm_coupling_types(int *n);
+
+/* coupling.scheme and every registered scheme's keys. */
+int mpm_coupling_add_schema(mpm_config *cfg);
+
+/* Build the scheme the case names for these modules. With fewer than two phases (or scheme
+ * = none) *c is NULL: no coupler work at all; a coupling key in a one-phase scene, a key of
+ * another scheme, or a scheme the scene cannot use is an input error. Collective. */
+int mpm_coupling_new(mpm_coupling **c, const mpm_config *cfg, mpm_grid *grid, mpm_module **modules,
+                     int nmodules);
+void mpm_coupling_destroy(mpm_coupling **c);
+
+/* The hooks, each a no-op for NULL or an op the scheme leaves out; timed as coupling. */
+int mpm_coupling_before_solve(mpm_coupling *c, double t, double h, mpm_pass pass);
+int mpm_coupling_after_solve(mpm_coupling *c, double t, double h, mpm_pass pass);
+int mpm_coupling_after_constrain(mpm_coupling *c, double t, double h, mpm_pass pass);
+
+/* ---- for the schemes ---------------------------------------------------------------------- */
+
+/* Set phase `role`'s v_i and a_i at box node l to v and a (dim values each; NULL keeps that
+ * one), recording the exchange (see the balance above). h: the classic step (0: method of
+ * lines). In the classic update the acceleration takes the velocity change as an impulse,
+ * a' = a + (v' - v) / h, whatever a is given, so FLIP and PIC particles see the same change. */
+void mpm_coupling_exchange(mpm_coupling *c, mpm_role role, mpm_lidx l, const double *v,
+                           const double *a, double h);
+
+/* Is there mass of phase role at node l (as the last nodal solve decided)? */
+static inline int mpm_coupling_has_mass(const mpm_coupling *c, mpm_role role, mpm_lidx l) {
+  const mpm_grid_phase *ph = &c->grid->phase[c->phase[role]];
+  return ph->m_i[l] > ph->m_empty;
+}
+
+/* The unit outward normal of the solid at node l from its mass gradient (which points into
+ * the solid), or 0 if the gradient vanishes there. */
+int mpm_coupling_solid_normal(const mpm_coupling *c, mpm_lidx l, double *n);
+
+/* ---- the interface report (coupling.csv) --------------------------------------------------- */
+
+/* After an accepted step from t - h to t: reduce the record of the RHS that made the step and
+ * return, summed over the ranks, the momentum rate into the solid and the fluid (dim each), the
+ * power on each side and the interpenetration. Collective; a NULL c gives zeros. */
+int mpm_coupling_step_record(mpm_coupling *c, double t, mpm_coupling_record *out);
+
+#endif

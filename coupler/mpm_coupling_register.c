@@ -1,0 +1,14 @@
+/* The registry of built-in spatial coupling schemes. Add a scheme here with one line; `none`
+ * stays first. */
+#include "mpm_coupling.h"
+
+extern const mpm_coupling_type coupling_none;
+
+static const mpm_coupling_type *const g_types[] = {
+    &coupling_none,
+};
+
+const mpm_coupling_type *const *mpm_coupling_types(int *n) {
+  *n = (int)(sizeof g_types / sizeof g_types[0]);
+  return g_types;
+}

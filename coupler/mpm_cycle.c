@@ -1,0 +1,62 @@
+/* The MPM cycle (see mpm_cycle.h). */
+#include "mpm_cycle.h"
+
+#include "mpm_error.h"
+#include "mpm_timer.h"
+
+#define CYCLE_MAX_FIELDS (4 * (2 + 3 * MPM_MAX_DIM))
+
+/* Sum the ghosts into the owners (reverse: m, mv, f and the mass gradient where a scheme asks
+ * for it) or copy the owners' v and a into the ghosts (forward). */
+static int halo(const mpm_cycle *c, int reverse) {
+  double *f[CYCLE_MAX_FIELDS];
+  int nf = 0;
+  const int dim = c->grid->dim;
+  for (int k = 0; k < c->nmod; ++k) {
+    mpm_grid_phase *ph = &c->grid->phase[c->mod[k]->phase];
+    if (reverse) f[nf++] = ph->m_i;
+    for (int d = 0; d < dim; ++d) {
+      f[nf++] = reverse ? ph->mv_i[d] : ph->v_i[d];
+      f[nf++] = reverse ? ph->f_i[d] : ph->a_i[d];
+      if (reverse && ph->normals) f[nf++] = ph->normal_i[d];
+    }
+  }
+  mpm_timer_start(MPM_T_HALO);
+  int rc = reverse ? mpm_grid_halo_reverse(c->grid, f, nf) : mpm_grid_halo_forward(c->grid, f, nf);
+  mpm_timer_stop(MPM_T_HALO);
+  return rc;
+}
+
+/* The grid work between the transfers. The solve takes the step only in the first pass. */
+static int grid_pass(const mpm_cycle *c, double t, double h, mpm_pass pass) {
+  const double hs = pass == MPM_PASS_FIRST ? h : 0.0;
+  MPM_CALL(halo(c, 1));
+  mpm_timer_start(MPM_T_GRID);
+  for (int k = 0; k < c->nmod; ++k) MPM_CALL(c->mod[k]->ops->forces(c->mod[k], t, h, pass));
+  MPM_CALL(mpm_coupling_before_solve(c->coupling, t, hs, pass));
+  for (int k = 0; k < c->nmod; ++k) MPM_CALL(mpm_grid_phase_update(c->grid, c->mod[k]->phase, hs));
+  MPM_CALL(mpm_coupling_after_solve(c->coupling, t, hs, pass));
+  for (int k = 0; k < c->nmod; ++k) MPM_CALL(c->mod[k]->ops->constrain(c->mod[k], t, h, pass));
+  MPM_CALL(mpm_coupling_after_constrain(c->coupling, t, hs, pass));
+  mpm_timer_stop(MPM_T_GRID);
+  return halo(c, 0);
+}
+
+int mpm_cycle_rhs(const mpm_cycle *c, double t, double *const *y, double *const *ydot, double h) {
+  for (int k = 0; k < c->nmod; ++k) {
+    mpm_grid_phase_zero(c->grid, c->mod[k]->phase);
+    MPM_CALL(c->mod[k]->ops->p2g(c->mod[k], t, y[k]));
+  }
+  MPM_CALL(grid_pass(c, t, h, MPM_PASS_FIRST));
+  if (c->musl) {
+    mpm_timer_start(MPM_T_P2G);
+    for (int k = 0; k < c->nmod; ++k)
+      if (c->mod[k]->ops->remap) MPM_CALL(c->mod[k]->ops->remap(c->mod[k], t, y[k], h));
+    mpm_timer_stop(MPM_T_P2G);
+    MPM_CALL(grid_pass(c, t, h, MPM_PASS_REMAP));
+  }
+  mpm_timer_start(MPM_T_G2P);
+  for (int k = 0; k < c->nmod; ++k) MPM_CALL(c->mod[k]->ops->g2p(c->mod[k], t, y[k], ydot[k], h));
+  mpm_timer_stop(MPM_T_G2P);
+  return 0;
+}
