@@ -15,7 +15,7 @@ static char g_choices[256];
 static char g_help[1024];
 
 static mpm_key_spec g_scheme_key[] = {
-    {"coupling.scheme", MPM_KEY_ENUM, "none", 0, 0, 0, 0, g_choices, g_help, 0},
+    {"coupling.scheme", MPM_KEY_ENUM, "velocity", 0, 0, 0, 0, g_choices, g_help, 0},
 };
 
 int mpm_coupling_add_schema(mpm_config *cfg) {
@@ -225,7 +225,7 @@ void mpm_coupling_exchange(mpm_coupling *c, mpm_role role, mpm_lidx l, const dou
     ph->v_i[d][l] = v1;
     ph->a_i[d][l] += da;
     force[d] = m * da;
-    power += force[d] * 0.5 * (v0 + v1);
+    power += force[d] * v1;
   }
   if (!c->recording || !c->owned[l]) return;
   mpm_coupling_record *r = &c->rec[c->latest];

@@ -18,9 +18,12 @@
  * The balance. Whatever a scheme changes goes through mpm_coupling_exchange(), which records,
  * per phase on the nodes this rank owns, the momentum rate the interface gives that phase,
  * F = sum m (a' - a) (in the classic update a' - a = (v' - v) / h, the impulse over the step),
- * and the power of that force on the nodal velocities, sum m (a' - a) . (v + v') / 2: the rate
- * of change of the nodal kinetic energy the exchange makes. F_solid + F_fluid = 0 to roundoff
- * for every scheme; P_solid + P_fluid is the energy the coupling creates (> 0) or destroys. */
+ * and the power of that force on the velocities the phase then moves with, sum m (a' - a) . v'.
+ * That is the energy the interface puts into the phase: the gas's total energy changes by
+ * exactly the power of its external nodal forces on v' (fluid_module.c), and so would a solid's
+ * whose transfer conserved energy. F_solid + F_fluid = 0 to roundoff for every scheme;
+ * P_solid + P_fluid is the energy the coupling creates (> 0) or destroys: zero where the two
+ * phases leave a node with the same velocity along the force. */
 #ifndef MPM_COUPLING_H
 #define MPM_COUPLING_H
 
@@ -104,6 +107,16 @@ void mpm_coupling_exchange(mpm_coupling *c, mpm_role role, mpm_lidx l, const dou
 static inline int mpm_coupling_has_mass(const mpm_coupling *c, mpm_role role, mpm_lidx l) {
   const mpm_grid_phase *ph = &c->grid->phase[c->phase[role]];
   return ph->m_i[l] > ph->m_empty;
+}
+
+/* Do both phases have mass at node l? */
+static inline int mpm_coupling_shared(const mpm_coupling *c, mpm_lidx l) {
+  return mpm_coupling_has_mass(c, MPM_ROLE_SOLID, l) && mpm_coupling_has_mass(c, MPM_ROLE_FLUID, l);
+}
+
+/* The phase of role r. */
+static inline mpm_grid_phase *mpm_coupling_phase(const mpm_coupling *c, mpm_role r) {
+  return &c->grid->phase[c->phase[r]];
 }
 
 /* The unit outward normal of the solid at node l from its mass gradient (which points into

@@ -3,9 +3,15 @@
 #include "mpm_coupling.h"
 
 extern const mpm_coupling_type coupling_none;
+extern const mpm_coupling_type coupling_velocity;
+extern const mpm_coupling_type coupling_contact;
+extern const mpm_coupling_type coupling_traction;
 
 static const mpm_coupling_type *const g_types[] = {
     &coupling_none,
+    &coupling_velocity,
+    &coupling_contact,
+    &coupling_traction,
 };
 
 const mpm_coupling_type *const *mpm_coupling_types(int *n) {

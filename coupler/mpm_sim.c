@@ -32,6 +32,9 @@ struct mpm_sim {
   mpm_integrator *it;
   mpm_output *out;
   mpm_diag *diag;
+  mpm_diag *coupling_csv;    /* coupling.csv, with a coupler only */
+  double coupling_work;      /* cumulative energy the coupling created (J; < 0: destroyed) */
+  double coupling_imbalance; /* largest |F_solid + F_fluid| / max(|F_solid|, |F_fluid|) */
   double t, t_end, h_next;
   long step;
   double out_interval, ckpt_interval;
@@ -185,13 +188,28 @@ static const char *const g_diag_cols[] = {"t",       "step",     "dt",    "parti
                                           "kinetic", "internal", "total", "rhs_evals"};
 enum { NDIAG = (int)(sizeof g_diag_cols / sizeof g_diag_cols[0]) };
 
+/* coupling.csv: the interface force on each phase (the momentum the other gives it per unit
+ * time; they cancel), the power of each, their sum (the energy rate the coupling creates), its
+ * time integral, the gas mass on nodes inside the solid, and each phase's total energy. */
+static const char *const g_coupling_cols2[] = {
+    "t",       "step",    "dt",    "Fx_solid", "Fy_solid",   "Fx_fluid", "Fy_fluid",
+    "P_solid", "P_fluid", "P_net", "W_net",    "gas_inside", "E_solid",  "E_fluid"};
+static const char *const g_coupling_cols3[] = {
+    "t",        "step",    "dt",      "Fx_solid", "Fy_solid", "Fz_solid",   "Fx_fluid", "Fy_fluid",
+    "Fz_fluid", "P_solid", "P_fluid", "P_net",    "W_net",    "gas_inside", "E_solid",  "E_fluid"};
+#define NCOUPLING(dim) ((dim) == 2 ? 14 : 16)
+
 static int open_outputs(mpm_sim *s, int append) {
   char path[4096];
   MPM_CALL(mpm_config_resolved_text(s->cfg, &s->config_text));
   MPM_CALL(mpm_output_new(&s->out, s->comm, s->dir, s->config_text, s->grid->dim, append, s->t));
   snprintf(path, sizeof path, "%s/diagnostics.csv", s->dir);
   MPM_CALL(mpm_diag_open(&s->diag, s->comm, path, NDIAG, g_diag_cols, append, s->t));
-  return 0;
+  if (!s->coupling) return 0;
+  const char *const *cols = s->grid->dim == 2 ? g_coupling_cols2 : g_coupling_cols3;
+  snprintf(path, sizeof path, "%s/coupling.csv", s->dir);
+  return mpm_diag_open(&s->coupling_csv, s->comm, path, NCOUPLING(s->grid->dim), cols, append,
+                       s->t);
 }
 
 static int sim_alloc(mpm_sim **sp, mpm_config *cfg) {
@@ -225,6 +243,8 @@ int mpm_sim_restart(mpm_sim **sp, mpm_config *cfg, const char *path) {
   int rc = mpm_checkpoint_attr(ck, "t", &s->t);
   if (!rc) rc = mpm_checkpoint_attr(ck, "step", &step);
   if (!rc) rc = mpm_checkpoint_attr(ck, "h_next", &s->h_next);
+  /* Checkpoints from before the coupler have no coupling work: it was zero. */
+  if (!rc && s->coupling) rc = mpm_checkpoint_attr(ck, "coupling_work", &s->coupling_work);
   for (int k = 0; !rc && k < s->nmod; ++k)
     rc = mpm_checkpoint_read_particles(ck, s->mod[k]->name, s->mod[k]->particles);
   mpm_checkpoint_close(&ck);
@@ -256,6 +276,7 @@ void mpm_sim_destroy(mpm_sim **sp) {
   for (int k = 0; k < s->nmod; ++k) mpm_module_destroy(&s->mod[k]);
   mpm_output_destroy(&s->out);
   mpm_diag_close(&s->diag);
+  mpm_diag_close(&s->coupling_csv);
   mpm_grid_destroy(&s->grid);
   free(s->config_text);
   free(s);
@@ -288,18 +309,41 @@ static int write_checkpoint(mpm_sim *s, const char *path) {
   MPM_CALL(prepare_output(s));
   const char *names[SIM_MAX_MODULES];
   for (int k = 0; k < s->nmod; ++k) p[k] = s->mod[k]->particles, names[k] = s->mod[k]->name;
-  const char *attr[] = {"t", "step", "h_next"};
-  const double val[] = {s->t, (double)s->step, s->h_next};
+  const char *attr[] = {"t", "step", "h_next", "coupling_work"};
+  const double val[] = {s->t, (double)s->step, s->h_next, s->coupling_work};
   mpm_timer_start(MPM_T_IO);
-  int rc = mpm_checkpoint_write(s->comm, path, s->config_text, attr, val, 3, p, names, s->nmod);
+  int rc = mpm_checkpoint_write(s->comm, path, s->config_text, attr, val, 4, p, names, s->nmod);
   mpm_timer_stop(MPM_T_IO);
   MPM_CALL(rc);
   mpm_log(MPM_LOG_INFO, "checkpoint %s at t = %.6g", path, s->t);
   return 0;
 }
 
+/* One row of coupling.csv for the step of size dt that reached s->t; energy[r] is the total
+ * energy of the phase of role r. */
+static int coupling_row(mpm_sim *s, double dt, const double *energy) {
+  mpm_coupling_record r;
+  MPM_CALL(mpm_coupling_step_record(s->coupling, s->t, &r));
+  const int dim = s->grid->dim, S = MPM_ROLE_SOLID, F = MPM_ROLE_FLUID;
+  const double net = r.power[S] + r.power[F];
+  double row[16], fs = 0, ff = 0, fsum = 0;
+  int c = 0;
+  if (dt > 0) s->coupling_work += dt * net;
+  row[c++] = s->t, row[c++] = (double)s->step, row[c++] = dt;
+  for (int d = 0; d < dim; ++d) row[c++] = r.force[S][d];
+  for (int d = 0; d < dim; ++d) row[c++] = r.force[F][d];
+  for (int d = 0; d < dim; ++d) {
+    fs += r.force[S][d] * r.force[S][d], ff += r.force[F][d] * r.force[F][d];
+    fsum += (r.force[S][d] + r.force[F][d]) * (r.force[S][d] + r.force[F][d]);
+  }
+  if (fs + ff > 0) s->coupling_imbalance = fmax(s->coupling_imbalance, sqrt(fsum / fmax(fs, ff)));
+  row[c++] = r.power[S], row[c++] = r.power[F], row[c++] = net, row[c++] = s->coupling_work;
+  row[c++] = r.gas_inside, row[c++] = energy[S], row[c++] = energy[F];
+  return mpm_diag_row(s->coupling_csv, row);
+}
+
 static int diagnostics_row(mpm_sim *s, double dt) {
-  double local[8] = {0}, sum[8];
+  double local[10] = {0}, sum[10];
   for (int k = 0; k < s->nmod; ++k) {
     mpm_module_sums m;
     s->mod[k]->ops->sums(s->mod[k], &m);
@@ -308,8 +352,10 @@ static int diagnostics_row(mpm_sim *s, double dt) {
     for (int d = 0; d < MPM_MAX_DIM; ++d) local[2 + d] += m.momentum[d];
     local[5] += m.kinetic;
     local[6] += m.internal;
+    local[8 + s->mod[k]->role] += m.kinetic + m.internal;
   }
-  MPM_CALL_MPI(MPI_Allreduce(local, sum, 8, MPI_DOUBLE, MPI_SUM, s->comm));
+  MPM_CALL_MPI(MPI_Allreduce(local, sum, 10, MPI_DOUBLE, MPI_SUM, s->comm));
+  if (s->coupling) MPM_CALL(coupling_row(s, dt, sum + 8));
   long steps, rhs, fails, retries;
   mpm_integrator_counts(s->it, &steps, &rhs, &fails, &retries);
   const double row[NDIAG] = {s->t,   (double)s->step, dt,     sum[0], sum[1],          sum[2],
@@ -374,6 +420,11 @@ static int write_summary(mpm_sim *s, double wall) {
           "done: t = %.6g, %ld steps (%ld rhs evaluations, %ld error-test failures, %ld "
           "retries), %.3f s wall, %.3g particle-steps/s",
           s->t, steps, rhs, fails, retries, wall, s->particle_steps / wall);
+  if (s->coupling)
+    mpm_log(MPM_LOG_INFO,
+            "coupling %s: interface momentum imbalance at most %.2g of the interface force; "
+            "energy created by the coupling %.6g J",
+            s->coupling->type->name, s->coupling_imbalance, s->coupling_work);
   if (s->rank != 0) return 0;
   snprintf(path, sizeof path, "%s/summary.json", s->dir);
   FILE *f = fopen(path, "w");
@@ -381,9 +432,11 @@ static int write_summary(mpm_sim *s, double wall) {
   fprintf(f,
           "{\"t\": %.17g, \"steps\": %ld, \"rhs_evals\": %ld, \"error_test_fails\": %ld, "
           "\"retries\": %ld, \"wall_s\": %.6f, \"ranks\": %d, \"particle_steps\": %.17g, "
-          "\"particle_steps_per_s\": %.6g}\n",
+          "\"particle_steps_per_s\": %.6g, \"coupling\": \"%s\", "
+          "\"coupling_imbalance\": %.6g, \"coupling_work\": %.17g}\n",
           s->t, steps, rhs, fails, retries, wall, s->size, s->particle_steps,
-          s->particle_steps / wall);
+          s->particle_steps / wall, s->coupling ? s->coupling->type->name : "none",
+          s->coupling_imbalance, s->coupling_work);
   fclose(f);
   return 0;
 }
