@@ -71,6 +71,9 @@ typedef struct mpm_module_ops {
    * into the nodal velocities (no force, no damping: the force acted in the first pass)
    * before g2p. Optional: NULL if the module has no MUSL. */
   int (*remap)(mpm_module *m, double t, const double *y, double h);
+  /* Space this module keeps to itself for another module's particles (the gas's static
+   * obstacles): the case-file key of the region containing x, or NULL. Optional. */
+  const char *(*reserved)(const mpm_module *m, const double *x);
   /* Refresh fields derived for output only (a gas's pressure, Mach number, ...) before a
    * snapshot or checkpoint is written. Optional. */
   int (*output)(mpm_module *m);

@@ -119,6 +119,38 @@ static int build(mpm_coupling *c, const mpm_config *cfg, mpm_module **mods, int 
   return 0;
 }
 
+/* No particle of one module may sit in space another keeps to itself (a solid inside a static
+ * obstacle of the gas). The lowest rank with an offender reports it. */
+static int check_reserved(const mpm_config *cfg, mpm_grid *grid, mpm_module **mods, int nmod) {
+  for (int k = 0; k < nmod; ++k) {
+    if (!mods[k]->ops->reserved) continue;
+    for (int j = 0; j < nmod; ++j) {
+      const mpm_particles *p = mods[j]->particles;
+      const char *key = NULL;
+      double x[3] = {0, 0, 0};
+      for (mpm_lidx i = 0; j != k && i < p->n && !key; ++i) {
+        for (int d = 0; d < p->dim; ++d) x[d] = mpm_particles_comp(p, 0, d)[i];
+        key = mods[k]->ops->reserved(mods[k], x);
+      }
+      int mine = key ? grid->rank : grid->size, who;
+      MPM_CALL_MPI(MPI_Allreduce(&mine, &who, 1, MPI_INT, MPI_MIN, grid->comm));
+      if (who == grid->size) continue;
+      char msg[256] = "";
+      if (grid->rank == who)
+        snprintf(msg, sizeof msg, "%s|a %s particle at (%g, %g%s) lies inside this obstacle", key,
+                 mods[j]->name, x[0], x[1], grid->dim == 3 ? ", ..." : "");
+      MPM_CALL_MPI(MPI_Bcast(msg, sizeof msg, MPI_CHAR, who, grid->comm));
+      char *bar = strchr(msg, '|');
+      *bar = '\0';
+      return mpm_config_fail(cfg, msg,
+                             "%s; a solid must not overlap a static obstacle: move one of them, or "
+                             "make the obstacle a [solid.NAME] with material = rigid",
+                             bar + 1);
+    }
+  }
+  return 0;
+}
+
 int mpm_coupling_new(mpm_coupling **cp, const mpm_config *cfg, mpm_grid *grid, mpm_module **mods,
                      int nmod) {
   const char *name;
@@ -136,6 +168,7 @@ int mpm_coupling_new(mpm_coupling **cp, const mpm_config *cfg, mpm_grid *grid, m
     return 0;
   }
   MPM_CALL(check_foreign_keys(cfg, type));
+  MPM_CALL(check_reserved(cfg, grid, mods, nmod));
   if (strcmp(type->name, "none") == 0) return 0;
   mpm_coupling *c;
   MPM_ALLOC(c, 1);

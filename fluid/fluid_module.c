@@ -338,6 +338,12 @@ static int fluid_boundary(mpm_module *m, double t, double h, int *changed) {
   return fluid_open_exchange(fc->open, m, t, h, changed);
 }
 
+static const char *fluid_reserved(const mpm_module *m, const double *x) {
+  const fluid_content *fc = m->content;
+  const int k = fluid_obstacles_which(&fc->obs, x);
+  return k >= 0 ? fc->obs.ob[k].shape_key : NULL;
+}
+
 static int fluid_output(mpm_module *m) {
   fluid_output_fields(m);
   return 0;
@@ -429,6 +435,7 @@ static const mpm_module_ops fluid_ops = {
     .destroy = fluid_destroy,
     .remap = fluid_remap,
     .output = fluid_output,
+    .reserved = fluid_reserved,
 };
 
 /* ---- construction -------------------------------------------------------------------------- */

@@ -355,6 +355,7 @@ static int build_one(fluid_obstacle *ob, const mpm_config *cfg, const mpm_grid *
   char key[KEY_LEN];
   snprintf(ob->name, sizeof ob->name, "%s", name);
   make_key(r.shape_key, &r, "shape");
+  snprintf(ob->shape_key, sizeof ob->shape_key, "%s", r.shape_key);
   MPM_CALL(mpm_config_get_string(cfg, r.shape_key, &shape));
   make_key(key, &r, "condition");
   MPM_CALL(mpm_config_get_string(cfg, key, &cond));
@@ -522,9 +523,13 @@ int fluid_obstacles_build(fluid_obstacles *o, const mpm_config *cfg, const mpm_g
 }
 
 int fluid_obstacles_inside(const fluid_obstacles *o, const double *x) {
+  return fluid_obstacles_which(o, x) >= 0;
+}
+
+int fluid_obstacles_which(const fluid_obstacles *o, const double *x) {
   for (int k = 0; k < o->count; ++k)
-    if (mpm_sdf_eval(&o->ob[k].sdf, x, NULL) < 0.0) return 1;
-  return 0;
+    if (mpm_sdf_eval(&o->ob[k].sdf, x, NULL) < 0.0) return k;
+  return -1;
 }
 
 void fluid_obstacles_deposit(fluid_obstacles *o, const mpm_grid *grid, mpm_lidx n,

@@ -52,6 +52,7 @@
 
 typedef struct fluid_obstacle {
   char name[64];
+  char shape_key[96]; /* obstacle.NAME.shape, for messages */
   mpm_sdf sdf;
   int no_slip;
   int has_ref;             /* reference area given: write Cd and Cl */
@@ -111,6 +112,8 @@ int fluid_obstacles_begin(fluid_obstacles *o, mpm_grid *grid, int phase, double 
                           int record);
 /* 1 if x lies inside an obstacle (phi < 0): no gas particle is seeded there. */
 int fluid_obstacles_inside(const fluid_obstacles *o, const double *x);
+/* The index of the first obstacle that contains x, or -1. */
+int fluid_obstacles_which(const fluid_obstacles *o, const double *x);
 /* Constrain the obstacle nodes of phase after a nodal update with step h (0: method of lines);
  * add the removed momentum to the force record begun by fluid_obstacles_begin when record is set.
  */

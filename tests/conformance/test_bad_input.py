@@ -190,4 +190,27 @@ for name, old, new, key, words in OBST_CASES:
               "reference area without speed": "reference_area"}.get(name) or new.splitlines()[-1]
     expect_error(name, text, key, words, line_of(text, needle))
 
+# Coupling, on gas_obstacles.ini with a solid block added (the gas overlapping it does not matter:
+# every error here comes before anything runs).
+SOLID = ("\n[geometry.plate]\ntype = box\nlo = {lo}\nhi = {hi}\n\n[solid.plate]\ngeometry = plate\n"
+         "material = linear_elastic\ndensity = 10\nE = 100\nnu = 0.3\n")
+FSI = OBST + SOLID.format(lo="0.1 0.8", hi="0.2 0.9")
+COUPLING_CASES = [
+    ("unknown coupling scheme", FSI, "scheme = veloctiy", "coupling.scheme", "did you mean 'velocity'"),
+    ("negative friction", FSI, "scheme = contact\nfriction = -0.1", "coupling.friction", ">= 0"),
+    ("friction with another scheme", FSI, "scheme = velocity\nfriction = 0.2", "coupling.friction",
+     "key of the contact scheme"),
+    ("coupling keys in a gas-only scene", OBST, "scheme = traction", "coupling.scheme",
+     "nothing to couple"),
+    ("coupling keys in a solid-only scene", BASE, "scheme = contact", "coupling.scheme",
+     "nothing to couple"),
+]
+for name, base, body, key, words in COUPLING_CASES:
+    text = base.rstrip("\n") + "\n\n[coupling]\n" + body + "\n"
+    expect_error(name, text, key, words, line_of(text, body.splitlines()[-1]))
+# A solid inside a static obstacle of the gas (obstacle block spans 0.8-0.9 x 0.15-0.35).
+text = OBST + SOLID.format(lo="0.82 0.2", hi="0.88 0.3")
+expect_error("solid overlapping a static obstacle", text, "obstacle.block.shape",
+             "must not overlap a static obstacle", line_of(text, "shape = box"))
+
 sys.exit(check.finish())
