@@ -40,8 +40,10 @@ typedef struct mpm_grid_phase {
   double *f_i[MPM_MAX_DIM];  /* force (internal + external) */
   double *v_i[MPM_MAX_DIM];  /* velocity */
   double *a_i[MPM_MAX_DIM];  /* acceleration */
-  /* Mass gradient sum_p m_p grad S_ip, deposited by P2G only when `normals` is set (a
-   * coupling scheme asks for it); it points into the phase's material. */
+  /* Mass gradient sum_p m_p grad S_i(x_p), deposited by P2G only when `normals` is set (a
+   * coupling scheme asks for it). It points out of the phase's material: node i's shape
+   * function falls towards the particles beyond it (it is minus the derivative of m_i with
+   * respect to the node's position). */
   double *normal_i[MPM_MAX_DIM];
   int normals;
   double m_empty; /* the last nodal solve treated nodes with m_i <= m_empty as empty */

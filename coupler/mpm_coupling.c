@@ -274,7 +274,7 @@ int mpm_coupling_solid_normal(const mpm_coupling *c, mpm_lidx l, double *n) {
   len = sqrt(len);
   /* A gradient below roundoff of m / dx: the node is deep inside or alone. */
   if (!(len > 1e-12 * ph->m_i[l] / c->grid->dx)) return 0;
-  for (int d = 0; d < dim; ++d) n[d] = -ph->normal_i[d][l] / len;
+  for (int d = 0; d < dim; ++d) n[d] = ph->normal_i[d][l] / len;
   return 1;
 }
 

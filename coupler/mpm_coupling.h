@@ -119,8 +119,8 @@ static inline mpm_grid_phase *mpm_coupling_phase(const mpm_coupling *c, mpm_role
   return &c->grid->phase[c->phase[r]];
 }
 
-/* The unit outward normal of the solid at node l from its mass gradient (which points into
- * the solid), or 0 if the gradient vanishes there. */
+/* The unit outward normal of the solid at node l from its deposited mass gradient, or 0 if
+ * the gradient vanishes there. */
 int mpm_coupling_solid_normal(const mpm_coupling *c, mpm_lidx l, double *n);
 
 /* ---- the interface report (coupling.csv) --------------------------------------------------- */

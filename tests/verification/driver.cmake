@@ -92,3 +92,5 @@ mpm_add_script_test(test_forward_step SCRIPT verification/test_forward_step.py
                     LABELS verification TIMEOUT 900)
 mpm_add_script_test(test_forward_step_long SCRIPT verification/test_forward_step.py ARGS long
                     LABELS "verification;long" TIMEOUT 3600)
+mpm_add_script_test(test_coupling_ranks SCRIPT verification/test_coupling_ranks.py
+                    LABELS "verification;mpi" TIMEOUT 900)
