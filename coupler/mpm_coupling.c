@@ -248,6 +248,11 @@ int mpm_coupling_after_constrain(mpm_coupling *c, double t, double h, mpm_pass p
 
 void mpm_coupling_exchange(mpm_coupling *c, mpm_role role, mpm_lidx l, const double *v,
                            const double *a, double h) {
+  mpm_coupling_exchange_force(c, role, l, v, a, h, NULL);
+}
+
+void mpm_coupling_exchange_force(mpm_coupling *c, mpm_role role, mpm_lidx l, const double *v,
+                                 const double *a, double h, double *f) {
   mpm_grid_phase *ph = &c->grid->phase[c->phase[role]];
   const int dim = c->grid->dim;
   const double m = ph->m_i[l];
@@ -260,10 +265,18 @@ void mpm_coupling_exchange(mpm_coupling *c, mpm_role role, mpm_lidx l, const dou
     force[d] = m * da;
     power += force[d] * v1;
   }
+  for (int d = 0; f && d < dim; ++d) f[d] = force[d];
   if (!c->recording || !c->owned[l]) return;
   mpm_coupling_record *r = &c->rec[c->latest];
   for (int d = 0; d < dim; ++d) r->force[role][d] += force[d];
   r->power[role] += power;
+}
+
+void mpm_coupling_record_force(mpm_coupling *c, mpm_role role, mpm_lidx l, const double *f,
+                               const double *v) {
+  if (!c->recording || !c->owned[l]) return;
+  mpm_coupling_record *r = &c->rec[c->latest];
+  for (int d = 0; d < c->grid->dim; ++d) r->force[role][d] += f[d], r->power[role] += f[d] * v[d];
 }
 
 int mpm_coupling_solid_normal(const mpm_coupling *c, mpm_lidx l, double *n) {

@@ -102,6 +102,15 @@ int mpm_coupling_after_constrain(mpm_coupling *c, double t, double h, mpm_pass p
  * a' = a + (v' - v) / h, whatever a is given, so FLIP and PIC particles see the same change. */
 void mpm_coupling_exchange(mpm_coupling *c, mpm_role role, mpm_lidx l, const double *v,
                            const double *a, double h);
+/* The same, and the force the phase received there in f (dim values). */
+void mpm_coupling_exchange_force(mpm_coupling *c, mpm_role role, mpm_lidx l, const double *v,
+                                 const double *a, double h, double *f);
+
+/* Record, without changing any field, that phase role received force f (dim values) at node l
+ * and moves there with velocity v: the reaction a constraint takes for a phase (a clamped or
+ * rigid solid holding the gas) counts as interface force. */
+void mpm_coupling_record_force(mpm_coupling *c, mpm_role role, mpm_lidx l, const double *f,
+                               const double *v);
 
 /* Is there mass of phase role at node l (as the last nodal solve decided)? */
 static inline int mpm_coupling_has_mass(const mpm_coupling *c, mpm_role role, mpm_lidx l) {

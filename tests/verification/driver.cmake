@@ -94,3 +94,5 @@ mpm_add_script_test(test_forward_step_long SCRIPT verification/test_forward_step
                     LABELS "verification;long" TIMEOUT 3600)
 mpm_add_script_test(test_coupling_ranks SCRIPT verification/test_coupling_ranks.py
                     LABELS "verification;mpi" TIMEOUT 900)
+mpm_add_script_test(test_coupling_rigid SCRIPT verification/test_coupling_rigid.py
+                    LABELS verification TIMEOUT 600)
