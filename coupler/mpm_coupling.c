@@ -258,12 +258,13 @@ void mpm_coupling_exchange_force(mpm_coupling *c, mpm_role role, mpm_lidx l, con
   const double m = ph->m_i[l];
   double power = 0.0, force[MPM_MAX_DIM] = {0};
   for (int d = 0; d < dim; ++d) {
-    const double v0 = ph->v_i[d][l], v1 = v ? v[d] : v0;
-    const double da = h > 0 ? (v1 - v0) / h : (a ? a[d] - ph->a_i[d][l] : 0.0);
+    const double v0 = ph->v_i[d][l], v1 = v ? v[d] : v0, a0 = ph->a_i[d][l];
+    const double da = h > 0 ? (v1 - v0) / h : (a ? a[d] - a0 : 0.0);
     ph->v_i[d][l] = v1;
     ph->a_i[d][l] += da;
     force[d] = m * da;
-    power += force[d] * v1;
+    /* The energy this puts into the phase (see the balance in mpm_coupling.h). */
+    power += h > 0 ? force[d] * 0.5 * (v0 - h * a0 + v1) : force[d] * v0 + m * a0 * (v0 - v1);
   }
   for (int d = 0; f && d < dim; ++d) f[d] = force[d];
   if (!c->recording || !c->owned[l]) return;

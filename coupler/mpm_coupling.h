@@ -18,12 +18,16 @@
  * The balance. Whatever a scheme changes goes through mpm_coupling_exchange(), which records,
  * per phase on the nodes this rank owns, the momentum rate the interface gives that phase,
  * F = sum m (a' - a) (in the classic update a' - a = (v' - v) / h, the impulse over the step),
- * and the power of that force on the velocities the phase then moves with, sum m (a' - a) . v'.
- * That is the energy the interface puts into the phase: the gas's total energy changes by
- * exactly the power of its external nodal forces on v' (fluid_module.c), and so would a solid's
- * whose transfer conserved energy. F_solid + F_fluid = 0 to roundoff for every scheme;
- * P_solid + P_fluid is the energy the coupling creates (> 0) or destroys: zero where the two
- * phases leave a node with the same velocity along the force. */
+ * and the energy rate it puts into the phase, the work of the phase's nodal forces as the
+ * gas's energy balance counts it (fluid_module.c, fluid_transfer.c):
+ *   classic update:  P = sum F . (v^n + v') / 2, the time-centred velocity (v^n = v - h a, the
+ *                    start-of-step nodal velocity, which an impulse leaves unchanged);
+ *   method of lines: P = sum F . v + m a . (v - v'): the particles' kinetic energy gains
+ *                    a' . (m v), and the stress works on the corrected velocity v'.
+ * F_solid + F_fluid = 0 to roundoff for every scheme; P_solid + P_fluid is the energy the
+ * coupling creates (> 0) or destroys. The gas's total energy changes by exactly its P (with
+ * walls and without other forces); a solid's only up to its own transfer's error (FLIP does not
+ * conserve energy). The changes of MUSL's remap pass are not recorded: no force acts there. */
 #ifndef MPM_COUPLING_H
 #define MPM_COUPLING_H
 
