@@ -74,6 +74,13 @@ typedef struct mpm_module_ops {
   /* Space this module keeps to itself for another module's particles (the gas's static
    * obstacles): the case-file key of the region containing x, or NULL. Optional. */
   const char *(*reserved)(const mpm_module *m, const double *x);
+  /* The bodies of a module made of several (a solid's [solid.NAME] sections): their count, and
+   * the name of body b in names[b] (pointers into the module) for b < max. Optional. */
+  int (*bodies)(const mpm_module *m, const char **names, int max);
+  /* The resultant of a nodal acceleration field a_i (valid on every box node) on each body,
+   * F[b MPM_MAX_DIM + d] = sum over the body's particles of m_p sum_i S_ip a_i[d], at the positions
+   * in y; this RHS's P2G has run. Optional; with bodies. */
+  int (*body_loads)(mpm_module *m, const double *y, const double *const *a_i, double *F);
   /* Refresh fields derived for output only (a gas's pressure, Mach number, ...) before a
    * snapshot or checkpoint is written. Optional. */
   int (*output)(mpm_module *m);

@@ -112,8 +112,15 @@ static int build(mpm_coupling *c, const mpm_config *cfg, mpm_module **mods, int 
   MPM_ALLOC(c->owned, g->nnodes);
   for (mpm_lidx l = 0; l < g->nnodes; ++l)
     c->owned[l] = (unsigned char)mpm_grid_node_is_owned(g, l);
-  if (c->type->needs & MPM_COUPLING_NORMALS)
-    for (int r = 0; r < MPM_ROLE_COUNT; ++r) g->phase[c->phase[r]].normals = 1;
+  if (c->type->needs & MPM_COUPLING_NORMALS) /* the schemes read the solid's normal only */
+    g->phase[c->phase[MPM_ROLE_SOLID]].normals = 1;
+  const mpm_module *solid = c->module[MPM_ROLE_SOLID];
+  const int nb =
+      solid->ops->bodies ? solid->ops->bodies(solid, c->body_name, MPM_COUPLING_MAX_BODIES) : 1;
+  if (nb > 1 && nb <= MPM_COUPLING_MAX_BODIES && solid->ops->body_loads) {
+    c->nbodies = nb;
+    for (int d = 0; d < g->dim; ++d) MPM_ALLOC(c->da[d], g->nnodes);
+  }
   if (c->type->ops->create) MPM_CALL(c->type->ops->create(c, cfg));
   if (c->type->ops->setup) MPM_CALL(c->type->ops->setup(c));
   return 0;
@@ -188,6 +195,7 @@ void mpm_coupling_destroy(mpm_coupling **cp) {
   mpm_coupling *c = *cp;
   if (c->type->ops->destroy) c->type->ops->destroy(c);
   free(c->owned);
+  for (int d = 0; d < MPM_MAX_DIM; ++d) free(c->da[d]);
   free(c);
   *cp = NULL;
 }
@@ -201,6 +209,8 @@ static void begin_record(mpm_coupling *c, double t, double h) {
   if (cur->set && cur->t != t) c->latest ^= 1, cur = &c->rec[c->latest];
   memset(cur, 0, sizeof *cur);
   cur->t = t, cur->set = 1, cur->classic = h > 0;
+  for (int d = 0; c->nbodies && d < c->grid->dim; ++d)
+    memset(c->da[d], 0, sizeof(double) * (size_t)c->grid->nnodes);
 }
 
 typedef int (*hook_fn)(mpm_coupling *c, double t, double h, mpm_pass pass);
@@ -267,6 +277,8 @@ void mpm_coupling_exchange_force(mpm_coupling *c, mpm_role role, mpm_lidx l, con
     power += h > 0 ? force[d] * 0.5 * (v0 - h * a0 + v1) : force[d] * v0 + m * a0 * (v0 - v1);
   }
   for (int d = 0; f && d < dim; ++d) f[d] = force[d];
+  if (c->recording && c->nbodies && role == MPM_ROLE_SOLID)
+    for (int d = 0; d < dim; ++d) c->da[d][l] += force[d] / m;
   if (!c->recording || !c->owned[l]) return;
   mpm_coupling_record *r = &c->rec[c->latest];
   for (int d = 0; d < dim; ++d) r->force[role][d] += force[d];
@@ -275,9 +287,24 @@ void mpm_coupling_exchange_force(mpm_coupling *c, mpm_role role, mpm_lidx l, con
 
 void mpm_coupling_record_force(mpm_coupling *c, mpm_role role, mpm_lidx l, const double *f,
                                const double *v) {
+  if (c->recording && c->nbodies && role == MPM_ROLE_SOLID)
+    for (int d = 0; d < c->grid->dim; ++d)
+      c->da[d][l] += f[d] / mpm_coupling_phase(c, role)->m_i[l];
   if (!c->recording || !c->owned[l]) return;
   mpm_coupling_record *r = &c->rec[c->latest];
   for (int d = 0; d < c->grid->dim; ++d) r->force[role][d] += f[d], r->power[role] += f[d] * v[d];
+}
+
+int mpm_coupling_body_loads(mpm_coupling *c, const double *y_solid) {
+  if (!c || !c->nbodies) return 0;
+  mpm_timer_start(MPM_T_COUPLING);
+  mpm_module *solid = c->module[MPM_ROLE_SOLID];
+  int rc = mpm_grid_halo_forward(c->grid, c->da, c->grid->dim);
+  if (!rc)
+    rc = solid->ops->body_loads(solid, y_solid, (const double *const *)c->da,
+                                &c->rec[c->latest].body[0][0]);
+  mpm_timer_stop(MPM_T_COUPLING);
+  return rc;
 }
 
 int mpm_coupling_solid_normal(const mpm_coupling *c, mpm_lidx l, double *n) {
@@ -309,5 +336,8 @@ int mpm_coupling_step_record(mpm_coupling *c, double t, mpm_coupling_record *out
   out->power[0] = sum[2 * MPM_MAX_DIM], out->power[1] = sum[2 * MPM_MAX_DIM + 1];
   out->gas_inside = sum[2 * MPM_MAX_DIM + 2];
   out->set = use->set, out->classic = use->classic;
+  if (c->nbodies)
+    MPM_CALL_MPI(MPI_Allreduce(use->body, out->body, MPM_COUPLING_MAX_BODIES * MPM_MAX_DIM,
+                               MPI_DOUBLE, MPI_SUM, c->grid->comm));
   return 0;
 }

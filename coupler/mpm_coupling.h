@@ -36,7 +36,7 @@
 
 typedef struct mpm_coupling mpm_coupling;
 
-/* What a scheme needs deposited: the phases' mass gradients (for interface normals). */
+/* What a scheme needs deposited: the solid's mass gradient (for interface normals). */
 enum { MPM_COUPLING_NORMALS = 1 };
 
 typedef struct mpm_coupling_ops {
@@ -59,13 +59,18 @@ typedef struct mpm_coupling_type {
   const mpm_coupling_ops *ops;
 } mpm_coupling_type;
 
+/* Bodies whose interface force is reported one by one (a solid of more bodies reports the
+ * resultant only). */
+#define MPM_COUPLING_MAX_BODIES 16
+
 /* The interface record of one RHS evaluation on this rank (first pass only). */
 typedef struct mpm_coupling_record {
   double t;
   int set, classic;
-  double force[MPM_ROLE_COUNT][MPM_MAX_DIM]; /* momentum rate into each phase, N */
-  double power[MPM_ROLE_COUNT];              /* its power on that phase's nodes, W */
-  double gas_inside;                         /* gas mass on nodes inside the solid, kg */
+  double force[MPM_ROLE_COUNT][MPM_MAX_DIM];         /* momentum rate into each phase, N */
+  double power[MPM_ROLE_COUNT];                      /* its power on that phase's nodes, W */
+  double gas_inside;                                 /* gas mass on nodes inside the solid, kg */
+  double body[MPM_COUPLING_MAX_BODIES][MPM_MAX_DIM]; /* the solid's force per body, N */
 } mpm_coupling_record;
 
 struct mpm_coupling {
@@ -78,6 +83,10 @@ struct mpm_coupling {
   mpm_coupling_record rec[2];         /* the latest RHS and the one before (another time) */
   int latest;
   int recording; /* inside a first pass: exchanges are recorded */
+  int nbodies;   /* solid bodies reported one by one (0: one body, or more than
+                    MPM_COUPLING_MAX_BODIES: the resultant only) */
+  const char *body_name[MPM_COUPLING_MAX_BODIES];
+  double *da[MPM_MAX_DIM]; /* with nbodies: the solid's interface acceleration per node */
 };
 
 /* The registered types, `none` first; count in *n. */
@@ -97,6 +106,10 @@ void mpm_coupling_destroy(mpm_coupling **c);
 int mpm_coupling_before_solve(mpm_coupling *c, double t, double h, mpm_pass pass);
 int mpm_coupling_after_solve(mpm_coupling *c, double t, double h, mpm_pass pass);
 int mpm_coupling_after_constrain(mpm_coupling *c, double t, double h, mpm_pass pass);
+
+/* After the first grid pass (forward halo done): split the solid's interface force of this RHS
+ * over its bodies, from the solid's state block y_solid. A no-op with one body. Collective. */
+int mpm_coupling_body_loads(mpm_coupling *c, const double *y_solid);
 
 /* ---- for the schemes ---------------------------------------------------------------------- */
 

@@ -48,6 +48,9 @@ int mpm_cycle_rhs(const mpm_cycle *c, double t, double *const *y, double *const 
     MPM_CALL(c->mod[k]->ops->p2g(c->mod[k], t, y[k]));
   }
   MPM_CALL(grid_pass(c, t, h, MPM_PASS_FIRST));
+  for (int k = 0; c->coupling && k < c->nmod; ++k)
+    if (c->mod[k] == c->coupling->module[MPM_ROLE_SOLID])
+      MPM_CALL(mpm_coupling_body_loads(c->coupling, y[k]));
   if (c->musl) {
     mpm_timer_start(MPM_T_P2G);
     for (int k = 0; k < c->nmod; ++k)

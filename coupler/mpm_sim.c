@@ -35,6 +35,7 @@ struct mpm_sim {
   mpm_diag *coupling_csv;    /* coupling.csv, with a coupler only */
   double coupling_work;      /* cumulative energy the coupling created (J; < 0: destroyed) */
   double coupling_imbalance; /* largest |F_solid + F_fluid| / max(|F_solid|, |F_fluid|) */
+  char body_cols[MPM_COUPLING_MAX_BODIES][MPM_MAX_DIM][80]; /* coupling.csv column names */
   double t, t_end, h_next;
   long step;
   double out_interval, ckpt_interval;
@@ -206,10 +207,20 @@ static int open_outputs(mpm_sim *s, int append) {
   snprintf(path, sizeof path, "%s/diagnostics.csv", s->dir);
   MPM_CALL(mpm_diag_open(&s->diag, s->comm, path, NDIAG, g_diag_cols, append, s->t));
   if (!s->coupling) return 0;
-  const char *const *cols = s->grid->dim == 2 ? g_coupling_cols2 : g_coupling_cols3;
+  const int dim = s->grid->dim, nb = s->coupling->nbodies;
+  const char *cols[NCOUPLING(3) + MPM_MAX_DIM * MPM_COUPLING_MAX_BODIES];
+  int n = NCOUPLING(dim);
+  memcpy(cols, dim == 2 ? g_coupling_cols2 : g_coupling_cols3, sizeof *cols * (size_t)n);
+  for (int b = 0; b < nb; ++b) { /* F<axis>_<body>, the body named without its "solid." */
+    const char *name = strrchr(s->coupling->body_name[b], '.');
+    name = name ? name + 1 : s->coupling->body_name[b];
+    for (int d = 0; d < dim; ++d) {
+      snprintf(s->body_cols[b][d], sizeof s->body_cols[b][d], "F%c_%s", "xyz"[d], name);
+      cols[n++] = s->body_cols[b][d];
+    }
+  }
   snprintf(path, sizeof path, "%s/coupling.csv", s->dir);
-  return mpm_diag_open(&s->coupling_csv, s->comm, path, NCOUPLING(s->grid->dim), cols, append,
-                       s->t);
+  return mpm_diag_open(&s->coupling_csv, s->comm, path, n, cols, append, s->t);
 }
 
 static int sim_alloc(mpm_sim **sp, mpm_config *cfg) {
@@ -326,7 +337,7 @@ static int coupling_row(mpm_sim *s, double dt, const double *energy) {
   MPM_CALL(mpm_coupling_step_record(s->coupling, s->t, &r));
   const int dim = s->grid->dim, S = MPM_ROLE_SOLID, F = MPM_ROLE_FLUID;
   const double net = r.power[S] + r.power[F];
-  double row[16], fs = 0, ff = 0, fsum = 0;
+  double row[NCOUPLING(3) + MPM_MAX_DIM * MPM_COUPLING_MAX_BODIES], fs = 0, ff = 0, fsum = 0;
   int c = 0;
   if (dt > 0) s->coupling_work += dt * net;
   row[c++] = s->t, row[c++] = (double)s->step, row[c++] = dt;
@@ -339,6 +350,8 @@ static int coupling_row(mpm_sim *s, double dt, const double *energy) {
   if (fs + ff > 0) s->coupling_imbalance = fmax(s->coupling_imbalance, sqrt(fsum / fmax(fs, ff)));
   row[c++] = r.power[S], row[c++] = r.power[F], row[c++] = net, row[c++] = s->coupling_work;
   row[c++] = r.gas_inside, row[c++] = energy[S], row[c++] = energy[F];
+  for (int b = 0; b < s->coupling->nbodies; ++b)
+    for (int d = 0; d < dim; ++d) row[c++] = r.body[b][d];
   return mpm_diag_row(s->coupling_csv, row);
 }
 

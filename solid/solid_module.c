@@ -631,6 +631,36 @@ static void solid_stress_rates(mpm_module *m, const double *y, double *ydot, con
   }
 }
 
+static int solid_bodies(const mpm_module *m, const char **names, int max) {
+  const solid_content *sc = m->content;
+  for (int b = 0; b < sc->nbodies && b < max; ++b) names[b] = sc->body[b].section;
+  return sc->nbodies;
+}
+
+/* Interpolate a_i to the particles (this RHS's grouping by body from P2G), sum m_p a_p per body. */
+static int solid_body_loads(mpm_module *m, const double *y, const double *const *a_i, double *F) {
+  const solid_content *sc = m->content;
+  const mpm_particles *p = m->particles;
+  const int dim = p->dim;
+  const mpm_lidx n = p->n;
+  const double *mass = mpm_particles_comp(p, sc->lay.f_m, 0);
+  mpm_g2p_args a = {.n = n, .lp = sc->lp};
+  for (int d = 0; d < dim; ++d) {
+    a.x[d] = y + (size_t)(p->offset[F_X] + d) * n;
+    a.v_i[d] = a.a_i[d] = a_i[d];
+    a.v_out[d] = sc->scratch + (size_t)d * n, a.a_out[d] = sc->scratch + (size_t)(dim + d) * n;
+  }
+  mpm_kernels_get(dim)->g2p(m->grid, &a);
+  const mpm_lidx *idx = sc->idx;
+  for (int b = 0; b < sc->nbodies; idx += sc->count[b++])
+    for (int d = 0; d < dim; ++d) {
+      double sum = 0.0;
+      for (mpm_lidx k = 0; k < sc->count[b]; ++k) sum += mass[idx[k]] * a.v_out[d][idx[k]];
+      F[b * MPM_MAX_DIM + d] = sum;
+    }
+  return 0;
+}
+
 /* After an accepted step (and migration): models with history store the returned state. */
 static int solid_post_step(mpm_module *m, double t, double h, int *changed) {
   (void)t, (void)h, (void)changed;
@@ -728,6 +758,8 @@ static const mpm_module_ops solid_ops = {
     .p2g = solid_p2g,
     .forces = solid_forces,
     .constrain = solid_constrain,
+    .bodies = solid_bodies,
+    .body_loads = solid_body_loads,
     .g2p = solid_g2p,
     .stable_dt = solid_stable_dt,
     .check = solid_check,
