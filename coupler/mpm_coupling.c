@@ -205,8 +205,7 @@ void mpm_coupling_destroy(mpm_coupling **cp) {
 /* A first pass starts a record: a new time a new one, the same time (a re-evaluation) replaces
  * the latest. */
 static void begin_record(mpm_coupling *c, double t, double h) {
-  mpm_coupling_record *cur = &c->rec[c->latest];
-  if (cur->set && cur->t != t) c->latest ^= 1, cur = &c->rec[c->latest];
+  mpm_coupling_record *cur = &c->rec[mpm_rhs_records_begin(&c->which, t, h)];
   memset(cur, 0, sizeof *cur);
   cur->t = t, cur->set = 1, cur->classic = h > 0;
   for (int d = 0; c->nbodies && d < c->grid->dim; ++d)
@@ -249,7 +248,7 @@ int mpm_coupling_after_constrain(mpm_coupling *c, double t, double h, mpm_pass p
   for (mpm_lidx l = 0; l < g->nnodes; ++l) mmax = ms[l] > mmax ? ms[l] : mmax;
   for (mpm_lidx l = 0; l < g->nnodes; ++l)
     if (c->owned[l] && ms[l] >= 0.9 * mmax && mmax > 0) inside += mf[l];
-  c->rec[c->latest].gas_inside = inside;
+  c->rec[c->which.latest].gas_inside = inside;
   mpm_timer_stop(MPM_T_COUPLING);
   return 0;
 }
@@ -266,21 +265,15 @@ void mpm_coupling_exchange_force(mpm_coupling *c, mpm_role role, mpm_lidx l, con
   mpm_grid_phase *ph = &c->grid->phase[c->phase[role]];
   const int dim = c->grid->dim;
   const double m = ph->m_i[l];
-  double power = 0.0, force[MPM_MAX_DIM] = {0};
-  for (int d = 0; d < dim; ++d) {
-    const double v0 = ph->v_i[d][l], v1 = v ? v[d] : v0, a0 = ph->a_i[d][l];
-    const double da = h > 0 ? (v1 - v0) / h : (a ? a[d] - a0 : 0.0);
-    ph->v_i[d][l] = v1;
-    ph->a_i[d][l] += da;
-    force[d] = m * da;
-    /* The energy this puts into the phase (see the balance in mpm_coupling.h). */
-    power += h > 0 ? force[d] * 0.5 * (v0 - h * a0 + v1) : force[d] * v0 + m * a0 * (v0 - v1);
-  }
+  double force[MPM_MAX_DIM], keep[MPM_MAX_DIM];
+  if (!v)
+    for (int d = 0; d < dim; ++d) keep[d] = ph->v_i[d][l];
+  const double power = mpm_impulse_apply(ph, dim, l, v ? v : keep, a, h, force);
   for (int d = 0; f && d < dim; ++d) f[d] = force[d];
   if (c->recording && c->nbodies && role == MPM_ROLE_SOLID)
     for (int d = 0; d < dim; ++d) c->da[d][l] += force[d] / m;
   if (!c->recording || !c->owned[l]) return;
-  mpm_coupling_record *r = &c->rec[c->latest];
+  mpm_coupling_record *r = &c->rec[c->which.latest];
   for (int d = 0; d < dim; ++d) r->force[role][d] += force[d];
   r->power[role] += power;
 }
@@ -291,7 +284,7 @@ void mpm_coupling_record_force(mpm_coupling *c, mpm_role role, mpm_lidx l, const
     for (int d = 0; d < c->grid->dim; ++d)
       c->da[d][l] += f[d] / mpm_coupling_phase(c, role)->m_i[l];
   if (!c->recording || !c->owned[l]) return;
-  mpm_coupling_record *r = &c->rec[c->latest];
+  mpm_coupling_record *r = &c->rec[c->which.latest];
   for (int d = 0; d < c->grid->dim; ++d) r->force[role][d] += f[d], r->power[role] += f[d] * v[d];
 }
 
@@ -302,7 +295,7 @@ int mpm_coupling_body_loads(mpm_coupling *c, const double *y_solid) {
   int rc = mpm_grid_halo_forward(c->grid, c->da, c->grid->dim);
   if (!rc)
     rc = solid->ops->body_loads(solid, y_solid, (const double *const *)c->da,
-                                &c->rec[c->latest].body[0][0]);
+                                &c->rec[c->which.latest].body[0][0]);
   mpm_timer_stop(MPM_T_COUPLING);
   return rc;
 }
@@ -323,9 +316,7 @@ int mpm_coupling_step_record(mpm_coupling *c, double t, mpm_coupling_record *out
   memset(out, 0, sizeof *out);
   out->t = t;
   if (!c) return 0;
-  /* The classic update's step used the RHS before the one at the end of the step. */
-  const mpm_coupling_record *cur = &c->rec[c->latest], *prev = &c->rec[c->latest ^ 1];
-  const mpm_coupling_record *use = cur->classic && cur->t >= t && prev->set ? prev : cur;
+  const mpm_coupling_record *use = &c->rec[mpm_rhs_records_pick(&c->which, t)];
   enum { N = 2 * MPM_MAX_DIM + 3 };
   double local[N], sum[N];
   memcpy(local, use->force, sizeof use->force);

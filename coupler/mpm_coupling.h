@@ -15,15 +15,12 @@
  * Every hook acts on all box nodes (owners hold the summed values; ghosts are overwritten by
  * the forward halo that follows, so what a scheme writes there does not matter).
  *
- * The balance. Whatever a scheme changes goes through mpm_coupling_exchange(), which records,
- * per phase on the nodes this rank owns, the momentum rate the interface gives that phase,
- * F = sum m (a' - a) (in the classic update a' - a = (v' - v) / h, the impulse over the step),
- * and the energy rate it puts into the phase, the work of the phase's nodal forces as the
- * gas's energy balance counts it (fluid_module.c, fluid_transfer.c):
- *   classic update:  P = sum F . (v^n + v') / 2, the time-centred velocity (v^n = v - h a, the
- *                    start-of-step nodal velocity, which an impulse leaves unchanged);
- *   method of lines: P = sum F . v + m a . (v - v'): the particles' kinetic energy gains
- *                    a' . (m v), and the stress works on the corrected velocity v'.
+ * The balance. Whatever a scheme changes goes through mpm_coupling_exchange(), an impulse in
+ * the classic update (common/mpm_impulse.h, as the gas's static obstacles apply theirs), which
+ * records per phase, on the nodes this rank owns, the momentum rate the interface gives that
+ * phase, F = sum m (a' - a), and the energy rate it puts into the phase as the gas's energy
+ * balance counts its forces' work (time-centred in the classic update; in the method of lines
+ * the work on v plus the internal forces' work on the kinematic correction v - v').
  * F_solid + F_fluid = 0 to roundoff for every scheme; P_solid + P_fluid is the energy the
  * coupling creates (> 0) or destroys. The gas's total energy changes by exactly its P (with
  * walls and without other forces); a solid's only up to its own transfer's error (FLIP does not
@@ -32,6 +29,7 @@
 #define MPM_COUPLING_H
 
 #include "mpm_config.h"
+#include "mpm_impulse.h"
 #include "mpm_module.h"
 
 typedef struct mpm_coupling mpm_coupling;
@@ -80,11 +78,11 @@ struct mpm_coupling {
   mpm_module *module[MPM_ROLE_COUNT]; /* by role; NULL if absent */
   int phase[MPM_ROLE_COUNT];          /* their grid phases */
   unsigned char *owned;               /* per box node: counted in the balance */
-  mpm_coupling_record rec[2];         /* the latest RHS and the one before (another time) */
-  int latest;
-  int recording; /* inside a first pass: exchanges are recorded */
-  int nbodies;   /* solid bodies reported one by one (0: one body, or more than
-                    MPM_COUPLING_MAX_BODIES: the resultant only) */
+  mpm_coupling_record rec[2];         /* the latest RHS and the one before (mpm_impulse.h) */
+  mpm_rhs_records which;              /* their times and which is the latest */
+  int recording;                      /* inside a first pass: exchanges are recorded */
+  int nbodies;                        /* solid bodies reported one by one (0: one body, or more than
+                                         MPM_COUPLING_MAX_BODIES: the resultant only) */
   const char *body_name[MPM_COUPLING_MAX_BODIES];
   double *da[MPM_MAX_DIM]; /* with nbodies: the solid's interface acceleration per node */
 };

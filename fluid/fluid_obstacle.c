@@ -516,7 +516,7 @@ int fluid_obstacles_build(fluid_obstacles *o, const mpm_config *cfg, const mpm_g
   if (count == 0) return 0;
   MPM_ALLOC(o->ob, count);
   o->count = count;
-  for (int k = 0; k < 2; ++k) MPM_ALLOC(o->rec[k].f, (size_t)grid->dim * count);
+  for (int k = 0; k < 2; ++k) MPM_ALLOC(o->f[k], (size_t)grid->dim * count);
   for (int k = 0; k < count; ++k)
     MPM_CALL(build_one(&o->ob[k], cfg, grid, names[k], band * grid->dx));
   return build_ghosts(o, grid);
@@ -567,19 +567,14 @@ int fluid_obstacles_begin(fluid_obstacles *o, mpm_grid *grid, int phase, double 
   const int dim = grid->dim;
   double *sm = o->sm, *smp = o->sm + grid->nnodes, *fields[2] = {sm, smp};
   MPM_CALL(mpm_grid_halo_reverse(grid, fields, 2));
-  /* A new time starts a new record; the same time (a re-evaluation) replaces the latest. */
-  fluid_force_record *cur = &o->rec[o->latest];
-  if (record && cur->set && cur->t != t) o->latest ^= 1, cur = &o->rec[o->latest];
-  if (record) {
-    memset(cur->f, 0, sizeof *cur->f * (size_t)dim * o->count);
-    cur->t = t, cur->set = 1, cur->classic = h > 0;
-  }
+  double *rec = o->f[record ? mpm_rhs_records_begin(&o->rec, t, h) : o->rec.latest];
+  if (record) memset(rec, 0, sizeof *rec * (size_t)dim * o->count);
   mpm_grid_phase *ph = &grid->phase[phase];
   for (mpm_lidx k = 0; k < o->gcount; ++k) {
     const mpm_lidx l = o->gnode[k];
     if (!(sm[l] > 0.0)) continue;
     const double p = smp[l] / sm[l];
-    double *f = cur->f + (size_t)dim * o->gob[k];
+    double *f = rec + (size_t)dim * o->gob[k];
     for (int d = 0; d < dim; ++d) {
       ph->f_i[d][l] += p * o->G[(size_t)dim * k + d];
       if (record && o->gowned[k]) f[d] -= p * o->G[(size_t)dim * k + d];
@@ -590,9 +585,7 @@ int fluid_obstacles_begin(fluid_obstacles *o, mpm_grid *grid, int phase, double 
 
 /* Constrain one obstacle's nodes; adds this rank's owned share of the force to f. Nodes with
  * less mass than hold_below are held entirely (see the header). In the classic update the
- * velocity change is an impulse over the step: the acceleration takes it too, so that
- * v_i^n = v_i - h a_i is unchanged (the transfer reads the time-centred velocity from it) and a
- * FLIP particle loses the removed velocity as the grid does. */
+ * velocity change is an impulse over the step (mpm_impulse.h). */
 static void apply_one(const fluid_obstacle *ob, mpm_grid_phase *ph, int dim, double h,
                       double hold_below, double *f) {
   for (mpm_lidx k = 0; k < ob->count; ++k) {
@@ -601,14 +594,15 @@ static void apply_one(const fluid_obstacle *ob, mpm_grid_phase *ph, int dim, dou
     if (!(m > 0.0)) continue; /* empty: the nodal update left v = a = 0 */
     const double *n = ob->normal + (size_t)dim * k;
     const int hold = ob->no_slip || m < hold_below;
-    double vn = 0.0, an = 0.0;
+    double vn = 0.0, an = 0.0, v[MPM_MAX_DIM], a[MPM_MAX_DIM], force[MPM_MAX_DIM];
     for (int d = 0; d < dim; ++d) vn += ph->v_i[d][l] * n[d], an += ph->a_i[d][l] * n[d];
     for (int d = 0; d < dim; ++d) {
-      const double dv = hold ? ph->v_i[d][l] : vn * n[d];
-      const double da = h > 0 ? dv / h : hold ? ph->a_i[d][l] : an * n[d];
-      ph->v_i[d][l] -= dv, ph->a_i[d][l] -= da;
-      if (ob->owned[k]) f[d] += m * da;
+      v[d] = hold ? 0.0 : ph->v_i[d][l] - vn * n[d];
+      a[d] = hold ? 0.0 : ph->a_i[d][l] - an * n[d];
     }
+    mpm_impulse_apply(ph, dim, l, v, a, h, force);
+    /* the force the gas exerts on the obstacle: minus the rate the obstacle gives the gas */
+    for (int d = 0; ob->owned[k] && d < dim; ++d) f[d] -= force[d];
   }
 }
 
@@ -622,7 +616,7 @@ int fluid_obstacles_apply(fluid_obstacles *o, mpm_grid *grid, int phase, double 
       if (ph->m_i[o->ob[k].node[j]] > mmax) mmax = ph->m_i[o->ob[k].node[j]];
   MPM_CALL_MPI(MPI_Allreduce(MPI_IN_PLACE, &mmax, 1, MPI_DOUBLE, MPI_MAX, grid->comm));
   for (int k = 0; k < o->count; ++k) {
-    double *f = record ? o->rec[o->latest].f + (size_t)dim * k : scratch;
+    double *f = record ? o->f[o->rec.latest] + (size_t)dim * k : scratch;
     apply_one(&o->ob[k], &grid->phase[phase], dim, h, FLUID_OBSTACLE_HOLD * mmax, f);
   }
   return 0;
@@ -642,12 +636,10 @@ int fluid_obstacles_report(fluid_obstacles *o, const mpm_grid *grid, double t, d
   if (o->count == 0) return 0;
   const int dim = grid->dim;
   if (!o->csv) MPM_CALL(open_csv(o, grid, t - h));
-  /* The classic update's step used the RHS before the one at the end of the step. */
-  const fluid_force_record *cur = &o->rec[o->latest], *prev = &o->rec[o->latest ^ 1];
-  const fluid_force_record *use = cur->classic && cur->t >= t && prev->set ? prev : cur;
+  const double *use = o->f[mpm_rhs_records_pick(&o->rec, t)];
   double *f;
   MPM_ALLOC(f, (size_t)dim * o->count);
-  int rc = MPI_Allreduce(use->f, f, dim * o->count, MPI_DOUBLE, MPI_SUM, grid->comm);
+  int rc = MPI_Allreduce(use, f, dim * o->count, MPI_DOUBLE, MPI_SUM, grid->comm);
   for (int k = 0; rc == MPI_SUCCESS && k < o->count; ++k) {
     const fluid_obstacle *ob = &o->ob[k];
     double row[6], drag = 0.0, lift = 0.0;
@@ -672,7 +664,7 @@ void fluid_obstacles_free(fluid_obstacles *o) {
     free(o->ob[k].node), free(o->ob[k].normal), free(o->ob[k].owned);
   }
   free(o->ob);
-  free(o->rec[0].f), free(o->rec[1].f);
+  free(o->f[0]), free(o->f[1]);
   free(o->gnode), free(o->G), free(o->gowned), free(o->gob), free(o->near), free(o->sm);
   mpm_diag_close(&o->csv);
   memset(o, 0, sizeof *o);

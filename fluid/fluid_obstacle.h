@@ -42,6 +42,7 @@
 #include "mpm_config.h"
 #include "mpm_diag.h"
 #include "mpm_grid.h"
+#include "mpm_impulse.h"
 #include "mpm_sdf.h"
 #include "mpm_shape.h"
 
@@ -64,19 +65,12 @@ typedef struct fluid_obstacle {
   unsigned char *owned;    /* counted in the force */
 } fluid_obstacle;
 
-/* The forces of one RHS evaluation on this rank (dim per obstacle). */
-typedef struct fluid_force_record {
-  double t;
-  int set, classic; /* classic: made with a step h > 0 */
-  double *f;
-} fluid_force_record;
-
 typedef struct fluid_obstacles {
   int count;
   fluid_obstacle *ob;
   unsigned char open[MPM_MAX_DIM][2]; /* the gas's open faces: ghosts continue beyond them */
-  fluid_force_record rec[2];          /* the latest RHS and the one before (at another time) */
-  int latest;
+  mpm_rhs_records rec;                /* the latest RHS and the one before (mpm_impulse.h) */
+  double *f[2];                       /* their forces on this rank, dim per obstacle */
   int ppc;
   double lp;       /* GIMP half-width of the particles and ghosts, cells */
   mpm_lidx gcount; /* nodes with a ghost force */
