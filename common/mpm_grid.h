@@ -46,7 +46,8 @@ typedef struct mpm_grid_phase {
    * respect to the node's position). */
   double *normal_i[MPM_MAX_DIM];
   int normals;
-  double m_empty; /* the last nodal solve treated nodes with m_i <= m_empty as empty */
+  double m_max;   /* the last nodal solve's largest nodal mass over the whole grid */
+  double m_empty; /* it treated nodes with m_i <= m_empty as empty */
 } mpm_grid_phase;
 
 typedef struct mpm_grid {

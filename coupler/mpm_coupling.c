@@ -239,13 +239,13 @@ int mpm_coupling_after_constrain(mpm_coupling *c, double t, double h, mpm_pass p
   MPM_CALL(run_hook(c, c->type->ops->after_constrain, t, h, pass));
   if (pass != MPM_PASS_FIRST) return 0;
   /* Interpenetration: gas mass on the owned nodes inside the solid, those with at least 90 %
-   * of the largest solid nodal mass on this rank (full support: the stencil is covered). */
+   * of the largest solid nodal mass of the grid (full support: the stencil is covered). */
   mpm_timer_start(MPM_T_COUPLING);
   const mpm_grid *g = c->grid;
   const double *ms = g->phase[c->phase[MPM_ROLE_SOLID]].m_i;
   const double *mf = g->phase[c->phase[MPM_ROLE_FLUID]].m_i;
-  double mmax = 0.0, inside = 0.0;
-  for (mpm_lidx l = 0; l < g->nnodes; ++l) mmax = ms[l] > mmax ? ms[l] : mmax;
+  const double mmax = g->phase[c->phase[MPM_ROLE_SOLID]].m_max;
+  double inside = 0.0;
   for (mpm_lidx l = 0; l < g->nnodes; ++l)
     if (c->owned[l] && ms[l] >= 0.9 * mmax && mmax > 0) inside += mf[l];
   c->rec[c->which.latest].gas_inside = inside;

@@ -98,5 +98,9 @@ for scheme in SCHEMES:
                                                           "Fy_lower")) / scale
     check(len(a) == len(b) and diff <= 1e-12, f"{scheme}: per-body forces on 2 ranks as on 1 to "
           f"{diff:.1e} of the largest force (tolerance 1e-12: roundoff, as the state)")
+    gi = float(np.abs(a["gas_inside"] - b["gas_inside"]).max()) / max(
+        float(np.abs(a["gas_inside"]).max()), 1e-300)
+    check(gi <= 1e-12, f"{scheme}: the interpenetration measure on 2 ranks as on 1 to {gi:.1e} "
+          f"relative (tolerance 1e-12)")
 
 sys.exit(check.finish())
