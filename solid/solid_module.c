@@ -1,5 +1,5 @@
-/* Solid module: seeding, constraints (walls, clamps, rigid bodies), surface tractions, and
- * the module phases of an MPM right-hand side.
+/* Solid module: its case keys, seeding, and the module phases of an MPM right-hand side. The
+ * constraints (walls, clamps, rigid bodies) and surface tractions are in solid_constraints.c.
  *
  * Invariants: particle field order is x, v, F, [sigma], [C] | m, V0, body, [hist], [fixed],
  * [fext] (see solid_particles_new; bracketed fields exist only when a body's model, the APIC
@@ -8,6 +8,7 @@
  * never go stale after migration, sorting or injection. A rigid body's particles keep F = I,
  * C = 0 and their seeded velocity, and its region moves rigidly with that velocity: at time t
  * it is the seeded region translated by v t (wrapped through periodic faces). */
+#include "solid_internal.h"
 #include "solid_module.h"
 #include "solid_tensor.h"
 
@@ -25,56 +26,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
-/* Field indices: x, v, F are always fields 0-2; sigma (rate-form stress) and hist (material
- * history) exist only when some body's model needs them (see solid_layout). */
-enum { F_X, F_V, F_F };
-
-typedef struct {
-  char section[96];
-  solid_material *mat;
-  double rho;
-  double c;           /* elastic wave speed of the model at rho (for the stable step) */
-  double v[3];        /* rigid bodies: the prescribed velocity */
-  mpm_region *region; /* rigid bodies: the seeded region (the nodes it holds); else NULL */
-} solid_body;
-
-typedef struct {
-  int f_sigma, f_C, f_m, f_V0, f_body, f_hist, f_fixed, f_fext; /* field indices (-1 if absent) */
-  int nhist; /* history components per particle */
-} solid_layout;
-
-/* A surface traction [traction.NAME]: constant nominal traction t (Pa) on the particles of
- * the deformable bodies inside `region` at seeding. Seeding counts what it tagged here. */
-typedef struct {
-  char name[64];
-  mpm_region *region;
-  double t[3];
-  mpm_gidx tagged; /* particles tagged on this rank */
-  double force[3]; /* their total force on this rank */
-  mpm_gidx off_id; /* smallest id of a tagged particle off its body's surface, or -1 */
-  double off_x[3]; /* its position */
-} solid_traction;
-
-typedef struct {
-  int nbodies;
-  solid_body *body;
-  solid_layout lay;
-  mpm_node_constraints cons; /* wall and clamp nodes */
-  int nclamps;
-  mpm_region **clamp; /* clamped regions */
-  int nrigid;         /* rigid bodies */
-  int ntractions;
-  solid_traction *traction;
-  double gravity[MPM_MAX_DIM];
-  double damping;         /* mass-proportional damping rate alpha, 1/s: f_i -= alpha (m v)_i */
-  mpm_transfer tr;        /* [transfer] settings and the time method's kind */
-  double *vnew;           /* MUSL: the particles' new velocities (dim n) */
-  double lp;              /* GIMP half-width in cells */
-  mpm_lidx cap;           /* capacity of the scratch arrays */
-  double *vsig, *scratch; /* V sigma (dim^2 n); G2P output v, a, L ((2 dim + dim^2) n) */
-  mpm_lidx *idx, *count;  /* particle indices grouped by body; counts per body */
-} solid_content;
 
 static mpm_key_spec solid_keys[] = {
     {"solid.*.geometry", MPM_KEY_STRING, NULL, 0, 0, 0, 0, NULL,
@@ -136,10 +87,6 @@ static int solid_particles_new(mpm_particles **p, int dim, solid_layout *lay, in
   return mpm_particles_new(p, dim, fields, nf, nstate);
 }
 
-static void key_of(char *key, size_t size, const char *section, const char *name) {
-  snprintf(key, size, "%s.%s", section, name);
-}
-
 /* A batch over particles `idx` of component-major arrays with stride n (state from y). */
 static solid_batch batch_of(const solid_content *sc, const mpm_particles *p, const double *y,
                             mpm_lidx count, const mpm_lidx *idx, double *out) {
@@ -170,56 +117,14 @@ static void init_history(const solid_content *sc, int b, int dim, mpm_lidx n, co
   free(idx);
 }
 
-static int in_clamp(const solid_content *sc, const double *x) {
-  for (int k = 0; k < sc->nclamps; ++k)
-    if (mpm_region_contains(sc->clamp[k], x)) return 1;
-  return 0;
-}
-
 /* A body's `velocity` key: dim values. */
-static int body_velocity(const mpm_config *cfg, const char *section, int dim, double v[3]) {
+int solid_body_velocity(const mpm_config *cfg, const char *section, int dim, double v[3]) {
   char key[160];
   int nv;
-  key_of(key, sizeof key, section, "velocity");
+  solid_key(key, sizeof key, section, "velocity");
   MPM_CALL(mpm_config_get_reals(cfg, key, v, 3, &nv));
   if (nv < dim) return mpm_config_fail(cfg, key, "needs %d values, got %d", dim, nv);
   return 0;
-}
-
-/* Tractions: the force of a tagged particle is t A_p with A_p = h^(dim-1), h = dx/ppc the
- * particle spacing: its share of the loaded face, if the traction's region covers exactly the
- * outermost particle layer there. Then the total force on a face aligned with the axes is t
- * times the face's area exactly, whatever the region's own extent (a region's surface area is
- * not the loaded area: a box around the end of a bar has five other faces). On a slanted or
- * curved face the layer is a staircase and the total is too large by up to |n_x| + |n_y|
- * (+ |n_z|) for unit normal n, so load axis-aligned faces. A particle is on its body's
- * surface if one of its 2 dim lattice neighbours (at +-h along an axis) is outside the body's
- * region; a tagged particle that is not (a region two layers deep, or inside the body) is
- * recorded, and seeding then fails naming the traction. Rigid bodies are not loaded: their
- * motion is prescribed. */
-static void traction_force(solid_content *sc, const mpm_region *body, int dim, double h,
-                           const double *xp, mpm_gidx id, double *f) {
-  const double area = pow(h, dim - 1);
-  for (int k = 0; k < sc->ntractions; ++k) {
-    solid_traction *tr = &sc->traction[k];
-    if (!mpm_region_contains(tr->region, xp)) continue;
-    int surface = 0;
-    for (int d = 0; d < dim && !surface; ++d)
-      for (int side = -1; side <= 1 && !surface; side += 2) {
-        double y[3] = {xp[0], xp[1], dim == 3 ? xp[2] : 0.0};
-        y[d] += side * h;
-        surface = !mpm_region_contains(body, y);
-      }
-    if (!surface && (tr->off_id < 0 || id < tr->off_id)) {
-      tr->off_id = id;
-      memcpy(tr->off_x, xp, sizeof tr->off_x);
-    }
-    tr->tagged++;
-    for (int d = 0; d < dim; ++d) {
-      f[d] += tr->t[d] * area;
-      tr->force[d] += tr->t[d] * area;
-    }
-  }
 }
 
 /* Seed one body and append it to the particle set. */
@@ -232,15 +137,15 @@ static int seed_body(mpm_module *m, const mpm_config *cfg, int b, double *lp) {
   const char *geom;
   int ppc;
   double v0[3] = {0, 0, 0};
-  key_of(key, sizeof key, sc->body[b].section, "geometry");
+  solid_key(key, sizeof key, sc->body[b].section, "geometry");
   MPM_CALL(mpm_config_get_string(cfg, key, &geom));
-  key_of(key, sizeof key, sc->body[b].section, "ppc");
+  solid_key(key, sizeof key, sc->body[b].section, "ppc");
   MPM_CALL(mpm_config_get_int(cfg, key, &ppc));
-  MPM_CALL(body_velocity(cfg, sc->body[b].section, dim, v0));
-  key_of(key, sizeof key, sc->body[b].section, "velocity");
+  MPM_CALL(solid_body_velocity(cfg, sc->body[b].section, dim, v0));
+  solid_key(key, sizeof key, sc->body[b].section, "velocity");
   mpm_expr *vfield = NULL;
   char vkey[160];
-  key_of(vkey, sizeof vkey, sc->body[b].section, "velocity_field");
+  solid_key(vkey, sizeof vkey, sc->body[b].section, "velocity_field");
   if (mpm_config_has(cfg, vkey)) {
     if (mpm_config_has(cfg, key))
       return mpm_config_fail(cfg, vkey, "give either velocity or velocity_field, not both");
@@ -255,7 +160,7 @@ static int seed_body(mpm_module *m, const mpm_config *cfg, int b, double *lp) {
   for (int d = 0; d < dim; ++d)
     if (rlo[d] < g->lo[d] || rhi[d] > g->hi[d]) {
       mpm_region_destroy(&region);
-      key_of(key, sizeof key, sc->body[b].section, "geometry");
+      solid_key(key, sizeof key, sc->body[b].section, "geometry");
       return mpm_config_fail(cfg, key,
                              "region '%s' spans [%g, %g] along axis %d, outside the domain "
                              "[%g, %g]; move the region or enlarge [domain]",
@@ -284,10 +189,11 @@ static int seed_body(mpm_module *m, const mpm_config *cfg, int b, double *lp) {
     data[(size_t)p->offset[sc->lay.f_m] * n + i] = sc->body[b].rho * vol;
     data[(size_t)p->offset[sc->lay.f_V0] * n + i] = vol;
     data[(size_t)p->offset[sc->lay.f_body] * n + i] = b;
-    if (sc->lay.f_fixed >= 0) data[(size_t)p->offset[sc->lay.f_fixed] * n + i] = in_clamp(sc, xp);
+    if (sc->lay.f_fixed >= 0)
+      data[(size_t)p->offset[sc->lay.f_fixed] * n + i] = solid_in_clamp(sc, xp);
     if (sc->lay.f_fext >= 0 && !sc->body[b].mat->ops->rigid) {
       double f[3] = {0, 0, 0};
-      traction_force(sc, region, dim, g->dx / ppc, xp, id[i], f);
+      solid_traction_force(sc, region, dim, g->dx / ppc, xp, id[i], f);
       for (int d = 0; d < dim; ++d) data[(size_t)(p->offset[sc->lay.f_fext] + d) * n + i] = f[d];
     }
   }
@@ -304,7 +210,7 @@ static int seed_body(mpm_module *m, const mpm_config *cfg, int b, double *lp) {
   mpm_gidx local = n, total;
   MPM_CALL_MPI(MPI_Allreduce(&local, &total, 1, MPM_MPI_GIDX, MPI_SUM, g->comm));
   if (total == 0) {
-    key_of(key, sizeof key, sc->body[b].section, "geometry");
+    solid_key(key, sizeof key, sc->body[b].section, "geometry");
     return mpm_config_fail(cfg, key,
                            "body '%s' has no particles: region '%s' is thinner than "
                            "the particle spacing %g; refine grid.dx or raise ppc",
@@ -393,61 +299,6 @@ static void damp(mpm_grid *grid, int phase, double alpha) {
     for (mpm_lidx l = 0; l < grid->nnodes; ++l) ph->f_i[d][l] -= alpha * ph->mv_i[d][l];
 }
 
-/* Does the rigid body hold the node of global index gi at time t: is the node inside the
- * body's region translated by v t? Along a periodic axis the body wraps: the node's canonical
- * image (index in [0, ncells)) moved back by v t is wrapped into [lo, hi) before the test, and
- * a point on the seam lo is tried at hi as well. */
-static int rigid_holds(const solid_body *body, const mpm_grid *g, const int *gi, double t) {
-  double x[3] = {0, 0, 0};
-  int seam = 0;
-  for (int d = 0; d < g->dim; ++d) {
-    if (!g->periodic[d]) {
-      x[d] = g->lo[d] + gi[d] * g->dx - body->v[d] * t;
-      continue;
-    }
-    const int n = g->ncells[d], k = ((gi[d] % n) + n) % n;
-    const double len = g->hi[d] - g->lo[d];
-    double y = fmod(g->lo[d] + k * g->dx - body->v[d] * t - g->lo[d], len);
-    if (y < 0) y += len;
-    x[d] = g->lo[d] + y;
-    seam |= y == 0.0;
-  }
-  if (mpm_region_contains(body->region, x)) return 1;
-  if (!seam) return 0;
-  for (int d = 0; d < g->dim; ++d)
-    if (g->periodic[d] && x[d] == g->lo[d]) x[d] = g->hi[d];
-  return mpm_region_contains(body->region, x);
-}
-
-/* A rigid body holds every box node inside its moving region (rigid_holds) at its velocity v,
- * with zero acceleration: a clamp that moves. The rule is geometric, so each rank applies it
- * to all its box nodes, owned and ghost, and gets what any other decomposition gets. Along a
- * non-periodic axis only the nodes of the translated bounding box (and one more layer, against
- * rounding in the index conversion; the test decides) are visited; along a periodic axis,
- * all. */
-static void hold_rigid_nodes(const solid_body *body, mpm_grid *g, int phase, double t) {
-  mpm_grid_phase *ph = &g->phase[phase];
-  const int dim = g->dim;
-  double lo[3], hi[3];
-  int first[3] = {0, 0, 0}, last[3] = {0, 0, 0}, gi[3] = {0, 0, 0};
-  mpm_region_bounds(body->region, lo, hi);
-  for (int d = 0; d < dim; ++d) {
-    const double shift = body->v[d] * t, b0 = g->box_lo[d], b1 = g->box_lo[d] + g->box_n[d] - 1;
-    first[d] = (int)b0, last[d] = (int)b1;
-    if (g->periodic[d]) continue;
-    /* clamped in floating point, so a far-away region cannot overflow the conversion */
-    first[d] = (int)fmin(fmax(floor((lo[d] + shift - g->lo[d]) / g->dx) - 1.0, b0), b1 + 1.0);
-    last[d] = (int)fmax(fmin(ceil((hi[d] + shift - g->lo[d]) / g->dx) + 1.0, b1), b0 - 1.0);
-  }
-  for (gi[2] = first[2]; gi[2] <= last[2]; ++gi[2])
-    for (gi[1] = first[1]; gi[1] <= last[1]; ++gi[1])
-      for (gi[0] = first[0]; gi[0] <= last[0]; ++gi[0]) {
-        if (!rigid_holds(body, g, gi, t)) continue;
-        const mpm_lidx l = mpm_grid_local_index(g, gi);
-        for (int d = 0; d < dim; ++d) ph->v_i[d][l] = body->v[d], ph->a_i[d][l] = 0.0;
-      }
-}
-
 /* Before the nodal solve: mirrored pad nodes folded into the walls, and damping (first pass
  * only: after MUSL's remap no force acts). */
 static int solid_forces(mpm_module *m, double t, double h, mpm_pass pass) {
@@ -464,16 +315,12 @@ static int solid_constrain(mpm_module *m, double t, double h, mpm_pass pass) {
   (void)h, (void)pass;
   solid_content *sc = m->content;
   for (int b = 0; b < sc->nbodies; ++b)
-    if (sc->body[b].region) hold_rigid_nodes(&sc->body[b], m->grid, m->phase, t);
+    if (sc->body[b].region) solid_hold_rigid_nodes(&sc->body[b], m->grid, m->phase, t);
   mpm_constraints_apply(&sc->cons, m->grid, m->phase);
   return 0;
 }
 
 static void solid_stress_rates(mpm_module *m, const double *y, double *ydot, const double *L);
-
-static void hold_fixed(const mpm_particles *p, int f_fixed, double *ydot);
-static void move_rigid(const solid_content *sc, const mpm_particles *p, double *ydot);
-static void rigid_velocity(const solid_content *sc, int dim, mpm_lidx n, double *v);
 
 /* G2P: v_out = sum S v_i, a_out = sum S a_i, and optionally L, the APIC C and dF/dt = L F
  * (NULL: not wanted). */
@@ -520,7 +367,7 @@ static int solid_remap(mpm_module *m, double t, const double *y, double h) {
     double *vn = sc->vnew + (size_t)d * n;
     for (mpm_lidx i = 0; i < n; ++i) vn[i] = (1.0 - pic) * (v[i] + h * ag[d][i]) + pic * vg[d][i];
   }
-  if (sc->nrigid) rigid_velocity(sc, dim, n, sc->vnew);
+  if (sc->nrigid) solid_rigid_velocity(sc, dim, n, sc->vnew);
   mpm_grid_phase_zero(m->grid, m->phase);
   mpm_p2g_args a = {.n = n, .m = mpm_particles_comp(p, sc->lay.f_m, 0), .C = C, .lp = sc->lp};
   for (int d = 0; d < dim; ++d) {
@@ -560,55 +407,9 @@ static int solid_g2p(mpm_module *m, double t, const double *y, double *ydot, dou
     for (size_t k = 0; k < (size_t)dim * dim * (size_t)n; ++k) Cdot[k] = (Cdot[k] - C[k]) / h;
   }
   if (sc->lay.f_sigma >= 0) solid_stress_rates(m, y, ydot, L);
-  if (sc->lay.f_fixed >= 0) hold_fixed(p, sc->lay.f_fixed, ydot);
-  if (sc->nrigid) move_rigid(sc, p, ydot);
+  if (sc->lay.f_fixed >= 0) solid_hold_fixed(p, sc->lay.f_fixed, ydot);
+  if (sc->nrigid) solid_move_rigid(sc, p, ydot);
   return 0;
-}
-
-/* Clamped particles keep their place and velocity. Their deformation gradient (and stress)
- * still follows the grid: those at the edge of a clamp carry the reaction stress, which a
- * frozen F would drop, turning the clamp's edge into a hinge. */
-static void hold_fixed(const mpm_particles *p, int f_fixed, double *ydot) {
-  const double *fixed = mpm_particles_comp(p, f_fixed, 0);
-  for (int c = 0; c < 2 * p->dim; ++c) /* the x and v fields */
-    for (mpm_lidx i = 0; i < p->n; ++i)
-      if (fixed[i] != 0.0) ydot[(size_t)c * p->n + i] = 0.0;
-}
-
-/* Entries idx[0..count) of ncomp component arrays with stride n (component c at a + c n) take
- * the values val[c], or 0 if val is NULL. */
-static void set_entries(double *a, mpm_lidx n, int ncomp, const mpm_lidx *idx, mpm_lidx count,
-                        const double *val) {
-  for (int c = 0; c < ncomp; ++c) {
-    double *ac = a + (size_t)c * n;
-    const double x = val ? val[c] : 0.0;
-    for (mpm_lidx k = 0; k < count; ++k) ac[idx[k]] = x;
-  }
-}
-
-/* A rigid body's particles move with its velocity whatever the grid says: dx/dt = v,
- * dv/dt = 0, dF/dt = 0, and under APIC dC/dt = 0 (C stays 0: no velocity gradient). A rigid
- * body has no rate-form stress, so its sigma rate stays 0. Particles are grouped by body as
- * in this RHS's P2G. */
-static void move_rigid(const solid_content *sc, const mpm_particles *p, double *ydot) {
-  const int dim = p->dim;
-  const mpm_lidx n = p->n, *idx = sc->idx;
-  for (int b = 0; b < sc->nbodies; idx += sc->count[b++]) {
-    if (!sc->body[b].region) continue;
-    const mpm_lidx count = sc->count[b];
-    set_entries(ydot + (size_t)p->offset[F_X] * n, n, dim, idx, count, sc->body[b].v);
-    set_entries(ydot + (size_t)p->offset[F_V] * n, n, dim, idx, count, NULL);
-    set_entries(ydot + (size_t)p->offset[F_F] * n, n, dim * dim, idx, count, NULL);
-    if (sc->lay.f_C >= 0)
-      set_entries(ydot + (size_t)p->offset[sc->lay.f_C] * n, n, dim * dim, idx, count, NULL);
-  }
-}
-
-/* MUSL's new particle velocities v (dim arrays with stride n): a rigid body's keep its v. */
-static void rigid_velocity(const solid_content *sc, int dim, mpm_lidx n, double *v) {
-  const mpm_lidx *idx = sc->idx;
-  for (int b = 0; b < sc->nbodies; idx += sc->count[b++])
-    if (sc->body[b].region) set_entries(v, n, dim, idx, sc->count[b], sc->body[b].v);
 }
 
 /* Rate-form models: d sigma/dt from L; the stress state of other bodies stays constant.
@@ -769,152 +570,6 @@ static const mpm_module_ops solid_ops = {
     .remap = solid_remap,
 };
 
-/* A clamp holds the nodes nearest its boundary: a node is held if the region contains it or
- * a point half a cell from it along an axis. Holding only the nodes strictly inside puts
- * the effective root of a clamped bar up to a cell inside the clamp (B-splines do not
- * interpolate), a first-order error that dominated CSM1 (tip uy +8.7 % at dx = 5 mm, against
- * +2.8 % when the node line at the clamp's face is held). */
-static int clamps_node(const solid_content *sc, const double *x, double half, int dim) {
-  if (in_clamp(sc, x)) return 1;
-  for (int d = 0; d < dim; ++d)
-    for (int s = -1; s <= 1; s += 2) {
-      double y[3] = {x[0], x[1], x[2]};
-      y[d] += s * half;
-      if (in_clamp(sc, y)) return 1;
-    }
-  return 0;
-}
-
-/* Walls on the domain faces and clamped regions ([clamp.NAME] geometry = ...): the nodes
- * they hold, listed once. */
-static int read_constraints(mpm_module *m, const mpm_config *cfg) {
-  solid_content *sc = m->content;
-  const mpm_grid *g = m->grid;
-  mpm_walls walls;
-  MPM_CALL(mpm_walls_from_config(&walls, cfg, g->dim));
-  MPM_CALL(mpm_constraints_add_walls(&sc->cons, &walls, g));
-  const char *const *names;
-  int count;
-  MPM_CALL(mpm_config_instances(cfg, "clamp", &names, &count));
-  if (count == 0) return 0;
-  MPM_ALLOC(sc->clamp, count);
-  for (int k = 0; k < count; ++k) {
-    char key[160];
-    const char *geom;
-    snprintf(key, sizeof key, "clamp.%s.geometry", names[k]);
-    MPM_CALL(mpm_config_get_string(cfg, key, &geom));
-    MPM_CALL(mpm_region_from_config(&sc->clamp[k], cfg, g->dim, geom));
-    sc->nclamps = k + 1;
-  }
-  const unsigned char all = (unsigned char)((1u << g->dim) - 1);
-  for (mpm_lidx l = 0; l < g->nnodes; ++l) {
-    int gi[MPM_MAX_DIM];
-    double x[3] = {0, 0, 0};
-    mpm_grid_node_global(g, l, gi);
-    for (int d = 0; d < g->dim; ++d) x[d] = g->lo[d] + gi[d] * g->dx;
-    if (clamps_node(sc, x, 0.5 * g->dx, g->dim)) MPM_CALL(mpm_constraints_add(&sc->cons, l, all));
-  }
-  return 0;
-}
-
-/* A rigid body's velocity and region (read on restarts too: the nodes it holds follow from
- * them and the time). */
-static int read_rigid(mpm_module *m, const mpm_config *cfg, solid_body *body) {
-  solid_content *sc = m->content;
-  char key[160];
-  const char *geom;
-  key_of(key, sizeof key, body->section, "velocity_field");
-  if (mpm_config_has(cfg, key))
-    return mpm_config_fail(cfg, key,
-                           "a rigid body moves with one constant velocity; give velocity = "
-                           "vx vy [vz] instead");
-  MPM_CALL(body_velocity(cfg, body->section, m->grid->dim, body->v));
-  key_of(key, sizeof key, body->section, "geometry");
-  MPM_CALL(mpm_config_get_string(cfg, key, &geom));
-  MPM_CALL(mpm_region_from_config(&body->region, cfg, m->grid->dim, geom));
-  sc->nrigid++;
-  return 0;
-}
-
-/* The [traction.NAME] sections: value and region. */
-static int read_tractions(mpm_module *m, const mpm_config *cfg) {
-  solid_content *sc = m->content;
-  const int dim = m->grid->dim;
-  const char *const *names;
-  int count;
-  MPM_CALL(mpm_config_instances(cfg, "traction", &names, &count));
-  if (count == 0) return 0;
-  MPM_ALLOC(sc->traction, count);
-  for (int k = 0; k < count; ++k) {
-    solid_traction *tr = &sc->traction[k];
-    char key[160];
-    const char *geom;
-    int nv;
-    snprintf(tr->name, sizeof tr->name, "%s", names[k]);
-    tr->off_id = -1;
-    snprintf(key, sizeof key, "traction.%s.value", names[k]);
-    MPM_CALL(mpm_config_get_reals(cfg, key, tr->t, 3, &nv));
-    if (nv != dim)
-      return mpm_config_fail(cfg, key, "needs %d values (one per axis), got %d", dim, nv);
-    snprintf(key, sizeof key, "traction.%s.geometry", names[k]);
-    MPM_CALL(mpm_config_get_string(cfg, key, &geom));
-    MPM_CALL(mpm_region_from_config(&tr->region, cfg, dim, geom));
-    sc->ntractions = k + 1;
-  }
-  return 0;
-}
-
-/* "(x, y)" or "(x, y, z)". */
-static const char *show_point(char *s, size_t size, int dim, const double *x) {
-  if (dim == 3)
-    snprintf(s, size, "(%.6g, %.6g, %.6g)", x[0], x[1], x[2]);
-  else
-    snprintf(s, size, "(%.6g, %.6g)", x[0], x[1]);
-  return s;
-}
-
-/* After seeding: every traction must have tagged particles, all on their bodies' surfaces.
- * Collective; the first misplaced particle (smallest id) is named whichever rank holds it. */
-static int check_tractions(mpm_module *m, const mpm_config *cfg) {
-  const solid_content *sc = m->content;
-  const MPI_Comm comm = m->grid->comm;
-  const int dim = m->grid->dim;
-  for (int k = 0; k < sc->ntractions; ++k) {
-    const solid_traction *tr = &sc->traction[k];
-    char key[160];
-    const char *geom;
-    mpm_gidx total, off, local_off = tr->off_id < 0 ? INT64_MAX : tr->off_id;
-    double x[3] = {0, 0, 0}, force[3];
-    char at[96];
-    snprintf(key, sizeof key, "traction.%s.geometry", tr->name);
-    MPM_CALL(mpm_config_get_string(cfg, key, &geom));
-    MPM_CALL_MPI(MPI_Allreduce(&tr->tagged, &total, 1, MPM_MPI_GIDX, MPI_SUM, comm));
-    if (total == 0)
-      return mpm_config_fail(cfg, key,
-                             "region '%s' holds no particle of a deformable solid body at "
-                             "seeding, so the traction would act on nothing; the region must "
-                             "cover the outermost particle layer of the loaded face",
-                             geom);
-    MPM_CALL_MPI(MPI_Allreduce(&local_off, &off, 1, MPM_MPI_GIDX, MPI_MIN, comm));
-    if (off != INT64_MAX) {
-      double mine[3] = {0, 0, 0};
-      if (off == tr->off_id) memcpy(mine, tr->off_x, sizeof mine);
-      MPM_CALL_MPI(MPI_Allreduce(mine, x, 3, MPI_DOUBLE, MPI_SUM, comm));
-      return mpm_config_fail(cfg, key,
-                             "region '%s' holds the particle at %s, which is not on its "
-                             "body's surface (its neighbours at one particle spacing are all "
-                             "inside the body); the region must cover only the outermost "
-                             "particle layer of the loaded face (thinner than dx/ppc)",
-                             geom, show_point(at, sizeof at, dim, x));
-    }
-    MPM_CALL_MPI(MPI_Allreduce(tr->force, force, 3, MPI_DOUBLE, MPI_SUM, comm));
-    mpm_log(MPM_LOG_INFO, "traction %s: %lld particles, total force %s N%s", tr->name,
-            (long long)total, show_point(at, sizeof at, dim, force),
-            dim == 2 ? " per unit depth" : "");
-  }
-  return 0;
-}
-
 /* Read the bodies' sections and build their materials. */
 static int read_bodies(mpm_module *m, const mpm_config *cfg) {
   solid_content *sc = m->content;
@@ -929,14 +584,14 @@ static int read_bodies(mpm_module *m, const mpm_config *cfg) {
     char key[160];
     const char *type;
     snprintf(sc->body[b].section, sizeof sc->body[b].section, "solid.%s", names[b]);
-    key_of(key, sizeof key, sc->body[b].section, "density");
+    solid_key(key, sizeof key, sc->body[b].section, "density");
     MPM_CALL(mpm_config_get_real(cfg, key, &sc->body[b].rho));
-    key_of(key, sizeof key, sc->body[b].section, "material");
+    solid_key(key, sizeof key, sc->body[b].section, "material");
     MPM_CALL(mpm_config_get_string(cfg, key, &type));
     MPM_CALL(solid_material_create(&sc->body[b].mat, type, cfg, sc->body[b].section, m->grid->dim));
     /* Constant per body: evaluated once, not per particle in every stable-step scan. */
     sc->body[b].c = sc->body[b].mat->ops->wave_speed(sc->body[b].mat, sc->body[b].rho);
-    if (sc->body[b].mat->ops->rigid) MPM_CALL(read_rigid(m, cfg, &sc->body[b]));
+    if (sc->body[b].mat->ops->rigid) MPM_CALL(solid_read_rigid(m, cfg, &sc->body[b]));
   }
   double g[3] = {0, 0, 0};
   MPM_CALL(mpm_config_get_reals(cfg, "physics.gravity", g, 3, &nv));
@@ -972,8 +627,8 @@ int solid_module_create(mpm_module **mp, const mpm_config *cfg, mpm_grid *grid, 
       has_rate |= ops->rate != NULL;
       if (ops->nhistory) nhist = MPM_MAX(nhist, ops->nhistory(grid->dim));
     }
-    if (!rc) rc = read_constraints(m, cfg);
-    if (!rc) rc = read_tractions(m, cfg);
+    if (!rc) rc = solid_read_constraints(m, cfg);
+    if (!rc) rc = solid_read_tractions(m, cfg);
     if (!rc)
       rc = solid_particles_new(&m->particles, grid->dim, &sc->lay, has_rate, sc->tr.apic, nhist,
                                sc->nclamps > 0, sc->ntractions > 0);
@@ -985,13 +640,13 @@ int solid_module_create(mpm_module **mp, const mpm_config *cfg, mpm_grid *grid, 
     else {
       char key[160];
       int ppc;
-      key_of(key, sizeof key, sc->body[b].section, "ppc");
+      solid_key(key, sizeof key, sc->body[b].section, "ppc");
       rc = mpm_config_get_int(cfg, key, &ppc);
       lp = fmin(lp, 0.5 / ppc);
     }
     sc->lp = lp;
   }
-  if (!rc && seed) rc = check_tractions(m, cfg);
+  if (!rc && seed) rc = solid_check_tractions(m, cfg);
   if (rc) {
     mpm_module_destroy(mp);
     return mpm_trace(__FILE__, __LINE__, __func__, rc);

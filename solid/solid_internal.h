@@ -1,0 +1,97 @@
+/* The solid module's private state, shared by its files (solid_module.c: keys, seeding, the RHS
+ * phases; solid_constraints.c: walls, clamps, rigid bodies, surface tractions). Private to
+ * solid/. */
+#ifndef SOLID_INTERNAL_H
+#define SOLID_INTERNAL_H
+
+#include "mpm_bc.h"
+#include "mpm_config.h"
+#include "mpm_geometry.h"
+#include "mpm_module.h"
+#include "mpm_transfer.h"
+#include "solid_material.h"
+
+#include <stdio.h>
+
+/* Field indices: x, v, F are always fields 0-2; sigma (rate-form stress) and hist (material
+ * history) exist only when some body's model needs them (see solid_layout). */
+enum { F_X, F_V, F_F };
+
+typedef struct {
+  char section[96];
+  solid_material *mat;
+  double rho;
+  double c;           /* elastic wave speed of the model at rho (for the stable step) */
+  double v[3];        /* rigid bodies: the prescribed velocity */
+  mpm_region *region; /* rigid bodies: the seeded region (the nodes it holds); else NULL */
+} solid_body;
+
+typedef struct {
+  int f_sigma, f_C, f_m, f_V0, f_body, f_hist, f_fixed, f_fext; /* field indices (-1 if absent) */
+  int nhist; /* history components per particle */
+} solid_layout;
+
+/* A surface traction [traction.NAME]: constant nominal traction t (Pa) on the particles of
+ * the deformable bodies inside `region` at seeding. Seeding counts what it tagged here. */
+typedef struct {
+  char name[64];
+  mpm_region *region;
+  double t[3];
+  mpm_gidx tagged; /* particles tagged on this rank */
+  double force[3]; /* their total force on this rank */
+  mpm_gidx off_id; /* smallest id of a tagged particle off its body's surface, or -1 */
+  double off_x[3]; /* its position */
+} solid_traction;
+
+typedef struct {
+  int nbodies;
+  solid_body *body;
+  solid_layout lay;
+  mpm_node_constraints cons; /* wall and clamp nodes */
+  int nclamps;
+  mpm_region **clamp; /* clamped regions */
+  int nrigid;         /* rigid bodies */
+  int ntractions;
+  solid_traction *traction;
+  double gravity[MPM_MAX_DIM];
+  double damping;         /* mass-proportional damping rate alpha, 1/s: f_i -= alpha (m v)_i */
+  mpm_transfer tr;        /* [transfer] settings and the time method's kind */
+  double *vnew;           /* MUSL: the particles' new velocities (dim n) */
+  double lp;              /* GIMP half-width in cells */
+  mpm_lidx cap;           /* capacity of the scratch arrays */
+  double *vsig, *scratch; /* V sigma (dim^2 n); G2P output v, a, L ((2 dim + dim^2) n) */
+  mpm_lidx *idx, *count;  /* particle indices grouped by body; counts per body */
+} solid_content;
+
+/* "SECTION.NAME" into key. */
+static inline void solid_key(char *key, size_t size, const char *section, const char *name) {
+  snprintf(key, size, "%s.%s", section, name);
+}
+
+/* A body's `velocity` key: dim values (solid_module.c). */
+int solid_body_velocity(const mpm_config *cfg, const char *section, int dim, double v[3]);
+
+/* ---- solid_constraints.c ------------------------------------------------------------------ */
+
+/* Walls on the domain faces and clamped regions: the nodes they hold, listed once. */
+int solid_read_constraints(mpm_module *m, const mpm_config *cfg);
+/* A rigid body's prescribed velocity and region. */
+int solid_read_rigid(mpm_module *m, const mpm_config *cfg, solid_body *body);
+/* The [traction.NAME] sections. */
+int solid_read_tractions(mpm_module *m, const mpm_config *cfg);
+/* After seeding: every traction loaded particles on its bodies' surfaces only (collective). */
+int solid_check_tractions(mpm_module *m, const mpm_config *cfg);
+/* Is x inside a clamped region? */
+int solid_in_clamp(const solid_content *sc, const double *x);
+/* At seeding: add the tractions' force on a particle at xp of body region `body` to f. */
+void solid_traction_force(solid_content *sc, const mpm_region *body, int dim, double h,
+                          const double *xp, mpm_gidx id, double *f);
+/* After the nodal solve: a rigid body holds the nodes inside its moving region at time t. */
+void solid_hold_rigid_nodes(const solid_body *body, mpm_grid *g, int phase, double t);
+/* In G2P: clamped particles keep their place and velocity; rigid bodies move with theirs. */
+void solid_hold_fixed(const mpm_particles *p, int f_fixed, double *ydot);
+void solid_move_rigid(const solid_content *sc, const mpm_particles *p, double *ydot);
+/* MUSL's new particle velocities: a rigid body's keep its velocity. */
+void solid_rigid_velocity(const solid_content *sc, int dim, mpm_lidx n, double *v);
+
+#endif
