@@ -35,6 +35,15 @@ def run(args, ranks=1, check=True):
     return p
 
 
+def cost(outdir):
+    """The cost of a run, from its summary.json, as one line: steps, wall time, particle-steps."""
+    import json
+    with open(os.path.join(outdir, "summary.json")) as f:
+        s = json.load(f)
+    return (f"{s['steps']} steps, {s['wall_s']:.2f} s wall on {s['ranks']} rank(s), "
+            f"{s['particle_steps']:.3g} particle-steps")
+
+
 def snapshots(outdir):
     """(time, path) of every snapshot named in series.xmf, in time order. Each snapshot is a
     child grid of the temporal collection, with a <Time> and HDF data items."""

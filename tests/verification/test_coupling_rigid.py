@@ -55,6 +55,7 @@ def run(text, name, extra):
         f.write(text)
     out = mt.outdir(name)
     mt.run(["run", path, f"output.dir={out}", "run.progress=false", LATE] + extra)
+    print(f"cost {name}: {mt.cost(out)}")
     return out
 
 

@@ -117,6 +117,7 @@ def run(case, name, scheme, method, extra):
     out = mt.outdir(f"{name}_{scheme}_{method}")
     mt.run(["run", mt.case(case), f"output.dir={out}", f"grid.dx={DX}", f"coupling.scheme={scheme}",
             f"time.method={method}", "run.progress=false"] + list(extra))
+    print(f"cost {name} {scheme} {method} dx = {DX}: {mt.cost(out)}")
     return out
 
 
