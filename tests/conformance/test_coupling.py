@@ -107,18 +107,14 @@ for scheme in SCHEMES:
 # interface power is recorded as the gas's energy balance counts its forces' work (time-centred
 # velocity in the classic update; in the method of lines the work on v plus the internal forces'
 # work on the kinematic correction: coupler/mpm_coupling.h). Tolerances 4-6x the largest figure:
-# - usl 8e-4 (measured: velocity 1.31e-4, contact 1.36e-4, traction 1.50e-4): the residual is the
+# - usl 8e-4 (measured: velocity 1.31e-4, contact 1.36e-4, traction 1.36e-4): the residual is the
 #   solid's FLIP transfer, which, unlike the gas's, does not close its energy (it does not fall as
 #   dt is cut);
-# - musl 8e-4 (measured: velocity 8.7e-5, contact 2.05e-4);
-# - bs32 4e-6 (measured: velocity 8.5e-7, traction 9.7e-7): the semi-discrete system conserves
+# - musl 8e-4 (measured: velocity 8.7e-5, contact 2.05e-4, traction 8.9e-5);
+# - bs32 4e-6 (measured: velocity 8.5e-7, traction 9.0e-7): the semi-discrete system conserves
 #   energy exactly, so the residual is the time error (time.rtol = 1e-6).
-# Known gap, KNOWN_GAPS below: traction with musl, 1.01e-3, the solid's part: traction's kinematic
-# wall in MUSL's remap pass moves the solid's F and positions (so its strain energy) but is not in
-# the record (no force acts in that pass). Reported as `xfail` here; asserted by
-# test_coupling_traction_musl_energy (argument `strict`), an expected failure.
-KNOWN_GAPS = {("traction", "musl")}
-STRICT = "strict" in sys.argv[1:]
+# (An earlier traction, whose wall kept the solid's velocity from before the gas's load, created
+# energy at every step and failed musl at 1.0e-3; see coupler/coupling_traction.c.)
 E_TOL = {"usl": 8e-4, "musl": 8e-4, "bs32": 4e-6}
 for scheme in SCHEMES:
     for method in ("usl", "musl", "bs32"):
@@ -140,10 +136,6 @@ for scheme in SCHEMES:
               f"{imb / max(Fmax, 1e-300):.1e} of max |F| {Fmax:.2e} (<= 1e-12)")
         E = c["E_solid"] + c["E_fluid"]
         res = float(np.abs(E - E[0] - c["W_net"]).max() / E[0])
-        if (scheme, method) in KNOWN_GAPS and not STRICT:
-            print(f"xfail energy closure, {scheme} {method}: {res:.2e} of E0 against "
-                  f"{E_TOL[method]:g} (known gap: MUSL's remap pass is not in the record)")
-            continue
         check(res <= E_TOL[method],
               f"energy closure, {scheme} {method}: max |E - E0 - W_net| {res:.2e} of E0 "
               f"(W_net {float(c['W_net'][-1]):+.2e} J, E0 {float(E[0]):.4f} J; <= {E_TOL[method]:g})")
