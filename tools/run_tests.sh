@@ -2,8 +2,10 @@
 # Install, build and run the default test selection (everything but the `long` and
 # `benchmark` labels), then the same selection again in a build with AddressSanitizer,
 # LeakSanitizer and UBSan, less the two gas flow cases (test_wedge, test_forward_step: 7 minutes
-# under the sanitizers, 33 s without) and the coupled wave cases (test_fsi_waves: 6 minutes under
-# the sanitizers).
+# under the sanitizers, 33 s without), the coupled wave cases (test_fsi_waves: 6 minutes under
+# the sanitizers) and test_decomposition (11 minutes under the sanitizers with 3 and 4 ranks
+# oversubscribed on 2 cores, 20 s without; the halo, migration and P2G on 1-4 ranks run under the
+# sanitizers in test_halo_np*, test_migrate_np*, test_p2g_np* and test_ranks_solid).
 # The code they run is the open faces', the obstacles', the gas module's and the coupler's, which
 # test_gas_boundaries, test_obstacles, test_sod, test_coupling, test_coupling_ranks and
 # test_coupling_rigid run under the sanitizers. Idempotent.
@@ -13,5 +15,5 @@ bash "$src/tools/setup.sh" "$src/build"
 (cd "$src/build" && ctest -LE "long|benchmark" --output-on-failure -j 2 --timeout 900)
 bash "$src/tools/setup.sh" "$src/build-asan" -DMPMFSI_SANITIZE=ON -DCMAKE_BUILD_TYPE=Debug
 (cd "$src/build-asan" &&
-  ctest -LE "long|benchmark" -E "^test_(wedge|forward_step|fsi_waves)$" \
+  ctest -LE "long|benchmark" -E "^test_(wedge|forward_step|fsi_waves|decomposition)$" \
     --output-on-failure -j 2 --timeout 1800)
