@@ -47,8 +47,8 @@ static int traction_after_solve(mpm_coupling *c, double t, double h, mpm_pass pa
       if (h > 0) continue;
       ag[d] += fg * an * n[d], as[d] += fs * an * n[d];
     }
-    mpm_coupling_exchange(c, MPM_ROLE_FLUID, l, vg, h > 0 ? NULL : ag, h);
-    mpm_coupling_exchange(c, MPM_ROLE_SOLID, l, vs, h > 0 ? NULL : as, h);
+    mpm_coupling_exchange(c, MPM_ROLE_FLUID, l, vg, ag, h);
+    mpm_coupling_exchange(c, MPM_ROLE_SOLID, l, vs, as, h);
   }
   return 0;
 }

@@ -207,7 +207,6 @@ void mpm_coupling_destroy(mpm_coupling **cp) {
 static void begin_record(mpm_coupling *c, double t, double h) {
   mpm_coupling_record *cur = &c->rec[mpm_rhs_records_begin(&c->which, t, h)];
   memset(cur, 0, sizeof *cur);
-  cur->t = t, cur->set = 1, cur->classic = h > 0;
   for (int d = 0; c->nbodies && d < c->grid->dim; ++d)
     memset(c->da[d], 0, sizeof(double) * (size_t)c->grid->nnodes);
 }
@@ -265,10 +264,8 @@ void mpm_coupling_exchange_force(mpm_coupling *c, mpm_role role, mpm_lidx l, con
   mpm_grid_phase *ph = &c->grid->phase[c->phase[role]];
   const int dim = c->grid->dim;
   const double m = ph->m_i[l];
-  double force[MPM_MAX_DIM], keep[MPM_MAX_DIM];
-  if (!v)
-    for (int d = 0; d < dim; ++d) keep[d] = ph->v_i[d][l];
-  const double power = mpm_impulse_apply(ph, dim, l, v ? v : keep, a, h, force);
+  double force[MPM_MAX_DIM];
+  const double power = mpm_impulse_apply(ph, dim, l, v, a, h, force);
   for (int d = 0; f && d < dim; ++d) f[d] = force[d];
   if (c->recording && c->nbodies && role == MPM_ROLE_SOLID)
     for (int d = 0; d < dim; ++d) c->da[d][l] += force[d] / m;
@@ -314,7 +311,6 @@ int mpm_coupling_solid_normal(const mpm_coupling *c, mpm_lidx l, double *n) {
 
 int mpm_coupling_step_record(mpm_coupling *c, double t, mpm_coupling_record *out) {
   memset(out, 0, sizeof *out);
-  out->t = t;
   if (!c) return 0;
   const mpm_coupling_record *use = &c->rec[mpm_rhs_records_pick(&c->which, t)];
   enum { N = 2 * MPM_MAX_DIM + 3 };
@@ -326,7 +322,6 @@ int mpm_coupling_step_record(mpm_coupling *c, double t, mpm_coupling_record *out
   memcpy(out->force, sum, sizeof out->force);
   out->power[0] = sum[2 * MPM_MAX_DIM], out->power[1] = sum[2 * MPM_MAX_DIM + 1];
   out->gas_inside = sum[2 * MPM_MAX_DIM + 2];
-  out->set = use->set, out->classic = use->classic;
   if (c->nbodies)
     MPM_CALL_MPI(MPI_Allreduce(use->body, out->body, MPM_COUPLING_MAX_BODIES * MPM_MAX_DIM,
                                MPI_DOUBLE, MPI_SUM, c->grid->comm));

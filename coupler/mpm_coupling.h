@@ -63,8 +63,6 @@ typedef struct mpm_coupling_type {
 
 /* The interface record of one RHS evaluation on this rank (first pass only). */
 typedef struct mpm_coupling_record {
-  double t;
-  int set, classic;
   double force[MPM_ROLE_COUNT][MPM_MAX_DIM];         /* momentum rate into each phase, N */
   double power[MPM_ROLE_COUNT];                      /* its power on that phase's nodes, W */
   double gas_inside;                                 /* gas mass on nodes inside the solid, kg */
@@ -111,10 +109,11 @@ int mpm_coupling_body_loads(mpm_coupling *c, const double *y_solid);
 
 /* ---- for the schemes ---------------------------------------------------------------------- */
 
-/* Set phase `role`'s v_i and a_i at box node l to v and a (dim values each; NULL keeps that
- * one), recording the exchange (see the balance above). h: the classic step (0: method of
- * lines). In the classic update the acceleration takes the velocity change as an impulse,
- * a' = a + (v' - v) / h, whatever a is given, so FLIP and PIC particles see the same change. */
+/* Set phase `role`'s v_i and a_i at box node l to v and a (dim values each; a NULL a keeps the
+ * acceleration in the method of lines), recording the exchange (see the balance above). h: the
+ * classic step (0: method of lines). In the classic update the acceleration takes the velocity
+ * change as an impulse, a' = a + (v' - v) / h, whatever a is given, so FLIP and PIC particles see
+ * the same change. */
 void mpm_coupling_exchange(mpm_coupling *c, mpm_role role, mpm_lidx l, const double *v,
                            const double *a, double h);
 /* The same, and the force the phase received there in f (dim values). */
