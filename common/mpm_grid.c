@@ -204,6 +204,7 @@ static void phase_free(mpm_grid_phase *ph) {
     free(ph->mv_i[d]), free(ph->f_i[d]), free(ph->v_i[d]);
     free(ph->a_i[d]), free(ph->normal_i[d]);
   }
+  free(ph->cell_n);
   memset(ph, 0, sizeof *ph);
 }
 

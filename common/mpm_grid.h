@@ -48,6 +48,8 @@ typedef struct mpm_grid_phase {
   int normals;
   double m_max;   /* the last nodal solve's largest nodal mass over the whole grid */
   double m_empty; /* it treated nodes with m_i <= m_empty as empty */
+  /* Particles per cell, at the cell's lower corner node (mpm_cells.h); NULL until counted. */
+  double *cell_n;
 } mpm_grid_phase;
 
 typedef struct mpm_grid {

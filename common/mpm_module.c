@@ -68,8 +68,8 @@ int mpm_module_check_positions(const mpm_module *m, const double *y, mpm_fault *
   for (mpm_lidx i = 0; i < n; ++i)
     for (int d = 0; d < p->dim; ++d) {
       const double x = y[(size_t)d * n + i];
-      const double lo = g->lo[d] - (m->open[d][0] ? g->dx : 0.0);
-      const double hi = g->hi[d] + (m->open[d][1] ? g->dx : 0.0);
+      const double lo = g->lo[d] - (m->open[d][0] ? 1.0 : m->wall_slack) * g->dx;
+      const double hi = g->hi[d] + (m->open[d][1] ? 1.0 : m->wall_slack) * g->dx;
       if (!g->periodic[d] && !(x >= lo && x < hi))
         return mpm_fault_at(fault, p, y, i, "the particle left the domain");
       const double cell = floor((x - g->lo[d]) / g->dx);

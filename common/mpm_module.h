@@ -97,8 +97,15 @@ struct mpm_module {
   /* Faces [axis][lo, hi] a particle may cross during a step: the module removes it between
    * steps (the gas's open faces). Elsewhere a particle outside the domain is a fault. */
   unsigned char open[MPM_MAX_DIM][2];
+  /* How far (in cells) a particle may lie beyond a closed (wall) face at the end of a stage
+   * without a fault; the module's boundary op returns it between steps (the gas, whose
+   * particles are pressed into the corners of walls and bodies; 0 elsewhere). */
+  double wall_slack;
   long step; /* accepted steps of the run (a restart continues the count); set by the sim
               * before boundary and post_step */
+  /* > 0: post_step at the steps that are multiples of this reads the cell occupancy of every
+   * phase (mpm_cells.h), which the sim counts after every module's migration. */
+  int cells_every;
 };
 
 /* Call ops->destroy and free the module; accepts NULL. */

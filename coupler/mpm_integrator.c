@@ -370,6 +370,13 @@ int mpm_integrator_resize(mpm_integrator *it, double t) {
   return 0;
 }
 
+int mpm_integrator_cfl_step(mpm_integrator *it, double *h) {
+  double hs;
+  MPM_CALL(stable_step(it, it->y, &hs));
+  *h = isfinite(hs) ? it->cfl * hs : 0.0;
+  return 0;
+}
+
 double mpm_integrator_next_step(const mpm_integrator *it) {
   mpm_sunreal h = 0;
   ERKStepGetCurrentStep(it->ark, &h);
@@ -433,6 +440,14 @@ static int attempt(mpm_integrator *it, double tstop, double scale, double *t, do
     return 0;
   }
   if (it->fault.set) return MPM_RETRY;
+  if (flag == ARK_ERR_FAILURE || flag == ARK_TOO_MUCH_ACC)
+    MPM_FAIL(MPM_ERR_UNPHYSICAL,
+             "the run blew up at t = %.6g: the adaptive %s step failed its error test "
+             "repeatedly (ERKStep flag %d): the state changes faster than time.rtol and "
+             "time.atol (in the state's units: m, m/s, J/kg) allow at any step; an impulsive "
+             "start or a near vacuum is the usual cause: loosen time.atol, start the flow "
+             "gradually, or use time.method = usl",
+             it->t_last, mpm_method_name(it->method), flag);
   MPM_FAIL(it->rhs_error ? MPM_ERR_INTERNAL : MPM_ERR_SUNDIALS,
            "ERKStep failed at t = %.6g with flag %d", it->t_last, flag);
 }

@@ -57,6 +57,10 @@ int mpm_integrator_step(mpm_integrator *it, double tstop, double *t, double *h);
 /* The particle sets changed (count, order or storage): re-wrap the state. Collective. */
 int mpm_integrator_resize(mpm_integrator *it, double t);
 
+/* The CFL step of the current state: time.cfl times the modules' stability limit, 0 if
+ * nothing limits it. Collective. */
+int mpm_integrator_cfl_step(mpm_integrator *it, double *h);
+
 /* Step ARKODE would try next (for checkpoints). */
 double mpm_integrator_next_step(const mpm_integrator *it);
 

@@ -2,10 +2,12 @@
 #include "mpm_sim.h"
 
 #include "mpm_bc.h"
+#include "mpm_cells.h"
 #include "mpm_coupling.h"
 #include "mpm_diag.h"
 #include "mpm_error.h"
 #include "mpm_geometry.h"
+#include "mpm_guard.h"
 #include "mpm_integrator.h"
 #include "mpm_output.h"
 #include "mpm_timer.h"
@@ -30,6 +32,8 @@ struct mpm_sim {
   int nmod;
   mpm_coupling *coupling; /* NULL: one phase, or scheme = none */
   mpm_integrator *it;
+  mpm_guard guard;
+  double energy; /* total energy at the last diagnostics row */
   mpm_output *out;
   mpm_diag *diag;
   mpm_diag *coupling_csv;    /* coupling.csv, with a coupler only */
@@ -91,6 +95,7 @@ static const mpm_key_spec sim_keys[] = {
 int mpm_sim_add_schema(mpm_config *cfg) {
   MPM_CALL(mpm_config_add_schema(cfg, sim_keys, (int)(sizeof sim_keys / sizeof sim_keys[0])));
   MPM_CALL(mpm_config_add_schema(cfg, mpm_integrator_keys, mpm_integrator_nkeys));
+  MPM_CALL(mpm_config_add_schema(cfg, mpm_guard_keys, mpm_guard_nkeys));
   MPM_CALL(mpm_config_add_schema(cfg, mpm_geometry_keys, mpm_geometry_nkeys));
   MPM_CALL(mpm_config_add_schema(cfg, mpm_bc_keys, mpm_bc_nkeys));
   MPM_CALL(mpm_coupling_add_schema(cfg));
@@ -368,6 +373,7 @@ static int diagnostics_row(mpm_sim *s, double dt) {
     local[8 + s->mod[k]->role] += m.kinetic + m.internal;
   }
   MPM_CALL_MPI(MPI_Allreduce(local, sum, 10, MPI_DOUBLE, MPI_SUM, s->comm));
+  s->energy = sum[5] + sum[6];
   if (s->coupling) MPM_CALL(coupling_row(s, dt, sum + 8));
   long steps, rhs, fails, retries;
   mpm_integrator_counts(s->it, &steps, &rhs, &fails, &retries);
@@ -375,6 +381,18 @@ static int diagnostics_row(mpm_sim *s, double dt) {
                              sum[3], sum[4],          sum[5], sum[6], sum[5] + sum[6], (double)rhs};
   if (dt > 0) s->particle_steps += sum[0]; /* the row at t = 0 is not a step */
   return mpm_diag_row(s->diag, row);
+}
+
+/* Total energy of every module, summed over the ranks. */
+static int total_energy(mpm_sim *s, double *energy) {
+  double local = 0.0;
+  for (int k = 0; k < s->nmod; ++k) {
+    mpm_module_sums m;
+    s->mod[k]->ops->sums(s->mod[k], &m);
+    local += m.kinetic + m.internal;
+  }
+  MPM_CALL_MPI(MPI_Allreduce(&local, energy, 1, MPI_DOUBLE, MPI_SUM, s->comm));
+  return 0;
 }
 
 static int diagnostics(mpm_sim *s, double dt) {
@@ -385,23 +403,30 @@ static int diagnostics(mpm_sim *s, double dt) {
 }
 
 /* Between steps: particles enter and leave through the boundary, move to their owners and
- * are sorted now and then; the modules do their post-step work; the integrator is told. */
+ * are sorted now and then; the cells' occupancy is counted when a module asks for it; the
+ * modules do their post-step work; the integrator is told. */
 static int after_step(mpm_sim *s, double h) {
-  int changed_any = 0;
+  int changed[SIM_MAX_MODULES] = {0}, changed_any = 0, want_cells = 0;
   mpm_timer_start(MPM_T_MIGRATE);
   for (int k = 0; k < s->nmod; ++k) {
     mpm_module *m = s->mod[k];
-    int changed = 0, migrated = 0;
+    int migrated = 0;
     m->step = s->step;
-    if (m->ops->boundary) MPM_CALL(m->ops->boundary(m, s->t, h, &changed));
+    if (m->ops->boundary) MPM_CALL(m->ops->boundary(m, s->t, h, &changed[k]));
     MPM_CALL(mpm_particles_migrate(m->particles, s->grid, &migrated));
-    changed |= migrated;
+    changed[k] |= migrated;
     if (s->sort_every > 0 && s->step % s->sort_every == 0) {
       MPM_CALL(mpm_particles_sort(m->particles, s->grid));
-      changed = 1;
+      changed[k] = 1;
     }
-    if (m->ops->post_step) MPM_CALL(m->ops->post_step(m, s->t, h, &changed));
-    changed_any |= changed;
+    want_cells |= m->cells_every > 0 && s->step % m->cells_every == 0;
+  }
+  for (int k = 0; want_cells && k < s->nmod; ++k)
+    MPM_CALL(mpm_cells_count(s->grid, s->mod[k]->phase, s->mod[k]->particles));
+  for (int k = 0; k < s->nmod; ++k) {
+    mpm_module *m = s->mod[k];
+    if (m->ops->post_step) MPM_CALL(m->ops->post_step(m, s->t, h, &changed[k]));
+    changed_any |= changed[k];
   }
   /* A module's own changes may be local to a rank; the resize is collective. */
   MPM_CALL_MPI(MPI_Allreduce(MPI_IN_PLACE, &changed_any, 1, MPI_INT, MPI_LOR, s->comm));
@@ -465,16 +490,22 @@ int mpm_sim_run(mpm_sim *s) {
     MPM_CALL(diagnostics(s, 0.0));
     if (s->snapshots) MPM_CALL(write_snapshot(s));
     s->out_next = 1;
+  } else {
+    MPM_CALL(total_energy(s, &s->energy));
   }
+  double h0;
+  MPM_CALL(mpm_integrator_cfl_step(s->it, &h0));
+  MPM_CALL(mpm_guard_init(&s->guard, s->cfg, h0, s->energy));
   const double t_stop = s->t_end * (1 - 1e-14);
   double dt = 0.0;
   while (s->t < t_stop) {
     const double t_out = fmin(s->out_next * s->out_interval, s->t_end);
-    const double t_ckpt = s->ckpt_next * s->ckpt_interval;
-    MPM_CALL(mpm_integrator_step(s->it, fmin(t_out, t_ckpt), &s->t, &dt));
+    const double t_ckpt = s->ckpt_next * s->ckpt_interval, tstop = fmin(t_out, t_ckpt);
+    MPM_CALL(mpm_integrator_step(s->it, tstop, &s->t, &dt));
     s->step++;
     MPM_CALL(after_step(s, dt));
     MPM_CALL(diagnostics(s, dt));
+    MPM_CALL(mpm_guard_check(&s->guard, s->t, s->step, dt, s->t >= tstop * (1 - 1e-14), s->energy));
     progress(s, dt, wall0, 0);
     if (s->t >= t_out * (1 - 1e-14)) {
       if (s->snapshots) MPM_CALL(write_snapshot(s));

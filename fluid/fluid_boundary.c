@@ -518,6 +518,20 @@ static int owns_face(const mpm_grid *g, const open_face *f) {
   return f->side ? g->coord[f->axis] == g->nproc[f->axis] - 1 : g->coord[f->axis] == 0;
 }
 
+void fluid_walls_return(mpm_module *m) {
+  mpm_particles *p = m->particles;
+  const mpm_grid *g = m->grid;
+  for (int d = 0; d < g->dim; ++d) {
+    if (g->periodic[d]) continue;
+    double *x = mpm_particles_comp(p, FLUID_X, d);
+    for (mpm_lidx i = 0; i < p->n; ++i) {
+      if (!m->open[d][0] && x[i] < g->lo[d]) x[i] = fmin(2.0 * g->lo[d] - x[i], g->hi[d]);
+      if (!m->open[d][1] && x[i] >= g->hi[d])
+        x[i] = fmax(nextafter(2.0 * g->hi[d] - x[i], g->lo[d]), g->lo[d]);
+    }
+  }
+}
+
 int fluid_open_exchange(fluid_open *o, mpm_module *m, double t, double h, int *changed) {
   if (!o) return 0;
   mpm_particles *p = m->particles;

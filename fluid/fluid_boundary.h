@@ -37,4 +37,11 @@ void fluid_open_hold(const fluid_open *open, mpm_module *m);
  * the free-stream layers that entered during the step h that ended at t. Local. */
 int fluid_open_exchange(fluid_open *open, mpm_module *m, double t, double h, int *changed);
 
+/* Between steps: a gas particle that ended a step beyond a wall face (by less than the
+ * module's wall_slack, which the stage checks allow) is mirrored back inside across that
+ * face. Only its position changes: mass, momentum and energy stay. A particle pressed into a
+ * wall corner (a stagnation corner at a body's foot) would otherwise fail the step check and
+ * make every later step retry at a fraction of its size. */
+void fluid_walls_return(mpm_module *m);
+
 #endif

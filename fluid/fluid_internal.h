@@ -35,6 +35,7 @@ typedef struct fluid_content {
   fluid_obstacles obs;       /* static obstacles (fluid_obstacle.h) */
   int reg_every;             /* regularise every reg_every steps (0: never) */
   int reg_min, reg_max;      /* particles per non-empty cell after regularisation */
+  int refill;                /* regularisation refills cells that expansion emptied */
   mpm_lidx cap;              /* capacity of the particle scratch arrays */
   double *vsig;              /* V sigma deposited by this RHS (dim^2 cap) */
   double *scratch;           /* G2P output v, a, L ((2 dim + dim^2) cap) */

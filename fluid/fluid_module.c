@@ -55,6 +55,11 @@ static const mpm_key_spec fluid_keys[] = {
      "merge and split gas particles every N accepted steps, conserving mass, momentum and "
      "total energy (0: never; the seed paper uses 30)",
      0},
+    {"fluid.refill", MPM_KEY_BOOL, "true", 0, 0, 0, 0, NULL,
+     "with regularisation: give every empty cell next to the gas (and free of other "
+     "material and obstacles) half of a neighbour's heaviest particle, conserving mass, "
+     "momentum and energy, so that strong expansions and wakes keep no empty cell",
+     0},
     {"fluid.regularise_min", MPM_KEY_INT, NULL, 1, HUGE_VAL, 0, 0, NULL,
      "split particles in a non-empty cell holding fewer than this (default ceil(ppc^dim / 2): "
      "refill where the gas has expanded to twice its seeding volume; 1 never splits)",
@@ -335,6 +340,7 @@ static int fluid_post_step(mpm_module *m, double t, double h, int *changed) {
 
 static int fluid_boundary(mpm_module *m, double t, double h, int *changed) {
   fluid_content *fc = m->content;
+  fluid_walls_return(m);
   return fluid_open_exchange(fc->open, m, t, h, changed);
 }
 
@@ -447,6 +453,7 @@ static int read_regularise(fluid_content *fc, const mpm_config *cfg, int dim) {
   for (int d = 0; d < dim; ++d) seeded *= fc->ppc;
   fc->reg_min = (seeded + 1) / 2, fc->reg_max = 4 * seeded;
   MPM_CALL(mpm_config_get_int(cfg, "fluid.regularise_every", &fc->reg_every));
+  MPM_CALL(mpm_config_get_bool(cfg, "fluid.refill", &fc->refill));
   if (mpm_config_has(cfg, kmin)) MPM_CALL(mpm_config_get_int(cfg, kmin, &fc->reg_min));
   if (mpm_config_has(cfg, kmax)) MPM_CALL(mpm_config_get_int(cfg, kmax, &fc->reg_max));
   if (fc->reg_min < fc->reg_max) return 0;
@@ -560,5 +567,7 @@ int fluid_module_create(mpm_module **mp, const mpm_config *cfg, mpm_grid *grid, 
     mpm_module_destroy(mp);
     return mpm_trace(__FILE__, __LINE__, __func__, rc);
   }
+  m->cells_every = fc->refill ? fc->reg_every : 0;
+  m->wall_slack = 0.5;
   return 0;
 }

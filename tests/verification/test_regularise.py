@@ -39,7 +39,7 @@ CASE = mt.case("gas_box.ini")
 T = 0.3
 FLOW = ["gas.air.pressure_field=1", "gas.air.velocity_field=sin(2*pi*x); sin(2*pi*y)",
         f"time.t_end={T}", "fluid.regularise_min=3", "fluid.regularise_max=6"]
-EVENT = re.compile(r"regularise step (\d+): (\d+) splits, (\d+) merges; mass (\S+) -> (\S+), "
+EVENT = re.compile(r"regularise step (\d+): (?:\d+) refills, (\d+) splits, (\d+) merges; mass (\S+) -> (\S+), "
                    r"momentum \((\S+), (\S+), (\S+)\) -> \((\S+), (\S+), (\S+)\), "
                    r"energy (\S+) -> (\S+)")
 

@@ -1,0 +1,37 @@
+/* The blow-up guard: stops a run that has gone unstable, under every time method, instead of
+ * letting it run on with a collapsing step or an exploding energy.
+ *
+ * A run is stopped (MPM_ERR_UNPHYSICAL, one message naming the criterion and the key that
+ * sets it) when
+ *   - the total energy is not finite, or exceeds time.energy_growth times its starting value
+ *     (or, for a run that starts with none, its first nonzero value): energy that enters
+ *     through open faces or loads grows it a few times, a blow-up by orders of magnitude;
+ *   - for time.collapse_steps accepted steps in a row, the step was below time.collapse_ratio
+ *     times the CFL step of the state the run started from (steps cut short to land on an
+ *     output or checkpoint time do not count, and do not break a streak).
+ * Both are checked after every accepted step, from the totals the diagnostics already sum. */
+#ifndef MPM_GUARD_H
+#define MPM_GUARD_H
+
+#include "mpm_config.h"
+
+typedef struct mpm_guard {
+  double ratio, growth; /* the thresholds (0: that criterion off) */
+  int window;           /* steps in a row */
+  double h0;            /* CFL step of the starting state (0: nothing limits it) */
+  double e_scale;       /* energy scale (0: not yet known) */
+  int low;              /* current streak of collapsed steps */
+} mpm_guard;
+
+extern const mpm_key_spec mpm_guard_keys[];
+extern const int mpm_guard_nkeys;
+
+/* Read the thresholds; h0 is the CFL step and e0 the total energy of the starting state. */
+int mpm_guard_init(mpm_guard *g, const mpm_config *cfg, double h0, double e0);
+
+/* After an accepted step of size h that ended at t (cut_short: it was shortened to land on a
+ * stop time) with total energy `energy`: 0, or the failure. Collective values only (every
+ * rank decides alike). */
+int mpm_guard_check(mpm_guard *g, double t, long step, double h, int cut_short, double energy);
+
+#endif

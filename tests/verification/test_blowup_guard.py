@@ -1,0 +1,73 @@
+"""The blow-up guard (coupler/mpm_guard.c): a run that goes unstable stops with one clear
+message under every time method, instead of running on with a collapsing step or an exploding
+energy.
+
+Case: the axial bar of test_stability (cases/axial_bar.ini, 50 cells, v0 = 1e-4: linear
+elastic waves, energy 6.25e-8 J, no energy enters), 20 time units.
+
+1. usl at time.cfl = 0.95, above the classic update's limit with quadratic B-splines
+   (test_stability: usl grows 2.4e4-fold at 0.9): the energy growth criterion stops it with a
+   message naming time.energy_growth, before t_end, exit status non-zero, and the last row of
+   diagnostics.csv is within one step's growth of the limit (< 1e4 x the start): it did not
+   run on.
+2. forward Euler at 0.9 (an explicit method without error control, ERK fixed step): the same.
+3. The adaptive pair bs32 (error-controlled): it does not blow up on this bar, so the step
+   collapse criterion is exercised with the error control itself: at rtol = 1e-12 its steps
+   are about 0.06 of the CFL step. With time.collapse_ratio = 0.2 the guard stops the run
+   after time.collapse_steps = 100 such steps (message naming time.collapse_ratio); with the
+   default ratio 0.01 the same run completes (a slow but healthy run is not stopped).
+4. A healthy run with default settings (bs32, default tolerances) completes: the guard does
+   not fire on ordinary runs.
+"""
+import os
+import sys
+
+import numpy as np
+
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "tools"))
+import mpmtest as mt  # noqa: E402
+
+check = mt.Checks("test_blowup_guard")
+BAR = ["grid.dx=0.5", "domain.hi=26 1", "geometry.bar.hi=25 1",
+       "solid.bar.velocity_field=1e-4*sin(pi*x/50); 0", "time.t_end=20", "output.snapshots=false",
+       "run.progress=false"]
+E0 = 6.25e-8
+
+
+def error_line(text):
+    lines = [l for l in text.splitlines() if l.startswith("error:")]
+    return lines[-1] if lines else ""
+
+
+def run(label, extra):
+    out = mt.outdir("blowup_" + label)
+    p = mt.run(["run", mt.case("axial_bar.ini"), f"output.dir={out}"] + BAR + extra, check=False)
+    d = np.genfromtxt(os.path.join(out, "diagnostics.csv"), delimiter=",", names=True)
+    return p, d
+
+
+for label, extra in (("usl", ["time.method=usl", "time.cfl=0.95"]),
+                     ("euler", ["time.method=euler", "time.cfl=0.9"])):
+    p, d = run(label, extra)
+    msg = error_line(p.stderr)
+    check(p.returncode != 0 and "blew up" in msg and "time.energy_growth" in msg,
+          f"{label}: stopped with status {p.returncode}: {msg.strip()[:160]}")
+    check(d["t"][-1] < 20 and d["total"][-1] < 1e4 * E0,
+          f"{label}: last row t = {d['t'][-1]:.3g} (< 20), energy {d['total'][-1] / E0:.3g} x "
+          "the start (< 1e4: stopped at the limit, did not run on)")
+
+slow = ["time.method=bs32", "time.rtol=1e-12", "time.atol=1e-18", "time.t_end=2"]
+p, d = run("bs32_collapse", slow + ["time.collapse_ratio=0.2"])
+msg = error_line(p.stderr)
+check(p.returncode != 0 and "blew up" in msg and "time.collapse_ratio" in msg,
+      f"bs32, ratio 0.2: stopped with status {p.returncode} after {len(d) - 1} steps: "
+      f"{msg.strip()[:160]}")
+check(len(d) - 1 == 100, f"bs32, ratio 0.2: stopped at step {len(d) - 1} (the 100th collapsed "
+      "step in a row)")
+p, d = run("bs32_slow", slow)
+check(p.returncode == 0, f"bs32 at rtol 1e-12, default ratio 0.01: completes (status "
+      f"{p.returncode}, {len(d) - 1} steps)")
+p, d = run("bs32_default", ["time.method=bs32"])
+check(p.returncode == 0 and abs(d["t"][-1] - 20) < 1e-9,
+      f"bs32 with default settings: completes to t = {d['t'][-1]:.6g} (status {p.returncode})")
+sys.exit(check.finish())

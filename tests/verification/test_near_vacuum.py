@@ -1,0 +1,116 @@
+"""Gas into near vacuum: the refill of regularisation (fluid/fluid_regularise.c, fluid.refill).
+
+Case: cases/double_rarefaction.ini, Toro's 123 problem (rho = 1, p = 0.4, u = -2 | +2, gamma
+1.4) on a strip of N x 3 cells, usl, regularised every 5 steps, to t = 0.15. The exact star
+state is a near vacuum (rho* = 0.0219, p* = 0.00189, 2.2 % of the initial density): a
+Lagrangian gas thins there to about one particle per 45 cells.
+
+Density measure: the gas's nodal density, sum_p m_p N_i(x_p) / (dx H) with the quadratic
+B-spline along x (H the strip height), at the interior nodes, against the exact solution
+averaged over [x_i - dx/2, x_i + dx/2]. It is the density the method itself works with (P2G),
+it is exact for particles on a regular lattice in uniform flow (the quadratic B-spline's
+transform vanishes at the lattice's aliasing frequencies), and unlike the particles' own
+density it does not hide an empty gap (an empty node reads 0).
+
+Arguments: `refill` (the ordinary test), `order` (the convergence target, an expected failure).
+
+refill:
+1. Every event conserves mass, momentum and total energy to 1e-13 relative (momentum against
+   sqrt(2 M E)), as test_regularise (the same summation-noise argument); refills happened.
+2. At t = 0.15 no node between the outermost particles has zero gas mass with refill, at
+   N = 200 and 800. The same runs without refill (fluid.refill = false) leave empty nodes (the
+   control: measured 51 at N = 200 and 149 at N = 800): the check can fail.
+3. With refill the L1 density error is below that of the run without refill at every N
+   (measured at 200 / 400 / 800: 0.0286 / 0.0276 / 0.0274 with refill against 0.0447 / 0.0461
+   / 0.0379 without).
+order:
+4. The L1 error falls with refinement at an observed order >= 0.5 from 200 to 800 cells (the
+   issue's target). NOT MET: the error stays at 0.027-0.028 at every N. It is dominated by the
+   rarefaction fans' low-density tails (0.023 of the 0.027), where the particles clump into
+   clusters a few cells apart under expansion (density spikes of 5x the exact value next to
+   near-empty nodes), with or without refill, with FLIP, a 5 % PIC blend or usl (APIC loses
+   positivity there). The refill keeps the cells filled but does not remove the clumping,
+   which is the gas's particle-based pressure under strong expansion.
+"""
+import os
+import re
+import sys
+
+import numpy as np
+
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "tools"))
+import mpmtest as mt  # noqa: E402
+from riemann import Riemann  # noqa: E402
+
+check = mt.Checks("test_near_vacuum")
+EXACT = Riemann((1.0, -2.0, 0.4), (1.0, 2.0, 0.4))
+EVENT = re.compile(r"regularise step (\d+): (\d+) refills, (\d+) splits, (\d+) merges; "
+                   r"mass (\S+) -> (\S+), momentum \((\S+), (\S+), (\S+)\) -> "
+                   r"\((\S+), (\S+), (\S+)\), energy (\S+) -> (\S+)")
+
+
+def run(N, refill, debug=False):
+    h = 3.0 / N
+    out = mt.outdir(f"near_vacuum_N{N}_{'refill' if refill else 'none'}")
+    p = mt.run(["run", mt.case("double_rarefaction.ini"), f"output.dir={out}",
+                f"grid.dx={1.0 / N}", f"domain.hi=1 {h}", f"geometry.left.hi=0.5 {h}",
+                f"geometry.right.hi=1 {h}", f"fluid.refill={'true' if refill else 'false'}",
+                "run.progress=false"] + (["run.log_level=debug"] if debug else []))
+    return out, p
+
+
+def bspline2(r):
+    a = np.abs(r)
+    return np.where(a < 0.5, 0.75 - a * a, np.where(a < 1.5, 0.5 * (1.5 - a) ** 2, 0.0))
+
+
+def measure(out, N):
+    """(L1 density error, empty nodes between the outermost particles) at the last snapshot."""
+    t, path = mt.snapshots(out)[-1]
+    P = mt.particles(path, "fluid")
+    x, m = P["x"][:, 0], P["m"][:, 0]
+    h = 1.0 / N
+    nodes = np.arange(2, N - 1)  # interior nodes: their stencils stay inside the domain
+    rho = np.zeros(len(nodes))
+    base = np.floor(x / h + 0.5).astype(int)
+    for off in (-1, 0, 1):
+        j = base + off
+        ok = (j >= nodes[0]) & (j <= nodes[-1])
+        np.add.at(rho, j[ok] - nodes[0], (bspline2(x / h - j) * m)[ok])
+    rho /= h * 3 * h
+    xi = nodes * h
+    edges = np.concatenate([xi - h / 2, [xi[-1] + h / 2]])
+    ref = EXACT.cell_averages(edges, t)[0]
+    inside = (xi > x.min()) & (xi < x.max())
+    return float(np.sum(np.abs(rho - ref)) * h), int(np.sum((rho == 0) & inside))
+
+
+mode = sys.argv[1] if len(sys.argv) > 1 else "refill"
+if mode == "refill":
+    out, p = run(200, True, debug=True)
+    ev = np.array([[float(v) for v in m.groups()] for m in EVENT.finditer(p.stderr)])
+    M, E = ev[:, 4], ev[:, 12]
+    dM = float(np.abs(ev[:, 5] - M).max() / M.max())
+    dP = float(np.abs(ev[:, 9:12] - ev[:, 6:9]).max() / np.sqrt(2 * M.max() * E.max()))
+    dE = float(np.abs(ev[:, 13] - E).max() / E.max())
+    check(ev[:, 1].sum() > 0, f"{len(ev)} events, {int(ev[:, 1].sum())} refills")
+    check(max(dM, dP, dE) <= 1e-13, f"per event, largest change of mass {dM:.1e}, momentum "
+          f"{dP:.1e} of sqrt(2 M E), total energy {dE:.1e} (each <= 1e-13)")
+    for N in (200, 800):
+        with_refill = out if N == 200 else run(N, True)[0]
+        l1, empty = measure(with_refill, N)
+        l1_0, empty_0 = measure(run(N, False)[0], N)
+        check(empty == 0 and empty_0 > 0, f"N = {N}: {empty} empty nodes inside the gas with "
+              f"refill (must be 0), {empty_0} without (the control, must be > 0)")
+        check(l1 < l1_0, f"N = {N}: L1 density error {l1:.4f} with refill, {l1_0:.4f} without "
+              f"({mt.cost(with_refill)})")
+else:
+    errs = []
+    for N in (200, 400, 800):
+        out = run(N, True)[0]
+        errs.append(measure(out, N)[0])
+        print(f"N = {N}: L1 density error {errs[-1]:.4f} ({mt.cost(out)})")
+    order = np.log(errs[0] / errs[2]) / np.log(4.0)
+    check(order >= 0.5, f"observed order of the L1 density error from 200 to 800 cells: "
+          f"{order:.2f} (target >= 0.5)")
+sys.exit(check.finish())
