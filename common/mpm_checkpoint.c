@@ -343,6 +343,10 @@ int mpm_checkpoint_attr(const mpm_checkpoint *ck, const char *name, double *valu
   return 0;
 }
 
+int mpm_checkpoint_attr_optional(const mpm_checkpoint *ck, const char *name, double *value) {
+  return attr_read(ck->file, name, H5T_NATIVE_DOUBLE, 1, value) == 0;
+}
+
 /* Describe p's fields as "x(2) v(2) m(1)" for messages. */
 static void describe_fields(const mpm_particles *p, char *s, size_t size) {
   size_t k = 0;

@@ -51,6 +51,8 @@ int mpm_checkpoint_open(mpm_checkpoint **ck, MPI_Comm comm, const char *path);
 void mpm_checkpoint_close(mpm_checkpoint **ck);
 const char *mpm_checkpoint_config(const mpm_checkpoint *ck);
 int mpm_checkpoint_attr(const mpm_checkpoint *ck, const char *name, double *value);
+/* The same for a value older checkpoints may lack: 1 if read, 0 if absent (no message). */
+int mpm_checkpoint_attr_optional(const mpm_checkpoint *ck, const char *name, double *value);
 /* Fill p (already created with the fields of the phase) with the stored particles: on the
  * same number of ranks each rank gets exactly what it wrote, in the same order; otherwise
  * the ranks get even chunks and the caller migrates. Sets p->id_next. Collective. */

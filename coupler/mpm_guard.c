@@ -4,29 +4,42 @@
 #include "mpm_error.h"
 
 #include <math.h>
+#include <stdlib.h>
 
 const mpm_key_spec mpm_guard_keys[] = {
-    {"time.collapse_ratio", MPM_KEY_REAL, "0.01", 0, 1, 0, 0, NULL,
+    {"time.collapse_ratio", MPM_KEY_REAL, "1e-4", 0, 1, 0, 0, NULL,
      "blow-up guard: stop when the step stays below this fraction of the starting state's CFL "
      "step for time.collapse_steps steps in a row (0: never)",
      0},
     {"time.collapse_steps", MPM_KEY_INT, "100", 1, HUGE_VAL, 0, 0, NULL,
      "blow-up guard: how many steps in a row the step must stay collapsed", 0},
     {"time.energy_growth", MPM_KEY_REAL, "1000", 0, HUGE_VAL, 0, 0, NULL,
-     "blow-up guard: stop when the total energy exceeds this multiple of the starting total "
-     "energy (0: never; a non-finite energy always stops the run)",
+     "blow-up guard: stop when the total energy exceeds this multiple of the largest total "
+     "energy of the first half of the steps taken (0: never; a non-finite energy always stops "
+     "the run)",
      0},
 };
 const int mpm_guard_nkeys = (int)(sizeof mpm_guard_keys / sizeof mpm_guard_keys[0]);
 
 int mpm_guard_init(mpm_guard *g, const mpm_config *cfg, double h0, double e0) {
-  *g = (mpm_guard){0};
+  mpm_guard_free(g);
   MPM_CALL(mpm_config_get_real(cfg, "time.collapse_ratio", &g->ratio));
   MPM_CALL(mpm_config_get_int(cfg, "time.collapse_steps", &g->window));
   MPM_CALL(mpm_config_get_real(cfg, "time.energy_growth", &g->growth));
-  g->h0 = h0, g->e_scale = fabs(e0);
+  g->h0 = h0;
+  g->cap = 1024;
+  MPM_ALLOC(g->emax, g->cap);
+  g->emax[0] = fabs(e0), g->n = 1;
   return 0;
 }
+
+void mpm_guard_free(mpm_guard *g) {
+  free(g->emax);
+  *g = (mpm_guard){0};
+}
+
+/* The steps before an energy test may fire (a start from rest grows fast at first). */
+#define GUARD_MIN_STEPS 20
 
 int mpm_guard_check(mpm_guard *g, double t, long step, double h, int cut_short, double energy) {
   if (!isfinite(energy))
@@ -34,14 +47,22 @@ int mpm_guard_check(mpm_guard *g, double t, long step, double h, int cut_short, 
              "the run blew up at t = %.6g (step %ld): the total energy is %g; lower time.cfl, "
              "refine grid.dx, or try another time.method",
              t, step, energy);
-  if (g->e_scale == 0.0) g->e_scale = fabs(energy);
-  if (g->growth > 0 && g->e_scale > 0 && fabs(energy) > g->growth * g->e_scale)
+  if (g->n == g->cap) {
+    double *e = realloc(g->emax, sizeof *e * (size_t)(2 * g->cap));
+    if (!e) MPM_FAIL(MPM_ERR_MEMORY, "blow-up guard: %ld steps of history", g->n);
+    g->emax = e, g->cap *= 2;
+  }
+  g->emax[g->n] = fmax(g->emax[g->n - 1], fabs(energy));
+  const double half = g->emax[g->n / 2];
+  g->n++;
+  if (g->growth > 0 && g->n > GUARD_MIN_STEPS && fabs(energy) > g->growth * half)
     MPM_FAIL(MPM_ERR_UNPHYSICAL,
              "the run blew up at t = %.6g (step %ld): the total energy %.6g J is more than "
-             "time.energy_growth = %g times its starting value %.6g J; lower time.cfl, refine "
-             "grid.dx, or try another time.method (raise time.energy_growth only if energy "
-             "really enters the scene that fast)",
-             t, step, energy, g->growth, g->e_scale);
+             "time.energy_growth = %g times the largest of the first half of the steps "
+             "(%.6g J): it grows geometrically; lower time.cfl, refine grid.dx, or try another "
+             "time.method (raise time.energy_growth only if energy really enters the scene "
+             "that fast)",
+             t, step, energy, g->growth, half);
   if (g->ratio <= 0 || g->h0 <= 0 || cut_short) return 0;
   g->low = h < g->ratio * g->h0 ? g->low + 1 : 0;
   if (g->low >= g->window)

@@ -10,6 +10,7 @@
 #include "mpm_guard.h"
 #include "mpm_integrator.h"
 #include "mpm_output.h"
+#include "mpm_probe.h"
 #include "mpm_timer.h"
 #include "fluid_module.h"
 #include "solid_module.h"
@@ -36,7 +37,9 @@ struct mpm_sim {
   double energy; /* total energy at the last diagnostics row */
   mpm_output *out;
   mpm_diag *diag;
-  mpm_diag *coupling_csv;    /* coupling.csv, with a coupler only */
+  mpm_diag *coupling_csv; /* coupling.csv, with a coupler only */
+  mpm_probes probes;
+  mpm_diag *probe_csv;       /* probes.csv, with probes only */
   double coupling_work;      /* cumulative energy the coupling created (J; < 0: destroyed) */
   double coupling_imbalance; /* largest |F_solid + F_fluid| / max(|F_solid|, |F_fluid|) */
   char body_cols[MPM_COUPLING_MAX_BODIES][MPM_MAX_DIM][80]; /* coupling.csv column names */
@@ -96,6 +99,7 @@ int mpm_sim_add_schema(mpm_config *cfg) {
   MPM_CALL(mpm_config_add_schema(cfg, sim_keys, (int)(sizeof sim_keys / sizeof sim_keys[0])));
   MPM_CALL(mpm_config_add_schema(cfg, mpm_integrator_keys, mpm_integrator_nkeys));
   MPM_CALL(mpm_config_add_schema(cfg, mpm_guard_keys, mpm_guard_nkeys));
+  MPM_CALL(mpm_config_add_schema(cfg, mpm_probe_keys, mpm_probe_nkeys));
   MPM_CALL(mpm_config_add_schema(cfg, mpm_geometry_keys, mpm_geometry_nkeys));
   MPM_CALL(mpm_config_add_schema(cfg, mpm_bc_keys, mpm_bc_nkeys));
   MPM_CALL(mpm_coupling_add_schema(cfg));
@@ -211,6 +215,12 @@ static int open_outputs(mpm_sim *s, int append) {
   MPM_CALL(mpm_output_new(&s->out, s->comm, s->dir, s->config_text, s->grid->dim, append, s->t));
   snprintf(path, sizeof path, "%s/diagnostics.csv", s->dir);
   MPM_CALL(mpm_diag_open(&s->diag, s->comm, path, NDIAG, g_diag_cols, append, s->t));
+  if (s->probes.n > 0) {
+    const char *pcols[MPM_PROBE_MAX * 2 * MPM_MAX_DIM + 1];
+    const int np = mpm_probes_columns(&s->probes, pcols);
+    snprintf(path, sizeof path, "%s/probes.csv", s->dir);
+    MPM_CALL(mpm_diag_open(&s->probe_csv, s->comm, path, np, pcols, append, s->t));
+  }
   if (!s->coupling) return 0;
   const int dim = s->grid->dim, nb = s->coupling->nbodies;
   const char *cols[NCOUPLING(3) + MPM_MAX_DIM * MPM_COUPLING_MAX_BODIES];
@@ -244,6 +254,7 @@ int mpm_sim_create(mpm_sim **sp, mpm_config *cfg) {
   MPM_CALL(sim_alloc(sp, cfg));
   mpm_sim *s = *sp;
   MPM_CALL(build_modules(s, 1));
+  MPM_CALL(mpm_probes_new(&s->probes, cfg, s->mod, s->nmod));
   s->out_next = 0;
   s->ckpt_next = 1;
   return mpm_integrator_new(&s->it, cfg, s->grid, s->mod, s->nmod, s->coupling);
@@ -263,6 +274,22 @@ int mpm_sim_restart(mpm_sim **sp, mpm_config *cfg, const char *path) {
   if (!rc && s->coupling) rc = mpm_checkpoint_attr(ck, "coupling_work", &s->coupling_work);
   for (int k = 0; !rc && k < s->nmod; ++k)
     rc = mpm_checkpoint_read_particles(ck, s->mod[k]->name, s->mod[k]->particles);
+  /* The probes follow the particles the run started with (a checkpoint without them, from a
+   * run without probes, starts them here). */
+  if (!rc) rc = mpm_probes_new(&s->probes, cfg, s->mod, s->nmod);
+  if (!rc && s->probes.n > 0) {
+    const char *names[MPM_PROBE_MAX * (1 + MPM_MAX_DIM)];
+    double val[MPM_PROBE_MAX * (1 + MPM_MAX_DIM)];
+    const int na = mpm_probes_attrs(&s->probes, names, val, MPM_PROBE_MAX * (1 + MPM_MAX_DIM));
+    for (int a = 0; !rc && a < na; ++a)
+      if (mpm_checkpoint_attr_optional(ck, names[a], &val[a])) {
+        const int k = a / (1 + s->probes.dim), q = a % (1 + s->probes.dim);
+        if (q == 0)
+          s->probes.id[k] = val[a];
+        else
+          s->probes.x0[k][q - 1] = val[a];
+      }
+  }
   mpm_checkpoint_close(&ck);
   MPM_CALL(rc);
   if (s->t_end <= s->t * (1 + 1e-14))
@@ -293,6 +320,8 @@ void mpm_sim_destroy(mpm_sim **sp) {
   mpm_output_destroy(&s->out);
   mpm_diag_close(&s->diag);
   mpm_diag_close(&s->coupling_csv);
+  mpm_diag_close(&s->probe_csv);
+  mpm_guard_free(&s->guard);
   mpm_grid_destroy(&s->grid);
   free(s->config_text);
   free(s);
@@ -325,10 +354,14 @@ static int write_checkpoint(mpm_sim *s, const char *path) {
   MPM_CALL(prepare_output(s));
   const char *names[SIM_MAX_MODULES];
   for (int k = 0; k < s->nmod; ++k) p[k] = s->mod[k]->particles, names[k] = s->mod[k]->name;
-  const char *attr[] = {"t", "step", "h_next", "coupling_work"};
-  const double val[] = {s->t, (double)s->step, s->h_next, s->coupling_work};
+  const char *attr[4 + MPM_PROBE_MAX * (1 + MPM_MAX_DIM)] = {"t", "step", "h_next",
+                                                             "coupling_work"};
+  double val[4 + MPM_PROBE_MAX * (1 + MPM_MAX_DIM)] = {s->t, (double)s->step, s->h_next,
+                                                       s->coupling_work};
+  const int na =
+      4 + mpm_probes_attrs(&s->probes, attr + 4, val + 4, MPM_PROBE_MAX * (1 + MPM_MAX_DIM));
   mpm_timer_start(MPM_T_IO);
-  int rc = mpm_checkpoint_write(s->comm, path, s->config_text, attr, val, 4, p, names, s->nmod);
+  int rc = mpm_checkpoint_write(s->comm, path, s->config_text, attr, val, na, p, names, s->nmod);
   mpm_timer_stop(MPM_T_IO);
   MPM_CALL(rc);
   mpm_log(MPM_LOG_INFO, "checkpoint %s at t = %.6g", path, s->t);
@@ -380,6 +413,11 @@ static int diagnostics_row(mpm_sim *s, double dt) {
   const double row[NDIAG] = {s->t,   (double)s->step, dt,     sum[0], sum[1],          sum[2],
                              sum[3], sum[4],          sum[5], sum[6], sum[5] + sum[6], (double)rhs};
   if (dt > 0) s->particle_steps += sum[0]; /* the row at t = 0 is not a step */
+  if (s->probes.n > 0) {
+    double prow[MPM_PROBE_MAX * 2 * MPM_MAX_DIM + 1];
+    MPM_CALL(mpm_probes_row(&s->probes, s->mod, s->t, prow));
+    MPM_CALL(mpm_diag_row(s->probe_csv, prow));
+  }
   return mpm_diag_row(s->diag, row);
 }
 
