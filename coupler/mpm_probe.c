@@ -15,8 +15,6 @@ const mpm_key_spec mpm_probe_keys[] = {
 };
 const int mpm_probe_nkeys = (int)(sizeof mpm_probe_keys / sizeof mpm_probe_keys[0]);
 
-static char g_attr[MPM_PROBE_MAX * (1 + MPM_MAX_DIM)][96];
-
 /* Global (distance, id) minimum: the nearest particle, ties to the lowest id. */
 static int nearest(const mpm_module *m, const double *x, int dim, MPI_Comm comm, double *id) {
   const mpm_particles *p = m->particles;
@@ -103,14 +101,28 @@ int mpm_probes_new(mpm_probes *pr, const mpm_config *cfg, mpm_module **mod, int 
 int mpm_probes_attrs(mpm_probes *pr, const char **names, double *values, int max) {
   int c = 0;
   for (int k = 0; k < pr->n && c + 1 + pr->dim <= max; ++k) {
-    snprintf(g_attr[c], sizeof g_attr[c], "probe.%s.id", pr->name[k]);
-    names[c] = g_attr[c], values[c++] = pr->id[k];
+    snprintf(pr->attr[c], sizeof pr->attr[c], "probe.%s.id", pr->name[k]);
+    names[c] = pr->attr[c], values[c++] = pr->id[k];
     for (int d = 0; d < pr->dim; ++d) {
-      snprintf(g_attr[c], sizeof g_attr[c], "probe.%s.x0_%c", pr->name[k], "xyz"[d]);
-      names[c] = g_attr[c], values[c++] = pr->x0[k][d];
+      snprintf(pr->attr[c], sizeof pr->attr[c], "probe.%s.x0_%c", pr->name[k], "xyz"[d]);
+      names[c] = pr->attr[c], values[c++] = pr->x0[k][d];
     }
   }
   return c;
+}
+
+void mpm_probes_restore(mpm_probes *pr, const mpm_checkpoint *ck) {
+  const char *names[MPM_PROBE_MAX * (1 + MPM_MAX_DIM)];
+  double val[MPM_PROBE_MAX * (1 + MPM_MAX_DIM)];
+  const int na = mpm_probes_attrs(pr, names, val, MPM_PROBE_MAX * (1 + MPM_MAX_DIM));
+  for (int a = 0; a < na; ++a) {
+    if (!mpm_checkpoint_attr_optional(ck, names[a], &val[a])) continue;
+    const int k = a / (1 + pr->dim), q = a % (1 + pr->dim);
+    if (q == 0)
+      pr->id[k] = val[a];
+    else
+      pr->x0[k][q - 1] = val[a];
+  }
 }
 
 int mpm_probes_columns(mpm_probes *pr, const char **cols) {

@@ -12,6 +12,7 @@
 
 #include "mpm_config.h"
 #include "mpm_module.h"
+#include "mpm_output.h"
 
 #define MPM_PROBE_MAX 8
 
@@ -22,6 +23,7 @@ typedef struct mpm_probes {
   double id[MPM_PROBE_MAX];  /* the particle followed */
   double x0[MPM_PROBE_MAX][MPM_MAX_DIM];
   char col[MPM_PROBE_MAX * 2 * MPM_MAX_DIM + 1][80]; /* probes.csv column names */
+  char attr[MPM_PROBE_MAX * (1 + MPM_MAX_DIM)][96];  /* checkpoint attribute names */
 } mpm_probes;
 
 extern const mpm_key_spec mpm_probe_keys[];
@@ -31,6 +33,9 @@ extern const int mpm_probe_nkeys;
 int mpm_probes_new(mpm_probes *pr, const mpm_config *cfg, mpm_module **mod, int nmod);
 /* The checkpoint attributes that carry the probes: names[k] (storage in pr) and values. */
 int mpm_probes_attrs(mpm_probes *pr, const char **names, double *values, int max);
+/* After mpm_probes_new on a restart: follow the particles the checkpoint names (a checkpoint
+ * of a run without probes names none: they start here). */
+void mpm_probes_restore(mpm_probes *pr, const mpm_checkpoint *ck);
 /* Column names of probes.csv (t first); returns their count. */
 int mpm_probes_columns(mpm_probes *pr, const char **cols);
 /* The row for the current state: t, then displacement and velocity per probe. Collective. */

@@ -277,19 +277,7 @@ int mpm_sim_restart(mpm_sim **sp, mpm_config *cfg, const char *path) {
   /* The probes follow the particles the run started with (a checkpoint without them, from a
    * run without probes, starts them here). */
   if (!rc) rc = mpm_probes_new(&s->probes, cfg, s->mod, s->nmod);
-  if (!rc && s->probes.n > 0) {
-    const char *names[MPM_PROBE_MAX * (1 + MPM_MAX_DIM)];
-    double val[MPM_PROBE_MAX * (1 + MPM_MAX_DIM)];
-    const int na = mpm_probes_attrs(&s->probes, names, val, MPM_PROBE_MAX * (1 + MPM_MAX_DIM));
-    for (int a = 0; !rc && a < na; ++a)
-      if (mpm_checkpoint_attr_optional(ck, names[a], &val[a])) {
-        const int k = a / (1 + s->probes.dim), q = a % (1 + s->probes.dim);
-        if (q == 0)
-          s->probes.id[k] = val[a];
-        else
-          s->probes.x0[k][q - 1] = val[a];
-      }
-  }
+  if (!rc) mpm_probes_restore(&s->probes, ck);
   mpm_checkpoint_close(&ck);
   MPM_CALL(rc);
   if (s->t_end <= s->t * (1 + 1e-14))

@@ -71,12 +71,13 @@ typedef struct reg_cell {
 
 /* The cells this rank owns: [c0, c0 + nc) along each axis, and the global lattice. */
 typedef struct reg_box {
+  const mpm_grid *g;
   int dim, c0[MPM_MAX_DIM], nc[MPM_MAX_DIM], ncells[MPM_MAX_DIM];
   double lo[MPM_MAX_DIM], dx;
 } reg_box;
 
 static void box_of(reg_box *b, const mpm_grid *g) {
-  b->dim = g->dim, b->dx = g->dx;
+  b->g = g, b->dim = g->dim, b->dx = g->dx;
   for (int d = 0; d < g->dim; ++d) {
     b->c0[d] = g->cell_split[d][g->coord[d]];
     b->nc[d] = g->cell_split[d][g->coord[d] + 1] - b->c0[d];
@@ -86,8 +87,7 @@ static void box_of(reg_box *b, const mpm_grid *g) {
 
 /* Global cell coordinate of x along d, as mpm_grid_owner_of computes it. */
 static int cell_coord(const reg_box *b, int d, double x) {
-  const int c = (int)floor((x - b->lo[d]) / b->dx);
-  return c < 0 ? 0 : c >= b->ncells[d] ? b->ncells[d] - 1 : c;
+  return mpm_cells_coord(b->g, d, x);
 }
 
 /* Local cell index of particle i (clamped into the box: after migration it is inside). */
