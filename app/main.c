@@ -4,7 +4,8 @@
  *   mpmfsi check CASE [key=value ...]     validate a case and print the resolved configuration
  *   mpmfsi restart CHECKPOINT [key=value ...]   continue a run from a checkpoint
  *
- * Exit codes: 0 success, 1 a failure during the run, 2 bad input (nothing was run). Input
+ * Exit codes: 0 success, 1 a failure during the run, 2 bad input (nothing was run), 3 stopped
+ * by SIGTERM or SIGINT (a final checkpoint was written; restart from it to go on). Input
  * errors and unphysical states are found identically on every rank, so they end the run
  * cleanly; any other failure aborts all ranks so that none is left waiting in a collective
  * call. */
@@ -43,20 +44,120 @@ static int set_logging(const mpm_config *cfg) {
   return 0;
 }
 
+/* The keys a restart honours: how and how long to integrate, what to write, how to log,
+ * and the rank layout. Everything else describes the state the checkpoint already holds. */
+static int restartable(const char *key) {
+  static const char *const prefix[] = {"time.", "output.", "run."};
+  for (size_t k = 0; k < sizeof prefix / sizeof prefix[0]; ++k)
+    if (strncmp(key, prefix[k], strlen(prefix[k])) == 0) return 1;
+  return strcmp(key, "grid.ranks") == 0;
+}
+
+/* The resolved text's assignments, defaults included, as "section.key = value" lines
+ * (comments dropped), in order: what two configurations are compared by. */
+static char *assignments(const mpm_config *cfg) {
+  char *text = NULL;
+  if (mpm_config_resolved_text(cfg, &text) != 0) return NULL;
+  const size_t cap = 2 * strlen(text) + 1;
+  char *out = malloc(cap), section[256] = "";
+  size_t len = 0;
+  for (char *line = strtok(text, "\n"); out && line; line = strtok(NULL, "\n")) {
+    if (line[0] == '[') {
+      snprintf(section, sizeof section, "%.*s", (int)strcspn(line + 1, "]"), line + 1);
+      continue;
+    }
+    /* A default is written commented out ("# key = value   # default"): compared as set. */
+    if (strncmp(line, "# ", 2) == 0 &&
+        line[2 + strspn(line + 2, "abcdefghijklmnopqrstuvwxyz_0123456789")] == ' ')
+      line += 2;
+    if (line[0] == '#' || !strchr(line, '=')) continue;
+    char *comment = strstr(line, "   #");
+    if (comment) *comment = 0;
+    len += (size_t)snprintf(out + len, cap - len, "%s.%s\n", section, line);
+  }
+  free(text);
+  return out;
+}
+
+/* The key of one "section.key = value" line, NUL-terminated in buf. */
+static const char *line_key(const char *line, char *buf, size_t n) {
+  snprintf(buf, n, "%.*s", (int)strcspn(line, " ="), line);
+  return buf;
+}
+
+/* Refuse what a restart would silently ignore: every key outside restartable() whose value
+ * differs from the checkpoint's (a new section counts as a change). */
+static int check_restart_changes(const mpm_config *cfg, const char *before, const char *path) {
+  char *after = assignments(cfg);
+  int bad = 0;
+  if (!after) return MPM_ERR_MEMORY;
+  for (char *line = after; *line; line += strcspn(line, "\n") + 1) {
+    const size_t n = strcspn(line, "\n");
+    char key[512];
+    line_key(line, key, sizeof key);
+    if (restartable(key)) continue;
+    int same = 0;
+    for (const char *b = before; *b && !same; b += strcspn(b, "\n") + 1)
+      same = strcspn(b, "\n") == n && strncmp(b, line, n) == 0;
+    if (same) continue;
+    mpm_log(MPM_LOG_ERROR,
+            "%s: %s = %.*s cannot change on restart: the checkpoint %s already holds the state "
+            "it describes. A restart may change only time.*, output.*, run.* and grid.ranks; "
+            "start a new run (mpmfsi run) to change the rest",
+            mpm_config_where(cfg, key), key, (int)(n - strlen(key) - 3), line + strlen(key) + 3,
+            path);
+    bad = 1;
+  }
+  free(after);
+  return bad ? MPM_ERR_INPUT : 0;
+}
+
+/* The folder a checkpoint lies in ("." for a bare name). */
+static int checkpoint_folder(const char *path, char *dir, size_t n) {
+  const char *slash = strrchr(path, '/');
+  const int len = slash ? (slash == path ? 1 : (int)(slash - path)) : 1;
+  return snprintf(dir, n, "output.dir=%.*s", len, slash ? path : ".") >= (int)n;
+}
+
+static int has_override(int argc, char **argv, const char *key) {
+  for (int k = 0; k < argc; ++k)
+    if (strncmp(argv[k], key, strlen(key)) == 0 && argv[k][strlen(key)] == '=') return 1;
+  return 0;
+}
+
+/* A restart: the checkpoint's stored case, then the overrides, which may change only what a
+ * restart honours. It continues in the checkpoint's own folder unless output.dir says
+ * otherwise (see mpm_rundir.h for when that is allowed). */
+static int load_restart(mpm_config *cfg, const char *path, int argc, char **argv) {
+  mpm_checkpoint *ck = NULL;
+  MPM_CALL(mpm_checkpoint_open(&ck, MPI_COMM_WORLD, path));
+  int rc = mpm_config_read_string(cfg, mpm_checkpoint_config(ck), path, ".");
+  mpm_checkpoint_close(&ck);
+  MPM_CALL(rc);
+  char *before = assignments(cfg);
+  if (!before) return MPM_ERR_MEMORY;
+  char dir[4096 + 16];
+  rc = apply_overrides(cfg, argc, argv);
+  if (!rc && !has_override(argc, argv, "output.dir")) {
+    if (checkpoint_folder(path, dir, sizeof dir)) rc = MPM_ERR_INPUT;
+    if (!rc) rc = mpm_config_override(cfg, dir);
+  }
+  if (!rc) rc = mpm_config_validate(cfg);
+  if (!rc) rc = check_restart_changes(cfg, before, path);
+  free(before);
+  return rc;
+}
+
 /* Read the case (or the checkpoint's stored case), apply overrides, validate. */
 static int load_config(mpm_config *cfg, const char *cmd, const char *path, int argc, char **argv) {
   MPM_CALL(mpm_sim_add_schema(cfg));
   if (strcmp(cmd, "restart") == 0) {
-    mpm_checkpoint *ck = NULL;
-    MPM_CALL(mpm_checkpoint_open(&ck, MPI_COMM_WORLD, path));
-    int rc = mpm_config_read_string(cfg, mpm_checkpoint_config(ck), path, ".");
-    mpm_checkpoint_close(&ck);
-    MPM_CALL(rc);
+    MPM_CALL(load_restart(cfg, path, argc, argv));
   } else {
     MPM_CALL(mpm_config_read_file(cfg, path));
+    MPM_CALL(apply_overrides(cfg, argc, argv));
+    MPM_CALL(mpm_config_validate(cfg));
   }
-  MPM_CALL(apply_overrides(cfg, argc, argv));
-  MPM_CALL(mpm_config_validate(cfg));
   return set_logging(cfg);
 }
 
@@ -104,10 +205,10 @@ int main(int argc, char **argv) {
     rc = run(argv[1], argv[2], argc - 3, argv + 3);
   }
   /* Input errors and unphysical states are detected on every rank alike: end cleanly. */
-  if (rc != 0 && rc != MPM_ERR_INPUT && rc != MPM_ERR_UNPHYSICAL) {
+  if (rc != 0 && rc != MPM_ERR_INPUT && rc != MPM_ERR_UNPHYSICAL && rc != MPM_ERR_INTERRUPTED) {
     mpm_log_all(MPM_LOG_DEBUG, "mpmfsi failed: %s", mpm_error_string(rc));
     MPI_Abort(MPI_COMM_WORLD, 1);
   }
   MPI_Finalize();
-  return rc == 0 ? 0 : rc == MPM_ERR_INPUT ? 2 : 1;
+  return rc == 0 ? 0 : rc == MPM_ERR_INPUT ? 2 : rc == MPM_ERR_INTERRUPTED ? 3 : 1;
 }

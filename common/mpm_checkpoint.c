@@ -4,6 +4,17 @@
  * and "field_ncomp", so that a restart can tell whether the stored particles fit the set
  * the run created. Invariants:
  *
+ * - A checkpoint proves its own integrity: it is written in the HDF5 1.10 format, whose
+ *   superblock, object headers (so every attribute) and chunk indexes carry checksums, every
+ *   dataset has the Fletcher32 filter, and "text_hash" attributes (on the root and on each
+ *   phase group) hash the strings, which HDF5 keeps in its unchecksummed global heap. A
+ *   reader refuses a file whose bytes changed, and then validates what it holds: finite
+ *   values, the stored step and time step, ids non-negative and unique over all ranks,
+ *   each field within the range its module declares (mpm_particles_set_range). Files of
+ *   format 1 (no checksums) are still read, with the same validation.
+ * - A damaged checkpoint is bad input (MPM_ERR_INPUT): one line names the file and what is
+ *   wrong; HDF5's own error stack stays silent from open to close.
+ *
  * - The file at PATH is always a complete checkpoint or absent: ranks write PATH.tmp, close
  *   it, agree that every rank succeeded, and only then rank 0 flushes it to disk and renames
  *   it over PATH. A failed write removes PATH.tmp and leaves an earlier PATH untouched.
@@ -21,55 +32,52 @@
 
 #include <errno.h>
 #include <fcntl.h>
+#include <math.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 
-#define CHECKPOINT_FORMAT "mpmfsi checkpoint 1"
+#define CHECKPOINT_FORMAT   "mpmfsi checkpoint 2"
+#define CHECKPOINT_FORMAT_1 "mpmfsi checkpoint 1" /* before checksums: still read */
 
 struct mpm_checkpoint {
   MPI_Comm comm;
   int rank, size;
   hid_t file;
   char *path, *config;
-  int nranks; /* ranks that wrote the checkpoint */
+  int nranks;         /* ranks that wrote the checkpoint */
+  int hashed;         /* the strings carry text_hash attributes (format 2) */
+  mpm_h5_quiet quiet; /* HDF5's error printing, silenced from open to close */
 };
+
+static int h5_failed(void);
 
 /* ---- reading attributes ---------------------------------------------------------------- */
 
 /* Read the n values of attribute name into value (memory type type); -1 if it is missing
- * or does not hold n values. */
+ * or does not hold n values, -2 if HDF5 cannot read it (a damaged file). */
 static int attr_read(hid_t loc, const char *name, hid_t type, int n, void *value) {
-  if (H5Aexists(loc, name) <= 0) return -1;
+  const htri_t exists = H5Aexists(loc, name);
+  if (exists <= 0) return exists < 0 ? h5_failed() : -1;
   const hid_t a = H5Aopen(loc, name, H5P_DEFAULT);
-  const hid_t space = a >= 0 ? H5Aget_space(a) : -1;
+  if (a < 0) return h5_failed();
+  const hid_t space = H5Aget_space(a);
   const hssize_t npoints = space >= 0 ? H5Sget_simple_extent_npoints(space) : -1;
-  const herr_t r = npoints == n ? H5Aread(a, type, value) : -1;
+  int st = npoints < 0 ? h5_failed() : npoints == n ? 0 : -1;
+  if (!st && H5Aread(a, type, value) < 0) st = h5_failed();
   if (space >= 0) H5Sclose(space);
-  if (a >= 0) H5Aclose(a);
-  return r < 0 ? -1 : 0;
+  H5Aclose(a);
+  return st;
 }
 
-/* A string attribute as a malloc'ed copy, or NULL if it is missing or not a string. */
-static char *attr_read_string(hid_t loc, const char *name) {
-  if (H5Aexists(loc, name) <= 0) return NULL;
-  const hid_t a = H5Aopen(loc, name, H5P_DEFAULT);
-  const hid_t ftype = a >= 0 ? H5Aget_type(a) : -1;
-  char *copy = NULL;
-  if (ftype >= 0 && H5Tget_class(ftype) == H5T_STRING && H5Tis_variable_str(ftype) > 0) {
-    const hid_t type = mpm_h5_string_type();
-    char *s = NULL;
-    if (type >= 0 && H5Aread(a, type, &s) >= 0 && s) {
-      copy = malloc(strlen(s) + 1);
-      if (copy) memcpy(copy, s, strlen(s) + 1);
-      H5free_memory(s);
-    }
-    if (type >= 0) H5Tclose(type);
-  }
-  if (ftype >= 0) H5Tclose(ftype);
-  if (a >= 0) H5Aclose(a);
-  return copy;
+/* ---- string hashes --------------------------------------------------------------------- */
+
+/* The hash of the strings a (and b, if not NULL), each with its terminating zero. */
+static unsigned long long text_hash(const char *a, const char *b) {
+  unsigned long long h = mpm_h5_hash(MPM_H5_HASH0, a, strlen(a) + 1);
+  return b ? mpm_h5_hash(h, b, strlen(b) + 1) : h;
 }
 
 /* ---- writing --------------------------------------------------------------------------- */
@@ -93,6 +101,8 @@ static int write_phase_attrs(const mpm_h5 *h, hid_t g, const mpm_particles *p) {
   if (!names) mpm_log_all(MPM_LOG_ERROR, "checkpoint: cannot list the field names");
   int rc = mpm_h5_agree(h->comm, names ? 0 : MPM_ERR_MEMORY);
   if (!rc) rc = mpm_h5_attr_string(h, g, "field_names", names);
+  const unsigned long long hash = names ? text_hash(names, NULL) : 0;
+  if (!rc) rc = mpm_h5_attr(h, g, "text_hash", H5T_NATIVE_ULLONG, 1, &hash);
   free(names);
   MPM_CALL(rc);
   MPM_CALL(mpm_h5_attr(h, g, "field_ncomp", H5T_NATIVE_INT, p->nfields, ncomp));
@@ -138,6 +148,8 @@ static int write_contents(const mpm_h5 *h, hid_t file, const void *arg) {
   const ck_contents *c = arg;
   MPM_CALL(mpm_h5_attr_string(h, file, "format", CHECKPOINT_FORMAT));
   MPM_CALL(mpm_h5_attr_string(h, file, "config", c->config));
+  const unsigned long long hash = text_hash(CHECKPOINT_FORMAT, c->config);
+  MPM_CALL(mpm_h5_attr(h, file, "text_hash", H5T_NATIVE_ULLONG, 1, &hash));
   MPM_CALL(mpm_h5_attr(h, file, "nranks", H5T_NATIVE_INT, 1, &c->size));
   for (int k = 0; k < c->nattr; ++k)
     MPM_CALL(mpm_h5_attr(h, file, c->attr_names[k], H5T_NATIVE_DOUBLE, 1, &c->attr_values[k]));
@@ -192,7 +204,8 @@ static int check_write_args(const char *path, const char *const *attr_names, int
   if (!path || !path[0]) MPM_FAIL(MPM_ERR_INPUT, "checkpoint: no path was given");
   for (int k = 0; k < nattr; ++k)
     if (!attr_names[k] || !attr_names[k][0] || strcmp(attr_names[k], "format") == 0 ||
-        strcmp(attr_names[k], "config") == 0 || strcmp(attr_names[k], "nranks") == 0)
+        strcmp(attr_names[k], "config") == 0 || strcmp(attr_names[k], "nranks") == 0 ||
+        strcmp(attr_names[k], "text_hash") == 0)
       MPM_FAIL(MPM_ERR_INTERNAL, "checkpoint: '%s' cannot name a checkpoint attribute",
                attr_names[k] ? attr_names[k] : "(null)");
   for (int k = 0; k < nphases; ++k)
@@ -241,7 +254,7 @@ int mpm_checkpoint_write(MPI_Comm comm, const char *path, const char *config_tex
                            names,      nphases,
                            counts};
     const mpm_h5 h = {comm, rank, "checkpoint"};
-    rc = mpm_h5_write_file(&h, tmp, write_contents, &c);
+    rc = mpm_h5_write_file_checksummed(&h, tmp, write_contents, &c);
     /* mpm_h5_write_file returns once every rank has closed the file: its agreement is the
      * barrier. */
     if (rank == 0 && rc) remove(tmp);
@@ -253,7 +266,54 @@ int mpm_checkpoint_write(MPI_Comm comm, const char *path, const char *config_tex
   return 0;
 }
 
-/* ---- reading --------------------------------------------------------------------------- */
+/* ---- reading: verdicts ----------------------------------------------------------------- */
+
+/* Set by the last failed HDF5 read: did HDF5 blame a checksum? (Read right after the
+ * failure: the next HDF5 call clears the error stack.) */
+static int g_checksum;
+
+static int h5_failed(void) {
+  g_checksum = mpm_h5_error_is_checksum();
+  return -2;
+}
+
+static const char *h5_cause(void) {
+  return g_checksum ? "checksum mismatch" : "HDF5 cannot read it";
+}
+
+/* Note the first thing found wrong, as the whole message, in why (of WHY_SIZE bytes). */
+#define WHY_SIZE 640
+static void note(char *why, const mpm_checkpoint *ck, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+static void note(char *why, const mpm_checkpoint *ck, const char *fmt, ...) {
+  if (why[0]) return;
+  char detail[480];
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(detail, sizeof detail, fmt, ap);
+  va_end(ap);
+  snprintf(why, WHY_SIZE, "the checkpoint '%s' is damaged: %s. Restart from an earlier checkpoint",
+           ck->path, detail);
+}
+
+/* Agree on the verdicts of all ranks (why empty: nothing wrong here): MPM_ERR_INPUT on every
+ * rank if any found something, explained once, by the lowest such rank. Collective. */
+static int agree_why(const mpm_checkpoint *ck, const char *why) {
+  int who = why[0] ? ck->rank : ck->size;
+  if (MPI_Allreduce(MPI_IN_PLACE, &who, 1, MPI_INT, MPI_MIN, ck->comm) != MPI_SUCCESS)
+    return MPM_ERR_MPI;
+  if (who == ck->size) return 0;
+  if (who == ck->rank) mpm_log_all(MPM_LOG_ERROR, "%s", why);
+  return MPM_ERR_INPUT;
+}
+
+#define AGREE_WHY(ck, why)                                                                         \
+  do {                                                                                             \
+    const int agree_rc_ = agree_why((ck), (why));                                                  \
+    if (agree_rc_) return mpm_trace(__FILE__, __LINE__, __func__, agree_rc_);                      \
+  } while (0)
+
+/* ---- reading: the file and its root attributes ----------------------------------------- */
 
 /* Rank 0 looks at the file first so that a missing or foreign file gets a clear message
  * before any collective HDF5 call. */
@@ -263,18 +323,103 @@ static int probe(const char *path) {
              "cannot read the checkpoint '%s': %s. Check the restart file named in the case "
              "file or on the command line",
              path, strerror(errno));
-  H5E_auto2_t func;
-  void *data;
-  H5Eget_auto2(H5E_DEFAULT, &func, &data);
-  H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
-  const htri_t is_h5 = H5Fis_hdf5(path);
-  H5Eset_auto2(H5E_DEFAULT, func, data);
+  const htri_t is_h5 = H5Fis_hdf5(path); /* HDF5's error printing is off (mpm_checkpoint_open) */
   if (is_h5 <= 0)
     MPM_FAIL(MPM_ERR_INPUT,
-             "'%s' is not an HDF5 file, so not an mpmfsi checkpoint. Restart from a file "
-             "written by mpmfsi (checkpoint output)",
+             "'%s' is not an HDF5 file, so not an mpmfsi checkpoint (or its first bytes are "
+             "damaged). Restart from a file written by mpmfsi (checkpoint output)",
              path);
   return 0;
+}
+
+/* What the writer (coupler/mpm_sim.c) stores at the root, beyond "finite": the step count
+ * is a whole number >= 0 and the next step size is >= 0 (0: no hint). */
+typedef struct root_check {
+  const mpm_checkpoint *ck;
+  char *why;
+} root_check;
+
+static herr_t check_root_value(hid_t loc, const char *name, const H5A_info_t *info, void *arg) {
+  (void)info;
+  const root_check *rc = arg;
+  const hid_t a = H5Aopen(loc, name, H5P_DEFAULT);
+  if (a < 0) return h5_failed();
+  const hid_t type = H5Aget_type(a), space = H5Aget_space(a);
+  const int real = type >= 0 && H5Tget_class(type) == H5T_FLOAT;
+  const hssize_t npoints = space >= 0 ? H5Sget_simple_extent_npoints(space) : -1;
+  double v = 0;
+  const herr_t r = real && npoints == 1 ? H5Aread(a, H5T_NATIVE_DOUBLE, &v) : 0;
+  if (r < 0 || type < 0 || space < 0) h5_failed();
+  if (type >= 0) H5Tclose(type);
+  if (space >= 0) H5Sclose(space);
+  H5Aclose(a);
+  if (r < 0 || type < 0 || space < 0) return -1;
+  if (!real || npoints != 1) return 0;
+  if (!isfinite(v))
+    note(rc->why, rc->ck, "its value '%s' is %g, not a finite number", name, v);
+  else if (strcmp(name, "step") == 0 && (v < 0 || v != floor(v) || v > 0x1p53))
+    note(rc->why, rc->ck, "its step count is %.17g, not a whole number >= 0", v);
+  else if (strcmp(name, "h_next") == 0 && v < 0)
+    note(rc->why, rc->ck, "its next step size h_next is %.17g, below zero", v);
+  return 0;
+}
+
+/* A string attribute as a malloc'ed copy in *out: 0, -1 if it is missing or not a string,
+ * -2 if HDF5 cannot read it. */
+static int attr_read_string(hid_t loc, const char *name, char **out) {
+  *out = NULL;
+  const htri_t exists = H5Aexists(loc, name);
+  if (exists <= 0) return exists < 0 ? h5_failed() : -1;
+  const hid_t a = H5Aopen(loc, name, H5P_DEFAULT);
+  if (a < 0) return h5_failed();
+  const hid_t ftype = H5Aget_type(a);
+  int st = ftype < 0 ? h5_failed() : -1;
+  if (ftype >= 0 && H5Tget_class(ftype) == H5T_STRING && H5Tis_variable_str(ftype) > 0) {
+    const hid_t type = mpm_h5_string_type();
+    char *s = NULL;
+    if (type >= 0 && H5Aread(a, type, &s) >= 0 && s) {
+      *out = malloc(strlen(s) + 1);
+      if (*out) memcpy(*out, s, strlen(s) + 1), st = 0;
+      H5free_memory(s);
+    } else if (type >= 0) {
+      st = h5_failed();
+    }
+    if (type >= 0) H5Tclose(type);
+  }
+  if (ftype >= 0) H5Tclose(ftype);
+  H5Aclose(a);
+  return st;
+}
+
+/* The root attributes: format mark, case text, rank count, the strings' hash, and every
+ * stored real value. why gets the first problem. */
+static void check_root(mpm_checkpoint *ck, char *why) {
+  char *format = NULL;
+  int st = attr_read_string(ck->file, "format", &format);
+  const int v2 = format && strcmp(format, CHECKPOINT_FORMAT) == 0;
+  if (st == -2) note(why, ck, "cannot read its format mark (%s)", h5_cause());
+  if (!why[0] && !v2 && !(format && strcmp(format, CHECKPOINT_FORMAT_1) == 0))
+    snprintf(why, WHY_SIZE,
+             "'%s' is an HDF5 file but not an mpmfsi checkpoint (no '%s' format mark). Restart "
+             "from a file written by mpmfsi",
+             ck->path, CHECKPOINT_FORMAT);
+  st = why[0] ? 0 : attr_read_string(ck->file, "config", &ck->config);
+  if (st) note(why, ck, "cannot read its case text (%s)", st == -2 ? h5_cause() : "missing");
+  st = why[0] ? 0 : attr_read(ck->file, "nranks", H5T_NATIVE_INT, 1, &ck->nranks);
+  if (st) note(why, ck, "cannot read its rank count (%s)", st == -2 ? h5_cause() : "missing");
+  if (!why[0] && ck->nranks < 1) note(why, ck, "its rank count is %d", ck->nranks);
+  unsigned long long hash = 0;
+  st = why[0] ? 0 : attr_read(ck->file, "text_hash", H5T_NATIVE_ULLONG, 1, &hash);
+  ck->hashed = st == 0;
+  if (st == -2 || (st == -1 && v2))
+    note(why, ck, "cannot read the hash of its strings (%s)", st == -2 ? h5_cause() : "missing");
+  if (!why[0] && ck->hashed && hash != text_hash(format, ck->config))
+    note(why, ck, "checksum mismatch in its format mark or case text (text_hash)");
+  free(format);
+  const root_check rc = {ck, why};
+  if (!why[0] &&
+      H5Aiterate2(ck->file, H5_INDEX_NAME, H5_ITER_NATIVE, NULL, check_root_value, (void *)&rc) < 0)
+    note(why, ck, "cannot read its root attributes (%s)", h5_cause());
 }
 
 static int open_file(mpm_checkpoint *ck) {
@@ -283,21 +428,13 @@ static int open_file(mpm_checkpoint *ck) {
   MPM_CALL(rc);
   ck->file = mpm_h5_open(ck->comm, ck->path);
   if (ck->file < 0)
-    MPM_FAIL_ON_ROOT(ck->rank, MPM_ERR_INPUT, "cannot open the checkpoint '%s' with HDF5",
+    MPM_FAIL_ON_ROOT(ck->rank, MPM_ERR_INPUT,
+                     "the checkpoint '%s' is damaged: HDF5 cannot open it (its superblock or "
+                     "root group is unreadable). Restart from an earlier checkpoint",
                      ck->path);
-  char *format = attr_read_string(ck->file, "format");
-  rc = format && strcmp(format, CHECKPOINT_FORMAT) == 0 ? 0 : MPM_ERR_INPUT;
-  free(format);
-  ck->config = attr_read_string(ck->file, "config");
-  if (!rc && (!ck->config || attr_read(ck->file, "nranks", H5T_NATIVE_INT, 1, &ck->nranks) < 0 ||
-              ck->nranks < 1))
-    rc = MPM_ERR_INPUT;
-  rc = mpm_h5_agree(ck->comm, rc);
-  if (rc)
-    MPM_FAIL_ON_ROOT(ck->rank, rc,
-                     "'%s' is an HDF5 file but not an mpmfsi checkpoint (no '%s' format mark, "
-                     "case text or rank count). Restart from a file written by mpmfsi",
-                     ck->path, CHECKPOINT_FORMAT);
+  char why[WHY_SIZE] = "";
+  check_root(ck, why);
+  AGREE_WHY(ck, why);
   return 0;
 }
 
@@ -307,6 +444,7 @@ int mpm_checkpoint_open(mpm_checkpoint **ck, MPI_Comm comm, const char *path) {
   if (!path || !path[0]) MPM_FAIL(MPM_ERR_INPUT, "checkpoint: no path was given");
   MPM_ALLOC(c, 1);
   c->comm = MPI_COMM_NULL, c->file = -1;
+  mpm_h5_quiet_begin(&c->quiet);
   int rc = MPI_Comm_dup(comm, &c->comm) == MPI_SUCCESS ? 0 : MPM_ERR_MPI;
   if (!rc) MPI_Comm_rank(c->comm, &c->rank), MPI_Comm_size(c->comm, &c->size);
   if (!rc) c->path = malloc(strlen(path) + 1);
@@ -324,6 +462,7 @@ void mpm_checkpoint_close(mpm_checkpoint **ck) {
   if (!ck || !*ck) return;
   mpm_checkpoint *c = *ck;
   if (c->file >= 0) H5Fclose(c->file);
+  mpm_h5_quiet_end(&c->quiet);
   if (c->comm != MPI_COMM_NULL) MPI_Comm_free(&c->comm);
   free(c->path), free(c->config);
   free(c);
@@ -335,7 +474,13 @@ const char *mpm_checkpoint_config(const mpm_checkpoint *ck) {
 }
 
 int mpm_checkpoint_attr(const mpm_checkpoint *ck, const char *name, double *value) {
-  if (attr_read(ck->file, name, H5T_NATIVE_DOUBLE, 1, value) < 0)
+  const int st = attr_read(ck->file, name, H5T_NATIVE_DOUBLE, 1, value);
+  if (st == -2)
+    MPM_FAIL_ON_ROOT(ck->rank, MPM_ERR_INPUT,
+                     "the checkpoint '%s' is damaged: cannot read its value '%s' (%s). Restart "
+                     "from an earlier checkpoint",
+                     ck->path, name, h5_cause());
+  if (st < 0)
     MPM_FAIL_ON_ROOT(ck->rank, MPM_ERR_INPUT,
                      "the checkpoint '%s' has no value '%s'; it was written by another version of "
                      "mpmfsi or another kind of run",
@@ -346,6 +491,8 @@ int mpm_checkpoint_attr(const mpm_checkpoint *ck, const char *name, double *valu
 int mpm_checkpoint_attr_optional(const mpm_checkpoint *ck, const char *name, double *value) {
   return attr_read(ck->file, name, H5T_NATIVE_DOUBLE, 1, value) == 0;
 }
+
+/* ---- reading: particles ---------------------------------------------------------------- */
 
 /* Describe p's fields as "x(2) v(2) m(1)" for messages. */
 static void describe_fields(const mpm_particles *p, char *s, size_t size) {
@@ -360,15 +507,21 @@ static void describe_fields(const mpm_particles *p, char *s, size_t size) {
 static int check_layout(const mpm_checkpoint *ck, hid_t g, const char *phase,
                         const mpm_particles *p) {
   int dim = 0, ncomp[MPM_PARTICLES_MAX_FIELDS] = {0}, nstored = 0;
-  char *names = attr_read_string(g, "field_names"), want[512], have[512] = "";
+  char *names = NULL, want[512], have[512] = "", why[WHY_SIZE] = "";
+  unsigned long long hash = 0;
+  int st = attr_read_string(g, "field_names", &names);
   if (names) {
     nstored = 1;
     for (const char *c = names; *c; ++c) nstored += *c == ',';
   }
-  int ok = names && attr_read(g, "dim", H5T_NATIVE_INT, 1, &dim) == 0 &&
-           nstored <= MPM_PARTICLES_MAX_FIELDS &&
-           attr_read(g, "field_ncomp", H5T_NATIVE_INT, nstored, ncomp) == 0;
-  if (ok) { /* "x,v,m" with ncomp {2,2,1} -> "x(2) v(2) m(1)" */
+  if (!st) st = attr_read(g, "dim", H5T_NATIVE_INT, 1, &dim);
+  if (!st) st = nstored <= MPM_PARTICLES_MAX_FIELDS ? 0 : -1;
+  if (!st) st = attr_read(g, "field_ncomp", H5T_NATIVE_INT, nstored, ncomp);
+  if (!st && ck->hashed) st = attr_read(g, "text_hash", H5T_NATIVE_ULLONG, 1, &hash);
+  if (st == -2) note(why, ck, "cannot read the layout of phase '%s' (%s)", phase, h5_cause());
+  if (!st && ck->hashed && hash != text_hash(names, NULL))
+    note(why, ck, "checksum mismatch in the field names of phase '%s' (text_hash)", phase);
+  if (!st && !why[0]) { /* "x,v,m" with ncomp {2,2,1} -> "x(2) v(2) m(1)" */
     size_t k = 0;
     int f = 0;
     char *save = NULL;
@@ -378,13 +531,13 @@ static int check_layout(const mpm_checkpoint *ck, hid_t g, const char *phase,
   }
   free(names);
   describe_fields(p, want, sizeof want);
+  if (st == -1)
+    snprintf(why, sizeof why,
+             "the checkpoint '%s' does not describe the fields of phase '%s'; it was not "
+             "written by this version of mpmfsi",
+             ck->path, phase);
   /* What one rank read decides for all: the ranks go on to collective reads together. */
-  const int rc = mpm_h5_agree(ck->comm, ok ? 0 : MPM_ERR_INPUT);
-  if (rc)
-    MPM_FAIL_ON_ROOT(ck->rank, rc,
-                     "the checkpoint '%s' does not describe the fields of phase '%s'; it was not "
-                     "written by this version of mpmfsi",
-                     ck->path, phase);
+  AGREE_WHY(ck, why);
   if (dim != p->dim || strcmp(have, want) != 0)
     MPM_FAIL_ON_ROOT(ck->rank, MPM_ERR_INPUT,
                      "the checkpoint '%s' holds phase '%s' as %d-D particles with fields %s, but "
@@ -407,17 +560,53 @@ static int has_extents(hid_t dset, int rank, const hsize_t *dims) {
   return 1;
 }
 
-/* Every rank reads the whole counts array (collectively); MPM_ERR_INPUT or MPM_ERR_HDF5 on
- * every rank if it is not nranks long or a count is negative. */
-static int read_counts(const mpm_checkpoint *ck, hid_t g, int64_t *counts) {
-  const hid_t dset = H5Dopen2(g, "counts", H5P_DEFAULT);
+/* Open dataset name of g with the given extents, or note in why what is wrong. */
+static hid_t open_dataset(const mpm_checkpoint *ck, hid_t g, const char *phase, const char *name,
+                          int rank, const hsize_t *dims, char *why) {
+  const hid_t d = H5Dopen2(g, name, H5P_DEFAULT);
+  if (d < 0) h5_failed();
+  if (d < 0)
+    note(why, ck, "cannot open the dataset '/%s/%s' (%s)", phase, name, h5_cause());
+  else if (!has_extents(d, rank, dims))
+    note(why, ck, "the dataset '/%s/%s' does not have the extents its particle counts imply", phase,
+         name);
+  return d;
+}
+
+/* Collective read of this rank's block of an open dataset (d < 0: this rank could not open
+ * it, and why says so). */
+static int read_dataset(const mpm_checkpoint *ck, hid_t d, const char *phase, const char *name,
+                        hid_t mtype, int rank, const hsize_t *start, const hsize_t *count,
+                        void *buf, char *why) {
+  AGREE_WHY(ck, why);
+  int checksum = 0;
+  if (mpm_h5_read_block(ck->comm, d, mtype, rank, start, count, buf, &checksum) != 0) {
+    note(why, ck, "cannot read the dataset '/%s/%s' (%s)", phase, name,
+         checksum ? "checksum mismatch in its data" : "HDF5 cannot read it");
+    if (ck->rank == 0) mpm_log_all(MPM_LOG_ERROR, "%s", why);
+    return mpm_trace(__FILE__, __LINE__, __func__, MPM_ERR_INPUT);
+  }
+  return 0;
+}
+
+/* Every rank reads the whole counts array (collectively): nranks counts, none negative. */
+static int read_counts(const mpm_checkpoint *ck, hid_t g, const char *phase, int64_t *counts) {
+  char why[WHY_SIZE] = "";
   const hsize_t start = 0, count = (hsize_t)ck->nranks;
-  int rc = mpm_h5_agree(ck->comm, has_extents(dset, 1, &count) ? 0 : MPM_ERR_INPUT);
-  if (!rc) rc = mpm_h5_read_block(ck->comm, dset, H5T_NATIVE_INT64, 1, &start, &count, counts);
+  const hid_t dset = open_dataset(ck, g, phase, "counts", 1, &count, why);
+  const int rc =
+      read_dataset(ck, dset, phase, "counts", H5T_NATIVE_INT64, 1, &start, &count, counts, why);
   if (dset >= 0) H5Dclose(dset);
-  for (int r = 0; !rc && r < ck->nranks; ++r) /* the same data on every rank */
-    if (counts[r] < 0) rc = MPM_ERR_INPUT;
-  return rc;
+  MPM_CALL(rc);
+  int64_t total = 0;
+  for (int r = 0; r < ck->nranks; ++r) { /* the same data on every rank */
+    if (counts[r] < 0 || counts[r] > ((int64_t)1 << 48) - total)
+      note(why, ck, "rank %d's particle count of phase '%s' is %lld", r, phase,
+           (long long)counts[r]);
+    total += why[0] ? 0 : counts[r];
+  }
+  AGREE_WHY(ck, why);
+  return 0;
 }
 
 /* This rank's slice [*offset, *offset + *n) of the *ntotal stored particles. */
@@ -427,13 +616,9 @@ static int choose_slice(const mpm_checkpoint *ck, hid_t g, const char *phase, in
   const int ok = mpm_h5_agree(ck->comm, counts ? 0 : MPM_ERR_MEMORY);
   if (ok) free(counts);
   MPM_CALL(ok);
-  if (read_counts(ck, g, counts) != 0) {
-    free(counts);
-    MPM_FAIL_ON_ROOT(ck->rank, MPM_ERR_INPUT,
-                     "the checkpoint '%s' has no valid particle counts for phase '%s'; the file is "
-                     "damaged",
-                     ck->path, phase);
-  }
+  const int rc = read_counts(ck, g, phase, counts);
+  if (rc) free(counts);
+  MPM_CALL(rc);
   int64_t total = 0, before = 0;
   for (int r = 0; r < ck->nranks; ++r) total += counts[r], before += r < ck->rank ? counts[r] : 0;
   if (ck->nranks == ck->size) { /* each rank takes back exactly what it wrote */
@@ -455,36 +640,48 @@ static int choose_slice(const mpm_checkpoint *ck, hid_t g, const char *phase, in
 
 /* Collective read of [offset, offset + n) of id [total] and data [ncomp][total]; the same
  * code on every rank. */
-static int read_datasets(MPI_Comm comm, hid_t g, int ncomp, int64_t total, int64_t offset,
-                         int64_t n, mpm_gidx *id, double *data) {
-  const hid_t did = H5Dopen2(g, "id", H5P_DEFAULT), dd = H5Dopen2(g, "data", H5P_DEFAULT);
+static int read_datasets(const mpm_checkpoint *ck, hid_t g, const char *phase, int ncomp,
+                         int64_t total, int64_t offset, int64_t n, mpm_gidx *id, double *data) {
+  char why[WHY_SIZE] = "";
   hsize_t dims[2] = {(hsize_t)ncomp, (hsize_t)total};
+  const hid_t did = open_dataset(ck, g, phase, "id", 1, &dims[1], why);
+  const hid_t dd = open_dataset(ck, g, phase, "data", 2, dims, why);
   hsize_t start[2] = {(hsize_t)offset}, count[2] = {(hsize_t)n};
-  int rc = mpm_h5_agree(
-      comm, has_extents(did, 1, &dims[1]) && has_extents(dd, 2, dims) ? 0 : MPM_ERR_INPUT);
-  if (!rc) rc = mpm_h5_read_block(comm, did, H5T_NATIVE_INT64, 1, start, count, id);
+  int rc = read_dataset(ck, did, phase, "id", H5T_NATIVE_INT64, 1, start, count, id, why);
   start[0] = 0, count[0] = (hsize_t)ncomp, start[1] = (hsize_t)offset, count[1] = (hsize_t)n;
-  if (!rc) rc = mpm_h5_read_block(comm, dd, H5T_NATIVE_DOUBLE, 2, start, count, data);
+  if (!rc) rc = read_dataset(ck, dd, phase, "data", H5T_NATIVE_DOUBLE, 2, start, count, data, why);
   if (did >= 0) H5Dclose(did);
   if (dd >= 0) H5Dclose(dd);
   return rc;
 }
 
-/* Read this rank's slice and make it p's whole contents. */
+/* What was read must be a state the run could have written: valid values (mpm_particles_
+ * find_invalid, with the ranges the module declared) and ids unique over all ranks. */
+static int validate(const mpm_checkpoint *ck, const char *phase, const mpm_particles *p, int64_t n,
+                    const mpm_gidx *id, const double *data) {
+  char why[WHY_SIZE] = "", detail[400];
+  if (mpm_particles_find_invalid(p, (mpm_lidx)n, id, data, detail, sizeof detail) >= 0)
+    note(why, ck, "in phase '%s', %s", phase, detail);
+  AGREE_WHY(ck, why);
+  mpm_gidx dup = -1;
+  MPM_CALL(mpm_particles_find_duplicate(ck->comm, id, (mpm_lidx)n, &dup));
+  if (dup >= 0)
+    MPM_FAIL_ON_ROOT(ck->rank, MPM_ERR_INPUT,
+                     "the checkpoint '%s' is damaged: in phase '%s', particle id %lld is held "
+                     "twice. Restart from an earlier checkpoint",
+                     ck->path, phase, (long long)dup);
+  return 0;
+}
+
+/* Read this rank's slice, check it, and make it p's whole contents. */
 static int read_slice(const mpm_checkpoint *ck, hid_t g, const char *phase, mpm_particles *p,
                       int64_t total, int64_t offset, int64_t n) {
   mpm_gidx *id = malloc(((size_t)n + 1) * sizeof *id);
   double *data = malloc(((size_t)p->ncomp * (size_t)n + 1) * sizeof *data);
   unsigned char *keep = calloc((size_t)p->n + 1, 1); /* all zero: drop what p held */
   int rc = mpm_h5_agree(ck->comm, id && data && keep ? 0 : MPM_ERR_MEMORY);
-  if (!rc && read_datasets(ck->comm, g, p->ncomp, total, offset, n, id, data) != 0) {
-    rc = MPM_ERR_INPUT; /* agreed: the same verdict on every rank */
-    if (ck->rank == 0)
-      mpm_log_all(MPM_LOG_ERROR,
-                  "cannot read the particles of phase '%s' from the checkpoint '%s': the "
-                  "file is damaged",
-                  phase, ck->path);
-  }
+  if (!rc) rc = read_datasets(ck, g, phase, p->ncomp, total, offset, n, id, data);
+  if (!rc) rc = validate(ck, phase, p, n, id, data);
   /* Through mpm_particles_edit, which owns the block's allocation and its invariants. */
   if (!rc) rc = mpm_particles_edit(p, keep, (mpm_lidx)n, id, data);
   free(id), free(data), free(keep);
@@ -495,33 +692,36 @@ static int read_slice(const mpm_checkpoint *ck, hid_t g, const char *phase, mpm_
 
 static int read_phase(mpm_checkpoint *ck, hid_t g, const char *phase, mpm_particles *p) {
   int64_t offset = 0, n = 0, total = 0, id_next = 0;
+  char why[WHY_SIZE] = "";
   MPM_CALL(check_layout(ck, g, phase, p));
-  const int rc = mpm_h5_agree(
-      ck->comm, attr_read(g, "id_next", H5T_NATIVE_INT64, 1, &id_next) < 0 ? MPM_ERR_INPUT : 0);
-  if (rc)
-    MPM_FAIL_ON_ROOT(ck->rank, rc, "the checkpoint '%s' has no id_next for phase '%s'", ck->path,
-                     phase);
+  const int st = attr_read(g, "id_next", H5T_NATIVE_INT64, 1, &id_next);
+  if (st || id_next < 0)
+    note(why, ck, "cannot read a valid id_next for phase '%s' (%s)", phase,
+         st == -2 ? h5_cause()
+         : st     ? "missing"
+                  : "negative");
+  AGREE_WHY(ck, why);
   MPM_CALL(choose_slice(ck, g, phase, &offset, &n, &total));
-  MPM_CALL(read_slice(ck, g, phase, p, total, offset, n));
   p->id_next = id_next;
+  MPM_CALL(read_slice(ck, g, phase, p, total, offset, n));
   return 0;
 }
 
 int mpm_checkpoint_read_particles(mpm_checkpoint *ck, const char *phase, mpm_particles *p) {
   /* Lookups are local: each is agreed on, so that all ranks reach the collective reads. */
-  int rc = mpm_h5_agree(ck->comm, H5Lexists(ck->file, phase, H5P_DEFAULT) > 0 ? 0 : MPM_ERR_INPUT);
-  if (rc)
-    MPM_FAIL_ON_ROOT(ck->rank, rc,
-                     "the checkpoint '%s' has no particles of phase '%s'; restart with the case "
-                     "that wrote it",
-                     ck->path, phase);
+  char why[WHY_SIZE] = "";
+  const htri_t exists = H5Lexists(ck->file, phase, H5P_DEFAULT);
+  if (exists < 0) h5_failed(), note(why, ck, "cannot look up phase '%s' (%s)", phase, h5_cause());
+  if (exists == 0)
+    snprintf(why, sizeof why,
+             "the checkpoint '%s' has no particles of phase '%s'; restart with the case that "
+             "wrote it",
+             ck->path, phase);
+  AGREE_WHY(ck, why);
   const hid_t g = H5Gopen2(ck->file, phase, H5P_DEFAULT);
-  rc = mpm_h5_agree(ck->comm, g < 0 ? MPM_ERR_INPUT : 0);
-  if (rc) {
-    if (g >= 0) H5Gclose(g);
-    MPM_FAIL_ON_ROOT(ck->rank, rc, "cannot open phase '%s' in '%s'", phase, ck->path);
-  }
-  rc = read_phase(ck, g, phase, p);
+  if (g < 0) h5_failed(), note(why, ck, "cannot open phase '%s' (%s)", phase, h5_cause());
+  AGREE_WHY(ck, why);
+  const int rc = read_phase(ck, g, phase, p);
   H5Gclose(g);
   MPM_CALL(rc);
   return 0;

@@ -10,7 +10,19 @@
  *  - Strings handed out (getters, where, instances) live as long as cfg: a replaced string
  *    is retired, not freed.
  *  - Every rank holds the same entries; messages go through mpm_log (rank 0 only).
- * Entries and specs are searched linearly: case files hold tens to hundreds of keys.
+ *  - The command line is one source, like one file: a key given twice there is an error.
+ * Entries and specs are searched linearly: case files hold tens to hundreds of keys, and a
+ * text with more than MAX_ENTRIES keys is refused (it is no case file, and the linear
+ * searches would make it slow). A case file must be a regular file of at most
+ * MAX_CASE_BYTES; error lines are capped at MAX_ERROR_LINES per read or validation, with
+ * one closing line counting the rest, so garbage gives a screenful, not a line per line.
+ *
+ * Resolved text (mpm_config_resolved_text) writes the keys that were set as "key = value"
+ * lines and the defaults as commented lines: reading it back sets exactly what was set, so
+ * every consumer sees the same configuration (a default written as a value would count as
+ * set: an obstacle's angle_of_attack would then be refused for a circle). Each line's
+ * comment names where its value came from; reading a resolved text back keeps those names,
+ * so resolving it again gives the same text.
  *
  * libinih splits lines into sections and name = value pairs. Our reader feeds it one line
  * at a time, so it knows the line number when the handler runs, and it checks each line
@@ -24,6 +36,7 @@
 
 #include <ctype.h>
 #include <errno.h>
+#include <fcntl.h>
 #include <ini.h>
 #include <limits.h>
 #include <math.h>
@@ -40,6 +53,7 @@ typedef struct {
   char *key, *value;
   char *path;  /* value resolved against its file's folder (what a PATH key means) */
   char *where; /* "case.ini:12" or "command line" */
+  char *from;  /* provenance carried over from a resolved text, or NULL */
   int line;    /* 0 for the command line */
   int source;  /* read call that set it: a key twice in one file is an error */
 } entry;
@@ -61,7 +75,23 @@ struct mpm_config {
   name_list *lists; /* instances() results, cached because cfg owns them */
   size_t nlists, cap_lists;
   int nsources;
+  int cmdline_source; /* source number of the command line, 0 before the first override */
+  /* Error lines shown and held back since the last flush, the origin of the first one held
+   * back ("case.ini", "command line"), and whether later ones came from elsewhere. */
+  int err_shown;
+  long long err_hidden;
+  char err_origin[256];
+  int err_mixed;
 };
+
+enum {
+  MAX_ERROR_LINES = 20,             /* error lines printed before the rest are only counted */
+  MAX_ENTRIES = 10000,              /* keys a text may set: case files hold hundreds at most */
+  MAX_CASE_BYTES = 16 * 1024 * 1024 /* size of a case file */
+};
+
+/* The first line of a resolved text; reading a text that starts with it keeps provenance. */
+static const char g_resolved_header[] = "# Resolved configuration:";
 
 /* ---- growable arrays and strings ----------------------------------------------------- */
 
@@ -275,6 +305,51 @@ static entry *find_entry(const mpm_config *cfg, const char *key) {
   return NULL;
 }
 
+/* ---- error lines --------------------------------------------------------------------- */
+
+/* Length of the origin in a where text: "case.ini" of "case.ini:12". */
+static size_t origin_len(const char *where) {
+  const char *colon = strrchr(where, ':');
+  if (colon && colon[1] && strspn(colon + 1, "0123456789") == strlen(colon + 1))
+    return (size_t)(colon - where);
+  return strlen(where);
+}
+
+/* 1 if one more error line may be printed; else the error is only counted, for
+ * errors_flush to sum up. The count lives in cfg behind a const pointer, like the instance
+ * cache (sound: cfg is never defined const). */
+static int error_room(const mpm_config *cfg, const char *where) {
+  mpm_config *c = (mpm_config *)cfg;
+  if (c->err_shown < MAX_ERROR_LINES) {
+    ++c->err_shown;
+    return 1;
+  }
+  const char *w = where ? where : "";
+  size_t n = origin_len(w);
+  if (n >= sizeof c->err_origin) n = sizeof c->err_origin - 1;
+  if (c->err_hidden++ == 0)
+    memcpy(c->err_origin, w, n), c->err_origin[n] = '\0';
+  else if (strlen(c->err_origin) != n || memcmp(c->err_origin, w, n) != 0)
+    c->err_mixed = 1;
+  return 0;
+}
+
+/* One closing line for the errors held back, then a fresh budget. */
+static void errors_flush(const mpm_config *cfg) {
+  mpm_config *c = (mpm_config *)cfg;
+  if (c->err_hidden > 0) {
+    const char *o = c->err_mixed ? "" : c->err_origin;
+    const int cl = strcmp(o, "command line") == 0;
+    mpm_log(MPM_LOG_ERROR, "... and %lld more error%s%s%s; fix the ones above first", c->err_hidden,
+            c->err_hidden == 1 ? "" : "s",
+            !*o  ? ""
+            : cl ? " on the "
+                 : " in ",
+            show(o).s);
+  }
+  c->err_shown = 0, c->err_hidden = 0, c->err_mixed = 0, c->err_origin[0] = '\0';
+}
+
 int mpm_config_new(mpm_config **cfg, MPI_Comm comm) {
   MPM_ALLOC(*cfg, 1);
   (*cfg)->comm = comm;
@@ -292,8 +367,9 @@ void mpm_config_destroy(mpm_config **cfg) {
   mpm_config *c = *cfg;
   for (size_t i = 0; i < c->n; ++i) {
     entry *e = &c->entries[i];
-    free(e->key), free(e->value), free(e->path), free(e->where);
+    free(e->key), free(e->value), free(e->path), free(e->where), free(e->from);
   }
+  errors_flush(c); /* a consumer's errors past the cap */
   for (size_t i = 0; i < c->nretired; ++i) free(c->retired[i]);
   for (size_t i = 0; i < c->nlists; ++i) free_names(&c->lists[i]);
   free(c->entries), free(c->retired), free(c->lists), free(c->specs), free(c);
@@ -304,19 +380,22 @@ void mpm_config_destroy(mpm_config **cfg) {
 
 /* A value being checked or read, with what a message needs to name it. */
 typedef struct {
+  const mpm_config *cfg;
   const mpm_key_spec *sp;
   const char *key, *value;
   const char *path;  /* resolved, for PATH keys */
-  const char *where; /* NULL for a default */
+  const char *where; /* where it was set, or for a default where its section is; or NULL */
   int line;          /* 0: command line or default (relative paths start at the cwd) */
+  int is_default;    /* the value is the spec's default */
 } item;
 
 /* One line: "where: key = value: msg (help)". */
 static void report(const item *it, const char *msg, int with_help) {
   const char *help = it->sp && with_help ? help_of(it->sp) : "";
+  if (!error_room(it->cfg, it->where)) return;
   mpm_log(MPM_LOG_ERROR, "%s%s%s = %s%s: %s%s%s%s", it->where ? it->where : "",
-          it->where ? ": " : "", show(it->key).s, show(it->value).s, it->where ? "" : " (default)",
-          msg, PAREN(help));
+          it->where ? ": " : "", show(it->key).s, show(it->value).s,
+          it->is_default ? " (default)" : "", msg, PAREN(help));
 }
 
 __attribute__((format(printf, 2, 3))) static int bad(const item *it, const char *fmt, ...) {
@@ -474,6 +553,9 @@ static int check_path(const item *it) {
     return bad(it, "cannot open '%s': %s; check the path (relative paths start at %s)", it->path,
                strerror(errno), from);
   if (S_ISDIR(st.st_mode)) return bad(it, "'%s' is a folder; give a file", it->path);
+  /* A device or FIFO could be read forever: only regular files are data. */
+  if (!S_ISREG(st.st_mode))
+    return bad(it, "'%s' is not a regular file (a device, FIFO or socket); give a file", it->path);
   return 0;
 }
 
@@ -502,8 +584,8 @@ static int check_value(const item *it) {
   return bad(it, "internal error: unknown key type %d", (int)it->sp->type);
 }
 
-static item entry_item(const mpm_key_spec *sp, const entry *e) {
-  return (item){sp, e->key, e->value, e->path, e->where, e->line};
+static item entry_item(const mpm_config *cfg, const mpm_key_spec *sp, const entry *e) {
+  return (item){cfg, sp, e->key, e->value, e->path, e->where, e->line, 0};
 }
 
 /* ---- schema ------------------------------------------------------------------------ */
@@ -521,7 +603,7 @@ static int check_spec(const mpm_config *cfg, const mpm_key_spec *sp) {
   for (size_t i = 0; i < cfg->nspecs; ++i)
     if (strcmp(cfg->specs[i]->key, k) == 0)
       MPM_FAIL(MPM_ERR_INTERNAL, "schema key '%s' is declared twice", show(k).s);
-  item it = {sp, k, sp->def, sp->def, NULL, 0};
+  item it = {cfg, sp, k, sp->def, sp->def, NULL, 0, 1};
   if (sp->def && sp->type != MPM_KEY_PATH && check_value(&it) != 0)
     MPM_FAIL(MPM_ERR_INTERNAL, "schema key '%s' has a bad default", show(k).s);
   return 0;
@@ -545,6 +627,7 @@ typedef struct {
   const char *dir;    /* folder for relative paths; NULL for the current one */
   int line;           /* 0 for the command line */
   int source;
+  const char *from; /* the line's provenance comment, in a resolved text; else NULL */
 } place;
 
 static char *resolve_path(const char *dir, const char *value) {
@@ -563,9 +646,15 @@ static char *where_text(const place *at) {
   return sb_take(&b);
 }
 
-static int duplicate(const entry *e, const place *at) {
-  mpm_log(MPM_LOG_ERROR, "%s:%d: %s is set twice (lines %d and %d); keep one", at->origin, at->line,
-          show(e->key).s, e->line, at->line);
+/* A key set twice by one source: a file names both lines, the command line both
+ * assignments. */
+static int duplicate(const mpm_config *cfg, const entry *e, const char *value, const place *at) {
+  if (at->line > 0 && error_room(cfg, at->origin))
+    mpm_log(MPM_LOG_ERROR, "%s:%d: %s is set twice (lines %d and %d); keep one", at->origin,
+            at->line, show(e->key).s, e->line, at->line);
+  else if (at->line <= 0 && error_room(cfg, at->origin))
+    mpm_log(MPM_LOG_ERROR, "%s: %s is given twice (%s=%s and %s=%s); keep one", at->origin,
+            show(e->key).s, show(e->key).s, show(e->value).s, show(e->key).s, show(value).s);
   return MPM_ERR_INPUT;
 }
 
@@ -574,22 +663,38 @@ static void replace(mpm_config *cfg, entry *e, entry *n) {
   cfg->retired[cfg->nretired++] = e->value;
   cfg->retired[cfg->nretired++] = e->path;
   cfg->retired[cfg->nretired++] = e->where;
-  e->value = n->value, e->path = n->path, e->where = n->where;
+  if (e->from) cfg->retired[cfg->nretired++] = e->from;
+  e->value = n->value, e->path = n->path, e->where = n->where, e->from = n->from;
   e->line = n->line, e->source = n->source;
+}
+
+static int too_many_keys(const mpm_config *cfg, const place *at) {
+  if (error_room(cfg, at->origin))
+    mpm_log(MPM_LOG_ERROR,
+            "%s:%d: more than %d keys; a case file holds tens to hundreds: is this a case "
+            "file?",
+            at->origin, at->line, MAX_ENTRIES);
+  return MPM_ERR_INPUT;
 }
 
 static int set_entry(mpm_config *cfg, const char *key, const char *value, const place *at) {
   entry *e = find_entry(cfg, key);
-  if (e && e->source == at->source) return duplicate(e, at);
+  if (e && e->source == at->source) return duplicate(cfg, e, value, at);
+  if (!e && cfg->n >= MAX_ENTRIES) return too_many_keys(cfg, at);
   if (e)
-    RESERVE(cfg->retired, cfg->nretired + 3, cfg->cap_retired);
+    RESERVE(cfg->retired, cfg->nretired + 4, cfg->cap_retired);
   else
     RESERVE(cfg->entries, cfg->n + 1, cfg->cap);
-  entry n = {NULL,           strdup(value), resolve_path(at->dir, value),
-             where_text(at), at->line,      at->source};
+  entry n = {NULL,
+             strdup(value),
+             resolve_path(at->dir, value),
+             where_text(at),
+             at->from ? strdup(at->from) : NULL,
+             at->line,
+             at->source};
   if (!e) n.key = strdup(key);
-  if (!n.value || !n.path || !n.where || (!e && !n.key)) {
-    free(n.key), free(n.value), free(n.path), free(n.where);
+  if (!n.value || !n.path || !n.where || (!e && !n.key) || (at->from && !n.from)) {
+    free(n.key), free(n.value), free(n.path), free(n.where), free(n.from);
     MPM_FAIL(MPM_ERR_MEMORY, "out of memory storing '%s'", show(key).s);
   }
   if (e)
@@ -608,7 +713,10 @@ typedef struct {
   sbuf line;        /* cleaned line being served, with its '\n' */
   size_t served;    /* bytes of line already handed to inih */
   sbuf section;     /* current section name; empty before the first header */
+  sbuf from;        /* a resolved text's provenance comment on the line, if any */
+  int resolved;     /* the text is a resolved text (it starts with g_resolved_header) */
   int section_ok;   /* 0 after a bad header: its keys are skipped (already reported) */
+  int stop;         /* 1: give up reading (too many keys) */
   int rc;           /* first failure */
 } parser;
 
@@ -618,7 +726,8 @@ __attribute__((format(printf, 2, 3))) static int parse_error(parser *ps, const c
   va_start(ap, fmt);
   sb_vprintf(&b, fmt, ap);
   va_end(ap);
-  mpm_log(MPM_LOG_ERROR, "%s:%d: %s", ps->at.origin, ps->at.line, b.failed ? fmt : b.s);
+  if (error_room(ps->cfg, ps->at.origin))
+    mpm_log(MPM_LOG_ERROR, "%s:%d: %s", ps->at.origin, ps->at.line, b.failed ? fmt : b.s);
   free(b.s);
   if (!ps->rc) ps->rc = MPM_ERR_INPUT;
   return 0;
@@ -667,6 +776,16 @@ static int lex_line(parser *ps, const char *s, size_t n) {
   return 1;
 }
 
+/* In a resolved text, the comment after a value names where the value came from: keep it
+ * (c[0..n) is the comment with its '#'), so that resolving the text again names the same. */
+static void keep_provenance(parser *ps, const char *c, size_t n) {
+  ps->from.len = 0;
+  if (!ps->resolved || n < 2) return;
+  ++c, --n;
+  trim(&c, &n);
+  if (n) sb_add(&ps->from, c, n);
+}
+
 /* Clean the next physical line (blanks, comment, a leading byte-order mark) into ps->line;
  * a bad line becomes blank. */
 static void next_line(parser *ps) {
@@ -677,8 +796,12 @@ static void next_line(parser *ps) {
   ps->line.len = 0;
   ps->served = 0;
   if (ps->at.line == 1 && n >= 3 && memcmp(s, "\xEF\xBB\xBF", 3) == 0) s += 3, n -= 3;
+  if (ps->at.line == 1)
+    ps->resolved = strncmp(s, g_resolved_header, strlen(g_resolved_header)) == 0;
   trim(&s, &n);
+  size_t whole = n;
   cut_comment(s, &n);
+  keep_provenance(ps, s + n, whole - n);
   trim(&s, &n);
   if (n && !lex_line(ps, s, n)) n = 0;
   sb_add(&ps->line, s, n);
@@ -688,6 +811,7 @@ static void next_line(parser *ps) {
 /* inih's fgets-like reader: one cleaned line per call (the buffer holds the longest). */
 static char *read_line(char *str, int num, void *stream) {
   parser *ps = stream;
+  if (ps->stop) return NULL;
   if (ps->served == ps->line.len) {
     if (!*ps->next) return NULL;
     next_line(ps);
@@ -716,8 +840,11 @@ static int on_pair(void *user, const char *section, const char *name, const char
   sb_add(&key, ps->section.s, ps->section.len);
   sb_add(&key, ".", 1);
   sb_str(&key, name);
+  if (ps->from.failed) key.failed = 1;
+  ps->at.from = ps->from.len ? ps->from.s : NULL;
   int rc = key.failed ? MPM_ERR_MEMORY : set_entry(ps->cfg, key.s, value, &ps->at);
   if (rc && !ps->rc) ps->rc = rc;
+  if (rc && ps->cfg->n >= MAX_ENTRIES) ps->stop = 1;
   free(key.s);
   return 1;
 }
@@ -760,10 +887,11 @@ static void ini_options_restore(const ini_options *o) {
 int mpm_config_read_string(mpm_config *cfg, const char *text, const char *origin, const char *dir) {
   if (!cfg || !text) MPM_FAIL(MPM_ERR_INTERNAL, "mpm_config_read_string: NULL argument");
   parser ps = {.cfg = cfg,
-               .at = {origin ? origin : "(text)", dir, 0, ++cfg->nsources},
+               .at = {origin ? origin : "(text)", dir, 0, ++cfg->nsources, NULL},
                .next = text,
                .section_ok = 1};
   size_t longest = longest_line(text);
+  errors_flush(cfg);
   if (longest > (size_t)INT_MAX - 8) {
     mpm_log(MPM_LOG_ERROR, "%s: a line is longer than %d bytes; is this a case file?", ps.at.origin,
             INT_MAX - 8);
@@ -774,29 +902,82 @@ int mpm_config_read_string(mpm_config *cfg, const char *text, const char *origin
   ini_options_restore(&saved);
   free(ps.line.s);
   free(ps.section.s);
+  free(ps.from.s);
   if (r == -2 && !ps.rc) ps.rc = MPM_ERR_MEMORY;
   if (r > 0 && !ps.rc) {
     mpm_log(MPM_LOG_ERROR, "%s:%d: syntax error", ps.at.origin, r);
     ps.rc = MPM_ERR_INPUT;
   }
+  errors_flush(cfg);
   return ps.rc ? mpm_trace(__FILE__, __LINE__, __func__, ps.rc) : 0;
 }
 
-/* Rank 0's part of read_file: the whole file, or an errno value. */
-static int slurp(const char *path, char **text, size_t *len) {
-  FILE *f = fopen(path, "rb");
-  if (!f) return errno ? errno : EIO;
+/* Why rank 0 could not read a case file: an errno value, or one of these. */
+enum { NOT_REGULAR = -1, TOO_LARGE = -2 };
+
+/* What kind of non-regular file mode is. */
+static const char *file_kind(mode_t mode) {
+  if (S_ISDIR(mode)) return "a folder";
+  if (S_ISCHR(mode)) return "a character device";
+  if (S_ISBLK(mode)) return "a block device";
+  if (S_ISFIFO(mode)) return "a FIFO";
+  if (S_ISSOCK(mode)) return "a socket";
+  return "not a regular file";
+}
+
+/* Rank 0's part of read_file: the whole file, or an errno value or NOT_REGULAR (*kind set)
+ * or TOO_LARGE. A device or FIFO would be read forever, or block the open: it is opened
+ * without blocking and refused by its type; at most MAX_CASE_BYTES are read. */
+static int slurp(const char *path, char **text, size_t *len, const char **kind) {
+  int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  struct stat st;
+  if (fd < 0) return errno ? errno : EIO;
+  if (fstat(fd, &st) != 0) {
+    int err = errno ? errno : EIO;
+    close(fd);
+    return err;
+  }
+  if (!S_ISREG(st.st_mode)) {
+    *kind = file_kind(st.st_mode);
+    close(fd);
+    return NOT_REGULAR;
+  }
+  if (st.st_size > MAX_CASE_BYTES) {
+    close(fd);
+    return TOO_LARGE;
+  }
+  FILE *f = fdopen(fd, "rb");
+  if (!f) {
+    int err = errno ? errno : EIO;
+    close(fd);
+    return err;
+  }
   sbuf b = {0};
   char chunk[1 << 16];
   size_t got;
-  while ((got = fread(chunk, 1, sizeof chunk, f)) > 0) sb_add(&b, chunk, got);
-  int err = ferror(f) ? (errno ? errno : EIO) : 0;
+  while (b.len <= MAX_CASE_BYTES && (got = fread(chunk, 1, sizeof chunk, f)) > 0)
+    sb_add(&b, chunk, got);
+  int err = ferror(f) ? (errno ? errno : EIO) : b.len > MAX_CASE_BYTES ? TOO_LARGE : 0;
   fclose(f);
   *len = b.len;
   *text = sb_take(&b);
   if (!err && !*text) err = ENOMEM;
   if (err) free(*text), *text = NULL;
   return err;
+}
+
+static void cannot_read(const char *path, int why, const char *kind) {
+  if (why == NOT_REGULAR)
+    mpm_log(MPM_LOG_ERROR,
+            "%s: cannot read it as a case file: it is %s; give the path of a case file",
+            show(path).s, kind);
+  else if (why == TOO_LARGE)
+    mpm_log(MPM_LOG_ERROR,
+            "%s: cannot read it as a case file: it is larger than %d MiB; a case file is a "
+            "few kB of text: check the path",
+            show(path).s, MAX_CASE_BYTES >> 20);
+  else
+    mpm_log(MPM_LOG_ERROR, "cannot read case file '%s': %s; check the path", path, strerror(why));
 }
 
 /* Broadcast the text in pieces that fit an int count. */
@@ -812,17 +993,17 @@ static int bcast_text(MPI_Comm comm, char *text, size_t len) {
 /* Every rank gets the file's text; a file rank 0 cannot read fails on every rank. */
 static int share_file(MPI_Comm comm, const char *path, char **text, size_t *len) {
   int rank;
-  long long head[2] = {0, 0}; /* length or -1, errno */
+  long long head[2] = {0, 0}; /* length or -1, why (see slurp) */
+  const char *kind = "";
   MPM_CALL_MPI(MPI_Comm_rank(comm, &rank));
   if (rank == 0) {
-    int err = slurp(path, text, len);
+    int err = slurp(path, text, len, &kind);
     head[0] = err ? -1 : (long long)*len;
     head[1] = err;
   }
   MPM_CALL_MPI(MPI_Bcast(head, 2, MPI_LONG_LONG, 0, comm));
   if (head[0] < 0) {
-    mpm_log(MPM_LOG_ERROR, "cannot read case file '%s': %s; check the path", path,
-            strerror((int)head[1]));
+    cannot_read(path, (int)head[1], kind); /* logged by rank 0, which knows the kind */
     return MPM_ERR_FILE;
   }
   if (rank != 0) {
@@ -868,17 +1049,19 @@ int mpm_config_override(mpm_config *cfg, const char *assignment) {
   size_t kn = eq ? (size_t)(eq - k) : 0, vn = strlen(v);
   trim(&k, &kn);
   if (!eq || !dotted_ok(k, kn, 0) || !memchr(k, '.', kn) || strchr(v, '\n')) {
-    mpm_log(MPM_LOG_ERROR,
-            "command line: expected key=value, got '%s'; keys name their section, as in "
-            "time.t_end=0.01",
-            show(assignment).s);
+    if (error_room(cfg, "command line"))
+      mpm_log(MPM_LOG_ERROR,
+              "command line: expected key=value, got '%s'; keys name their section, as in "
+              "time.t_end=0.01",
+              show(assignment).s);
     return MPM_ERR_INPUT;
   }
   trim(&v, &vn);
   cut_comment(v, &vn);
   trim(&v, &vn);
   char *key = dup_n(k, kn), *value = dup_n(v, vn);
-  place at = {"command line", NULL, 0, ++cfg->nsources};
+  if (!cfg->cmdline_source) cfg->cmdline_source = ++cfg->nsources;
+  place at = {"command line", NULL, 0, cfg->cmdline_source, NULL};
   int rc = key && value ? set_entry(cfg, key, value, &at) : MPM_ERR_MEMORY;
   free(key), free(value);
   return rc ? mpm_trace(__FILE__, __LINE__, __func__, rc) : 0;
@@ -969,6 +1152,7 @@ static char *section_keys(const mpm_config *cfg, const char *key) {
 }
 
 static void unknown_key(const mpm_config *cfg, const entry *e) {
+  if (!error_room(cfg, e->where)) return;
   char *near = nearest_key(cfg, e->key), *keys = near ? NULL : section_keys(cfg, e->key);
   if (near)
     mpm_log(MPM_LOG_ERROR, "%s: unknown key '%s'; did you mean '%s'?", e->where, show(e->key).s,
@@ -986,6 +1170,11 @@ static void unknown_key(const mpm_config *cfg, const entry *e) {
 static int first_in_section(const mpm_config *cfg, size_t j, const char *pat, size_t plen) {
   const char *key = cfg->entries[j].key;
   size_t len = section_in(key, pat, plen);
+  /* Sections are mostly contiguous: looking at the entry before first keeps this O(1). */
+  for (size_t i = j ? j - 1 : 0; i < j; ++i)
+    if (section_in(cfg->entries[i].key, pat, plen) == len &&
+        memcmp(cfg->entries[i].key, key, len) == 0)
+      return 0;
   for (size_t i = 0; i < j; ++i)
     if (section_in(cfg->entries[i].key, pat, plen) == len &&
         memcmp(cfg->entries[i].key, key, len) == 0)
@@ -1016,8 +1205,9 @@ static int check_required(const mpm_config *cfg, const mpm_key_spec *sp) {
     size_t len = section_in(e->key, sp->key, plen);
     if (!len || !first_in_section(cfg, j, sp->key, plen) || section_has(cfg, e->key, len, last))
       continue;
-    mpm_log(MPM_LOG_ERROR, "%s: [%s] lacks the required key '%s'%s%s%s; add '%s = ...' to it",
-            e->where, show_n(e->key, len).s, last, PAREN(help_of(sp)), last);
+    if (error_room(cfg, e->where))
+      mpm_log(MPM_LOG_ERROR, "%s: [%s] lacks the required key '%s'%s%s%s; add '%s = ...' to it",
+              e->where, show_n(e->key, len).s, last, PAREN(help_of(sp)), last);
     bad_any = 1;
   }
   return bad_any;
@@ -1025,10 +1215,11 @@ static int check_required(const mpm_config *cfg, const mpm_key_spec *sp) {
 
 int mpm_config_validate(const mpm_config *cfg) {
   int bad_any = 0;
+  errors_flush(cfg);
   for (size_t i = 0; i < cfg->n; ++i) {
     const entry *e = &cfg->entries[i];
     const mpm_key_spec *sp = find_spec(cfg, e->key);
-    item it = entry_item(sp, e);
+    item it = entry_item(cfg, sp, e);
     if (!sp)
       unknown_key(cfg, e), bad_any = 1;
     else if (check_value(&it) != 0)
@@ -1036,6 +1227,7 @@ int mpm_config_validate(const mpm_config *cfg) {
   }
   for (size_t i = 0; i < cfg->nspecs; ++i)
     if (is_required(cfg->specs[i]) && check_required(cfg, cfg->specs[i])) bad_any = 1;
+  errors_flush(cfg);
   return bad_any ? mpm_trace(__FILE__, __LINE__, __func__, MPM_ERR_INPUT) : 0;
 }
 
@@ -1053,9 +1245,9 @@ static int lookup(const mpm_config *cfg, const char *key, unsigned types, item *
              show(key).s, g_type_names[sp->type]);
   const entry *e = find_entry(cfg, key);
   if (e)
-    *it = entry_item(sp, e);
+    *it = entry_item(cfg, sp, e);
   else if (sp->def)
-    *it = (item){sp, key, sp->def, sp->def, NULL, 0};
+    *it = (item){cfg, sp, key, sp->def, sp->def, NULL, 0, 1};
   else {
     size_t n = section_len(key);
     mpm_log(MPM_LOG_ERROR, "missing required key '%s'%s%s%s; add '%s = ...' under [%s]",
@@ -1183,23 +1375,33 @@ int mpm_config_instances(const mpm_config *cfg, const char *prefix, const char *
 /* ---- reporting a consumer's problem -------------------------------------------------- */
 
 /* A key that is not set, or a section name: locate it by the first entry inside it. */
+/* Where the first entry of the section that key lies in was set, or NULL. */
+static const char *section_where(const mpm_config *cfg, const char *key) {
+  size_t sec = section_len(key);
+  for (size_t i = 0; sec && i < cfg->n; ++i) {
+    const entry *e = &cfg->entries[i];
+    if (strncmp(e->key, key, sec) == 0 && e->key[sec] == '.') return e->where;
+  }
+  return NULL;
+}
+
 static void fail_unset(const mpm_config *cfg, const char *key, const char *msg) {
-  size_t n = strlen(key), sec = section_len(key);
+  size_t n = strlen(key);
   for (size_t i = 0; i < cfg->n; ++i) {
     const entry *e = &cfg->entries[i];
     if (strncmp(e->key, key, n) == 0 && e->key[n] == '.') {
-      mpm_log(MPM_LOG_ERROR, "%s: [%s]: %s", e->where, show(key).s, msg);
+      if (error_room(cfg, e->where))
+        mpm_log(MPM_LOG_ERROR, "%s: [%s]: %s", e->where, show(key).s, msg);
       return;
     }
   }
-  for (size_t i = 0; sec && i < cfg->n; ++i) {
-    const entry *e = &cfg->entries[i];
-    if (strncmp(e->key, key, sec) == 0 && e->key[sec] == '.') {
-      mpm_log(MPM_LOG_ERROR, "%s: %s: %s", e->where, show(key).s, msg);
-      return;
-    }
-  }
-  mpm_log(MPM_LOG_ERROR, "%s: %s", show(key).s, msg);
+  const char *where = section_where(cfg, key);
+  if (!error_room(cfg, where))
+    return;
+  else if (where)
+    mpm_log(MPM_LOG_ERROR, "%s: %s: %s", where, show(key).s, msg);
+  else
+    mpm_log(MPM_LOG_ERROR, "%s: %s", show(key).s, msg);
 }
 
 int mpm_config_fail(const mpm_config *cfg, const char *key, const char *fmt, ...) {
@@ -1211,8 +1413,9 @@ int mpm_config_fail(const mpm_config *cfg, const char *key, const char *fmt, ...
   const char *msg = b.failed ? fmt : b.s;
   const entry *e = find_entry(cfg, key);
   const mpm_key_spec *sp = find_spec(cfg, key);
-  item it = {sp, key, sp ? sp->def : NULL, NULL, NULL, 0};
-  if (e) it = entry_item(sp, e);
+  /* A default is located by its section, when that is set somewhere. */
+  item it = {cfg, sp, key, sp ? sp->def : NULL, NULL, section_where(cfg, key), 0, 1};
+  if (e) it = entry_item(cfg, sp, e);
   if (it.value)
     report(&it, msg, 0); /* the consumer's message says enough: no help text */
   else
@@ -1249,7 +1452,9 @@ static void emit_path(emitter *em, const char *path) {
   sb_str(&em->b, path);
 }
 
-/* "last = value   # where" for spec sp in section sec, if sp is the spec of that key. */
+/* "last = value   # where" for spec sp in section sec, if sp is the spec of that key; a
+ * default as a comment, "# last = value   # default", which reading back leaves unset (a
+ * default written as a value would count as set, and may not apply to the instance). */
 static void emit_key(emitter *em, const mpm_key_spec *sp, const char *sec, size_t slen,
                      int *header) {
   const char *last = sp->key + section_len(sp->key) + 1;
@@ -1267,12 +1472,12 @@ static void emit_key(emitter *em, const mpm_key_spec *sp, const char *sec, size_
       sb_str(&em->b, "]\n");
       *header = 1;
     }
-    sb_printf(&em->b, "%s = ", last);
+    sb_printf(&em->b, "%s%s = ", e ? "" : "# ", last);
     if (sp->type == MPM_KEY_PATH)
       emit_path(em, e ? e->path : sp->def);
     else
       sb_str(&em->b, e ? e->value : sp->def);
-    sb_printf(&em->b, "   # %s\n", e ? show(e->where).s : "default");
+    sb_printf(&em->b, "   # %s\n", e ? show(e->from ? e->from : e->where).s : "default");
   }
   free(k.s);
 }
@@ -1333,8 +1538,10 @@ static void emit_all(emitter *em) {
 
 int mpm_config_resolved_text(const mpm_config *cfg, char **text) {
   emitter em = {{0}, cfg, current_dir()};
-  sb_str(&em.b, "# Resolved configuration: every key of every section in use; the comment "
-                "says where each value came from.\n");
+  sb_printf(&em.b,
+            "%s every key of every section in use, defaults commented out; the comment after "
+            "a value says where it came from.\n",
+            g_resolved_header);
   emit_all(&em);
   free(em.cwd);
   *text = sb_take(&em.b);

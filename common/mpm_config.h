@@ -50,11 +50,15 @@ void mpm_config_destroy(mpm_config **cfg);
 int mpm_config_add_schema(mpm_config *cfg, const mpm_key_spec *specs, int n);
 
 /* Read a case file: rank 0 reads it, every rank parses the same text. A missing or
- * unreadable file, or a syntax error, is reported with the file (and line). */
+ * unreadable file, one that is no regular file (a folder, device or FIFO) or larger than
+ * 16 MiB, or a syntax error, is reported with the file (and line). At most 20 error lines
+ * are printed per read (and per validation), then one line counting the rest. */
 int mpm_config_read_file(mpm_config *cfg, const char *path);
 /* Parse case text; origin names it in messages ("case.ini"), dir resolves relative paths. */
 int mpm_config_read_string(mpm_config *cfg, const char *text, const char *origin, const char *dir);
-/* One "key=value" override from the command line; replaces an earlier value. */
+/* One "key=value" override from the command line; replaces a value read from a file. The
+ * command line is one source, like one file: a key given twice there is an input error
+ * naming both assignments. */
 int mpm_config_override(mpm_config *cfg, const char *assignment);
 
 /* Check every entry against the schema: unknown keys (with the nearest valid key), types,
@@ -91,8 +95,12 @@ int mpm_config_fail(const mpm_config *cfg, const char *key, const char *fmt, ...
     __attribute__((format(printf, 3, 4)));
 
 /* The resolved configuration as case-file text: every schema key of every section in use,
- * with its value and, as a comment, where it came from. Feeding it back in gives the same
- * configuration. *text is malloc'ed. */
+ * the keys that were set as "key = value   # where" and the defaults commented out
+ * ("# key = value   # default"), so that reading it back sets exactly what was set (a
+ * default does not count as set, and may not apply to the instance: an obstacle's
+ * angle_of_attack is refused for a circle). Feeding it back in gives the same
+ * configuration, and resolving that again the same text: a resolved text read back keeps
+ * its "# where" comments as provenance. *text is malloc'ed. */
 int mpm_config_resolved_text(const mpm_config *cfg, char **text);
 
 #endif

@@ -17,6 +17,7 @@
   X(MPM_ERR_HDF5, "HDF5 call failed")                                                              \
   X(MPM_ERR_SUNDIALS, "SUNDIALS call failed")                                                      \
   X(MPM_ERR_UNPHYSICAL, "unphysical state")                                                        \
+  X(MPM_ERR_INTERRUPTED, "stopped by a signal")                                                    \
   X(MPM_ERR_INTERNAL, "internal error")
 
 typedef enum {
@@ -64,12 +65,21 @@ int mpm_trace(const char *file, int line, const char *func, int code);
     if (mpm_rc_ < 0) MPM_FAIL(MPM_ERR_SUNDIALS, "%s failed with flag %d", #expr, mpm_rc_);         \
   } while (0)
 
+/* What a user is told when memory runs out (the code location is in the debug traceback). */
+#define MPM_OOM_MESSAGE                                                                            \
+  "out of memory: %.4g MB more could not be allocated on this rank; the case needs more "          \
+  "memory than each rank has: coarsen grid.dx, use fewer particles per cell, or run on more "      \
+  "ranks or nodes"
+
+/* Fail with MPM_ERR_MEMORY and the message above, for an allocation of `bytes`. */
+#define MPM_FAIL_OOM(bytes) MPM_FAIL(MPM_ERR_MEMORY, MPM_OOM_MESSAGE, (double)(bytes) / 1e6)
+
 /* Allocation that fails with MPM_ERR_MEMORY. */
 #define MPM_ALLOC(ptr, count)                                                                      \
   do {                                                                                             \
     size_t mpm_n_ = (size_t)(count);                                                               \
     (ptr) = calloc(mpm_n_ ? mpm_n_ : 1, sizeof(*(ptr)));                                           \
-    if (!(ptr)) MPM_FAIL(MPM_ERR_MEMORY, "cannot allocate %zu items for %s", mpm_n_, #ptr);        \
+    if (!(ptr)) MPM_FAIL(MPM_ERR_MEMORY, MPM_OOM_MESSAGE, (double)mpm_n_ * sizeof(*(ptr)) / 1e6);  \
   } while (0)
 
 #include "mpm_log.h"

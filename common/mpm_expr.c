@@ -3,7 +3,10 @@
 
 #include "mpm_error.h"
 
+#include <limits.h>
+#include <math.h>
 #include <matheval.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -73,4 +76,56 @@ double mpm_expr_eval(const mpm_expr *e, int c, const double *x) {
   char *names[3] = {"x", "y", "z"}; /* libmatheval takes non-const names */
   double v[3] = {x[0], x[1], x[2]};
   return evaluator_evaluate(e->f[c], 3, names, v);
+}
+
+const char *mpm_expr_value_text(double v, char *buf) {
+  if (isnan(v)) return "NaN";
+  if (isinf(v)) return v > 0 ? "+inf" : "-inf";
+  snprintf(buf, 32, "%g", v);
+  return buf;
+}
+
+/* The first point of this rank where a component is not finite: its index, or -1. */
+static mpm_lidx first_bad(const mpm_expr *e, int dim, mpm_lidx n, const double *x,
+                          const unsigned char *keep, int *comp, double *value) {
+  for (mpm_lidx i = 0; i < n; ++i) {
+    if (keep && !keep[i]) continue;
+    double xp[3] = {0, 0, 0};
+    for (int d = 0; d < dim; ++d) xp[d] = x[(size_t)d * (size_t)n + (size_t)i];
+    for (int c = 0; c < e->ncomp; ++c) {
+      double v = mpm_expr_eval(e, c, xp);
+      if (!isfinite(v)) {
+        *comp = c, *value = v;
+        return i;
+      }
+    }
+  }
+  return -1;
+}
+
+int mpm_expr_check_finite(const mpm_expr *e, const mpm_config *cfg, const char *key, MPI_Comm comm,
+                          int dim, mpm_lidx n, const double *x, const unsigned char *keep) {
+  int rank, comp = 0, who;
+  double value = 0.0, info[5] = {0, 0, 0, 0, 0}; /* value, component, point */
+  MPM_CALL_MPI(MPI_Comm_rank(comm, &rank));
+  mpm_lidx i = first_bad(e, dim, n, x, keep, &comp, &value);
+  int mine = i >= 0 ? rank : INT_MAX;
+  MPM_CALL_MPI(MPI_Allreduce(&mine, &who, 1, MPI_INT, MPI_MIN, comm));
+  if (who == INT_MAX) return 0;
+  if (rank == who) {
+    info[0] = value, info[1] = comp;
+    for (int d = 0; d < dim; ++d) info[2 + d] = x[(size_t)d * (size_t)n + (size_t)i];
+  }
+  MPM_CALL_MPI(MPI_Bcast(info, 5, MPI_DOUBLE, who, comm));
+  char vbuf[32], at[128], which[48] = "";
+  int k = snprintf(at, sizeof at, "(%g", info[2]);
+  for (int d = 1; d < dim && k > 0 && (size_t)k < sizeof at; ++d)
+    k += snprintf(at + k, sizeof at - (size_t)k, ", %g", info[2 + d]);
+  if (k > 0 && (size_t)k < sizeof at) snprintf(at + k, sizeof at - (size_t)k, ")");
+  if (e->ncomp > 1) snprintf(which, sizeof which, " in component %d", (int)info[1] + 1);
+  return mpm_config_fail(cfg, key,
+                         "gives %s%s at %s; the field must be finite wherever it is used: "
+                         "check for a division by zero, sqrt or log of a negative number or "
+                         "zero, or an overflow",
+                         mpm_expr_value_text(info[0], vbuf), which, at);
 }

@@ -11,6 +11,7 @@
 #define _POSIX_C_SOURCE 200809L
 #include "mpm_geometry.h"
 #include "mpm_error.h"
+#include "mpm_sdf.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -18,7 +19,8 @@
 #include <string.h>
 
 #define KEY_LEN       256
-#define MAX_BAD_LINES 10 /* polygon file lines reported before giving up */
+#define MAX_BAD_LINES 10    /* polygon file lines reported before giving up */
+#define MAX_VERTICES  20000 /* a polygon's vertices: the crossing check costs their square */
 
 const mpm_key_spec mpm_geometry_keys[] = {
     {"geometry.*.type", MPM_KEY_ENUM, NULL, 0, 0, 0, 0,
@@ -276,12 +278,17 @@ static int read_vertices(mpm_region *r, const build_ctx *ctx, const char *key, F
     double xy[2];
     ++lineno;
     if (is_blank(line)) continue;
-    if (parse_vertex(line, xy)) {
+    if (!parse_vertex(line, xy)) {
+      if (++bad <= MAX_BAD_LINES) {
+        line[strcspn(line, "\r\n")] = '\0';
+        mpm_config_fail(ctx->cfg, key, "%s:%d: expected a vertex \"x y\" or \"x,y\", got \"%s\"",
+                        path, lineno, line);
+      }
+    } else if (r->nv == MAX_VERTICES) {
+      rc = mpm_config_fail(ctx->cfg, key, "%s:%d: more than %d vertices; simplify the outline",
+                           path, lineno, MAX_VERTICES);
+    } else {
       rc = push_vertex(r, &cap, xy);
-    } else if (++bad <= MAX_BAD_LINES) {
-      line[strcspn(line, "\r\n")] = '\0';
-      mpm_config_fail(ctx->cfg, key, "%s:%d: expected a vertex \"x y\" or \"x,y\", got \"%s\"",
-                      path, lineno, line);
     }
   }
   free(line);
@@ -291,20 +298,23 @@ static int read_vertices(mpm_region *r, const build_ctx *ctx, const char *key, F
   return bad ? MPM_ERR_INPUT : 0;
 }
 
-static double polygon_area(const mpm_region *r) {
-  double a = 0.0;
-  for (int i = 0, j = r->nv - 1; i < r->nv; j = i++)
-    a += r->v[2 * j] * r->v[2 * i + 1] - r->v[2 * i] * r->v[2 * j + 1];
-  return 0.5 * a;
+int mpm_polygon_check(const mpm_config *cfg, const char *key, const double *xy, int nv) {
+  int i, j;
+  if (nv < 3) return mpm_config_fail(cfg, key, "a polygon needs at least 3 vertices, got %d", nv);
+  if (mpm_polygon_self_intersects(xy, nv, &i, &j))
+    return mpm_config_fail(cfg, key,
+                           "the outline crosses itself: edge %d (from vertex %d) meets edge %d; "
+                           "list the vertices in order around the shape",
+                           i + 1, i + 1, j + 1);
+  if (mpm_polygon_area(xy, nv) == 0.0)
+    return mpm_config_fail(cfg, key, "the vertices enclose no area (all collinear?)");
+  return 0;
 }
 
 /* Drop an explicit closing vertex (common in exported outlines), then check the shape. */
 static int check_polygon(mpm_region *r, const build_ctx *ctx, const char *key) {
   if (r->nv > 1 && r->v[0] == r->v[2 * r->nv - 2] && r->v[1] == r->v[2 * r->nv - 1]) --r->nv;
-  if (r->nv < 3)
-    return mpm_config_fail(ctx->cfg, key, "a polygon needs at least 3 vertices, found %d", r->nv);
-  if (polygon_area(r) == 0.0)
-    return mpm_config_fail(ctx->cfg, key, "the vertices enclose no area (all collinear?)");
+  MPM_CALL(mpm_polygon_check(ctx->cfg, key, r->v, r->nv));
   for (int i = 0; i < r->nv; ++i)
     for (int d = 0; d < 2; ++d) {
       r->lo[d] = i ? fmin(r->lo[d], r->v[2 * i + d]) : r->v[d];

@@ -23,6 +23,12 @@ extern const int mpm_geometry_nkeys;
 int mpm_region_from_config(mpm_region **r, const mpm_config *cfg, int dim, const char *name);
 void mpm_region_destroy(mpm_region **r);
 
+/* The checks every polygon outline of the case passes, with one message each naming key:
+ * at least 3 vertices, an outline that does not cross itself (inside tests and signed
+ * distances would be wrong), a non-zero area. xy holds nv (x, y) pairs without a repeated
+ * closing vertex. Shared by [geometry] polygons and the gas's polygon obstacles. */
+int mpm_polygon_check(const mpm_config *cfg, const char *key, const double *xy, int nv);
+
 /* 1 if x is inside (the boundary counts as inside). */
 int mpm_region_contains(const mpm_region *r, const double *x);
 /* Axis-aligned bounding box. */

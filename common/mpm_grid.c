@@ -57,7 +57,12 @@ static int count_cells(int dim, const double *lo, const double *hi, double dx, i
     FAIL_INPUT("grid: the cell size dx = %g must be positive and finite", dx);
   for (int d = 0; d < dim; ++d) {
     const double r = (hi[d] - lo[d]) / dx, n = nearbyint(r);
-    if (!(n >= 1) || n > INT_MAX / 4 || fabs(r - n) > 1e-9 * fabs(r))
+    if (r > INT_MAX / 4)
+      FAIL_INPUT("grid: the domain [%g, %g] along %c holds %.6g cells of size dx = %g, more than "
+                 "the %d cells per direction a grid can index; coarsen grid.dx or shrink the "
+                 "domain",
+                 lo[d], hi[d], g_axis[d], r, dx, INT_MAX / 4);
+    if (!(n >= 1) || fabs(r - n) > 1e-9 * fabs(r))
       FAIL_INPUT("grid: the domain [%g, %g] along %c holds %.12g cells of size dx = %g; it must "
                  "hold a positive whole number of cells: change the domain bounds or dx",
                  lo[d], hi[d], g_axis[d], r, dx);
@@ -66,21 +71,67 @@ static int count_cells(int dim, const double *lo, const double *hi, double dx, i
   return 0;
 }
 
-/* Ranks per direction: the caller's where given, MPI's choice where 0. */
-static int choose_nproc(int size, int dim, const int *nproc, int *dims) {
-  int given = 1, all = 1;
-  for (int d = 0; d < dim; ++d) {
-    dims[d] = nproc ? nproc[d] : 0;
-    if (dims[d] < 0) FAIL_INPUT("grid: %d ranks along %c", dims[d], g_axis[d]);
-    if (dims[d] > 0) given *= dims[d];
-    all = all && dims[d] > 0;
+/* Does a layout leave every rank at least `ghost` cells along each split or periodic
+ * direction (see check_cells_per_rank)? */
+static int layout_fits(const mpm_grid *g, const int *dims) {
+  for (int d = 0; d < g->dim; ++d)
+    if ((dims[d] > 1 || g->periodic[d]) && g->ncells[d] / dims[d] < g->ghost) return 0;
+  return 1;
+}
+
+/* The halo a layout exchanges: the cut faces, in cells (periodic axes are cut once more). */
+static double layout_cost(const mpm_grid *g, const int *dims) {
+  double cost = 0;
+  for (int d = 0; d < g->dim; ++d) {
+    double face = 1;
+    for (int e = 0; e < g->dim; ++e)
+      if (e != d) face *= g->ncells[e];
+    cost += (dims[d] - 1 + (g->periodic[d] && dims[d] > 1)) * face;
+  }
+  return cost;
+}
+
+/* Every layout with the given counts fixed whose product is size: keep the one that fits with
+ * the smallest halo (ties: the earlier axis gets more ranks, as MPI_Dims_create orders). */
+static void layout_search(const mpm_grid *g, int size, const int *fixed, int d, int *dims,
+                          int *best, double *best_cost) {
+  if (d == g->dim) {
+    if (size != 1 || !layout_fits(g, dims)) return;
+    const double c = layout_cost(g, dims);
+    if (c < *best_cost) {
+      *best_cost = c;
+      for (int e = 0; e < g->dim; ++e) best[e] = dims[e];
+    }
+    return;
+  }
+  for (int n = size; n >= 1; --n) {
+    if (size % n != 0 || (fixed[d] > 0 && n != fixed[d])) continue;
+    dims[d] = n;
+    layout_search(g, size / n, fixed, d + 1, dims, best, best_cost);
+  }
+}
+
+/* Ranks per direction: the caller's where given; elsewhere the layout with the smallest halo
+ * among those that leave every rank enough cells, so any rank count that can run the grid
+ * does. If none fits, MPI's balanced choice goes on to check_cells_per_rank, which says why. */
+static int choose_nproc(mpm_grid *g, int size, const int *nproc) {
+  int given = 1, all = 1, fixed[MPM_MAX_DIM] = {0, 0, 0}, dims[MPM_MAX_DIM] = {1, 1, 1};
+  for (int d = 0; d < g->dim; ++d) {
+    fixed[d] = nproc ? nproc[d] : 0;
+    if (fixed[d] < 0) FAIL_INPUT("grid: %d ranks along %c", fixed[d], g_axis[d]);
+    if (fixed[d] > 0) given *= fixed[d];
+    all = all && fixed[d] > 0;
   }
   if (all ? given != size : size % given != 0)
     FAIL_INPUT("grid: the requested ranks per direction (product %d) do not fit the %d ranks "
                "of the run; give counts whose product is the number of ranks, or 0 to let MPI "
                "choose",
                given, size);
-  MPM_CALL_MPI(MPI_Dims_create(size, dim, dims));
+  double cost = HUGE_VAL;
+  layout_search(g, size, fixed, 0, dims, g->nproc, &cost);
+  if (cost < HUGE_VAL) return 0;
+  for (int d = 0; d < g->dim; ++d) g->nproc[d] = fixed[d];
+  MPM_CALL_MPI(MPI_Dims_create(size, g->dim, g->nproc));
   return 0;
 }
 
@@ -121,7 +172,7 @@ static int make_comm(mpm_grid *g, MPI_Comm comm) {
  * of a non-periodic axis own the pad layers (and node ncells), those of a periodic one
  * do not. */
 static int make_layout(mpm_grid *g) {
-  long long nnodes = 1;
+  double nnodes = 1; /* a double: the product of huge extents must not overflow */
   for (int d = 0; d < g->dim; ++d) {
     const int np = g->nproc[d], c = g->coord[d];
     MPM_ALLOC(g->cell_split[d], np + 1);
@@ -135,9 +186,9 @@ static int make_layout(mpm_grid *g) {
   }
   if (nnodes > INT32_MAX)
     MPM_FAIL(MPM_ERR_INPUT,
-             "grid: %lld nodes on one rank exceed the local index range; use more ranks or a "
-             "coarser grid",
-             nnodes);
+             "grid: %.6g nodes on one rank exceed the local index range (%d); use more ranks or "
+             "a coarser grid.dx",
+             nnodes, INT32_MAX);
   g->nnodes = (mpm_lidx)nnodes;
   return 0;
 }
@@ -156,7 +207,7 @@ static int grid_setup(mpm_grid *g, MPI_Comm comm, const double *lo, const double
   int size;
   MPM_CALL(count_cells(g->dim, lo, hi, dx, g->ncells));
   MPM_CALL_MPI(MPI_Comm_size(comm, &size));
-  MPM_CALL(choose_nproc(size, g->dim, nproc, g->nproc));
+  MPM_CALL(choose_nproc(g, size, nproc));
   MPM_CALL(check_cells_per_rank(g));
   for (int d = 0; d < g->dim; ++d) g->lo[d] = lo[d], g->hi[d] = hi[d];
   g->dx = dx;

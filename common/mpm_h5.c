@@ -4,7 +4,26 @@
  * MPI_Allreduce, and the stage's collective HDF5 call runs only where every rank is ready
  * for it, so a local failure never leaves the other ranks waiting inside HDF5. The last
  * stage is agreed on too, so every helper returns the same code on every rank. */
+#define _POSIX_C_SOURCE 200809L /* statvfs */
 #include "mpm_h5.h"
+
+#include <errno.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/statvfs.h>
+#include <unistd.h>
+
+/* While mpm_h5_write_file runs, the helpers record what failed here instead of logging, so
+ * that the user reads one line that names the file and the cause. */
+static struct {
+  int active;
+  char what[160]; /* the first object that failed, e.g. "dataset 'data'" */
+  int err;        /* errno just after the first failure on this rank */
+  int checksums;  /* the file being written gets checksums */
+} g_write;
 
 int mpm_h5_agree(MPI_Comm comm, int rc) {
   int worst = rc;
@@ -17,16 +36,65 @@ static int stage(MPI_Comm comm, int failed) {
   return mpm_h5_agree(comm, failed ? MPM_ERR_HDF5 : 0);
 }
 
+unsigned long long mpm_h5_hash(unsigned long long h, const void *s, size_t n) {
+  const unsigned char *b = s;
+  for (size_t k = 0; k < n; ++k) h = (h ^ b[k]) * 0x100000001b3ULL;
+  return h;
+}
+
+static herr_t blames_checksum(unsigned n, const H5E_error2_t *e, void *found) {
+  (void)n;
+  if (e->desc && (strstr(e->desc, "checksum") || strstr(e->desc, "Checksum"))) *(int *)found = 1;
+  return 0;
+}
+
+int mpm_h5_error_is_checksum(void) {
+  int found = 0;
+  H5Ewalk2(H5E_DEFAULT, H5E_WALK_DOWNWARD, blames_checksum, &found);
+  return found;
+}
+
+void mpm_h5_quiet_begin(mpm_h5_quiet *saved) {
+  H5Eget_auto2(H5E_DEFAULT, &saved->func, &saved->data);
+  H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
+}
+
+void mpm_h5_quiet_end(const mpm_h5_quiet *saved) {
+  H5Eset_auto2(H5E_DEFAULT, saved->func, saved->data);
+}
+
+/* A helper's failure: recorded for mpm_h5_write_file's one line, or explained at once
+ * outside it. */
+static int write_failed(const mpm_h5 *h, int rc, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+static int write_failed(const mpm_h5 *h, int rc, const char *fmt, ...) {
+  char what[160];
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(what, sizeof what, fmt, ap);
+  va_end(ap);
+  if (g_write.active) {
+    if (!g_write.what[0]) snprintf(g_write.what, sizeof g_write.what, "%s", what);
+    return rc;
+  }
+  if (h->rank == 0) mpm_log_all(MPM_LOG_ERROR, "cannot write the %s %s", h->what, what);
+  return rc;
+}
+
 /* ---- files ----------------------------------------------------------------------------- */
 
 /* Create or open path on every rank of comm. Collective metadata writes let HDF5 flush its
  * metadata cache in one collective write; they are harmless for a read-only file, which
  * has no metadata to write. HDF5's error stack is silenced: the caller says what went
  * wrong in words a user can act on. */
-static hid_t file_access(MPI_Comm comm, const char *path, int create) {
+static hid_t file_access(MPI_Comm comm, const char *path, int create, int checksums) {
   const hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
-  const int ready = fapl >= 0 && H5Pset_fapl_mpio(fapl, comm, MPI_INFO_NULL) >= 0 &&
-                    H5Pset_coll_metadata_write(fapl, 1) >= 0;
+  /* The 1.10 format checksums the superblock, every object header and the chunk indexes
+   * (fixed arrays, single-chunk); the 1.8 one would still index chunks by v1 B-trees. */
+  const int ready =
+      fapl >= 0 && H5Pset_fapl_mpio(fapl, comm, MPI_INFO_NULL) >= 0 &&
+      H5Pset_coll_metadata_write(fapl, 1) >= 0 &&
+      (!checksums || H5Pset_libver_bounds(fapl, H5F_LIBVER_V110, H5F_LIBVER_V110) >= 0);
   hid_t file = -1;
   if (!stage(comm, !ready)) {
     H5E_auto2_t func;
@@ -45,22 +113,96 @@ static hid_t file_access(MPI_Comm comm, const char *path, int create) {
 }
 
 hid_t mpm_h5_open(MPI_Comm comm, const char *path) {
-  return file_access(comm, path, 0);
+  return file_access(comm, path, 0, 0);
+}
+
+/* The directory part of path (malloc'ed), "." for a bare name. */
+static char *parent_dir(const char *path) {
+  char *dir = malloc(strlen(path) + 2);
+  if (!dir) return NULL;
+  strcpy(dir, path);
+  char *slash = strrchr(dir, '/');
+  if (!slash)
+    strcpy(dir, ".");
+  else if (slash == dir)
+    dir[1] = 0;
+  else
+    *slash = 0;
+  return dir;
+}
+
+/* Rank 0's one line for a failed write: the file, what failed, the likely cause. err is the
+ * largest errno over the ranks (MPI-IO does not always leave a meaningful one). */
+static void explain_write_failure(const mpm_h5 *h, const char *path, const char *what, int err) {
+  char *dir = parent_dir(path), cause[320];
+  struct statvfs fs;
+  struct stat st;
+  const long long avail =
+      dir && statvfs(dir, &fs) == 0 ? (long long)fs.f_bavail * (long long)fs.f_frsize : -1;
+  if (err == ENOSPC || err == EDQUOT || (avail >= 0 && avail < (1LL << 20)))
+    snprintf(cause, sizeof cause,
+             "the file system is full (%lld bytes free%s); free some space or write the output "
+             "elsewhere (output.dir)",
+             avail, err == EDQUOT ? ", or the disk quota is exhausted" : "");
+  else if (!what[0] && stat(path, &st) == 0 && S_ISDIR(st.st_mode))
+    snprintf(cause, sizeof cause, "a directory of that name is in the way; move it");
+  else if (!what[0] && (!dir || access(dir, W_OK) != 0))
+    snprintf(cause, sizeof cause, "its directory %s is missing or not writable (%s)",
+             dir ? dir : "", strerror(errno));
+  else if (err == EACCES || err == EROFS || err == EIO || err == EFBIG)
+    snprintf(cause, sizeof cause, "%s; check the disk and the permissions of its directory",
+             strerror(err));
+  else
+    snprintf(cause, sizeof cause,
+             "HDF5 could not write it (%lld bytes free); check the disk and the permissions of "
+             "its directory",
+             avail);
+  mpm_log_all(MPM_LOG_ERROR,
+              "cannot write the %s %s (%s): %s. Any earlier file of the same name is left as it "
+              "was",
+              h->what, path, what[0] ? what : "creating the file", cause);
+  free(dir);
+}
+
+static int write_file(const mpm_h5 *h, const char *path, mpm_h5_fill fill, const void *arg,
+                      int checksums) {
+  mpm_h5_quiet quiet;
+  mpm_h5_quiet_begin(&quiet);
+  g_write.active = 1, g_write.what[0] = 0, g_write.err = 0, g_write.checksums = checksums;
+  errno = 0;
+  const hid_t file = file_access(h->comm, path, 1, checksums);
+  int rc = file < 0 ? MPM_ERR_FILE : 0;
+  if (file < 0) g_write.err = errno;
+  if (file >= 0) {
+    rc = fill(h, file, arg);
+    if (rc && !g_write.err) g_write.err = errno;
+    errno = 0;
+    const int closed = mpm_h5_agree(h->comm, H5Fclose(file) < 0 ? MPM_ERR_FILE : 0);
+    if (closed && !rc) {
+      rc = closed;
+      if (!g_write.err) g_write.err = errno;
+      snprintf(g_write.what, sizeof g_write.what, "flushing it on close");
+    }
+  }
+  const int recorded = g_write.what[0] || file < 0;
+  g_write.active = 0, g_write.checksums = 0;
+  mpm_h5_quiet_end(&quiet);
+  /* errno is local; the largest one is as good a guess as any rank's. */
+  int err = g_write.err, any = recorded;
+  MPI_Allreduce(MPI_IN_PLACE, &err, 1, MPI_INT, MPI_MAX, h->comm);
+  MPI_Allreduce(MPI_IN_PLACE, &any, 1, MPI_INT, MPI_MAX, h->comm);
+  if (rc && any && h->rank == 0) explain_write_failure(h, path, g_write.what, err);
+  MPM_CALL(rc);
+  return 0;
 }
 
 int mpm_h5_write_file(const mpm_h5 *h, const char *path, mpm_h5_fill fill, const void *arg) {
-  const hid_t file = file_access(h->comm, path, 1);
-  if (file < 0)
-    MPM_FAIL_ON_ROOT(h->rank, MPM_ERR_FILE,
-                     "cannot create the %s %s: check that its directory exists and is "
-                     "writable, and that the disk is not full",
-                     h->what, path);
-  const int rc = fill(h, file, arg);
-  const int closed = mpm_h5_agree(h->comm, H5Fclose(file) < 0 ? MPM_ERR_FILE : 0);
-  if (closed && !rc)
-    MPM_FAIL_ON_ROOT(h->rank, closed, "cannot finish the %s %s (is the disk full?)", h->what, path);
-  MPM_CALL(rc);
-  return 0;
+  return write_file(h, path, fill, arg, 0);
+}
+
+int mpm_h5_write_file_checksummed(const mpm_h5 *h, const char *path, mpm_h5_fill fill,
+                                  const void *arg) {
+  return write_file(h, path, fill, arg, 1);
 }
 
 /* ---- attributes and groups ------------------------------------------------------------- */
@@ -85,7 +227,8 @@ int mpm_h5_attr(const mpm_h5 *h, hid_t loc, const char *name, hid_t type, int n,
   if (!rc) rc = stage(h->comm, H5Awrite(a, type, value) < 0);
   if (a >= 0) H5Aclose(a);
   if (space >= 0) H5Sclose(space);
-  if (rc) MPM_FAIL_ON_ROOT(h->rank, rc, "cannot write the %s attribute '%s'", h->what, name);
+  if (rc)
+    return mpm_trace(__FILE__, __LINE__, __func__, write_failed(h, rc, "attribute '%s'", name));
   return 0;
 }
 
@@ -103,7 +246,7 @@ int mpm_h5_group(const mpm_h5 *h, hid_t loc, const char *name, hid_t *group) {
   if (rc) {
     if (*group >= 0) H5Gclose(*group);
     *group = -1;
-    MPM_FAIL_ON_ROOT(h->rank, rc, "cannot create the %s group '%s'", h->what, name);
+    return mpm_trace(__FILE__, __LINE__, __func__, write_failed(h, rc, "group '%s'", name));
   }
   return 0;
 }
@@ -112,9 +255,10 @@ int mpm_h5_group(const mpm_h5 *h, hid_t loc, const char *name, hid_t *group) {
 
 /* Collective transfer of this rank's block [start, start + count) of dset (which may be
  * invalid on this rank: a failed open or create) to or from the contiguous buffer buf. A
- * rank with an empty block selects nothing but still takes part. */
+ * rank with an empty block selects nothing but still takes part. On a failed read,
+ * *checksum (if not NULL) says, on every rank, whether any rank's HDF5 blamed a checksum. */
 static int block_io(MPI_Comm comm, hid_t dset, int write, hid_t mtype, int rank,
-                    const hsize_t *start, const hsize_t *count, void *buf) {
+                    const hsize_t *start, const hsize_t *count, void *buf, int *checksum) {
   static double dummy; /* a valid pointer for an empty transfer */
   hsize_t n = 1, one = 1;
   for (int d = 0; d < rank; ++d) n *= count[d];
@@ -126,14 +270,17 @@ static int block_io(MPI_Comm comm, hid_t dset, int write, hid_t mtype, int rank,
   if (st >= 0) st = H5Pset_dxpl_mpio(dxpl, H5FD_MPIO_COLLECTIVE);
   if (st >= 0 && n) st = H5Sselect_hyperslab(fspace, H5S_SELECT_SET, start, NULL, count, NULL);
   if (st >= 0 && !n) st = H5Sselect_none(fspace) < 0 || H5Sselect_none(mspace) < 0 ? -1 : 0;
-  int rc = stage(comm, st < 0);
+  int rc = stage(comm, st < 0), bad_sum = 0;
   /* An empty dataset has no storage: even an empty collective transfer would fail on it.
    * Every rank sees the same extents, so all skip it together. */
   if (!rc && total > 0) {
     void *p = n ? buf : &dummy;
     st = write ? H5Dwrite(dset, mtype, mspace, fspace, dxpl, p)
                : H5Dread(dset, mtype, mspace, fspace, dxpl, p);
+    if (st < 0) bad_sum = mpm_h5_error_is_checksum();
+    if (st < 0 && write) g_write.err = errno;
     rc = stage(comm, st < 0);
+    if (rc && !write && checksum) *checksum = mpm_h5_agree(comm, bad_sum);
   }
   if (dxpl >= 0) H5Pclose(dxpl);
   if (mspace >= 0) H5Sclose(mspace);
@@ -141,22 +288,50 @@ static int block_io(MPI_Comm comm, hid_t dset, int write, hid_t mtype, int rank,
   return rc;
 }
 
+/* Chunks of at most CHUNK_MAX elements, whole along the last (fastest) dimensions. */
+#define CHUNK_MAX 65536
+
+/* The creation properties of a dataset of extents fdims: checksummed chunks if the file
+ * being written asks for them and the dataset has any element (an empty one has no storage
+ * to protect). */
+static hid_t dataset_create_plist(int rank, const hsize_t *fdims) {
+  hsize_t chunk[8], below = 1, total = 1;
+  for (int d = 0; d < rank; ++d) total *= fdims[d];
+  if (!g_write.checksums || total == 0 || rank > 8) return H5Pcopy(H5P_DATASET_CREATE_DEFAULT);
+  for (int d = rank - 1; d >= 0; --d) {
+    const hsize_t room = below < CHUNK_MAX ? CHUNK_MAX / below : 1;
+    chunk[d] = fdims[d] < room ? fdims[d] : room;
+    below *= chunk[d];
+  }
+  const hid_t dcpl = H5Pcreate(H5P_DATASET_CREATE);
+  /* Every element is written at once: no fill values to write first. */
+  if (dcpl >= 0 && (H5Pset_chunk(dcpl, rank, chunk) < 0 || H5Pset_fletcher32(dcpl) < 0 ||
+                    H5Pset_fill_time(dcpl, H5D_FILL_TIME_NEVER) < 0 ||
+                    H5Pset_alloc_time(dcpl, H5D_ALLOC_TIME_EARLY) < 0)) {
+    H5Pclose(dcpl);
+    return -1;
+  }
+  return dcpl;
+}
+
 int mpm_h5_write_block(const mpm_h5 *h, hid_t loc, const char *name, hid_t ftype, hid_t mtype,
                        int rank, const hsize_t *fdims, const hsize_t *start, const hsize_t *count,
                        const void *buf) {
   const hid_t space = H5Screate_simple(rank, fdims, NULL);
-  int rc = stage(h->comm, space < 0);
-  const hid_t dset =
-      rc ? -1 : H5Dcreate2(loc, name, ftype, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+  const hid_t dcpl = dataset_create_plist(rank, fdims);
+  int rc = stage(h->comm, space < 0 || dcpl < 0);
+  const hid_t dset = rc ? -1 : H5Dcreate2(loc, name, ftype, space, H5P_DEFAULT, dcpl, H5P_DEFAULT);
   /* block_io's first stage takes in whether the create succeeded here. */
-  if (!rc) rc = block_io(h->comm, dset, 1, mtype, rank, start, count, (void *)buf);
+  if (!rc) rc = block_io(h->comm, dset, 1, mtype, rank, start, count, (void *)buf, NULL);
   if (dset >= 0) H5Dclose(dset);
+  if (dcpl >= 0) H5Pclose(dcpl);
   if (space >= 0) H5Sclose(space);
-  if (rc) MPM_FAIL_ON_ROOT(h->rank, rc, "cannot write the %s dataset '%s'", h->what, name);
+  if (rc) return mpm_trace(__FILE__, __LINE__, __func__, write_failed(h, rc, "dataset '%s'", name));
   return 0;
 }
 
 int mpm_h5_read_block(MPI_Comm comm, hid_t dset, hid_t mtype, int rank, const hsize_t *start,
-                      const hsize_t *count, void *buf) {
-  return block_io(comm, dset, 0, mtype, rank, start, count, buf);
+                      const hsize_t *count, void *buf, int *checksum) {
+  if (checksum) *checksum = 0;
+  return block_io(comm, dset, 0, mtype, rank, start, count, buf, checksum);
 }

@@ -14,8 +14,17 @@
  * - A failure every rank meets at once is explained by rank 0 only (MPM_FAIL_ON_ROOT); a
  *   purely local failure is explained by the rank that met it.
  * - Files are opened through the MPI-IO driver with collective metadata writes, and with
- *   HDF5's own error stack silenced while opening, so the caller's message is the one the
- *   user reads. Metadata reads stay independent: reading attributes needs no agreement. */
+ *   HDF5's own error stack silenced while opening and while a file is written, so the
+ *   caller's message is the one the user reads. Metadata reads stay independent: reading
+ *   attributes needs no agreement.
+ * - A file written with checksums (checkpoints) uses the HDF5 1.10 file format, whose
+ *   superblock, object headers (attributes included) and chunk indexes all carry
+ *   checksums, and stores every non-empty dataset chunked with the Fletcher32 filter, so
+ *   HDF5 itself refuses to return altered bytes. Variable-length strings live in the global
+ *   heap, which has no checksum: the caller protects those (mpm_h5_hash).
+ * - A failed write is explained in one line by mpm_h5_write_file, naming the file, the
+ *   object that failed and the likely cause (a full file system, from statvfs and errno);
+ *   the helpers it runs stay silent. */
 #ifndef MPM_H5_H
 #define MPM_H5_H
 
@@ -23,6 +32,7 @@
 
 #include <hdf5.h>
 #include <mpi.h>
+#include <stddef.h>
 
 /* A failure every rank meets at once: rank 0 explains it and the others only return the
  * code, so the user reads the message once. */
@@ -43,12 +53,36 @@ typedef struct mpm_h5 {
   const char *what; /* the kind of file, for messages: "snapshot", "checkpoint" */
 } mpm_h5;
 
+/* A 64-bit FNV-1a hash of the n bytes at s, continuing from h (start with MPM_H5_HASH0):
+ * what protects the strings of a checkpoint, which HDF5 keeps in the unchecksummed global
+ * heap. */
+#define MPM_H5_HASH0 0xcbf29ce484222325ULL
+unsigned long long mpm_h5_hash(unsigned long long h, const void *s, size_t n);
+
+/* After a failed HDF5 call (before any other): 1 if HDF5's error stack blames a checksum,
+ * i.e. the bytes in the file were altered. */
+int mpm_h5_error_is_checksum(void);
+
+/* Silence HDF5's automatic error printing (*saved keeps the handler), or restore it. */
+typedef struct mpm_h5_quiet {
+  H5E_auto2_t func;
+  void *data;
+} mpm_h5_quiet;
+void mpm_h5_quiet_begin(mpm_h5_quiet *saved);
+void mpm_h5_quiet_end(const mpm_h5_quiet *saved);
+
 /* Fills a freshly created file; returns an agreed code. */
 typedef int (*mpm_h5_fill)(const mpm_h5 *h, hid_t file, const void *arg);
 
 /* Create path (truncating it), fill it and close it. Returns once every rank has closed the
- * file, so the agreement doubles as a barrier: rank 0 may then rename it. */
+ * file, so the agreement doubles as a barrier: rank 0 may then rename it. A failure of the
+ * helpers below (a full disk) is reported here, once, as one line. */
 int mpm_h5_write_file(const mpm_h5 *h, const char *path, mpm_h5_fill fill, const void *arg);
+
+/* The same with checksums: the 1.10 file format (checksummed metadata) and every non-empty
+ * dataset that fill writes chunked with the Fletcher32 filter. */
+int mpm_h5_write_file_checksummed(const mpm_h5 *h, const char *path, mpm_h5_fill fill,
+                                  const void *arg);
 
 /* Open path read-only; the same file on every rank, or -1 on every rank (without a
  * message: the caller says what went wrong). */
@@ -75,8 +109,9 @@ int mpm_h5_write_block(const mpm_h5 *h, hid_t loc, const char *name, hid_t ftype
                        const void *buf);
 
 /* Read this rank's block [start, start + count) of dset into buf. 0, or MPM_ERR_HDF5 on
- * every rank without a message. */
+ * every rank without a message; then *checksum (may be NULL) is 1 on every rank if HDF5
+ * found a checksum mismatch on any rank. */
 int mpm_h5_read_block(MPI_Comm comm, hid_t dset, hid_t mtype, int rank, const hsize_t *start,
-                      const hsize_t *count, void *buf);
+                      const hsize_t *count, void *buf, int *checksum);
 
 #endif

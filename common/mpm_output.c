@@ -349,7 +349,9 @@ static int snapshot_write(mpm_output *out, snapshot *s) {
   int rc = snapshot_paths(out, &tmp, &final);
   s->buf = rc ? NULL : malloc(buffer_size(s->phases, s->nphases, s->grid) * sizeof(double));
   if (!s->buf && !rc) rc = MPM_ERR_MEMORY;
-  if (rc) mpm_log_all(MPM_LOG_ERROR, "output: cannot allocate the snapshot buffers");
+  if (rc)
+    mpm_log_all(MPM_LOG_ERROR, MPM_OOM_MESSAGE,
+                (double)buffer_size(s->phases, s->nphases, s->grid) * sizeof(double) / 1e6);
   rc = mpm_h5_agree(out->comm, rc);
   const mpm_h5 h = {out->comm, out->rank, "snapshot"};
   if (!rc) rc = mpm_h5_write_file(&h, tmp, write_contents, s);

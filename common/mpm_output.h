@@ -12,9 +12,16 @@
  * atomically after each snapshot, so it is valid XML at every moment.
  *
  * Checkpoint (any path; written to PATH.tmp, then renamed by rank 0 once complete):
- *   /  attributes config (string), nranks (int), and named double attributes from the caller
+ *   /  attributes format ("mpmfsi checkpoint 2"), config (string), text_hash (uint64, FNV-1a
+ *      of format and config), nranks (int), and named double attributes from the caller
  *   /<phase>/id int64 [N], /<phase>/data double [ncomp][N] (component-major, rank order),
- *   /<phase>/counts int64 [nranks] particles per writing rank, /<phase> attribute id_next. */
+ *   /<phase>/counts int64 [nranks] particles per writing rank, /<phase> attributes dim,
+ *   field_names, field_ncomp, text_hash (of field_names), id_next.
+ *   HDF5 1.10 file format (checksummed superblock, object headers and chunk indexes); every
+ *   non-empty dataset chunked with the Fletcher32 filter. A reader refuses altered bytes and
+ *   invalid contents (non-finite values, a negative step or h_next, ids repeated or not
+ *   below id_next, fields outside their module's ranges) as MPM_ERR_INPUT with one line
+ *   naming the file; format-1 files (no checksums) are still read and validated. */
 #ifndef MPM_OUTPUT_H
 #define MPM_OUTPUT_H
 
@@ -45,8 +52,10 @@ int mpm_checkpoint_write(MPI_Comm comm, const char *path, const char *config_tex
 
 typedef struct mpm_checkpoint mpm_checkpoint;
 
-/* Open a checkpoint for reading (collective); a missing or foreign file is an input error
- * naming the path. */
+/* Open a checkpoint for reading (collective); a missing, foreign or damaged file is an input
+ * error naming the path. Checks the root: format, the strings' hash, every real attribute
+ * finite, "step" a whole number >= 0, "h_next" >= 0. HDF5's error printing stays off until
+ * mpm_checkpoint_close. */
 int mpm_checkpoint_open(mpm_checkpoint **ck, MPI_Comm comm, const char *path);
 void mpm_checkpoint_close(mpm_checkpoint **ck);
 const char *mpm_checkpoint_config(const mpm_checkpoint *ck);
@@ -55,7 +64,9 @@ int mpm_checkpoint_attr(const mpm_checkpoint *ck, const char *name, double *valu
 int mpm_checkpoint_attr_optional(const mpm_checkpoint *ck, const char *name, double *value);
 /* Fill p (already created with the fields of the phase) with the stored particles: on the
  * same number of ranks each rank gets exactly what it wrote, in the same order; otherwise
- * the ranks get even chunks and the caller migrates. Sets p->id_next. Collective. */
+ * the ranks get even chunks and the caller migrates. Sets p->id_next. Data that fails its
+ * checksum or validation (p's field ranges, ids unique over all ranks) is an input error on
+ * every rank, explained once. Collective. */
 int mpm_checkpoint_read_particles(mpm_checkpoint *ck, const char *phase, mpm_particles *p);
 
 #endif

@@ -101,7 +101,7 @@ static int block_alloc(const mpm_particles *p, mpm_lidx n, mpm_gidx **id, double
   *data = calloc((size_t)p->ncomp * (size_t)n + 1, sizeof **data);
   if (!*data) {
     free(*id), *id = NULL;
-    MPM_FAIL(MPM_ERR_MEMORY, "particles: cannot allocate %d particles", (int)n);
+    MPM_FAIL_OOM((double)p->ncomp * (double)n * sizeof **data);
   }
   return 0;
 }
@@ -205,7 +205,7 @@ static void migration_free(migration *m) {
 static void *try_alloc(size_t n, size_t size, int *rc) {
   void *q = calloc(n ? n : 1, size);
   if (!q && !*rc) {
-    mpm_log_all(MPM_LOG_ERROR, "particles: cannot allocate %zu bytes", n * size);
+    mpm_log_all(MPM_LOG_ERROR, MPM_OOM_MESSAGE, (double)n * (double)size / 1e6);
     *rc = mpm_trace(__FILE__, __LINE__, __func__, MPM_ERR_MEMORY);
   }
   return q;
@@ -441,5 +441,108 @@ int mpm_particles_sort(mpm_particles *p, const mpm_grid *grid) {
   if (!rc) rc = sort_passes(p, grid, cell, perm, tmp, start);
   free(cell), free(perm), free(tmp), free(start);
   MPM_CALL(rc);
+  return 0;
+}
+
+/* ---- validation of data from outside the run ------------------------------------------- */
+
+void mpm_particles_set_range(mpm_particles *p, int f, double lo, double hi, int flags) {
+  if (f >= 0 && f < p->nfields) p->range[f] = (mpm_field_range){lo, hi, flags | MPM_FIELD_BOUNDED};
+}
+
+static int value_valid(const mpm_field_range *r, double v) {
+  if (!isfinite(v)) return 0;
+  if (!(r->flags & MPM_FIELD_BOUNDED)) return 1;
+  if (v > r->hi || v < r->lo) return 0;
+  if ((r->flags & MPM_FIELD_LO_OPEN) && v == r->lo) return 0;
+  return !(r->flags & MPM_FIELD_INTEGER) || v == floor(v);
+}
+
+static void describe_range(const mpm_field_range *r, char *s, size_t size) {
+  const char *kind = r->flags & MPM_FIELD_INTEGER ? "an integer" : "a finite value";
+  if (!(r->flags & MPM_FIELD_BOUNDED) || (r->lo == -HUGE_VAL && r->hi == HUGE_VAL))
+    snprintf(s, size, "%s", kind);
+  else if (r->hi == HUGE_VAL)
+    snprintf(s, size, "%s %s %g", kind, r->flags & MPM_FIELD_LO_OPEN ? ">" : ">=", r->lo);
+  else
+    snprintf(s, size, "%s in %c%g, %g]", kind, r->flags & MPM_FIELD_LO_OPEN ? '(' : '[', r->lo,
+             r->hi);
+}
+
+mpm_lidx mpm_particles_find_invalid(const mpm_particles *p, mpm_lidx n, const mpm_gidx *id,
+                                    const double *data, char *why, size_t size) {
+  for (mpm_lidx i = 0; i < n; ++i)
+    if (id[i] < 0) { /* ids beyond id_next are legal: the gas's inflow has its own ranges */
+      snprintf(why, size, "particle id %" PRId64 " is negative", (int64_t)id[i]);
+      return i;
+    }
+  /* Field by field: each component is one contiguous run. */
+  for (int f = 0; f < p->nfields; ++f)
+    for (int c = 0; c < p->field[f].ncomp; ++c) {
+      const double *v = data + (size_t)(p->offset[f] + c) * (size_t)n;
+      for (mpm_lidx i = 0; i < n; ++i)
+        if (!value_valid(&p->range[f], v[i])) {
+          char want[96];
+          describe_range(&p->range[f], want, sizeof want);
+          snprintf(why, size, "particle %" PRId64 " has %s[%d] = %.17g, but it must be %s",
+                   (int64_t)id[i], p->field[f].name, c, v[i], want);
+          return i;
+        }
+    }
+  return -1;
+}
+
+static int compare_gidx(const void *a, const void *b) {
+  const mpm_gidx x = *(const mpm_gidx *)a, y = *(const mpm_gidx *)b;
+  return (x > y) - (x < y);
+}
+
+/* The ids this rank checks (those with id % size == rank), sorted, in *mine (*nmine). */
+static int gather_by_owner(MPI_Comm comm, int size, const mpm_gidx *id, mpm_lidx n, mpm_gidx **mine,
+                           int *nmine) {
+  int *cnt = calloc(4 * (size_t)size, sizeof *cnt);
+  mpm_gidx *send = malloc(((size_t)n + 1) * sizeof *send);
+  int rc = cnt && send ? 0 : MPM_ERR_MEMORY;
+  int *displ = cnt ? cnt + size : NULL, *rcnt = cnt ? cnt + 2 * size : NULL,
+      *rdispl = cnt ? cnt + 3 * size : NULL;
+  for (mpm_lidx i = 0; !rc && i < n; ++i) cnt[id[i] % size]++;
+  if (!rc) prefix_sum(cnt, displ, size);
+  for (mpm_lidx i = 0; !rc && i < n; ++i) send[displ[id[i] % size]++] = id[i];
+  if (!rc) prefix_sum(cnt, displ, size);
+  int failed = rc;
+  MPI_Allreduce(MPI_IN_PLACE, &failed, 1, MPI_INT, MPI_MAX, comm);
+  if (!failed && MPI_Alltoall(cnt, 1, MPI_INT, rcnt, 1, MPI_INT, comm) != MPI_SUCCESS)
+    failed = MPM_ERR_MPI;
+  long long total = 0;
+  for (int r = 0; !failed && r < size; ++r) total += rcnt[r];
+  *mine = failed || total > INT32_MAX ? NULL : malloc(((size_t)total + 1) * sizeof **mine);
+  rc = failed ? failed : *mine ? 0 : MPM_ERR_MEMORY;
+  if (!failed) MPI_Allreduce(MPI_IN_PLACE, &rc, 1, MPI_INT, MPI_MAX, comm);
+  if (!rc) {
+    prefix_sum(rcnt, rdispl, size);
+    if (MPI_Alltoallv(send, cnt, displ, MPM_MPI_GIDX, *mine, rcnt, rdispl, MPM_MPI_GIDX, comm) !=
+        MPI_SUCCESS)
+      rc = MPM_ERR_MPI;
+  }
+  *nmine = (int)total;
+  free(cnt), free(send);
+  if (rc) free(*mine), *mine = NULL;
+  return rc;
+}
+
+int mpm_particles_find_duplicate(MPI_Comm comm, const mpm_gidx *id, mpm_lidx n, mpm_gidx *dup) {
+  int size;
+  MPM_CALL_MPI(MPI_Comm_size(comm, &size));
+  mpm_gidx *mine = NULL;
+  int nmine = 0;
+  *dup = -1;
+  MPM_CALL(gather_by_owner(comm, size, id, n, &mine, &nmine));
+  qsort(mine, (size_t)nmine, sizeof *mine, compare_gidx);
+  mpm_gidx first = INT64_MAX;
+  for (int k = 1; k < nmine && first == INT64_MAX; ++k)
+    if (mine[k] == mine[k - 1]) first = mine[k];
+  free(mine);
+  MPM_CALL_MPI(MPI_Allreduce(MPI_IN_PLACE, &first, 1, MPM_MPI_GIDX, MPI_MIN, comm));
+  *dup = first == INT64_MAX ? -1 : first;
   return 0;
 }

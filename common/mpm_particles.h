@@ -16,12 +16,24 @@
 #include "mpm_grid.h"
 #include "mpm_types.h"
 
+#include <stddef.h>
+
 #define MPM_PARTICLES_MAX_FIELDS 16
 
 typedef struct mpm_field_desc {
   const char *name;
   int ncomp;
 } mpm_field_desc;
+
+/* What a valid value of a field is, for data read from outside the run (a checkpoint):
+ * always finite, and with MPM_FIELD_BOUNDED (which mpm_particles_set_range adds) within
+ * [lo, hi], lo itself excluded with MPM_FIELD_LO_OPEN, and an integer with
+ * MPM_FIELD_INTEGER (an index or flag stored as a double). A zeroed range: any finite value. */
+enum { MPM_FIELD_INTEGER = 1, MPM_FIELD_LO_OPEN = 2, MPM_FIELD_BOUNDED = 4 };
+typedef struct mpm_field_range {
+  double lo, hi;
+  int flags;
+} mpm_field_range;
 
 typedef struct mpm_particles {
   int dim;
@@ -33,7 +45,8 @@ typedef struct mpm_particles {
   mpm_lidx n;                           /* particles on this rank */
   mpm_gidx *id;
   double *data;
-  mpm_gidx id_next; /* next free global id; equal on every rank */
+  mpm_gidx id_next;                                /* next free global id; equal on every rank */
+  mpm_field_range range[MPM_PARTICLES_MAX_FIELDS]; /* all reals unless the module narrows it */
 } mpm_particles;
 
 /* A set with no particles. The first nstate_fields fields are the state; fields 0 and 1
@@ -68,6 +81,22 @@ int mpm_particles_migrate(mpm_particles *p, const mpm_grid *grid, int *changed);
 
 /* Reorder the particles by the cell that contains them (x fastest), stably. Local. */
 int mpm_particles_sort(mpm_particles *p, const mpm_grid *grid);
+
+/* Narrow the valid values of field f (see mpm_field_range); the module that owns the set
+ * says what its fields mean. */
+void mpm_particles_set_range(mpm_particles *p, int f, double lo, double hi, int flags);
+
+/* Check n particles given as ids and component-major data (stride n) in p's layout: every
+ * id >= 0 (ids beyond id_next are legal: the gas's inflow hands out its own ranges) and
+ * every value valid for its field. Returns the index of the first
+ * invalid particle and describes it in why, or -1 if all are valid. Local. */
+mpm_lidx mpm_particles_find_invalid(const mpm_particles *p, mpm_lidx n, const mpm_gidx *id,
+                                    const double *data, char *why, size_t size);
+
+/* Are the n ids on each rank unique over all ranks? Sets *dup to the
+ * smallest id held twice, or -1, the same on every rank. O(N log N) over the ranks: each id
+ * is checked by the rank id % size. Collective. */
+int mpm_particles_find_duplicate(MPI_Comm comm, const mpm_gidx *id, mpm_lidx n, mpm_gidx *dup);
 
 /* Global particle count (collective). */
 int mpm_particles_global_count(const mpm_particles *p, MPI_Comm comm, mpm_gidx *count);

@@ -1,4 +1,5 @@
 /* The simulation object and its step loop (see mpm_sim.h). */
+#define _POSIX_C_SOURCE 200809L /* sigaction */
 #include "mpm_sim.h"
 
 #include "mpm_bc.h"
@@ -11,11 +12,14 @@
 #include "mpm_integrator.h"
 #include "mpm_output.h"
 #include "mpm_probe.h"
+#include "mpm_rundir.h"
 #include "mpm_timer.h"
 #include "fluid_module.h"
 #include "solid_module.h"
 
+#include <limits.h>
 #include <math.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -34,7 +38,10 @@ struct mpm_sim {
   mpm_coupling *coupling; /* NULL: one phase, or scheme = none */
   mpm_integrator *it;
   mpm_guard guard;
-  double energy; /* total energy at the last diagnostics row */
+  double energy;      /* total energy at the last diagnostics row */
+  mpm_rundir *rundir; /* the claim on the output folder, while the run writes */
+  double run_id;      /* the run's id, in its folder's run.id and its checkpoints */
+  char *checkpoint;   /* restart: the checkpoint it started from */
   mpm_output *out;
   mpm_diag *diag;
   mpm_diag *coupling_csv; /* coupling.csv, with a coupler only */
@@ -47,10 +54,10 @@ struct mpm_sim {
   long step;
   double out_interval, ckpt_interval;
   long out_next, ckpt_next; /* index k of the next output / checkpoint at time k * interval */
-  int sort_every, snapshots, grid_fields, progress;
+  int sort_every, snapshots, grid_fields, progress, overwrite, truncate;
   const char *dir;
-  int restarted;
   double particle_steps;
+  double progress_interval; /* s of wall time between progress log lines (not a terminal) */
 };
 
 static const mpm_key_spec sim_keys[] = {
@@ -59,7 +66,15 @@ static const mpm_key_spec sim_keys[] = {
      "how much to log; debug also prints the traceback of a failure", 0},
     {"run.log_all_ranks", MPM_KEY_BOOL, "false", 0, 0, 0, 0, NULL, "log on every rank", 0},
     {"run.progress", MPM_KEY_BOOL, "true", 0, 0, 0, 0, NULL,
-     "progress line with ETA when stderr is a terminal", 0},
+     "show progress: a live line with ETA when stderr is a terminal, otherwise a log line "
+     "every run.progress_interval seconds",
+     0},
+    {"run.progress_interval", MPM_KEY_REAL, "60", 0, HUGE_VAL, 0, 0, NULL,
+     "wall-clock seconds between progress log lines when stderr is not a terminal", 0},
+    {"run.max_steps", MPM_KEY_REAL, "1e8", 1, HUGE_VAL, 0, 0, NULL,
+     "refuse a run whose estimated step count (time to run / starting stable step) is larger; "
+     "raise it for a run that really needs more",
+     0},
     {"run.sort_every", MPM_KEY_INT, "20", 0, 1e9, 0, 0, NULL,
      "sort particles by cell every N steps (0: never)", 0},
     {"domain.dim", MPM_KEY_INT, "2", 2, 3, 0, 0, NULL, "spatial dimension, 2 or 3", 0},
@@ -93,6 +108,20 @@ static const mpm_key_spec sim_keys[] = {
      "add nodal mass and velocity to the snapshots", 0},
     {"output.checkpoint_interval", MPM_KEY_REAL, "0", 0, HUGE_VAL, 0, 0, NULL,
      "time between checkpoints, s (0: only at the end)", 0},
+    {"output.max_gb", MPM_KEY_REAL, "100", 0, HUGE_VAL, 0, 0, NULL,
+     "refuse a run whose estimated snapshots and checkpoints exceed this many GB; raise it "
+     "for a run that really writes more",
+     0},
+    {"output.max_files", MPM_KEY_REAL, "100000", 1, HUGE_VAL, 0, 0, NULL,
+     "refuse a run that would write more snapshots and checkpoints than this", 0},
+    {"output.overwrite", MPM_KEY_BOOL, "false", 0, 0, 0, 0, NULL,
+     "delete the results of an earlier run found in output.dir before writing (otherwise "
+     "such a folder is refused)",
+     0},
+    {"output.truncate", MPM_KEY_BOOL, "false", 0, 0, 0, 0, NULL,
+     "restart in the checkpoint's own folder although it holds later results: cut the run "
+     "back to the checkpoint (its later snapshots and checkpoints are deleted)",
+     0},
 };
 
 int mpm_sim_add_schema(mpm_config *cfg) {
@@ -142,6 +171,11 @@ static int build_grid(mpm_sim *s) {
   }
   for (int d = 0; d < dim; ++d) {
     const double cells = (hi[d] - lo[d]) / dx;
+    if (cells > INT_MAX / 4)
+      return mpm_config_fail(s->cfg, "grid.dx",
+                             "the domain length %g along axis %d holds %.6g cells of %g, more "
+                             "than the %d cells per axis a grid can index; coarsen grid.dx",
+                             hi[d] - lo[d], d, cells, dx, INT_MAX / 4);
     if (fabs(cells - round(cells)) > 1e-9 * cells)
       return mpm_config_fail(s->cfg, "grid.dx",
                              "the domain length %g along axis %d is not a whole number of cells "
@@ -172,9 +206,12 @@ static int read_run_settings(mpm_sim *s) {
   MPM_CALL(mpm_config_get_real(s->cfg, "output.checkpoint_interval", &s->ckpt_interval));
   MPM_CALL(mpm_config_get_int(s->cfg, "run.sort_every", &s->sort_every));
   MPM_CALL(mpm_config_get_bool(s->cfg, "run.progress", &s->progress));
+  MPM_CALL(mpm_config_get_real(s->cfg, "run.progress_interval", &s->progress_interval));
   MPM_CALL(mpm_config_get_bool(s->cfg, "output.snapshots", &s->snapshots));
   MPM_CALL(mpm_config_get_bool(s->cfg, "output.grid_fields", &s->grid_fields));
   MPM_CALL(mpm_config_get_string(s->cfg, "output.dir", &s->dir));
+  MPM_CALL(mpm_config_get_bool(s->cfg, "output.overwrite", &s->overwrite));
+  MPM_CALL(mpm_config_get_bool(s->cfg, "output.truncate", &s->truncate));
   if (s->out_interval <= 0) s->out_interval = s->t_end / 10;
   if (s->ckpt_interval <= 0) s->ckpt_interval = HUGE_VAL;
   return 0;
@@ -209,8 +246,14 @@ static const char *const g_coupling_cols3[] = {
     "Fz_fluid", "P_solid", "P_fluid", "P_net",    "W_net",    "gas_inside", "E_solid",  "E_fluid"};
 #define NCOUPLING(dim) ((dim) == 2 ? 14 : 16)
 
-static int open_outputs(mpm_sim *s, int append) {
+/* Claim the output folder (see mpm_rundir.h), then open the outputs in it: continued from the
+ * checkpoint's time when the run carries on its folder's record, new otherwise. */
+static int open_outputs(mpm_sim *s) {
   char path[4096];
+  int append;
+  const mpm_rundir_request req = {s->dir,        s->overwrite, s->truncate,
+                                  s->checkpoint, s->t,         s->run_id};
+  MPM_CALL(mpm_rundir_claim(&s->rundir, s->comm, &req, &append, &s->run_id));
   MPM_CALL(mpm_config_resolved_text(s->cfg, &s->config_text));
   MPM_CALL(mpm_output_new(&s->out, s->comm, s->dir, s->config_text, s->grid->dim, append, s->t));
   snprintf(path, sizeof path, "%s/diagnostics.csv", s->dir);
@@ -250,6 +293,73 @@ static int sim_alloc(mpm_sim **sp, mpm_config *cfg) {
   return build_grid(s);
 }
 
+/* ---- the run's budget ------------------------------------------------------------------ */
+
+/* Bytes of one snapshot or checkpoint: every particle's fields, and the grid fields. */
+static int output_bytes(const mpm_sim *s, double *bytes) {
+  double local = 0;
+  for (int k = 0; k < s->nmod; ++k)
+    local += 8.0 * s->mod[k]->particles->ncomp * s->mod[k]->particles->n;
+  MPM_CALL_MPI(MPI_Allreduce(&local, bytes, 1, MPI_DOUBLE, MPI_SUM, s->comm));
+  if (s->grid_fields) {
+    double nodes = 1;
+    for (int d = 0; d < s->grid->dim; ++d) nodes *= s->grid->ncells[d] + 1.0;
+    *bytes += 8.0 * nodes * (1 + s->grid->dim) * s->nmod;
+  }
+  return 0;
+}
+
+/* Refuse a run whose step count or output is absurd (a mistyped interval, t_end or dx), with
+ * the estimate and the key to change: before it starts, not once the disk is full. Checked
+ * by `check` too. The step count is estimated from the stable step of the starting state,
+ * the output from the particles it holds. */
+static int check_budget(mpm_sim *s) {
+  double h0, max_steps, max_gb, max_files, bytes;
+  MPM_CALL(mpm_config_get_real(s->cfg, "run.max_steps", &max_steps));
+  MPM_CALL(mpm_config_get_real(s->cfg, "output.max_gb", &max_gb));
+  MPM_CALL(mpm_config_get_real(s->cfg, "output.max_files", &max_files));
+  MPM_CALL(mpm_integrator_cfl_step(s->it, &h0));
+  /* Every output time ends a step too. */
+  const double span = s->t_end - s->t, nout = span / s->out_interval;
+  const double nck = isfinite(s->ckpt_interval) ? span / s->ckpt_interval : 0;
+  const double stable = h0 > 0 && isfinite(h0) ? span / h0 : 0, steps = stable + nout + nck;
+  const double nsnap = s->snapshots ? nout + 1 : 0, nckpt = nck + 1; /* and the final one */
+  if (stable > max_steps)
+    return mpm_config_fail(s->cfg, "time.t_end",
+                           "this run would take about %.3g steps (%.6g s to run at the starting "
+                           "stable step of %.3g s), more than run.max_steps = %.3g; shorten "
+                           "time.t_end or coarsen grid.dx, or raise run.max_steps if you mean it",
+                           stable, span, h0, max_steps);
+  MPM_CALL(output_bytes(s, &bytes));
+  const double gb = (nsnap + nckpt) * bytes / 1e9;
+  if (nsnap + nckpt > max_files)
+    return mpm_config_fail(s->cfg, nsnap > nckpt ? "output.interval" : "output.checkpoint_interval",
+                           "this run would write about %.3g snapshots and %.3g checkpoints "
+                           "(%.3g GB), more than output.max_files = %.3g; lengthen "
+                           "output.interval or output.checkpoint_interval, or raise "
+                           "output.max_files if you mean it",
+                           nsnap, nckpt, gb, max_files);
+  if (gb > max_gb)
+    return mpm_config_fail(s->cfg, nsnap > nckpt ? "output.interval" : "output.checkpoint_interval",
+                           "this run would write about %.3g GB (%.3g snapshots and %.3g "
+                           "checkpoints of %.3g MB), more than output.max_gb = %.3g; lengthen "
+                           "output.interval or output.checkpoint_interval, or raise "
+                           "output.max_gb if you mean it",
+                           gb, nsnap, nckpt, bytes / 1e6, max_gb);
+  if (steps > max_steps) /* the outputs' times force the steps */
+    return mpm_config_fail(s->cfg, "output.interval",
+                           "this run would take about %.3g steps, %.3g of them to reach output "
+                           "and checkpoint times, more than run.max_steps = %.3g; lengthen "
+                           "output.interval or output.checkpoint_interval, or raise "
+                           "run.max_steps if you mean it",
+                           steps, nout + nck, max_steps);
+  mpm_log(MPM_LOG_INFO,
+          "estimate: about %.3g steps (starting stable step %.6g s), %.3g snapshots and %.3g "
+          "checkpoints, %.3g GB",
+          steps, h0, nsnap, nckpt, gb);
+  return 0;
+}
+
 int mpm_sim_create(mpm_sim **sp, mpm_config *cfg) {
   MPM_CALL(sim_alloc(sp, cfg));
   mpm_sim *s = *sp;
@@ -257,7 +367,8 @@ int mpm_sim_create(mpm_sim **sp, mpm_config *cfg) {
   MPM_CALL(mpm_probes_new(&s->probes, cfg, s->mod, s->nmod));
   s->out_next = 0;
   s->ckpt_next = 1;
-  return mpm_integrator_new(&s->it, cfg, s->grid, s->mod, s->nmod, s->coupling);
+  MPM_CALL(mpm_integrator_new(&s->it, cfg, s->grid, s->mod, s->nmod, s->coupling));
+  return check_budget(s);
 }
 
 int mpm_sim_restart(mpm_sim **sp, mpm_config *cfg, const char *path) {
@@ -272,6 +383,8 @@ int mpm_sim_restart(mpm_sim **sp, mpm_config *cfg, const char *path) {
   if (!rc) rc = mpm_checkpoint_attr(ck, "h_next", &s->h_next);
   /* Checkpoints from before the coupler have no coupling work: it was zero. */
   if (!rc && s->coupling) rc = mpm_checkpoint_attr(ck, "coupling_work", &s->coupling_work);
+  if (!rc) mpm_checkpoint_attr_optional(ck, "run_id", &s->run_id); /* 0: from before run ids */
+  if (!rc && !(s->checkpoint = strdup(path))) rc = MPM_ERR_MEMORY;
   for (int k = 0; !rc && k < s->nmod; ++k)
     rc = mpm_checkpoint_read_particles(ck, s->mod[k]->name, s->mod[k]->particles);
   /* The probes follow the particles the run started with (a checkpoint without them, from a
@@ -294,7 +407,7 @@ int mpm_sim_restart(mpm_sim **sp, mpm_config *cfg, const char *path) {
   for (int k = 0; k < s->nmod; ++k)
     MPM_CALL(mpm_particles_migrate(s->mod[k]->particles, s->grid, NULL));
   MPM_CALL(mpm_integrator_new(&s->it, cfg, s->grid, s->mod, s->nmod, s->coupling));
-  s->restarted = 1;
+  MPM_CALL(check_budget(s));
   mpm_log(MPM_LOG_INFO, "restarted from %s at t = %.6g, step %ld", path, s->t, s->step);
   return 0;
 }
@@ -311,6 +424,8 @@ void mpm_sim_destroy(mpm_sim **sp) {
   mpm_diag_close(&s->probe_csv);
   mpm_guard_free(&s->guard);
   mpm_grid_destroy(&s->grid);
+  mpm_rundir_release(&s->rundir);
+  free(s->checkpoint);
   free(s->config_text);
   free(s);
   *sp = NULL;
@@ -342,12 +457,10 @@ static int write_checkpoint(mpm_sim *s, const char *path) {
   MPM_CALL(prepare_output(s));
   const char *names[SIM_MAX_MODULES];
   for (int k = 0; k < s->nmod; ++k) p[k] = s->mod[k]->particles, names[k] = s->mod[k]->name;
-  const char *attr[4 + MPM_PROBE_MAX * (1 + MPM_MAX_DIM)] = {"t", "step", "h_next",
-                                                             "coupling_work"};
-  double val[4 + MPM_PROBE_MAX * (1 + MPM_MAX_DIM)] = {s->t, (double)s->step, s->h_next,
-                                                       s->coupling_work};
-  const int na =
-      4 + mpm_probes_attrs(&s->probes, attr + 4, val + 4, MPM_PROBE_MAX * (1 + MPM_MAX_DIM));
+  enum { NA = 5, MAXA = NA + MPM_PROBE_MAX * (1 + MPM_MAX_DIM) };
+  const char *attr[MAXA] = {"t", "step", "h_next", "coupling_work", "run_id"};
+  double val[MAXA] = {s->t, (double)s->step, s->h_next, s->coupling_work, s->run_id};
+  const int na = NA + mpm_probes_attrs(&s->probes, attr + NA, val + NA, MAXA - NA);
   mpm_timer_start(MPM_T_IO);
   int rc = mpm_checkpoint_write(s->comm, path, s->config_text, attr, val, na, p, names, s->nmod);
   mpm_timer_stop(MPM_T_IO);
@@ -461,17 +574,55 @@ static int after_step(mpm_sim *s, double h) {
   return 0;
 }
 
+/* Progress: a live line on a terminal; otherwise (a batch job, a pipe) a log line every
+ * progress_interval seconds of wall time, so that a long run is never silent. */
 static void progress(mpm_sim *s, double dt, double wall0, int final) {
-  static double last = 0;
-  if (!s->progress || s->rank != 0 || !isatty(STDERR_FILENO)) return;
+  static double last = -HUGE_VAL;
+  if (!s->progress || s->rank != 0) return;
+  const int tty = isatty(STDERR_FILENO);
   const double now = MPI_Wtime();
-  if (!final && now - last < 0.5) return;
+  if (last == -HUGE_VAL) last = wall0;
+  if (!final && now - last < (tty ? 0.5 : s->progress_interval)) return;
+  if (final && !tty) return;
   last = now;
   const double frac = s->t / s->t_end, eta = frac > 0 ? (now - wall0) * (1 - frac) / frac : 0;
+  if (!tty) {
+    mpm_log(MPM_LOG_INFO,
+            "progress: step %ld, t = %.6g (%.1f%%), dt = %.3g, %.0f s wall, ETA %.0f s", s->step,
+            s->t, 100 * frac, dt, now - wall0, eta);
+    return;
+  }
   fprintf(stderr, "\rstep %8ld  t = %-11.5g dt = %-10.3g %5.1f%%  ETA %6.0f s  ", s->step, s->t, dt,
           100 * frac, eta);
   if (final) fputc('\n', stderr);
   fflush(stderr);
+}
+
+/* ---- stopping on a signal -------------------------------------------------------------- */
+
+static volatile sig_atomic_t g_signal;
+
+/* The first SIGTERM or SIGINT asks the run to stop at the end of its step; a second one acts
+ * at once (the default action is back). */
+static void on_signal(int sig) {
+  g_signal = sig;
+  signal(sig, SIG_DFL);
+}
+
+static void catch_signals(void) {
+  struct sigaction sa;
+  memset(&sa, 0, sizeof sa);
+  sa.sa_handler = on_signal;
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGTERM, &sa, NULL);
+  sigaction(SIGINT, &sa, NULL);
+}
+
+/* The signal any rank has received (0: none), agreed by all. */
+static int signalled(const mpm_sim *s, int *sig) {
+  int mine = (int)g_signal;
+  MPM_CALL_MPI(MPI_Allreduce(&mine, sig, 1, MPI_INT, MPI_MAX, s->comm));
+  return 0;
 }
 
 static int write_summary(mpm_sim *s, double wall) {
@@ -507,7 +658,7 @@ static int write_summary(mpm_sim *s, double wall) {
 
 int mpm_sim_run(mpm_sim *s) {
   char path[4096];
-  MPM_CALL(open_outputs(s, s->restarted));
+  MPM_CALL(open_outputs(s));
   mpm_timer_reset();
   mpm_timer_start(MPM_T_TOTAL);
   const double wall0 = MPI_Wtime();
@@ -524,6 +675,9 @@ int mpm_sim_run(mpm_sim *s) {
   MPM_CALL(mpm_guard_init(&s->guard, s->cfg, h0, s->energy));
   const double t_stop = s->t_end * (1 - 1e-14);
   double dt = 0.0;
+  int sig = 0;
+  g_signal = 0;
+  catch_signals();
   while (s->t < t_stop) {
     const double t_out = fmin(s->out_next * s->out_interval, s->t_end);
     const double t_ckpt = s->ckpt_next * s->ckpt_interval, tstop = fmin(t_out, t_ckpt);
@@ -545,11 +699,22 @@ int mpm_sim_run(mpm_sim *s) {
       /* Exactly what a restart from this file does. */
       MPM_CALL(mpm_integrator_start(s->it, s->t, s->h_next));
     }
+    MPM_CALL(signalled(s, &sig));
+    if (sig) break;
   }
   progress(s, dt, wall0, 1);
   s->h_next = mpm_integrator_next_step(s->it);
   snprintf(path, sizeof path, "%s/checkpoint_final.h5", s->dir);
   MPM_CALL(write_checkpoint(s, path));
   mpm_timer_stop(MPM_T_TOTAL);
-  return write_summary(s, MPI_Wtime() - wall0);
+  MPM_CALL(write_summary(s, MPI_Wtime() - wall0));
+  if (!sig) return 0;
+  mpm_log(MPM_LOG_WARN,
+          "stopped by %s at t = %.6g (step %ld) before t_end = %.6g; %s holds the state: continue "
+          "with `mpmfsi restart %s`",
+          sig == SIGINT    ? "SIGINT"
+          : sig == SIGTERM ? "SIGTERM"
+                           : "a signal",
+          s->t, s->step, s->t_end, path, path);
+  return MPM_ERR_INTERRUPTED;
 }

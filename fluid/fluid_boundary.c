@@ -539,7 +539,7 @@ int fluid_open_exchange(fluid_open *o, mpm_module *m, double t, double h, int *c
   const mpm_lidx n = p->n;
   /* Removal. */
   unsigned char *keep = malloc((size_t)(n ? n : 1));
-  if (!keep) MPM_FAIL(MPM_ERR_MEMORY, "cannot allocate the removal mask");
+  if (!keep) MPM_FAIL_OOM(n);
   mpm_lidx removed = 0;
   for (mpm_lidx i = 0; i < n; ++i) {
     keep[i] = 1;

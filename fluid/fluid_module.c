@@ -531,6 +531,12 @@ static int build(mpm_module *m, const mpm_config *cfg, int seed) {
   MPM_ALLOC(fc->node, (size_t)(g->dim + 3) * g->nnodes);
   MPM_CALL(
       particles_new(&m->particles, g->dim, &fc->lay, fc->tr.apic, fc->gas.mu > 0, fc->tr.classic));
+  /* What a checkpoint may hold: positive mass, volume, volume ratio and internal energy (the
+   * module's check faults on any other). */
+  mpm_particles_set_range(m->particles, fc->lay.f_m, 0.0, HUGE_VAL, MPM_FIELD_LO_OPEN);
+  mpm_particles_set_range(m->particles, fc->lay.f_V0, 0.0, HUGE_VAL, MPM_FIELD_LO_OPEN);
+  mpm_particles_set_range(m->particles, FLUID_J, 0.0, HUGE_VAL, MPM_FIELD_LO_OPEN);
+  mpm_particles_set_range(m->particles, FLUID_E, 0.0, HUGE_VAL, MPM_FIELD_LO_OPEN);
   if (seed) MPM_CALL(fluid_seed(m, cfg));
   return 0;
 }

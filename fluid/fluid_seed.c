@@ -104,6 +104,21 @@ static int check_positive(const mpm_config *cfg, const mpm_grid *g, const char *
                          name, worst.v, at[0], at[1], at[2]);
 }
 
+/* Every field expression of s must be finite at the kept points (1/0, sqrt(-1) and log(0)
+ * are not); the first bad point is reported with the value as it is. Collective. */
+static int check_finite(const mpm_config *cfg, const mpm_grid *g, const gas_state *s, mpm_lidx n,
+                        const double *x, const unsigned char *keep) {
+  const mpm_expr *f[3] = {s->rho_f, s->p_f, s->v_f};
+  static const char *const name[3] = {"density", "pressure", "velocity"};
+  for (int c = 0; c < 3; ++c) {
+    if (!f[c]) continue;
+    char key[160];
+    snprintf(key, sizeof key, "%s.%s_field", s->section, name[c]);
+    MPM_CALL(mpm_expr_check_finite(f[c], cfg, key, g->comm, g->dim, n, x, keep));
+  }
+  return 0;
+}
+
 /* The lattice points of section k not claimed by an earlier section and outside every
  * obstacle: keep[i] = 1. */
 static mpm_lidx claim(const gas_state *s, int k, const fluid_obstacles *obs, int dim, mpm_lidx n,
@@ -174,6 +189,7 @@ static int seed_one(mpm_module *m, const mpm_config *cfg, gas_state *s, int k) {
     fill(fc, p, &s[k], pow(g->dx / fc->ppc, g->dim), n, x, keep, nk, data, minv, where);
   }
   /* Collective checks first, so that every rank takes the same path. */
+  if (!rc) rc = check_finite(cfg, g, &s[k], n, x, keep);
   if (!rc && s[k].rho_f) rc = check_positive(cfg, g, s[k].section, "density", minv[0], where[0]);
   if (!rc && s[k].p_f) rc = check_positive(cfg, g, s[k].section, "pressure", minv[1], where[1]);
   if (!rc) rc = mpm_particles_edit(p, NULL, nk, kid, data);

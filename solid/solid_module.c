@@ -87,6 +87,15 @@ static int solid_particles_new(mpm_particles **p, int dim, solid_layout *lay, in
   return mpm_particles_new(p, dim, fields, nf, nstate);
 }
 
+/* What a checkpoint may hold in the fields that are not plain reals: positive masses and
+ * volumes, a body index among this run's bodies, a 0/1 clamp flag. */
+static void solid_set_ranges(mpm_particles *p, const solid_layout *lay, int nbodies) {
+  mpm_particles_set_range(p, lay->f_m, 0.0, HUGE_VAL, MPM_FIELD_LO_OPEN);
+  mpm_particles_set_range(p, lay->f_V0, 0.0, HUGE_VAL, MPM_FIELD_LO_OPEN);
+  mpm_particles_set_range(p, lay->f_body, 0.0, nbodies - 1, MPM_FIELD_INTEGER);
+  if (lay->f_fixed >= 0) mpm_particles_set_range(p, lay->f_fixed, 0.0, 1.0, MPM_FIELD_INTEGER);
+}
+
 /* A batch over particles `idx` of component-major arrays with stride n (state from y). */
 static solid_batch batch_of(const solid_content *sc, const mpm_particles *p, const double *y,
                             mpm_lidx count, const mpm_lidx *idx, double *out) {
@@ -172,6 +181,9 @@ static int seed_body(mpm_module *m, const mpm_config *cfg, int b, double *lp) {
   /* Each body takes a fresh block of ids as wide as its seeding lattice. */
   const mpm_gidx id_base = p->id_next;
   int rc = mpm_region_seed(region, g, ppc, id_base, &n, &x, &id);
+  /* A velocity_field must be finite at every particle (1/0, sqrt(-1) and log(0) are not). */
+  if (!rc && vfield && (rc = mpm_expr_check_finite(vfield, cfg, vkey, g->comm, dim, n, x, NULL)))
+    free(x), free(id);
   if (rc) mpm_expr_destroy(&vfield), mpm_region_destroy(&region);
   MPM_CALL(rc);
 
@@ -632,6 +644,7 @@ int solid_module_create(mpm_module **mp, const mpm_config *cfg, mpm_grid *grid, 
     if (!rc)
       rc = solid_particles_new(&m->particles, grid->dim, &sc->lay, has_rate, sc->tr.apic, nhist,
                                sc->nclamps > 0, sc->ntractions > 0);
+    if (!rc) solid_set_ranges(m->particles, &sc->lay, sc->nbodies);
   }
   for (int b = 0; !rc && b < sc->nbodies; ++b) {
     double lp = sc->lp;

@@ -289,10 +289,19 @@ static void check_input_errors(void) {
   CHECK(mpm_grid_new(&g, MPI_COMM_WORLD, 2, lo, hi, -0.1, MPM_SHAPE_LINEAR, auto_split) ==
             MPM_ERR_INPUT,
         "negative dx");
-  /* Too few cells for the ghost layers is an error only along a direction that is split. */
+  /* Too few cells for the ghost layers is an error only along a direction that is split:
+   * the automatic layout then splits the other direction, an explicit split fails. */
+  const int split_x[3] = {g_size, 0, 0};
   const int thin =
-      mpm_grid_new(&g, MPI_COMM_WORLD, 2, lo, one_cell, 0.1, MPM_SHAPE_QUADRATIC, auto_split);
+      mpm_grid_new(&g, MPI_COMM_WORLD, 2, lo, one_cell, 0.1, MPM_SHAPE_QUADRATIC, split_x);
   CHECK(thin == (g_size > 1 ? MPM_ERR_INPUT : 0), "fewer cells than ghost layers: %d", thin);
+  mpm_grid_destroy(&g);
+  const int along_y =
+      mpm_grid_new(&g, MPI_COMM_WORLD, 2, lo, one_cell, 0.1, MPM_SHAPE_QUADRATIC, auto_split);
+  const int fits = 10 / g_size >= mpm_shape_ghost_width(MPM_SHAPE_QUADRATIC); /* 10 cells in y */
+  CHECK(fits ? along_y == 0 && g && g->nproc[0] == 1 && g->nproc[1] == g_size
+             : along_y == MPM_ERR_INPUT,
+        "one cell along x: the automatic layout splits y where it can (%d)", along_y);
   mpm_grid_destroy(&g);
   CHECK(mpm_grid_new(&g, MPI_COMM_WORLD, 2, lo, hi, 0.1, MPM_SHAPE_LINEAR, too_many) ==
             MPM_ERR_INPUT,

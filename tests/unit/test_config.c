@@ -346,12 +346,24 @@ static void test_paths(void **state) {
   cap_begin();
   assert_int_equal(mpm_config_override(cfg, file), MPM_ERR_INPUT); /* no '=' */
   cap_end();
+  mpm_config_destroy(&cfg);
+  cfg = new_cfg();
+  assert_int_equal(mpm_config_read_string(cfg, "[mesh]\nfile = mesh.dat\n", "c.ini", sub), 0);
   snprintf(text, sizeof text, "mesh.file=%s", file);
   assert_int_equal(mpm_config_override(cfg, text), 0);
   cap_begin();
   rc = mpm_config_validate(cfg);
   cap_end();
   assert_int_equal(rc, 0);
+  mpm_config_destroy(&cfg);
+  /* A device (or FIFO) would be read forever: only regular files are data. */
+  cfg = new_cfg();
+  assert_int_equal(mpm_config_read_string(cfg, "[mesh]\nfile = /dev/zero\n", "c.ini", sub), 0);
+  cap_begin();
+  rc = mpm_config_validate(cfg);
+  cap_end();
+  assert_int_equal(rc, MPM_ERR_INPUT);
+  expect_log("c.ini:2: mesh.file = /dev/zero: '/dev/zero' is not a regular file");
   mpm_config_destroy(&cfg);
   unlink(file);
   rmdir(sub);
@@ -493,8 +505,96 @@ static void test_missing_file(void **state) {
   rc = mpm_config_read_file(cfg, g_dir);
   cap_end();
   assert_int_equal(rc, MPM_ERR_FILE);
-  expect_log("Is a directory");
+  expect_log(": cannot read it as a case file: it is a folder; give the path of a case file");
+  assert_int_equal(log_lines(), 1);
   mpm_config_destroy(&cfg);
+}
+
+/* A device, a FIFO or a huge file is no case file: refused at once, without reading it
+ * (a FIFO without a writer would block the open, /dev/zero would never end). */
+static void test_not_a_case_file(void **state) {
+  (void)state;
+  char fifo[300], big[300];
+  mpm_config *cfg = new_cfg();
+  cap_begin();
+  int rc = mpm_config_read_file(cfg, "/dev/zero");
+  cap_end();
+  assert_int_equal(rc, MPM_ERR_FILE);
+  expect_log("error: /dev/zero: cannot read it as a case file: it is a character device; give "
+             "the path of a case file\n");
+  assert_int_equal(log_lines(), 1);
+  snprintf(fifo, sizeof fifo, "%s/pipe.ini", g_dir);
+  assert_int_equal(mkfifo(fifo, 0600), 0);
+  cap_begin();
+  rc = mpm_config_read_file(cfg, fifo);
+  cap_end();
+  assert_int_equal(rc, MPM_ERR_FILE);
+  expect_log("pipe.ini: cannot read it as a case file: it is a FIFO");
+  unlink(fifo);
+  /* 17 MiB of valid-looking text: over the size limit. */
+  snprintf(big, sizeof big, "%s/big.ini", g_dir);
+  FILE *f = fopen(big, "w");
+  assert_non_null(f);
+  for (int k = 0; k < 17 * 1024; ++k) {
+    char line[1024];
+    memset(line, ' ', sizeof line);
+    memcpy(line, "# ", 2);
+    line[sizeof line - 1] = '\n';
+    assert_int_equal(fwrite(line, 1, sizeof line, f), sizeof line);
+  }
+  fclose(f);
+  cap_begin();
+  rc = mpm_config_read_file(cfg, big);
+  cap_end();
+  assert_int_equal(rc, MPM_ERR_FILE);
+  expect_log("big.ini: cannot read it as a case file: it is larger than 16 MiB");
+  unlink(big);
+  mpm_config_destroy(&cfg);
+}
+
+/* Garbage gives a screenful of errors, then one line counting the rest. */
+static void test_error_cap(void **state) {
+  (void)state;
+  size_t n = 0;
+  char *text = malloc(1000 * 16);
+  assert_non_null(text);
+  for (int k = 0; k < 1000; ++k) n += (size_t)sprintf(text + n, "garbage %d\n", k);
+  mpm_config *cfg = new_cfg();
+  cap_begin();
+  int rc = mpm_config_read_string(cfg, text, "junk.ini", ".");
+  cap_end();
+  assert_int_equal(rc, MPM_ERR_INPUT);
+  assert_int_equal(log_lines(), 21);
+  expect_log("error: junk.ini:20: syntax error");
+  expect_log("error: ... and 980 more errors in junk.ini; fix the ones above first\n");
+  mpm_config_destroy(&cfg);
+  /* Validation too: 30 unknown keys and a missing one give 20 lines and the count. */
+  n = (size_t)sprintf(text, "[grid]\n");
+  for (int k = 0; k < 30; ++k) n += (size_t)sprintf(text + n, "zz%d = 1\n", k);
+  cfg = new_cfg();
+  assert_int_equal(mpm_config_read_string(cfg, text, "junk.ini", "."), 0);
+  cap_begin();
+  rc = mpm_config_validate(cfg);
+  cap_end();
+  assert_int_equal(rc, MPM_ERR_INPUT);
+  assert_int_equal(log_lines(), 21);
+  expect_log("error: ... and 11 more errors in junk.ini; fix the ones above first\n");
+  mpm_config_destroy(&cfg);
+  /* More keys than any case file has: refused, and reading stops there. */
+  free(text);
+  text = malloc(12000 * 16);
+  assert_non_null(text);
+  n = (size_t)sprintf(text, "[grid]\n");
+  for (int k = 0; k < 12000; ++k) n += (size_t)sprintf(text + n, "k%d = 1\n", k);
+  cfg = new_cfg();
+  cap_begin();
+  rc = mpm_config_read_string(cfg, text, "many.ini", ".");
+  cap_end();
+  assert_int_equal(rc, MPM_ERR_INPUT);
+  expect_log("error: many.ini:10002: more than 10000 keys");
+  assert_int_equal(log_lines(), 1);
+  mpm_config_destroy(&cfg);
+  free(text);
 }
 
 static void test_nul_in_file(void **state) {
@@ -520,7 +620,6 @@ static void test_overrides(void **state) {
   assert_int_equal(mpm_config_read_string(cfg, "[grid]\ndx = 1\n", "case.ini", "."), 0);
   const char *before;
   assert_int_equal(mpm_config_get_string(cfg, "run.name", &before), 0);
-  assert_int_equal(mpm_config_override(cfg, "grid.dx=2"), 0);
   assert_int_equal(mpm_config_override(cfg, "  grid.dx =  3   # a comment"), 0);
   assert_int_equal(mpm_config_override(cfg, "run.name = a = b"), 0);
   assert_int_equal(mpm_config_override(cfg, "geometry.g.type=sphere"), 0);
@@ -545,7 +644,17 @@ static void test_overrides(void **state) {
     expect_log("command line: expected key=value, got '");
     assert_int_equal(log_lines(), 1);
   }
+  /* The command line is one source, like a file: a key given twice there is an error that
+   * names both assignments, as a file names both lines. */
+  cap_begin();
+  assert_int_equal(mpm_config_override(cfg, "grid.dx=4"), MPM_ERR_INPUT);
+  cap_end();
+  expect_log("error: command line: grid.dx is given twice (grid.dx=3 and grid.dx=4); keep one\n");
+  assert_int_equal(log_lines(), 1);
+  mpm_config_destroy(&cfg);
   /* An override with a bad value is caught by validate, naming the command line. */
+  cfg = new_cfg();
+  assert_int_equal(mpm_config_read_string(cfg, "[grid]\ndx = 1\n", "case.ini", "."), 0);
   assert_int_equal(mpm_config_override(cfg, "grid.dx=-4"), 0);
   cap_begin();
   assert_int_equal(mpm_config_validate(cfg), MPM_ERR_INPUT);
@@ -600,9 +709,10 @@ static void test_fail(void **state) {
   assert_int_equal(mpm_config_fail(cfg, "solid", "no bodies"), MPM_ERR_INPUT);
   cap_end();
   expect_log("error: case.ini:2: grid.dx = 1: too coarse for 3 cells\n");
-  expect_log("error: grid.n = 10 (default): not a power of two\n");
+  /* A default is located by its section. */
+  expect_log("error: case.ini:2: grid.n = 10 (default): not a power of two\n");
   expect_log("error: case.ini:4: [geometry.g]: is empty\n");
-  expect_log("error: geometry.g.radius = 1 (default): is odd\n");
+  expect_log("error: case.ini:4: geometry.g.radius = 1 (default): is odd\n");
   expect_log("error: solid: no bodies\n");
   mpm_config_destroy(&cfg);
 }
@@ -688,11 +798,12 @@ static void test_resolved_round_trip(void **state) {
   cap_end();
   char *ta = NULL, *tb = NULL;
   assert_int_equal(mpm_config_resolved_text(a, &ta), 0);
-  assert_non_null(strstr(ta, "[grid]\ndx = 0.5   # case.ini:2\nn = 10   # default\n"));
+  /* Defaults are comments: read back, they stay unset. */
+  assert_non_null(strstr(ta, "[grid]\ndx = 0.5   # case.ini:2\n# n = 10   # default\n"));
   assert_non_null(strstr(ta, "t_end = 2.5   # command line\n"));
   assert_non_null(strstr(ta, "[geometry.zeta]\n"));
   assert_true(strstr(ta, "[geometry.zeta]") < strstr(ta, "[geometry.alpha]"));
-  assert_non_null(strstr(ta, "[mesh]\nscale = 1   # default\nfile = /"));
+  assert_non_null(strstr(ta, "[mesh]\n# scale = 1   # default\nfile = /"));
   /* Fed back in, it gives the same configuration and the same text. */
   cap_begin();
   int rc = mpm_config_read_string(b, ta, "resolved.ini", "/nonexistent");
@@ -702,6 +813,11 @@ static void test_resolved_round_trip(void **state) {
   assert_int_equal(mpm_config_resolved_text(b, &tb), 0);
   char *sa = strip_comments(ta), *sb = strip_comments(tb);
   assert_string_equal(sa, sb);
+  /* The provenance comments are kept too: the same text, byte for byte. */
+  assert_string_equal(ta, tb);
+  assert_false(mpm_config_has(b, "grid.n"));
+  assert_false(mpm_config_has(b, "geometry.alpha.radius"));
+  assert_string_equal(mpm_config_where(b, "grid.dx"), "resolved.ini:4");
   for (int i = 0; i < g_nkeys; ++i) {
     const char *key = g_keys[i].key;
     char inst[64];
@@ -790,6 +906,8 @@ int main(int argc, char **argv) {
       cmocka_unit_test(test_validate_reports_all),
       cmocka_unit_test(test_read_file),
       cmocka_unit_test(test_missing_file),
+      cmocka_unit_test(test_not_a_case_file),
+      cmocka_unit_test(test_error_cap),
       cmocka_unit_test(test_nul_in_file),
       cmocka_unit_test(test_overrides),
       cmocka_unit_test(test_instances),

@@ -41,7 +41,9 @@ def error_line(text):
 
 def run(label, extra):
     out = mt.outdir("blowup_" + label)
-    p = mt.run(["run", mt.case("axial_bar.ini"), f"output.dir={out}"] + BAR + extra, check=False)
+    keys = {a.split("=", 1)[0] for a in extra}  # extra replaces BAR's (a key may be given once)
+    base = [a for a in BAR if a.split("=", 1)[0] not in keys]
+    p = mt.run(["run", mt.case("axial_bar.ini"), f"output.dir={out}"] + base + extra, check=False)
     d = np.genfromtxt(os.path.join(out, "diagnostics.csv"), delimiter=",", names=True)
     return p, d
 

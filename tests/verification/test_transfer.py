@@ -23,14 +23,15 @@ import mpmtest as mt  # noqa: E402
 
 check = mt.Checks("test_transfer")
 
-for name, args in (("pic_fraction 0", ["transfer.pic_fraction=0"]),
-                   ("pic_fraction 0.5", ["transfer.pic_fraction=0.5"]),
-                   ("pic_fraction 1", ["transfer.pic_fraction=1"]),
-                   ("apic", ["transfer.velocity=apic"]),
+# (A key may be given once on the command line: each variant names its time method.)
+for name, args in (("pic_fraction 0", ["time.method=usl", "transfer.pic_fraction=0"]),
+                   ("pic_fraction 0.5", ["time.method=usl", "transfer.pic_fraction=0.5"]),
+                   ("pic_fraction 1", ["time.method=usl", "transfer.pic_fraction=1"]),
+                   ("apic", ["time.method=usl", "transfer.velocity=apic"]),
                    ("apic musl", ["transfer.velocity=apic", "time.method=musl"])):
     out = mt.outdir("uniform_" + name.replace(" ", "_"))
-    mt.run(["run", mt.case("ballistic2d.ini"), f"output.dir={out}", "time.method=usl",
-            "physics.gravity=0 0", "run.progress=false"] + args)
+    mt.run(["run", mt.case("ballistic2d.ini"), f"output.dir={out}", "physics.gravity=0 0",
+            "run.progress=false"] + args)
     p = mt.particles(mt.snapshots(out)[-1][1])
     dv = float(np.abs(p["v"] - np.array([3.0, 2.0])).max())
     check(dv <= 1e-13, f"uniform motion, {name}: max |v - v0| = {dv:.1e} m/s")

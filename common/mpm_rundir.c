@@ -1,0 +1,429 @@
+/* The output folder of a run (see mpm_rundir.h). All file work is done by rank 0; the outcome
+ * is broadcast, so every rank returns the same code. */
+#define _DEFAULT_SOURCE /* flock, realpath-free stat comparisons, dirent d_type */
+#include "mpm_rundir.h"
+
+#include "mpm_error.h"
+#include "mpm_h5.h"
+
+#include <dirent.h>
+#include <errno.h>
+#include <fcntl.h>
+#include <fnmatch.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/file.h>
+#include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
+
+#define LOCK_NAME  ".lock"
+#define RUNID_NAME "run.id"
+
+struct mpm_rundir {
+  int fd; /* the locked file, rank 0 only (-1 elsewhere) */
+};
+
+/* What mpmfsi and its post-processing write into an output folder. Anything else in the
+ * folder belongs to the user and is never touched. */
+static const char *const g_ours[] = {"snap_*.h5", "checkpoint_*.h5", "*.tmp",    "series.xmf",
+                                     "*.csv",     "summary.json",    RUNID_NAME, "*.png"};
+
+static int is_ours(const char *name) {
+  for (size_t k = 0; k < sizeof g_ours / sizeof g_ours[0]; ++k)
+    if (fnmatch(g_ours[k], name, 0) == 0) return 1;
+  return 0;
+}
+
+static char *join(const char *dir, const char *name) {
+  const size_t n = strlen(dir) + strlen(name) + 2;
+  char *p = malloc(n);
+  if (p) snprintf(p, n, "%s/%s", dir, name);
+  return p;
+}
+
+/* mkdir -p, then make sure dir is a writable directory. */
+static int make_dir(const char *dir) {
+  const size_t len = strlen(dir);
+  char *p = malloc(len + 1);
+  int err = p ? 0 : ENOMEM;
+  if (p) memcpy(p, dir, len + 1);
+  for (char *q = p ? p + 1 : NULL; q && !err; ++q) {
+    if (*q != '/' && *q != 0) continue;
+    const char c = *q;
+    *q = 0;
+    if (mkdir(p, 0777) != 0 && errno != EEXIST) err = errno;
+    *q = c;
+    if (!c) break;
+  }
+  free(p);
+  struct stat st;
+  if (!err && stat(dir, &st) != 0) err = errno;
+  if (!err && !S_ISDIR(st.st_mode)) err = ENOTDIR;
+  if (!err && access(dir, W_OK | X_OK) != 0) err = errno;
+  if (err)
+    MPM_FAIL(MPM_ERR_INPUT,
+             "cannot use '%s' as the output folder: %s; choose another output.dir, or create "
+             "this one with write permission",
+             dir, strerror(err));
+  return 0;
+}
+
+/* ---- the lock -------------------------------------------------------------------------- */
+
+static int take_lock(const char *dir, int *fd_out) {
+  char *path = join(dir, LOCK_NAME);
+  if (!path) MPM_FAIL(MPM_ERR_MEMORY, "out of memory naming the lock of '%s'", dir);
+  const int fd = open(path, O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  free(path);
+  if (fd < 0)
+    MPM_FAIL(MPM_ERR_INPUT, "cannot create the lock file %s/%s: %s; choose another output.dir", dir,
+             LOCK_NAME, strerror(errno));
+  if (flock(fd, LOCK_EX | LOCK_NB) != 0) {
+    char owner[128] = "";
+    const ssize_t n = pread(fd, owner, sizeof owner - 1, 0);
+    owner[n > 0 ? n : 0] = 0;
+    owner[strcspn(owner, "\n")] = 0;
+    close(fd);
+    MPM_FAIL(MPM_ERR_INPUT,
+             "output folder '%s' is in use by another mpmfsi run (%s); wait for it to end or "
+             "choose another output.dir",
+             dir, owner[0] ? owner : "owner unknown");
+  }
+  char owner[128];
+  const int n =
+      snprintf(owner, sizeof owner, "pid %ld, started %ld\n", (long)getpid(), (long)time(NULL));
+  if (ftruncate(fd, 0) != 0 || pwrite(fd, owner, (size_t)n, 0) != n) { /* informative only */
+  }
+  *fd_out = fd;
+  return 0;
+}
+
+/* ---- what the folder holds ------------------------------------------------------------- */
+
+typedef struct listing {
+  char **name;
+  int n;
+} listing;
+
+static void listing_free(listing *l) {
+  for (int k = 0; k < l->n; ++k) free(l->name[k]);
+  free(l->name);
+  l->name = NULL, l->n = 0;
+}
+
+/* The folder's mpmfsi files (regular files only; the lock excluded). */
+static int list_ours(const char *dir, listing *l) {
+  DIR *d = opendir(dir);
+  if (!d) MPM_FAIL(MPM_ERR_INPUT, "cannot list the output folder '%s': %s", dir, strerror(errno));
+  int cap = 0, rc = 0;
+  for (struct dirent *e; !rc && (e = readdir(d));) {
+    if (!is_ours(e->d_name)) continue;
+    if (l->n == cap) {
+      char **nn = realloc(l->name, sizeof *nn * (size_t)(cap = 2 * cap + 16));
+      if (!nn) {
+        rc = MPM_ERR_MEMORY;
+        break;
+      }
+      l->name = nn;
+    }
+    if (!(l->name[l->n] = strdup(e->d_name)))
+      rc = MPM_ERR_MEMORY;
+    else
+      ++l->n;
+  }
+  closedir(d);
+  if (rc) MPM_FAIL(rc, "out of memory listing the output folder '%s'", dir);
+  return 0;
+}
+
+static int remove_file(const char *dir, const char *name) {
+  char *path = join(dir, name);
+  const int ok = path && (unlink(path) == 0 || errno == ENOENT);
+  const int e = errno;
+  free(path);
+  if (!ok)
+    MPM_FAIL(MPM_ERR_INPUT,
+             "cannot delete %s/%s: %s; remove it by hand or choose another "
+             "output.dir",
+             dir, name, strerror(e));
+  return 0;
+}
+
+/* The whole of a small text file, or NULL. */
+static char *slurp(const char *dir, const char *name) {
+  char *path = join(dir, name), *buf = NULL;
+  FILE *f = path ? fopen(path, "r") : NULL;
+  free(path);
+  if (!f) return NULL;
+  size_t len = 0, cap = 0;
+  for (int c; (c = fgetc(f)) != EOF;) {
+    if (len + 2 > cap) {
+      char *nb = realloc(buf, cap = 2 * cap + 4096);
+      if (!nb) {
+        free(buf), fclose(f);
+        return NULL;
+      }
+      buf = nb;
+    }
+    buf[len++] = (char)c;
+  }
+  fclose(f);
+  if (buf) buf[len] = 0;
+  return buf;
+}
+
+/* The time of the last row of a CSV whose first column is t (-inf: no rows). */
+static double csv_last_time(const char *dir, const char *name) {
+  char *text = slurp(dir, name);
+  double t = -HUGE_VAL;
+  if (!text) return t;
+  for (char *line = strchr(text, '\n'); line && line[1]; line = strchr(line + 1, '\n')) {
+    char *end;
+    const double v = strtod(line + 1, &end);
+    if (end != line + 1 && isfinite(v)) t = fmax(t, v);
+  }
+  free(text);
+  return t;
+}
+
+/* The snapshots the index lists, each with its time: calls f(name, t) for each. */
+static void index_entries(const char *dir, void (*f)(const char *, double, void *), void *arg) {
+  char *text = slurp(dir, "series.xmf");
+  if (!text) return;
+  for (char *p = strstr(text, "<Time Value=\""); p; p = strstr(p, "<Time Value=\"")) {
+    p += strlen("<Time Value=\"");
+    const double t = strtod(p, NULL);
+    char *s = strstr(p, "snap_"), name[64];
+    if (!s) break;
+    const size_t n = strspn(s + 5, "0123456789");
+    if (n == 0 || n > 40) continue;
+    snprintf(name, sizeof name, "snap_%.*s.h5", (int)n, s + 5);
+    f(name, t, arg);
+  }
+  free(text);
+}
+
+/* The time stored in a checkpoint, or NaN if it cannot be read (a damaged or partial file is
+ * no later result). */
+static double checkpoint_time(const char *dir, const char *name) {
+  char *path = join(dir, name);
+  double t = NAN;
+  if (!path) return t;
+  H5E_auto2_t fn;
+  void *data;
+  H5Eget_auto2(H5E_DEFAULT, &fn, &data);
+  H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
+  const hid_t file = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
+  if (file >= 0) {
+    if (H5Aexists(file, "t") > 0) {
+      const hid_t a = H5Aopen(file, "t", H5P_DEFAULT);
+      if (a < 0 || H5Aread(a, H5T_NATIVE_DOUBLE, &t) < 0) t = NAN;
+      if (a >= 0) H5Aclose(a);
+    }
+    H5Fclose(file);
+  }
+  H5Eset_auto2(H5E_DEFAULT, fn, data);
+  free(path);
+  return t;
+}
+
+static int same_file(const char *a, const char *b) {
+  struct stat sa, sb;
+  return stat(a, &sa) == 0 && stat(b, &sb) == 0 && sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
+}
+
+/* The folder that holds a file (".", for a bare name). */
+static char *parent_of(const char *path) {
+  const char *slash = strrchr(path, '/');
+  if (!slash) return strdup(".");
+  if (slash == path) return strdup("/");
+  return strndup(path, (size_t)(slash - path));
+}
+
+/* ---- the decisions --------------------------------------------------------------------- */
+
+static double new_run_id(void) {
+  unsigned char b[6] = {0};
+  FILE *f = fopen("/dev/urandom", "rb");
+  const int got = f && fread(b, 1, sizeof b, f) == sizeof b;
+  if (f) fclose(f);
+  uint64_t v = 0;
+  for (int k = 0; k < 6; ++k) v = v << 8 | b[k];
+  if (!got) v = ((uint64_t)time(NULL) << 16) ^ (uint64_t)getpid();
+  return (double)((v & ((1ULL << 48) - 1)) + 1); /* exact in a double, never 0 */
+}
+
+static double folder_run_id(const char *dir) {
+  char *text = slurp(dir, RUNID_NAME);
+  double id = 0;
+  if (text && sscanf(text, "mpmfsi run %lf", &id) != 1) id = 0;
+  free(text);
+  return id;
+}
+
+static int write_run_id(const char *dir, double id) {
+  char *path = join(dir, RUNID_NAME), *tmp = join(dir, RUNID_NAME ".tmp");
+  FILE *f = tmp ? fopen(tmp, "w") : NULL;
+  int ok = f && fprintf(f, "mpmfsi run %.0f\n", id) > 0;
+  if (f) ok = fclose(f) == 0 && ok;
+  ok = ok && rename(tmp, path) == 0;
+  const int e = errno;
+  free(path), free(tmp);
+  if (!ok)
+    MPM_FAIL(MPM_ERR_INPUT, "cannot write %s/%s: %s; check the output folder", dir, RUNID_NAME,
+             strerror(e));
+  return 0;
+}
+
+/* A new record in dir: refused if an earlier run's results are there, unless overwrite. */
+static int start_fresh(const char *dir, int overwrite, const listing *l) {
+  int results = 0, first = -1;
+  for (int k = 0; k < l->n; ++k)
+    if (fnmatch("*.tmp", l->name[k], 0) != 0 && ++results == 1) first = k;
+  if (results > 0 && !overwrite)
+    MPM_FAIL(MPM_ERR_INPUT,
+             "output folder '%s' already holds the results of another run (%d files, e.g. %s); "
+             "choose a new output.dir, or add output.overwrite=true to delete them first",
+             dir, results, l->name[first]);
+  for (int k = 0; k < l->n; ++k) MPM_CALL(remove_file(dir, l->name[k]));
+  if (results > 0)
+    mpm_log(MPM_LOG_INFO, "output.overwrite: deleted the %d result files of the earlier run in %s",
+            results, dir);
+  return 0;
+}
+
+typedef struct later {
+  const char *dir;
+  double t, latest;
+  int remove, failed, removed;
+} later;
+
+static void later_snapshot(const char *name, double t, void *arg) {
+  later *L = arg;
+  if (!(t > L->t * (1 + 1e-12))) return;
+  L->latest = fmax(L->latest, t);
+  if (L->remove && !L->failed) {
+    L->failed = remove_file(L->dir, name) != 0;
+    L->removed += !L->failed;
+  }
+}
+
+/* Continue dir's record from a checkpoint in it at time t: refused if later results exist,
+ * unless truncate (then they are deleted; the index and CSVs are cut when reopened). */
+static int continue_in_place(const mpm_rundir_request *req, const listing *l) {
+  const char *dir = req->dir;
+  later L = {dir, req->t, -HUGE_VAL, 0, 0, 0};
+  static const char *const csv[] = {"diagnostics.csv", "coupling.csv", "probes.csv"};
+  for (int k = 0; k < 3; ++k) L.latest = fmax(L.latest, csv_last_time(dir, csv[k]));
+  index_entries(dir, later_snapshot, &L);
+  double later_ckpt = -HUGE_VAL;
+  for (int k = 0; k < l->n; ++k) {
+    if (fnmatch("checkpoint_*.h5", l->name[k], 0) != 0) continue;
+    char *path = join(dir, l->name[k]);
+    const int self = path && same_file(path, req->checkpoint);
+    free(path);
+    const double t = self ? NAN : checkpoint_time(dir, l->name[k]);
+    if (t > req->t * (1 + 1e-12)) later_ckpt = fmax(later_ckpt, t);
+  }
+  L.latest = fmax(L.latest, later_ckpt);
+  if (!(L.latest > req->t * (1 + 1e-12))) return 0;
+  if (!req->truncate)
+    MPM_FAIL(MPM_ERR_INPUT,
+             "output folder '%s' holds this run's results up to t = %.6g, later than the "
+             "checkpoint (t = %.6g); continuing there would mix them. Give output.dir=NEW_FOLDER "
+             "to continue in a new folder, or output.truncate=true to cut this run back to "
+             "t = %.6g (its later snapshots and checkpoints are deleted)",
+             dir, L.latest, req->t, req->t);
+  L.remove = 1;
+  index_entries(dir, later_snapshot, &L);
+  if (L.failed) return MPM_ERR_INPUT;
+  for (int k = 0; k < l->n; ++k) {
+    const int tmp = fnmatch("*.tmp", l->name[k], 0) == 0;
+    int stale = tmp || strcmp(l->name[k], "summary.json") == 0;
+    if (fnmatch("checkpoint_*.h5", l->name[k], 0) == 0) {
+      char *path = join(dir, l->name[k]);
+      const int self = path && same_file(path, req->checkpoint);
+      free(path);
+      stale = !self && checkpoint_time(dir, l->name[k]) > req->t * (1 + 1e-12);
+    }
+    if (stale) MPM_CALL(remove_file(dir, l->name[k]));
+    L.removed += stale && !tmp;
+  }
+  mpm_log(MPM_LOG_INFO, "output.truncate: %s cut back to t = %.6g (%d later files deleted)", dir,
+          req->t, L.removed);
+  return 0;
+}
+
+static int claim(const mpm_rundir_request *req, int *fd, int *append, double *run_id) {
+  const char *dir = req->dir;
+  listing l = {NULL, 0};
+  *append = 0;
+  MPM_CALL(make_dir(dir));
+  MPM_CALL(take_lock(dir, fd));
+  int rc = list_ours(dir, &l);
+  int in_place = 0;
+  if (!rc && req->checkpoint) {
+    char *parent = parent_of(req->checkpoint);
+    in_place = parent && same_file(parent, dir);
+    free(parent);
+  }
+  if (!rc && in_place) {
+    const double owner = folder_run_id(dir);
+    if (owner != 0 && req->run_id != 0 && owner != req->run_id) {
+      mpm_log_all(MPM_LOG_ERROR,
+                  "output folder '%s' belongs to another run (run.id %.0f) than the checkpoint "
+                  "%s (run %.0f); give output.dir=NEW_FOLDER to continue in a new folder",
+                  dir, owner, req->checkpoint, req->run_id);
+      rc = MPM_ERR_INPUT;
+    }
+    if (!rc) rc = continue_in_place(req, &l);
+    *append = 1;
+    *run_id = req->run_id != 0 ? req->run_id : owner != 0 ? owner : new_run_id();
+  } else if (!rc) {
+    rc = start_fresh(dir, req->overwrite, &l);
+    *run_id = new_run_id();
+  }
+  listing_free(&l);
+  if (!rc) rc = write_run_id(dir, *run_id);
+  return rc;
+}
+
+int mpm_rundir_claim(mpm_rundir **rd, MPI_Comm comm, const mpm_rundir_request *req, int *append,
+                     double *run_id) {
+  int rank;
+  *rd = NULL;
+  MPM_CALL_MPI(MPI_Comm_rank(comm, &rank));
+  mpm_rundir *r = malloc(sizeof *r);
+  int rc = r ? 0 : MPM_ERR_MEMORY;
+  double state[3] = {0, 0, 0};
+  if (r) r->fd = -1;
+  if (!rc && rank == 0) {
+    rc = claim(req, &r->fd, append, run_id);
+    state[1] = *append, state[2] = *run_id;
+  }
+  state[0] = rc;
+  MPM_CALL_MPI(MPI_Bcast(state, 3, MPI_DOUBLE, 0, comm));
+  rc = mpm_h5_agree(comm, rc ? rc : (int)state[0]);
+  if (rc) {
+    mpm_rundir_release(&r);
+    return mpm_trace(__FILE__, __LINE__, __func__, rc);
+  }
+  *append = (int)state[1], *run_id = state[2];
+  *rd = r;
+  return 0;
+}
+
+void mpm_rundir_release(mpm_rundir **rd) {
+  if (!rd || !*rd) return;
+  if ((*rd)->fd >= 0) {
+    if (ftruncate((*rd)->fd, 0) != 0) { /* the owner line is informative only */
+    }
+    close((*rd)->fd); /* releases the lock */
+  }
+  free(*rd);
+  *rd = NULL;
+}

@@ -1,0 +1,45 @@
+/* The output folder of a run: one folder, one run.
+ *
+ * A run claims its folder before it writes anything: rank 0 takes an exclusive lock on
+ * DIR/.lock (flock, held until the run ends, released by the kernel if the process dies), so
+ * a second run started into the same folder is refused at once. Then the folder's contents
+ * decide:
+ *
+ * - A new run (and a restart into a folder other than its checkpoint's) needs a folder with
+ *   no mpmfsi results in it (files of other kinds are left alone). With `overwrite` the
+ *   earlier run's results are deleted first, never mixed with the new ones.
+ * - A restart in its checkpoint's own folder continues that run: allowed when nothing in the
+ *   folder is later than the checkpoint (the usual "carry on to a later t_end"). When later
+ *   results exist (an earlier checkpoint of a finished or crashed run) it is refused, unless
+ *   `truncate` asks to cut the run back: the later snapshots and checkpoints are deleted, and
+ *   the index and the CSV files are cut by the output writers that reopen them.
+ *
+ * The folder records its run in DIR/run.id; checkpoints carry the same id, so a checkpoint
+ * copied into another run's folder is not taken for that run's. */
+#ifndef MPM_RUNDIR_H
+#define MPM_RUNDIR_H
+
+#include <mpi.h>
+
+typedef struct mpm_rundir mpm_rundir;
+
+typedef struct mpm_rundir_request {
+  const char *dir;        /* the output folder */
+  int overwrite;          /* delete an earlier run's results found in dir */
+  int truncate;           /* restart in place: cut the later results of the run */
+  const char *checkpoint; /* restart: the checkpoint file; NULL for a new run */
+  double t;               /* restart: the checkpoint's time */
+  double run_id;          /* restart: the checkpoint's run id (0: unknown) */
+} mpm_rundir_request;
+
+/* Claim the folder (collective; rank 0 does the file work). On success *append is 1 when the
+ * run continues the folder's existing record (restart in place), 0 when it starts a new one,
+ * and *run_id is the id to store in checkpoints. A folder that cannot be claimed is an input
+ * error with one message saying what to do. */
+int mpm_rundir_claim(mpm_rundir **rd, MPI_Comm comm, const mpm_rundir_request *req, int *append,
+                     double *run_id);
+
+/* Release the lock (the folder and its files stay). */
+void mpm_rundir_release(mpm_rundir **rd);
+
+#endif
