@@ -130,8 +130,21 @@ static int choose_nproc(mpm_grid *g, int size, const int *nproc) {
   double cost = HUGE_VAL;
   layout_search(g, size, fixed, 0, dims, g->nproc, &cost);
   if (cost < HUGE_VAL) return 0;
+  /* None fits: name the most ranks that do (with the counts the caller fixed, if any). */
+  int fit = 0, best[MPM_MAX_DIM] = {1, 1, 1}, free_fixed[MPM_MAX_DIM] = {0, 0, 0};
+  const int *keep = given > 1 ? fixed : free_fixed;
+  for (int r = size - 1; r >= 1 && !fit; --r) {
+    layout_search(g, r, keep, 0, dims, best, &cost);
+    if (cost < HUGE_VAL) fit = r;
+  }
+  if (fit)
+    FAIL_INPUT("grid: no layout of %d ranks leaves every rank the %d cells per split direction "
+               "that the %s shape needs (the grid has %d x %d%s cells); run on at most %d ranks "
+               "(grid.ranks = %d %d%s), or refine the grid",
+               size, g->ghost, mpm_shape_name(g->shape), g->ncells[0], g->ncells[1],
+               g->dim == 3 ? " x ..." : "", fit, best[0], best[1], g->dim == 3 ? " ..." : "");
   for (int d = 0; d < g->dim; ++d) g->nproc[d] = fixed[d];
-  MPM_CALL_MPI(MPI_Dims_create(size, g->dim, g->nproc));
+  MPM_CALL_MPI(MPI_Dims_create(size, g->dim, g->nproc)); /* check_cells_per_rank says why */
   return 0;
 }
 

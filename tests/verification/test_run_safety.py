@@ -20,7 +20,8 @@ failed on the code before the fix.
 7. SIGTERM (1 rank, usl) ends the run with exit 3 and a final checkpoint; restarting it ends
    bitwise where the uninterrupted run does (tolerance 0, as 3). SIGINT on 2 ranks too.
 8. cases/sod.ini (400 x 3 cells, periodic in y) runs on 4 ranks: the layout puts every rank
-   along x instead of failing; a grid too large to index says so (not "not a whole number").
+   along x instead of failing; where no layout fits, the message names the most ranks that do
+   and their layout; a grid too large to index says so (not "not a whole number").
 9. An allocation failure (address space capped at 1.5 GB) gives one line that says what to
    change and names no internal variable (skipped under AddressSanitizer, which cannot run
    with a capped address space)."""
@@ -235,6 +236,10 @@ p = mt.run(["run", SOD, f"output.dir={o}", "time.t_end=0.01"] + QUIET, 4, check=
 check(p.returncode == 0 and "4 ranks (4 x 1)" in p.stderr,
       f"sod on 4 ranks: exit {p.returncode}, layout "
       f"{re.search(r'[0-9]+ ranks [(][^)]*[)]', p.stderr).group(0) if p.returncode == 0 else errors(p)[:1]}")
+p = mt.run(["check", SOD, "grid.dx=0.1", "domain.hi=1 0.3"], 5, check=False)
+check(p.returncode == 2 and "run on at most 3 ranks (grid.ranks = 3 1)" in p.stderr,
+      f"10 x 3 cells on 5 ranks (no layout fits): the message names the layout to use: "
+      f"{[l for l in p.stderr.splitlines() if l.startswith('error:')][:1]}")
 p = mt.run(["check", SOD, "grid.dx=1e-12"], check=False)
 check(one_error(p, "grid.dx", "more than", "can index") and "whole number" not in p.stderr,
       f"a grid too large to index: {errors(p)[:1]}")
