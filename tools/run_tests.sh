@@ -7,7 +7,9 @@
 # oversubscribed on 2 cores, 20 s without; the halo, migration and P2G on 1-4 ranks run under the
 # sanitizers in test_halo_np*, test_migrate_np*, test_p2g_np* and test_ranks_solid), the main
 # job's scene (test_supersonic_bar, a flow case like the wedge) and the near-vacuum convergence
-# study (test_near_vacuum_order, an expected failure; test_near_vacuum runs the refill there).
+# study (test_near_vacuum_order, an expected failure; test_near_vacuum runs the refill there),
+# and test_restart_cases (every case's restart: 3 minutes under the sanitizers; the checkpoint
+# code it runs is test_restart's, test_gas_output's and test_coupling_ranks', which do run there).
 # The code they run is the open faces', the obstacles', the gas module's and the coupler's, which
 # test_gas_boundaries, test_obstacles, test_sod, test_coupling, test_coupling_ranks and
 # test_coupling_rigid run under the sanitizers. Idempotent.
@@ -17,5 +19,5 @@ bash "$src/tools/setup.sh" "$src/build"
 (cd "$src/build" && ctest -LE "long|benchmark" --output-on-failure -j 2 --timeout 900)
 bash "$src/tools/setup.sh" "$src/build-asan" -DMPMFSI_SANITIZE=ON -DCMAKE_BUILD_TYPE=Debug
 (cd "$src/build-asan" &&
-  ctest -LE "long|benchmark" -E "^test_(wedge|forward_step|fsi_waves|decomposition|supersonic_bar|supersonic_bar_standoff|near_vacuum_order)$" \
+  ctest -LE "long|benchmark" -E "^test_(wedge|forward_step|fsi_waves|decomposition|supersonic_bar|supersonic_bar_standoff|near_vacuum_order|restart_cases)$" \
     --output-on-failure -j 2 --timeout 1800)
