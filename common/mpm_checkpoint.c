@@ -37,6 +37,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #define CHECKPOINT_FORMAT   "mpmfsi checkpoint 2"
@@ -323,6 +324,12 @@ static int probe(const char *path) {
              "cannot read the checkpoint '%s': %s. Check the restart file named in the case "
              "file or on the command line",
              path, strerror(errno));
+  struct stat st; /* a FIFO or a device would block or never end */
+  if (stat(path, &st) != 0 || !S_ISREG(st.st_mode))
+    MPM_FAIL(MPM_ERR_INPUT,
+             "'%s' is not a regular file, so not an mpmfsi checkpoint. Restart from a file "
+             "written by mpmfsi (checkpoint output)",
+             path);
   const htri_t is_h5 = H5Fis_hdf5(path); /* HDF5's error printing is off (mpm_checkpoint_open) */
   if (is_h5 <= 0)
     MPM_FAIL(MPM_ERR_INPUT,

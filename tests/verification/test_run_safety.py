@@ -14,6 +14,7 @@ failed on the code before the fix.
    ends bitwise where the straight run ended (usl: no step history; tolerance 0).
 4. Restart overrides that cannot be honoured (a density, a new section) are refused, naming
    the keys that may change; an override equal to the stored value and time.t_end are fine.
+   A FIFO, a device or a folder given as the checkpoint is refused at once (a FIFO hung).
 5. Runaway settings (10^300 s, a snapshot every 1e-9 s) are refused by check and run with the
    estimate and the key; raising the limit key accepts them.
 6. With stderr not a terminal, progress lines appear every run.progress_interval seconds.
@@ -172,6 +173,16 @@ o = mt.outdir("overrides_section")
 p = mt.run(["restart", ck1, f"output.dir={o}", "probe.tip.point=0.5 0.004"] + QUIET, check=False)
 check(p.returncode == 2 and any("probe.tip" in e for e in errors(p)),
       f"restart with a new [probe] section refused: {errors(p)[:1]}")
+
+fifo = os.path.join(mt.outdir("fifo"), "checkpoint.h5")
+os.mkfifo(fifo)
+for label, path in (("a FIFO", fifo), ("a device", "/dev/zero"), ("a folder", full)):
+    try:
+        p = subprocess.run([mt.BIN, "restart", path], capture_output=True, text=True, timeout=60)
+        ok, what = one_error(p, "not a regular file"), errors(p)[:1]
+    except subprocess.TimeoutExpired:
+        ok, what = False, "no answer in 60 s"
+    check(ok, f"restart from {label} refused at once: {what}")
 
 # ---- 5. runaway runs ---------------------------------------------------------------------
 for words, args in ((("steps", "run.max_steps"), ["time.t_end=1e300"]),
