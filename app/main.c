@@ -12,6 +12,7 @@
 #include "mpm_config.h"
 #include "mpm_error.h"
 #include "mpm_output.h"
+#include "mpm_path.h"
 #include "mpm_sim.h"
 
 #include <stdio.h>
@@ -112,13 +113,6 @@ static int check_restart_changes(const mpm_config *cfg, const char *before, cons
   return bad ? MPM_ERR_INPUT : 0;
 }
 
-/* The folder a checkpoint lies in ("." for a bare name). */
-static int checkpoint_folder(const char *path, char *dir, size_t n) {
-  const char *slash = strrchr(path, '/');
-  const int len = slash ? (slash == path ? 1 : (int)(slash - path)) : 1;
-  return snprintf(dir, n, "output.dir=%.*s", len, slash ? path : ".") >= (int)n;
-}
-
 static int has_override(int argc, char **argv, const char *key) {
   for (int k = 0; k < argc; ++k)
     if (strncmp(argv[k], key, strlen(key)) == 0 && argv[k][strlen(key)] == '=') return 1;
@@ -139,7 +133,10 @@ static int load_restart(mpm_config *cfg, const char *path, int argc, char **argv
   char dir[4096 + 16];
   rc = apply_overrides(cfg, argc, argv);
   if (!rc && !has_override(argc, argv, "output.dir")) {
-    if (checkpoint_folder(path, dir, sizeof dir)) rc = MPM_ERR_INPUT;
+    char *parent = mpm_path_parent(path);
+    if (!parent || snprintf(dir, sizeof dir, "output.dir=%s", parent) >= (int)sizeof dir)
+      rc = MPM_ERR_INPUT;
+    free(parent);
     if (!rc) rc = mpm_config_override(cfg, dir);
   }
   if (!rc) rc = mpm_config_validate(cfg);

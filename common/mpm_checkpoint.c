@@ -28,6 +28,7 @@
 #define _POSIX_C_SOURCE 200809L /* fsync, O_DIRECTORY */
 #include "mpm_error.h"
 #include "mpm_h5.h"
+#include "mpm_path.h"
 #include "mpm_output.h"
 
 #include <errno.h>
@@ -176,16 +177,8 @@ static void sync_path(const char *path, int directory) {
 }
 
 static void sync_parent(const char *path) {
-  char *dir = malloc(strlen(path) + 2);
+  char *dir = mpm_path_parent(path);
   if (!dir) return;
-  strcpy(dir, path);
-  char *slash = strrchr(dir, '/');
-  if (!slash)
-    strcpy(dir, ".");
-  else if (slash == dir)
-    dir[1] = 0;
-  else
-    *slash = 0;
   sync_path(dir, 1);
   free(dir);
 }

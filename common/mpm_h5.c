@@ -6,6 +6,7 @@
  * stage is agreed on too, so every helper returns the same code on every rank. */
 #define _POSIX_C_SOURCE 200809L /* statvfs */
 #include "mpm_h5.h"
+#include "mpm_path.h"
 
 #include <errno.h>
 #include <stdarg.h>
@@ -116,25 +117,10 @@ hid_t mpm_h5_open(MPI_Comm comm, const char *path) {
   return file_access(comm, path, 0, 0);
 }
 
-/* The directory part of path (malloc'ed), "." for a bare name. */
-static char *parent_dir(const char *path) {
-  char *dir = malloc(strlen(path) + 2);
-  if (!dir) return NULL;
-  strcpy(dir, path);
-  char *slash = strrchr(dir, '/');
-  if (!slash)
-    strcpy(dir, ".");
-  else if (slash == dir)
-    dir[1] = 0;
-  else
-    *slash = 0;
-  return dir;
-}
-
 /* Rank 0's one line for a failed write: the file, what failed, the likely cause. err is the
  * largest errno over the ranks (MPI-IO does not always leave a meaningful one). */
 static void explain_write_failure(const mpm_h5 *h, const char *path, const char *what, int err) {
-  char *dir = parent_dir(path), cause[320];
+  char *dir = mpm_path_parent(path), cause[320];
   struct statvfs fs;
   struct stat st;
   const long long avail =

@@ -19,6 +19,7 @@
 #include "mpm_output.h"
 #include "mpm_error.h"
 #include "mpm_h5.h"
+#include "mpm_path.h"
 #include "mpm_xdmf.h"
 
 #include <errno.h>
@@ -43,13 +44,6 @@ struct mpm_output {
 typedef struct phase_rows {
   int64_t n, offset, total;
 } phase_rows;
-
-static char *path_join(const char *dir, const char *name) {
-  const size_t len = strlen(dir) + strlen(name) + 2;
-  char *s = malloc(len);
-  if (s) snprintf(s, len, "%s/%s", dir, name);
-  return s;
-}
 
 /* ---- particles ------------------------------------------------------------------------- */
 
@@ -252,7 +246,7 @@ static int index_add(mpm_output *out, const snapshot *s) {
 }
 
 static int index_write(const mpm_output *out) {
-  char *path = path_join(out->dir, INDEX_NAME);
+  char *path = mpm_path_join(out->dir, INDEX_NAME);
   if (!path) MPM_FAIL(MPM_ERR_MEMORY, "output: cannot build the path of the index");
   const int rc = mpm_xdmf_write(out->index, path);
   free(path);
@@ -338,9 +332,9 @@ static size_t buffer_size(const mpm_particles *const *phases, int nphases, const
 static int snapshot_paths(const mpm_output *out, char **tmp, char **final) {
   char name[40];
   snprintf(name, sizeof name, "snap_%06d.h5.tmp", out->next);
-  *tmp = path_join(out->dir, name);
+  *tmp = mpm_path_join(out->dir, name);
   name[strlen(name) - 4] = 0;
-  *final = path_join(out->dir, name);
+  *final = mpm_path_join(out->dir, name);
   return *tmp && *final ? 0 : MPM_ERR_MEMORY;
 }
 
@@ -389,41 +383,17 @@ int mpm_output_count(const mpm_output *out) {
 
 /* ---- construction ---------------------------------------------------------------------- */
 
-/* mkdir -p: create every missing component, then make sure the result is a writable
- * directory. */
-static int make_dir(const char *dir) {
-  const size_t len = strlen(dir);
-  char *p;
-  int err = 0;
-  MPM_ALLOC(p, len + 1);
-  memcpy(p, dir, len + 1);
-  for (char *q = p + 1; !err; ++q) {
-    if (*q != '/' && *q != 0) continue;
-    const char c = *q;
-    *q = 0;
-    if (mkdir(p, 0777) != 0 && errno != EEXIST) err = errno;
-    *q = c;
-    if (!c) break;
-  }
-  free(p);
-  struct stat st;
-  if (!err && stat(dir, &st) != 0) err = errno;
-  if (!err && !S_ISDIR(st.st_mode)) err = ENOTDIR;
-  if (!err && access(dir, W_OK | X_OK) != 0) err = errno;
+/* Rank 0: the directory, and the index kept from an earlier run on a restart. */
+static int prepare_index(mpm_output *out, int append, double t_restart) {
+  const int err = mpm_path_make_dir(out->dir);
   if (err)
     MPM_FAIL(MPM_ERR_FILE,
              "cannot use '%s' as the output directory: %s. Choose another output directory in "
              "the case file, or create this one with write permission",
-             dir, strerror(err));
-  return 0;
-}
-
-/* Rank 0: the directory, and the index kept from an earlier run on a restart. */
-static int prepare_index(mpm_output *out, int append, double t_restart) {
-  MPM_CALL(make_dir(out->dir));
+             out->dir, strerror(err));
   MPM_CALL(mpm_xdmf_new(&out->index, out->dim));
   if (append) {
-    char *path = path_join(out->dir, INDEX_NAME);
+    char *path = mpm_path_join(out->dir, INDEX_NAME);
     int found = 0;
     if (!path) MPM_FAIL(MPM_ERR_MEMORY, "output: cannot build the path of the index");
     const int rc = mpm_xdmf_load(out->index, path, t_restart, &found);

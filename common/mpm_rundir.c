@@ -5,6 +5,7 @@
 
 #include "mpm_error.h"
 #include "mpm_h5.h"
+#include "mpm_path.h"
 
 #include <dirent.h>
 #include <errno.h>
@@ -38,44 +39,10 @@ static int is_ours(const char *name) {
   return 0;
 }
 
-static char *join(const char *dir, const char *name) {
-  const size_t n = strlen(dir) + strlen(name) + 2;
-  char *p = malloc(n);
-  if (p) snprintf(p, n, "%s/%s", dir, name);
-  return p;
-}
-
-/* mkdir -p, then make sure dir is a writable directory. */
-static int make_dir(const char *dir) {
-  const size_t len = strlen(dir);
-  char *p = malloc(len + 1);
-  int err = p ? 0 : ENOMEM;
-  if (p) memcpy(p, dir, len + 1);
-  for (char *q = p ? p + 1 : NULL; q && !err; ++q) {
-    if (*q != '/' && *q != 0) continue;
-    const char c = *q;
-    *q = 0;
-    if (mkdir(p, 0777) != 0 && errno != EEXIST) err = errno;
-    *q = c;
-    if (!c) break;
-  }
-  free(p);
-  struct stat st;
-  if (!err && stat(dir, &st) != 0) err = errno;
-  if (!err && !S_ISDIR(st.st_mode)) err = ENOTDIR;
-  if (!err && access(dir, W_OK | X_OK) != 0) err = errno;
-  if (err)
-    MPM_FAIL(MPM_ERR_INPUT,
-             "cannot use '%s' as the output folder: %s; choose another output.dir, or create "
-             "this one with write permission",
-             dir, strerror(err));
-  return 0;
-}
-
 /* ---- the lock -------------------------------------------------------------------------- */
 
 static int take_lock(const char *dir, int *fd_out) {
-  char *path = join(dir, LOCK_NAME);
+  char *path = mpm_path_join(dir, LOCK_NAME);
   if (!path) MPM_FAIL(MPM_ERR_MEMORY, "out of memory naming the lock of '%s'", dir);
   const int fd = open(path, O_RDWR | O_CREAT | O_CLOEXEC, 0644);
   free(path);
@@ -141,7 +108,7 @@ static int list_ours(const char *dir, listing *l) {
 }
 
 static int remove_file(const char *dir, const char *name) {
-  char *path = join(dir, name);
+  char *path = mpm_path_join(dir, name);
   const int ok = path && (unlink(path) == 0 || errno == ENOENT);
   const int e = errno;
   free(path);
@@ -155,7 +122,7 @@ static int remove_file(const char *dir, const char *name) {
 
 /* The whole of a small text file, or NULL. */
 static char *slurp(const char *dir, const char *name) {
-  char *path = join(dir, name), *buf = NULL;
+  char *path = mpm_path_join(dir, name), *buf = NULL;
   FILE *f = path ? fopen(path, "r") : NULL;
   free(path);
   if (!f) return NULL;
@@ -210,7 +177,7 @@ static void index_entries(const char *dir, void (*f)(const char *, double, void 
 /* The time stored in a checkpoint, or NaN if it cannot be read (a damaged or partial file is
  * no later result). */
 static double checkpoint_time(const char *dir, const char *name) {
-  char *path = join(dir, name);
+  char *path = mpm_path_join(dir, name);
   double t = NAN;
   if (!path) return t;
   H5E_auto2_t fn;
@@ -236,14 +203,6 @@ static int same_file(const char *a, const char *b) {
   return stat(a, &sa) == 0 && stat(b, &sb) == 0 && sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
 }
 
-/* The folder that holds a file (".", for a bare name). */
-static char *parent_of(const char *path) {
-  const char *slash = strrchr(path, '/');
-  if (!slash) return strdup(".");
-  if (slash == path) return strdup("/");
-  return strndup(path, (size_t)(slash - path));
-}
-
 /* ---- the decisions --------------------------------------------------------------------- */
 
 static double new_run_id(void) {
@@ -266,7 +225,7 @@ static double folder_run_id(const char *dir) {
 }
 
 static int write_run_id(const char *dir, double id) {
-  char *path = join(dir, RUNID_NAME), *tmp = join(dir, RUNID_NAME ".tmp");
+  char *path = mpm_path_join(dir, RUNID_NAME), *tmp = mpm_path_join(dir, RUNID_NAME ".tmp");
   FILE *f = tmp ? fopen(tmp, "w") : NULL;
   int ok = f && fprintf(f, "mpmfsi run %.0f\n", id) > 0;
   if (f) ok = fclose(f) == 0 && ok;
@@ -323,7 +282,7 @@ static int continue_in_place(const mpm_rundir_request *req, const listing *l) {
   double later_ckpt = -HUGE_VAL;
   for (int k = 0; k < l->n; ++k) {
     if (fnmatch("checkpoint_*.h5", l->name[k], 0) != 0) continue;
-    char *path = join(dir, l->name[k]);
+    char *path = mpm_path_join(dir, l->name[k]);
     const int self = path && same_file(path, req->checkpoint);
     free(path);
     const double t = self ? NAN : checkpoint_time(dir, l->name[k]);
@@ -345,7 +304,7 @@ static int continue_in_place(const mpm_rundir_request *req, const listing *l) {
     const int tmp = fnmatch("*.tmp", l->name[k], 0) == 0;
     int stale = tmp || strcmp(l->name[k], "summary.json") == 0;
     if (fnmatch("checkpoint_*.h5", l->name[k], 0) == 0) {
-      char *path = join(dir, l->name[k]);
+      char *path = mpm_path_join(dir, l->name[k]);
       const int self = path && same_file(path, req->checkpoint);
       free(path);
       stale = !self && checkpoint_time(dir, l->name[k]) > req->t * (1 + 1e-12);
@@ -362,12 +321,17 @@ static int claim(const mpm_rundir_request *req, int *fd, int *append, double *ru
   const char *dir = req->dir;
   listing l = {NULL, 0};
   *append = 0;
-  MPM_CALL(make_dir(dir));
+  const int err = mpm_path_make_dir(dir);
+  if (err)
+    MPM_FAIL(MPM_ERR_INPUT,
+             "cannot use '%s' as the output folder: %s; choose another output.dir, or create "
+             "this one with write permission",
+             dir, strerror(err));
   MPM_CALL(take_lock(dir, fd));
   int rc = list_ours(dir, &l);
   int in_place = 0;
   if (!rc && req->checkpoint) {
-    char *parent = parent_of(req->checkpoint);
+    char *parent = mpm_path_parent(req->checkpoint);
     in_place = parent && same_file(parent, dir);
     free(parent);
   }
