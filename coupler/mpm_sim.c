@@ -1,8 +1,8 @@
 /* The simulation object and its step loop (see mpm_sim.h). */
-#define _POSIX_C_SOURCE 200809L /* sigaction */
 #include "mpm_sim.h"
 
 #include "mpm_bc.h"
+#include "mpm_budget.h"
 #include "mpm_cells.h"
 #include "mpm_coupling.h"
 #include "mpm_diag.h"
@@ -13,13 +13,13 @@
 #include "mpm_output.h"
 #include "mpm_probe.h"
 #include "mpm_rundir.h"
+#include "mpm_signal.h"
 #include "mpm_timer.h"
 #include "fluid_module.h"
 #include "solid_module.h"
 
 #include <limits.h>
 #include <math.h>
-#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -71,10 +71,6 @@ static const mpm_key_spec sim_keys[] = {
      0},
     {"run.progress_interval", MPM_KEY_REAL, "60", 0, HUGE_VAL, 0, 0, NULL,
      "wall-clock seconds between progress log lines when stderr is not a terminal", 0},
-    {"run.max_steps", MPM_KEY_REAL, "1e8", 1, HUGE_VAL, 0, 0, NULL,
-     "refuse a run whose estimated step count (time to run / starting stable step) is larger; "
-     "raise it for a run that really needs more",
-     0},
     {"run.sort_every", MPM_KEY_INT, "20", 0, 1e9, 0, 0, NULL,
      "sort particles by cell every N steps (0: never)", 0},
     {"domain.dim", MPM_KEY_INT, "2", 2, 3, 0, 0, NULL, "spatial dimension, 2 or 3", 0},
@@ -108,12 +104,6 @@ static const mpm_key_spec sim_keys[] = {
      "add nodal mass and velocity to the snapshots", 0},
     {"output.checkpoint_interval", MPM_KEY_REAL, "0", 0, HUGE_VAL, 0, 0, NULL,
      "time between checkpoints, s (0: only at the end)", 0},
-    {"output.max_gb", MPM_KEY_REAL, "100", 0, HUGE_VAL, 0, 0, NULL,
-     "refuse a run whose estimated snapshots and checkpoints exceed this many GB; raise it "
-     "for a run that really writes more",
-     0},
-    {"output.max_files", MPM_KEY_REAL, "100000", 1, HUGE_VAL, 0, 0, NULL,
-     "refuse a run that would write more snapshots and checkpoints than this", 0},
     {"output.overwrite", MPM_KEY_BOOL, "false", 0, 0, 0, 0, NULL,
      "delete the results of an earlier run found in output.dir before writing (otherwise "
      "such a folder is refused)",
@@ -128,6 +118,7 @@ int mpm_sim_add_schema(mpm_config *cfg) {
   MPM_CALL(mpm_config_add_schema(cfg, sim_keys, (int)(sizeof sim_keys / sizeof sim_keys[0])));
   MPM_CALL(mpm_config_add_schema(cfg, mpm_integrator_keys, mpm_integrator_nkeys));
   MPM_CALL(mpm_config_add_schema(cfg, mpm_guard_keys, mpm_guard_nkeys));
+  MPM_CALL(mpm_config_add_schema(cfg, mpm_budget_keys, mpm_budget_nkeys));
   MPM_CALL(mpm_config_add_schema(cfg, mpm_probe_keys, mpm_probe_nkeys));
   MPM_CALL(mpm_config_add_schema(cfg, mpm_geometry_keys, mpm_geometry_nkeys));
   MPM_CALL(mpm_config_add_schema(cfg, mpm_bc_keys, mpm_bc_nkeys));
@@ -309,55 +300,12 @@ static int output_bytes(const mpm_sim *s, double *bytes) {
   return 0;
 }
 
-/* Refuse a run whose step count or output is absurd (a mistyped interval, t_end or dx), with
- * the estimate and the key to change: before it starts, not once the disk is full. Checked
- * by `check` too. The step count is estimated from the stable step of the starting state,
- * the output from the particles it holds. */
+/* Refuse an absurd run before it starts (mpm_budget.h). */
 static int check_budget(mpm_sim *s) {
-  double h0, max_steps, max_gb, max_files, bytes;
-  MPM_CALL(mpm_config_get_real(s->cfg, "run.max_steps", &max_steps));
-  MPM_CALL(mpm_config_get_real(s->cfg, "output.max_gb", &max_gb));
-  MPM_CALL(mpm_config_get_real(s->cfg, "output.max_files", &max_files));
-  MPM_CALL(mpm_integrator_cfl_step(s->it, &h0));
-  /* Every output time ends a step too. */
-  const double span = s->t_end - s->t, nout = span / s->out_interval;
-  const double nck = isfinite(s->ckpt_interval) ? span / s->ckpt_interval : 0;
-  const double stable = h0 > 0 && isfinite(h0) ? span / h0 : 0, steps = stable + nout + nck;
-  const double nsnap = s->snapshots ? nout + 1 : 0, nckpt = nck + 1; /* and the final one */
-  if (stable > max_steps)
-    return mpm_config_fail(s->cfg, "time.t_end",
-                           "this run would take about %.3g steps (%.6g s to run at the starting "
-                           "stable step of %.3g s), more than run.max_steps = %.3g; shorten "
-                           "time.t_end or coarsen grid.dx, or raise run.max_steps if you mean it",
-                           stable, span, h0, max_steps);
-  MPM_CALL(output_bytes(s, &bytes));
-  const double gb = (nsnap + nckpt) * bytes / 1e9;
-  if (nsnap + nckpt > max_files)
-    return mpm_config_fail(s->cfg, nsnap > nckpt ? "output.interval" : "output.checkpoint_interval",
-                           "this run would write about %.3g snapshots and %.3g checkpoints "
-                           "(%.3g GB), more than output.max_files = %.3g; lengthen "
-                           "output.interval or output.checkpoint_interval, or raise "
-                           "output.max_files if you mean it",
-                           nsnap, nckpt, gb, max_files);
-  if (gb > max_gb)
-    return mpm_config_fail(s->cfg, nsnap > nckpt ? "output.interval" : "output.checkpoint_interval",
-                           "this run would write about %.3g GB (%.3g snapshots and %.3g "
-                           "checkpoints of %.3g MB), more than output.max_gb = %.3g; lengthen "
-                           "output.interval or output.checkpoint_interval, or raise "
-                           "output.max_gb if you mean it",
-                           gb, nsnap, nckpt, bytes / 1e6, max_gb);
-  if (steps > max_steps) /* the outputs' times force the steps */
-    return mpm_config_fail(s->cfg, "output.interval",
-                           "this run would take about %.3g steps, %.3g of them to reach output "
-                           "and checkpoint times, more than run.max_steps = %.3g; lengthen "
-                           "output.interval or output.checkpoint_interval, or raise "
-                           "run.max_steps if you mean it",
-                           steps, nout + nck, max_steps);
-  mpm_log(MPM_LOG_INFO,
-          "estimate: about %.3g steps (starting stable step %.6g s), %.3g snapshots and %.3g "
-          "checkpoints, %.3g GB",
-          steps, h0, nsnap, nckpt, gb);
-  return 0;
+  mpm_budget b = {s->t, s->t_end, 0, s->out_interval, s->ckpt_interval, s->snapshots, 0};
+  MPM_CALL(mpm_integrator_cfl_step(s->it, &b.h0));
+  MPM_CALL(output_bytes(s, &b.bytes));
+  return mpm_budget_check(s->cfg, &b);
 }
 
 int mpm_sim_create(mpm_sim **sp, mpm_config *cfg) {
@@ -598,33 +546,6 @@ static void progress(mpm_sim *s, double dt, double wall0, int final) {
   fflush(stderr);
 }
 
-/* ---- stopping on a signal -------------------------------------------------------------- */
-
-static volatile sig_atomic_t g_signal;
-
-/* The first SIGTERM or SIGINT asks the run to stop at the end of its step; a second one acts
- * at once (the default action is back). */
-static void on_signal(int sig) {
-  g_signal = sig;
-  signal(sig, SIG_DFL);
-}
-
-static void catch_signals(void) {
-  struct sigaction sa;
-  memset(&sa, 0, sizeof sa);
-  sa.sa_handler = on_signal;
-  sigemptyset(&sa.sa_mask);
-  sigaction(SIGTERM, &sa, NULL);
-  sigaction(SIGINT, &sa, NULL);
-}
-
-/* The signal any rank has received (0: none), agreed by all. */
-static int signalled(const mpm_sim *s, int *sig) {
-  int mine = (int)g_signal;
-  MPM_CALL_MPI(MPI_Allreduce(&mine, sig, 1, MPI_INT, MPI_MAX, s->comm));
-  return 0;
-}
-
 static int write_summary(mpm_sim *s, double wall) {
   long steps, rhs, fails, retries;
   mpm_integrator_counts(s->it, &steps, &rhs, &fails, &retries);
@@ -676,8 +597,7 @@ int mpm_sim_run(mpm_sim *s) {
   const double t_stop = s->t_end * (1 - 1e-14);
   double dt = 0.0;
   int sig = 0;
-  g_signal = 0;
-  catch_signals();
+  mpm_signal_catch();
   while (s->t < t_stop) {
     const double t_out = fmin(s->out_next * s->out_interval, s->t_end);
     const double t_ckpt = s->ckpt_next * s->ckpt_interval, tstop = fmin(t_out, t_ckpt);
@@ -699,7 +619,7 @@ int mpm_sim_run(mpm_sim *s) {
       /* Exactly what a restart from this file does. */
       MPM_CALL(mpm_integrator_start(s->it, s->t, s->h_next));
     }
-    MPM_CALL(signalled(s, &sig));
+    MPM_CALL(mpm_signal_agreed(s->comm, &sig));
     if (sig) break;
   }
   progress(s, dt, wall0, 1);
@@ -712,9 +632,6 @@ int mpm_sim_run(mpm_sim *s) {
   mpm_log(MPM_LOG_WARN,
           "stopped by %s at t = %.6g (step %ld) before t_end = %.6g; %s holds the state: continue "
           "with `mpmfsi restart %s`",
-          sig == SIGINT    ? "SIGINT"
-          : sig == SIGTERM ? "SIGTERM"
-                           : "a signal",
-          s->t, s->step, s->t_end, path, path);
+          mpm_signal_name(sig), s->t, s->step, s->t_end, path, path);
   return MPM_ERR_INTERRUPTED;
 }

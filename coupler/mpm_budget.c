@@ -1,0 +1,66 @@
+/* The run's budget (see mpm_budget.h). */
+#include "mpm_budget.h"
+
+#include "mpm_error.h"
+
+#include <math.h>
+
+const mpm_key_spec mpm_budget_keys[] = {
+    {"run.max_steps", MPM_KEY_REAL, "1e8", 1, HUGE_VAL, 0, 0, NULL,
+     "refuse a run whose estimated step count (time to run / starting stable step) is larger; "
+     "raise it for a run that really needs more",
+     0},
+    {"output.max_gb", MPM_KEY_REAL, "100", 0, HUGE_VAL, 0, 0, NULL,
+     "refuse a run whose estimated snapshots and checkpoints exceed this many GB; raise it "
+     "for a run that really writes more",
+     0},
+    {"output.max_files", MPM_KEY_REAL, "100000", 1, HUGE_VAL, 0, 0, NULL,
+     "refuse a run that would write more snapshots and checkpoints than this", 0},
+};
+const int mpm_budget_nkeys = (int)(sizeof mpm_budget_keys / sizeof mpm_budget_keys[0]);
+
+int mpm_budget_check(const mpm_config *cfg, const mpm_budget *b) {
+  double max_steps, max_gb, max_files;
+  MPM_CALL(mpm_config_get_real(cfg, "run.max_steps", &max_steps));
+  MPM_CALL(mpm_config_get_real(cfg, "output.max_gb", &max_gb));
+  MPM_CALL(mpm_config_get_real(cfg, "output.max_files", &max_files));
+  const double span = b->t_end - b->t, nout = span / b->out_interval;
+  const double nck = isfinite(b->ckpt_interval) ? span / b->ckpt_interval : 0;
+  const double stable = b->h0 > 0 && isfinite(b->h0) ? span / b->h0 : 0;
+  const double steps = stable + nout + nck; /* every output time ends a step too */
+  const double nsnap = b->snapshots ? nout + 1 : 0, nckpt = nck + 1; /* and the final one */
+  const double gb = (nsnap + nckpt) * b->bytes / 1e9;
+  const char *interval = nsnap > nckpt ? "output.interval" : "output.checkpoint_interval";
+  if (stable > max_steps)
+    return mpm_config_fail(cfg, "time.t_end",
+                           "this run would take about %.3g steps (%.6g s to run at the starting "
+                           "stable step of %.3g s), more than run.max_steps = %.3g; shorten "
+                           "time.t_end or coarsen grid.dx, or raise run.max_steps if you mean it",
+                           stable, span, b->h0, max_steps);
+  if (nsnap + nckpt > max_files)
+    return mpm_config_fail(cfg, interval,
+                           "this run would write about %.3g snapshots and %.3g checkpoints "
+                           "(%.3g GB), more than output.max_files = %.3g; lengthen "
+                           "output.interval or output.checkpoint_interval, or raise "
+                           "output.max_files if you mean it",
+                           nsnap, nckpt, gb, max_files);
+  if (gb > max_gb)
+    return mpm_config_fail(cfg, interval,
+                           "this run would write about %.3g GB (%.3g snapshots and %.3g "
+                           "checkpoints of %.3g MB), more than output.max_gb = %.3g; lengthen "
+                           "output.interval or output.checkpoint_interval, or raise "
+                           "output.max_gb if you mean it",
+                           gb, nsnap, nckpt, b->bytes / 1e6, max_gb);
+  if (steps > max_steps) /* the outputs' times force the steps */
+    return mpm_config_fail(cfg, "output.interval",
+                           "this run would take about %.3g steps, %.3g of them to reach output "
+                           "and checkpoint times, more than run.max_steps = %.3g; lengthen "
+                           "output.interval or output.checkpoint_interval, or raise "
+                           "run.max_steps if you mean it",
+                           steps, nout + nck, max_steps);
+  mpm_log(MPM_LOG_INFO,
+          "estimate: about %.3g steps (starting stable step %.6g s), %.3g snapshots and %.3g "
+          "checkpoints, %.3g GB",
+          steps, b->h0, nsnap, nckpt, gb);
+  return 0;
+}

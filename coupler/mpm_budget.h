@@ -1,0 +1,31 @@
+/* The run's budget: a run whose step count or output volume is absurd (a mistyped t_end,
+ * interval or dx) is refused before it starts, with the estimate and the key to change, not
+ * once the disk is full or after years of steps. `check` applies it too.
+ *
+ * Estimates: steps = (t_end - t) / h0, with h0 the stable step of the starting state, plus a
+ * step to each output and checkpoint time (they end steps); files = the snapshots and the
+ * checkpoints (and the final one); bytes = files times the size of one (every particle's
+ * fields, and the grid fields where written). Limits: run.max_steps, output.max_files,
+ * output.max_gb; a user who means it raises them. */
+#ifndef MPM_BUDGET_H
+#define MPM_BUDGET_H
+
+#include "mpm_config.h"
+
+extern const mpm_key_spec mpm_budget_keys[];
+extern const int mpm_budget_nkeys;
+
+typedef struct mpm_budget {
+  double t, t_end;      /* the time to run */
+  double h0;            /* stable step of the starting state (0 or inf: nothing limits it) */
+  double out_interval;  /* time between snapshots (> 0) */
+  double ckpt_interval; /* time between checkpoints (inf: only the final one) */
+  int snapshots;        /* are snapshots written? */
+  double bytes;         /* size of one snapshot or checkpoint */
+} mpm_budget;
+
+/* 0 and an "estimate:" log line, or an input error naming the key to change. Every rank
+ * must pass the same values. */
+int mpm_budget_check(const mpm_config *cfg, const mpm_budget *b);
+
+#endif
