@@ -11,8 +11,10 @@
  * call. */
 #include "mpm_config.h"
 #include "mpm_error.h"
+#include "mpm_h5.h"
 #include "mpm_output.h"
 #include "mpm_path.h"
+#include "mpm_rundir.h"
 #include "mpm_sim.h"
 
 #include <stdio.h>
@@ -59,7 +61,7 @@ static int restartable(const char *key) {
 static char *assignments(const mpm_config *cfg) {
   char *text = NULL;
   if (mpm_config_resolved_text(cfg, &text) != 0) return NULL;
-  const size_t cap = 2 * strlen(text) + 1;
+  const size_t cap = 2 * strlen(text) + 4096;
   char *out = malloc(cap), section[256] = "";
   size_t len = 0;
   for (char *line = strtok(text, "\n"); out && line; line = strtok(NULL, "\n")) {
@@ -74,7 +76,8 @@ static char *assignments(const mpm_config *cfg) {
     if (line[0] == '#' || !strchr(line, '=')) continue;
     char *comment = strstr(line, "   #");
     if (comment) *comment = 0;
-    len += (size_t)snprintf(out + len, cap - len, "%s.%s\n", section, line);
+    const int w = snprintf(out + len, cap - len, "%s.%s\n", section, line);
+    len = w < 0 ? len : len + (size_t)w < cap ? len + (size_t)w : cap - 1; /* never past cap */
   }
   free(text);
   return out;
@@ -113,33 +116,74 @@ static int check_restart_changes(const mpm_config *cfg, const char *before, cons
   return bad ? MPM_ERR_INPUT : 0;
 }
 
+/* Is key given on the command line (as the parser reads it: "key=value", spaces allowed
+ * around the key)? */
 static int has_override(int argc, char **argv, const char *key) {
-  for (int k = 0; k < argc; ++k)
-    if (strncmp(argv[k], key, strlen(key)) == 0 && argv[k][strlen(key)] == '=') return 1;
+  const size_t n = strlen(key);
+  for (int k = 0; k < argc; ++k) {
+    const char *a = argv[k] + strspn(argv[k], " \t");
+    if (strncmp(a, key, n) == 0 && a[n + strspn(a + n, " \t")] == '=') return 1;
+  }
+  return 0;
+}
+
+/* Where a restart writes when output.dir is not given: the checkpoint's own folder, unless
+ * that folder records results later than the checkpoint (an earlier checkpoint of a finished
+ * or crashed run) and output.truncate is off; then a new folder beside it, named after the
+ * checkpoint, so nothing is mixed or lost. */
+static int restart_folder(const mpm_config *cfg, const char *path, double t, char *dir, size_t n) {
+  int truncate;
+  double latest;
+  MPM_CALL(mpm_config_get_bool(cfg, "output.truncate", &truncate));
+  char *parent = mpm_path_parent(path);
+  if (!parent) return MPM_ERR_MEMORY;
+  int rc = truncate ? 0 : mpm_rundir_latest(MPI_COMM_WORLD, parent, path, t, &latest);
+  int len;
+  if (!rc && !truncate && latest > t * (1 + 1e-12)) {
+    const char *name = strrchr(path, '/') ? strrchr(path, '/') + 1 : path;
+    const int stem =
+        (int)(strlen(name) > 3 && strcmp(name + strlen(name) - 3, ".h5") == 0 ? strlen(name) - 3
+                                                                              : strlen(name));
+    const int top = strcmp(parent, ".") == 0 || strcmp(parent, "/") == 0;
+    len = snprintf(dir, n, "%s%s-from-%.*s", top ? "" : parent, top ? "restart" : "", stem, name);
+    mpm_log(MPM_LOG_INFO,
+            "restart: %s holds results up to t = %.6g, later than the checkpoint (t = %.6g); "
+            "continuing in %s (output.truncate=true would cut %s back instead)",
+            parent, latest, t, dir, parent);
+  } else {
+    len = snprintf(dir, n, "%s", parent);
+  }
+  free(parent);
+  MPM_CALL(rc);
+  if (len >= (int)n) MPM_FAIL(MPM_ERR_INPUT, "restart: the path '%s' is too long", path);
   return 0;
 }
 
 /* A restart: the checkpoint's stored case, then the overrides, which may change only what a
- * restart honours. It continues in the checkpoint's own folder unless output.dir says
- * otherwise (see mpm_rundir.h for when that is allowed). */
+ * restart honours. output.overwrite and output.truncate act only when given with this
+ * restart (never inherited from the stored case). The output folder: restart_folder. */
 static int load_restart(mpm_config *cfg, const char *path, int argc, char **argv) {
   mpm_checkpoint *ck = NULL;
+  double t = 0;
   MPM_CALL(mpm_checkpoint_open(&ck, MPI_COMM_WORLD, path));
   int rc = mpm_config_read_string(cfg, mpm_checkpoint_config(ck), path, ".");
+  if (!rc) rc = mpm_checkpoint_attr(ck, "t", &t);
   mpm_checkpoint_close(&ck);
   MPM_CALL(rc);
   char *before = assignments(cfg);
-  if (!before) return MPM_ERR_MEMORY;
-  char dir[4096 + 16];
+  MPM_CALL(mpm_h5_agree(MPI_COMM_WORLD, before ? 0 : MPM_ERR_MEMORY));
+  char dir[4096];
   rc = apply_overrides(cfg, argc, argv);
-  if (!rc && !has_override(argc, argv, "output.dir")) {
-    char *parent = mpm_path_parent(path);
-    if (!parent || snprintf(dir, sizeof dir, "output.dir=%s", parent) >= (int)sizeof dir)
-      rc = MPM_ERR_INPUT;
-    free(parent);
-    if (!rc) rc = mpm_config_override(cfg, dir);
-  }
+  static const char *const intent[] = {"output.overwrite", "output.truncate"};
+  for (int k = 0; k < 2 && !rc; ++k)
+    if (!has_override(argc, argv, intent[k]))
+      rc = mpm_config_set(cfg, intent[k], "false", "restart (not inherited)");
   if (!rc) rc = mpm_config_validate(cfg);
+  if (!rc && !has_override(argc, argv, "output.dir")) {
+    rc = restart_folder(cfg, path, t, dir, sizeof dir);
+    if (!rc) rc = mpm_config_set(cfg, "output.dir", dir, "restart (the checkpoint's folder)");
+    if (!rc) rc = mpm_config_validate(cfg);
+  }
   if (!rc) rc = check_restart_changes(cfg, before, path);
   free(before);
   return rc;

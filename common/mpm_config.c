@@ -1067,6 +1067,12 @@ int mpm_config_override(mpm_config *cfg, const char *assignment) {
   return rc ? mpm_trace(__FILE__, __LINE__, __func__, rc) : 0;
 }
 
+int mpm_config_set(mpm_config *cfg, const char *key, const char *value, const char *where) {
+  place at = {where, NULL, 0, ++cfg->nsources, NULL};
+  MPM_CALL(set_entry(cfg, key, value, &at));
+  return 0;
+}
+
 /* ---- validation ---------------------------------------------------------------------- */
 
 /* Levenshtein distance, letters compared without case (a wrong case is a near miss), or

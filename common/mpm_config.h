@@ -60,6 +60,9 @@ int mpm_config_read_string(mpm_config *cfg, const char *text, const char *origin
  * command line is one source, like one file: a key given twice there is an input error
  * naming both assignments. */
 int mpm_config_override(mpm_config *cfg, const char *assignment);
+/* Set key to value verbatim (no comment stripping: for values the program derives, such as
+ * a path), recorded as coming from `where` (a string that outlives cfg). */
+int mpm_config_set(mpm_config *cfg, const char *key, const char *value, const char *where);
 
 /* Check every entry against the schema: unknown keys (with the nearest valid key), types,
  * ranges, enum choices, file existence, required keys of every used instance. Reports

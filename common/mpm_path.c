@@ -27,6 +27,7 @@ char *mpm_path_parent(const char *path) {
 }
 
 int mpm_path_make_dir(const char *dir) {
+  if (!dir[0]) return ENOENT;
   const size_t len = strlen(dir);
   char *p = malloc(len + 1);
   int err = p ? 0 : ENOMEM;

@@ -1,6 +1,6 @@
 /* The output folder of a run (see mpm_rundir.h). All file work is done by rank 0; the outcome
  * is broadcast, so every rank returns the same code. */
-#define _DEFAULT_SOURCE /* flock, realpath-free stat comparisons, dirent d_type */
+#define _DEFAULT_SOURCE /* flock, realpath, lstat */
 #include "mpm_rundir.h"
 
 #include "mpm_error.h"
@@ -28,14 +28,22 @@ struct mpm_rundir {
   int fd; /* the locked file, rank 0 only (-1 elsewhere) */
 };
 
-/* What mpmfsi and its post-processing write into an output folder. Anything else in the
- * folder belongs to the user and is never touched. */
-static const char *const g_ours[] = {"snap_*.h5", "checkpoint_*.h5", "*.tmp",    "series.xmf",
-                                     "*.csv",     "summary.json",    RUNID_NAME, "*.png"};
+/* What mpmfsi writes into an output folder, by exact name pattern. Anything else in the
+ * folder belongs to the user (post-processing too) and is never touched. */
+static const char *const g_ours[] = {"snap_[0-9]*.h5",      "checkpoint_[0-9]*.h5",
+                                     "checkpoint_final.h5", "series.xmf",
+                                     "diagnostics.csv",     "coupling.csv",
+                                     "probes.csv",          "timers.csv",
+                                     "summary.json",        RUNID_NAME};
 
+/* 1: a result; 2: a leftover of an interrupted write (a result's name + ".tmp"); 0: not ours. */
 static int is_ours(const char *name) {
+  char base[256];
+  const size_t n = strlen(name);
+  const int tmp = n > 4 && n < sizeof base && strcmp(name + n - 4, ".tmp") == 0;
+  if (tmp) snprintf(base, sizeof base, "%.*s", (int)(n - 4), name);
   for (size_t k = 0; k < sizeof g_ours / sizeof g_ours[0]; ++k)
-    if (fnmatch(g_ours[k], name, 0) == 0) return 1;
+    if (fnmatch(g_ours[k], tmp ? base : name, 0) == 0) return tmp ? 2 : 1;
   return 0;
 }
 
@@ -49,6 +57,15 @@ static int take_lock(const char *dir, int *fd_out) {
   if (fd < 0)
     MPM_FAIL(MPM_ERR_INPUT, "cannot create the lock file %s/%s: %s; choose another output.dir", dir,
              LOCK_NAME, strerror(errno));
+  if (flock(fd, LOCK_EX | LOCK_NB) != 0 && errno != EWOULDBLOCK) {
+    const int e = errno;
+    close(fd);
+    MPM_FAIL(MPM_ERR_INPUT,
+             "cannot lock %s/%s: %s (the file system may not support locks, as Lustre without "
+             "-o flock or some network mounts); choose an output.dir on a local or lock-capable "
+             "file system",
+             dir, LOCK_NAME, strerror(e));
+  }
   if (flock(fd, LOCK_EX | LOCK_NB) != 0) {
     char owner[128] = "";
     const ssize_t n = pread(fd, owner, sizeof owner - 1, 0);
@@ -89,6 +106,11 @@ static int list_ours(const char *dir, listing *l) {
   int cap = 0, rc = 0;
   for (struct dirent *e; !rc && (e = readdir(d));) {
     if (!is_ours(e->d_name)) continue;
+    struct stat st;
+    char *path = mpm_path_join(dir, e->d_name);
+    const int regular = path && lstat(path, &st) == 0 && S_ISREG(st.st_mode);
+    free(path);
+    if (!regular) continue; /* a FIFO, a link or a folder of that name is not ours */
     if (l->n == cap) {
       char **nn = realloc(l->name, sizeof *nn * (size_t)(cap = 2 * cap + 16));
       if (!nn) {
@@ -238,11 +260,21 @@ static int write_run_id(const char *dir, double id) {
   return 0;
 }
 
-/* A new record in dir: refused if an earlier run's results are there, unless overwrite. */
-static int start_fresh(const char *dir, int overwrite, const listing *l) {
+/* A new record in dir: refused if an earlier run's results are there, unless overwrite.
+ * Never deletes the checkpoint the run restarts from (keep, or NULL). */
+static int start_fresh(const char *dir, int overwrite, const listing *l, const char *keep) {
   int results = 0, first = -1;
-  for (int k = 0; k < l->n; ++k)
-    if (fnmatch("*.tmp", l->name[k], 0) != 0 && ++results == 1) first = k;
+  for (int k = 0; k < l->n; ++k) {
+    char *path = keep ? mpm_path_join(dir, l->name[k]) : NULL;
+    const int self = path && same_file(path, keep);
+    free(path);
+    if (self)
+      MPM_FAIL(MPM_ERR_INPUT,
+               "output folder '%s' holds the checkpoint this run restarts from (%s); choose "
+               "another output.dir",
+               dir, l->name[k]);
+    if (is_ours(l->name[k]) == 1 && ++results == 1) first = k;
+  }
   if (results > 0 && !overwrite)
     MPM_FAIL(MPM_ERR_INPUT,
              "output folder '%s' already holds the results of another run (%d files, e.g. %s); "
@@ -273,22 +305,27 @@ static void later_snapshot(const char *name, double t, void *arg) {
 
 /* Continue dir's record from a checkpoint in it at time t: refused if later results exist,
  * unless truncate (then they are deleted; the index and CSVs are cut when reopened). */
-static int continue_in_place(const mpm_rundir_request *req, const listing *l) {
-  const char *dir = req->dir;
-  later L = {dir, req->t, -HUGE_VAL, 0, 0, 0};
+/* The latest time dir records beyond t: CSV rows, snapshots in the index, checkpoints other
+ * than the one at `checkpoint` (-inf: nothing later). */
+static double latest_result(const char *dir, const char *checkpoint, double t, const listing *l) {
+  later L = {dir, t, -HUGE_VAL, 0, 0, 0};
   static const char *const csv[] = {"diagnostics.csv", "coupling.csv", "probes.csv"};
   for (int k = 0; k < 3; ++k) L.latest = fmax(L.latest, csv_last_time(dir, csv[k]));
   index_entries(dir, later_snapshot, &L);
-  double later_ckpt = -HUGE_VAL;
   for (int k = 0; k < l->n; ++k) {
     if (fnmatch("checkpoint_*.h5", l->name[k], 0) != 0) continue;
     char *path = mpm_path_join(dir, l->name[k]);
-    const int self = path && same_file(path, req->checkpoint);
+    const int self = path && same_file(path, checkpoint);
     free(path);
-    const double t = self ? NAN : checkpoint_time(dir, l->name[k]);
-    if (t > req->t * (1 + 1e-12)) later_ckpt = fmax(later_ckpt, t);
+    const double tk = self ? NAN : checkpoint_time(dir, l->name[k]);
+    if (tk > t * (1 + 1e-12)) L.latest = fmax(L.latest, tk);
   }
-  L.latest = fmax(L.latest, later_ckpt);
+  return L.latest;
+}
+
+static int continue_in_place(const mpm_rundir_request *req, const listing *l) {
+  const char *dir = req->dir;
+  later L = {dir, req->t, latest_result(dir, req->checkpoint, req->t, l), 0, 0, 0};
   if (!(L.latest > req->t * (1 + 1e-12))) return 0;
   if (!req->truncate)
     MPM_FAIL(MPM_ERR_INPUT,
@@ -301,7 +338,7 @@ static int continue_in_place(const mpm_rundir_request *req, const listing *l) {
   index_entries(dir, later_snapshot, &L);
   if (L.failed) return MPM_ERR_INPUT;
   for (int k = 0; k < l->n; ++k) {
-    const int tmp = fnmatch("*.tmp", l->name[k], 0) == 0;
+    const int tmp = is_ours(l->name[k]) == 2;
     int stale = tmp || strcmp(l->name[k], "summary.json") == 0;
     if (fnmatch("checkpoint_*.h5", l->name[k], 0) == 0) {
       char *path = mpm_path_join(dir, l->name[k]);
@@ -317,7 +354,8 @@ static int continue_in_place(const mpm_rundir_request *req, const listing *l) {
   return 0;
 }
 
-static int claim(const mpm_rundir_request *req, int *fd, int *append, double *run_id) {
+static int claim(const mpm_rundir_request *req, int *fd, int *append, double *run_id,
+                 long *next_checkpoint) {
   const char *dir = req->dir;
   listing l = {NULL, 0};
   *append = 0;
@@ -330,10 +368,11 @@ static int claim(const mpm_rundir_request *req, int *fd, int *append, double *ru
   MPM_CALL(take_lock(dir, fd));
   int rc = list_ours(dir, &l);
   int in_place = 0;
-  if (!rc && req->checkpoint) {
-    char *parent = mpm_path_parent(req->checkpoint);
+  if (!rc && req->checkpoint) { /* the folder the file really lies in (links resolved) */
+    char *real = realpath(req->checkpoint, NULL);
+    char *parent = real ? mpm_path_parent(real) : NULL;
     in_place = parent && same_file(parent, dir);
-    free(parent);
+    free(parent), free(real);
   }
   if (!rc && in_place) {
     const double owner = folder_run_id(dir);
@@ -348,35 +387,64 @@ static int claim(const mpm_rundir_request *req, int *fd, int *append, double *ru
     *append = 1;
     *run_id = req->run_id != 0 ? req->run_id : owner != 0 ? owner : new_run_id();
   } else if (!rc) {
-    rc = start_fresh(dir, req->overwrite, &l);
+    rc = start_fresh(dir, req->overwrite, &l, req->checkpoint);
     *run_id = new_run_id();
+  }
+  /* Checkpoints are numbered after the highest number left in the folder, so none is ever
+   * replaced (a restart may change the interval). */
+  listing_free(&l);
+  if (!rc) rc = list_ours(dir, &l);
+  *next_checkpoint = 1;
+  for (int k = 0; !rc && k < l.n; ++k) {
+    long num;
+    int used = 0;
+    if (sscanf(l.name[k], "checkpoint_%ld.h5%n", &num, &used) == 1 &&
+        used == (int)strlen(l.name[k]) && num >= *next_checkpoint)
+      *next_checkpoint = num + 1;
   }
   listing_free(&l);
   if (!rc) rc = write_run_id(dir, *run_id);
   return rc;
 }
 
+int mpm_rundir_latest(MPI_Comm comm, const char *dir, const char *checkpoint, double t,
+                      double *latest) {
+  int rank;
+  double v[2] = {0, -HUGE_VAL};
+  MPM_CALL_MPI(MPI_Comm_rank(comm, &rank));
+  if (rank == 0) {
+    listing l = {NULL, 0};
+    struct stat st;
+    if (stat(dir, &st) == 0 && S_ISDIR(st.st_mode)) v[0] = list_ours(dir, &l);
+    if (!v[0]) v[1] = latest_result(dir, checkpoint, t, &l);
+    listing_free(&l);
+  }
+  MPM_CALL_MPI(MPI_Bcast(v, 2, MPI_DOUBLE, 0, comm));
+  *latest = v[1];
+  return (int)v[0];
+}
+
 int mpm_rundir_claim(mpm_rundir **rd, MPI_Comm comm, const mpm_rundir_request *req, int *append,
-                     double *run_id) {
+                     double *run_id, long *next_checkpoint) {
   int rank;
   *rd = NULL;
   MPM_CALL_MPI(MPI_Comm_rank(comm, &rank));
   mpm_rundir *r = malloc(sizeof *r);
   int rc = r ? 0 : MPM_ERR_MEMORY;
-  double state[3] = {0, 0, 0};
+  double state[4] = {0, 0, 0, 1};
   if (r) r->fd = -1;
   if (!rc && rank == 0) {
-    rc = claim(req, &r->fd, append, run_id);
-    state[1] = *append, state[2] = *run_id;
+    rc = claim(req, &r->fd, append, run_id, next_checkpoint);
+    state[1] = *append, state[2] = *run_id, state[3] = (double)*next_checkpoint;
   }
   state[0] = rc;
-  MPM_CALL_MPI(MPI_Bcast(state, 3, MPI_DOUBLE, 0, comm));
+  MPM_CALL_MPI(MPI_Bcast(state, 4, MPI_DOUBLE, 0, comm));
   rc = mpm_h5_agree(comm, rc ? rc : (int)state[0]);
   if (rc) {
     mpm_rundir_release(&r);
     return mpm_trace(__FILE__, __LINE__, __func__, rc);
   }
-  *append = (int)state[1], *run_id = state[2];
+  *append = (int)state[1], *run_id = state[2], *next_checkpoint = (long)state[3];
   *rd = r;
   return 0;
 }

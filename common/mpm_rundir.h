@@ -12,7 +12,9 @@
  *   folder is later than the checkpoint (the usual "carry on to a later t_end"). When later
  *   results exist (an earlier checkpoint of a finished or crashed run) it is refused, unless
  *   `truncate` asks to cut the run back: the later snapshots and checkpoints are deleted, and
- *   the index and the CSV files are cut by the output writers that reopen them.
+ *   the index and the CSV files are cut by the output writers that reopen them. (`mpmfsi
+ *   restart` without an output.dir sends such a restart to a new folder instead, see
+ *   app/main.c, so the refusal is met only when that folder is named explicitly.)
  *
  * The folder records its run in DIR/run.id; checkpoints carry the same id, so a checkpoint
  * copied into another run's folder is not taken for that run's. */
@@ -33,11 +35,18 @@ typedef struct mpm_rundir_request {
 } mpm_rundir_request;
 
 /* Claim the folder (collective; rank 0 does the file work). On success *append is 1 when the
- * run continues the folder's existing record (restart in place), 0 when it starts a new one,
- * and *run_id is the id to store in checkpoints. A folder that cannot be claimed is an input
- * error with one message saying what to do. */
+ * run continues the folder's existing record (restart in place), 0 when it starts a new one;
+ * *run_id is the id to store in checkpoints; *next_checkpoint the number of the next
+ * checkpoint_NNNNNN.h5 (after every number in the folder, so none is replaced). A folder that
+ * cannot be claimed is an input error with one message saying what to do. */
 int mpm_rundir_claim(mpm_rundir **rd, MPI_Comm comm, const mpm_rundir_request *req, int *append,
-                     double *run_id);
+                     double *run_id, long *next_checkpoint);
+
+/* The latest time the folder dir records beyond a checkpoint at time t that lies in it
+ * (snapshots, CSV rows, other checkpoints), or -inf when nothing there is later: what decides
+ * whether a restart can continue in dir. Collective; rank 0 reads. */
+int mpm_rundir_latest(MPI_Comm comm, const char *dir, const char *checkpoint, double t,
+                      double *latest);
 
 /* Release the lock (the folder and its files stay). */
 void mpm_rundir_release(mpm_rundir **rd);

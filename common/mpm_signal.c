@@ -18,6 +18,7 @@ void mpm_signal_catch(void) {
   struct sigaction sa;
   memset(&sa, 0, sizeof sa);
   sa.sa_handler = on_signal;
+  sa.sa_flags = SA_RESTART; /* a log write the signal interrupts goes on */
   sigemptyset(&sa.sa_mask);
   g_signal = 0;
   sigaction(SIGTERM, &sa, NULL);

@@ -24,8 +24,8 @@ int mpm_budget_check(const mpm_config *cfg, const mpm_budget *b) {
   MPM_CALL(mpm_config_get_real(cfg, "run.max_steps", &max_steps));
   MPM_CALL(mpm_config_get_real(cfg, "output.max_gb", &max_gb));
   MPM_CALL(mpm_config_get_real(cfg, "output.max_files", &max_files));
-  const double span = b->t_end - b->t, nout = span / b->out_interval;
-  const double nck = isfinite(b->ckpt_interval) ? span / b->ckpt_interval : 0;
+  const double span = b->t_end - b->t, nout = floor(span / b->out_interval * (1 + 1e-12));
+  const double nck = isfinite(b->ckpt_interval) ? floor(span / b->ckpt_interval * (1 + 1e-12)) : 0;
   const double stable = b->h0 > 0 && isfinite(b->h0) ? span / b->h0 : 0;
   const double steps = stable + nout + nck; /* every output time ends a step too */
   const double nsnap = b->snapshots ? nout + 1 : 0, nckpt = nck + 1; /* and the final one */

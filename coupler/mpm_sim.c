@@ -54,6 +54,7 @@ struct mpm_sim {
   long step;
   double out_interval, ckpt_interval;
   long out_next, ckpt_next; /* index k of the next output / checkpoint at time k * interval */
+  long ckpt_number;         /* the number in the next checkpoint_NNNNNN.h5 */
   int sort_every, snapshots, grid_fields, progress, overwrite, truncate;
   const char *dir;
   double particle_steps;
@@ -201,6 +202,8 @@ static int read_run_settings(mpm_sim *s) {
   MPM_CALL(mpm_config_get_bool(s->cfg, "output.snapshots", &s->snapshots));
   MPM_CALL(mpm_config_get_bool(s->cfg, "output.grid_fields", &s->grid_fields));
   MPM_CALL(mpm_config_get_string(s->cfg, "output.dir", &s->dir));
+  if (!s->dir[0])
+    return mpm_config_fail(s->cfg, "output.dir", "is empty; name the folder to write into");
   MPM_CALL(mpm_config_get_bool(s->cfg, "output.overwrite", &s->overwrite));
   MPM_CALL(mpm_config_get_bool(s->cfg, "output.truncate", &s->truncate));
   if (s->out_interval <= 0) s->out_interval = s->t_end / 10;
@@ -244,7 +247,7 @@ static int open_outputs(mpm_sim *s) {
   int append;
   const mpm_rundir_request req = {s->dir,        s->overwrite, s->truncate,
                                   s->checkpoint, s->t,         s->run_id};
-  MPM_CALL(mpm_rundir_claim(&s->rundir, s->comm, &req, &append, &s->run_id));
+  MPM_CALL(mpm_rundir_claim(&s->rundir, s->comm, &req, &append, &s->run_id, &s->ckpt_number));
   MPM_CALL(mpm_config_resolved_text(s->cfg, &s->config_text));
   MPM_CALL(mpm_output_new(&s->out, s->comm, s->dir, s->config_text, s->grid->dim, append, s->t));
   snprintf(path, sizeof path, "%s/diagnostics.csv", s->dir);
@@ -614,7 +617,7 @@ int mpm_sim_run(mpm_sim *s) {
     if (s->t >= t_ckpt * (1 - 1e-14) && s->t < t_stop) {
       s->h_next = mpm_integrator_next_step(s->it);
       s->ckpt_next++;
-      snprintf(path, sizeof path, "%s/checkpoint_%06ld.h5", s->dir, s->ckpt_next - 1);
+      snprintf(path, sizeof path, "%s/checkpoint_%06ld.h5", s->dir, s->ckpt_number++);
       MPM_CALL(write_checkpoint(s, path));
       /* Exactly what a restart from this file does. */
       MPM_CALL(mpm_integrator_start(s->it, s->t, s->h_next));

@@ -7,9 +7,10 @@ failed on the code before the fix.
 1. A second run into a folder that holds a run's results is refused (exit 2) and leaves them
    byte for byte; output.overwrite=true deletes them first (files that are not mpmfsi's stay).
 2. Two runs started at once into one folder: the second is refused at once (the lock).
-3. Restart of an earlier checkpoint in its own folder is refused while later results exist;
-   into a new folder it runs and leaves the old one untouched; a copy of a checkpoint in
-   another folder continues there; output.truncate=true cuts the old run back consistently
+3. Restart of an earlier checkpoint continues in a new folder beside the old one (named after
+   the checkpoint), which stays byte for byte; a second such restart is refused; naming the
+   old folder as output.dir is refused while later results exist; a named new folder works;
+   a copy of a checkpoint in another folder continues there; output.truncate=true cuts the old run back consistently
    (no later snapshot, checkpoint or CSV row is left, the index lists exactly the files) and
    ends bitwise where the straight run ended (usl: no step history; tolerance 0).
 4. Restart overrides that cannot be honoured (a density, a new section) are refused, naming
@@ -105,6 +106,16 @@ check(p.returncode == 0 and ok and not os.path.exists(os.path.join(a, "snap_0000
       f"output.overwrite=true: the earlier run's files deleted (stray snap_000077.h5 too), "
       f"notes.txt kept, the new run alone in the index (times {times})")
 
+u = mt.outdir("user_files")
+for name, text in (("analysis.csv", "a,b\n1,2\n"), ("notes.tmp", "draft\n"), ("plot.png", "")):
+    with open(os.path.join(u, name), "w") as f:
+        f.write(text)
+p = mt.run(["run", SOD, f"output.dir={u}", "output.overwrite=true"] + SHORT, check=False)
+kept = all(os.path.exists(os.path.join(u, n)) for n in ("analysis.csv", "notes.tmp", "plot.png"))
+check(p.returncode == 0 and kept,
+      "a folder holding only the user's files (analysis.csv, notes.tmp, plot.png) is no run's: "
+      "the run goes ahead, even with overwrite, and leaves them")
+
 # ---- 2. the lock -------------------------------------------------------------------------
 b = mt.outdir("locked")
 first = subprocess.Popen([mt.BIN, "run", SOD, f"output.dir={b}", "time.t_end=0.2"] + QUIET,
@@ -128,14 +139,24 @@ mt.run(["run", SOD, f"output.dir={full}"] + USL)
 ck1 = os.path.join(full, "checkpoint_000001.h5")
 before = listing(full)
 p = mt.run(["restart", ck1] + QUIET, check=False)
+branch = full + "-from-checkpoint_000001"
+check(p.returncode == 0 and listing(full) == before and os.path.isdir(branch)
+      and bitwise(final(full), final(branch)) and f"continuing in {branch}" in p.stderr,
+      f"restart of an earlier checkpoint: continues in {os.path.basename(branch)}, ends bitwise "
+      f"where the straight run ends, the original folder byte for byte")
+p = mt.run(["restart", ck1] + QUIET, check=False)
+check(one_error(p, "already holds the results of another run") and listing(full) == before,
+      f"the same restart again: refused, its first result kept: {errors(p)[:1]}")
+p = mt.run(["restart", ck1, f"output.dir={full}"] + QUIET, check=False)
 check(one_error(p, "later than the checkpoint", "output.dir=", "output.truncate=true")
       and listing(full) == before,
-      f"restart of an earlier checkpoint in its folder refused: {errors(p)[:1]}; folder unchanged")
+      f"restart of an earlier checkpoint into its own folder, named: refused: {errors(p)[:1]}; "
+      f"folder unchanged")
 new = mt.outdir("continued")
 p = mt.run(["restart", ck1, f"output.dir={new}"] + QUIET, check=False)
 check(p.returncode == 0 and listing(full) == before and bitwise(final(full), final(new)),
-      "restart into a new folder: runs, ends bitwise where the straight run ends, and leaves "
-      "the original folder byte for byte")
+      "restart into a named new folder: runs, ends bitwise where the straight run ends, and "
+      "leaves the original folder byte for byte")
 copy_dir = mt.outdir("copy")
 shutil.copy(ck1, copy_dir)
 p = mt.run(["restart", os.path.join(copy_dir, "checkpoint_000001.h5")] + QUIET, check=False)
@@ -160,6 +181,35 @@ ok, times, t_last = index_consistent(cut)
 check(p.returncode == 0 and ok and bitwise(final(cut), ref),
       f"... and continued in place from its final checkpoint to 0.04: ends bitwise where the "
       f"straight run ends; index {len(times)} snapshots, consistent")
+
+# Overwrite is an intent of one command, not inherited by restarts of its checkpoints.
+o1, o2 = mt.outdir("overwriting"), mt.outdir("someone_else")
+mt.run(["run", SOD, f"output.dir={o1}", "output.overwrite=true"] + SHORT)
+mt.run(["run", SOD, f"output.dir={o2}"] + SHORT)
+before2 = listing(o2)
+p = mt.run(["restart", os.path.join(o1, "checkpoint_final.h5"), f"output.dir={o2}",
+            "time.t_end=0.03"] + QUIET, check=False)
+check(one_error(p, "already holds the results of another run") and listing(o2) == before2,
+      "a restart of a checkpoint written with output.overwrite=true does not overwrite: refused")
+# A restart in place with another checkpoint interval numbers its checkpoints after the last.
+c = mt.outdir("renumber")
+mt.run(["run", SOD, f"output.dir={c}", "time.t_end=0.01", "output.checkpoint_interval=0.004"]
+       + QUIET)
+old2 = listing(c)["checkpoint_000002.h5"][2]
+p = mt.run(["restart", os.path.join(c, "checkpoint_final.h5"), "time.t_end=0.03",
+            "output.checkpoint_interval=0.01"] + QUIET, check=False)
+check(p.returncode == 0 and listing(c)["checkpoint_000002.h5"][2] == old2
+      and os.path.exists(os.path.join(c, "checkpoint_000003.h5")),
+      "restart in place with a new checkpoint interval: checkpoint_000002.h5 (t = 0.008) kept, "
+      "the next one is checkpoint_000003.h5")
+# A checkpoint reached through a link: its real folder decides; it is never deleted.
+link = os.path.join(mt.outdir("link"), "ck.h5")
+os.symlink(os.path.abspath(os.path.join(c, "checkpoint_final.h5")), link)
+p = mt.run(["restart", link, f"output.dir={c}", "output.overwrite=true", "time.t_end=0.04"]
+           + QUIET, check=False)
+check(p.returncode == 0 and os.path.exists(os.path.join(c, "checkpoint_000002.h5")),
+      "restart through a symbolic link into the checkpoint's real folder continues that run "
+      "(nothing deleted, although overwrite was given)")
 
 # ---- 4. restart overrides ----------------------------------------------------------------
 o = mt.outdir("overrides")
