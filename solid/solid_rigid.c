@@ -5,8 +5,8 @@
  * the model's side: zero stress and energy, and a wave speed of 0 so that only the body's
  * velocity enters the stable step. Parameters: density only (it gives the particle mass).
  * E and sigma_y given to a rigid body are input errors. nu and hardening have defaults, so a
- * resolved case (the text a checkpoint stores) always holds them: they are ignored, as every
- * model ignores the keys it does not use. */
+ * user may set them to their defaults' values: they are ignored, as every model ignores the
+ * keys it does not use. */
 #include "solid_material.h"
 
 #include <stdio.h>

@@ -26,7 +26,7 @@
  *         b-f concern an elastic response and are skipped for them, each with its reason;
  *         batch and a apply unchanged. A rigid model is created without E, nu, sigma_y and
  *         hardening, and must refuse E and sigma_y as bad input (nu and hardening have
- *         defaults, so a resolved case always holds them).
+ *         defaults, so they are accepted and ignored).
  *
  * Cauchy stress is read back from stress() as out / V with V = V0 det F (the contract:
  * out = V sigma); the small-strain model takes V = V0, which these checks see as an O(e)

@@ -26,7 +26,7 @@ pushing into an elastic bar (E = 100, rho = 1, nu = 0, c = 10, height A = 2), bs
   nodes follow from the restored time).
 - Bad input: E or sigma_y given to a rigid body, velocity_field for a rigid body: one error
   line each naming file:line and the key, exit 2, nothing written. (nu and hardening have
-  defaults, which a checkpoint's resolved case holds, so they are accepted and ignored.)
+  defaults, so they are accepted and ignored.)
 
 - Under the classic updates (usl, musl, and usl with APIC), with an output every step: the
   piston moves exactly at v (1e-12 m), its v and F stay exact, and under APIC its affine
