@@ -303,8 +303,18 @@ static void later_snapshot(const char *name, double t, void *arg) {
   }
 }
 
-/* Continue dir's record from a checkpoint in it at time t: refused if later results exist,
- * unless truncate (then they are deleted; the index and CSVs are cut when reopened). */
+/* The time of the checkpoint `name` in dir if it is another one than `checkpoint` and later
+ * than t; NaN otherwise (also when it is no checkpoint or cannot be read). */
+static double later_checkpoint(const char *dir, const char *name, const char *checkpoint,
+                               double t) {
+  if (fnmatch("checkpoint_*.h5", name, 0) != 0) return NAN;
+  char *path = mpm_path_join(dir, name);
+  const int self = path && same_file(path, checkpoint);
+  free(path);
+  const double tk = self ? NAN : checkpoint_time(dir, name);
+  return tk > t * (1 + 1e-12) ? tk : NAN;
+}
+
 /* The latest time dir records beyond t: CSV rows, snapshots in the index, checkpoints other
  * than the one at `checkpoint` (-inf: nothing later). */
 static double latest_result(const char *dir, const char *checkpoint, double t, const listing *l) {
@@ -312,17 +322,13 @@ static double latest_result(const char *dir, const char *checkpoint, double t, c
   static const char *const csv[] = {"diagnostics.csv", "coupling.csv", "probes.csv"};
   for (int k = 0; k < 3; ++k) L.latest = fmax(L.latest, csv_last_time(dir, csv[k]));
   index_entries(dir, later_snapshot, &L);
-  for (int k = 0; k < l->n; ++k) {
-    if (fnmatch("checkpoint_*.h5", l->name[k], 0) != 0) continue;
-    char *path = mpm_path_join(dir, l->name[k]);
-    const int self = path && same_file(path, checkpoint);
-    free(path);
-    const double tk = self ? NAN : checkpoint_time(dir, l->name[k]);
-    if (tk > t * (1 + 1e-12)) L.latest = fmax(L.latest, tk);
-  }
+  for (int k = 0; k < l->n; ++k) /* fmax ignores NaN */
+    L.latest = fmax(L.latest, later_checkpoint(dir, l->name[k], checkpoint, t));
   return L.latest;
 }
 
+/* Continue dir's record from a checkpoint in it at time t: refused if later results exist,
+ * unless truncate (then they are deleted; the index and CSVs are cut when reopened). */
 static int continue_in_place(const mpm_rundir_request *req, const listing *l) {
   const char *dir = req->dir;
   later L = {dir, req->t, latest_result(dir, req->checkpoint, req->t, l), 0, 0, 0};
@@ -339,13 +345,8 @@ static int continue_in_place(const mpm_rundir_request *req, const listing *l) {
   if (L.failed) return MPM_ERR_INPUT;
   for (int k = 0; k < l->n; ++k) {
     const int tmp = is_ours(l->name[k]) == 2;
-    int stale = tmp || strcmp(l->name[k], "summary.json") == 0;
-    if (fnmatch("checkpoint_*.h5", l->name[k], 0) == 0) {
-      char *path = mpm_path_join(dir, l->name[k]);
-      const int self = path && same_file(path, req->checkpoint);
-      free(path);
-      stale = !self && checkpoint_time(dir, l->name[k]) > req->t * (1 + 1e-12);
-    }
+    const int stale = tmp || strcmp(l->name[k], "summary.json") == 0 ||
+                      !isnan(later_checkpoint(dir, l->name[k], req->checkpoint, req->t));
     if (stale) MPM_CALL(remove_file(dir, l->name[k]));
     L.removed += stale && !tmp;
   }
