@@ -37,6 +37,7 @@ struct mpm_integrator {
   double tstop;     /* stop time of the current step */
   double scale;     /* step reduction of the current retry (1 when not retrying) */
   int fn_stale;     /* ERKStep's stored f(t_n, y_n) used another step size: re-evaluate */
+  double checked_t; /* time of the last step end whose state the classic update checked */
   mpm_fault fault;  /* last unphysical state seen by the RHS (same on every rank) */
   int rhs_error;    /* a non-recoverable failure inside the RHS */
   long steps, rhs_evals, fails, retries;
@@ -100,25 +101,39 @@ static int cycle_rhs(mpm_integrator *it, N_Vector y, N_Vector ydot, double t) {
 static int classic_limit(mpm_integrator *it, N_Vector y, double *h);
 static double classic_step(const mpm_integrator *it, double t, double h_limit, int at_end);
 
+/* In the classic update ERKStep's end-of-step f is the next step's one stage, but the driver
+ * nearly always changes the particles between steps (migration, inflow, outflow,
+ * regularisation) and the next stop time or retry may change the step it was computed for.
+ * So the end of a step only checks the new state; the next attempt finds its stability limit
+ * and evaluates f from scratch (fn_stale). The RHS is a function of (t, y, h) alone (the
+ * lagged strain rate is part of y), so this changes no result and halves the MPM cycles. */
 static int rhs(mpm_sunreal t, N_Vector y, N_Vector ydot, void *user) {
   mpm_integrator *it = user;
   mpm_fault local = {0};
-  it->rhs_evals++;
+  const int classic = mpm_method_is_classic(it->method);
+  const int at_end = t != it->t_last; /* the end of a step, where the next one starts */
   mpm_timer_start(MPM_T_CHECK);
-  if (mpm_method_is_classic(it->method)) {
-    if (classic_limit(it, y, &it->h_limit) != 0) {
+  if (classic && !at_end) {
+    if (!it->h_limit_set && classic_limit(it, y, &it->h_limit) != 0) {
       it->rhs_error = 1;
       return -1;
     }
     it->h_limit_set = 1;
-    /* Not at t_last: at the end of a step, where the next one starts. */
-    it->h_classic = classic_step(it, t, it->h_limit, t != it->t_last);
+    it->h_classic = classic_step(it, t, it->h_limit, 0);
   }
-  for (int k = 0; k < it->nmod && !local.set; ++k)
+  /* A classic step's state was checked at the end of the step that made it (below); the
+   * particles the driver adds between steps are made valid. */
+  const int checked = classic && !at_end && it->checked_t == t;
+  for (int k = 0; k < it->nmod && !local.set && !checked; ++k)
     it->mod[k]->ops->check(it->mod[k], module_data(y, k), &local);
-  const int faulty = share_fault(it, &local);
+  const int faulty = !checked && share_fault(it, &local);
   mpm_timer_stop(MPM_T_CHECK);
   if (faulty) return 1;
+  if (classic && at_end) { /* ydot is never read: the next attempt re-evaluates */
+    it->checked_t = t, it->fn_stale = 1, it->h_limit_set = 0;
+    return 0;
+  }
+  it->rhs_evals++;
   if (cycle_rhs(it, y, ydot, t) != 0) {
     it->rhs_error = 1;
     return -1;
@@ -360,6 +375,7 @@ int mpm_integrator_start(mpm_integrator *it, double t, double h0) {
   if (!it->ark) MPM_FAIL(MPM_ERR_SUNDIALS, "ERKStepCreate failed");
   it->t_last = t;
   it->scale = 1.0, it->fn_stale = 0, it->fails_seen = 0, it->h_limit_set = 0;
+  it->checked_t = NAN;
   return configure(it, h0);
 }
 
