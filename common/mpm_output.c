@@ -14,7 +14,12 @@
  * - Particle rows are in rank order: rank r holds rows [offset_r, offset_r + n_r) with
  *   offset_r = MPI_Exscan of the counts. Particle data is component-major in memory and
  *   row-major ([N][ncomp]) on disk, so each field is transposed through one buffer.
- * - The XDMF index lives on rank 0 only (mpm_xdmf.c). */
+ * - The XDMF indexes live on rank 0 only (mpm_xdmf.c): series.xmf lists the particles of
+ *   every snapshot, grid.xmf the grid fields of those that have them. grid.xmf exists only
+ *   while it lists a snapshot, so it never outlives the grid fields of an earlier run.
+ * - Every snapshot holds /xdmf/<phase>, int64 [N] = 0 .. N-1, the connectivity of the
+ *   phase's Polyvertex topology in the index (mpm_xdmf.h). It lies outside the phase group,
+ *   whose datasets are all per-particle fields in rank order. */
 #define _POSIX_C_SOURCE 200809L /* mkdir, stat, access */
 #include "mpm_output.h"
 #include "mpm_error.h"
@@ -29,15 +34,16 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#define OUTPUT_VERSION "mpmfsi 0.1"
-#define INDEX_NAME     "series.xmf"
+#define OUTPUT_VERSION  "mpmfsi 0.1"
+#define INDEX_NAME      "series.xmf"
+#define GRID_INDEX_NAME "grid.xmf"
 
 struct mpm_output {
   MPI_Comm comm; /* a duplicate, so our collectives never mix with the caller's */
   int rank, size, dim;
   char *dir, *config; /* config: rank 0's text, the same on every rank */
   int next;
-  mpm_xdmf *index; /* rank 0 only */
+  mpm_xdmf *index, *grid_index; /* rank 0 only: particles, grid fields */
 };
 
 /* Where this rank's particles of one phase go in the snapshot. */
@@ -76,6 +82,30 @@ static int write_particles(const mpm_h5 *h, hid_t file, const mpm_particles *p, 
   hid_t g;
   MPM_CALL(mpm_h5_group(h, file, name, &g));
   const int rc = write_particle_fields(h, g, p, r, buf);
+  H5Gclose(g);
+  MPM_CALL(rc);
+  return 0;
+}
+
+/* The Polyvertex connectivity of each phase: row r holds r. buf holds at least n doubles,
+ * and as many int64. */
+static int write_vertices(const mpm_h5 *h, hid_t g, const char *name, const phase_rows *r,
+                          double *buf) {
+  int64_t *v = (int64_t *)buf;
+  for (int64_t i = 0; i < r->n; ++i) v[i] = r->offset + i;
+  hsize_t fdims[1] = {(hsize_t)r->total}, start[1] = {(hsize_t)r->offset},
+          count[1] = {(hsize_t)r->n};
+  MPM_CALL(
+      mpm_h5_write_block(h, g, name, H5T_STD_I64LE, H5T_NATIVE_INT64, 1, fdims, start, count, v));
+  return 0;
+}
+
+static int write_all_vertices(const mpm_h5 *h, hid_t file, const char *const *names, int nphases,
+                              const phase_rows *rows, double *buf) {
+  hid_t g;
+  MPM_CALL(mpm_h5_group(h, file, MPM_XDMF_VERTICES, &g));
+  int rc = 0;
+  for (int k = 0; k < nphases && !rc; ++k) rc = write_vertices(h, g, names[k], &rows[k], buf);
   H5Gclose(g);
   MPM_CALL(rc);
   return 0;
@@ -206,6 +236,7 @@ static int write_contents(const mpm_h5 *h, hid_t file, const void *arg) {
   MPM_CALL(mpm_h5_attr_string(h, file, "version", OUTPUT_VERSION));
   for (int k = 0; k < s->nphases; ++k)
     MPM_CALL(write_particles(h, file, s->phases[k], s->names[k], &s->rows[k], s->buf));
+  MPM_CALL(write_all_vertices(h, file, s->names, s->nphases, s->rows, s->buf));
   if (s->grid) MPM_CALL(write_grid(h, file, s->grid, s->names, s->nphases, s->buf));
   return 0;
 }
@@ -239,18 +270,34 @@ static int index_add(mpm_output *out, const snapshot *s) {
     for (int d = 0; d < g->dim; ++d)
       m->n[d] = lattice_nodes(g, d), m->origin[d] = g->lo[d] - g->pad * g->dx;
   }
-  const int rc = mpm_xdmf_add(out->index, s->t, out->next, ph, s->nphases, mesh, nmesh);
+  int rc = mpm_xdmf_add(out->index, s->t, out->next, ph, s->nphases, NULL, 0);
+  if (!rc && nmesh > 0) rc = mpm_xdmf_add(out->grid_index, s->t, out->next, NULL, 0, mesh, nmesh);
   free(ph), free(fields), free(mesh);
   MPM_CALL(rc);
   return 0;
 }
 
-static int index_write(const mpm_output *out) {
-  char *path = mpm_path_join(out->dir, INDEX_NAME);
-  if (!path) MPM_FAIL(MPM_ERR_MEMORY, "output: cannot build the path of the index");
-  const int rc = mpm_xdmf_write(out->index, path);
+/* Write index x as dir/name; an optional index that lists nothing is deleted instead. */
+static int write_index(const char *dir, const mpm_xdmf *x, const char *name, int optional) {
+  char *path = mpm_path_join(dir, name);
+  if (!path) MPM_FAIL(MPM_ERR_MEMORY, "output: cannot build the path of %s", name);
+  if (optional && mpm_xdmf_count(x) == 0) {
+    const int gone = remove(path) == 0 || errno == ENOENT, e = errno;
+    free(path);
+    if (!gone)
+      MPM_FAIL(MPM_ERR_FILE, "cannot delete the stale index %s/%s: %s; delete it by hand", dir,
+               name, strerror(e));
+    return 0;
+  }
+  const int rc = mpm_xdmf_write(x, path);
   free(path);
   MPM_CALL(rc);
+  return 0;
+}
+
+static int index_write(const mpm_output *out) {
+  MPM_CALL(write_index(out->dir, out->index, INDEX_NAME, 0));
+  MPM_CALL(write_index(out->dir, out->grid_index, GRID_INDEX_NAME, 1));
   return 0;
 }
 
@@ -271,10 +318,11 @@ static int publish(mpm_output *out, const char *tmp, const char *final, const sn
 /* ---- checks ---------------------------------------------------------------------------- */
 
 static int check_phase(const mpm_output *out, const mpm_particles *p, const char *name) {
-  if (!p || !name || !name[0] || strchr(name, '/') || strcmp(name, "grid") == 0)
+  if (!p || !name || !name[0] || strchr(name, '/') || strcmp(name, "grid") == 0 ||
+      strcmp(name, MPM_XDMF_VERTICES) == 0)
     MPM_FAIL(MPM_ERR_INPUT,
              "output: phase name '%s' cannot name an HDF5 group (it must be "
-             "non-empty, without '/', and not 'grid')",
+             "non-empty, without '/', and not 'grid' or '" MPM_XDMF_VERTICES "')",
              name ? name : "(null)");
   if (p->dim != out->dim || p->nfields < 1 || strcmp(p->field[0].name, "x") != 0 ||
       p->field[0].ncomp != out->dim)
@@ -383,7 +431,17 @@ int mpm_output_count(const mpm_output *out) {
 
 /* ---- construction ---------------------------------------------------------------------- */
 
-/* Rank 0: the directory, and the index kept from an earlier run on a restart. */
+/* The entries of dir/name with time <= t_max; *found is 0 if there is no such file. */
+static int load_index(const char *dir, mpm_xdmf *x, const char *name, double t_max, int *found) {
+  char *path = mpm_path_join(dir, name);
+  if (!path) MPM_FAIL(MPM_ERR_MEMORY, "output: cannot build the path of %s", name);
+  const int rc = mpm_xdmf_load(x, path, t_max, found);
+  free(path);
+  MPM_CALL(rc);
+  return 0;
+}
+
+/* Rank 0: the directory, and the indexes kept from an earlier run on a restart. */
 static int prepare_index(mpm_output *out, int append, double t_restart) {
   const int err = mpm_path_make_dir(out->dir);
   if (err)
@@ -392,21 +450,19 @@ static int prepare_index(mpm_output *out, int append, double t_restart) {
              "the case file, or create this one with write permission",
              out->dir, strerror(err));
   MPM_CALL(mpm_xdmf_new(&out->index, out->dim));
+  MPM_CALL(mpm_xdmf_new(&out->grid_index, out->dim));
   if (append) {
-    char *path = mpm_path_join(out->dir, INDEX_NAME);
-    int found = 0;
-    if (!path) MPM_FAIL(MPM_ERR_MEMORY, "output: cannot build the path of the index");
-    const int rc = mpm_xdmf_load(out->index, path, t_restart, &found);
-    if (!rc && !found)
+    int found = 0, grid_found;
+    MPM_CALL(load_index(out->dir, out->index, INDEX_NAME, t_restart, &found));
+    MPM_CALL(load_index(out->dir, out->grid_index, GRID_INDEX_NAME, t_restart, &grid_found));
+    if (!found)
       mpm_log(MPM_LOG_WARN, "restart: no %s in %s; the index starts empty", INDEX_NAME, out->dir);
-    free(path);
-    MPM_CALL(rc);
     out->next = mpm_xdmf_next_index(out->index);
     mpm_log(MPM_LOG_INFO, "restart: %s keeps %d snapshot(s) with t <= %g; the next is snap_%06d.h5",
             INDEX_NAME, mpm_xdmf_count(out->index), t_restart, out->next);
   }
   /* Written now so that an index left by an earlier run never lists files this run is
-   * about to overwrite. */
+   * about to overwrite (a fresh run's grid index is empty: an earlier one is deleted). */
   MPM_CALL(index_write(out));
   return 0;
 }
@@ -465,6 +521,7 @@ void mpm_output_destroy(mpm_output **out) {
   mpm_output *o = *out;
   if (o->comm != MPI_COMM_NULL) MPI_Comm_free(&o->comm);
   mpm_xdmf_destroy(&o->index);
+  mpm_xdmf_destroy(&o->grid_index);
   free(o->dir), free(o->config);
   free(o);
   *out = NULL;

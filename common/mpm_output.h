@@ -7,9 +7,12 @@
  *   /<phase>/<field>  double [N][ncomp] for every particle field (x is [N][dim])
  *   /grid/<phase>/m, /grid/<phase>/v  (optional) nodal mass [Nz][Ny][Nx] and velocity
  *                     [Nz][Ny][Nx][dim] over the global node lattice including pad layers
- * OUTDIR/series.xmf indexes every snapshot written so far (a temporal collection of
- * Polyvertex grids per phase, and CoRectMesh grids for grid fields) and is rewritten
- * atomically after each snapshot, so it is valid XML at every moment.
+ *   /xdmf/<phase>     int64 [N] = 0 .. N-1, the connectivity of the phase's Polyvertex
+ *                     grid in series.xmf (phase names 'grid' and 'xdmf' are reserved)
+ * OUTDIR/series.xmf indexes the particles of every snapshot written so far, OUTDIR/grid.xmf
+ * the grid fields of those that have them (absent when none has); mpm_xdmf.h gives their
+ * layout. Both are rewritten atomically after each snapshot, so they are valid XML at
+ * every moment.
  *
  * Checkpoint (any path; written to PATH.tmp, then renamed by rank 0 once complete):
  *   /  attributes format ("mpmfsi checkpoint 2"), config (string), text_hash (uint64, FNV-1a

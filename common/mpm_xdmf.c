@@ -8,7 +8,8 @@
  *   and "time <= t_restart" on a restart keeps exactly the snapshots written up to then.
  *
  * Reading back is deliberately narrow: it finds the snapshot blocks of a file this module
- * wrote (by element nesting, not by line layout) and keeps their text verbatim. */
+ * wrote (by element nesting, not by line layout) and keeps their text verbatim. A block's
+ * time is its first <Time> (the snapshot's; the grids inside repeat it). */
 #define _POSIX_C_SOURCE 200809L /* strcasecmp */
 #include "mpm_xdmf.h"
 #include "mpm_error.h"
@@ -140,6 +141,10 @@ static int push_entry(mpm_xdmf *x, double time, int index, char *xml) {
 
 /* ---- rendering one snapshot ------------------------------------------------------------ */
 
+/* The fields ParaView should colour by when a series is opened, in order of preference; a
+ * phase lists the first it has as its only Scalar attribute (see mpm_xdmf.h). */
+static const char *const g_colour_fields[] = {"rho"};
+
 static void data_item(strbuf *b, const char *indent, const char *dims, const char *type,
                       const char *file, const char *group, const char *name) {
   sb_printf(b, "%s<DataItem Dimensions=\"%s\" NumberType=\"%s\" Precision=\"8\" Format=\"HDF\">",
@@ -152,73 +157,109 @@ static void data_item(strbuf *b, const char *indent, const char *dims, const cha
   sb_printf(b, "</DataItem>\n");
 }
 
-/* ParaView reads Scalar, Vector (2 or 3 components) and Tensor (9) with their meaning, and
- * any other count as a Matrix whose components it keeps in order. Tensor6 is avoided: its
- * component order need not match a 6-component field's. */
-static const char *attribute_type(int ncomp, int dim) {
-  if (ncomp == 1) return "Scalar";
+/* The one-grid temporal collection that gives a block a stable place, and its grid's Time
+ * (spelled with TimeType: one `<Time Value=` per entry). */
+static void open_block(strbuf *b, const char *name, const char *suffix, double time) {
+  sb_printf(b, "        <Grid Name=\"");
+  sb_escaped(b, name);
+  sb_printf(b, "%s\" GridType=\"Collection\" CollectionType=\"Temporal\">\n", suffix);
+  sb_printf(b, "          <Grid Name=\"");
+  sb_escaped(b, name);
+  sb_printf(b, "%s\" GridType=\"Uniform\">\n", suffix);
+  sb_printf(b, "            <Time TimeType=\"Single\" Value=\"%.17g\"/>\n", time);
+}
+
+static void close_block(strbuf *b) {
+  sb_printf(b, "          </Grid>\n"
+               "        </Grid>\n");
+}
+
+/* Index of the phase's colour field, or -1. */
+static int colour_field(const mpm_xdmf_phase *ph) {
+  for (size_t k = 0; k < sizeof g_colour_fields / sizeof g_colour_fields[0]; ++k)
+    for (int f = 1; f < ph->nfields; ++f)
+      if (ph->field[f].ncomp == 1 && strcmp(ph->field[f].name, g_colour_fields[k]) == 0) return f;
+  return -1;
+}
+
+/* Scalar only for the colour field: the readers make the first Scalar the active scalars.
+ * Vector for dim components (ParaView pads 2-D ones to 3), Tensor for 9, else a Matrix whose
+ * components ParaView keeps in order. Tensor6 is avoided: its component order need not
+ * match a 6-component field's. */
+static const char *attribute_type(int ncomp, int dim, int colour) {
+  if (colour) return "Scalar";
   if (ncomp == dim) return "Vector";
   if (ncomp == 9) return "Tensor";
   return "Matrix";
 }
 
-static void render_phase(strbuf *b, const char *file, const mpm_xdmf_phase *ph, int dim) {
+/* One-component fields are described as [n 1] (a Matrix needs its column count). */
+static void render_field(strbuf *b, const char *file, const mpm_xdmf_phase *ph, int f, int dim,
+                         int colour) {
   char dims[64];
-  sb_printf(b, "        <Grid Name=\"");
-  sb_escaped(b, ph->name);
-  sb_printf(b, "\" GridType=\"Uniform\">\n");
+  sb_printf(b, "            <Attribute Name=\"");
+  sb_escaped(b, ph->field[f].name);
+  sb_printf(b, "\" AttributeType=\"%s\" Center=\"Node\">\n",
+            attribute_type(ph->field[f].ncomp, dim, colour));
+  snprintf(dims, sizeof dims, "%" PRId64 " %d", ph->n, ph->field[f].ncomp);
+  data_item(b, "              ", dims, "Float", file, ph->name, ph->field[f].name);
+  sb_printf(b, "            </Attribute>\n");
+}
+
+/* Attributes in this order: the colour field, the other fields as stored (velocity first),
+ * the id (a one-column Matrix: never the active scalars). */
+static void render_phase(strbuf *b, const char *file, const mpm_xdmf_phase *ph, int dim,
+                         double time) {
+  char dims[64];
+  open_block(b, ph->name, "", time);
   sb_printf(b,
-            "          <Topology TopologyType=\"Polyvertex\" NumberOfElements=\"%" PRId64
-            "\" NodesPerElement=\"1\"/>\n",
+            "            <Topology TopologyType=\"Polyvertex\" NumberOfElements=\"%" PRId64
+            "\" NodesPerElement=\"1\">\n",
             ph->n);
-  sb_printf(b, "          <Geometry GeometryType=\"%s\">\n", dim == 2 ? "XY" : "XYZ");
-  snprintf(dims, sizeof dims, "%" PRId64 " %d", ph->n, dim);
-  data_item(b, "            ", dims, "Float", file, ph->name, ph->field[0].name);
-  sb_printf(b, "          </Geometry>\n");
   snprintf(dims, sizeof dims, "%" PRId64, ph->n);
-  sb_printf(b, "          <Attribute Name=\"id\" AttributeType=\"Scalar\" Center=\"Node\">\n");
-  data_item(b, "            ", dims, "Int", file, ph->name, "id");
-  sb_printf(b, "          </Attribute>\n");
-  for (int f = 1; f < ph->nfields; ++f) {
-    sb_printf(b, "          <Attribute Name=\"");
-    sb_escaped(b, ph->field[f].name);
-    sb_printf(b, "\" AttributeType=\"%s\" Center=\"Node\">\n",
-              attribute_type(ph->field[f].ncomp, dim));
-    snprintf(dims, sizeof dims, "%" PRId64 " %d", ph->n, ph->field[f].ncomp);
-    data_item(b, "            ", dims, "Float", file, ph->name, ph->field[f].name);
-    sb_printf(b, "          </Attribute>\n");
-  }
-  sb_printf(b, "        </Grid>\n");
+  data_item(b, "              ", dims, "Int", file, MPM_XDMF_VERTICES, ph->name);
+  sb_printf(b, "            </Topology>\n");
+  sb_printf(b, "            <Geometry GeometryType=\"%s\">\n", dim == 2 ? "XY" : "XYZ");
+  snprintf(dims, sizeof dims, "%" PRId64 " %d", ph->n, dim);
+  data_item(b, "              ", dims, "Float", file, ph->name, ph->field[0].name);
+  sb_printf(b, "            </Geometry>\n");
+  const int colour = colour_field(ph);
+  if (colour > 0) render_field(b, file, ph, colour, dim, 1);
+  for (int f = 1; f < ph->nfields; ++f)
+    if (f != colour) render_field(b, file, ph, f, dim, 0);
+  sb_printf(b, "            <Attribute Name=\"id\" AttributeType=\"Matrix\" Center=\"Node\">\n");
+  snprintf(dims, sizeof dims, "%" PRId64 " 1", ph->n);
+  data_item(b, "              ", dims, "Int", file, ph->name, "id");
+  sb_printf(b, "            </Attribute>\n");
+  close_block(b);
 }
 
 /* XDMF lists structured extents, origins and spacings slowest axis first (z y x). */
-static void render_mesh(strbuf *b, const char *file, const mpm_xdmf_mesh *m, int dim) {
+static void render_mesh(strbuf *b, const char *file, const mpm_xdmf_mesh *m, int dim, double time) {
   char dims[96], group[96];
   const double dz = m->spacing; /* also for the single layer of a 2-D lattice */
   snprintf(dims, sizeof dims, "%d %d %d", m->n[2], m->n[1], m->n[0]);
-  sb_printf(b, "        <Grid Name=\"");
-  sb_escaped(b, m->name);
-  sb_printf(b, "_grid\" GridType=\"Uniform\">\n");
-  sb_printf(b, "          <Topology TopologyType=\"3DCoRectMesh\" Dimensions=\"%s\"/>\n", dims);
-  sb_printf(b, "          <Geometry GeometryType=\"ORIGIN_DXDYDZ\">\n");
+  open_block(b, m->name, "_grid", time);
+  sb_printf(b, "            <Topology TopologyType=\"3DCoRectMesh\" Dimensions=\"%s\"/>\n", dims);
+  sb_printf(b, "            <Geometry GeometryType=\"ORIGIN_DXDYDZ\">\n");
   sb_printf(b,
-            "            <DataItem Name=\"Origin\" Dimensions=\"3\" NumberType=\"Float\" "
+            "              <DataItem Name=\"Origin\" Dimensions=\"3\" NumberType=\"Float\" "
             "Precision=\"8\" Format=\"XML\">%.17g %.17g %.17g</DataItem>\n",
             dim == 3 ? m->origin[2] : 0.0, m->origin[1], m->origin[0]);
   sb_printf(b,
-            "            <DataItem Name=\"Spacing\" Dimensions=\"3\" NumberType=\"Float\" "
+            "              <DataItem Name=\"Spacing\" Dimensions=\"3\" NumberType=\"Float\" "
             "Precision=\"8\" Format=\"XML\">%.17g %.17g %.17g</DataItem>\n",
             dz, m->spacing, m->spacing);
-  sb_printf(b, "          </Geometry>\n");
+  sb_printf(b, "            </Geometry>\n");
   snprintf(group, sizeof group, "grid/%s", m->name); /* names are checked to fit */
-  sb_printf(b, "          <Attribute Name=\"m\" AttributeType=\"Scalar\" Center=\"Node\">\n");
-  data_item(b, "            ", dims, "Float", file, group, "m");
-  sb_printf(b, "          </Attribute>\n");
-  sb_printf(b, "          <Attribute Name=\"v\" AttributeType=\"Vector\" Center=\"Node\">\n");
+  sb_printf(b, "            <Attribute Name=\"m\" AttributeType=\"Scalar\" Center=\"Node\">\n");
+  data_item(b, "              ", dims, "Float", file, group, "m");
+  sb_printf(b, "            </Attribute>\n");
+  sb_printf(b, "            <Attribute Name=\"v\" AttributeType=\"Vector\" Center=\"Node\">\n");
   snprintf(dims, sizeof dims, "%d %d %d %d", m->n[2], m->n[1], m->n[0], dim);
-  data_item(b, "            ", dims, "Float", file, group, "v");
-  sb_printf(b, "          </Attribute>\n");
-  sb_printf(b, "        </Grid>\n");
+  data_item(b, "              ", dims, "Float", file, group, "v");
+  sb_printf(b, "            </Attribute>\n");
+  close_block(b);
 }
 
 int mpm_xdmf_add(mpm_xdmf *x, double time, int index, const mpm_xdmf_phase *phase, int nphases,
@@ -234,8 +275,8 @@ int mpm_xdmf_add(mpm_xdmf *x, double time, int index, const mpm_xdmf_phase *phas
             "        <Time Value=\"%.17g\"/>\n",
             index, time);
   for (int k = 0; k < nphases; ++k)
-    if (phase[k].n > 0) render_phase(&b, file, &phase[k], x->dim);
-  for (int k = 0; k < nmeshes; ++k) render_mesh(&b, file, &mesh[k], x->dim);
+    if (phase[k].n > 0) render_phase(&b, file, &phase[k], x->dim, time);
+  for (int k = 0; k < nmeshes; ++k) render_mesh(&b, file, &mesh[k], x->dim, time);
   sb_printf(&b, "      </Grid>");
   if (b.failed) {
     free(b.s);
@@ -385,7 +426,7 @@ static int parse_index(mpm_xdmf *x, const char *text, const char *path, double t
           strcasecmp(type, "Spatial") == 0)
         block_open(&s, p, end, depth);
       if (!empty) ++depth;
-    } else if (s.start && tag_is(p, end, "Time")) {
+    } else if (s.start && !s.has_time && tag_is(p, end, "Time")) { /* the snapshot's */
       char val[64];
       char *e;
       if (tag_attr(p, end, "Value", val, sizeof val) == 0) {

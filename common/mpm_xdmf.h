@@ -2,16 +2,47 @@
  *
  * The index is a list of entries, one per snapshot file snap_NNNNNN.h5, in the order they
  * were added. Each entry keeps its time, its index NNNNNN and its rendered XML block, so
- * that entries kept from an earlier run (read back from series.xmf on a restart) and new
+ * that entries kept from an earlier run (read back from the file on a restart) and new
  * ones are written the same way without re-parsing every detail. mpm_xdmf_write() always
  * writes the whole list to PATH.tmp and renames it, so the file on disk is complete XML
  * at every moment.
  *
- * Layout (XDMF 2, which ParaView's default reader handles): a temporal collection of
- * spatial collections, one per snapshot, holding a Polyvertex grid per particle phase and a
- * CoRectMesh per grid phase. A 2-D lattice is written as a 3DCoRectMesh one node thick,
- * because VTK's XDMF 2 reader places a 2DCoRectMesh in the y-z plane and mis-sizes the
- * selection of its 2-component node vectors. */
+ * Layout (XDMF 2), chosen so that ParaView's three XDMF readers (XDMFReader, Xdmf3ReaderS,
+ * Xdmf3ReaderT) show the same thing and keep it across time steps (verified with 5.11):
+ *
+ *   Temporal collection "series"
+ *     Spatial collection "snap_NNNNNN" with <Time Value="t"/>, one per snapshot
+ *       Temporal collection NAME (one per particle phase or grid phase), holding
+ *         one Uniform grid NAME with <Time TimeType="Single" Value="t"/>
+ *
+ * - Block names: both readers rename every uniform grid to a name unique over the whole
+ *   file (solid, solid[1], ... one per step), so a block could not be hidden once for all
+ *   steps. The one-grid temporal collection around each grid gives the block its place:
+ *   XDMFReader names it after the collection ("solid" in every step), Xdmf3ReaderT keeps
+ *   its position (Block0, Block1, ...), and Xdmf3ReaderS merges all blocks into one
+ *   partitioned dataset anyway. The grid's own Time keeps Xdmf3 from inventing time 0 for
+ *   it; TimeType is spelled out so that each entry holds exactly one `<Time Value=` (the
+ *   snapshot's), which mpm_rundir.c's scan of series.xmf relies on.
+ * - Particles: a Polyvertex topology of N one-point cells whose connectivity 0 .. N-1 is
+ *   the dataset /MPM_XDMF_VERTICES/<phase> of the snapshot. Without it Xdmf3 makes no cells
+ *   and ParaView's default Surface representation draws nothing.
+ * - Colouring: ParaView colours a new source by the active scalars when all blocks that
+ *   have some agree, and the readers make the first Scalar attribute active. So a phase
+ *   lists its colour field first (the first of mpm_xdmf.c's colour fields it has: gas
+ *   `rho`) as the only Scalar attribute; its other one-component fields (and id) are
+ *   one-column Matrix attributes, which ParaView reads the same but never makes active, and
+ *   the velocity follows. A phase without a colour field (a solid) so leaves the gas's
+ *   colouring in place and is drawn in the solid colour. (Xdmf3ReaderS draws all phases as
+ *   one dataset, which keeps only the fields every phase has: v, m, V0, id.)
+ * - Tensors: dim x dim fields are row-major (T_xx T_xy T_yx T_yy in 2-D), and ParaView numbers
+ *   the components 0 .. ncomp-1 in that order. 9 components are a Tensor (3-D), other counts
+ *   (2-D tensors) a Matrix. Padding 2-D tensors to 3 x 3 in the index would need an XDMF
+ *   Function or HyperSlab, which VTK's Xdmf3 reader cannot read.
+ * - Grid phases are a 3DCoRectMesh (a 2-D lattice one node thick, because VTK's XDMF 2
+ *   reader places a 2DCoRectMesh in the y-z plane and mis-sizes the selection of its
+ *   2-component node vectors). The output layer keeps them in an index of their own
+ *   (grid.xmf): in the particle index the lattice's surface covers the particles, and
+ *   Xdmf3ReaderS merges it with them so that no particle field can colour them. */
 #ifndef MPM_XDMF_H
 #define MPM_XDMF_H
 
@@ -23,6 +54,10 @@ typedef struct mpm_xdmf_field {
   const char *name;
   int ncomp;
 } mpm_xdmf_field;
+
+/* Where the output layer writes the Polyvertex connectivity of each phase: the int64
+ * dataset /MPM_XDMF_VERTICES/<phase> [n] holding 0 .. n-1. */
+#define MPM_XDMF_VERTICES "xdmf"
 
 /* One particle phase of a snapshot: n particles in all; field[0] is the position x. */
 typedef struct mpm_xdmf_phase {
@@ -49,7 +84,8 @@ void mpm_xdmf_destroy(mpm_xdmf **x);
 int mpm_xdmf_load(mpm_xdmf *x, const char *path, double t_max, int *found);
 
 /* Append the entry of snapshot `index` (file snap_NNNNNN.h5 beside the index). Phases with
- * no particles are left out, since an empty Polyvertex grid upsets readers. */
+ * no particles are left out, since an empty Polyvertex grid upsets readers (Xdmf3ReaderT's
+ * block positions after it shift for that step). */
 int mpm_xdmf_add(mpm_xdmf *x, double time, int index, const mpm_xdmf_phase *phase, int nphases,
                  const mpm_xdmf_mesh *mesh, int nmeshes);
 

@@ -3,15 +3,17 @@
 
 Usage: check_snapshot.py OUTDIR [OUTDIR ...]
 
-For every snapshot listed in OUTDIR/series.xmf this opens the HDF5 file with h5py and
+For every snapshot listed in OUTDIR/series.xmf (and OUTDIR/grid.xmf, the grid fields, if
+present) this opens the HDF5 file with h5py and
 checks that
   - the file exists, and its root attributes time, step, dim, config and version are there,
     with time equal to the <Time> of its entry;
   - every dataset a DataItem names exists, with the element count of its Dimensions and the
     same extents once axes of length 1 are dropped (a 2-D lattice is listed as one node
     thick in z, while the file stores it as [Ny][Nx]);
-  - a Polyvertex grid has as many points as its Topology says, and every particle dataset
-    of the phase group (not only those listed) has one row per particle;
+  - a Polyvertex grid has as many points as its Topology says, its connectivity dataset
+    holds 0 .. N-1, and every particle dataset of the phase group (not only those listed)
+    has one row per particle;
   - times increase from one entry to the next.
 It prints one summary line per snapshot and exits with status 1 if anything is wrong.
 Run it with Debian's /usr/bin/python3, which has h5py.
@@ -59,6 +61,15 @@ class Checker:
     def check_particles(self, grid, files, where):
         topo = grid.find("Topology")
         n = int(topo.get("NumberOfElements", "-1"))
+        conn = topo.find("DataItem")
+        cdims = self.check_dataitem(conn, files, where + "/Topology") if conn is not None else None
+        if cdims != (n,):
+            self.fail(f"{where}: Polyvertex connectivity {cdims}, not ({n},)")
+        else:
+            fname, _, dset = (conn.text or "").strip().partition(":")
+            if fname in files and dset in files[fname]:
+                if not np.array_equal(files[fname][dset][()], np.arange(n)):
+                    self.fail(f"{where}: {fname}:{dset} is not 0 .. {n - 1}")
         geom = grid.find("Geometry/DataItem")
         dims = self.check_dataitem(geom, files, where + "/Geometry")
         if dims and dims[0] != n:
@@ -116,7 +127,10 @@ class Checker:
                 if "time" in own.attrs and float(own.attrs["time"]) != t:
                     self.fail(f"{name}: time attribute {own.attrs['time']} but index time {t}")
             parts = []
-            for grid in snap.findall("Grid"):
+            # each block is a temporal collection around one uniform grid (mpm_xdmf.h)
+            for grid in snap.iter("Grid"):
+                if grid.get("GridType", "Uniform") != "Uniform":
+                    continue
                 gname = grid.get("Name")
                 topo = grid.find("Topology").get("TopologyType", "")
                 if topo.lower() == "polyvertex":
@@ -132,18 +146,23 @@ class Checker:
         return t
 
     def run(self):
-        index = os.path.join(self.outdir, "series.xmf")
+        self.run_index("series.xmf")
+        if os.path.exists(os.path.join(self.outdir, "grid.xmf")):
+            self.run_index("grid.xmf")
+
+    def run_index(self, name):
+        index = os.path.join(self.outdir, name)
         try:
             root = ET.parse(index).getroot()
         except (OSError, ET.ParseError) as err:
-            self.fail(f"cannot parse series.xmf: {err}")
+            self.fail(f"cannot parse {name}: {err}")
             return
         series = root.find("Domain/Grid")
         if series is None or series.get("CollectionType") != "Temporal":
-            self.fail("series.xmf has no temporal collection")
+            self.fail(f"{name} has no temporal collection")
             return
         snaps = series.findall("Grid")
-        print(f"{self.outdir}: {len(snaps)} snapshot(s)")
+        print(f"{self.outdir}/{name}: {len(snaps)} snapshot(s)")
         last = None
         for snap in snaps:
             last = self.check_snapshot(snap, last)

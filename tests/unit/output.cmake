@@ -23,3 +23,7 @@ foreach(np 1 2 3)
                       LABELS ${labels} ARGS ${dir}/snap2d ${dir}/snap3d TIMEOUT 60)
   set_tests_properties(check_snapshot_${name} PROPERTIES FIXTURES_REQUIRED ${name}_files)
 endforeach()
+
+# The XDMF indexes in the form ParaView's readers need (run in ParaView too where pvpython is).
+mpm_add_script_test(test_xdmf_paraview SCRIPT verification/test_xdmf_paraview.py
+                    LABELS "conformance;mpi" TIMEOUT 120)

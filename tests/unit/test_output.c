@@ -421,11 +421,22 @@ static void test_snapshot_2d(void **state) {
     }
     assert_int_equal(count_occurrences(xmf, "<Time Value=\"0.5\"/>"), 1);
     assert_int_equal(count_occurrences(xmf, "CollectionType=\"Spatial\""), 3);
-    /* rank 1 has no fluid, but the phase as a whole does when there are other ranks */
-    assert_int_equal(count_occurrences(xmf, "Name=\"fluid\""), 3);
-    assert_int_equal(count_occurrences(xmf, "Name=\"solid_grid\""), 3);
+    /* rank 1 has no fluid, but the phase as a whole does when there are other ranks; each
+     * phase is a temporal collection around one grid of the same name (mpm_xdmf.h) */
+    assert_int_equal(count_occurrences(xmf, "Name=\"fluid\""), 6);
+    assert_int_equal(count_occurrences(xmf, ".h5:/xdmf/fluid<"), 3); /* Polyvertex cells */
+    assert_int_equal(count_occurrences(xmf, "_grid"), 0);            /* grid fields: grid.xmf */
     assert_int_equal(count_occurrences(xmf, "other"), 0);
-    assert_int_equal(count_occurrences(xmf, "AttributeType=\"Matrix\""), 3); /* F, 4 comps */
+    /* F has 4 components: a Matrix; no phase has a colour field (rho), so no Scalar */
+    assert_int_equal(count_occurrences(xmf, "Name=\"F\" AttributeType=\"Matrix\""), 3);
+    assert_int_equal(count_occurrences(xmf, "AttributeType=\"Scalar\""), 0);
+    free(xmf);
+    path_of(path, sizeof path, dir, "grid.xmf");
+    xmf = read_text(path);
+    assert_non_null(xmf);
+    assert_int_equal(count_occurrences(xmf, "Name=\"solid_grid\""), 6);
+    assert_int_equal(count_occurrences(xmf, "other"), 0);
+    assert_int_equal(count_occurrences(xmf, "Polyvertex"), 0);
     free(xmf);
   }
   free_set(&solid), free_set(&fluid), free_grid(&grid);
@@ -470,7 +481,12 @@ static void test_snapshot_3d(void **state) {
     assert_non_null(xmf);
     assert_int_equal(count_occurrences(xmf, "Name=\"empty\""), 0); /* no particles at all */
     assert_int_equal(count_occurrences(xmf, "AttributeType=\"Tensor\""), 2); /* F, twice */
-    assert_int_equal(count_occurrences(xmf, "3DCoRectMesh"), 1);
+    assert_int_equal(count_occurrences(xmf, "3DCoRectMesh"), 0);
+    free(xmf);
+    path_of(path, sizeof path, dir, "grid.xmf");
+    xmf = read_text(path);
+    assert_non_null(xmf);
+    assert_int_equal(count_occurrences(xmf, "3DCoRectMesh"), 1); /* the first snapshot only */
     free(xmf);
   }
   free(config);
@@ -502,7 +518,13 @@ static void test_snapshot_append(void **state) {
     assert_int_equal(count_occurrences(xmf, "<Time Value=\"0.75\"/>"), 1);
     assert_int_equal(count_occurrences(xmf, "<Time Value=\"1\"/>"), 0);
     assert_int_equal(count_occurrences(xmf, "snap_000002.h5:/solid/x"), 1);
-    assert_int_equal(count_occurrences(xmf, "Name=\"fluid\""), 2); /* kept entries verbatim */
+    assert_int_equal(count_occurrences(xmf, "Name=\"fluid\""), 4); /* kept entries verbatim */
+    free(xmf);
+    path_of(path, sizeof path, dir, "grid.xmf"); /* kept up to t = 0.5; none at 0.75 */
+    xmf = read_text(path);
+    assert_non_null(xmf);
+    assert_int_equal(count_occurrences(xmf, "CollectionType=\"Spatial\""), 2);
+    assert_int_equal(count_occurrences(xmf, "<Time Value=\"1\"/>"), 0);
     free(xmf);
     path_of(path, sizeof path, dir, "snap_000002.h5");
     const hid_t f = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
