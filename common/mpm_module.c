@@ -65,18 +65,24 @@ int mpm_module_check_positions(const mpm_module *m, const double *y, mpm_fault *
                           "a state value is not finite (NaN or Inf)");
   /* Beyond a periodic face a particle is fine until migration wraps it; only the drift
    * check (cells as doubles: a far particle's cell may not fit an int) limits it there. */
-  for (mpm_lidx i = 0; i < n; ++i)
-    for (int d = 0; d < p->dim; ++d) {
-      const double x = y[(size_t)d * n + i];
-      const double lo = g->lo[d] - (m->open[d][0] ? 1.0 : m->wall_slack) * g->dx;
-      const double hi = g->hi[d] + (m->open[d][1] ? 1.0 : m->wall_slack) * g->dx;
-      if (!g->periodic[d] && !(x >= lo && x < hi))
+  for (int d = 0; d < p->dim; ++d) {
+    const double *x = y + (size_t)d * n;
+    const double lo = g->lo[d] - (m->open[d][0] ? 1.0 : m->wall_slack) * g->dx;
+    const double hi = g->hi[d] + (m->open[d][1] ? 1.0 : m->wall_slack) * g->dx;
+    /* The rank's cells, widened by the one cell a particle may cross in a step. */
+    const int c = g->coord[d];
+    const double near_lo = g->lo[d] + (g->cell_split[d][c] - 1) * g->dx;
+    const double near_hi = g->lo[d] + (g->cell_split[d][c + 1] + 1) * g->dx;
+    int bad = 0; /* one pass without jumps; the culprit is found only when there is one */
+    for (mpm_lidx i = 0; i < n; ++i)
+      bad |= (!g->periodic[d] && !(x[i] >= lo && x[i] < hi)) | !(x[i] >= near_lo && x[i] < near_hi);
+    for (mpm_lidx i = 0; bad && i < n; ++i) {
+      if (!g->periodic[d] && !(x[i] >= lo && x[i] < hi))
         return mpm_fault_at(fault, p, y, i, "the particle left the domain");
-      const double cell = floor((x - g->lo[d]) / g->dx);
-      const int c = g->coord[d];
-      if (cell < g->cell_split[d][c] - 1 || cell > g->cell_split[d][c + 1])
+      if (!(x[i] >= near_lo && x[i] < near_hi))
         return mpm_fault_at(fault, p, y, i,
                             "the particle moved more than one cell within one step");
     }
+  }
   return 0;
 }
