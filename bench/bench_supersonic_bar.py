@@ -1,0 +1,216 @@
+#!/usr/bin/python3
+"""The main job under refinement, per spatial coupling scheme and time method: a
+work-precision table for cases/supersonic_bar.ini (3 ms, 2 ranks).
+
+For each run: whether it completed (or the message it stopped with), wall time, steps,
+particle-steps, the bow shock's stand-off and the empty cells inside the gas at every snapshot
+(tools/supersonic_bar.py), the tip displacement at 1.5 ms and its largest value, the interface
+momentum imbalance and the energy the coupling created. Per scheme, the successive
+differences of the stand-off (at 3 ms) and of the tip displacement (at 1.5 ms) over the
+resolutions, and the error of each run against the finest `usl` run of the same scheme
+(work-precision), plotted against wall time.
+
+Usage (from the repository root, after building):
+  /usr/bin/python3 bench/bench_supersonic_bar.py [--dx 0.004,0.003,0.002]
+      [--schemes velocity,contact,traction] [--methods usl] [--ranks 2] [--report]
+Rows accumulate in bench/results/supersonic_bar_runs.json; a run whose row is there is not
+repeated (an interrupted sweep resumes where it stopped; delete a row to redo it). Each run's
+output stays in out/bench_supersonic_bar/<name>. The table (.md, .csv) and the plot (.png)
+are rewritten from all rows; the page keeps whatever follows its NOTES line. Wall times on a
+shared 2-core machine are noisy: compare within one invocation.
+"""
+import argparse
+import csv
+import json
+import os
+import subprocess
+import sys
+import time
+
+import numpy as np
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.join(ROOT, "tools"))
+sys.path.insert(0, os.path.join(ROOT, "tests", "tools"))
+os.environ.setdefault("MPMFSI_BIN", os.path.join(ROOT, "build", "app", "mpmfsi"))
+os.environ.setdefault("MPMFSI_SOURCE_DIR", ROOT)
+import supersonic_bar as sb  # noqa: E402
+
+RESULTS = os.path.join(ROOT, "bench", "results")
+STORE = os.path.join(RESULTS, "supersonic_bar_runs.json")
+PAGE = os.path.join(RESULTS, "supersonic_bar_work_precision")
+OUT = os.path.join(ROOT, "out", "bench_supersonic_bar")
+CASE = os.path.join(ROOT, "cases", "supersonic_bar.ini")
+ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
+           OMPI_MCA_btl_vader_single_copy_mechanism="none", OMPI_MCA_mpi_yield_when_idle="1")
+T_TIP = 0.0015
+
+
+def name_of(scheme, method, dx):
+    return f"{scheme}_{method}_dx{dx * 1e3:g}mm"
+
+
+def measure(out):
+    """The figures of a finished run folder."""
+    with open(os.path.join(out, "summary.json")) as f:
+        s = json.load(f)
+    with open(os.devnull, "w") as null:
+        stdout, sys.stdout = sys.stdout, null
+        try:
+            sb.main(out)
+        finally:
+            sys.stdout = stdout
+    with open(os.path.join(out, "standoff.csv")) as f:
+        so = [(float(r["t"]), float(r["standoff_m"]), int(r["empty_cells_inside_gas"]))
+              for r in csv.DictReader(f)]
+    pr = np.genfromtxt(os.path.join(out, "probes.csv"), delimiter=",", names=True)
+    return {"wall_s": s["wall_s"], "steps": s["steps"], "particle_steps": s["particle_steps"],
+            "imbalance": s.get("coupling_imbalance"), "coupling_work": s.get("coupling_work"),
+            "standoff": [[t, v] for t, v, _ in so], "empty": [[t, e] for t, _, e in so],
+            "tip_ux_1p5ms": float(np.interp(T_TIP, pr["t"], pr["tip_ux"])),
+            "tip_ux_max": float(np.nanmax(pr["tip_ux"])), "t_end": float(pr["t"][-1])}
+
+
+def run_one(scheme, method, dx, ranks):
+    name = name_of(scheme, method, dx)
+    out = os.path.join(OUT, name)
+    cmd = [os.environ["MPMFSI_BIN"], "run", CASE, f"output.dir={out}", "output.overwrite=true",
+           f"grid.dx={dx}", f"coupling.scheme={scheme}", f"time.method={method}",
+           "run.progress=false"]
+    if ranks > 1:
+        cmd = ["mpiexec", "-n", str(ranks)] + cmd
+    t0 = time.time()
+    p = subprocess.run(cmd, env=ENV, capture_output=True, text=True)
+    row = {"name": name, "scheme": scheme, "method": method, "dx": dx, "ranks": ranks,
+           "ok": p.returncode == 0}
+    if p.returncode != 0:
+        err = [ln for ln in (p.stdout + p.stderr).splitlines() if "error" in ln.lower()]
+        row["message"] = err[0] if err else f"exit code {p.returncode}"
+        row["wall_s"] = time.time() - t0
+    else:
+        row.update(measure(out))
+    return row
+
+
+def load():
+    if os.path.exists(STORE):
+        with open(STORE) as f:
+            return json.load(f)
+    return []
+
+
+def at(series, t):
+    """The value of a [[t, v], ...] series at time t (the nearest snapshot)."""
+    s = np.array(series)
+    return float(s[np.argmin(abs(s[:, 0] - t)), 1]) if len(s) else float("nan")
+
+
+def report(rows):
+    ok = [r for r in rows if r["ok"]]
+    ref = {}  # per scheme: the finest usl run
+    for r in ok:
+        if r["method"] == "usl" and (r["scheme"] not in ref or r["dx"] < ref[r["scheme"]]["dx"]):
+            ref[r["scheme"]] = r
+    table = []
+    for r in sorted(rows, key=lambda r: (r["scheme"], r["method"], -r["dx"])):
+        e = {"name": r["name"], "scheme": r["scheme"], "method": r["method"],
+             "dx_mm": 1e3 * r["dx"], "ok": r["ok"], "wall_s": round(r["wall_s"], 1)}
+        if r["ok"]:
+            f = ref.get(r["scheme"])
+            so3, so15 = at(r["standoff"], 0.003), at(r["standoff"], 0.0015)
+            e.update({"steps": r["steps"], "Mps_per_s": r["particle_steps"] / r["wall_s"] / 1e6,
+                      "standoff_1p5ms_mm": 1e3 * so15, "standoff_3ms_mm": 1e3 * so3,
+                      "tip_ux_1p5ms_mm": 1e3 * r["tip_ux_1p5ms"],
+                      "tip_ux_max_mm": 1e3 * r["tip_ux_max"],
+                      "empty_cells_max": max(v for _, v in r["empty"]),
+                      "imbalance": r["imbalance"], "coupling_work_J": r["coupling_work"]})
+            if f is not None and f is not r:
+                e["tip_err_mm"] = 1e3 * abs(r["tip_ux_1p5ms"] - f["tip_ux_1p5ms"])
+                e["standoff_err_mm"] = 1e3 * abs(so3 - at(f["standoff"], 0.003))
+        else:
+            e["message"] = r["message"]
+        table.append(e)
+    cols = ["scheme", "method", "dx_mm", "ok", "wall_s", "steps", "Mps_per_s",
+            "standoff_1p5ms_mm", "standoff_3ms_mm", "tip_ux_1p5ms_mm", "tip_ux_max_mm",
+            "empty_cells_max", "imbalance", "coupling_work_J", "tip_err_mm", "standoff_err_mm",
+            "message"]
+    with open(PAGE + ".csv", "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=cols, extrasaction="ignore")
+        w.writeheader()
+        w.writerows(table)
+
+    def fmt(v):
+        if isinstance(v, float):
+            return f"{v:.3g}"
+        return "" if v is None else str(v)
+    notes = ""
+    if os.path.exists(PAGE + ".md"):
+        text = open(PAGE + ".md").read()
+        if "<!-- NOTES -->" in text:
+            notes = text.split("<!-- NOTES -->", 1)[1]
+    with open(PAGE + ".md", "w") as f:
+        f.write("# supersonic_bar: refinement and work-precision (bench/bench_supersonic_bar.py)"
+                "\n\nStand-off: bow shock to the bar's upstream face (tools/supersonic_bar.py); "
+                "tip: probes.csv at 1.5 ms; errors against the finest usl run of the same "
+                "scheme; empty cells: the most, over the snapshots, of cells without gas whose "
+                "four neighbours hold gas. Wall times on the shared 2-core machine, 2 ranks.\n\n")
+        f.write("| " + " | ".join(cols) + " |\n|" + "---|" * len(cols) + "\n")
+        for e in table:
+            f.write("| " + " | ".join(fmt(e.get(c)) for c in cols) + " |\n")
+        f.write("\n<!-- NOTES -->" + notes)
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, axes = plt.subplots(1, 2, figsize=(10, 4))
+    for (scheme, method), mark in zip(sorted({(e["scheme"], e["method"]) for e in table}),
+                                      "osd^v<>"):
+        pts = [e for e in table if e["scheme"] == scheme and e["method"] == method
+               and "tip_err_mm" in e]
+        if not pts:
+            continue
+        w = [e["wall_s"] for e in pts]
+        axes[0].loglog(w, [max(e["tip_err_mm"], 1e-3) for e in pts], mark + "-",
+                       label=f"{scheme} {method}")
+        axes[1].loglog(w, [max(e["standoff_err_mm"], 1e-2) for e in pts], mark + "-",
+                       label=f"{scheme} {method}")
+    axes[0].set_ylabel("|tip ux(1.5 ms) - finest|, mm")
+    axes[1].set_ylabel("|stand-off(3 ms) - finest|, mm")
+    for ax in axes:
+        ax.set_xlabel("wall time, s (2 ranks)"), ax.grid(alpha=0.3, which="both")
+        ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(PAGE + ".png", dpi=100)
+    plt.close(fig)
+    print(f"wrote {PAGE}.md, .csv, .png")
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--dx", default="0.004,0.003,0.002")
+    ap.add_argument("--schemes", default="velocity,contact,traction")
+    ap.add_argument("--methods", default="usl")
+    ap.add_argument("--ranks", type=int, default=2)
+    ap.add_argument("--report", action="store_true", help="only rewrite the table and plot")
+    a = ap.parse_args()
+    rows = load()
+    if not a.report:
+        todo = [(s, m, float(d)) for s in a.schemes.split(",") for m in a.methods.split(",")
+                for d in a.dx.split(",")]
+        for k, (s, m, d) in enumerate(todo):
+            if any(r["name"] == name_of(s, m, d) for r in rows):
+                print(f"[{k + 1}/{len(todo)}] {name_of(s, m, d)}: done before, kept")
+                continue
+            print(f"[{k + 1}/{len(todo)}] {name_of(s, m, d)} ...", flush=True)
+            row = run_one(s, m, d, a.ranks)
+            rows = [r for r in load() if r["name"] != row["name"]] + [row]
+            os.makedirs(RESULTS, exist_ok=True)
+            with open(STORE + ".tmp", "w") as f:
+                json.dump(rows, f, indent=1)
+            os.replace(STORE + ".tmp", STORE)
+            print(f"    {'ok' if row['ok'] else 'STOPPED: ' + row['message']}, "
+                  f"{row['wall_s']:.0f} s", flush=True)
+    report(rows)
+
+
+if __name__ == "__main__":
+    main()
