@@ -120,8 +120,8 @@ def main(out):
     ext = (lo[0], hi[0], lo[1], hi[1])
     shown = [s for s in snaps if s[0] > 0]
     aspect = (hi[1] - lo[1]) / (hi[0] - lo[0])
-    fig, axes = plt.subplots(len(shown), 1, figsize=(7, 1.1 + 6 * aspect * len(shown)),
-                             squeeze=False)
+    fig, axes = plt.subplots(len(shown), 1, figsize=(7, 0.3 + 5.2 * aspect * len(shown)),
+                             squeeze=False, constrained_layout=True)
     rows = []
     for ax, (t, path) in zip(axes[:, 0], shown):
         G, S = mt.particles(path, "fluid"), solid_particles(path)
@@ -147,7 +147,7 @@ def main(out):
         ax.set_title(f"t = {t * 1e3:.2f} ms   stand-off {so * 1e3:.1f} mm", fontsize=9)
         ax.set_aspect("equal")
     fig.colorbar(im, ax=axes[:, 0].tolist(), label="density, kg/m³", shrink=0.6)
-    fig.savefig(os.path.join(out, "density_strip.png"), dpi=110)
+    fig.savefig(os.path.join(out, "density_strip.png"), dpi=110, bbox_inches="tight")
     plt.close(fig)
     with open(os.path.join(out, "standoff.csv"), "w", newline="") as f:
         w = csv.writer(f)
