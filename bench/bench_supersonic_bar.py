@@ -12,7 +12,8 @@ resolutions, and the error of each run against the finest `usl` run of the same 
 
 Usage (from the repository root, after building):
   /usr/bin/python3 bench/bench_supersonic_bar.py [--dx 0.004,0.003,0.002]
-      [--schemes velocity,contact,traction] [--methods usl] [--ranks 2] [--report]
+      [--schemes velocity,contact,traction] [--methods usl] [--ranks 2] [--timeout 1800]
+      [--report]
 Rows accumulate in bench/results/supersonic_bar_runs.json; a run whose row is there is not
 repeated (an interrupted sweep resumes where it stopped; delete a row to redo it). Each run's
 output stays in out/bench_supersonic_bar/<name>. The table (.md, .csv) and the plot (.png)
@@ -23,6 +24,8 @@ import argparse
 import csv
 import json
 import os
+import re
+import signal
 import subprocess
 import sys
 import time
@@ -71,7 +74,21 @@ def measure(out):
             "tip_ux_max": float(np.nanmax(pr["tip_ux"])), "t_end": float(pr["t"][-1])}
 
 
-def run_one(scheme, method, dx, ranks):
+def stop_message(log, out, code):
+    """Why a run stopped: its error line, or for a run stopped by a signal (exit code 3, e.g.
+    after --timeout) where it was and the step it had fallen to (diagnostics.csv)."""
+    err = [ln for ln in log.splitlines() if re.match(r"(\[\d+\] )?error:", ln)]
+    if err:
+        return err[0]
+    try:
+        d = np.genfromtxt(os.path.join(out, "diagnostics.csv"), delimiter=",", names=True)
+        return (f"stopped (exit code {code}) at t = {d['t'][-1]:.4g} s after {int(d['step'][-1])} "
+                f"steps, the step at {d['dt'][-1]:.2g} s (the first {d['dt'][1]:.2g} s)")
+    except (OSError, ValueError, IndexError):
+        return f"exit code {code}"
+
+
+def run_one(scheme, method, dx, ranks, timeout):
     name = name_of(scheme, method, dx)
     out = os.path.join(OUT, name)
     cmd = [os.environ["MPMFSI_BIN"], "run", CASE, f"output.dir={out}", "output.overwrite=true",
@@ -80,12 +97,18 @@ def run_one(scheme, method, dx, ranks):
     if ranks > 1:
         cmd = ["mpiexec", "-n", str(ranks)] + cmd
     t0 = time.time()
-    p = subprocess.run(cmd, env=ENV, capture_output=True, text=True)
+    proc = subprocess.Popen(cmd, env=ENV, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            text=True)
+    try:
+        stdout, stderr = proc.communicate(timeout=timeout)
+    except subprocess.TimeoutExpired:  # SIGTERM: mpmfsi ends after its step, exit code 3
+        proc.send_signal(signal.SIGTERM)
+        stdout, stderr = proc.communicate()
+    p = subprocess.CompletedProcess(cmd, proc.returncode, stdout, stderr)
     row = {"name": name, "scheme": scheme, "method": method, "dx": dx, "ranks": ranks,
            "ok": p.returncode == 0}
     if p.returncode != 0:
-        err = [ln for ln in (p.stdout + p.stderr).splitlines() if "error" in ln.lower()]
-        row["message"] = err[0] if err else f"exit code {p.returncode}"
+        row["message"] = stop_message(p.stdout + p.stderr, out, p.returncode)
         row["wall_s"] = time.time() - t0
     else:
         row.update(measure(out))
@@ -190,6 +213,8 @@ def main():
     ap.add_argument("--schemes", default="velocity,contact,traction")
     ap.add_argument("--methods", default="usl")
     ap.add_argument("--ranks", type=int, default=2)
+    ap.add_argument("--timeout", type=float, default=1800,
+                    help="wall seconds a run may take before it is stopped (recorded as such)")
     ap.add_argument("--report", action="store_true", help="only rewrite the table and plot")
     a = ap.parse_args()
     rows = load()
@@ -201,7 +226,7 @@ def main():
                 print(f"[{k + 1}/{len(todo)}] {name_of(s, m, d)}: done before, kept")
                 continue
             print(f"[{k + 1}/{len(todo)}] {name_of(s, m, d)} ...", flush=True)
-            row = run_one(s, m, d, a.ranks)
+            row = run_one(s, m, d, a.ranks, a.timeout)
             rows = [r for r in load() if r["name"] != row["name"]] + [row]
             os.makedirs(RESULTS, exist_ok=True)
             with open(STORE + ".tmp", "w") as f:
