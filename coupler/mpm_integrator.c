@@ -8,7 +8,6 @@
 #include "mpm_timer.h"
 
 #include <arkode/arkode_erkstep.h>
-#include <float.h>
 #include <math.h>
 #include <nvector/nvector_mpimanyvector.h>
 #include <nvector/nvector_serial.h>
@@ -99,7 +98,7 @@ static int cycle_rhs(mpm_integrator *it, N_Vector y, N_Vector ydot, double t) {
 }
 
 static int classic_limit(mpm_integrator *it, N_Vector y, double *h);
-static double classic_step(const mpm_integrator *it, double t, double h_limit, int at_end);
+static double classic_step(const mpm_integrator *it, double t, double h_limit);
 
 /* In the classic update ERKStep's end-of-step f is the next step's one stage, but the driver
  * nearly always changes the particles between steps (migration, inflow, outflow,
@@ -119,7 +118,7 @@ static int rhs(mpm_sunreal t, N_Vector y, N_Vector ydot, void *user) {
       return -1;
     }
     it->h_limit_set = 1;
-    it->h_classic = classic_step(it, t, it->h_limit, 0);
+    it->h_classic = classic_step(it, t, it->h_limit);
   }
   /* A classic step's state was checked at the end of the step that made it (below); the
    * particles the driver adds between steps are made valid. */
@@ -173,19 +172,10 @@ static int classic_limit(mpm_integrator *it, N_Vector y, double *h) {
 }
 
 /* The fixed step from t: the limit (or, without one, the rest of the way to the stop time)
- * times the retry scale, capped by the stop time so that a step lands on it. ERKStep
- * evaluates f at the end of each step and reuses it as the next step's only stage, so the
- * classic update's RHS computes the step it will be used with from the same (t, y) the
- * driver uses to set the fixed step.
- *
- * At the end of a step that reached the stop time (at_end, within a few ulps) the next stop
- * time is not known yet. The step is then the one a stop time at least a step away allows,
- * as the next one usually is, so the driver can keep this f rather than evaluate it again
- * (see attempt). */
-static double classic_step(const mpm_integrator *it, double t, double h_limit, int at_end) {
+ * times the retry scale, capped by the stop time so that a step lands on it. The classic
+ * update's RHS computes it from the same (t, y) the driver uses to set the fixed step. */
+static double classic_step(const mpm_integrator *it, double t, double h_limit) {
   const double rest = it->tstop - t;
-  if (at_end && h_limit > 0 && rest <= 4 * DBL_EPSILON * fabs(it->tstop))
-    return it->scale * h_limit;
   return fmin(it->scale * (h_limit > 0 ? h_limit : rest), rest);
 }
 
@@ -426,15 +416,16 @@ static int report_fault(const mpm_integrator *it, double t, int tries) {
 static int attempt(mpm_integrator *it, double tstop, double scale, double *t, double *h) {
   mpm_sunreal tret = it->t_last;
   if (it->fixed) {
-    /* The classic update's stored f (from the end of the last step) holds for the step it
-     * was computed with; another stop time or retry scale may change the step (the f of
-     * the other fixed-step methods does not depend on it). Its RHS left the stability limit
-     * of this state, unless the particles changed since. */
+    /* The classic update's f depends on the step. After a step it is always re-evaluated
+     * (the end of a step only checks, see rhs); the first f, from ERKStep's setup, holds if
+     * the step it was computed with stands. The f of the other fixed-step methods does not
+     * depend on the step. The stability limit of this state is known from its first RHS,
+     * unless the particles changed since. */
     const int classic = mpm_method_is_classic(it->method);
     const double h_stored = it->h_classic;
     it->tstop = tstop, it->scale = scale;
     if (!it->h_limit_set) MPM_CALL(classic_limit(it, it->y, &it->h_limit));
-    const double hf = classic_step(it, it->t_last, it->h_limit, 0);
+    const double hf = classic_step(it, it->t_last, it->h_limit);
     if (classic && hf != h_stored) it->fn_stale = 1;
     if (classic) it->h_classic = hf;
     MPM_CALL_SUN(ERKStepSetFixedStep(it->ark, hf));
