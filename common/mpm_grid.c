@@ -347,13 +347,15 @@ static int coord_of_cell(const int *split, int np, int c) {
 }
 
 int mpm_grid_owner_of(const mpm_grid *g, const double *x) {
-  int coords[MPM_MAX_DIM], rank;
+  int coords[MPM_MAX_DIM], rank, own = 1;
   for (int d = 0; d < g->dim; ++d) {
     if (!(x[d] >= g->lo[d] && x[d] < g->hi[d])) return -1; /* also rejects NaN */
     int c = (int)floor((x[d] - g->lo[d]) / g->dx);
     if (c >= g->ncells[d]) c = g->ncells[d] - 1; /* x just below hi may round up */
     coords[d] = coord_of_cell(g->cell_split[d], g->nproc[d], c);
+    own &= coords[d] == g->coord[d];
   }
+  if (own) return g->rank; /* most particles stay: no MPI call for them */
   if (MPI_Cart_rank(g->comm, coords, &rank) != MPI_SUCCESS) return -1;
   return rank;
 }

@@ -249,25 +249,13 @@ static mpm_lidx wrap_positions(mpm_particles *p, const mpm_grid *g) {
   return nwrap;
 }
 
-/* Whether x lies in a cell of this rank, as mpm_grid_owner_of would find (most particles
- * stay: this spares them its rank lookup). */
-static int in_own_cells(const mpm_grid *g, const double *x) {
-  for (int d = 0; d < g->dim; ++d) {
-    if (!(x[d] >= g->lo[d] && x[d] < g->hi[d])) return 0;
-    int c = (int)floor((x[d] - g->lo[d]) / g->dx);
-    if (c >= g->ncells[d]) c = g->ncells[d] - 1;
-    if (c < g->cell_split[d][g->coord[d]] || c >= g->cell_split[d][g->coord[d] + 1]) return 0;
-  }
-  return 1;
-}
-
 /* Owner of every particle; fails naming the first particle outside the domain. */
 static int find_owners(const mpm_particles *p, const mpm_grid *g, migration *m) {
   mpm_lidx nout = 0, first = -1;
   for (mpm_lidx i = 0; i < p->n; ++i) {
     double x[MPM_MAX_DIM];
     for (int d = 0; d < p->dim; ++d) x[d] = mpm_particles_comp(p, 0, d)[i];
-    m->dest[i] = in_own_cells(g, x) ? g->rank : mpm_grid_owner_of(g, x);
+    m->dest[i] = mpm_grid_owner_of(g, x);
     if (m->dest[i] < 0 && nout++ == 0) first = i;
     m->keep[i] = m->dest[i] == g->rank;
     m->nmove += m->dest[i] != g->rank;
