@@ -32,7 +32,8 @@ import time
 
 import numpy as np
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+from benchrun import ENV, ROOT  # noqa: E402
+
 sys.path.insert(0, os.path.join(ROOT, "tools"))
 sys.path.insert(0, os.path.join(ROOT, "tests", "tools"))
 os.environ.setdefault("MPMFSI_BIN", os.path.join(ROOT, "build", "app", "mpmfsi"))
@@ -44,8 +45,6 @@ STORE = os.path.join(RESULTS, "supersonic_bar_runs.json")
 PAGE = os.path.join(RESULTS, "supersonic_bar_work_precision")
 OUT = os.path.join(ROOT, "out", "bench_supersonic_bar")
 CASE = os.path.join(ROOT, "cases", "supersonic_bar.ini")
-ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
-           OMPI_MCA_btl_vader_single_copy_mechanism="none", OMPI_MCA_mpi_yield_when_idle="1")
 T_TIP = 0.0015
 
 

@@ -126,8 +126,7 @@ def main(out):
     for ax, (t, path) in zip(axes[:, 0], shown):
         G, S = mt.particles(path, "fluid"), solid_particles(path)
         rho = density(G, lo, hi, dx)
-        bar = np.zeros(rho.shape, bool)  # cells of the bar: its particles, or the obstacle
-        if S is not None:
+        if S is not None:  # cells of the bar: its particles, or the obstacle
             bar = np.histogram2d(S["x"][:, 0], S["x"][:, 1], bins=rho.shape,
                                  range=((lo[0], hi[0]), (lo[1], hi[1])))[0] > 0
         else:

@@ -91,6 +91,13 @@ class Checks:
         return 1 if self.failed else 0
 
 
+def time_mean(t, F, a, b):
+    """Time average over (a, b] of a per-step history (each row holds the step ending at t)."""
+    dt = np.diff(np.concatenate([[0.0], t]))
+    m = (t > a) & (t <= b * (1 + 1e-12))
+    return float((F[m] * dt[m]).sum() / dt[m].sum())
+
+
 def worst_difference(a, b):
     """Largest difference over the fields of two particle sets with the same ids (from
     particles()), each relative to the field's largest magnitude; and the fields compared."""

@@ -42,13 +42,6 @@ def obstacle_text(condition):
                    f"lo = 0.4 0.4\nhi = 0.6 0.6\ncondition = {condition}\n")
 
 
-def mean_force(t, F, a, b):
-    """Time average over (a, b] of the per-step force (each row holds the step ending at t)."""
-    dt = np.diff(np.concatenate([[0.0], t]))
-    m = (t > a) & (t <= b * (1 + 1e-12))
-    return float((F[m] * dt[m]).sum() / dt[m].sum())
-
-
 def run(text, name, extra):
     path = os.path.join(mt.outdir(name + "_case"), "case.ini")
     with open(path, "w") as f:
@@ -69,14 +62,14 @@ for cond in ("slip", "no_slip"):
 for scheme, cond in (("velocity", "no_slip"), ("contact", "slip"), ("traction", "slip")):
     out = run(TEXT, f"rigid_{scheme}", [f"coupling.scheme={scheme}"])
     c = np.genfromtxt(os.path.join(out, "coupling.csv"), delimiter=",", names=True)
-    f_body = mean_force(c["t"], c["Fx_solid"], *WINDOW)
-    f_obst = mean_force(*obstacle[cond], *WINDOW)
+    f_body = mt.time_mean(c["t"], c["Fx_solid"], *WINDOW)
+    f_obst = mt.time_mean(*obstacle[cond], *WINDOW)
     rel = f_body / f_obst - 1
     check(abs(rel) <= TOL, f"{scheme}: mean drag on the rigid post over t in {WINDOW} "
           f"{f_body:.4f} N/m against the {cond} obstacle's {f_obst:.4f}: {100 * rel:+.1f} % "
           f"(tolerance {100 * TOL:.1f} %)")
-    late_b, late_o = (mean_force(c["t"], c["Fx_solid"], 0.2, 0.4),
-                      mean_force(*obstacle[cond], 0.2, 0.4))
+    late_b, late_o = (mt.time_mean(c["t"], c["Fx_solid"], 0.2, 0.4),
+                      mt.time_mean(*obstacle[cond], 0.2, 0.4))
     print(f"info {scheme}: over t in (0.2, 0.4] {late_b:.4f} against {late_o:.4f} "
           f"({100 * (late_b / late_o - 1):+.0f} %, not asserted: the wake)")
     # The post is held: the solid's momentum stays zero, and the balance holds.

@@ -93,13 +93,6 @@ def rigid_case():
     return write_case("twin_rigid", "".join(out))
 
 
-def mean(t, F, a, b):
-    """Time average over (a, b] of a per-step history (each row: the step ending at t)."""
-    dt = np.diff(np.concatenate([[0.0], t]))
-    m = (t > a) & (t <= b * (1 + 1e-12))
-    return float((F[m] * dt[m]).sum() / dt[m].sum())
-
-
 def run(name, case, extra=()):
     out = mt.outdir(name)
     mt.run(["run", case, f"output.dir={out}"] + ARGS + list(extra), 2)
@@ -111,12 +104,12 @@ def run(name, case, extra=()):
             rows[round(t, 9)] = sb.standoff(rho, sc)
     t, Fx, _ = sb.forces(out)
     print(f"cost {name}: {mt.cost(out)}")
-    return rows, mean(t, Fx, *WINDOW)
+    return rows, mt.time_mean(t, Fx, *WINDOW)
 
 
 ref = np.genfromtxt(REF, delimiter=",", names=True)
 ref_so = {round(s, 9): float(np.interp(s, ref["t"], ref["standoff"])) for s in TIMES}
-ref_drag = mean(ref["t"], ref["Fx"], *WINDOW)
+ref_drag = mt.time_mean(ref["t"], ref["Fx"], *WINDOW)
 print("reference stand-off (mm): " + ", ".join(f"{1e3 * v:.1f}" for v in ref_so.values())
       + f"; mean drag {ref_drag:.0f} N/m")
 
