@@ -4,7 +4,9 @@
  *
  * - data holds ncomp * n doubles, component c of particle i at data[c * n + i]; id[i] is
  *   the global id of particle i. The block is only ever replaced whole (install()), so n,
- *   id and data always change together.
+ *   id and data always change together. The block replaced is kept as the spare and reused
+ *   by the next replacement that fits in it (block_get()): a pointer into the block is
+ *   valid only until the next edit, migration or sort.
  * - Ids are unique over all ranks and never reused: id_next exceeds every id handed out
  *   and is equal on every rank (inject() advances it by the global count on every rank).
  * - Migration first wraps positions that left through a periodic face back into [lo, hi)
@@ -82,8 +84,8 @@ int mpm_particles_new(mpm_particles **p, int dim, const mpm_field_desc *fields, 
 void mpm_particles_destroy(mpm_particles **p) {
   if (!p || !*p) return;
   for (int f = 0; f < (*p)->nfields; ++f) free((char *)(*p)->field[f].name);
-  free((*p)->id);
-  free((*p)->data);
+  free((*p)->id), free((*p)->spare_id);
+  free((*p)->data), free((*p)->spare_data);
   free(*p);
   *p = NULL;
 }
@@ -96,20 +98,33 @@ int mpm_particles_find(const mpm_particles *p, const char *name) {
 
 /* ---- the block ------------------------------------------------------------------------- */
 
-static int block_alloc(const mpm_particles *p, mpm_lidx n, mpm_gidx **id, double **data) {
-  MPM_ALLOC(*id, n);
-  *data = calloc((size_t)p->ncomp * (size_t)n + 1, sizeof **data);
-  if (!*data) {
-    free(*id), *id = NULL;
-    MPM_FAIL_OOM((double)p->ncomp * (double)n * sizeof **data);
+/* A block with room for n particles: the spare if it is large enough, else a new one with an
+ * eighth more room than asked, so that a slowly growing set does not allocate at every step.
+ * Its contents are undefined: every caller writes all n particles of every component. */
+static int block_get(mpm_particles *p, mpm_lidx n, mpm_gidx **id, double **data, mpm_lidx *cap) {
+  if (p->spare_data && p->spare_cap >= n) {
+    *id = p->spare_id, *data = p->spare_data, *cap = p->spare_cap;
+    p->spare_id = NULL, p->spare_data = NULL, p->spare_cap = 0;
+    return 0;
   }
+  const mpm_lidx room = n + n / 8 + 16;
+  *id = malloc(sizeof **id * (size_t)room);
+  *data = malloc(sizeof **data * (size_t)p->ncomp * (size_t)room);
+  if (!*id || !*data) {
+    free(*id), free(*data), *id = NULL, *data = NULL;
+    MPM_FAIL_OOM((double)p->ncomp * (double)room * sizeof **data);
+  }
+  *cap = room;
   return 0;
 }
 
-/* Replace the block by (n, id, data), which the set now owns. */
-static void install(mpm_particles *p, mpm_lidx n, mpm_gidx *id, double *data) {
-  free(p->id), free(p->data);
-  p->n = n, p->id = id, p->data = data;
+/* Replace the block by (n, id, data) of room cap, which the set now owns; the old block
+ * becomes the spare. Component c starts at data + c n (the stride is n, not cap: the state
+ * components stay one contiguous array for the integrator). */
+static void install(mpm_particles *p, mpm_lidx n, mpm_gidx *id, double *data, mpm_lidx cap) {
+  free(p->spare_id), free(p->spare_data);
+  p->spare_id = p->id, p->spare_data = p->data, p->spare_cap = p->cap;
+  p->n = n, p->id = id, p->data = data, p->cap = cap;
 }
 
 static mpm_lidx count_kept(const mpm_particles *p, const unsigned char *keep) {
@@ -119,18 +134,23 @@ static mpm_lidx count_kept(const mpm_particles *p, const unsigned char *keep) {
   return k;
 }
 
-/* Copy the kept particles, in order, to the front of a block with room for nnew. */
+/* Copy the kept particles, in order, to the front of a block whose components are nnew
+ * apart. Runs of kept particles go by memcpy: an edit or a migration keeps nearly all. */
 static void copy_kept(const mpm_particles *p, const unsigned char *keep, mpm_lidx nnew,
                       mpm_gidx *id, double *data) {
   mpm_lidx k = 0;
-  for (mpm_lidx i = 0; i < p->n; ++i)
-    if (!keep || keep[i]) id[k++] = p->id[i];
-  for (int c = 0; c < p->ncomp; ++c) {
-    const double *src = p->data + (size_t)c * (size_t)p->n;
-    double *dst = data + (size_t)c * (size_t)nnew;
-    k = 0;
-    for (mpm_lidx i = 0; i < p->n; ++i)
-      if (!keep || keep[i]) dst[k++] = src[i];
+  for (mpm_lidx i = 0; i < p->n;) {
+    mpm_lidx j = i;
+    while (j < p->n && (!keep || keep[j])) ++j;
+    const size_t run = (size_t)(j - i);
+    if (run) {
+      memcpy(id + k, p->id + i, run * sizeof *id);
+      for (int c = 0; c < p->ncomp; ++c)
+        memcpy(data + (size_t)c * (size_t)nnew + (size_t)k, p->data + (size_t)c * (size_t)p->n + i,
+               run * sizeof *data);
+    }
+    k += (mpm_lidx)run;
+    for (i = j; i < p->n && keep && !keep[i];) ++i; /* the dropped run */
   }
 }
 
@@ -145,13 +165,14 @@ int mpm_particles_edit(mpm_particles *p, const unsigned char *keep, mpm_lidx nad
   const mpm_lidx nnew = kept + nadd;
   mpm_gidx *id;
   double *data;
-  MPM_CALL(block_alloc(p, nnew, &id, &data));
+  mpm_lidx cap;
+  MPM_CALL(block_get(p, nnew, &id, &data, &cap));
   copy_kept(p, keep, nnew, id, data);
   if (nadd > 0) memcpy(id + kept, add_id, (size_t)nadd * sizeof *id);
   for (int c = 0; c < p->ncomp && nadd > 0; ++c)
     memcpy(data + (size_t)c * (size_t)nnew + (size_t)kept, add_data + (size_t)c * (size_t)nadd,
            (size_t)nadd * sizeof *data);
-  install(p, nnew, id, data);
+  install(p, nnew, id, data, cap);
   return 0;
 }
 
@@ -193,6 +214,7 @@ typedef struct migration {
   double *sendbuf, *recvbuf;
   mpm_gidx *id; /* the new block, filled after the exchange */
   double *data;
+  mpm_lidx cap;
   mpm_lidx nmove, nkeep, nrecv;
 } migration;
 
@@ -299,7 +321,7 @@ static int plan_sends(const mpm_particles *p, const mpm_grid *g, migration *m) {
 }
 
 /* After the counts arrived: receive offsets and room for arrivals and the new block. */
-static int plan_receives(const mpm_particles *p, const mpm_grid *g, migration *m) {
+static int plan_receives(mpm_particles *p, const mpm_grid *g, migration *m) {
   int rc = 0, *rcount = m->count + g->size;
   int64_t nrecv = 0;
   for (int r = 0; r < g->size; ++r) nrecv += rcount[r];
@@ -311,8 +333,7 @@ static int plan_receives(const mpm_particles *p, const mpm_grid *g, migration *m
   m->nrecv = (mpm_lidx)nrecv;
   prefix_sum(rcount, m->displ + g->size, g->size);
   m->recvbuf = try_alloc((size_t)m->nrecv * (1 + (size_t)p->ncomp), sizeof(double), &rc);
-  m->id = try_alloc((size_t)(m->nkeep + m->nrecv), sizeof *m->id, &rc);
-  m->data = try_alloc((size_t)(m->nkeep + m->nrecv) * (size_t)p->ncomp, sizeof(double), &rc);
+  if (!rc) rc = block_get(p, m->nkeep + m->nrecv, &m->id, &m->data, &m->cap);
   return rc;
 }
 
@@ -339,7 +360,7 @@ static void assemble(mpm_particles *p, migration *m) {
     memcpy(&m->id[i], r, sizeof *r);
     for (int c = 0; c < p->ncomp; ++c) m->data[(size_t)c * nnew + i] = r[1 + c];
   }
-  install(p, (mpm_lidx)nnew, m->id, m->data);
+  install(p, (mpm_lidx)nnew, m->id, m->data, m->cap);
   m->id = NULL, m->data = NULL;
 }
 
@@ -403,14 +424,15 @@ static void counting_pass(const int *key, int nkeys, mpm_lidx n, const mpm_lidx 
 static int apply_permutation(mpm_particles *p, const mpm_lidx *perm) {
   mpm_gidx *id;
   double *data;
-  MPM_CALL(block_alloc(p, p->n, &id, &data));
+  mpm_lidx cap;
+  MPM_CALL(block_get(p, p->n, &id, &data, &cap));
   for (mpm_lidx k = 0; k < p->n; ++k) id[k] = p->id[perm[k]];
   for (int c = 0; c < p->ncomp; ++c) {
     const double *src = p->data + (size_t)c * (size_t)p->n;
     double *dst = data + (size_t)c * (size_t)p->n;
     for (mpm_lidx k = 0; k < p->n; ++k) dst[k] = src[perm[k]];
   }
-  install(p, p->n, id, data);
+  install(p, p->n, id, data, cap);
   return 0;
 }
 

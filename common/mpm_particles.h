@@ -45,6 +45,12 @@ typedef struct mpm_particles {
   mpm_lidx n;                           /* particles on this rank */
   mpm_gidx *id;
   double *data;
+  /* Room of the block (id, data) in particles, and the block an edit replaced, kept for the
+   * next edit: particles change at nearly every step (inflow, outflow, migration), and a fresh
+   * block each time costs page faults and zeroing. */
+  mpm_lidx cap, spare_cap;
+  mpm_gidx *spare_id;
+  double *spare_data;
   mpm_gidx id_next;                                /* next free global id; equal on every rank */
   mpm_field_range range[MPM_PARTICLES_MAX_FIELDS]; /* all reals unless the module narrows it */
 } mpm_particles;
