@@ -36,6 +36,9 @@ typedef struct fluid_content {
   int reg_every;             /* regularise every reg_every steps (0: never) */
   int reg_min, reg_max;      /* particles per non-empty cell after regularisation */
   int refill;                /* regularisation refills cells that expansion emptied */
+  int stable_local;          /* fluid.stable_step = neighbourhood (fluid_stable.c) */
+  double s_local;            /* its fastest signal for this step, m/s; < 0: not yet known */
+  double *cellsum;           /* its per-cell sums (3 nnodes) */
   mpm_lidx cap;              /* capacity of the particle scratch arrays */
   double *vsig;              /* V sigma deposited by this RHS (dim^2 cap) */
   double *scratch;           /* G2P output v, a, L ((2 dim + dim^2) cap) */
@@ -60,6 +63,11 @@ void fluid_classic_transfer(mpm_module *m, const double *y, double h, const flui
 
 /* Seed every [gas.NAME] region into the (empty) particle set (fluid_seed.c). */
 int fluid_seed(mpm_module *m, const mpm_config *cfg);
+
+/* The fastest signal the nodes carry, from mass-weighted sums over the 3^dim cells around
+ * every owned cell (fluid_stable.c); the particles must sit on the ranks owning their cells.
+ * Collective. */
+int fluid_neighbourhood_signal(const mpm_module *m, double *smax);
 
 /* Merge and split particles so that every non-empty cell holds reg_min to reg_max of them,
  * conserving mass, momentum and total energy, when step is a multiple of reg_every. Sets

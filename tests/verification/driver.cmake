@@ -96,3 +96,6 @@ mpm_add_script_test(test_coupling_ranks SCRIPT verification/test_coupling_ranks.
                     LABELS "verification;mpi" TIMEOUT 900)
 mpm_add_script_test(test_coupling_rigid SCRIPT verification/test_coupling_rigid.py
                     LABELS verification TIMEOUT 600)
+# The gas's stable-step estimates: particle against neighbourhood, checked against the formulas.
+mpm_add_script_test(test_stable_step SCRIPT verification/test_stable_step.py
+                    LABELS "verification;mpi" TIMEOUT 600)

@@ -1,0 +1,91 @@
+/* The neighbourhood estimate of the gas's fastest signal (fluid.stable_step = neighbourhood).
+ *
+ * The explicit update is stable when the step resolves the fastest signal the grid's nodes
+ * carry. A node's mass, stiffness and momentum are sums over the particles its shape function
+ * reaches, so a particle counts in proportion to its mass: a light particle that is hot, fast
+ * or strongly compressed among heavier ones cannot set a node's frequency alone, and positions
+ * move with the nodal velocity, a mass-weighted mean of the particles' velocities. The default
+ * estimate (fluid.stable_step = particle) instead takes the largest c + |v| + 2 nu / dx of any
+ * single particle, which in a wake refilled with light particles can be several times what any
+ * node carries (measured on the main job: the limiting particles hold 1/16 to 1/1000 of a
+ * seeded particle's mass).
+ *
+ * Here, for every cell c the grid owns, over the 3 x 3 (x 3) cells around it (the reach of the
+ * quadratic B-spline):
+ *   s_c = sqrt(sum m s_p^2 / sum m) + sum m |v_p| / sum m,
+ * with s_p = c_p + 2 nu_p / dx the particle's acoustic and viscous (artificial and physical)
+ * speed, and the step is dx over the largest s_c. The sums are taken per cell after
+ * migration, when every particle sits on the rank owning its cell, and the forward halo gives
+ * each rank its neighbours' cells: the result does not depend on the decomposition (up to the
+ * order of the sums). It is computed once per step, at the first estimate after the step
+ * began (every rank asks at the same points: the estimate is collective), from the state the
+ * step starts from; the adaptive pairs' stage and end-of-step estimates reuse it. */
+#include "fluid_internal.h"
+
+#include "fluid_stress.h"
+#include "mpm_cells.h"
+#include "mpm_error.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Deposit m, m s^2 and m |v| of every particle into its cell (at the cell's lower corner
+ * node, as mpm_cells.h stores cells). */
+static void deposit(const mpm_module *m, double *const *sum) {
+  const fluid_content *fc = m->content;
+  const mpm_particles *p = m->particles;
+  const mpm_grid *g = m->grid;
+  const double dx = g->dx, gamma = fc->gas.gamma;
+  const double *mass = mpm_particles_comp(p, fc->lay.f_m, 0);
+  const double *V0 = mpm_particles_comp(p, fc->lay.f_V0, 0);
+  const double *divv = mpm_particles_comp(p, fc->lay.f_divv, 0);
+  const double *J = mpm_particles_comp(p, FLUID_J, 0), *e = mpm_particles_comp(p, FLUID_E, 0);
+  for (mpm_lidx i = 0; i < p->n; ++i) {
+    int c[MPM_MAX_DIM] = {0};
+    double v2 = 0.0;
+    for (int d = 0; d < g->dim; ++d) {
+      const double v = mpm_particles_comp(p, FLUID_V, d)[i];
+      v2 += v * v;
+      c[d] = mpm_cells_coord(g, d, mpm_particles_comp(p, FLUID_X, d)[i]);
+    }
+    const double rho = mass[i] / (V0[i] * J[i]);
+    const double cs = sqrt(gamma * (gamma - 1.0) * fabs(e[i]));
+    const double s = cs + fluid_viscous_speed(&fc->gas, rho, cs, divv[i], dx);
+    const mpm_lidx l = mpm_grid_local_index(g, c);
+    sum[0][l] += mass[i], sum[1][l] += mass[i] * s * s, sum[2][l] += mass[i] * sqrt(v2);
+  }
+}
+
+int fluid_neighbourhood_signal(const mpm_module *m, double *smax) {
+  fluid_content *fc = m->content;
+  mpm_grid *g = m->grid;
+  const size_t nn = (size_t)g->nnodes;
+  double *sum[3] = {fc->cellsum, fc->cellsum + nn, fc->cellsum + 2 * nn};
+  memset(fc->cellsum, 0, sizeof *fc->cellsum * 3 * nn);
+  deposit(m, sum);
+  MPM_CALL(mpm_grid_halo_forward(g, sum, 3));
+  int lo[MPM_MAX_DIM] = {0}, n[MPM_MAX_DIM] = {1, 1, 1};
+  mpm_lidx total = 1;
+  for (int d = 0; d < g->dim; ++d) {
+    lo[d] = g->cell_split[d][g->coord[d]];
+    n[d] = g->cell_split[d][g->coord[d] + 1] - lo[d];
+    total *= n[d];
+  }
+  double best = 0.0;
+  for (mpm_lidx k = 0; k < total; ++k) {
+    int c[MPM_MAX_DIM] = {0};
+    mpm_lidx r = k;
+    for (int d = 0; d < g->dim; ++d) c[d] = lo[d] + (int)(r % n[d]), r /= n[d];
+    double s[3] = {0, 0, 0};
+    for (int o = 0; o < (g->dim == 3 ? 27 : 9); ++o) { /* the 3^dim block around c */
+      int q[MPM_MAX_DIM] = {0};
+      for (int d = 0, w = o; d < g->dim; ++d, w /= 3) q[d] = c[d] + w % 3 - 1;
+      const mpm_lidx l = mpm_grid_local_index(g, q);
+      for (int j = 0; j < 3; ++j) s[j] += sum[j][l];
+    }
+    if (s[0] > 0.0) best = fmax(best, sqrt(s[1] / s[0]) + s[2] / s[0]);
+  }
+  *smax = best;
+  return 0;
+}
