@@ -1312,6 +1312,17 @@ int mpm_config_has(const mpm_config *cfg, const char *key) {
   return find_entry(cfg, key) != NULL;
 }
 
+int mpm_config_set_off_default(const mpm_config *cfg, const mpm_key_spec *sp) {
+  if (!mpm_config_has(cfg, sp->key)) return 0;
+  if (!sp->def) return 1;
+  if (sp->type == MPM_KEY_REAL || sp->type == MPM_KEY_INT) {
+    double v;
+    return mpm_config_get_real(cfg, sp->key, &v) != 0 || v != strtod(sp->def, NULL);
+  }
+  const char *v;
+  return mpm_config_get_string(cfg, sp->key, &v) != 0 || strcmp(v, sp->def) != 0;
+}
+
 const char *mpm_config_where(const mpm_config *cfg, const char *key) {
   const entry *e = find_entry(cfg, key);
   return e ? e->where : "default";

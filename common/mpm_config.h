@@ -83,6 +83,9 @@ int mpm_config_get_reals(const mpm_config *cfg, const char *key, double *values,
 
 /* 1 if the key was set in the file or on the command line. */
 int mpm_config_has(const mpm_config *cfg, const char *key);
+/* Is the key of spec set to something other than its default? (A checkpoint's resolved case
+ * lists the defaults too, so "set" alone does not say the user chose it.) */
+int mpm_config_set_off_default(const mpm_config *cfg, const mpm_key_spec *spec);
 
 /* Instance names used under a prefix, in order of first appearance: for "geometry" and
  * entries geometry.a.type, geometry.b.lo it gives {"a", "b"}. *names is owned by cfg. */

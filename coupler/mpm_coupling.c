@@ -36,19 +36,6 @@ int mpm_coupling_add_schema(mpm_config *cfg) {
   return 0;
 }
 
-/* Is the key set to something other than its default? (A checkpoint's resolved case lists the
- * defaults too, so a restart of a one-phase run must not count them as set.) */
-static int set_off_default(const mpm_config *cfg, const mpm_key_spec *sp) {
-  if (!mpm_config_has(cfg, sp->key)) return 0;
-  if (!sp->def) return 1;
-  if (sp->type == MPM_KEY_REAL) {
-    double v;
-    return mpm_config_get_real(cfg, sp->key, &v) != 0 || v != strtod(sp->def, NULL);
-  }
-  const char *v;
-  return mpm_config_get_string(cfg, sp->key, &v) != 0 || strcmp(v, sp->def) != 0;
-}
-
 /* Does type t declare key? */
 static int declares(const mpm_coupling_type *t, const char *key) {
   for (int k = 0; k < t->nkeys; ++k)
@@ -63,7 +50,8 @@ static int check_foreign_keys(const mpm_config *cfg, const mpm_coupling_type *ch
   for (int k = 0; k < n; ++k)
     for (int j = 0; j < types[k]->nkeys; ++j) {
       const char *key = types[k]->keys[j].key;
-      if (types[k] != chosen && !declares(chosen, key) && set_off_default(cfg, &types[k]->keys[j]))
+      if (types[k] != chosen && !declares(chosen, key) &&
+          mpm_config_set_off_default(cfg, &types[k]->keys[j]))
         return mpm_config_fail(cfg, key,
                                "is a key of the %s scheme, and coupling.scheme = %s does not read "
                                "it; remove it or choose coupling.scheme = %s",
@@ -76,10 +64,10 @@ static int check_foreign_keys(const mpm_config *cfg, const mpm_coupling_type *ch
 static const char *first_coupling_key(const mpm_config *cfg) {
   int n;
   const mpm_coupling_type *const *types = mpm_coupling_types(&n);
-  if (set_off_default(cfg, &g_scheme_key[0])) return g_scheme_key[0].key;
+  if (mpm_config_set_off_default(cfg, &g_scheme_key[0])) return g_scheme_key[0].key;
   for (int k = 0; k < n; ++k)
     for (int j = 0; j < types[k]->nkeys; ++j)
-      if (set_off_default(cfg, &types[k]->keys[j])) return types[k]->keys[j].key;
+      if (mpm_config_set_off_default(cfg, &types[k]->keys[j])) return types[k]->keys[j].key;
   return NULL;
 }
 
@@ -267,6 +255,8 @@ void mpm_coupling_exchange_force(mpm_coupling *c, mpm_role role, mpm_lidx l, con
   double force[MPM_MAX_DIM];
   const double power = mpm_impulse_apply(ph, dim, l, v, a, h, force);
   for (int d = 0; f && d < dim; ++d) f[d] = force[d];
+  if (c->capture && role == MPM_ROLE_SOLID)
+    for (int d = 0; d < dim; ++d) c->capture->capture[d][l] += force[d];
   if (c->recording && c->nbodies && role == MPM_ROLE_SOLID)
     for (int d = 0; d < dim; ++d) c->da[d][l] += force[d] / m;
   if (!c->recording || !c->owned[l]) return;
@@ -277,12 +267,36 @@ void mpm_coupling_exchange_force(mpm_coupling *c, mpm_role role, mpm_lidx l, con
 
 void mpm_coupling_record_force(mpm_coupling *c, mpm_role role, mpm_lidx l, const double *f,
                                const double *v) {
+  if (c->capture && role == MPM_ROLE_SOLID)
+    for (int d = 0; d < c->grid->dim; ++d) c->capture->capture[d][l] += f[d];
   if (c->recording && c->nbodies && role == MPM_ROLE_SOLID)
     for (int d = 0; d < c->grid->dim; ++d)
       c->da[d][l] += f[d] / mpm_coupling_phase(c, role)->m_i[l];
   if (!c->recording || !c->owned[l]) return;
   mpm_coupling_record *r = &c->rec[c->which.latest];
   for (int d = 0; d < c->grid->dim; ++d) r->force[role][d] += f[d], r->power[role] += f[d] * v[d];
+}
+
+int mpm_coupling_apply_load(mpm_coupling *c, double t, double h, const double *const *load) {
+  mpm_timer_start(MPM_T_COUPLING);
+  begin_record(c, t, h);
+  c->recording = 1;
+  const mpm_grid_phase *s = mpm_coupling_phase(c, MPM_ROLE_SOLID);
+  const int dim = c->grid->dim;
+  for (mpm_lidx l = 0; l < c->grid->nnodes; ++l) {
+    if (!mpm_coupling_has_mass(c, MPM_ROLE_SOLID, l)) continue;
+    double v[MPM_MAX_DIM], a[MPM_MAX_DIM];
+    int any = 0;
+    for (int d = 0; d < dim; ++d) {
+      const double q = load[d][l] / s->m_i[l];
+      any |= q != 0.0;
+      v[d] = s->v_i[d][l] + h * q, a[d] = s->a_i[d][l] + q;
+    }
+    if (any) mpm_coupling_exchange(c, MPM_ROLE_SOLID, l, v, a, h);
+  }
+  c->recording = 0;
+  mpm_timer_stop(MPM_T_COUPLING);
+  return 0;
 }
 
 int mpm_coupling_body_loads(mpm_coupling *c, const double *y_solid) {

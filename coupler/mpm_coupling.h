@@ -30,6 +30,7 @@
 
 #include "mpm_config.h"
 #include "mpm_impulse.h"
+#include "mpm_interface.h"
 #include "mpm_module.h"
 
 typedef struct mpm_coupling mpm_coupling;
@@ -67,6 +68,8 @@ typedef struct mpm_coupling_record {
   double power[MPM_ROLE_COUNT];                      /* its power on that phase's nodes, W */
   double gas_inside;                                 /* gas mass on nodes inside the solid, kg */
   double body[MPM_COUPLING_MAX_BODIES][MPM_MAX_DIM]; /* the solid's force per body, N */
+  double owed[MPM_MAX_DIM]; /* a staggered scheme: momentum the gas gave up at the interface
+                               that the solid has yet to receive, N s (mpm_interface.h) */
 } mpm_coupling_record;
 
 struct mpm_coupling {
@@ -83,6 +86,7 @@ struct mpm_coupling {
                                          MPM_COUPLING_MAX_BODIES: the resultant only) */
   const char *body_name[MPM_COUPLING_MAX_BODIES];
   double *da[MPM_MAX_DIM]; /* with nbodies: the solid's interface acceleration per node */
+  mpm_interface *capture;  /* non-NULL: what the solid is given goes there instead (held) */
 };
 
 /* The registered types, `none` first; count in *n. */
@@ -102,6 +106,19 @@ void mpm_coupling_destroy(mpm_coupling **c);
 int mpm_coupling_before_solve(mpm_coupling *c, double t, double h, mpm_pass pass);
 int mpm_coupling_after_solve(mpm_coupling *c, double t, double h, mpm_pass pass);
 int mpm_coupling_after_constrain(mpm_coupling *c, double t, double h, mpm_pass pass);
+
+/* A staggered scheme's load (mpm_interface.h): after the solid's solve, add load (N per box
+ * node, dim arrays) to the solid wherever it has mass, as an exchange (recorded as the
+ * interface force on the solid; in the classic update as the impulse h load). Starts this RHS's
+ * record like before_solve. */
+int mpm_coupling_apply_load(mpm_coupling *c, double t, double h, const double *const *load);
+
+/* While ifc is set (a held cycle's first pass), every exchange into the solid and every force
+ * recorded for it is also added to ifc->capture: what the gas gave the held solid. NULL ends it.
+ * A no-op for a NULL c. */
+static inline void mpm_coupling_capture(mpm_coupling *c, mpm_interface *ifc) {
+  if (c) c->capture = ifc;
+}
 
 /* After the first grid pass (forward halo done): split the solid's interface force of this RHS
  * over its bodies, from the solid's state block y_solid. A no-op with one body. Collective. */

@@ -7,7 +7,7 @@
 #define CYCLE_MAX_FIELDS (4 * (2 + 3 * MPM_MAX_DIM))
 
 /* Sum the ghosts into the owners (reverse: m, mv, f and the mass gradient where a scheme asks
- * for it) or copy the owners' v and a into the ghosts (forward). */
+ * for it) or copy the owners' v and a into the ghosts (forward), for the modules advanced. */
 static int halo(const mpm_cycle *c, int reverse) {
   double *f[CYCLE_MAX_FIELDS];
   int nf = 0;
@@ -27,19 +27,51 @@ static int halo(const mpm_cycle *c, int reverse) {
   return rc;
 }
 
+/* The held solid, in a held cycle (NULL otherwise). */
+static mpm_module *held(const mpm_cycle *c) {
+  return c->mode == MPM_CYCLE_HELD ? c->coupling->module[MPM_ROLE_SOLID] : NULL;
+}
+
+/* The coupling between the solve and the constraints: the spatial scheme (joint, held: its
+ * exchanges into the held solid are captured) or the load (loaded, first pass only). */
+static int interact(const mpm_cycle *c, double t, double hs, mpm_pass pass) {
+  if (c->mode != MPM_CYCLE_LOADED) return mpm_coupling_after_solve(c->coupling, t, hs, pass);
+  if (pass != MPM_PASS_FIRST) return 0;
+  return mpm_coupling_apply_load(c->coupling, t, hs, (const double *const *)c->iface->load);
+}
+
 /* The grid work between the transfers. The solve takes the step only in the first pass. */
 static int grid_pass(const mpm_cycle *c, double t, double h, mpm_pass pass) {
   const double hs = pass == MPM_PASS_FIRST ? h : 0.0;
+  mpm_module *hm = held(c);
+  const int hooks = c->mode != MPM_CYCLE_LOADED;
   MPM_CALL(halo(c, 1));
   mpm_timer_start(MPM_T_GRID);
   for (int k = 0; k < c->nmod; ++k) MPM_CALL(c->mod[k]->ops->forces(c->mod[k], t, h, pass));
-  MPM_CALL(mpm_coupling_before_solve(c->coupling, t, hs, pass));
+  if (hm) mpm_interface_restore(c->iface);
+  if (hm && pass == MPM_PASS_FIRST) mpm_interface_capture_begin(c->iface);
+  mpm_coupling_capture(c->coupling, hm && pass == MPM_PASS_FIRST ? c->iface : NULL);
+  if (hooks) MPM_CALL(mpm_coupling_before_solve(c->coupling, t, hs, pass));
   for (int k = 0; k < c->nmod; ++k) MPM_CALL(mpm_grid_phase_update(c->grid, c->mod[k]->phase, hs));
-  MPM_CALL(mpm_coupling_after_solve(c->coupling, t, hs, pass));
+  if (hm) MPM_CALL(mpm_grid_phase_update(c->grid, hm->phase, hs));
+  MPM_CALL(interact(c, t, hs, pass));
   for (int k = 0; k < c->nmod; ++k) MPM_CALL(c->mod[k]->ops->constrain(c->mod[k], t, h, pass));
-  MPM_CALL(mpm_coupling_after_constrain(c->coupling, t, hs, pass));
+  if (hm) MPM_CALL(hm->ops->constrain(hm, t, h, pass));
+  if (hooks) MPM_CALL(mpm_coupling_after_constrain(c->coupling, t, hs, pass));
+  mpm_coupling_capture(c->coupling, NULL);
   mpm_timer_stop(MPM_T_GRID);
   return halo(c, 0);
+}
+
+int mpm_cycle_deposit(const mpm_cycle *c, double t, double *const *y) {
+  for (int k = 0; k < c->nmod; ++k) {
+    mpm_grid_phase_zero(c->grid, c->mod[k]->phase);
+    MPM_CALL(c->mod[k]->ops->p2g(c->mod[k], t, y[k]));
+  }
+  MPM_CALL(halo(c, 1));
+  for (int k = 0; k < c->nmod; ++k)
+    MPM_CALL(c->mod[k]->ops->forces(c->mod[k], t, 0.0, MPM_PASS_FIRST));
+  return 0;
 }
 
 int mpm_cycle_rhs(const mpm_cycle *c, double t, double *const *y, double *const *ydot, double h) {

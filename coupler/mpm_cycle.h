@@ -1,32 +1,51 @@
 /* The MPM cycle: one right-hand side of the coupled modules, the algorithm on one screen.
  *
  *   for each module: zero its phase, p2g
- *   grid pass (first):  halo reverse -> forces -> coupling before_solve -> solve
- *                       -> coupling after_solve -> constrain -> coupling after_constrain
- *                       -> halo forward
+ *   grid pass (first):  halo reverse -> forces -> [held: restore] -> coupling before_solve
+ *                       -> solve -> coupling after_solve (or, loaded: the load) -> constrain
+ *                       -> coupling after_constrain -> halo forward
  *   MUSL only:          remap -> grid pass (remap)
  *   for each module: g2p
  *
  * The solve is the coupler's: v_i = mv_i / m_i + h a_i, a_i = f_i / m_i on every phase
  * (mpm_grid_phase_update); each module completes its forces before it and constrains its
- * nodes after it, and the coupling scheme acts between. A time scheme calls the cycle with the
- * state blocks of the modules it advances. */
+ * nodes after it, and the coupling scheme acts between.
+ *
+ * A time scheme calls the cycle with the state blocks of the modules it advances, in one of
+ * three modes (mpm_timescheme.h):
+ *   joint   every module advances and the spatial scheme acts on all of them (monolithic);
+ *   held    the modules advance against a partner held at its last deposit (mpm_interface.h):
+ *           its nodal fields are restored before the solve and it is solved and constrained
+ *           with them, the spatial scheme acts as in a joint cycle, and what it gives the held
+ *           partner is captured instead of applied (the partner takes no G2P);
+ *   loaded  the modules advance alone, under the interface load captured from the partner's
+ *           last advance (no spatial scheme hook runs). */
 #ifndef MPM_CYCLE_H
 #define MPM_CYCLE_H
 
 #include "mpm_coupling.h"
+#include "mpm_interface.h"
 #include "mpm_module.h"
+
+typedef enum { MPM_CYCLE_JOINT, MPM_CYCLE_HELD, MPM_CYCLE_LOADED } mpm_cycle_mode;
 
 typedef struct mpm_cycle {
   mpm_grid *grid;
-  mpm_module **mod;
+  mpm_module **mod; /* the modules this cycle advances */
   int nmod;
   mpm_coupling *coupling; /* NULL: the modules do not interact */
   int musl;               /* run MUSL's second transfer */
+  mpm_cycle_mode mode;
+  mpm_interface *iface; /* held and loaded: the interface data */
 } mpm_cycle;
 
 /* One RHS at (t, y): y[k] and ydot[k] are module k's state blocks; h is the classic step (0:
  * method of lines). */
 int mpm_cycle_rhs(const mpm_cycle *c, double t, double *const *y, double *const *ydot, double h);
+
+/* The first half of a cycle, for a module about to be held: zero its phase, P2G from y,
+ * reverse halo and its forces (first pass). Its nodal fields then hold what
+ * mpm_interface_hold saves. Collective. */
+int mpm_cycle_deposit(const mpm_cycle *c, double t, double *const *y);
 
 #endif

@@ -172,11 +172,14 @@ static int classic_limit(mpm_integrator *it, N_Vector y, double *h) {
 }
 
 /* The fixed step from t: the limit (or, without one, the rest of the way to the stop time)
- * times the retry scale, capped by the stop time so that a step lands on it. The classic
+ * times the retry scale, capped by the stop time so that a step lands on it (and stretched to
+ * it when the limit falls short by roundoff only). The classic
  * update's RHS computes it from the same (t, y) the driver uses to set the fixed step. */
 static double classic_step(const mpm_integrator *it, double t, double h_limit) {
-  const double rest = it->tstop - t;
-  return fmin(it->scale * (h_limit > 0 ? h_limit : rest), rest);
+  const double rest = it->tstop - t, h = it->scale * (h_limit > 0 ? h_limit : rest);
+  /* A limit a few ulps short of the rest (a staggered scheme's coupling step, t + H - t) would
+   * leave a step of roundoff size. */
+  return h >= rest * (1 - 1e-12) ? rest : h;
 }
 
 #if SUNDIALS_VERSION_MAJOR < 7
@@ -244,23 +247,20 @@ static int read_settings(mpm_integrator *it, const mpm_config *cfg) {
   return 0;
 }
 
-int mpm_integrator_new(mpm_integrator **itp, const mpm_config *cfg, mpm_grid *grid,
-                       mpm_module **modules, int nmodules, mpm_coupling *coupling) {
-  if (nmodules < 1 || nmodules > MPM_MAX_MODULES)
-    MPM_FAIL(MPM_ERR_INPUT, "a run needs 1 to %d modules, got %d", MPM_MAX_MODULES, nmodules);
+int mpm_integrator_new(mpm_integrator **itp, const mpm_config *cfg, const mpm_cycle *cycle) {
+  if (cycle->nmod < 1 || cycle->nmod > MPM_MAX_MODULES)
+    MPM_FAIL(MPM_ERR_INPUT, "a run needs 1 to %d modules, got %d", MPM_MAX_MODULES, cycle->nmod);
   mpm_integrator *it;
   MPM_ALLOC(it, 1);
   *itp = it;
-  it->comm = grid->comm;
-  it->grid = grid;
-  it->nmod = nmodules;
-  for (int k = 0; k < nmodules; ++k) it->mod[k] = modules[k];
+  it->comm = cycle->grid->comm;
+  it->grid = cycle->grid;
+  it->nmod = cycle->nmod;
+  for (int k = 0; k < cycle->nmod; ++k) it->mod[k] = cycle->mod[k];
   MPM_CALL(read_settings(it, cfg));
-  it->cycle = (mpm_cycle){.grid = grid,
-                          .mod = it->mod,
-                          .nmod = nmodules,
-                          .coupling = coupling,
-                          .musl = it->method == MPM_METHOD_MUSL};
+  it->cycle = *cycle;
+  it->cycle.mod = it->mod;
+  it->cycle.musl = it->method == MPM_METHOD_MUSL;
   if (mpm_sun_context_create(&it->comm, &it->ctx) != 0)
     MPM_FAIL(MPM_ERR_SUNDIALS, "SUNContext_Create failed");
   return wrap_state(it);

@@ -19,8 +19,7 @@
 #define MPM_INTEGRATOR_H
 
 #include "mpm_config.h"
-#include "mpm_coupling.h"
-#include "mpm_module.h"
+#include "mpm_cycle.h"
 
 typedef enum {
   MPM_METHOD_USL,         /* classic MPM update, fixed step from the CFL limit */
@@ -40,10 +39,9 @@ extern const int mpm_integrator_nkeys;
 
 typedef struct mpm_integrator mpm_integrator;
 
-/* coupling: the spatial scheme the cycle runs (NULL: the modules do not interact); the caller
- * keeps it alive and destroys it. */
-int mpm_integrator_new(mpm_integrator **it, const mpm_config *cfg, mpm_grid *grid,
-                       mpm_module **modules, int nmodules, mpm_coupling *coupling);
+/* An integrator of the modules of `cycle`, whose RHS is that cycle (copied; its musl flag is
+ * set from time.method). The caller keeps the grid, modules, coupling and interface alive. */
+int mpm_integrator_new(mpm_integrator **it, const mpm_config *cfg, const mpm_cycle *cycle);
 void mpm_integrator_destroy(mpm_integrator **it);
 
 /* (Re)start the integration at (t, current particle state) with first step h0 (0: let

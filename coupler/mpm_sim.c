@@ -10,6 +10,7 @@
 #include "mpm_geometry.h"
 #include "mpm_guard.h"
 #include "mpm_integrator.h"
+#include "mpm_timescheme.h"
 #include "mpm_output.h"
 #include "mpm_probe.h"
 #include "mpm_rundir.h"
@@ -36,7 +37,7 @@ struct mpm_sim {
   mpm_module *mod[SIM_MAX_MODULES];
   int nmod;
   mpm_coupling *coupling; /* NULL: one phase, or scheme = none */
-  mpm_integrator *it;
+  mpm_timescheme *it;     /* the temporal coupling scheme */
   mpm_guard guard;
   double energy;      /* total energy at the last diagnostics row */
   mpm_rundir *rundir; /* the claim on the output folder, while the run writes */
@@ -48,7 +49,8 @@ struct mpm_sim {
   mpm_probes probes;
   mpm_diag *probe_csv;       /* probes.csv, with probes only */
   double coupling_work;      /* cumulative energy the coupling created (J; < 0: destroyed) */
-  double coupling_imbalance; /* largest |F_solid + F_fluid| / max(|F_solid|, |F_fluid|) */
+  double coupling_imbalance; /* largest |F_solid + F_fluid + d owed/dt| / max(|F_s|, |F_f|) */
+  double owed[MPM_MAX_DIM];  /* interface momentum the solid has yet to receive (staggered) */
   char body_cols[MPM_COUPLING_MAX_BODIES][MPM_MAX_DIM][80]; /* coupling.csv column names */
   double t, t_end, h_next;
   long step;
@@ -124,6 +126,7 @@ int mpm_sim_add_schema(mpm_config *cfg) {
   MPM_CALL(mpm_config_add_schema(cfg, mpm_geometry_keys, mpm_geometry_nkeys));
   MPM_CALL(mpm_config_add_schema(cfg, mpm_bc_keys, mpm_bc_nkeys));
   MPM_CALL(mpm_coupling_add_schema(cfg));
+  MPM_CALL(mpm_timescheme_add_schema(cfg));
   MPM_CALL(solid_add_schema(cfg));
   MPM_CALL(fluid_add_schema(cfg));
   return 0;
@@ -306,7 +309,7 @@ static int output_bytes(const mpm_sim *s, double *bytes) {
 /* Refuse an absurd run before it starts (mpm_budget.h). */
 static int check_budget(mpm_sim *s) {
   mpm_budget b = {s->t, s->t_end, 0, s->out_interval, s->ckpt_interval, s->snapshots, 0};
-  MPM_CALL(mpm_integrator_cfl_step(s->it, &b.h0));
+  MPM_CALL(mpm_timescheme_cfl_step(s->it, &b.h0));
   MPM_CALL(output_bytes(s, &b.bytes));
   return mpm_budget_check(s->cfg, &b);
 }
@@ -318,7 +321,7 @@ int mpm_sim_create(mpm_sim **sp, mpm_config *cfg) {
   MPM_CALL(mpm_probes_new(&s->probes, cfg, s->mod, s->nmod));
   s->out_next = 0;
   s->ckpt_next = 1;
-  MPM_CALL(mpm_integrator_new(&s->it, cfg, s->grid, s->mod, s->nmod, s->coupling));
+  MPM_CALL(mpm_timescheme_new(&s->it, cfg, s->grid, s->mod, s->nmod, s->coupling));
   return check_budget(s);
 }
 
@@ -357,7 +360,7 @@ int mpm_sim_restart(mpm_sim **sp, mpm_config *cfg, const char *path) {
       isfinite(s->ckpt_interval) ? (long)floor(s->t / s->ckpt_interval * (1 + 1e-12)) + 1 : 1;
   for (int k = 0; k < s->nmod; ++k)
     MPM_CALL(mpm_particles_migrate(s->mod[k]->particles, s->grid, NULL));
-  MPM_CALL(mpm_integrator_new(&s->it, cfg, s->grid, s->mod, s->nmod, s->coupling));
+  MPM_CALL(mpm_timescheme_new(&s->it, cfg, s->grid, s->mod, s->nmod, s->coupling));
   MPM_CALL(check_budget(s));
   mpm_log(MPM_LOG_INFO, "restarted from %s at t = %.6g, step %ld", path, s->t, s->step);
   return 0;
@@ -366,7 +369,7 @@ int mpm_sim_restart(mpm_sim **sp, mpm_config *cfg, const char *path) {
 void mpm_sim_destroy(mpm_sim **sp) {
   if (!sp || !*sp) return;
   mpm_sim *s = *sp;
-  mpm_integrator_destroy(&s->it);
+  mpm_timescheme_destroy(&s->it);
   mpm_coupling_destroy(&s->coupling);
   for (int k = 0; k < s->nmod; ++k) mpm_module_destroy(&s->mod[k]);
   mpm_output_destroy(&s->out);
@@ -424,7 +427,7 @@ static int write_checkpoint(mpm_sim *s, const char *path) {
  * energy of the phase of role r. */
 static int coupling_row(mpm_sim *s, double dt, const double *energy) {
   mpm_coupling_record r;
-  MPM_CALL(mpm_coupling_step_record(s->coupling, s->t, &r));
+  MPM_CALL(mpm_timescheme_record(s->it, s->t, &r));
   const int dim = s->grid->dim, S = MPM_ROLE_SOLID, F = MPM_ROLE_FLUID;
   const double net = r.power[S] + r.power[F];
   double row[NCOUPLING(3) + MPM_MAX_DIM * MPM_COUPLING_MAX_BODIES], fs = 0, ff = 0, fsum = 0;
@@ -433,9 +436,13 @@ static int coupling_row(mpm_sim *s, double dt, const double *energy) {
   row[c++] = s->t, row[c++] = (double)s->step, row[c++] = dt;
   for (int d = 0; d < dim; ++d) row[c++] = r.force[S][d];
   for (int d = 0; d < dim; ++d) row[c++] = r.force[F][d];
+  /* The momentum the fluid gives up at the interface reaches the solid, now or (staggered) at
+   * its next advance: F_solid + F_fluid + d(owed)/dt = 0. */
   for (int d = 0; d < dim; ++d) {
+    const double late = dt > 0 ? (r.owed[d] - s->owed[d]) / dt : 0.0;
     fs += r.force[S][d] * r.force[S][d], ff += r.force[F][d] * r.force[F][d];
-    fsum += (r.force[S][d] + r.force[F][d]) * (r.force[S][d] + r.force[F][d]);
+    fsum += (r.force[S][d] + r.force[F][d] + late) * (r.force[S][d] + r.force[F][d] + late);
+    s->owed[d] = r.owed[d];
   }
   if (fs + ff > 0) s->coupling_imbalance = fmax(s->coupling_imbalance, sqrt(fsum / fmax(fs, ff)));
   row[c++] = r.power[S], row[c++] = r.power[F], row[c++] = net, row[c++] = s->coupling_work;
@@ -461,7 +468,7 @@ static int diagnostics_row(mpm_sim *s, double dt) {
   s->energy = sum[5] + sum[6];
   if (s->coupling) MPM_CALL(coupling_row(s, dt, sum + 8));
   long steps, rhs, fails, retries;
-  mpm_integrator_counts(s->it, &steps, &rhs, &fails, &retries);
+  mpm_timescheme_counts(s->it, &steps, &rhs, &fails, &retries);
   const double row[NDIAG] = {s->t,   (double)s->step, dt,     sum[0], sum[1],          sum[2],
                              sum[3], sum[4],          sum[5], sum[6], sum[5] + sum[6], (double)rhs};
   if (dt > 0) s->particle_steps += sum[0]; /* the row at t = 0 is not a step */
@@ -520,7 +527,7 @@ static int after_step(mpm_sim *s, double h) {
   }
   /* A module's own changes may be local to a rank; the resize is collective. */
   MPM_CALL_MPI(MPI_Allreduce(MPI_IN_PLACE, &changed_any, 1, MPI_INT, MPI_LOR, s->comm));
-  if (changed_any) MPM_CALL(mpm_integrator_resize(s->it, s->t));
+  if (changed_any) MPM_CALL(mpm_timescheme_resize(s->it, s->t));
   mpm_timer_stop(MPM_T_MIGRATE);
   return 0;
 }
@@ -551,7 +558,7 @@ static void progress(mpm_sim *s, double dt, double wall0, int final) {
 
 static int write_summary(mpm_sim *s, double wall) {
   long steps, rhs, fails, retries;
-  mpm_integrator_counts(s->it, &steps, &rhs, &fails, &retries);
+  mpm_timescheme_counts(s->it, &steps, &rhs, &fails, &retries);
   char path[4096];
   snprintf(path, sizeof path, "%s/timers.csv", s->dir);
   MPM_CALL(mpm_timer_report(s->comm, path));
@@ -586,7 +593,7 @@ int mpm_sim_run(mpm_sim *s) {
   mpm_timer_reset();
   mpm_timer_start(MPM_T_TOTAL);
   const double wall0 = MPI_Wtime();
-  MPM_CALL(mpm_integrator_start(s->it, s->t, s->h_next));
+  MPM_CALL(mpm_timescheme_start(s->it, s->t, s->h_next));
   if (s->out_next == 0) {
     MPM_CALL(diagnostics(s, 0.0));
     if (s->snapshots) MPM_CALL(write_snapshot(s));
@@ -595,7 +602,7 @@ int mpm_sim_run(mpm_sim *s) {
     MPM_CALL(total_energy(s, &s->energy));
   }
   double h0;
-  MPM_CALL(mpm_integrator_cfl_step(s->it, &h0));
+  MPM_CALL(mpm_timescheme_cfl_step(s->it, &h0));
   MPM_CALL(mpm_guard_init(&s->guard, s->cfg, h0, s->energy));
   const double t_stop = s->t_end * (1 - 1e-14);
   double dt = 0.0;
@@ -604,7 +611,7 @@ int mpm_sim_run(mpm_sim *s) {
   while (s->t < t_stop) {
     const double t_out = fmin(s->out_next * s->out_interval, s->t_end);
     const double t_ckpt = s->ckpt_next * s->ckpt_interval, tstop = fmin(t_out, t_ckpt);
-    MPM_CALL(mpm_integrator_step(s->it, tstop, &s->t, &dt));
+    MPM_CALL(mpm_timescheme_step(s->it, tstop, &s->t, &dt));
     s->step++;
     MPM_CALL(after_step(s, dt));
     MPM_CALL(diagnostics(s, dt));
@@ -615,18 +622,18 @@ int mpm_sim_run(mpm_sim *s) {
       s->out_next++;
     }
     if (s->t >= t_ckpt * (1 - 1e-14) && s->t < t_stop) {
-      s->h_next = mpm_integrator_next_step(s->it);
+      s->h_next = mpm_timescheme_next_step(s->it);
       s->ckpt_next++;
       snprintf(path, sizeof path, "%s/checkpoint_%06ld.h5", s->dir, s->ckpt_number++);
       MPM_CALL(write_checkpoint(s, path));
       /* Exactly what a restart from this file does. */
-      MPM_CALL(mpm_integrator_start(s->it, s->t, s->h_next));
+      MPM_CALL(mpm_timescheme_start(s->it, s->t, s->h_next));
     }
     MPM_CALL(mpm_signal_agreed(s->comm, &sig));
     if (sig) break;
   }
   progress(s, dt, wall0, 1);
-  s->h_next = mpm_integrator_next_step(s->it);
+  s->h_next = mpm_timescheme_next_step(s->it);
   snprintf(path, sizeof path, "%s/checkpoint_final.h5", s->dir);
   MPM_CALL(write_checkpoint(s, path));
   mpm_timer_stop(MPM_T_TOTAL);

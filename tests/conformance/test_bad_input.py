@@ -204,10 +204,21 @@ COUPLING_CASES = [
      "nothing to couple"),
     ("coupling keys in a solid-only scene", BASE, "scheme = contact", "coupling.scheme",
      "nothing to couple"),
+    ("unknown time scheme", FSI, "time = stagered", "coupling.time", "did you mean 'staggered'"),
+    ("staggered in a gas-only scene", OBST, "time = staggered", "coupling.time",
+     "no coupled pair"),
+    ("order of another time scheme", FSI, "order = gas_first", "coupling.order",
+     "key of the staggered time scheme"),
+    ("unknown staggered order", FSI, "time = staggered\norder = fluid_first", "coupling.order",
+     "gas_first"),
 ]
 for name, base, body, key, words in COUPLING_CASES:
     text = base.rstrip("\n") + "\n\n[coupling]\n" + body + "\n"
     expect_error(name, text, key, words, line_of(text, body.splitlines()[-1]))
+# A staggered scheme with an adaptive pair: the error names time.method, on its own line.
+text = FSI.replace("method = usl", "method = bs32", 1) + "\n[coupling]\ntime = staggered\n"
+expect_error("staggered with an adaptive pair", text, "time.method", "classic update",
+             line_of(text, "method = bs32"))
 # A solid inside a static obstacle of the gas (obstacle block spans 0.8-0.9 x 0.15-0.35).
 text = OBST + SOLID.format(lo="0.82 0.2", hi="0.88 0.3")
 expect_error("solid overlapping a static obstacle", text, "obstacle.block.shape",

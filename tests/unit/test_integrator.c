@@ -187,7 +187,8 @@ static void run_two_modules(double limit, const char *label) {
                          flight_new(grid, "b", 1000, 25, limit)};
   mpm_config *cfg = make_config("bs32", "max_retries = 12\n");
   mpm_integrator *it = NULL;
-  CHECK(mpm_integrator_new(&it, cfg, grid, mods, 2, NULL) == 0, "integrator_new");
+  const mpm_cycle cyc = {.grid = grid, .mod = mods, .nmod = 2};
+  CHECK(mpm_integrator_new(&it, cfg, &cyc) == 0, "integrator_new");
   mpm_integrator_start(it, 0.0, 0.0);
   double t = 0.0, h;
   mpm_gidx first = 1 << 30;
@@ -239,7 +240,8 @@ static void run_hopeless(void) {
   mpm_module *m = flight_new(grid, "a", 0, 10, 0.0);
   mpm_config *cfg = make_config("bs32", "max_retries = 3\n");
   mpm_integrator *it = NULL;
-  mpm_integrator_new(&it, cfg, grid, &m, 1, NULL);
+  const mpm_cycle cyc = {.grid = grid, .mod = &m, .nmod = 1};
+  mpm_integrator_new(&it, cfg, &cyc);
   mpm_integrator_start(it, 0.0, 0.0);
   double t, h;
   const int rc = mpm_integrator_step(it, 1.0, &t, &h);
@@ -271,7 +273,8 @@ static void run_classic(void) {
   mpm_module *m = flight_new(grid, "a", 0, NP, 1e30);
   mpm_config *cfg = make_config("usl", "dt_max = 0.03125\n");
   mpm_integrator *it = NULL;
-  CHECK(mpm_integrator_new(&it, cfg, grid, &m, 1, NULL) == 0, "integrator_new");
+  const mpm_cycle cyc = {.grid = grid, .mod = &m, .nmod = 1};
+  CHECK(mpm_integrator_new(&it, cfg, &cyc) == 0, "integrator_new");
   mpm_integrator_start(it, 0.0, 0.0);
   double xr[NP][2], vr[NP][2], t = 0.0, h;
   for (int i = 0; i < NP; ++i) initial(i, xr[i], vr[i]);

@@ -6,3 +6,8 @@ mpm_add_script_test(test_fsi_waves SCRIPT verification/test_fsi_waves.py
                     LABELS verification TIMEOUT 600)
 mpm_add_script_test(test_fsi_waves_long SCRIPT verification/test_fsi_waves.py ARGS long
                     LABELS "verification;long" TIMEOUT 1800)
+# Temporal coupling: the Piperno-Farhat energy check (cases/fsi_piston.ini): monolithic against
+# the uncoupled modules, staggered solid_first's interface energy at three coupling steps (order
+# 2), its momentum balance, gas_first = monolithic, and 2 ranks against 1.
+mpm_add_script_test(test_piperno_farhat SCRIPT verification/test_piperno_farhat.py
+                    LABELS "verification;mpi" TIMEOUT 900)

@@ -1,0 +1,94 @@
+/* The interface data of a staggered time scheme (see mpm_interface.h). */
+#include "mpm_interface.h"
+
+#include "mpm_error.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+int mpm_interface_new(mpm_interface **ifcp, mpm_grid *grid, int phase) {
+  mpm_interface *ifc;
+  MPM_ALLOC(ifc, 1);
+  *ifcp = ifc;
+  ifc->grid = grid, ifc->phase = phase;
+  const size_t nn = (size_t)grid->nnodes;
+  MPM_ALLOC(ifc->m, nn);
+  for (int d = 0; d < grid->dim; ++d) {
+    MPM_ALLOC(ifc->mv[d], nn);
+    MPM_ALLOC(ifc->f[d], nn);
+    MPM_ALLOC(ifc->capture[d], nn);
+    MPM_ALLOC(ifc->impulse[d], nn);
+    MPM_ALLOC(ifc->load[d], nn);
+    if (grid->phase[phase].normals) MPM_ALLOC(ifc->normal[d], nn);
+  }
+  return 0;
+}
+
+void mpm_interface_destroy(mpm_interface **ifcp) {
+  if (!ifcp || !*ifcp) return;
+  mpm_interface *ifc = *ifcp;
+  free(ifc->m);
+  for (int d = 0; d < MPM_MAX_DIM; ++d) {
+    free(ifc->mv[d]), free(ifc->f[d]), free(ifc->normal[d]);
+    free(ifc->capture[d]), free(ifc->impulse[d]), free(ifc->load[d]);
+  }
+  free(ifc);
+  *ifcp = NULL;
+}
+
+/* Copy the held fields between the phase and the store (save: phase -> store). */
+static void copy_fields(const mpm_interface *ifc, int save) {
+  mpm_grid_phase *ph = &ifc->grid->phase[ifc->phase];
+  const size_t bytes = sizeof(double) * (size_t)ifc->grid->nnodes;
+#define MPM_IFC_COPY(store, field) memcpy(save ? (store) : (field), save ? (field) : (store), bytes)
+  MPM_IFC_COPY(ifc->m, ph->m_i);
+  for (int d = 0; d < ifc->grid->dim; ++d) {
+    MPM_IFC_COPY(ifc->mv[d], ph->mv_i[d]);
+    MPM_IFC_COPY(ifc->f[d], ph->f_i[d]);
+    if (ifc->normal[d]) MPM_IFC_COPY(ifc->normal[d], ph->normal_i[d]);
+  }
+#undef MPM_IFC_COPY
+}
+
+void mpm_interface_hold(mpm_interface *ifc) {
+  copy_fields(ifc, 1);
+}
+
+void mpm_interface_restore(const mpm_interface *ifc) {
+  copy_fields(ifc, 0);
+}
+
+void mpm_interface_capture_begin(mpm_interface *ifc) {
+  for (int d = 0; d < ifc->grid->dim; ++d)
+    memset(ifc->capture[d], 0, sizeof(double) * (size_t)ifc->grid->nnodes);
+}
+
+void mpm_interface_capture_accept(mpm_interface *ifc, double h) {
+  for (int d = 0; d < ifc->grid->dim; ++d)
+    for (mpm_lidx l = 0; l < ifc->grid->nnodes; ++l) ifc->impulse[d][l] += h * ifc->capture[d][l];
+}
+
+void mpm_interface_load(mpm_interface *ifc, double H) {
+  const double inv = H > 0 ? 1.0 / H : 0.0;
+  ifc->span = H;
+  for (int d = 0; d < ifc->grid->dim; ++d)
+    for (mpm_lidx l = 0; l < ifc->grid->nnodes; ++l) {
+      ifc->load[d][l] = ifc->impulse[d][l] * inv;
+      ifc->impulse[d][l] = 0.0;
+    }
+}
+
+void mpm_interface_unload(mpm_interface *ifc) {
+  const mpm_grid_phase *ph = &ifc->grid->phase[ifc->phase];
+  for (int d = 0; d < ifc->grid->dim; ++d)
+    for (mpm_lidx l = 0; l < ifc->grid->nnodes; ++l)
+      if (!(ph->m_i[l] > ph->m_empty)) ifc->impulse[d][l] += ifc->load[d][l] * ifc->span;
+}
+
+void mpm_interface_owed(const mpm_interface *ifc, const unsigned char *owned, double *J) {
+  for (int d = 0; d < ifc->grid->dim; ++d) {
+    J[d] = 0.0;
+    for (mpm_lidx l = 0; l < ifc->grid->nnodes; ++l)
+      if (owned[l]) J[d] += ifc->impulse[d][l];
+  }
+}

@@ -1,0 +1,61 @@
+/* The interface data of a partitioned (staggered) time scheme: what the gas knows of the solid,
+ * and the solid of the gas, between their exchanges. The gas always advances against a held
+ * solid; the solid always advances under the load the gas left it.
+ *
+ * Held fields. Before the gas advances, the solid is deposited (P2G, reverse halo, forces:
+ * mpm_cycle_deposit) and its nodal mass, momentum, force and mass gradient are saved here.
+ * Every gas RHS restores them before the solve, so the spatial scheme meets the solid as it was
+ * at the deposit, whatever the scheme wrote into the solid's nodes during the RHS before.
+ *
+ * Capture. While the gas advances, what the spatial scheme gives the solid is not applied: the
+ * coupling adds it to `capture` (N per node) during each RHS (mpm_coupling.h). After each
+ * accepted gas step the time scheme adds h capture to `impulse`: the momentum the gas gave up at
+ * the interface, node by node, owed to the solid.
+ *
+ * Load. Before the solid advances over a coupling step H, the owed impulse becomes its load,
+ * impulse / H N per node, applied after the solve of every solid RHS over that step
+ * (mpm_coupling_apply_load): the solid receives exactly the momentum the gas gave up, so the
+ * interface balances over every exchange, to roundoff, whatever the order of the advances.
+ *
+ * Only owned nodes matter: a cycle acts on every box node, but the forward halo overwrites the
+ * ghosts, and the balance counts owners only. Invariant: the arrays span the grid's box nodes,
+ * which never change during a run. */
+#ifndef MPM_INTERFACE_H
+#define MPM_INTERFACE_H
+
+#include "mpm_grid.h"
+
+typedef struct mpm_interface {
+  mpm_grid *grid;
+  int phase; /* the held phase (the solid's) */
+  double *m, *mv[MPM_MAX_DIM], *f[MPM_MAX_DIM], *normal[MPM_MAX_DIM]; /* held nodal fields */
+  double *capture[MPM_MAX_DIM]; /* during a gas RHS: the force into the solid per node, N */
+  double *impulse[MPM_MAX_DIM]; /* owed to the solid since its last load, N s per node */
+  double *load[MPM_MAX_DIM];    /* the load of the solid's current advance, N per node */
+  double span;                  /* the length of that advance, s */
+} mpm_interface;
+
+int mpm_interface_new(mpm_interface **ifc, mpm_grid *grid, int phase);
+void mpm_interface_destroy(mpm_interface **ifc);
+
+/* Save the held phase's m, mv, f (and mass gradient) as they are now. */
+void mpm_interface_hold(mpm_interface *ifc);
+/* Put them back into the held phase. */
+void mpm_interface_restore(const mpm_interface *ifc);
+
+/* A gas RHS begins: nothing captured yet. */
+void mpm_interface_capture_begin(mpm_interface *ifc);
+/* A gas step of size h was accepted: its RHS's capture is owed, impulse += h capture. */
+void mpm_interface_capture_accept(mpm_interface *ifc, double h);
+
+/* The solid is about to advance over H: load = impulse / H, and nothing is owed any more. */
+void mpm_interface_load(mpm_interface *ifc, double H);
+/* The solid has advanced: the load on nodes where its last RHS found no solid mass (the solid
+ * moved off them since the load was captured) was not applied, and stays owed. */
+void mpm_interface_unload(mpm_interface *ifc);
+
+/* The momentum owed to the solid on the nodes this rank owns (dim values; the caller reduces):
+ * the gas gave it up, the solid has not yet received it. */
+void mpm_interface_owed(const mpm_interface *ifc, const unsigned char *owned, double *J);
+
+#endif

@@ -1,0 +1,80 @@
+/* Temporal coupling schemes: how the modules advance in time together. An object with an ops
+ * table, registered by name (mpm_timescheme_register.c) and chosen with
+ * `[coupling] time = NAME`, like the spatial schemes (mpm_coupling.h): a new scheme is one file
+ * that exports its type plus one line in the register.
+ *
+ * The ops are the integrator's public face, what the step loop (mpm_sim.c) calls: start, step,
+ * resize, the CFL step, the next step, the counters, and the interface record of the step just
+ * taken. A scheme owns one ARKODE integrator (mpm_integrator.h) or more, each over the MPM cycle
+ * of a subset of the modules (mpm_cycle.h), and decides the order of their advances and what
+ * they exchange (mpm_interface.h). Built-in:
+ *   monolithic  one integrator over every module, one step for both (joint cycle);
+ *   staggered   one integrator per module, exchanging once per coupling step. */
+#ifndef MPM_TIMESCHEME_H
+#define MPM_TIMESCHEME_H
+
+#include "mpm_config.h"
+#include "mpm_coupling.h"
+#include "mpm_module.h"
+
+typedef struct mpm_timescheme mpm_timescheme;
+
+typedef struct mpm_timescheme_ops {
+  /* Read the scheme's keys, check what it is combined with, build its integrators. */
+  int (*create)(mpm_timescheme *ts, const mpm_config *cfg);
+  void (*destroy)(mpm_timescheme *ts);
+  /* (Re)start at (t, current particle state) with first step h0 (0: the scheme chooses). */
+  int (*start)(mpm_timescheme *ts, double t, double h0);
+  /* Take one accepted (coupling) step, not past tstop. *t is the new time, *h the step. */
+  int (*step)(mpm_timescheme *ts, double tstop, double *t, double *h);
+  /* The particle sets changed (count, order or storage). Collective. */
+  int (*resize)(mpm_timescheme *ts, double t);
+  /* time.cfl times the stability limit of the current state (0: no limit). Collective. */
+  int (*cfl_step)(mpm_timescheme *ts, double *h);
+  double (*next_step)(const mpm_timescheme *ts);
+  void (*counts)(const mpm_timescheme *ts, long *steps, long *rhs, long *fails, long *retries);
+  /* The interface record of the step that reached t, reduced over the ranks. Optional: the
+   * coupling's own record of its latest RHS (mpm_coupling_step_record). Collective. */
+  int (*record)(mpm_timescheme *ts, double t, mpm_coupling_record *out);
+} mpm_timescheme_ops;
+
+typedef struct mpm_timescheme_type {
+  const char *name;
+  const char *help;         /* one line for the key's documentation */
+  const mpm_key_spec *keys; /* the scheme's own [coupling] keys (may be NULL) */
+  int nkeys;
+  const mpm_timescheme_ops *ops;
+} mpm_timescheme_type;
+
+struct mpm_timescheme {
+  const mpm_timescheme_type *type;
+  void *content;
+  mpm_grid *grid;
+  mpm_module **mod;
+  int nmod;
+  mpm_coupling *coupling; /* NULL: one phase, or the modules do not interact */
+};
+
+/* The registered types, monolithic first; count in *n. */
+const mpm_timescheme_type *const *mpm_timescheme_types(int *n);
+
+/* coupling.time and every registered scheme's keys. */
+int mpm_timescheme_add_schema(mpm_config *cfg);
+
+/* Build the scheme the case names over these modules and coupling (kept alive by the caller).
+ * A scheme that needs two coupled phases, or a key of a scheme not chosen, is an input error. */
+int mpm_timescheme_new(mpm_timescheme **ts, const mpm_config *cfg, mpm_grid *grid,
+                       mpm_module **modules, int nmodules, mpm_coupling *coupling);
+void mpm_timescheme_destroy(mpm_timescheme **ts);
+
+/* The ops, dispatched (see mpm_timescheme_ops). */
+int mpm_timescheme_start(mpm_timescheme *ts, double t, double h0);
+int mpm_timescheme_step(mpm_timescheme *ts, double tstop, double *t, double *h);
+int mpm_timescheme_resize(mpm_timescheme *ts, double t);
+int mpm_timescheme_cfl_step(mpm_timescheme *ts, double *h);
+double mpm_timescheme_next_step(const mpm_timescheme *ts);
+void mpm_timescheme_counts(const mpm_timescheme *ts, long *steps, long *rhs, long *fails,
+                           long *retries);
+int mpm_timescheme_record(mpm_timescheme *ts, double t, mpm_coupling_record *out);
+
+#endif

@@ -1,0 +1,64 @@
+/* `monolithic`: one ARKODE integrator over the MPIManyVector of every module, one step for all
+ * of them; the joint MPM cycle is its RHS, so the spatial scheme acts inside every stage. The
+ * default, and the reference the partitioned schemes are measured against. */
+#include "mpm_integrator.h"
+#include "mpm_timescheme.h"
+
+static int mono_create(mpm_timescheme *ts, const mpm_config *cfg) {
+  const mpm_cycle cycle = {.grid = ts->grid,
+                           .mod = ts->mod,
+                           .nmod = ts->nmod,
+                           .coupling = ts->coupling,
+                           .mode = MPM_CYCLE_JOINT};
+  mpm_integrator *it = NULL;
+  const int rc = mpm_integrator_new(&it, cfg, &cycle);
+  ts->content = it;
+  return rc;
+}
+
+static void mono_destroy(mpm_timescheme *ts) {
+  mpm_integrator *it = ts->content;
+  mpm_integrator_destroy(&it);
+}
+
+static int mono_start(mpm_timescheme *ts, double t, double h0) {
+  return mpm_integrator_start(ts->content, t, h0);
+}
+
+static int mono_step(mpm_timescheme *ts, double tstop, double *t, double *h) {
+  return mpm_integrator_step(ts->content, tstop, t, h);
+}
+
+static int mono_resize(mpm_timescheme *ts, double t) {
+  return mpm_integrator_resize(ts->content, t);
+}
+
+static int mono_cfl_step(mpm_timescheme *ts, double *h) {
+  return mpm_integrator_cfl_step(ts->content, h);
+}
+
+static double mono_next_step(const mpm_timescheme *ts) {
+  return mpm_integrator_next_step(ts->content);
+}
+
+static void mono_counts(const mpm_timescheme *ts, long *steps, long *rhs, long *fails,
+                        long *retries) {
+  mpm_integrator_counts(ts->content, steps, rhs, fails, retries);
+}
+
+static const mpm_timescheme_ops mono_ops = {
+    .create = mono_create,
+    .destroy = mono_destroy,
+    .start = mono_start,
+    .step = mono_step,
+    .resize = mono_resize,
+    .cfl_step = mono_cfl_step,
+    .next_step = mono_next_step,
+    .counts = mono_counts,
+};
+
+const mpm_timescheme_type timescheme_monolithic = {
+    .name = "monolithic",
+    .help = "one integrator over both modules, one step for both; the default",
+    .ops = &mono_ops,
+};
