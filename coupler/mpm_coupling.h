@@ -113,8 +113,9 @@ int mpm_coupling_after_constrain(mpm_coupling *c, double t, double h, mpm_pass p
  * record like before_solve. */
 int mpm_coupling_apply_load(mpm_coupling *c, double t, double h, const double *const *load);
 
-/* While ifc is set (a held cycle's first pass), every exchange into the solid and every force
- * recorded for it is also added to ifc->capture: what the gas gave the held solid. NULL ends it.
+/* While ifc is set (the first pass of a held or loaded cycle), every exchange into the solid and
+ * every force recorded for it is also added to ifc->capture: what the gas gave the held solid,
+ * or what the load gave the solid. NULL ends it.
  * A no-op for a NULL c. */
 static inline void mpm_coupling_capture(mpm_coupling *c, mpm_interface *ifc) {
   if (c) c->capture = ifc;

@@ -37,7 +37,7 @@ static mpm_module *held(const mpm_cycle *c) {
 static int interact(const mpm_cycle *c, double t, double hs, mpm_pass pass) {
   if (c->mode != MPM_CYCLE_LOADED) return mpm_coupling_after_solve(c->coupling, t, hs, pass);
   if (pass != MPM_PASS_FIRST) return 0;
-  return mpm_coupling_apply_load(c->coupling, t, hs, (const double *const *)c->iface->load);
+  return mpm_coupling_apply_load(c->coupling, t, hs, mpm_interface_load_at(c->iface, t, hs));
 }
 
 /* The grid work between the transfers. The solve takes the step only in the first pass. */
@@ -49,8 +49,10 @@ static int grid_pass(const mpm_cycle *c, double t, double h, mpm_pass pass) {
   mpm_timer_start(MPM_T_GRID);
   for (int k = 0; k < c->nmod; ++k) MPM_CALL(c->mod[k]->ops->forces(c->mod[k], t, h, pass));
   if (hm) mpm_interface_restore(c->iface);
-  if (hm && pass == MPM_PASS_FIRST) mpm_interface_capture_begin(c->iface);
-  mpm_coupling_capture(c->coupling, hm && pass == MPM_PASS_FIRST ? c->iface : NULL);
+  /* Held and loaded first passes capture what the solid is given (mpm_interface.h). */
+  mpm_interface *cap = c->mode != MPM_CYCLE_JOINT && pass == MPM_PASS_FIRST ? c->iface : NULL;
+  if (cap) mpm_interface_capture_begin(cap);
+  mpm_coupling_capture(c->coupling, cap);
   if (hooks) MPM_CALL(mpm_coupling_before_solve(c->coupling, t, hs, pass));
   for (int k = 0; k < c->nmod; ++k) MPM_CALL(mpm_grid_phase_update(c->grid, c->mod[k]->phase, hs));
   if (hm) MPM_CALL(mpm_grid_phase_update(c->grid, hm->phase, hs));

@@ -31,6 +31,7 @@ void mpm_interface_destroy(mpm_interface **ifcp) {
   for (int d = 0; d < MPM_MAX_DIM; ++d) {
     free(ifc->mv[d]), free(ifc->f[d]), free(ifc->normal[d]);
     free(ifc->capture[d]), free(ifc->impulse[d]), free(ifc->load[d]);
+    free(ifc->trend[d]), free(ifc->prev[d]), free(ifc->now[d]);
   }
   free(ifc);
   *ifcp = NULL;
@@ -63,26 +64,45 @@ void mpm_interface_capture_begin(mpm_interface *ifc) {
     memset(ifc->capture[d], 0, sizeof(double) * (size_t)ifc->grid->nnodes);
 }
 
-void mpm_interface_capture_accept(mpm_interface *ifc, double h) {
+void mpm_interface_capture_accept(mpm_interface *ifc, double h, int sign) {
+  const double w = sign * h;
   for (int d = 0; d < ifc->grid->dim; ++d)
-    for (mpm_lidx l = 0; l < ifc->grid->nnodes; ++l) ifc->impulse[d][l] += h * ifc->capture[d][l];
+    for (mpm_lidx l = 0; l < ifc->grid->nnodes; ++l) ifc->impulse[d][l] += w * ifc->capture[d][l];
 }
 
-void mpm_interface_load(mpm_interface *ifc, double H) {
+int mpm_interface_want_trend(mpm_interface *ifc) {
+  const size_t nn = (size_t)ifc->grid->nnodes;
+  for (int d = 0; d < ifc->grid->dim; ++d) {
+    MPM_ALLOC(ifc->trend[d], nn);
+    MPM_ALLOC(ifc->prev[d], nn);
+    MPM_ALLOC(ifc->now[d], nn);
+  }
+  return 0;
+}
+
+void mpm_interface_load(mpm_interface *ifc, double t0, double H, int interpolate) {
   const double inv = H > 0 ? 1.0 / H : 0.0;
-  ifc->span = H;
+  const int trend = interpolate && ifc->trend[0];
+  const double gap = 0.5 * (H + ifc->span_prev);
   for (int d = 0; d < ifc->grid->dim; ++d)
     for (mpm_lidx l = 0; l < ifc->grid->nnodes; ++l) {
-      ifc->load[d][l] = ifc->impulse[d][l] * inv;
-      ifc->impulse[d][l] = 0.0;
+      const double load = ifc->impulse[d][l] * inv;
+      ifc->load[d][l] = load;
+      if (!trend) continue;
+      ifc->trend[d][l] = ifc->span_prev > 0 ? (load - ifc->prev[d][l]) / gap : 0.0;
+      ifc->prev[d][l] = load;
     }
+  ifc->span = H, ifc->t_mid = t0 + 0.5 * H;
+  ifc->span_prev = trend ? H : 0.0;
 }
 
-void mpm_interface_unload(mpm_interface *ifc) {
-  const mpm_grid_phase *ph = &ifc->grid->phase[ifc->phase];
+const double *const *mpm_interface_load_at(mpm_interface *ifc, double t, double h) {
+  if (!ifc->trend[0] || ifc->span_prev <= 0) return (const double *const *)ifc->load;
+  const double s = t + 0.5 * h - ifc->t_mid;
   for (int d = 0; d < ifc->grid->dim; ++d)
     for (mpm_lidx l = 0; l < ifc->grid->nnodes; ++l)
-      if (!(ph->m_i[l] > ph->m_empty)) ifc->impulse[d][l] += ifc->load[d][l] * ifc->span;
+      ifc->now[d][l] = ifc->load[d][l] + s * ifc->trend[d][l];
+  return (const double *const *)ifc->now;
 }
 
 void mpm_interface_owed(const mpm_interface *ifc, const unsigned char *owned, double *J) {

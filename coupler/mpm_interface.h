@@ -14,8 +14,10 @@
  *
  * Load. Before the solid advances over a coupling step H, the owed impulse becomes its load,
  * impulse / H N per node, applied after the solve of every solid RHS over that step
- * (mpm_coupling_apply_load): the solid receives exactly the momentum the gas gave up, so the
- * interface balances over every exchange, to roundoff, whatever the order of the advances.
+ * (mpm_coupling_apply_load) where the solid has mass; what a RHS applied is captured too, and an
+ * accepted solid step takes h capture off the impulse. The solid receives exactly the momentum
+ * the gas gave up, or it stays owed: the interface balances to roundoff, whatever the order of
+ * the advances and the substeps.
  *
  * Only owned nodes matter: a cycle acts on every box node, but the forward halo overwrites the
  * ghosts, and the balance counts owners only. Invariant: the arrays span the grid's box nodes,
@@ -32,7 +34,11 @@ typedef struct mpm_interface {
   double *capture[MPM_MAX_DIM]; /* during a gas RHS: the force into the solid per node, N */
   double *impulse[MPM_MAX_DIM]; /* owed to the solid since its last load, N s per node */
   double *load[MPM_MAX_DIM];    /* the load of the solid's current advance, N per node */
-  double span;                  /* the length of that advance, s */
+  double span, t_mid;           /* the length and the midpoint of that advance, s */
+  double *trend[MPM_MAX_DIM];   /* with interpolation: d load / dt, N/s per node (else NULL) */
+  double *prev[MPM_MAX_DIM];    /* the load of the advance before, and its length */
+  double span_prev;
+  double *now[MPM_MAX_DIM]; /* load + trend (t - t_mid) for one RHS */
 } mpm_interface;
 
 int mpm_interface_new(mpm_interface **ifc, mpm_grid *grid, int phase);
@@ -43,17 +49,25 @@ void mpm_interface_hold(mpm_interface *ifc);
 /* Put them back into the held phase. */
 void mpm_interface_restore(const mpm_interface *ifc);
 
-/* A gas RHS begins: nothing captured yet. */
+/* A gas or solid RHS begins: nothing captured yet. */
 void mpm_interface_capture_begin(mpm_interface *ifc);
-/* A gas step of size h was accepted: its RHS's capture is owed, impulse += h capture. */
-void mpm_interface_capture_accept(mpm_interface *ifc, double h);
+/* A step of size h was accepted. The gas's: what its RHS captured is owed to the solid,
+ * impulse += h capture (sign +1). The solid's: what its RHS delivered of the load (captured on
+ * the nodes where the solid had mass) is owed no more, impulse -= h capture (sign -1). */
+void mpm_interface_capture_accept(mpm_interface *ifc, double h, int sign);
 
-/* The solid is about to advance over H: load = impulse / H, and nothing is owed any more. */
-void mpm_interface_load(mpm_interface *ifc, double H);
-/* The solid has advanced: the load on nodes where its last RHS found no solid mass (the solid
- * moved off them since the load was captured) was not applied, and stays owed. */
-void mpm_interface_unload(mpm_interface *ifc);
+/* Allocate what interpolated loads need (below). */
+int mpm_interface_want_trend(mpm_interface *ifc);
 
+/* The solid is about to advance from t0 over H under load = impulse / H; the impulse stays owed
+ * until the solid's accepted steps deliver it (above), so whatever a step could not deliver (a
+ * node the solid has left) is still owed after the advance. With interpolate, its substeps see
+ * the load's linear trend, the change from the last load over the distance between the two
+ * advances' midpoints: load + trend (t - t_mid), whose mean over equal substeps is the load. */
+void mpm_interface_load(mpm_interface *ifc, double t0, double H, int interpolate);
+/* The load of a solid RHS at t with classic step h (the trend at the step's midpoint; h = 0:
+ * at t). */
+const double *const *mpm_interface_load_at(mpm_interface *ifc, double t, double h);
 /* The momentum owed to the solid on the nodes this rank owns (dim values; the caller reduces):
  * the gas gave it up, the solid has not yet received it. */
 void mpm_interface_owed(const mpm_interface *ifc, const unsigned char *owned, double *J);

@@ -4,10 +4,12 @@
 
 extern const mpm_timescheme_type timescheme_monolithic;
 extern const mpm_timescheme_type timescheme_staggered;
+extern const mpm_timescheme_type timescheme_multirate;
 
 static const mpm_timescheme_type *const g_types[] = {
     &timescheme_monolithic,
     &timescheme_staggered,
+    &timescheme_multirate,
 };
 
 const mpm_timescheme_type *const *mpm_timescheme_types(int *n) {
