@@ -3,6 +3,7 @@
 
 #include "mpm_error.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -110,5 +111,67 @@ void mpm_interface_owed(const mpm_interface *ifc, const unsigned char *owned, do
     J[d] = 0.0;
     for (mpm_lidx l = 0; l < ifc->grid->nnodes; ++l)
       if (owned[l]) J[d] += ifc->impulse[d][l];
+  }
+}
+
+/* ---- checkpoints ---------------------------------------------------------------------------- */
+
+enum { IFC_X, IFC_J, IFC_L, IFC_SPAN, IFC_NFIELDS };
+
+int mpm_interface_particles_new(mpm_particles **p, int dim) {
+  const mpm_field_desc fields[IFC_NFIELDS] = {{"x", dim}, {"v", dim}, {"L", dim}, {"span", 1}};
+  return mpm_particles_new(p, dim, fields, IFC_NFIELDS, 2);
+}
+
+/* Does node l carry state? */
+static int carries(const mpm_interface *ifc, mpm_lidx l) {
+  int any = 0;
+  for (int d = 0; d < ifc->grid->dim; ++d)
+    any |= ifc->impulse[d][l] != 0.0 || (ifc->prev[d] && ifc->prev[d][l] != 0.0);
+  return any;
+}
+
+int mpm_interface_pack(const mpm_interface *ifc, const unsigned char *owned, mpm_particles *p) {
+  const mpm_grid *g = ifc->grid;
+  const int dim = g->dim;
+  mpm_lidx n = 0;
+  for (mpm_lidx l = 0; l < g->nnodes; ++l) n += owned[l] && carries(ifc, l);
+  double *add;
+  const size_t stride = (size_t)p->ncomp;
+  MPM_ALLOC(add, stride * (n ? n : 1));
+  /* add is component-major (mpm_particles_edit): component c of particle k at c n + k. The
+   * position is a quarter cell inside the node's own cell (the last node's: inside the cell
+   * below), so that migration takes it to the rank that owns the node. */
+  mpm_lidx k = 0;
+  for (mpm_lidx l = 0; l < g->nnodes; ++l) {
+    if (!owned[l] || !carries(ifc, l)) continue;
+    mpm_lidx r = l;
+    for (int d = 0; d < dim; ++d) {
+      const int gi = g->box_lo[d] + (int)(r % g->box_n[d]);
+      r /= g->box_n[d];
+      const double inward = gi < g->ncells[d] ? 0.25 : -0.25;
+      add[(size_t)d * n + k] = g->lo[d] + (gi + inward) * g->dx;
+      add[(size_t)(dim + d) * n + k] = ifc->impulse[d][l];
+      add[(size_t)(2 * dim + d) * n + k] = ifc->prev[d] ? ifc->prev[d][l] : 0.0;
+    }
+    add[(size_t)(3 * dim) * n + k++] = ifc->span_prev;
+  }
+  const int rc = mpm_particles_inject(p, g->comm, n, add);
+  free(add);
+  return rc;
+}
+
+void mpm_interface_unpack(mpm_interface *ifc, const mpm_particles *p) {
+  const mpm_grid *g = ifc->grid;
+  for (mpm_lidx i = 0; i < p->n; ++i) {
+    int gi[MPM_MAX_DIM] = {0};
+    for (int d = 0; d < g->dim; ++d)
+      gi[d] = (int)lround((mpm_particles_comp(p, IFC_X, d)[i] - g->lo[d]) / g->dx);
+    const mpm_lidx l = mpm_grid_local_index(g, gi);
+    for (int d = 0; d < g->dim; ++d) {
+      ifc->impulse[d][l] = mpm_particles_comp(p, IFC_J, d)[i];
+      if (ifc->prev[d]) ifc->prev[d][l] = mpm_particles_comp(p, IFC_L, d)[i];
+    }
+    ifc->span_prev = ifc->trend[0] ? mpm_particles_comp(p, IFC_SPAN, 0)[i] : 0.0;
   }
 }

@@ -26,6 +26,7 @@
 #define MPM_INTERFACE_H
 
 #include "mpm_grid.h"
+#include "mpm_particles.h"
 
 typedef struct mpm_interface {
   mpm_grid *grid;
@@ -71,5 +72,20 @@ const double *const *mpm_interface_load_at(mpm_interface *ifc, double t, double 
 /* The momentum owed to the solid on the nodes this rank owns (dim values; the caller reduces):
  * the gas gave it up, the solid has not yet received it. */
 void mpm_interface_owed(const mpm_interface *ifc, const unsigned char *owned, double *J);
+
+/* ---- checkpoints ---------------------------------------------------------------------------
+ * What an interface carries from one coupling step to the next is state: the momentum owed to
+ * the solid and, with interpolated loads, the last load and its span. A checkpoint stores it as
+ * a particle set, one particle per owned node that carries any (x: the node, v: the owed
+ * impulse, L: the last load, span), so that a restart on any number of ranks finds it by
+ * position, after migration, on the node it came from. */
+
+/* An empty set with that layout, and its name in a checkpoint. */
+#define MPM_INTERFACE_PHASE "interface"
+int mpm_interface_particles_new(mpm_particles **p, int dim);
+/* Fill p (from mpm_interface_particles_new) with this rank's owned nodes that carry state. */
+int mpm_interface_pack(const mpm_interface *ifc, const unsigned char *owned, mpm_particles *p);
+/* Put the state of p (migrated to the owners of its nodes) back on the nodes. */
+void mpm_interface_unpack(mpm_interface *ifc, const mpm_particles *p);
 
 #endif

@@ -161,3 +161,26 @@ int mpm_partitioned_record(mpm_timescheme *ts, double t, mpm_coupling_record *ou
   *out = pp->rec;
   return 0;
 }
+
+int mpm_partitioned_save(mpm_timescheme *ts, mpm_particles **p, const char **name) {
+  mpm_partitioned *pp = ts->content;
+  MPM_CALL(mpm_interface_particles_new(p, ts->grid->dim));
+  *name = MPM_INTERFACE_PHASE;
+  return mpm_interface_pack(pp->ifc, ts->coupling->owned, *p);
+}
+
+int mpm_partitioned_restore(mpm_timescheme *ts, mpm_checkpoint *ck) {
+  mpm_partitioned *pp = ts->content;
+  mpm_particles *p = NULL;
+  int rc = mpm_interface_particles_new(&p, ts->grid->dim);
+  if (!rc) rc = mpm_checkpoint_read_particles(ck, MPM_INTERFACE_PHASE, p);
+  if (!rc) rc = mpm_particles_migrate(p, ts->grid, NULL);
+  if (!rc) mpm_interface_unpack(pp->ifc, p);
+  mpm_particles_destroy(&p);
+  MPM_CALL(rc);
+  /* The momentum owed at the checkpoint, as the record of the step that reached it had it. */
+  double owed[MPM_MAX_DIM] = {0};
+  mpm_interface_owed(pp->ifc, ts->coupling->owned, owed);
+  MPM_CALL_MPI(MPI_Allreduce(owed, pp->rec.owed, MPM_MAX_DIM, MPI_DOUBLE, MPI_SUM, ts->grid->comm));
+  return 0;
+}

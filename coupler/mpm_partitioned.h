@@ -61,5 +61,7 @@ double mpm_partitioned_next_step(const mpm_timescheme *ts);
 void mpm_partitioned_counts(const mpm_timescheme *ts, long *steps, long *rhs, long *fails,
                             long *retries);
 int mpm_partitioned_record(mpm_timescheme *ts, double t, mpm_coupling_record *out);
+int mpm_partitioned_save(mpm_timescheme *ts, mpm_particles **p, const char **name);
+int mpm_partitioned_restore(mpm_timescheme *ts, mpm_checkpoint *ck);
 
 #endif

@@ -345,22 +345,28 @@ int mpm_sim_restart(mpm_sim **sp, mpm_config *cfg, const char *path) {
    * run without probes, starts them here). */
   if (!rc) rc = mpm_probes_new(&s->probes, cfg, s->mod, s->nmod);
   if (!rc) mpm_probes_restore(&s->probes, ck);
-  mpm_checkpoint_close(&ck);
+  if (rc) mpm_checkpoint_close(&ck);
   MPM_CALL(rc);
-  if (s->t_end <= s->t * (1 + 1e-14))
+  if (s->t_end <= s->t * (1 + 1e-14)) {
+    mpm_checkpoint_close(&ck);
     return mpm_config_fail(cfg, "time.t_end",
                            "the checkpoint is at t = %.6g, so there is nothing to run until "
                            "t_end = %.6g; restart with time.t_end=<a later time>",
                            s->t, s->t_end);
+  }
   s->step = (long)step;
   /* Outputs continue on the (possibly new) intervals: the next ones after t. Written at t
    * already, so strictly after it. */
   s->out_next = (long)floor(s->t / s->out_interval * (1 + 1e-12)) + 1;
   s->ckpt_next =
       isfinite(s->ckpt_interval) ? (long)floor(s->t / s->ckpt_interval * (1 + 1e-12)) + 1 : 1;
-  for (int k = 0; k < s->nmod; ++k)
-    MPM_CALL(mpm_particles_migrate(s->mod[k]->particles, s->grid, NULL));
-  MPM_CALL(mpm_timescheme_new(&s->it, cfg, s->grid, s->mod, s->nmod, s->coupling));
+  for (int k = 0; !rc && k < s->nmod; ++k)
+    rc = mpm_particles_migrate(s->mod[k]->particles, s->grid, NULL);
+  /* The time scheme's own state (a partitioned scheme's owed momentum) follows the particles. */
+  if (!rc) rc = mpm_timescheme_new(&s->it, cfg, s->grid, s->mod, s->nmod, s->coupling);
+  if (!rc) rc = mpm_timescheme_restore(s->it, ck);
+  mpm_checkpoint_close(&ck);
+  MPM_CALL(rc);
   MPM_CALL(check_budget(s));
   mpm_log(MPM_LOG_INFO, "restarted from %s at t = %.6g, step %ld", path, s->t, s->step);
   return 0;
@@ -407,17 +413,23 @@ static int write_snapshot(mpm_sim *s) {
 }
 
 static int write_checkpoint(mpm_sim *s, const char *path) {
-  const mpm_particles *p[SIM_MAX_MODULES];
+  const mpm_particles *p[SIM_MAX_MODULES + 1];
   MPM_CALL(prepare_output(s));
-  const char *names[SIM_MAX_MODULES];
+  const char *names[SIM_MAX_MODULES + 1];
   for (int k = 0; k < s->nmod; ++k) p[k] = s->mod[k]->particles, names[k] = s->mod[k]->name;
+  /* The time scheme's own state, as one more particle set. */
+  mpm_particles *own = NULL;
+  MPM_CALL(mpm_timescheme_save(s->it, &own, &names[s->nmod]));
+  p[s->nmod] = own;
   enum { NA = 5, MAXA = NA + MPM_PROBE_MAX * (1 + MPM_MAX_DIM) };
   const char *attr[MAXA] = {"t", "step", "h_next", "coupling_work", "run_id"};
   double val[MAXA] = {s->t, (double)s->step, s->h_next, s->coupling_work, s->run_id};
   const int na = NA + mpm_probes_attrs(&s->probes, attr + NA, val + NA, MAXA - NA);
   mpm_timer_start(MPM_T_IO);
-  int rc = mpm_checkpoint_write(s->comm, path, s->config_text, attr, val, na, p, names, s->nmod);
+  int rc = mpm_checkpoint_write(s->comm, path, s->config_text, attr, val, na, p, names,
+                                s->nmod + (own != NULL));
   mpm_timer_stop(MPM_T_IO);
+  mpm_particles_destroy(&own);
   MPM_CALL(rc);
   mpm_log(MPM_LOG_INFO, "checkpoint %s at t = %.6g", path, s->t);
   return 0;
@@ -600,6 +612,11 @@ int mpm_sim_run(mpm_sim *s) {
     s->out_next = 1;
   } else {
     MPM_CALL(total_energy(s, &s->energy));
+  }
+  if (s->coupling) { /* the interface momentum owed at the start (a restarted staggered run) */
+    mpm_coupling_record r;
+    MPM_CALL(mpm_timescheme_record(s->it, s->t, &r));
+    memcpy(s->owed, r.owed, sizeof s->owed);
   }
   double h0;
   MPM_CALL(mpm_timescheme_cfl_step(s->it, &h0));

@@ -105,3 +105,12 @@ int mpm_timescheme_record(mpm_timescheme *ts, double t, mpm_coupling_record *out
   if (ts->type->ops->record) return ts->type->ops->record(ts, t, out);
   return mpm_coupling_step_record(ts->coupling, t, out);
 }
+
+int mpm_timescheme_save(mpm_timescheme *ts, mpm_particles **p, const char **name) {
+  *p = NULL, *name = NULL;
+  return ts->type->ops->save ? ts->type->ops->save(ts, p, name) : 0;
+}
+
+int mpm_timescheme_restore(mpm_timescheme *ts, mpm_checkpoint *ck) {
+  return ts->type->ops->restore ? ts->type->ops->restore(ts, ck) : 0;
+}

@@ -16,6 +16,7 @@
 #include "mpm_config.h"
 #include "mpm_coupling.h"
 #include "mpm_module.h"
+#include "mpm_output.h"
 
 typedef struct mpm_timescheme mpm_timescheme;
 
@@ -36,6 +37,11 @@ typedef struct mpm_timescheme_ops {
   /* The interface record of the step that reached t, reduced over the ranks. Optional: the
    * coupling's own record of its latest RHS (mpm_coupling_step_record). Collective. */
   int (*record)(mpm_timescheme *ts, double t, mpm_coupling_record *out);
+  /* The scheme's own state for a checkpoint, as a particle set to store under *name (the
+   * caller destroys it). Optional: none. Collective. */
+  int (*save)(mpm_timescheme *ts, mpm_particles **p, const char **name);
+  /* Read back what save stored. Optional. Collective. */
+  int (*restore)(mpm_timescheme *ts, mpm_checkpoint *ck);
 } mpm_timescheme_ops;
 
 typedef struct mpm_timescheme_type {
@@ -76,5 +82,8 @@ double mpm_timescheme_next_step(const mpm_timescheme *ts);
 void mpm_timescheme_counts(const mpm_timescheme *ts, long *steps, long *rhs, long *fails,
                            long *retries);
 int mpm_timescheme_record(mpm_timescheme *ts, double t, mpm_coupling_record *out);
+/* *p is NULL for a scheme without state of its own. */
+int mpm_timescheme_save(mpm_timescheme *ts, mpm_particles **p, const char **name);
+int mpm_timescheme_restore(mpm_timescheme *ts, mpm_checkpoint *ck);
 
 #endif

@@ -81,6 +81,8 @@ static const mpm_timescheme_ops stag_ops = {
     .next_step = mpm_partitioned_next_step,
     .counts = mpm_partitioned_counts,
     .record = mpm_partitioned_record,
+    .save = mpm_partitioned_save,
+    .restore = mpm_partitioned_restore,
 };
 
 const mpm_timescheme_type timescheme_staggered = {
