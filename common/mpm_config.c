@@ -1323,6 +1323,20 @@ int mpm_config_set_off_default(const mpm_config *cfg, const mpm_key_spec *sp) {
   return mpm_config_get_string(cfg, sp->key, &v) != 0 || strcmp(v, sp->def) != 0;
 }
 
+void mpm_config_enum_text(char *choices, size_t nchoices, char *help, size_t nhelp,
+                          const char *intro, const char *const *name, const char *const *help_of,
+                          int n) {
+  size_t used = 0, hused = (size_t)snprintf(help, nhelp, "%s", intro);
+  choices[0] = '\0';
+  for (int k = 0; k < n; ++k) {
+    if (used < nchoices)
+      used += (size_t)snprintf(choices + used, nchoices - used, "%s%s", k ? "|" : "", name[k]);
+    if (hused < nhelp)
+      hused += (size_t)snprintf(help + hused, nhelp - hused, " %s (%s)%s", name[k], help_of[k],
+                                k + 1 < n ? ";" : "");
+  }
+}
+
 const char *mpm_config_where(const mpm_config *cfg, const char *key) {
   const entry *e = find_entry(cfg, key);
   return e ? e->where : "default";

@@ -87,6 +87,12 @@ int mpm_config_has(const mpm_config *cfg, const char *key);
  * lists the defaults too, so "set" alone does not say the user chose it.) */
 int mpm_config_set_off_default(const mpm_config *cfg, const mpm_key_spec *spec);
 
+/* The text of an ENUM key over a registry of n implementations (name[k], with help[k]):
+ * choices "a|b|c" and help "intro a (help a); b (help b); ...". Truncated to the buffers. */
+void mpm_config_enum_text(char *choices, size_t nchoices, char *help, size_t nhelp,
+                          const char *intro, const char *const *name, const char *const *help_of,
+                          int n);
+
 /* Instance names used under a prefix, in order of first appearance: for "geometry" and
  * entries geometry.a.type, geometry.b.lo it gives {"a", "b"}. *names is owned by cfg. */
 int mpm_config_instances(const mpm_config *cfg, const char *prefix, const char *const **names,

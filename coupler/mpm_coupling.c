@@ -21,15 +21,11 @@ static mpm_key_spec g_scheme_key[] = {
 int mpm_coupling_add_schema(mpm_config *cfg) {
   int n;
   const mpm_coupling_type *const *types = mpm_coupling_types(&n);
-  size_t used = 0, hused = 0;
-  hused += (size_t)snprintf(g_help, sizeof g_help,
-                            "how the solid and the gas interact where both have mass:");
-  for (int k = 0; k < n; ++k) {
-    used += (size_t)snprintf(g_choices + used, sizeof g_choices - used, "%s%s", k ? "|" : "",
-                             types[k]->name);
-    hused += (size_t)snprintf(g_help + hused, sizeof g_help - hused, " %s (%s)%s", types[k]->name,
-                              types[k]->help, k + 1 < n ? ";" : "");
-  }
+  const char *names[16], *helps[16];
+  for (int k = 0; k < n && k < 16; ++k) names[k] = types[k]->name, helps[k] = types[k]->help;
+  mpm_config_enum_text(g_choices, sizeof g_choices, g_help, sizeof g_help,
+                       "how the solid and the gas interact where both have mass:", names, helps,
+                       n < 16 ? n : 16);
   MPM_CALL(mpm_config_add_schema(cfg, g_scheme_key, 1));
   for (int k = 0; k < n; ++k)
     if (types[k]->nkeys) MPM_CALL(mpm_config_add_schema(cfg, types[k]->keys, types[k]->nkeys));

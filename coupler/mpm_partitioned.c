@@ -91,11 +91,17 @@ static int advance(mpm_timescheme *ts, mpm_integrator *it, mpm_role role, double
                    int n) {
   mpm_partitioned *pp = ts->content;
   mpm_coupling_record *sum = &pp->sum;
-  double t = t0;
+  mpm_module *m = role == MPM_ROLE_SOLID ? pp->solid : pp->gas;
+  double t = t0, h = 0.0;
   for (int k = 1; k <= n; ++k) {
     const double tk = k == n ? t1 : t0 + (t1 - t0) * k / n;
     while (t < tk) {
-      double h;
+      if (t > t0 && ts->between) { /* the step loop's work between two substeps */
+        int changed = 0;
+        MPM_CALL(ts->between(ts->between_ctx, m, t, h, &changed));
+        MPM_CALL_MPI(MPI_Allreduce(MPI_IN_PLACE, &changed, 1, MPI_INT, MPI_LOR, ts->grid->comm));
+        if (changed) MPM_CALL(mpm_integrator_resize(it, t));
+      }
       MPM_CALL(mpm_integrator_step(it, tk, &t, &h));
       mpm_interface_capture_accept(pp->ifc, h, role == MPM_ROLE_FLUID ? 1 : -1);
       mpm_coupling_record r;

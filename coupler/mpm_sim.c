@@ -314,6 +314,8 @@ static int check_budget(mpm_sim *s) {
   return mpm_budget_check(s->cfg, &b);
 }
 
+static int between_substeps(void *ctx, mpm_module *m, double t, double h, int *changed);
+
 int mpm_sim_create(mpm_sim **sp, mpm_config *cfg) {
   MPM_CALL(sim_alloc(sp, cfg));
   mpm_sim *s = *sp;
@@ -322,6 +324,7 @@ int mpm_sim_create(mpm_sim **sp, mpm_config *cfg) {
   s->out_next = 0;
   s->ckpt_next = 1;
   MPM_CALL(mpm_timescheme_new(&s->it, cfg, s->grid, s->mod, s->nmod, s->coupling));
+  s->it->between = between_substeps, s->it->between_ctx = s;
   return check_budget(s);
 }
 
@@ -367,6 +370,7 @@ int mpm_sim_restart(mpm_sim **sp, mpm_config *cfg, const char *path) {
   if (!rc) rc = mpm_timescheme_restore(s->it, ck);
   mpm_checkpoint_close(&ck);
   MPM_CALL(rc);
+  s->it->between = between_substeps, s->it->between_ctx = s;
   MPM_CALL(check_budget(s));
   mpm_log(MPM_LOG_INFO, "restarted from %s at t = %.6g, step %ld", path, s->t, s->step);
   return 0;
@@ -508,6 +512,18 @@ static int diagnostics(mpm_sim *s, double dt) {
   mpm_timer_start(MPM_T_DIAG);
   int rc = diagnostics_row(s, dt);
   mpm_timer_stop(MPM_T_DIAG);
+  return rc;
+}
+
+/* Between two substeps of one module inside a coupling step (mpm_timescheme_between). */
+static int between_substeps(void *ctx, mpm_module *m, double t, double h, int *changed) {
+  mpm_sim *s = ctx;
+  int migrated = 0;
+  mpm_timer_start(MPM_T_MIGRATE);
+  int rc = m->ops->boundary ? m->ops->boundary(m, t, h, changed) : 0;
+  if (!rc) rc = mpm_particles_migrate(m->particles, s->grid, &migrated);
+  mpm_timer_stop(MPM_T_MIGRATE);
+  *changed |= migrated;
   return rc;
 }
 

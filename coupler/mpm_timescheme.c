@@ -18,14 +18,10 @@ static mpm_key_spec g_time_key[] = {
 int mpm_timescheme_add_schema(mpm_config *cfg) {
   int n;
   const mpm_timescheme_type *const *types = mpm_timescheme_types(&n);
-  size_t used = 0, hused = 0;
-  hused += (size_t)snprintf(g_help, sizeof g_help, "how the modules advance in time together:");
-  for (int k = 0; k < n; ++k) {
-    used += (size_t)snprintf(g_choices + used, sizeof g_choices - used, "%s%s", k ? "|" : "",
-                             types[k]->name);
-    hused += (size_t)snprintf(g_help + hused, sizeof g_help - hused, " %s (%s)%s", types[k]->name,
-                              types[k]->help, k + 1 < n ? ";" : "");
-  }
+  const char *names[16], *helps[16];
+  for (int k = 0; k < n && k < 16; ++k) names[k] = types[k]->name, helps[k] = types[k]->help;
+  mpm_config_enum_text(g_choices, sizeof g_choices, g_help, sizeof g_help,
+                       "how the modules advance in time together:", names, helps, n < 16 ? n : 16);
   MPM_CALL(mpm_config_add_schema(cfg, g_time_key, 1));
   for (int k = 0; k < n; ++k)
     if (types[k]->nkeys) MPM_CALL(mpm_config_add_schema(cfg, types[k]->keys, types[k]->nkeys));

@@ -52,13 +52,21 @@ typedef struct mpm_timescheme_type {
   const mpm_timescheme_ops *ops;
 } mpm_timescheme_type;
 
+/* Between the substeps of one module inside a coupling step (multirate): what the step loop
+ * does between steps for that module alone, particles entering and leaving through open faces
+ * and migrating to their owners, so that a module substepping many times keeps its particles in
+ * their boxes. Sets *changed when the module's particle set changed on this rank. */
+typedef int (*mpm_timescheme_between)(void *ctx, mpm_module *m, double t, double h, int *changed);
+
 struct mpm_timescheme {
   const mpm_timescheme_type *type;
   void *content;
   mpm_grid *grid;
   mpm_module **mod;
   int nmod;
-  mpm_coupling *coupling; /* NULL: one phase, or the modules do not interact */
+  mpm_coupling *coupling;         /* NULL: one phase, or the modules do not interact */
+  mpm_timescheme_between between; /* set by the step loop (may be NULL) */
+  void *between_ctx;
 };
 
 /* The registered types, monolithic first; count in *n. */

@@ -45,16 +45,32 @@ static double limit(double h) {
   return h > 0 ? h : HUGE_VAL;
 }
 
+/* The coupling step from the two modules' CFL steps (before the stop time): the slow one's,
+ * or m times the fast one's when coupling.substeps = m is smaller. */
+static double coupling_step(const mpm_partitioned *pp, double h_fast, double h_slow) {
+  const double H = pp->substeps > 0 ? fmin(h_slow, pp->substeps * h_fast) : h_slow;
+  return fmin(H, pp->dt_max);
+}
+
+/* The step loop's CFL step (its run budget and blow-up guard) is the coupling step. */
+static int multirate_cfl_step(mpm_timescheme *ts, double *h) {
+  double hs, hg;
+  MPM_CALL(mpm_partitioned_cfl_steps(ts, &hs, &hg));
+  hs = limit(hs), hg = limit(hg);
+  const double H = coupling_step(ts->content, fmin(hs, hg), fmax(hs, hg));
+  *h = isfinite(H) ? H : 0.0;
+  return 0;
+}
+
 static int multirate_step(mpm_timescheme *ts, double tstop, double *t, double *h) {
   const mpm_partitioned *pp = ts->content;
   double hs, hg;
   MPM_CALL(mpm_partitioned_cfl_steps(ts, &hs, &hg));
   hs = limit(hs), hg = limit(hg);
   const int solid_fast = hs < hg;
-  const double h_fast = fmin(hs, hg), h_slow = fmax(hs, hg);
+  const double h_fast = fmin(hs, hg);
   const double t0 = *t, rest = tstop - t0;
-  double H = pp->substeps > 0 ? fmin(h_slow, pp->substeps * h_fast) : h_slow;
-  H = fmin(fmin(H, pp->dt_max), rest);
+  const double H = fmin(coupling_step(pp, h_fast, fmax(hs, hg)), rest);
   int m = pp->substeps;
   if (m == 0) m = isfinite(h_fast) ? (int)fmax(1.0, ceil(H / h_fast * (1 - 1e-12))) : 1;
   const double t1 = H < rest ? t0 + H : tstop;
@@ -72,7 +88,7 @@ static const mpm_timescheme_ops multirate_ops = {
     .start = mpm_partitioned_start,
     .step = multirate_step,
     .resize = mpm_partitioned_resize,
-    .cfl_step = mpm_partitioned_cfl_step,
+    .cfl_step = multirate_cfl_step,
     .next_step = mpm_partitioned_next_step,
     .counts = mpm_partitioned_counts,
     .record = mpm_partitioned_record,

@@ -1,0 +1,275 @@
+"""Coupling-scheme ablation: one case under every combination of spatial scheme x temporal
+scheme x time method, at several coupling steps, against a fine monolithic reference.
+
+    /usr/bin/python3 bench/ablate.py CASE [options] [key=value ...]
+
+For each spatial scheme a reference run (monolithic, usl, time.cfl = --ref-cfl) gives the
+quantity's history; every other run's coupling error is the largest and the RMS difference of
+its history from the reference's (interpolated to the reference's times). The quantity is a
+probe column of probes.csv (--quantity, default the first probe's x displacement). Each run
+records its wall time, steps and RHS evaluations, the interface energy the coupling created
+(W_net, J, and relative to the case's --energy-scale if given), the largest interface momentum
+imbalance, and whether it stayed stable (exit 0, no blow-up) or failed, with the message.
+
+Combinations: temporal `monolithic` with usl, musl and bs32; `staggered` with coupling.order =
+solid_first, gas_first, parallel and `multirate` with coupling.load = held, interpolated, each
+with usl and musl (the partitioned schemes take the classic update only); `contact` with the
+classic update only (its own restriction). Coupling steps: time.cfl in --cfl.
+
+Results go to --out (default bench/results/ablate_<case>; the runs' own output to
+out/ablate/<case>/): runs.csv (one row per run, written as
+each run ends: an interrupted sweep resumes without redoing finished runs; delete a row to redo
+it), ablation.md (the table and the findings' figures), and plots: error against wall time,
+and the interface energy against the coupling step. --ranks 2 runs every run on 2 ranks. The
+sweep prints progress and its own wall time.
+"""
+import argparse
+import csv
+import json
+import math
+import os
+import subprocess
+import sys
+import time
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
+from benchrun import ENV, ROOT  # noqa: E402
+
+FIELDS = ["name", "spatial", "temporal", "variant", "method", "cfl", "status", "wall_s",
+          "steps", "rhs_evals", "err_max", "err_rms", "err_rel", "W_net", "W_rel",
+          "imbalance", "message"]
+VARIANTS = [("monolithic", "", []),
+            ("staggered", "solid_first", ["coupling.order=solid_first"]),
+            ("staggered", "gas_first", ["coupling.order=gas_first"]),
+            ("staggered", "parallel", ["coupling.order=parallel"]),
+            ("multirate", "held", ["coupling.load=held"]),
+            ("multirate", "interpolated", ["coupling.load=interpolated"])]
+
+
+def parse():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("case")
+    ap.add_argument("overrides", nargs="*", help="key=value for every run")
+    ap.add_argument("--spatial", nargs="+", default=["velocity", "contact", "traction"])
+    ap.add_argument("--temporal", nargs="+", default=["monolithic", "staggered", "multirate"])
+    ap.add_argument("--methods", nargs="+", default=["usl", "musl", "bs32"])
+    ap.add_argument("--cfl", nargs="+", type=float, default=[0.4, 0.2, 0.1])
+    ap.add_argument("--ref-cfl", type=float, default=0.05)
+    ap.add_argument("--quantity", default=None, help="probes.csv column (default: the first "
+                    "probe's x displacement)")
+    ap.add_argument("--energy-scale", type=float, default=None,
+                    help="J: report W_net relative to it")
+    ap.add_argument("--ranks", type=int, default=1)
+    ap.add_argument("--timeout", type=float, default=1800, help="s per run")
+    ap.add_argument("--out", default=None)
+    ap.add_argument("--binary", default=os.path.join(ROOT, "build", "app", "mpmfsi"))
+    ap.add_argument("--sweep-s", type=float, default=None,
+                    help="with every run already in runs.csv: the sweep's wall time to report")
+    return ap.parse_args()
+
+
+def run(args, out, extra):
+    """Run one case; returns (status, message, summary or None)."""
+    cmd = [args.binary, "run", args.case, f"output.dir={out}", "output.overwrite=true",
+           "output.interval=1e9"] + args.overrides + extra
+    if args.ranks > 1:
+        cmd = ["mpiexec", "-n", str(args.ranks)] + cmd
+    try:
+        p = subprocess.run(cmd, env=ENV, capture_output=True, text=True, timeout=args.timeout)
+    except subprocess.TimeoutExpired:
+        return "timeout", f"stopped after {args.timeout:.0f} s", None
+    if p.returncode == 2:
+        line = next((x for x in p.stderr.splitlines() if "error" in x), p.stderr.strip()[-200:])
+        return "not offered", line.split("error: ")[-1][:200], None
+    if p.returncode != 0:
+        line = next((x for x in p.stderr.splitlines() if "error" in x), "")
+        return "unstable", line.split("error: ")[-1][:200], None
+    with open(os.path.join(out, "summary.json")) as f:
+        return "ok", "", json.load(f)
+
+
+def history(out, quantity):
+    with open(os.path.join(out, "probes.csv")) as f:
+        rows = list(csv.DictReader(f))
+    if not rows:
+        raise SystemExit(f"{out}/probes.csv is empty: the case needs a [probe.NAME]")
+    col = quantity or [k for k in rows[0] if k != "t"][0]
+    if col not in rows[0]:
+        raise SystemExit(f"no column '{col}' in probes.csv; columns: {', '.join(rows[0])}")
+    return col, np.array([float(r["t"]) for r in rows]), np.array([float(r[col]) for r in rows])
+
+
+def combos(args):
+    for spatial in args.spatial:
+        for temporal, variant, keys in VARIANTS:
+            if temporal not in args.temporal:
+                continue
+            for method in args.methods:
+                classic = method in ("usl", "musl")
+                if (temporal != "monolithic" or spatial == "contact") and not classic:
+                    continue
+                for cfl in args.cfl:
+                    name = f"{spatial}-{temporal}{'-' + variant if variant else ''}-{method}-{cfl:g}"
+                    extra = [f"coupling.scheme={spatial}", f"coupling.time={temporal}",
+                             f"time.method={method}", f"time.cfl={cfl}"] + keys
+                    yield name, spatial, temporal, variant, method, cfl, extra
+
+
+def load_rows(path):
+    if not os.path.exists(path):
+        return {}
+    with open(path) as f:
+        return {r["name"]: r for r in csv.DictReader(f)}
+
+
+def append_row(path, row):
+    new = not os.path.exists(path)
+    with open(path, "a", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=FIELDS)
+        if new:
+            w.writeheader()
+        w.writerow(row)
+
+
+def fmt(x, spec=".3g"):
+    try:
+        v = float(x)
+    except (TypeError, ValueError):
+        return str(x)
+    return "" if math.isnan(v) else format(v, spec)
+
+
+def report(args, rows, outdir, col, sweep_s, nruns):
+    ok = [r for r in rows if r["status"] == "ok"]
+    lines = [f"# Coupling ablation: {os.path.basename(args.case)}", "",
+             f"Quantity: `{col}` (probes.csv); error against a monolithic usl run at time.cfl = "
+             f"{args.ref_cfl:g} with the same spatial scheme; {args.ranks} rank(s); overrides: "
+             f"{' '.join(args.overrides) or 'none'}. Sweep wall time {sweep_s:.0f} s for {nruns} "
+             f"runs made here ({sweep_s / max(nruns, 1):.1f} s each).", "",
+             "| run | status | wall (s) | steps | RHS | error max | error RMS | error / max | "
+             "W_net (J) | W_net rel. | imbalance |",
+             "|---|---|---|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        lines.append(f"| {r['name']} | {r['status']} | {fmt(r['wall_s'], '.2f')} | {r['steps']} | "
+                     f"{r['rhs_evals']} | {fmt(r['err_max'])} | {fmt(r['err_rms'])} | "
+                     f"{fmt(r['err_rel'])} | {fmt(r['W_net'])} | {fmt(r['W_rel'])} | "
+                     f"{fmt(r['imbalance'], '.1e')} |")
+    bad = [r for r in rows if r["status"] != "ok"]
+    lines += ["", "Not stable or not offered:" if bad else "Every combination ran stably."]
+    lines += [f"- {r['name']}: {r['status']}: {r['message']}" for r in bad]
+    if ok:
+        best = {}
+        for r in ok:
+            key = (r["spatial"], r["cfl"])
+            if key not in best or float(r["err_max"]) < float(best[key]["err_max"]):
+                best[key] = r
+        lines += ["", "Least error at each coupling step:"]
+        lines += [f"- {k[0]}, cfl {k[1]}: {v['name']} ({fmt(v['err_max'])} in "
+                  f"{fmt(v['wall_s'], '.2f')} s)" for k, v in sorted(best.items())]
+    with open(os.path.join(outdir, "ablation.md"), "w") as f:
+        f.write("\n".join(lines) + "\n")
+    plot(ok, outdir, col)
+
+
+def plot(rows, outdir, col):
+    """Error against wall time and |W_net| against the coupling step: colour = temporal scheme
+    and variant, marker = spatial scheme, line = time method."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.lines import Line2D
+    variants = sorted({(r["temporal"], r["variant"]) for r in rows})
+    colour = {v: plt.cm.tab10(k % 10) for k, v in enumerate(variants)}
+    marker = {"velocity": "o", "contact": "s", "traction": "^"}
+    line = {"usl": "-", "musl": "--", "bs32": ":"}
+    fig, ax = plt.subplots(1, 2, figsize=(13, 5.5))
+    groups = {}
+    for r in rows:
+        groups.setdefault((r["spatial"], r["temporal"], r["variant"], r["method"]), []).append(r)
+    for (spatial, temporal, variant, method), rs in groups.items():
+        rs.sort(key=lambda r: float(r["cfl"]))
+        style = dict(color=colour[(temporal, variant)], marker=marker.get(spatial, "x"),
+                     ls=line.get(method, "-."), ms=5, lw=1)
+        ax[0].loglog([float(r["wall_s"]) for r in rs],
+                     [max(float(r["err_max"]), 1e-300) for r in rs], **style)
+        ax[1].loglog([float(r["cfl"]) for r in rs],
+                     [max(abs(float(r["W_net"])), 1e-300) for r in rs], **style)
+    ax[0].set_xlabel("wall time (s)")
+    ax[0].set_ylabel(f"max |{col} - reference|")
+    ax[0].set_title("coupling error against cost (points: time.cfl)")
+    ax[1].set_xlabel("time.cfl (coupling step)")
+    ax[1].set_ylabel("|W_net|: energy the coupling created or destroyed (J)")
+    ax[1].set_title("interface energy")
+    handles = [Line2D([], [], color=colour[v], lw=3, label=" ".join(x for x in v if x))
+               for v in variants]
+    handles += [Line2D([], [], color="k", marker=m, ls="", label=k) for k, m in marker.items()]
+    handles += [Line2D([], [], color="k", ls=l, label=k) for k, l in line.items()]
+    ax[1].legend(handles=handles, fontsize=7, ncol=2)
+    fig.tight_layout()
+    fig.savefig(os.path.join(outdir, "ablation.png"), dpi=110)
+
+
+def main():
+    args = parse()
+    args.case = os.path.abspath(args.case)
+    name = os.path.splitext(os.path.basename(args.case))[0]
+    outdir = os.path.abspath(args.out or os.path.join(HERE, "results", f"ablate_{name}"))
+    scratch = os.path.join(ROOT, "out", "ablate", name)  # the runs' own output, not committed
+    os.makedirs(scratch, exist_ok=True)
+    os.makedirs(outdir, exist_ok=True)
+    table = os.path.join(outdir, "runs.csv")
+    done = load_rows(table)
+    refs = {}
+    for spatial in args.spatial:
+        out = os.path.join(scratch, f"reference-{spatial}")
+        status, msg, _ = ("ok", "", None)
+        if not os.path.exists(os.path.join(out, "summary.json")):
+            print(f"reference for {spatial} (monolithic usl, cfl {args.ref_cfl:g}) ...", flush=True)
+            status, msg, _ = run(args, out, [f"coupling.scheme={spatial}", "time.method=usl",
+                                            f"time.cfl={args.ref_cfl}"])
+        if status != "ok":
+            print(f"  reference for {spatial} failed ({status}: {msg}); its runs are skipped")
+            continue
+        refs[spatial] = history(out, args.quantity)
+    todo = [c for c in combos(args) if c[1] in refs]
+    t0, made = time.time(), 0
+    for k, (rname, spatial, temporal, variant, method, cfl, extra) in enumerate(todo, 1):
+        if rname in done:
+            continue
+        out = os.path.join(scratch, rname)
+        t_run = time.time()
+        status, msg, s = run(args, out, extra)
+        made += 1
+        row = dict(name=rname, spatial=spatial, temporal=temporal, variant=variant, method=method,
+                   cfl=cfl, status=status, message=msg, wall_s="", steps="", rhs_evals="",
+                   err_max="", err_rms="", err_rel="", W_net="", W_rel="", imbalance="")
+        if s:
+            col, tr, ur = refs[spatial]
+            _, t, u = history(out, col)
+            diff = np.interp(tr, t, u) - ur
+            scale = max(float(np.max(np.abs(ur))), 1e-300)
+            row.update(wall_s=s["wall_s"], steps=s["steps"], rhs_evals=s["rhs_evals"],
+                       err_max=float(np.max(np.abs(diff))),
+                       err_rms=float(np.sqrt(np.mean(diff**2))),
+                       err_rel=float(np.max(np.abs(diff))) / scale, W_net=s["coupling_work"],
+                       W_rel=(s["coupling_work"] / args.energy_scale if args.energy_scale
+                              else ""), imbalance=s["coupling_imbalance"])
+        append_row(table, row)
+        done[rname] = row
+        elapsed = time.time() - t0
+        eta = elapsed / made * sum(1 for c in todo[k:] if c[0] not in done)
+        err = f", error {row['err_max']:.3g}" if s else ""
+        print(f"[{k}/{len(todo)}] {rname}: {status} in {time.time() - t_run:.1f} s{err} "
+              f"(sweep {elapsed:.0f} s, ETA {eta:.0f} s)", flush=True)
+    rows = [done[c[0]] for c in todo if c[0] in done]
+    col = refs[next(iter(refs))][0] if refs else "?"
+    sweep = time.time() - t0 if made or args.sweep_s is None else args.sweep_s
+    report(args, rows, outdir, col, sweep, made or len(rows))
+    print(f"wrote {table}, {outdir}/ablation.md, {outdir}/ablation.png")
+
+
+if __name__ == "__main__":
+    main()
