@@ -17,7 +17,9 @@
 # test_stability (their materials, kernels, halos and wraps: test_materials, test_j2,
 # test_kernels_*, test_halo_np*, test_periodic_*, test_ballistic, test_rigid, test_traction)
 # and the gas tubes test_sod and test_strong_shock (the same gas path as test_gas_output,
-# test_gas_conservation and test_gas_boundaries).
+# test_gas_conservation and test_gas_boundaries). The temporal-coupling studies test_piperno_farhat
+# and test_timeschemes (1-2 minutes each in the plain pass) run there as test_timeschemes_quick:
+# every temporal scheme's held, loaded and joint cycles, checkpoint and restart, on 1 and 2 ranks.
 # The code they run is the open faces', the obstacles', the gas module's and the coupler's, which
 # test_gas_boundaries, test_obstacles, test_sod, test_coupling, test_coupling_ranks and
 # test_coupling_rigid run under the sanitizers. Idempotent.
@@ -27,5 +29,5 @@ bash "$src/tools/setup.sh" "$src/build"
 (cd "$src/build" && ctest -LE "long|benchmark" --output-on-failure -j 2 --timeout 900)
 bash "$src/tools/setup.sh" "$src/build-asan" -DMPMFSI_SANITIZE=ON -DCMAKE_BUILD_TYPE=Debug
 (cd "$src/build-asan" &&
-  ctest -LE "long|benchmark" -E "^test_(wedge|forward_step|fsi_waves|decomposition|supersonic_bar|supersonic_bar_standoff|supersonic_bar_twin|near_vacuum_order|restart_cases|csm1|csm3_fast|axial_bar|cantilever3d|model_swap|ranks_solid|periodic|stability|sod|strong_shock)$" \
+  ctest -LE "long|benchmark" -E "^test_(wedge|forward_step|fsi_waves|decomposition|supersonic_bar|supersonic_bar_standoff|supersonic_bar_twin|near_vacuum_order|restart_cases|csm1|csm3_fast|axial_bar|cantilever3d|model_swap|ranks_solid|periodic|stability|sod|strong_shock|piperno_farhat|timeschemes)$" \
     --output-on-failure -j 2 --timeout 1800)

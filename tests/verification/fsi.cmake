@@ -15,3 +15,6 @@ mpm_add_script_test(test_piperno_farhat SCRIPT verification/test_piperno_farhat.
 # reference, the momentum balance, bitwise restart of every temporal scheme, 2 ranks against 1.
 mpm_add_script_test(test_timeschemes SCRIPT verification/test_timeschemes.py
                     LABELS "verification;mpi" TIMEOUT 900)
+# Its restart checks alone, short (the sanitizer pass runs this one, not the whole study).
+mpm_add_script_test(test_timeschemes_quick SCRIPT verification/test_timeschemes.py ARGS quick
+                    LABELS "verification;mpi" TIMEOUT 600)

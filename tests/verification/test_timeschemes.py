@@ -22,6 +22,9 @@ probe at its middle (probes.csv, every step).
    multirate (held and interpolated) and monolithic, run to 0.6 with a checkpoint at 0.3 and
    restarted from it on 1 rank: the last snapshots equal to the bit, and the restarted run's
    momentum balance still closes (the owed momentum is in the checkpoint).
+`quick` (the argument; for the sanitizer pass): check 4 alone, to t = 0.06 with the checkpoint at
+0.03, and on 2 ranks the restarts of staggered solid_first and multirate.
+
 5. multirate on 2 ranks gives 1 rank's result: positions and velocities by id, differing by no
    more than 10 times what a 1e-15 relative change of the slab's initial velocity does on 1 rank
    (fixed steps: roundoff in the reductions only, which the stiff slab amplifies as it amplifies
@@ -38,7 +41,8 @@ import numpy as np
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "tools"))
 import mpmtest as mt  # noqa: E402
 
-check = mt.Checks("test_timeschemes")
+QUICK = sys.argv[1:] == ["quick"]
+check = mt.Checks("test_timeschemes_quick" if QUICK else "test_timeschemes")
 CASE = mt.case("fsi_piston.ini")
 STIFF = ["solid.slab.E=5200", "time.t_end=1.5"]
 
@@ -81,50 +85,55 @@ def largest_difference(a, b, fields=None):
 
 balances = []
 
-# 1. substeps = 1 is the monolithic step.
-mono = run("ts_mono", STIFF)
-one = run("ts_multirate_1", STIFF + ["coupling.time=multirate", "coupling.substeps=1"])
-worst = 0.0
-for key in ("dt", "px", "kinetic", "internal", "total"):
-    x = np.array([float(r[key]) for r in rows(mono)])
-    y = np.array([float(r[key]) for r in rows(one)])
-    worst = max(worst, float(np.max(np.abs(x - y)) / np.max(np.abs(x))))
-check(len(rows(mono)) == len(rows(one)) and worst < 1e-12,
-      f"multirate, substeps = 1, against monolithic over {len(rows(one)) - 1} steps: largest "
-      f"difference {worst:.1e} (tolerance 1e-12)")
-balances.append(summary(one)["coupling_imbalance"])
 
-# 2. The coupling error against a fine monolithic reference.
-ref = run("ts_reference", STIFF + ["time.cfl=0.05"])
-t_ref, u_ref = displacement(ref)
-amplitude = float(np.max(np.abs(u_ref)))
-CFLS = (0.4, 0.2, 0.1)
-errors = {}
-for label, args in (("monolithic", []),
-                    ("multirate held", ["coupling.time=multirate"]),
-                    ("multirate interpolated", ["coupling.time=multirate",
-                                                "coupling.load=interpolated"])):
-    errors[label] = []
-    for cfl in CFLS:
-        out = run(f"ts_{label.replace(' ', '_')}_{cfl}", STIFF + args + [f"time.cfl={cfl}"])
-        t, u = displacement(out)
-        err = float(np.max(np.abs(np.interp(t_ref, t, u) - u_ref)))
-        errors[label].append(err)
-        if label != "monolithic":
-            balances.append(summary(out)["coupling_imbalance"])
-        print(f"{label}, cfl {cfl}: displacement error {err:.3e} ({err / amplitude:.2%} of the "
-              f"amplitude {amplitude:.3e}); {mt.cost(out)}, {summary(out)['rhs_evals']} RHS")
-e = errors["multirate held"]
-orders = [math.log(e[k] / e[k + 1]) / math.log(2) for k in range(len(e) - 1)]
-overall = math.log(e[0] / e[-1]) / math.log(CFLS[0] / CFLS[-1])
-check(all(o > 0 for o in orders) and overall >= 0.7,
-      f"multirate (held): error {', '.join(f'{x:.3e}' for x in e)} at cfl "
-      f"{', '.join(map(str, CFLS))}: orders {', '.join(f'{o:.2f}' for o in orders)}, overall "
-      f"{overall:.2f} (predicted 1; at least 0.7)")
+def consistency_and_convergence():
 
-# 3. Momentum balance.
-check(max(balances) < 1e-9, f"partitioned runs: interface momentum imbalance at most "
-      f"{max(balances):.1e} of the interface force (tolerance 1e-9)")
+    # 1. substeps = 1 is the monolithic step.
+    mono = run("ts_mono", STIFF)
+    one = run("ts_multirate_1", STIFF + ["coupling.time=multirate", "coupling.substeps=1"])
+    worst = 0.0
+    for key in ("dt", "px", "kinetic", "internal", "total"):
+        x = np.array([float(r[key]) for r in rows(mono)])
+        y = np.array([float(r[key]) for r in rows(one)])
+        worst = max(worst, float(np.max(np.abs(x - y)) / np.max(np.abs(x))))
+    check(len(rows(mono)) == len(rows(one)) and worst < 1e-12,
+          f"multirate, substeps = 1, against monolithic over {len(rows(one)) - 1} steps: largest "
+          f"difference {worst:.1e} (tolerance 1e-12)")
+    balances.append(summary(one)["coupling_imbalance"])
+
+    # 2. The coupling error against a fine monolithic reference.
+    ref = run("ts_reference", STIFF + ["time.cfl=0.05"])
+    t_ref, u_ref = displacement(ref)
+    amplitude = float(np.max(np.abs(u_ref)))
+    CFLS = (0.4, 0.2, 0.1)
+    errors = {}
+    for label, args in (("monolithic", []),
+                        ("multirate held", ["coupling.time=multirate"]),
+                        ("multirate interpolated", ["coupling.time=multirate",
+                                                    "coupling.load=interpolated"])):
+        errors[label] = []
+        for cfl in CFLS:
+            out = run(f"ts_{label.replace(' ', '_')}_{cfl}", STIFF + args + [f"time.cfl={cfl}"])
+            t, u = displacement(out)
+            err = float(np.max(np.abs(np.interp(t_ref, t, u) - u_ref)))
+            errors[label].append(err)
+            if label != "monolithic":
+                balances.append(summary(out)["coupling_imbalance"])
+            print(f"{label}, cfl {cfl}: displacement error {err:.3e} ({err / amplitude:.2%} of the "
+                  f"amplitude {amplitude:.3e}); {mt.cost(out)}, {summary(out)['rhs_evals']} RHS")
+    e = errors["multirate held"]
+    orders = [math.log(e[k] / e[k + 1]) / math.log(2) for k in range(len(e) - 1)]
+    overall = math.log(e[0] / e[-1]) / math.log(CFLS[0] / CFLS[-1])
+    check(all(o > 0 for o in orders) and overall >= 0.7,
+          f"multirate (held): error {', '.join(f'{x:.3e}' for x in e)} at cfl "
+          f"{', '.join(map(str, CFLS))}: orders {', '.join(f'{o:.2f}' for o in orders)}, overall "
+          f"{overall:.2f} (predicted 1; at least 0.7)")
+
+    # 3. Momentum balance.
+    check(max(balances) < 1e-9, f"partitioned runs: interface momentum imbalance at most "
+          f"{max(balances):.1e} of the interface force (tolerance 1e-9)")
+
+
 
 # 4. Restart, every temporal scheme.
 SCHEMES = [("monolithic", ["coupling.time=monolithic"]),
@@ -134,16 +143,30 @@ SCHEMES = [("monolithic", ["coupling.time=monolithic"]),
            ("multirate held", ["coupling.time=multirate", "solid.slab.E=5200"]),
            ("multirate interpolated", ["coupling.time=multirate", "coupling.load=interpolated",
                                        "solid.slab.E=5200"])]
-for label, args in SCHEMES:
-    name = label.replace(" ", "_")
-    full = run(f"ts_restart_{name}", args + ["time.t_end=0.6", "output.interval=0.3",
-                                             "output.checkpoint_interval=0.3"])
-    again = mt.outdir(f"ts_restarted_{name}")
-    mt.run(["restart", os.path.join(full, "checkpoint_000001.h5"), f"output.dir={again}"])
-    d = largest_difference(final_particles(full), final_particles(again))
-    imb = summary(again)["coupling_imbalance"]
-    check(d == 0 and imb < 1e-9, f"{label}: restarted from t = 0.3, the state at 0.6 differs by "
-          f"{d:.1e} (tolerance 0: bitwise); momentum imbalance after the restart {imb:.1e}")
+
+
+def restarts(t_half, ranks, schemes):
+    for label, args in schemes:
+        name = label.replace(" ", "_")
+        full = run(f"ts_restart_{name}_np{ranks}", args + [
+            f"time.t_end={2 * t_half}", f"output.interval={t_half}",
+            f"output.checkpoint_interval={t_half}"], ranks=ranks)
+        again = mt.outdir(f"ts_restarted_{name}_np{ranks}")
+        mt.run(["restart", os.path.join(full, "checkpoint_000001.h5"), f"output.dir={again}"],
+               ranks=ranks)
+        d = largest_difference(final_particles(full), final_particles(again))
+        imb = summary(again)["coupling_imbalance"]
+        check(d == 0 and imb < 1e-9, f"{label} on {ranks} rank(s): restarted from t = {t_half}, "
+              f"the state at {2 * t_half} differs by {d:.1e} (tolerance 0: bitwise); momentum "
+              f"imbalance after the restart {imb:.1e}")
+
+
+if QUICK:
+    restarts(0.03, 1, SCHEMES)
+    restarts(0.03, 2, [SCHEMES[1], SCHEMES[5]])
+    sys.exit(check.finish())
+consistency_and_convergence()
+restarts(0.3, 1, SCHEMES)
 
 # 5. 2 ranks against 1, against what a 1e-15 change of the input does on 1 rank.
 args = ["solid.slab.E=5200", "coupling.time=multirate", "time.t_end=0.5"]
