@@ -211,6 +211,9 @@ COUPLING_CASES = [
      "key of the staggered time scheme"),
     ("unknown staggered order", FSI, "time = staggered\norder = fluid_first", "coupling.order",
      "gas_first"),
+    ("no substeps", FSI, "time = multirate\nsubsteps = 0", "coupling.substeps", ">= 1"),
+    ("substeps with another time scheme", FSI, "time = staggered\nsubsteps = 4",
+     "coupling.substeps", "key of the multirate time scheme"),
 ]
 for name, base, body, key, words in COUPLING_CASES:
     text = base.rstrip("\n") + "\n\n[coupling]\n" + body + "\n"
