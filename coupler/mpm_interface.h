@@ -1,5 +1,5 @@
-/* The interface data of a partitioned (staggered) time scheme: what the gas knows of the solid,
- * and the solid of the gas, between their exchanges. The gas always advances against a held
+/* The interface data of a partitioned time scheme (staggered, multirate): what the gas knows of the
+ * solid, and the solid of the gas, between their exchanges. The gas always advances against a held
  * solid; the solid always advances under the load the gas left it.
  *
  * Held fields. Before the gas advances, the solid is deposited (P2G, reverse halo, forces:
@@ -32,7 +32,7 @@ typedef struct mpm_interface {
   mpm_grid *grid;
   int phase; /* the held phase (the solid's) */
   double *m, *mv[MPM_MAX_DIM], *f[MPM_MAX_DIM], *normal[MPM_MAX_DIM]; /* held nodal fields */
-  double *capture[MPM_MAX_DIM]; /* during a gas RHS: the force into the solid per node, N */
+  double *capture[MPM_MAX_DIM]; /* during a held or loaded RHS: the force into the solid, N */
   double *impulse[MPM_MAX_DIM]; /* owed to the solid since its last load, N s per node */
   double *load[MPM_MAX_DIM];    /* the load of the solid's current advance, N per node */
   double span, t_mid;           /* the length and the midpoint of that advance, s */
