@@ -103,7 +103,8 @@ static mpm_particles *make_set(const set_spec *s, int r) {
 /* Field names point at the spec's literals, so only the blocks are freed. */
 static void free_set(mpm_particles **p) {
   if (!*p) return;
-  free((*p)->id), free((*p)->data), free(*p);
+  /* A read keeps the block it replaced as the set's spare (mpm_particles.h). */
+  free((*p)->id), free((*p)->data), free((*p)->spare_id), free((*p)->spare_data), free(*p);
   *p = NULL;
 }
 
