@@ -66,6 +66,8 @@ def parse():
     ap.add_argument("--timeout", type=float, default=1800, help="s per run")
     ap.add_argument("--out", default=None)
     ap.add_argument("--binary", default=os.path.join(ROOT, "build", "app", "mpmfsi"))
+    ap.add_argument("--report-only", action="store_true",
+                    help="make no run: write the table and plot from runs.csv as it stands")
     ap.add_argument("--sweep-s", type=float, default=None,
                     help="with every run already in runs.csv: the sweep's wall time to report")
     return ap.parse_args()
@@ -226,6 +228,8 @@ def main():
     for spatial in args.spatial:
         out = os.path.join(scratch, f"reference-{spatial}")
         status, msg, _ = ("ok", "", None)
+        if args.report_only and not os.path.exists(os.path.join(out, "summary.json")):
+            continue
         if not os.path.exists(os.path.join(out, "summary.json")):
             print(f"reference for {spatial} (monolithic usl, cfl {args.ref_cfl:g}) ...", flush=True)
             status, msg, _ = run(args, out, [f"coupling.scheme={spatial}", "time.method=usl",
@@ -237,7 +241,7 @@ def main():
     todo = [c for c in combos(args) if c[1] in refs]
     t0, made = time.time(), 0
     for k, (rname, spatial, temporal, variant, method, cfl, extra) in enumerate(todo, 1):
-        if rname in done:
+        if rname in done or args.report_only:
             continue
         out = os.path.join(scratch, rname)
         t_run = time.time()
@@ -265,9 +269,16 @@ def main():
         print(f"[{k}/{len(todo)}] {rname}: {status} in {time.time() - t_run:.1f} s{err} "
               f"(sweep {elapsed:.0f} s, ETA {eta:.0f} s)", flush=True)
     rows = [done[c[0]] for c in todo if c[0] in done]
+    if len(rows) < len(todo):
+        print(f"{len(todo) - len(rows)} of {len(todo)} runs not made yet: the table is partial")
     col = refs[next(iter(refs))][0] if refs else "?"
     sweep = time.time() - t0 if made or args.sweep_s is None else args.sweep_s
     report(args, rows, outdir, col, sweep, made or len(rows))
+    if len(rows) < len(todo):
+        with open(os.path.join(outdir, "ablation.md"), "a") as f:
+            missing = [c[0] for c in todo if c[0] not in done]
+            f.write(f"\n**Partial**: {len(missing)} of {len(todo)} runs not made yet "
+                    f"({missing[0]} ... {missing[-1]}); run the same command again to finish.\n")
     print(f"wrote {table}, {outdir}/ablation.md, {outdir}/ablation.png")
 
 
