@@ -102,7 +102,7 @@ static int write_phase_attrs(const mpm_h5 *h, hid_t g, const mpm_particles *p) {
   char *names = field_names(p);
   if (!names) mpm_log_all(MPM_LOG_ERROR, "checkpoint: cannot list the field names");
   int rc = mpm_h5_agree(h->comm, names ? 0 : MPM_ERR_MEMORY);
-  if (!rc) rc = mpm_h5_attr_string(h, g, "field_names", names);
+  if (!rc) rc = mpm_h5_attr_fixed_string(h, g, "field_names", names);
   const unsigned long long hash = names ? text_hash(names, NULL) : 0;
   if (!rc) rc = mpm_h5_attr(h, g, "text_hash", H5T_NATIVE_ULLONG, 1, &hash);
   free(names);
@@ -148,8 +148,8 @@ typedef struct ck_contents {
 /* Fills the checkpoint file (an mpm_h5_fill; arg is the ck_contents). */
 static int write_contents(const mpm_h5 *h, hid_t file, const void *arg) {
   const ck_contents *c = arg;
-  MPM_CALL(mpm_h5_attr_string(h, file, "format", CHECKPOINT_FORMAT));
-  MPM_CALL(mpm_h5_attr_string(h, file, "config", c->config));
+  MPM_CALL(mpm_h5_attr_fixed_string(h, file, "format", CHECKPOINT_FORMAT));
+  MPM_CALL(mpm_h5_attr_fixed_string(h, file, "config", c->config));
   const unsigned long long hash = text_hash(CHECKPOINT_FORMAT, c->config);
   MPM_CALL(mpm_h5_attr(h, file, "text_hash", H5T_NATIVE_ULLONG, 1, &hash));
   MPM_CALL(mpm_h5_attr(h, file, "nranks", H5T_NATIVE_INT, 1, &c->size));
@@ -365,7 +365,8 @@ static herr_t check_root_value(hid_t loc, const char *name, const H5A_info_t *in
 }
 
 /* A string attribute as a malloc'ed copy in *out: 0, -1 if it is missing or not a string,
- * -2 if HDF5 cannot read it. */
+ * -2 if HDF5 cannot read it. Fixed-length (what mpmfsi writes) or variable-length (checkpoints
+ * written before fixed-length strings). */
 static int attr_read_string(hid_t loc, const char *name, char **out) {
   *out = NULL;
   const htri_t exists = H5Aexists(loc, name);
@@ -374,7 +375,9 @@ static int attr_read_string(hid_t loc, const char *name, char **out) {
   if (a < 0) return h5_failed();
   const hid_t ftype = H5Aget_type(a);
   int st = ftype < 0 ? h5_failed() : -1;
-  if (ftype >= 0 && H5Tget_class(ftype) == H5T_STRING && H5Tis_variable_str(ftype) > 0) {
+  const int is_string = ftype >= 0 && H5Tget_class(ftype) == H5T_STRING;
+  const htri_t variable = is_string ? H5Tis_variable_str(ftype) : 0;
+  if (is_string && variable > 0) {
     const hid_t type = mpm_h5_string_type();
     char *s = NULL;
     if (type >= 0 && H5Aread(a, type, &s) >= 0 && s) {
@@ -384,6 +387,15 @@ static int attr_read_string(hid_t loc, const char *name, char **out) {
     } else if (type >= 0) {
       st = h5_failed();
     }
+    if (type >= 0) H5Tclose(type);
+  } else if (is_string && variable == 0) {
+    const size_t size = H5Tget_size(ftype);
+    const hid_t type = H5Tcopy(ftype); /* its own size, padding and character set */
+    char *s = size > 0 ? calloc(size + 1, 1) : NULL;
+    if (s && type >= 0 && H5Aread(a, type, s) >= 0)
+      *out = s, st = 0;
+    else
+      free(s), st = h5_failed();
     if (type >= 0) H5Tclose(type);
   }
   if (ftype >= 0) H5Tclose(ftype);

@@ -226,6 +226,16 @@ int mpm_h5_attr_string(const mpm_h5 *h, hid_t loc, const char *name, const char 
   return 0;
 }
 
+int mpm_h5_attr_fixed_string(const mpm_h5 *h, hid_t loc, const char *name, const char *value) {
+  const hid_t type = H5Tcopy(H5T_C_S1);
+  const int bad = type < 0 || H5Tset_size(type, strlen(value) + 1) < 0 ||
+                  H5Tset_strpad(type, H5T_STR_NULLTERM) < 0 || H5Tset_cset(type, H5T_CSET_UTF8) < 0;
+  const int rc = mpm_h5_attr(h, loc, name, bad ? -1 : type, 1, value);
+  if (type >= 0) H5Tclose(type);
+  MPM_CALL(rc);
+  return 0;
+}
+
 int mpm_h5_group(const mpm_h5 *h, hid_t loc, const char *name, hid_t *group) {
   *group = H5Gcreate2(loc, name, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
   const int rc = stage(h->comm, *group < 0);

@@ -94,6 +94,10 @@ int mpm_h5_attr(const mpm_h5 *h, hid_t loc, const char *name, hid_t type, int n,
 /* A variable-length UTF-8 string: it lives in the file's global heap, so a long case text
  * does not hit the 64 KiB limit of an object header, and h5py reads it as str. */
 int mpm_h5_attr_string(const mpm_h5 *h, hid_t loc, const char *name, const char *value);
+/* The same as a fixed-length string: it lives in the object header (or the dense attribute
+ * storage), which HDF5 checksums, where a variable-length string's bytes sit in the global heap,
+ * which it does not (a damaged heap can crash the reader). Checkpoints use this. */
+int mpm_h5_attr_fixed_string(const mpm_h5 *h, hid_t loc, const char *name, const char *value);
 
 /* The memory type of mpm_h5_attr_string; the caller closes it. */
 hid_t mpm_h5_string_type(void);
