@@ -93,7 +93,7 @@ void mpm_interface_load(mpm_interface *ifc, double t0, double H, int interpolate
       ifc->trend[d][l] = ifc->span_prev > 0 ? (load - ifc->prev[d][l]) / gap : 0.0;
       ifc->prev[d][l] = load;
     }
-  ifc->span = H, ifc->t_mid = t0 + 0.5 * H;
+  ifc->t_mid = t0 + 0.5 * H;
   ifc->span_prev = trend ? H : 0.0;
 }
 

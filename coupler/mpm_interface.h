@@ -35,7 +35,7 @@ typedef struct mpm_interface {
   double *capture[MPM_MAX_DIM]; /* during a held or loaded RHS: the force into the solid, N */
   double *impulse[MPM_MAX_DIM]; /* owed to the solid since its last load, N s per node */
   double *load[MPM_MAX_DIM];    /* the load of the solid's current advance, N per node */
-  double span, t_mid;           /* the length and the midpoint of that advance, s */
+  double t_mid;                 /* the midpoint of that advance, s */
   double *trend[MPM_MAX_DIM];   /* with interpolation: d load / dt, N/s per node (else NULL) */
   double *prev[MPM_MAX_DIM];    /* the load of the advance before, and its length */
   double span_prev;
