@@ -122,8 +122,15 @@ int mpm_partitioned_advance_gas(mpm_timescheme *ts, double t0, double t1, int n)
 }
 
 int mpm_partitioned_advance_solid(mpm_timescheme *ts, double t0, double t1, int n) {
+  return mpm_partitioned_advance_solid_under(ts, t0, t1, n, NULL);
+}
+
+int mpm_partitioned_advance_solid_under(mpm_timescheme *ts, double t0, double t1, int n,
+                                        const double *const *q) {
   mpm_partitioned *pp = ts->content;
   mpm_interface_load(pp->ifc, t0, t1 - t0, pp->interpolate);
+  for (int d = 0; q && d < ts->grid->dim; ++d)
+    for (mpm_lidx l = 0; l < ts->grid->nnodes; ++l) pp->ifc->load[d][l] += q[d][l];
   return advance(ts, pp->it_solid, MPM_ROLE_SOLID, t0, t1, n);
 }
 

@@ -28,7 +28,8 @@ typedef struct mpm_partitioned {
   /* The scheme's own settings, read by its create. */
   int order;    /* staggered: the order of the advances */
   int substeps; /* multirate: substeps of the fast module per coupling step (0: from the ratio) */
-  int interpolate; /* multirate: the solid's substeps see a linear trend of the load */
+  int interpolate;           /* multirate: the solid's substeps see a linear trend of the load */
+  struct mpm_strong *strong; /* staggered: sub-iterations (NULL: none) */
   long steps;
   mpm_coupling_record sum; /* the coupling step under way: sums of h times the rates */
   mpm_coupling_record rec; /* the last coupling step's record */
@@ -49,6 +50,11 @@ int mpm_partitioned_advance_gas(mpm_timescheme *ts, double t0, double t1, int n)
 /* Advance the solid from t0 to t1 in n equal substeps under the owed momentum (spread evenly
  * over t1 - t0, or with the trend since the last load when interpolating). Collective. */
 int mpm_partitioned_advance_solid(mpm_timescheme *ts, double t0, double t1, int n);
+/* The same with the load rate q (N per node, dim arrays over the box nodes) added to that of the
+ * owed momentum: the solid receives H q more than it is owed, which the gas's advance is then
+ * expected to pay (strong coupling, mpm_strong.h). Collective. */
+int mpm_partitioned_advance_solid_under(mpm_timescheme *ts, double t0, double t1, int n,
+                                        const double *const *q);
 /* Close the coupling step t0 -> t1: its record, the owed momentum. Collective. */
 int mpm_partitioned_end(mpm_timescheme *ts, double t0, double t1);
 

@@ -214,6 +214,16 @@ COUPLING_CASES = [
     ("no substeps", FSI, "time = multirate\nsubsteps = 0", "coupling.substeps", ">= 1"),
     ("substeps with another time scheme", FSI, "time = staggered\nsubsteps = 4",
      "coupling.substeps", "key of the multirate time scheme"),
+    ("iterations without a tolerance", FSI, "time = staggered\niterations = 5",
+     "coupling.iterations", "give coupling.tolerance"),
+    ("iterations of the parallel order", FSI, "time = staggered\norder = parallel\ntolerance = "
+     "1e-6\niterations = 5", "coupling.iterations", "solid_first only"),
+    ("a tolerance without iterations", FSI, "time = staggered\ntolerance = 1e-6",
+     "coupling.tolerance", "coupling.iterations is 1"),
+    ("a negative tolerance", FSI, "time = staggered\niterations = 5\ntolerance = -1",
+     "coupling.tolerance", "must be in (0, 1]"),
+    ("iterations with multirate", FSI, "time = multirate\niterations = 5",
+     "coupling.iterations", "key of the staggered time scheme"),
 ]
 for name, base, body, key, words in COUPLING_CASES:
     text = base.rstrip("\n") + "\n\n[coupling]\n" + body + "\n"
