@@ -27,7 +27,8 @@ set -euo pipefail
 src=$(cd "$(dirname "$0")/.." && pwd)
 bash "$src/tools/setup.sh" "$src/build"
 (cd "$src/build" && ctest -LE "long|benchmark" --output-on-failure -j 2 --timeout 900)
-# -O1 (asserts on): the sanitizers' own guidance for usable speed, about twice as fast as -O0 here.
+# -O1 (asserts on), as the sanitizers advise for usable speed: test_regularise takes 67 s against
+# 105 s at -O0, side by side on 2 cores.
 bash "$src/tools/setup.sh" "$src/build-asan" -DMPMFSI_SANITIZE=ON -DCMAKE_BUILD_TYPE=Debug \
   "-DCMAKE_C_FLAGS_DEBUG=-g -O1"
 (cd "$src/build-asan" &&
