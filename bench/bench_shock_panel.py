@@ -19,6 +19,12 @@ and the published simulations, and the cost of multirate against monolithic.
 
 Writes bench/results/shock_panel_tip.csv (t, ux, uy in mm), shock_panel_tip.png (against the
 references) and shock_panel.md (the figures).
+
+--partial (with --reuse DIR): a run that stopped before its end (no summary.json): writes its tip
+history as shock_panel_tip_partial.csv and .png against the references, and nothing else.
+
+--cost-only: step 2 alone, the two runs side by side (one rank each, so that both see the same
+load on a shared machine; --ranks is ignored), written to shock_panel_cost.md and .json.
 """
 import argparse
 import csv
@@ -82,6 +88,93 @@ def references():
     return exp, gio, m2c
 
 
+def write_tip_csv(path, t, ux, uy, note):
+    with open(path, "w", newline="") as f:
+        f.write(note)
+        w = csv.writer(f)
+        w.writerow(["t_ms", "tip_dx_mm", "tip_dy_mm"])
+        for k in range(0, len(t), max(1, len(t) // 2000)):
+            w.writerow([f"{t[k]:.6f}", f"{ux[k]:.6f}", f"{uy[k]:.6f}"])
+
+
+def plot_tip(path, t, ux, label):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    exp, gio, m2c = references()
+    fig, ax = plt.subplots(figsize=(9, 5))
+    ax.errorbar(exp[:, 0], exp[:, 1], yerr=exp[:, 2], fmt="s", ms=3, color="tab:red", alpha=0.6,
+                label="experiment (Giordano et al. 2005)")
+    ax.plot(gio[:, 0], gio[:, 1], "-.", color="tab:blue", label="Giordano et al. simulation")
+    ax.plot(m2c[:, 0], m2c[:, 3], "--", color="tab:gray", label="m2c (fine)")
+    ax.plot(t, ux, "-", color="k", lw=1.6, label=label)
+    ax.set_xlabel("t (ms)")
+    ax.set_ylabel("tip displacement x (mm)")
+    ax.set_xlim(0, max(5.0, t[-1]))
+    ax.grid(alpha=0.3)
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+
+
+def partial(out):
+    t, ux, uy = tip(out)
+    note = (f"# cases/shock_panel.ini, {os.path.basename(os.path.normpath(out))}: the run stopped at "
+            f"t = {t[-1]:.4f} ms (no summary.json)\n")
+    write_tip_csv(os.path.join(RESULTS, "shock_panel_tip_partial.csv"), t, ux, uy, note)
+    plot_tip(os.path.join(RESULTS, "shock_panel_tip_partial.png"), t, ux,
+             f"mpmfsi (stopped at {t[-1]:.3f} ms)")
+    print(f"partial history to {t[-1]:.4f} ms; tip {ux[-1]:.3f} mm there")
+
+
+def cost_side_by_side(binary, window_s, overrides):
+    """multirate and monolithic over the first window_s seconds, started together, one rank
+    each: (summary, tip x at the end in mm, wall s) per scheme."""
+    window = [f"time.t_end={window_s}", "output.interval=1"] + overrides
+    procs = {}
+    for scheme in ("multirate", "monolithic"):
+        wout = os.path.join(ROOT, "out", f"bench_shock_panel_{scheme}")
+        cmd = [binary, "run", CASE, f"output.dir={wout}", "output.overwrite=true",
+               f"coupling.time={scheme}"] + window
+        procs[scheme] = (wout, subprocess.Popen(cmd, env=ENV, stdout=subprocess.DEVNULL,
+                                                stderr=subprocess.PIPE, text=True))
+    res = {}
+    for scheme, (wout, pr) in procs.items():
+        _, err = pr.communicate()
+        if pr.returncode != 0:
+            raise SystemExit(f"{scheme} failed ({pr.returncode}):\n{err[-2000:]}")
+        with open(os.path.join(wout, "summary.json")) as f:
+            summ = json.load(f)
+        res[scheme] = (summ, tip(wout)[1][-1])
+    return res
+
+
+def cost_only(a):
+    print(f"cost window {a.cost_window} s: multirate and monolithic side by side ...", flush=True)
+    res = cost_side_by_side(a.binary, a.cost_window, a.overrides)
+    mr, mo = res["multirate"], res["monolithic"]
+    ratio = mo[0]["wall_s"] / mr[0]["wall_s"]
+    diff = abs(mr[1] - mo[1])
+    lines = ["# Shock-loaded panel: multirate against monolithic over a window", "",
+             f"`cases/shock_panel.ini` {' '.join(a.overrides)} to t = {a.cost_window * 1e3:.3f} ms, "
+             "both runs started together on one rank each (the same machine load).", "",
+             "| scheme | wall (s) | coupling steps | RHS | tip x at the end (mm) |",
+             "|---|---|---|---|---|"]
+    for scheme, (summ, u_end) in res.items():
+        lines.append(f"| {scheme} | {summ['wall_s']:.1f} | {summ['steps']} | {summ['rhs_evals']} | "
+                     f"{u_end:.5f} |")
+    lines += ["", f"monolithic / multirate wall time: **{ratio:.2f}**; the tips differ by "
+              f"{diff:.2e} mm ({diff / max(abs(mo[1]), 1e-300):.2%} of monolithic's)."]
+    with open(os.path.join(RESULTS, "shock_panel_cost.md"), "w") as f:
+        f.write("\n".join(lines) + "\n")
+    with open(os.path.join(RESULTS, "shock_panel_cost.json"), "w") as f:
+        json.dump({"window_s": a.cost_window, "overrides": a.overrides, "ratio": ratio,
+                   "tip_difference_mm": diff,
+                   "runs": {k: {"summary": v[0], "tip_mm": v[1]} for k, v in res.items()}},
+                  f, indent=1)
+    print("\n".join(lines))
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("overrides", nargs="*")
@@ -89,8 +182,18 @@ def main():
     ap.add_argument("--reuse", default=None)
     ap.add_argument("--cost-window", type=float, default=2e-4)
     ap.add_argument("--binary", default=os.path.join(ROOT, "build", "app", "mpmfsi"))
+    ap.add_argument("--partial", action="store_true")
+    ap.add_argument("--cost-only", action="store_true")
     a = ap.parse_args()
     os.makedirs(RESULTS, exist_ok=True)
+    if a.cost_only:
+        cost_only(a)
+        return
+    if a.partial:
+        if not a.reuse:
+            raise SystemExit("--partial needs --reuse DIR (the run that stopped)")
+        partial(a.reuse)
+        return
     out = a.reuse or os.path.join(ROOT, "out", "bench_shock_panel")
     if a.reuse:
         with open(os.path.join(out, "summary.json")) as f:
@@ -102,11 +205,7 @@ def main():
     tp, up, tm, um = peak_and_trough(t, ux)
     period = 2 * (tm - tp)
     exp, gio, m2c = references()
-    with open(os.path.join(RESULTS, "shock_panel_tip.csv"), "w", newline="") as f:
-        w = csv.writer(f)
-        w.writerow(["t_ms", "tip_dx_mm", "tip_dy_mm"])
-        for k in range(0, len(t), max(1, len(t) // 2000)):
-            w.writerow([f"{t[k]:.6f}", f"{ux[k]:.6f}", f"{uy[k]:.6f}"])
+    write_tip_csv(os.path.join(RESULTS, "shock_panel_tip.csv"), t, ux, uy, "")
     refs = {"m2c coarse": peak_and_trough(m2c[:, 0], m2c[:, 1]),
             "m2c fine": peak_and_trough(m2c[:, 0], m2c[:, 3]),
             "Giordano simulation": peak_and_trough(gio[:, 0], gio[:, 1])}
@@ -122,22 +221,8 @@ def main():
         cost[scheme] = (s, uw[-1])
     ratio = cost["monolithic"][0]["wall_s"] / cost["multirate"][0]["wall_s"]
 
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    fig, ax = plt.subplots(figsize=(9, 5))
-    ax.errorbar(exp[:, 0], exp[:, 1], yerr=exp[:, 2], fmt="s", ms=3, color="tab:red", alpha=0.6,
-                label="experiment (Giordano et al. 2005)")
-    ax.plot(gio[:, 0], gio[:, 1], "-.", color="tab:blue", label="Giordano et al. simulation")
-    ax.plot(m2c[:, 0], m2c[:, 3], "--", color="tab:gray", label="m2c (fine)")
-    ax.plot(t, ux, "-", color="k", lw=1.6, label=f"mpmfsi ({full.get('coupling', '')}, multirate)")
-    ax.set_xlabel("t (ms)")
-    ax.set_ylabel("tip displacement x (mm)")
-    ax.set_xlim(0, max(5.0, t[-1]))
-    ax.grid(alpha=0.3)
-    ax.legend()
-    fig.tight_layout()
-    fig.savefig(os.path.join(RESULTS, "shock_panel_tip.png"), dpi=110)
+    plot_tip(os.path.join(RESULTS, "shock_panel_tip.png"), t, ux,
+             f"mpmfsi ({full.get('coupling', '')}, multirate)")
 
     lines = ["# Shock-loaded panel (Giordano et al. 2005)", "",
              f"Run: `cases/shock_panel.ini` {' '.join(a.overrides)} on {full['ranks']} rank(s): "
