@@ -373,7 +373,7 @@ int mpm_integrator_start(mpm_integrator *it, double t, double h0) {
 int mpm_integrator_resize(mpm_integrator *it, double t) {
   MPM_CALL(wrap_state(it));
   it->h_limit_set = 0; /* particles moved between ranks, or were added or removed */
-  it->checked_t = NAN;  /* and the next RHS checks them before any transfer */
+  it->checked_t = NAN; /* and the next RHS checks them before any transfer */
   MPM_CALL_SUN(ERKStepResize(it->ark, it->y, 1.0, t, NULL, NULL));
   return 0;
 }
