@@ -22,6 +22,9 @@ struct mpm_strong {
   /* The modules' particle data and the owed impulse at the start of the step. */
   double *mark[2], *owed0[MPM_MAX_DIM];
   size_t mark_cap[2];
+  mpm_lidx mark_n[2];       /* the particle counts at the mark */
+  const double *mark_at[2]; /* and their storage: a rewind needs the same set */
+  long moved;               /* steps whose particle set changed under a retried substep */
   /* The run's figures. */
   long steps, iters, unconverged;
   int most;
@@ -54,9 +57,10 @@ void mpm_strong_destroy(mpm_strong **sp) {
   if (s->steps > 0)
     mpm_log(MPM_LOG_INFO,
             "strong coupling: %ld coupling steps, %.2f sub-iterations a step on average, at most "
-            "%d; %ld steps missed coupling.tolerance = %g (largest residual accepted %.3g)",
+            "%d; %ld steps missed coupling.tolerance = %g (largest residual accepted %.3g); %ld "
+            "could not go back to their start",
             s->steps, (double)s->iters / (double)s->steps, s->most, s->unconverged, s->tolerance,
-            s->worst);
+            s->worst, s->moved);
   for (int d = 0; d < MPM_MAX_DIM; ++d) {
     free(s->q[d]), free(s->after_solid[d]), free(s->r_prev[d]), free(s->g[d]);
     free(s->owed0[d]), free(s->q_best[d]);
@@ -77,9 +81,20 @@ static int keep_particles(mpm_strong *s, int k, mpm_particles *p, int save) {
     MPM_ALLOC(s->mark[k], count);
     s->mark_cap[k] = count;
   }
+  if (save) s->mark_n[k] = p->n, s->mark_at[k] = p->data;
   if (count > 0)
     memcpy(save ? s->mark[k] : p->data, save ? p->data : s->mark[k], sizeof(double) * count);
   return 0;
+}
+
+/* Can the step go back to its mark? Not if a retried substep let the step loop's open faces or
+ * migration change a particle set (its count or storage) since. Collective. */
+static int can_rewind(mpm_strong *s, const mpm_grid *grid) {
+  const mpm_particles *p[2] = {s->pp->solid->particles, s->pp->gas->particles};
+  int same = 1;
+  for (int k = 0; k < 2; ++k) same &= p[k]->n == s->mark_n[k] && p[k]->data == s->mark_at[k];
+  MPI_Allreduce(MPI_IN_PLACE, &same, 1, MPI_INT, MPI_LAND, grid->comm);
+  return same;
 }
 
 static int keep_state(mpm_strong *s, int save) {
@@ -158,7 +173,12 @@ int mpm_strong_step(mpm_strong *s, mpm_timescheme *ts, double t0, double t1) {
   MPM_CALL(keep_state(s, 1));
   double w = s->relaxation, rel = 0.0, best = HUGE_VAL;
   int k = 1, best_k = 0;
+  int stuck = 0;
   for (;; ++k) {
+    if (k > 1 && !can_rewind(s, grid)) { /* keep what the last sub-iteration reached */
+      stuck = 1, --k;
+      break;
+    }
     MPM_CALL(pass(s, ts, t0, t1, k == 1, (const double *const *)s->q, &rel));
     mpm_log(MPM_LOG_TRACE, "strong coupling: t = %.6g, sub-iteration %d: residual %.3g", t0, k,
             rel);
@@ -167,7 +187,7 @@ int mpm_strong_step(mpm_strong *s, mpm_timescheme *ts, double t0, double t1) {
     if (k == s->iterations) {
       /* Not converged: keep the best iterate, not the last (an iteration that wanders off
        * would pass its wild trial load to the solid). */
-      if (best_k != k) {
+      if (best_k != k && can_rewind(s, grid)) {
         MPM_CALL(pass(s, ts, t0, t1, 0, (const double *const *)s->q_best, &rel));
         ++k;
       }
@@ -193,6 +213,12 @@ int mpm_strong_step(mpm_strong *s, mpm_timescheme *ts, double t0, double t1) {
   copy_nodal(grid, ifc->prev, s->g);
   s->steps++, s->iters += k;
   if (k > s->most) s->most = k;
+  if (stuck && ++s->moved <= MPM_STRONG_WARNINGS)
+    mpm_log(MPM_LOG_WARN,
+            "strong coupling: at t = %.6g a retried substep changed a particle set (open faces or "
+            "migration), so the step could not go back to its start: it keeps sub-iteration %d "
+            "(relative residual %.3g)",
+            t0, k, rel);
   if (rel > s->tolerance) {
     if (++s->unconverged <= MPM_STRONG_WARNINGS)
       mpm_log(MPM_LOG_WARN,

@@ -14,9 +14,11 @@
  * Momentum. The interface accounting of mpm_interface.h is untouched: the solid receives what
  * it was given, the gas's impulse is added to what is owed, so whatever a last iteration leaves
  * unmatched (H r_K, at most the tolerance) stays owed to the next step; the balance holds to
- * roundoff whether or not the iterations converged. A step that reaches coupling.iterations
- * without converging is accepted with a warning (the first few are named; the run's count is
- * reported at the end).
+ * roundoff whether or not the iterations converged. A step whose particle set changed under a
+ * retried substep (the step loop's open faces and migration run between a module's substeps)
+ * cannot go back to its start: it keeps the sub-iteration it reached, with a warning. A step that
+ * reaches coupling.iterations without converging is accepted with a warning (the first few are
+ * named; the run's count is reported at the end).
  *
  * State. The predictor is interface state carried between steps: it is the interface's `prev`
  * (mpm_interface.h), which checkpoints store, so a restart continues bitwise. */
