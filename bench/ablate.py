@@ -58,6 +58,9 @@ def parse():
     ap.add_argument("overrides", nargs="*", help="key=value for every run")
     ap.add_argument("--spatial", nargs="+", default=["velocity", "contact", "traction"])
     ap.add_argument("--temporal", nargs="+", default=["monolithic", "staggered", "multirate"])
+    ap.add_argument("--skip-variants", nargs="+", default=[],
+                    help="variants to leave out (solid_first, gas_first, parallel, strong, held, "
+                         "interpolated)")
     ap.add_argument("--methods", nargs="+", default=["usl", "musl", "bs32"])
     ap.add_argument("--cfl", nargs="+", type=float, default=[0.4, 0.2, 0.1])
     ap.add_argument("--ref-cfl", type=float, default=0.05)
@@ -110,7 +113,7 @@ def history(out, quantity):
 def combos(args):
     for spatial in args.spatial:
         for temporal, variant, keys in VARIANTS:
-            if temporal not in args.temporal:
+            if temporal not in args.temporal or variant in args.skip_variants:
                 continue
             for method in args.methods:
                 classic = method in ("usl", "musl")
