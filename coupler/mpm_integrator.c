@@ -428,6 +428,21 @@ static int attempt(mpm_integrator *it, double tstop, double scale, double *t, do
     it->tstop = tstop, it->scale = scale;
     if (!it->h_limit_set) MPM_CALL(classic_limit(it, it->y, &it->h_limit));
     const double hf = classic_step(it, it->t_last, it->h_limit);
+    /* A step that does not move the time would evaluate the end of the step at its start,
+     * where the state is not checked. From a stability limit that small, the run has blown up;
+     * from a stop time that close, a caller asked for a roundoff-sized step. */
+    if (!(it->t_last + hf > it->t_last)) {
+      if (hf < tstop - it->t_last)
+        MPM_FAIL(MPM_ERR_UNPHYSICAL,
+                 "the run blew up at t = %.6g: the stable step of the state fell to %.3g s, too "
+                 "small to advance the time (speeds or wave speeds without bound); reduce "
+                 "time.cfl, refine the grid, or check the scene near the fastest particles",
+                 it->t_last, hf);
+      MPM_FAIL(MPM_ERR_INTERNAL,
+               "a classic step of %.3g s from t = %.17g to the stop time %.17g does not advance "
+               "the time (roundoff): the time scheme asked for it",
+               hf, it->t_last, tstop);
+    }
     if (classic && hf != h_stored) it->fn_stale = 1;
     if (classic) it->h_classic = hf;
     MPM_CALL_SUN(ERKStepSetFixedStep(it->ark, hf));

@@ -83,6 +83,11 @@ int mpm_partitioned_hold(mpm_timescheme *ts, double t) {
   return 0;
 }
 
+/* A substep is planned from the module's stable step, so it takes one integrator step, or a
+ * few after retries; this many means the module's stable step collapsed within one coupling
+ * step: the blow-up guard (which sees coupling steps) could not. */
+#define MPM_PARTITIONED_MAX_STEPS 1000
+
 /* Advance one integrator from t0 to t1 in n equal substeps (each one step, or more after a
  * retry), adding each step's interface record for the module's role, times its size, to the
  * step's sums. The gas's accepted steps add what they captured to the owed momentum, the
@@ -93,9 +98,20 @@ static int advance(mpm_timescheme *ts, mpm_integrator *it, mpm_role role, double
   mpm_coupling_record *sum = &pp->sum;
   mpm_module *m = role == MPM_ROLE_SOLID ? pp->solid : pp->gas;
   double t = t0, h = 0.0;
+  /* A substep ends within this of its end time: the rest is roundoff (t0 + (t1 - t0) k / n and
+   * the sum of the steps taken need not agree to the last bit), and a step of that size would
+   * not advance the time at all. */
+  const double arrived = 1e-9 * (t1 - t0) / n;
   for (int k = 1; k <= n; ++k) {
     const double tk = k == n ? t1 : t0 + (t1 - t0) * k / n;
-    while (t < tk) {
+    for (long taken = 0; tk - t > arrived; ++taken) {
+      if (taken == MPM_PARTITIONED_MAX_STEPS)
+        MPM_FAIL(MPM_ERR_UNPHYSICAL,
+                 "the run blew up at t = %.6g: the %s module has taken %d steps inside one "
+                 "substep of %.3g s, its stable step %.3g s and falling (it was planned from "
+                 "the module's stable step when the coupling step began): reduce time.cfl, "
+                 "refine the grid, or check the scene near the interface",
+                 t, m->name, MPM_PARTITIONED_MAX_STEPS, (t1 - t0) / n, h);
       if (t > t0 && ts->between) { /* the step loop's work between two substeps */
         int changed = 0;
         MPM_CALL(ts->between(ts->between_ctx, m, t, h, &changed));

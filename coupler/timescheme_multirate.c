@@ -40,6 +40,10 @@ static int multirate_create(mpm_timescheme *ts, const mpm_config *cfg) {
   return 0;
 }
 
+/* More substeps than this in one coupling step (with coupling.substeps unset) means the fast
+ * module's stable step has collapsed: the ratio of two stable modules' steps is 10-100. */
+#define MULTIRATE_MAX_SUBSTEPS 1e4
+
 /* A limit of 0 means none. */
 static double limit(double h) {
   return h > 0 ? h : HUGE_VAL;
@@ -72,7 +76,17 @@ static int multirate_step(mpm_timescheme *ts, double tstop, double *t, double *h
   const double t0 = *t, rest = tstop - t0;
   const double H = fmin(coupling_step(pp, h_fast, fmax(hs, hg)), rest);
   int m = pp->substeps;
-  if (m == 0) m = isfinite(h_fast) ? (int)fmax(1.0, ceil(H / h_fast * (1 - 1e-12))) : 1;
+  if (m == 0) {
+    const double need = isfinite(h_fast) ? fmax(1.0, ceil(H / h_fast * (1 - 1e-12))) : 1.0;
+    if (need > MULTIRATE_MAX_SUBSTEPS)
+      MPM_FAIL(MPM_ERR_UNPHYSICAL,
+               "the run blew up at t = %.6g: the %s module's stable step %.3g s is %.3g times "
+               "below the coupling step %.3g s (its particles have reached speeds no stable scene "
+               "has); the blow-up guard sees coupling steps only. Reduce time.cfl, refine the "
+               "grid, or check the scene near the interface",
+               t0, solid_fast ? "solid" : "gas", h_fast, need, H);
+    m = (int)need;
+  }
   const double t1 = H < rest ? t0 + H : tstop;
   MPM_CALL(mpm_partitioned_hold(ts, t0));
   MPM_CALL(mpm_partitioned_advance_gas(ts, t0, t1, solid_fast ? 1 : m));

@@ -18,6 +18,14 @@ elastic waves, energy 6.25e-8 J, no energy enters), 20 time units.
    default ratio 1e-4 the same run completes (a slow but healthy run is not stopped).
 4. A healthy run with default settings (bs32, default tolerances) completes: the guard does
    not fire on ordinary runs.
+5. The partitioned time schemes, where the guard sees coupling steps only: the main job's scene
+   at 6 mm (cases/supersonic_bar.ini, to 1 ms) with `traction` blows up under `multirate`
+   (held and interpolated loads, usl) and with `contact` under `multirate` with musl, all at
+   time.cfl = 0.4 (found by the ablation sweep). The gas is the fast module there: its stable step
+   collapses inside one coupling step. Each run must stop with status 1 and one "blew up"
+   message. Before the fix each ended in a segmentation fault: the gas's stable step reached
+   1e-20 s, a step that small no longer moved the time, and the end of that step was transferred
+   unchecked.
 """
 import os
 import sys
@@ -72,4 +80,17 @@ check(p.returncode == 0, f"bs32 at rtol 1e-12, default ratio 1e-4: completes (st
 p, d = run("bs32_default", ["time.method=bs32"])
 check(p.returncode == 0 and abs(d["t"][-1] - 20) < 1e-9,
       f"bs32 with default settings: completes to t = {d['t'][-1]:.6g} (status {p.returncode})")
+# 5. Blow-ups inside a coupling step.
+MAIN = ["grid.dx=0.006", "time.t_end=0.001", "output.interval=1e9", "coupling.time=multirate",
+        "time.cfl=0.4", "run.progress=false"]
+for label, extra in (("traction multirate held", ["coupling.scheme=traction", "coupling.load=held"]),
+                     ("traction multirate interpolated", ["coupling.scheme=traction",
+                                                          "coupling.load=interpolated"]),
+                     ("contact multirate musl", ["coupling.scheme=contact", "time.method=musl"])):
+    out = mt.outdir("blowup_" + label.replace(" ", "_"))
+    p = mt.run(["run", mt.case("supersonic_bar.ini"), f"output.dir={out}"] + MAIN + extra,
+               check=False)
+    msg = error_line(p.stderr)
+    check(p.returncode == 1 and "blew up" in msg,
+          f"{label}: stopped with status {p.returncode} (1 expected, no signal): {msg.strip()[:160]}")
 sys.exit(check.finish())
