@@ -120,9 +120,8 @@ static int rhs(mpm_sunreal t, N_Vector y, N_Vector ydot, void *user) {
     it->h_limit_set = 1;
     it->h_classic = classic_step(it, t, it->h_limit);
   }
-  /* A classic step's state was checked at the end of the step that made it (below), unless the
-   * particle set changed since (resize): then it is checked again, as a transfer of a particle
-   * outside the grid box would read and write past the nodal arrays. */
+  /* A classic step's state was checked at the end of the step that made it (below); the
+   * particles the driver adds between steps are made valid. */
   const int checked = classic && !at_end && it->checked_t == t;
   for (int k = 0; k < it->nmod && !local.set && !checked; ++k)
     it->mod[k]->ops->check(it->mod[k], module_data(y, k), &local);
@@ -373,7 +372,6 @@ int mpm_integrator_start(mpm_integrator *it, double t, double h0) {
 int mpm_integrator_resize(mpm_integrator *it, double t) {
   MPM_CALL(wrap_state(it));
   it->h_limit_set = 0; /* particles moved between ranks, or were added or removed */
-  it->checked_t = NAN; /* and the next RHS checks them before any transfer */
   MPM_CALL_SUN(ERKStepResize(it->ark, it->y, 1.0, t, NULL, NULL));
   return 0;
 }

@@ -97,15 +97,18 @@ static int can_rewind(mpm_strong *s, const mpm_grid *grid) {
   return same;
 }
 
+static void copy_nodal(const mpm_grid *grid, double *const *to, double *const *from) {
+  for (int d = 0; d < grid->dim; ++d) memcpy(to[d], from[d], sizeof(double) * (size_t)grid->nnodes);
+}
+
 static int keep_state(mpm_strong *s, int save) {
   mpm_partitioned *pp = s->pp;
   MPM_CALL(keep_particles(s, 0, pp->solid->particles, save));
   MPM_CALL(keep_particles(s, 1, pp->gas->particles, save));
-  const mpm_grid *grid = pp->ifc->grid;
-  const size_t bytes = sizeof(double) * (size_t)grid->nnodes;
-  for (int d = 0; d < grid->dim; ++d)
-    memcpy(save ? s->owed0[d] : pp->ifc->impulse[d], save ? pp->ifc->impulse[d] : s->owed0[d],
-           bytes);
+  if (save)
+    copy_nodal(pp->ifc->grid, s->owed0, pp->ifc->impulse);
+  else
+    copy_nodal(pp->ifc->grid, pp->ifc->impulse, s->owed0);
   return 0;
 }
 
@@ -157,10 +160,6 @@ static int pass(mpm_strong *s, mpm_timescheme *ts, double t0, double t1, int fir
       dots(ts, 2, (double *const *const[]){r, s->g}, (double *const *const[]){r, s->g}, norms));
   *rel = norms[1] > 0 ? sqrt(norms[0] / norms[1]) : 0.0;
   return 0;
-}
-
-static void copy_nodal(const mpm_grid *grid, double *const *to, double *const *from) {
-  for (int d = 0; d < grid->dim; ++d) memcpy(to[d], from[d], sizeof(double) * (size_t)grid->nnodes);
 }
 
 int mpm_strong_step(mpm_strong *s, mpm_timescheme *ts, double t0, double t1) {
