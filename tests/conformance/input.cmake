@@ -3,4 +3,4 @@
 # a self-crossing solid outline, devices/FIFOs/huge files as cases, non-finite field
 # expressions, and garbage (capped errors).
 mpm_add_script_test(test_input_safety SCRIPT conformance/test_input_safety.py
-                    LABELS conformance TIMEOUT 300)
+                    LABELS conformance TIMEOUT 300 NO_LEAK_CHECK)

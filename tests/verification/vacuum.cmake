@@ -10,6 +10,9 @@ set_tests_properties(test_near_vacuum_order PROPERTIES WILL_FAIL TRUE)
 # The blow-up guard: a run that goes unstable stops with a clear message under every method.
 mpm_add_script_test(test_blowup_guard SCRIPT verification/test_blowup_guard.py
                     LABELS verification TIMEOUT 600)
+# ... and inside a partitioned scheme's coupling step, on the main job's scene (section 5).
+mpm_add_script_test(test_blowup_guard_coupled SCRIPT verification/test_blowup_guard.py
+                    ARGS coupled LABELS verification TIMEOUT 600)
 # The main job's scene, coarse and short: runs, balances, bow shock, tip, restart.
 mpm_add_script_test(test_supersonic_bar SCRIPT verification/test_supersonic_bar.py
                     LABELS "verification;mpi" TIMEOUT 600)
