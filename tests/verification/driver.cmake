@@ -78,6 +78,9 @@ mpm_add_script_test(test_regularise SCRIPT verification/test_regularise.py
                     LABELS "verification;mpi" TIMEOUT 600)
 mpm_add_script_test(test_gas_boundaries SCRIPT verification/test_gas_boundaries.py
                     LABELS "verification;mpi" TIMEOUT 600)
+# A farfield face where the gas inside slows down lets in what the gas takes, not the free stream.
+mpm_add_script_test(test_farfield_refill SCRIPT verification/test_farfield_refill.py
+                    LABELS verification TIMEOUT 600)
 # Field images: tools/plot_fields.py on a short Sod run and a 3-D box (binning, PNG size).
 mpm_add_script_test(test_plot_fields SCRIPT conformance/test_plot_fields.py LABELS conformance
                     TIMEOUT 300)
