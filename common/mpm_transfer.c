@@ -6,11 +6,12 @@
 
 #include <string.h>
 
-int mpm_transfer_from_config(mpm_transfer *t, const mpm_config *cfg) {
+int mpm_transfer_from_config(mpm_transfer *t, const mpm_config *cfg, const char *pic_key) {
   const char *method, *velocity;
   MPM_CALL(mpm_config_get_string(cfg, "time.method", &method));
   MPM_CALL(mpm_config_get_string(cfg, "transfer.velocity", &velocity));
-  MPM_CALL(mpm_config_get_real(cfg, "transfer.pic_fraction", &t->pic));
+  if (!pic_key || !mpm_config_has(cfg, pic_key)) pic_key = "transfer.pic_fraction";
+  MPM_CALL(mpm_config_get_real(cfg, pic_key, &t->pic));
   t->musl = strcmp(method, "musl") == 0;
   t->classic = t->musl || strcmp(method, "usl") == 0;
   t->apic = strcmp(velocity, "apic") == 0;
@@ -20,10 +21,10 @@ int mpm_transfer_from_config(mpm_transfer *t, const mpm_config *cfg) {
                            "update; use time.method = usl or musl, or velocity = flip with %s",
                            method);
   if (t->apic && t->pic > 0)
-    return mpm_config_fail(cfg, "transfer.pic_fraction",
+    return mpm_config_fail(cfg, pic_key,
                            "APIC has no PIC fraction; set pic_fraction = 0 or velocity = flip");
   if (t->pic > 0 && !t->classic)
-    return mpm_config_fail(cfg, "transfer.pic_fraction",
+    return mpm_config_fail(cfg, pic_key,
                            "a PIC fraction is defined per step of the classic update; use "
                            "time.method = usl or musl, or pic_fraction = 0 with %s",
                            method);

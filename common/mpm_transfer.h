@@ -21,8 +21,9 @@ typedef struct mpm_transfer {
 } mpm_transfer;
 
 /* Read time.method and the [transfer] keys; APIC or a PIC fraction without the classic
- * update, or both together, is an input error naming the key. */
-int mpm_transfer_from_config(mpm_transfer *t, const mpm_config *cfg);
+ * update, or both together, is an input error naming the key. pic_key, if given and set,
+ * is a module's own PIC fraction, in place of transfer.pic_fraction. */
+int mpm_transfer_from_config(mpm_transfer *t, const mpm_config *cfg, const char *pic_key);
 
 /* G2P over a particle set whose positions are field 0 of state y: v_out = sum S v_i,
  * a_out = sum S a_i of phase, and L_out, C_out as in mpm_g2p_args (NULL: not wanted). */

@@ -49,6 +49,11 @@ static const mpm_key_spec fluid_keys[] = {
      0},
     {"fluid.av_quadratic", MPM_KEY_REAL, "2", 0, HUGE_VAL, 0, 0, NULL,
      "quadratic artificial viscosity coefficient c_quad (see av_linear)", 0},
+    {"fluid.pic_fraction", MPM_KEY_REAL, NULL, 0, 1, 0, 0, NULL,
+     "the gas's own PIC share of the particle velocity update, in place of "
+     "transfer.pic_fraction (default: that); damps the gas's particle noise without damping "
+     "the solid; classic update only",
+     1},
     {"fluid.ppc", MPM_KEY_INT, "2", 1, 8, 0, 0, NULL,
      "gas particles per cell per direction at seeding", 0},
     {"fluid.regularise_every", MPM_KEY_INT, "0", 0, HUGE_VAL, 0, 0, NULL,
@@ -491,7 +496,7 @@ static int read_settings(fluid_content *fc, const mpm_config *cfg, const mpm_gri
   MPM_CALL(read_regularise(fc, cfg, g->dim));
   MPM_CALL(mpm_config_get_reals(cfg, "physics.gravity", grav, 3, &nv));
   memcpy(fc->gravity, grav, sizeof grav);
-  MPM_CALL(mpm_transfer_from_config(&fc->tr, cfg));
+  MPM_CALL(mpm_transfer_from_config(&fc->tr, cfg, "fluid.pic_fraction"));
   fc->gas.l = g->dx;
   fc->lp = 0.5 / fc->ppc;
   return 0;

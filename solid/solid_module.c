@@ -609,7 +609,7 @@ static int read_bodies(mpm_module *m, const mpm_config *cfg) {
   MPM_CALL(mpm_config_get_reals(cfg, "physics.gravity", g, 3, &nv));
   memcpy(sc->gravity, g, sizeof g);
   MPM_CALL(mpm_config_get_real(cfg, "physics.damping", &sc->damping));
-  MPM_CALL(mpm_transfer_from_config(&sc->tr, cfg));
+  MPM_CALL(mpm_transfer_from_config(&sc->tr, cfg, NULL));
   return 0;
 }
 

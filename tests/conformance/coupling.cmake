@@ -3,3 +3,5 @@
 # shared nodal velocity (velocity), no interpenetration and separation (contact).
 mpm_add_script_test(test_coupling SCRIPT conformance/test_coupling.py LABELS conformance
                     TIMEOUT 600)
+# fluid.pic_fraction: the gas's own PIC share leaves the solid alone.
+mpm_add_script_test(test_gas_pic SCRIPT conformance/test_gas_pic.py LABELS conformance TIMEOUT 300)
