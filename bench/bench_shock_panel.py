@@ -88,7 +88,8 @@ def references():
         delimiter=",", comments="#", skip_header=1, usecols=(0, 1))
     m2c = np.genfromtxt(os.path.join(VALID, "giordano_panel_m2c_simulation_tip_displacement.csv"),
                         delimiter=",", comments="#", skip_header=1)
-    return exp, gio, m2c
+    # the column-name rows read as NaN
+    return tuple(a[~np.isnan(a).any(axis=1)] for a in (exp, gio, m2c))
 
 
 def write_tip_csv(path, t, ux, uy, note):
