@@ -108,6 +108,9 @@ typedef struct open_face {
   mpm_lidx nout;               /* box nodes beyond the face (and on it, for inflow) */
   mpm_lidx *out;               /* per node: its index, the face node and the one inside it */
   int *beyond;                 /* cells beyond the face */
+  double *dout;                /* a refilling face, per line across it on this rank: the */
+  mpm_lidx *src;               /* outermost particle's depth and index (outermost()), */
+  mpm_lidx nlines;             /* for this many lines */
 } open_face;
 
 struct fluid_open {
@@ -294,7 +297,7 @@ void fluid_open_destroy(fluid_open **openp) {
   if (!o) return;
   for (int k = 0; k < o->nfaces; ++k)
     free(o->face[k].node), free(o->face[k].r), free(o->face[k].wt), free(o->face[k].out),
-        free(o->face[k].beyond);
+        free(o->face[k].beyond), free(o->face[k].dout), free(o->face[k].src);
   free(o->cand);
   free(o);
   *openp = NULL;
@@ -588,10 +591,10 @@ static int entering_state(const fluid_open *o, const open_face *f, double pp, co
 }
 
 /* The particles refilling face f adds on this rank, appended to the arrays (component-major,
- * stride cap) from index *nadd on; with data NULL, only counted into *nadd. */
-static int refill(const fluid_open *o, const open_face *f, const mpm_module *m,
-                  const unsigned char *keep, mpm_lidx cap, double *data, mpm_gidx *id,
-                  mpm_lidx *nadd) {
+ * stride cap) from index *nadd on; with data NULL (the first call of an exchange), only counted
+ * into *nadd, and the lines' outermost particles found for the second. */
+static int refill(const fluid_open *o, open_face *f, const mpm_module *m, const unsigned char *keep,
+                  mpm_lidx cap, double *data, mpm_gidx *id, mpm_lidx *nadd) {
   const fluid_content *fc = m->content;
   const mpm_particles *p = m->particles;
   const mpm_grid *g = m->grid;
@@ -601,13 +604,18 @@ static int refill(const fluid_open *o, const open_face *f, const mpm_module *m,
   int lo[MPM_MAX_DIM], cnt[MPM_MAX_DIM];
   mpm_gidx total;
   const mpm_lidx nacross = across_points(g, f, o->ppc, lo, cnt, &total);
-  double *dout = malloc(sizeof *dout * (size_t)(nacross ? nacross : 1));
-  mpm_lidx *src = malloc(sizeof *src * (size_t)(nacross ? nacross : 1));
-  if (!dout || !src) {
-    free(dout), free(src);
-    MPM_FAIL_OOM(nacross);
+  if (!data) {
+    if (!f->dout || f->nlines != nacross) {
+      free(f->dout), free(f->src);
+      f->dout = NULL, f->src = NULL;
+      MPM_ALLOC(f->dout, nacross);
+      MPM_ALLOC(f->src, nacross);
+      f->nlines = nacross;
+    }
+    outermost(o, f, m, keep, lo, cnt, nacross, f->dout, f->src);
   }
-  outermost(o, f, m, keep, lo, cnt, nacross, dout, src);
+  const double *dout = f->dout;
+  const mpm_lidx *src = f->src;
   const double *mass = mpm_particles_comp(p, fc->lay.f_m, 0);
   const double *V0 = mpm_particles_comp(p, fc->lay.f_V0, 0);
   for (mpm_lidx a = 0; a < nacross; ++a) {
@@ -652,7 +660,6 @@ static int refill(const fluid_open *o, const open_face *f, const mpm_module *m,
       ++*nadd;
     }
   }
-  free(dout), free(src);
   return 0;
 }
 
@@ -716,7 +723,7 @@ int fluid_open_exchange(fluid_open *o, mpm_module *m, double t, double h, int *c
     rc = data && id ? 0 : MPM_ERR_MEMORY;
     mpm_lidx q = 0;
     for (int k = 0; !rc && k < o->nfaces; ++k) {
-      const open_face *f = &o->face[k];
+      open_face *f = &o->face[k];
       if (!f->inject || !owns_face(g, f)) continue;
       if (f->kind == MPM_WALL_INFLOW)
         layers(o, f, m, k0[k], k1[k], t, nadd, data, id, &q);
