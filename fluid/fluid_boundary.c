@@ -493,47 +493,69 @@ static mpm_lidx across_points(const mpm_grid *g, const open_face *f, int ppc, in
   return n;
 }
 
+/* The coordinate along face f's normal of a point at depth d inside it (kept below the box's
+ * hi face, which is not inside). */
+static double at_depth(const mpm_grid *g, const open_face *f, double d) {
+  const double xn = f->side ? g->hi[f->axis] - d : g->lo[f->axis] + d;
+  return xn < g->hi[f->axis] ? xn : nextafter(g->hi[f->axis], g->lo[f->axis]);
+}
+
+/* Lattice line a across face f on this rank (lo, cnt from across_points): its tangential
+ * coordinates into x (x[f->axis] untouched) and its index across the face over all ranks. */
+static mpm_gidx lattice_line(const mpm_grid *g, const open_face *f, int ppc, const int *lo,
+                             const int *cnt, mpm_lidx a, double *x) {
+  const double delta = g->dx / ppc;
+  mpm_gidx line = 0, stride = 1;
+  for (int t = 0; t < g->dim; ++t) {
+    if (t == f->axis) continue;
+    const int j = lo[t] + (int)(a % cnt[t]);
+    a /= cnt[t];
+    x[t] = g->lo[t] + (j + 0.5) * delta;
+    line += stride * j;
+    stride *= (mpm_gidx)g->ncells[t] * ppc;
+  }
+  return line;
+}
+
+/* Write a new gas particle (lattice cell volume vol, at rest: J = 1) as entry q of the arrays
+ * (component-major, stride cap). */
+static void put_particle(const mpm_module *m, mpm_lidx cap, double *data, mpm_gidx *id, mpm_lidx q,
+                         mpm_gidx idq, const double *x, const double *v, double rho, double e,
+                         double vol) {
+  const fluid_content *fc = m->content;
+  const mpm_particles *p = m->particles;
+  for (int d = 0; d < m->grid->dim; ++d) {
+    data[(size_t)(p->offset[FLUID_X] + d) * cap + q] = x[d];
+    data[(size_t)(p->offset[FLUID_V] + d) * cap + q] = v[d];
+  }
+  data[(size_t)p->offset[FLUID_J] * cap + q] = 1.0;
+  data[(size_t)p->offset[FLUID_E] * cap + q] = e;
+  data[(size_t)p->offset[fc->lay.f_m] * cap + q] = rho * vol;
+  data[(size_t)p->offset[fc->lay.f_V0] * cap + q] = vol;
+  id[q] = idq;
+}
+
 /* Append the layers k0 .. k1-1 of face f at time t to the arrays (component-major, stride
  * cap) from index *nadd on. */
 static void layers(const fluid_open *o, const open_face *f, const mpm_module *m, long long k0,
                    long long k1, double t, mpm_lidx cap, double *data, mpm_gidx *id,
                    mpm_lidx *nadd) {
   const fluid_content *fc = m->content;
-  const mpm_particles *p = m->particles;
   const mpm_grid *g = m->grid;
-  const int dim = g->dim, ppc = o->ppc;
-  const double delta = g->dx / ppc, vol = pow(delta, dim);
+  const double delta = g->dx / o->ppc, vol = pow(delta, g->dim);
   int lo[MPM_MAX_DIM], cnt[MPM_MAX_DIM];
   mpm_gidx total;
-  const mpm_lidx nacross = across_points(g, f, ppc, lo, cnt, &total);
+  const mpm_lidx nacross = across_points(g, f, o->ppc, lo, cnt, &total);
   const mpm_gidx base = (mpm_gidx)(2 * f->axis + f->side + 1) << ID_FACE_SHIFT;
   for (long long k = k0; k < k1; ++k) {
-    const double d = f->speed * t - (k + 0.5) * delta; /* depth inside the face */
-    double xn = f->side ? g->hi[f->axis] - d : g->lo[f->axis] + d;
-    if (xn >= g->hi[f->axis]) xn = nextafter(g->hi[f->axis], g->lo[f->axis]);
+    const double xn = at_depth(g, f, f->speed * t - (k + 0.5) * delta);
     for (mpm_lidx a = 0; a < nacross; ++a) {
-      mpm_lidx rest = a, q = *nadd;
-      mpm_gidx gidx = 0, stride = 1;
-      for (int t2 = 0; t2 < dim; ++t2) {
-        double xt = xn;
-        if (t2 != f->axis) {
-          const int j = lo[t2] + (int)(rest % cnt[t2]);
-          rest /= cnt[t2];
-          xt = g->lo[t2] + (j + 0.5) * delta;
-          gidx += stride * j;
-          stride *= (mpm_gidx)g->ncells[t2] * ppc;
-        }
-        data[(size_t)(p->offset[FLUID_X] + t2) * cap + q] = xt;
-        data[(size_t)(p->offset[FLUID_V] + t2) * cap + q] = o->v[t2];
-      }
-      data[(size_t)p->offset[FLUID_J] * cap + q] = 1.0;
-      data[(size_t)p->offset[FLUID_E] * cap + q] = o->e;
-      data[(size_t)p->offset[fc->lay.f_m] * cap + q] = o->rho * vol;
-      data[(size_t)p->offset[fc->lay.f_V0] * cap + q] = vol;
-      id[q] = base + (mpm_gidx)k * total + gidx;
       double xq[3] = {0, 0, 0};
-      for (int d = 0; d < dim; ++d) xq[d] = data[(size_t)(p->offset[FLUID_X] + d) * cap + q];
-      if (!fluid_obstacles_inside(&fc->obs, xq)) ++*nadd; /* else overwritten by the next */
+      const mpm_gidx line = lattice_line(g, f, o->ppc, lo, cnt, a, xq);
+      xq[f->axis] = xn;
+      if (fluid_obstacles_inside(&fc->obs, xq)) continue;
+      put_particle(m, cap, data, id, (*nadd)++, base + (mpm_gidx)k * total + line, xq, o->v, o->rho,
+                   o->e, vol);
     }
   }
 }
@@ -629,34 +651,13 @@ static int refill(const fluid_open *o, open_face *f, const mpm_module *m, const 
     }
     if (!entering_state(o, f, pp, v, &rho, vb, &e)) continue;
     double xq[3] = {0, 0, 0};
-    mpm_lidx rest = a;
-    mpm_gidx line = 0, stride = 1; /* the line's index across the face, over all ranks */
-    for (int t = 0; t < dim; ++t) {
-      if (t == f->axis) continue;
-      const int j = lo[t] + (int)(rest % cnt[t]);
-      rest /= cnt[t];
-      xq[t] = g->lo[t] + (j + 0.5) * delta;
-      line += stride * j;
-      stride *= (mpm_gidx)g->ncells[t] * o->ppc;
-    }
+    const mpm_gidx line = lattice_line(g, f, o->ppc, lo, cnt, a, xq);
     for (int k = 1; k <= MAX_COPIES && dout[a] - k * delta >= 0.0; ++k) {
-      const double dep = dout[a] - k * delta;
-      double xn = f->side ? g->hi[f->axis] - dep : g->lo[f->axis] + dep;
-      if (xn >= g->hi[f->axis]) xn = nextafter(g->hi[f->axis], g->lo[f->axis]);
-      xq[f->axis] = xn;
+      xq[f->axis] = at_depth(g, f, dout[a] - k * delta);
       if (fluid_obstacles_inside(&fc->obs, xq)) continue;
-      if (data) {
-        const mpm_lidx q = *nadd;
-        for (int d = 0; d < dim; ++d) {
-          data[(size_t)(p->offset[FLUID_X] + d) * cap + q] = xq[d];
-          data[(size_t)(p->offset[FLUID_V] + d) * cap + q] = vb[d];
-        }
-        data[(size_t)p->offset[FLUID_J] * cap + q] = 1.0;
-        data[(size_t)p->offset[FLUID_E] * cap + q] = e;
-        data[(size_t)p->offset[fc->lay.f_m] * cap + q] = rho * vol;
-        data[(size_t)p->offset[fc->lay.f_V0] * cap + q] = vol;
-        id[q] = p->id_next + line * MAX_COPIES + (k - 1);
-      }
+      if (data)
+        put_particle(m, cap, data, id, *nadd, p->id_next + line * MAX_COPIES + (k - 1), xq, vb, rho,
+                     e, vol);
       ++*nadd;
     }
   }
