@@ -6,6 +6,7 @@
 #include "fluid_boundary.h"
 #include "fluid_obstacle.h"
 #include "fluid_stress.h"
+#include "fluid_wall_ls.h"
 
 #include "mpm_bc.h"
 #include "mpm_config.h"
@@ -33,6 +34,7 @@ typedef struct fluid_content {
   fluid_open *open;          /* open faces (inflow, outflow, far field), or NULL */
   fluid_virtual virt;        /* virtual particles of the open faces and obstacles */
   fluid_obstacles obs;       /* static obstacles (fluid_obstacle.h) */
+  fluid_wall_ls wall;        /* their least-squares wall treatment (fluid_wall_ls.h) */
   int reg_every;             /* regularise every reg_every steps (0: never) */
   int reg_min, reg_max;      /* particles per non-empty cell after regularisation */
   int refill;                /* regularisation refills cells that expansion emptied */

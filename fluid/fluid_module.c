@@ -104,6 +104,7 @@ static const mpm_key_spec fluid_keys[] = {
 int fluid_add_schema(mpm_config *cfg) {
   MPM_CALL(mpm_config_add_schema(cfg, fluid_boundary_keys, fluid_boundary_nkeys));
   MPM_CALL(mpm_config_add_schema(cfg, fluid_obstacle_keys, fluid_obstacle_nkeys));
+  MPM_CALL(mpm_config_add_schema(cfg, fluid_wall_keys, fluid_wall_nkeys));
   return mpm_config_add_schema(cfg, fluid_keys, (int)(sizeof fluid_keys / sizeof fluid_keys[0]));
 }
 
@@ -208,6 +209,7 @@ static int fluid_constrain(mpm_module *m, double t, double h, mpm_pass pass) {
   if (fc->obs.count) {
     MPM_CALL(fluid_obstacles_apply(&fc->obs, m->grid, m->phase, first ? h : 0.0, first));
     mpm_constraints_apply(&fc->cons, m->grid, m->phase);
+    if (first) MPM_CALL(fluid_obstacles_work(&fc->obs, m->grid, m->phase, h));
   }
   return 0;
 }
@@ -332,7 +334,11 @@ static int fluid_g2p(mpm_module *m, double t, const double *y, double *ydot, dou
     if (Cdot) as_rate(Cdot, fc->Cnew, C, nC, h);
   }
   volume_rate(m, y, ydot, L, h);
+  const double *pos[MPM_MAX_DIM] = {NULL};
+  for (int d = 0; d < dim; ++d) pos[d] = state(p, y, FLUID_X) + (size_t)d * n;
+  fluid_obstacles_heat(&fc->obs, m->grid, m->phase, n, pos, fc->power);
   memcpy(ydot + (size_t)p->offset[FLUID_E] * n, fc->power, sizeof(double) * (size_t)n);
+  if (h > 0) MPM_CALL(fluid_wall_ls_apply(m, y, ydot, h));
   return 0;
 }
 
@@ -436,6 +442,7 @@ static void fluid_destroy(mpm_module *m) {
     mpm_constraints_free(&fc->cons);
     fluid_open_destroy(&fc->open);
     fluid_obstacles_free(&fc->obs);
+    fluid_wall_ls_free(&fc->wall);
     fluid_virtual_free(&fc->virt);
     free(fc->vsig), free(fc->scratch), free(fc->vnew), free(fc->Cnew), free(fc->power);
     free(fc->tscratch), free(fc->node), free(fc->cellsum);
@@ -546,6 +553,7 @@ static int build(mpm_module *m, const mpm_config *cfg, int seed) {
   MPM_CALL(mpm_constraints_add_walls(&fc->cons, &walls, g));
   MPM_CALL(fluid_open_new(&fc->open, m, cfg, &walls, fc->gas.gamma, fc->ppc));
   MPM_CALL(fluid_obstacles_build(&fc->obs, cfg, g, fc->ppc, (const unsigned char(*)[2])m->open));
+  MPM_CALL(fluid_wall_ls_init(m, cfg, fc->tr.classic));
   fc->virt.phase = -1;
   if (fluid_open_uses_virtual(fc->open)) MPM_CALL(fluid_virtual_init(&fc->virt, g));
   MPM_ALLOC(fc->node, (size_t)(g->dim + 3) * g->nnodes);

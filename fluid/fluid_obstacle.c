@@ -483,7 +483,9 @@ static int build_ghosts(fluid_obstacles *o, const mpm_grid *g) {
   o->gob = rc ? NULL : malloc(sizeof *o->gob * (size_t)(count + 1));
   o->near = rc ? NULL : calloc((size_t)g->nnodes, 1);
   o->sm = rc ? NULL : malloc(sizeof *o->sm * 2 * (size_t)g->nnodes);
-  if (!rc && !(o->gnode && o->G && o->gowned && o->gob && o->near && o->sm)) rc = MPM_ERR_MEMORY;
+  o->q = rc ? NULL : calloc((size_t)g->nnodes, sizeof *o->q);
+  if (!rc && !(o->gnode && o->G && o->gowned && o->gob && o->near && o->sm && o->q))
+    rc = MPM_ERR_MEMORY;
   for (mpm_lidx l = 0; !rc && l < g->nnodes; ++l) {
     int any = 0, gi[MPM_MAX_DIM];
     for (int d = 0; d < dim; ++d) any |= G[d][l] != 0.0;
@@ -495,6 +497,12 @@ static int build_ghosts(fluid_obstacles *o, const mpm_grid *g) {
     o->gnode[o->gcount++] = l;
     flag_near(o, g, gi);
   }
+  for (int k = 0; !rc && k < o->count; ++k) /* the heat reaches the constrained nodes too */
+    for (mpm_lidx j = 0; j < o->ob[k].count; ++j) {
+      int gi[MPM_MAX_DIM];
+      mpm_grid_node_global(g, o->ob[k].node[j], gi);
+      flag_near(o, g, gi);
+    }
   for (int d = 0; d < dim; ++d) free(G[d]);
   if (rc) MPM_FAIL(rc, "cannot allocate the obstacles' ghost nodes");
   return 0;
@@ -507,7 +515,7 @@ int fluid_obstacles_build(fluid_obstacles *o, const mpm_config *cfg, const mpm_g
   int count;
   double band;
   memset(o, 0, sizeof *o);
-  o->ppc = ppc, o->lp = 0.5 / ppc;
+  o->ppc = ppc, o->lp = 0.5 / ppc, o->hold = FLUID_OBSTACLE_HOLD;
   memcpy(o->open, open, sizeof o->open);
   MPM_CALL(mpm_config_get_real(cfg, "fluid.obstacle_band", &band));
   MPM_CALL(mpm_config_get_string(cfg, "output.dir", &dir));
@@ -568,7 +576,10 @@ int fluid_obstacles_begin(fluid_obstacles *o, mpm_grid *grid, int phase, double 
   double *sm = o->sm, *smp = o->sm + grid->nnodes, *fields[2] = {sm, smp};
   MPM_CALL(mpm_grid_halo_reverse(grid, fields, 2));
   double *rec = o->f[record ? mpm_rhs_records_begin(&o->rec, t, h) : o->rec.latest];
-  if (record) memset(rec, 0, sizeof *rec * (size_t)dim * o->count);
+  if (record) {
+    memset(rec, 0, sizeof *rec * (size_t)dim * o->count);
+    memset(o->q, 0, sizeof *o->q * (size_t)grid->nnodes);
+  }
   mpm_grid_phase *ph = &grid->phase[phase];
   for (mpm_lidx k = 0; k < o->gcount; ++k) {
     const mpm_lidx l = o->gnode[k];
@@ -587,7 +598,7 @@ int fluid_obstacles_begin(fluid_obstacles *o, mpm_grid *grid, int phase, double 
  * less mass than hold_below are held entirely (see the header). In the classic update the
  * velocity change is an impulse over the step (mpm_impulse.h). */
 static void apply_one(const fluid_obstacle *ob, mpm_grid_phase *ph, int dim, double h,
-                      double hold_below, double *f) {
+                      double hold_below, int coast, double *f, double *q) {
   for (mpm_lidx k = 0; k < ob->count; ++k) {
     const mpm_lidx l = ob->node[k];
     const double m = ph->m_i[l];
@@ -600,7 +611,13 @@ static void apply_one(const fluid_obstacle *ob, mpm_grid_phase *ph, int dim, dou
       v[d] = hold ? 0.0 : ph->v_i[d][l] - vn * n[d];
       a[d] = hold ? 0.0 : ph->a_i[d][l] - an * n[d];
     }
-    mpm_impulse_apply(ph, dim, l, v, a, h, force);
+    if (hold && coast && h > 0 && !ob->no_slip) { /* v^n = v - h a, slip-projected */
+      double v0n = 0.0;
+      for (int d = 0; d < dim; ++d) v0n += (ph->v_i[d][l] - h * ph->a_i[d][l]) * n[d];
+      for (int d = 0; d < dim; ++d) v[d] = ph->v_i[d][l] - h * ph->a_i[d][l] - v0n * n[d];
+    }
+    const double power = mpm_impulse_apply(ph, dim, l, v, a, h, force);
+    if (q) q[l] += power;
     /* the force the gas exerts on the obstacle: minus the rate the obstacle gives the gas */
     for (int d = 0; ob->owned[k] && d < dim; ++d) f[d] -= force[d];
   }
@@ -617,9 +634,55 @@ int fluid_obstacles_apply(fluid_obstacles *o, mpm_grid *grid, int phase, double 
   MPM_CALL_MPI(MPI_Allreduce(MPI_IN_PLACE, &mmax, 1, MPI_DOUBLE, MPI_MAX, grid->comm));
   for (int k = 0; k < o->count; ++k) {
     double *f = record ? o->f[o->rec.latest] + (size_t)dim * k : scratch;
-    apply_one(&o->ob[k], &grid->phase[phase], dim, h, FLUID_OBSTACLE_HOLD * mmax, f);
+    apply_one(&o->ob[k], &grid->phase[phase], dim, h, o->hold * mmax, o->coast, f,
+              record ? o->q : NULL);
   }
   return 0;
+}
+
+int fluid_obstacles_work(fluid_obstacles *o, mpm_grid *grid, int phase, double h) {
+  if (o->count == 0) return 0;
+  const int dim = grid->dim;
+  const mpm_grid_phase *ph = &grid->phase[phase];
+  const double *sm = o->sm, *smp = o->sm + grid->nnodes;
+  for (mpm_lidx k = 0; k < o->gcount; ++k) {
+    const mpm_lidx l = o->gnode[k];
+    if (!(sm[l] > 0.0)) continue;
+    const double p = smp[l] / sm[l];
+    for (int d = 0; d < dim; ++d)
+      o->q[l] += p * o->G[(size_t)dim * k + d] * (ph->v_i[d][l] - 0.5 * h * ph->a_i[d][l]);
+  }
+  /* Per unit of nodal mass, from the owners (the ghost copies' sums are partial until the
+   * forward exchange). */
+  for (mpm_lidx l = 0; l < grid->nnodes; ++l)
+    o->q[l] = ph->m_i[l] > 0.0 ? o->q[l] / ph->m_i[l] : 0.0;
+  return mpm_grid_halo_forward(grid, &o->q, 1);
+}
+
+void fluid_obstacles_heat(const fluid_obstacles *o, const mpm_grid *grid, int phase, mpm_lidx n,
+                          const double *const *x, double *power) {
+  if (o->count == 0) return;
+  const int dim = grid->dim;
+  (void)phase;
+  for (mpm_lidx i = 0; i < n; ++i) {
+    int gi[MPM_MAX_DIM], in = 1;
+    double xp[MPM_MAX_DIM];
+    for (int d = 0; d < dim; ++d) {
+      xp[d] = x[d][i];
+      gi[d] = mpm_shape_floor((xp[d] - grid->lo[d]) / grid->dx);
+      in &= gi[d] >= grid->box_lo[d] && gi[d] < grid->box_lo[d] + grid->box_n[d];
+    }
+    if (!in || !o->near[mpm_grid_local_index(grid, gi)]) continue;
+    stencil st;
+    stencil_at(&st, grid, xp, o->lp);
+    double heat = 0.0;
+    for (int s = 0; s < stencil_count(&st, dim); ++s) {
+      double w;
+      const mpm_lidx l = stencil_node(&st, grid, s, &w, NULL);
+      if (l >= 0) heat -= w * o->q[l];
+    }
+    power[i] += heat;
+  }
 }
 
 static int open_csv(fluid_obstacles *o, const mpm_grid *g, double t0) {
@@ -665,7 +728,7 @@ void fluid_obstacles_free(fluid_obstacles *o) {
   }
   free(o->ob);
   free(o->f[0]), free(o->f[1]);
-  free(o->gnode), free(o->G), free(o->gowned), free(o->gob), free(o->near), free(o->sm);
+  free(o->gnode), free(o->G), free(o->gowned), free(o->gob), free(o->near), free(o->sm), free(o->q);
   mpm_diag_close(&o->csv);
   memset(o, 0, sizeof *o);
 }

@@ -1,0 +1,415 @@
+/* The least-squares wall treatment (see fluid_wall_ls.h). */
+#include "fluid_internal.h"
+
+#include "mpm_error.h"
+#include "mpm_shape.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+const mpm_key_spec fluid_wall_keys[] = {
+    {"fluid.wall_treatment", MPM_KEY_ENUM, "ghost", 0, 0, 0, 0, "ghost|least_squares",
+     "gas next to [obstacle] surfaces: ghost (ghost pressure and held nodes) or least_squares "
+     "(the particles within fluid.wall_band take a least-squares fit over the particles "
+     "behind them, with the wall condition imposed; classic update only; see "
+     "fluid/fluid_wall_ls.h)",
+     0},
+    {"fluid.wall_band", MPM_KEY_REAL, "1", 0, 3, 1, 0, NULL,
+     "least_squares: particles closer to an obstacle than this many cells are fitted, in "
+     "(0, 3]",
+     0},
+    {"fluid.wall_fit_order", MPM_KEY_INT, "0", 0, 1, 0, 0, NULL,
+     "least_squares: order of the fit of the tangential velocity, e and rho: 0 (the donors' "
+     "weighted mean) or 1 (linear; it extrapolates the gradients next to the wall: the "
+     "wedge's wall layer ran 10-57 % over the post-shock pressure); the normal velocity is "
+     "always linear and zero on the surface",
+     0},
+};
+const int fluid_wall_nkeys = (int)(sizeof fluid_wall_keys / sizeof fluid_wall_keys[0]);
+
+/* ---- small dense systems ------------------------------------------------------------------- */
+
+/* Solve the symmetric positive definite system A x = b of order n <= 4 (A row-major, both
+ * overwritten) by Cholesky; 1 if a pivot falls below tol times the largest diagonal entry. */
+static int spd_solve(int n, double *A, double *b, double tol) {
+  double dmax = 0.0;
+  for (int i = 0; i < n; ++i) dmax = fmax(dmax, A[i * n + i]);
+  for (int j = 0; j < n; ++j) {
+    double d = A[j * n + j];
+    for (int k = 0; k < j; ++k) d -= A[j * n + k] * A[j * n + k];
+    if (!(d > tol * dmax)) return 1;
+    d = sqrt(d);
+    A[j * n + j] = d;
+    for (int i = j + 1; i < n; ++i) {
+      double s = A[i * n + j];
+      for (int k = 0; k < j; ++k) s -= A[i * n + k] * A[j * n + k];
+      A[i * n + j] = s / d;
+    }
+  }
+  for (int i = 0; i < n; ++i) { /* L y = b */
+    for (int k = 0; k < i; ++k) b[i] -= A[i * n + k] * b[k];
+    b[i] /= A[i * n + i];
+  }
+  for (int i = n - 1; i >= 0; --i) { /* L^T x = y */
+    for (int k = i + 1; k < n; ++k) b[i] -= A[k * n + i] * b[k];
+    b[i] /= A[i * n + i];
+  }
+  return 0;
+}
+
+/* Pivots below this fraction of the largest diagonal entry mean the donors cannot fix a
+ * gradient (they lie on a line, or one holds all the weight). */
+#define SINGULAR 1e-8
+
+/* ---- the moments ---------------------------------------------------------------------------- */
+
+/* Index layout of the nodal moments, r in cells: M0, M1[dim], M2[dim (dim + 1) / 2] (a <= b),
+ * then per field F0, F1[dim]. */
+typedef struct layout {
+  int dim, nf, m1, m2, f0;
+} layout;
+
+static layout layout_of(int dim, int nf) {
+  layout L = {.dim = dim, .nf = nf, .m1 = 1, .m2 = 1 + dim};
+  L.f0 = L.m2 + dim * (dim + 1) / 2;
+  return L;
+}
+static int m2_index(const layout *L, int a, int b) { /* a <= b */
+  int k = L->m2;
+  for (int r = 0; r < a; ++r) k += L->dim - r;
+  return k + b - a;
+}
+static int f_index(const layout *L, int f) {
+  return L->f0 + f * (1 + L->dim);
+}
+
+/* The weighted sums of one wall particle, gathered from the nodal moments. */
+typedef struct sums {
+  double S0, S1[MPM_MAX_DIM], S2[MPM_MAX_DIM][MPM_MAX_DIM];
+  double G0[2 * MPM_MAX_DIM + 2], G1[2 * MPM_MAX_DIM + 2][MPM_MAX_DIM];
+} sums;
+
+/* Visit the stencil of a point at xi (cells): fn(l, w, d) for every box node l, with d its
+ * offset x_i - x in cells. */
+#define FOR_STENCIL(g, xi, lp, BODY)                                                               \
+  do {                                                                                             \
+    int base_[MPM_MAX_DIM], sup_ = mpm_shape_support((g)->shape);                                  \
+    double w_[MPM_MAX_DIM][MPM_SHAPE_MAX_SUPPORT], dw_[MPM_MAX_DIM][MPM_SHAPE_MAX_SUPPORT];        \
+    mpm_shape_eval((g)->shape, (g)->dim, xi, lp, base_, w_, dw_);                                  \
+    const int cnt_ = (g)->dim == 2 ? sup_ * sup_ : sup_ * sup_ * sup_;                             \
+    for (int s_ = 0; s_ < cnt_; ++s_) {                                                            \
+      int gi_[MPM_MAX_DIM], k_ = s_, in_ = 1;                                                      \
+      double W = 1.0, D[MPM_MAX_DIM];                                                              \
+      for (int d_ = 0; d_ < (g)->dim; ++d_) {                                                      \
+        const int kd_ = k_ % sup_;                                                                 \
+        k_ /= sup_;                                                                                \
+        gi_[d_] = base_[d_] + kd_;                                                                 \
+        in_ &= gi_[d_] >= (g)->box_lo[d_] && gi_[d_] < (g)->box_lo[d_] + (g)->box_n[d_];           \
+        W *= w_[d_][kd_];                                                                          \
+        D[d_] = gi_[d_] - (xi)[d_];                                                                \
+      }                                                                                            \
+      if (!in_ || W == 0.0) continue;                                                              \
+      const mpm_lidx L_ = mpm_grid_local_index(g, gi_);                                            \
+      BODY                                                                                         \
+    }                                                                                              \
+  } while (0)
+
+static void deposit(double *mom, mpm_lidx nn, const layout *L, const mpm_grid *g, const double *xi,
+                    double lp, double V, const double *f) {
+  const int dim = L->dim;
+  FOR_STENCIL(g, xi, lp, {
+    const double w = W * V;
+    double r[MPM_MAX_DIM];
+    for (int a = 0; a < dim; ++a) r[a] = -D[a]; /* x_q - x_i */
+    mom[L_] += w;
+    for (int a = 0; a < dim; ++a) {
+      mom[(size_t)(L->m1 + a) * nn + L_] += w * r[a];
+      for (int b = a; b < dim; ++b) mom[(size_t)m2_index(L, a, b) * nn + L_] += w * r[a] * r[b];
+    }
+    for (int k = 0; k < L->nf; ++k) {
+      const int i0 = f_index(L, k);
+      mom[(size_t)i0 * nn + L_] += w * f[k];
+      for (int a = 0; a < dim; ++a) mom[(size_t)(i0 + 1 + a) * nn + L_] += w * f[k] * r[a];
+    }
+  });
+}
+
+static void gather(sums *s, const double *mom, mpm_lidx nn, const layout *L, const mpm_grid *g,
+                   const double *xi, double lp) {
+  const int dim = L->dim;
+  memset(s, 0, sizeof *s);
+  FOR_STENCIL(g, xi, lp, {
+    const double m0 = mom[L_];
+    double m1[MPM_MAX_DIM];
+    for (int a = 0; a < dim; ++a) m1[a] = mom[(size_t)(L->m1 + a) * nn + L_];
+    s->S0 += W * m0;
+    for (int a = 0; a < dim; ++a) {
+      s->S1[a] += W * (m1[a] + D[a] * m0);
+      for (int b = a; b < dim; ++b)
+        s->S2[a][b] += W * (mom[(size_t)m2_index(L, a, b) * nn + L_] + m1[a] * D[b] + D[a] * m1[b] +
+                            D[a] * D[b] * m0);
+    }
+    for (int k = 0; k < L->nf; ++k) {
+      const int i0 = f_index(L, k);
+      const double f0 = mom[(size_t)i0 * nn + L_];
+      s->G0[k] += W * f0;
+      for (int a = 0; a < dim; ++a)
+        s->G1[k][a] += W * (mom[(size_t)(i0 + 1 + a) * nn + L_] + D[a] * f0);
+    }
+  });
+  for (int a = 0; a < dim; ++a)
+    for (int b = 0; b < a; ++b) s->S2[a][b] = s->S2[b][a];
+}
+
+/* The unconstrained fits a + g . r of every field at r = 0 into out (nf values); 1 if singular
+ * (out then holds the weighted means). */
+static int fit_free(const sums *s, const layout *L, double *out) {
+  const int dim = L->dim, n = dim + 1;
+  double A[16];
+  A[0] = s->S0;
+  for (int a = 0; a < dim; ++a) {
+    A[a + 1] = A[(a + 1) * n] = s->S1[a];
+    for (int b = 0; b < dim; ++b) A[(a + 1) * n + b + 1] = s->S2[a][b];
+  }
+  /* One factorisation, many right-hand sides: factor a copy per field (n <= 4, cheap). */
+  for (int k = 0; k < L->nf; ++k) {
+    double Ak[16], b[4];
+    memcpy(Ak, A, sizeof Ak);
+    b[0] = s->G0[k];
+    for (int a = 0; a < dim; ++a) b[a + 1] = s->G1[k][a];
+    if (spd_solve(n, Ak, b, SINGULAR)) {
+      for (int j = 0; j < L->nf; ++j) out[j] = s->G0[j] / s->S0;
+      return 1;
+    }
+    out[k] = b[0];
+  }
+  return 0;
+}
+
+/* The fit u . t ~ c . (x - x_w) of the velocity field starting at field k0 along the unit
+ * vector t, zero on the surface point x_w = x_p - phi n (phi, n in cells): its value at x_p. */
+static double fit_constrained(const sums *s, const layout *L, int k0, const double *t, double phi,
+                              const double *n) {
+  const int dim = L->dim;
+  double A[9] = {0}, b[3] = {0};
+  for (int a = 0; a < dim; ++a) {
+    double ga = 0.0, g0 = 0.0;
+    for (int f = 0; f < dim; ++f) ga += t[f] * s->G1[k0 + f][a], g0 += t[f] * s->G0[k0 + f];
+    b[a] = ga + phi * n[a] * g0;
+    for (int c = 0; c < dim; ++c)
+      A[a * dim + c] =
+          s->S2[a][c] + phi * (s->S1[a] * n[c] + n[a] * s->S1[c]) + phi * phi * s->S0 * n[a] * n[c];
+  }
+  double An[9], bn[3];
+  memcpy(An, A, sizeof An), memcpy(bn, b, sizeof bn);
+  if (!spd_solve(dim, An, bn, SINGULAR)) {
+    double cn = 0.0;
+    for (int a = 0; a < dim; ++a) cn += bn[a] * n[a];
+    return phi * cn;
+  }
+  /* Donors on a line: vary along the normal only. */
+  double nAn = 0.0, nb = 0.0;
+  for (int a = 0; a < dim; ++a) {
+    nb += n[a] * b[a];
+    for (int c = 0; c < dim; ++c) nAn += n[a] * A[a * dim + c] * n[c];
+  }
+  return nAn > 0.0 ? phi * nb / nAn : 0.0;
+}
+
+/* ---- setup ---------------------------------------------------------------------------------- */
+
+/* The nearest obstacle to x: its index, phi and outward normal. */
+static int nearest(const fluid_obstacles *o, const double *x, double *phi, double *normal) {
+  int best = -1;
+  double nb[MPM_MAX_DIM];
+  *phi = HUGE_VAL;
+  for (int k = 0; k < o->count; ++k) {
+    const double f = mpm_sdf_eval(&o->ob[k].sdf, x, nb);
+    if (f < *phi) *phi = f, best = k, memcpy(normal, nb, sizeof nb);
+  }
+  return best;
+}
+
+int fluid_wall_ls_init(mpm_module *m, const mpm_config *cfg, int classic) {
+  fluid_content *fc = m->content;
+  fluid_wall_ls *w = &fc->wall;
+  const mpm_grid *g = m->grid;
+  const char *kind;
+  memset(w, 0, sizeof *w);
+  MPM_CALL(mpm_config_get_string(cfg, "fluid.wall_treatment", &kind));
+  if (strcmp(kind, "least_squares") != 0) return 0;
+  if (!classic)
+    return mpm_config_fail(cfg, "fluid.wall_treatment",
+                           "least_squares needs the classic update (time.method = usl or musl): "
+                           "its fit is not part of an adaptive pair's error control");
+  if (fc->obs.count == 0)
+    return mpm_config_fail(cfg, "fluid.wall_treatment",
+                           "least_squares acts on [obstacle.NAME] surfaces and this scene has "
+                           "none (domain walls keep their mirror rules): remove the key or add "
+                           "an obstacle");
+  double band;
+  MPM_CALL(mpm_config_get_real(cfg, "fluid.wall_band", &band));
+  w->on = 1, w->band = band * g->dx;
+  MPM_CALL(mpm_config_get_int(cfg, "fluid.wall_fit_order", &w->order));
+  fc->obs.coast = 1;
+  const int dim = g->dim;
+  w->nf = 2 * dim + 2;
+  const layout L = layout_of(dim, w->nf);
+  w->nmom = f_index(&L, w->nf);
+  MPM_ALLOC(w->mom, (size_t)w->nmom * g->nnodes);
+  MPM_ALLOC(w->mom_ptr, w->nmom);
+  for (int k = 0; k < w->nmom; ++k) w->mom_ptr[k] = w->mom + (size_t)k * g->nnodes;
+  /* A donor reaches a wall particle's fit if a node is within a stencil of both: donors lie
+   * within band + 2 stencil radii of a body; a cell is near if its centre is within that and
+   * half a cell diagonal. */
+  const double reach = w->band + (mpm_shape_support(g->shape) + 0.5 * sqrt((double)dim)) * g->dx;
+  MPM_ALLOC(w->reach, g->nnodes);
+  for (mpm_lidx l = 0; l < g->nnodes; ++l) {
+    int gi[MPM_MAX_DIM];
+    double xc[MPM_MAX_DIM], phi, nrm[MPM_MAX_DIM];
+    mpm_grid_node_global(g, l, gi);
+    for (int d = 0; d < dim; ++d) xc[d] = g->lo[d] + (gi[d] + 0.5) * g->dx;
+    nearest(&fc->obs, xc, &phi, nrm);
+    w->reach[l] = phi < reach;
+  }
+  return 0;
+}
+
+static int ensure(fluid_wall_ls *w, mpm_lidx n, int dim) {
+  if (n <= w->cap) return 0;
+  const mpm_lidx cap = n + n / 4 + 16;
+  free(w->kind), free(w->ob), free(w->geo), free(w->val);
+  w->kind = malloc((size_t)cap);
+  w->ob = malloc(sizeof *w->ob * (size_t)cap);
+  w->geo = malloc(sizeof *w->geo * (size_t)(1 + dim) * cap);
+  w->val = malloc(sizeof *w->val * (size_t)w->nf * cap);
+  w->cap = cap;
+  if (!(w->kind && w->ob && w->geo && w->val)) {
+    w->cap = 0;
+    MPM_FAIL(MPM_ERR_MEMORY, "cannot allocate the least-squares wall scratch for %ld particles",
+             (long)n);
+  }
+  return 0;
+}
+
+/* ---- the step ------------------------------------------------------------------------------- */
+
+int fluid_wall_ls_apply(mpm_module *m, const double *y, double *ydot, double h) {
+  fluid_content *fc = m->content;
+  fluid_wall_ls *w = &fc->wall;
+  if (!w->on) return 0;
+  const mpm_particles *p = m->particles;
+  mpm_grid *g = m->grid;
+  const int dim = g->dim, nf = w->nf;
+  const mpm_lidx n = p->n, nn = g->nnodes;
+  const layout L = layout_of(dim, nf);
+  MPM_CALL(ensure(w, n, dim));
+  const double *mass = mpm_particles_comp(p, fc->lay.f_m, 0);
+  const double *V0 = mpm_particles_comp(p, fc->lay.f_V0, 0);
+  const size_t ox = (size_t)p->offset[FLUID_X] * n, ov = (size_t)p->offset[FLUID_V] * n;
+  const size_t oJ = (size_t)p->offset[FLUID_J] * n, oe = (size_t)p->offset[FLUID_E] * n;
+  memset(w->mom, 0, sizeof *w->mom * (size_t)w->nmom * nn);
+
+  /* Classify, and deposit the donors' new values. */
+  for (mpm_lidx i = 0; i < n; ++i) {
+    double x[MPM_MAX_DIM], xi[MPM_MAX_DIM];
+    int gi[MPM_MAX_DIM], in = 1;
+    for (int d = 0; d < dim; ++d) {
+      x[d] = y[ox + (size_t)d * n + i];
+      xi[d] = (x[d] - g->lo[d]) / g->dx;
+      gi[d] = mpm_shape_floor(xi[d]);
+      in &= gi[d] >= g->box_lo[d] && gi[d] < g->box_lo[d] + g->box_n[d];
+    }
+    w->kind[i] = -1;
+    if (!in || !w->reach[mpm_grid_local_index(g, gi)]) continue;
+    double *geo = w->geo + (size_t)(1 + dim) * i, *f = w->val + (size_t)nf * i;
+    w->ob[i] = nearest(&fc->obs, x, &geo[0], geo + 1);
+    const double J1 = y[oJ + i] + h * ydot[oJ + i], V = V0[i] * J1;
+    for (int d = 0; d < dim; ++d) {
+      f[d] = y[ov + (size_t)d * n + i] + h * ydot[ov + (size_t)d * n + i];
+      f[dim + d] = ydot[ox + (size_t)d * n + i];
+    }
+    f[2 * dim] = y[oe + i] + h * ydot[oe + i];
+    f[2 * dim + 1] = mass[i] / V;
+    w->kind[i] = geo[0] < w->band;
+    if (w->kind[i] == 0) deposit(w->mom, nn, &L, g, xi, fc->lp, V, f);
+  }
+  MPM_CALL(mpm_grid_halo_reverse(g, w->mom_ptr, w->nmom));
+  MPM_CALL(mpm_grid_halo_forward(g, w->mom_ptr, w->nmom));
+
+  /* Fit the wall particles; book the momentum; sum the energy change. */
+  double *force = fc->obs.f[fc->obs.rec.latest];
+  double bal[2] = {0.0, 0.0}; /* the fit's energy change, and sum m e of the fitted */
+  for (mpm_lidx i = 0; i < n; ++i) {
+    if (w->kind[i] != 1) continue;
+    double xi[MPM_MAX_DIM], out[2 * MPM_MAX_DIM + 2];
+    for (int d = 0; d < dim; ++d) xi[d] = (y[ox + (size_t)d * n + i] - g->lo[d]) / g->dx;
+    sums s;
+    gather(&s, w->mom, nn, &L, g, xi, fc->lp);
+    double *f = w->val + (size_t)nf * i;
+    if (!(s.S0 > 0.0)) { /* no donor near: keep the transfer's values */
+      w->kind[i] = 2;
+      continue;
+    }
+    int mean = w->order == 0;
+    if (!mean) mean = fit_free(&s, &L, out);
+    if (mean)
+      for (int k = 0; k < nf; ++k) out[k] = s.G0[k] / s.S0;
+    for (int k = 2 * dim; k < nf; ++k) { /* e and rho of a linear fit: see the header */
+      const double mk = s.G0[k] / s.S0;
+      if (!(out[k] > 0.5 * mk && out[k] < 2.0 * mk)) out[k] = mk;
+    }
+    /* The wall condition on both velocities. */
+    const double phi = w->geo[(size_t)(1 + dim) * i] / g->dx;
+    const double *nrm = w->geo + (size_t)(1 + dim) * i + 1;
+    const int no_slip = fc->obs.ob[w->ob[i]].no_slip;
+    for (int k0 = 0; k0 <= dim; k0 += dim) {
+      double t[MPM_MAX_DIM] = {0}, un = 0.0;
+      if (no_slip) {
+        for (int c = 0; c < dim; ++c) {
+          memset(t, 0, sizeof t), t[c] = 1.0;
+          out[k0 + c] = fit_constrained(&s, &L, k0, t, phi, nrm);
+        }
+        continue;
+      }
+      for (int d = 0; d < dim; ++d) un += out[k0 + d] * nrm[d];
+      const double fitted = fit_constrained(&s, &L, k0, nrm, phi, nrm);
+      for (int d = 0; d < dim; ++d) out[k0 + d] += (fitted - un) * nrm[d];
+    }
+    /* Momentum to the obstacle, energy to the balance. */
+    double *F = force + (size_t)dim * w->ob[i];
+    double dke = 0.0;
+    for (int d = 0; d < dim; ++d) {
+      const double v0 = y[ov + (size_t)d * n + i];
+      F[d] -= mass[i] * (out[d] - f[d]) / h;
+      dke += 0.5 * (out[d] * out[d] - f[d] * f[d]);
+      ydot[ov + (size_t)d * n + i] = (out[d] - v0) / h;
+      ydot[ox + (size_t)d * n + i] = out[dim + d];
+    }
+    bal[0] += mass[i] * (dke + out[2 * dim] - f[2 * dim]);
+    bal[1] += mass[i] * out[2 * dim];
+    f[2 * dim] = out[2 * dim], f[2 * dim + 1] = out[2 * dim + 1];
+  }
+  MPM_CALL_MPI(MPI_Allreduce(MPI_IN_PLACE, bal, 2, MPI_DOUBLE, MPI_SUM, g->comm));
+  const double scale = bal[1] > 0.0 ? 1.0 - bal[0] / bal[1] : 1.0;
+  if (!(scale > 0.0))
+    MPM_FAIL(MPM_ERR_UNPHYSICAL,
+             "the least-squares wall fit changed the total energy of the wall particles by "
+             "%.3g J, more than all their internal energy (%.3g J): the flow next to the "
+             "obstacles is not resolved; refine grid.dx or use fluid.wall_treatment = ghost",
+             bal[0], bal[1]);
+  for (mpm_lidx i = 0; i < n; ++i) {
+    if (w->kind[i] != 1) continue;
+    const double *f = w->val + (size_t)nf * i;
+    ydot[oe + i] = (scale * f[2 * dim] - y[oe + i]) / h;
+    ydot[oJ + i] = (mass[i] / (f[2 * dim + 1] * V0[i]) - y[oJ + i]) / h;
+  }
+  return 0;
+}
+
+void fluid_wall_ls_free(fluid_wall_ls *w) {
+  free(w->reach), free(w->mom), free(w->mom_ptr);
+  free(w->kind), free(w->ob), free(w->geo), free(w->val);
+  memset(w, 0, sizeof *w);
+}
