@@ -336,7 +336,7 @@ static int fluid_g2p(mpm_module *m, double t, const double *y, double *ydot, dou
   volume_rate(m, y, ydot, L, h);
   const double *pos[MPM_MAX_DIM] = {NULL};
   for (int d = 0; d < dim; ++d) pos[d] = state(p, y, FLUID_X) + (size_t)d * n;
-  fluid_obstacles_heat(&fc->obs, m->grid, m->phase, n, pos, fc->power);
+  fluid_obstacles_heat(&fc->obs, m->grid, n, pos, state(p, y, FLUID_E), h, fc->power);
   memcpy(ydot + (size_t)p->offset[FLUID_E] * n, fc->power, sizeof(double) * (size_t)n);
   if (h > 0) MPM_CALL(fluid_wall_ls_apply(m, y, ydot, h));
   return 0;

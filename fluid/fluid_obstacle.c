@@ -484,8 +484,11 @@ static int build_ghosts(fluid_obstacles *o, const mpm_grid *g) {
   o->near = rc ? NULL : calloc((size_t)g->nnodes, 1);
   o->sm = rc ? NULL : malloc(sizeof *o->sm * 2 * (size_t)g->nnodes);
   o->q = rc ? NULL : calloc((size_t)g->nnodes, sizeof *o->q);
-  if (!rc && !(o->gnode && o->G && o->gowned && o->gob && o->near && o->sm && o->q))
+  o->own = rc ? NULL : malloc((size_t)g->nnodes);
+  if (!rc && !(o->gnode && o->G && o->gowned && o->gob && o->near && o->sm && o->q && o->own))
     rc = MPM_ERR_MEMORY;
+  for (mpm_lidx l = 0; !rc && l < g->nnodes; ++l)
+    o->own[l] = (unsigned char)mpm_grid_node_is_owned(g, l);
   for (mpm_lidx l = 0; !rc && l < g->nnodes; ++l) {
     int any = 0, gi[MPM_MAX_DIM];
     for (int d = 0; d < dim; ++d) any |= G[d][l] != 0.0;
@@ -641,7 +644,7 @@ int fluid_obstacles_apply(fluid_obstacles *o, mpm_grid *grid, int phase, double 
 }
 
 int fluid_obstacles_work(fluid_obstacles *o, mpm_grid *grid, int phase, double h) {
-  if (o->count == 0) return 0;
+  if (o->count == 0 || !o->heat) return 0;
   const int dim = grid->dim;
   const mpm_grid_phase *ph = &grid->phase[phase];
   const double *sm = o->sm, *smp = o->sm + grid->nnodes;
@@ -652,18 +655,18 @@ int fluid_obstacles_work(fluid_obstacles *o, mpm_grid *grid, int phase, double h
     for (int d = 0; d < dim; ++d)
       o->q[l] += p * o->G[(size_t)dim * k + d] * (ph->v_i[d][l] - 0.5 * h * ph->a_i[d][l]);
   }
-  /* Per unit of nodal mass, from the owners (the ghost copies' sums are partial until the
-   * forward exchange). */
+  /* Per unit of nodal mass, from the owners: the ghost copies' sums are partial until the
+   * forward exchange, and a mirrored pad node beyond a wall (owned by no rank) was constrained
+   * before the wall copied its image into it. */
   for (mpm_lidx l = 0; l < grid->nnodes; ++l)
-    o->q[l] = ph->m_i[l] > 0.0 ? o->q[l] / ph->m_i[l] : 0.0;
+    o->q[l] = o->own[l] && ph->m_i[l] > 0.0 ? o->q[l] / ph->m_i[l] : 0.0;
   return mpm_grid_halo_forward(grid, &o->q, 1);
 }
 
-void fluid_obstacles_heat(const fluid_obstacles *o, const mpm_grid *grid, int phase, mpm_lidx n,
-                          const double *const *x, double *power) {
-  if (o->count == 0) return;
+void fluid_obstacles_heat(const fluid_obstacles *o, const mpm_grid *grid, mpm_lidx n,
+                          const double *const *x, const double *e, double h, double *power) {
+  if (o->count == 0 || !o->heat) return;
   const int dim = grid->dim;
-  (void)phase;
   for (mpm_lidx i = 0; i < n; ++i) {
     int gi[MPM_MAX_DIM], in = 1;
     double xp[MPM_MAX_DIM];
@@ -681,6 +684,8 @@ void fluid_obstacles_heat(const fluid_obstacles *o, const mpm_grid *grid, int ph
       const mpm_lidx l = stencil_node(&st, grid, s, &w, NULL);
       if (l >= 0) heat -= w * o->q[l];
     }
+    /* The step may cool a particle to half its internal energy, no further. */
+    if (h > 0.0 && heat < -0.5 * e[i] / h - power[i]) heat = -0.5 * e[i] / h - power[i];
     power[i] += heat;
   }
 }
@@ -728,7 +733,8 @@ void fluid_obstacles_free(fluid_obstacles *o) {
   }
   free(o->ob);
   free(o->f[0]), free(o->f[1]);
-  free(o->gnode), free(o->G), free(o->gowned), free(o->gob), free(o->near), free(o->sm), free(o->q);
+  free(o->gnode), free(o->G), free(o->gowned), free(o->gob), free(o->near), free(o->sm), free(o->q),
+      free(o->own);
   mpm_diag_close(&o->csv);
   memset(o, 0, sizeof *o);
 }

@@ -219,24 +219,34 @@ static int widest_gap_axis(const reg_cell *c, const reg_box *b, int nc) {
   return axis;
 }
 
-/* Split the heaviest row into two halves; the new half gets id `id`. */
+/* Split the heaviest row into two halves; the new half gets id `id`. The halves move apart
+ * along the axis of the widest gap, or the next axis where neither would land inside an
+ * obstacle (a cell the surface cuts), or stay together. */
 static int split_heaviest(reg_cell *c, const fluid_layout *lay, const mpm_particles *p,
-                          const reg_box *b, mpm_gidx id) {
+                          const reg_box *b, const fluid_obstacles *obs, mpm_gidx id) {
   const int nc = p->ncomp, om = p->offset[lay->f_m];
   MPM_CALL(cell_reserve(c, c->k + 1, nc));
   int h = 0;
   for (int a = 1; a < c->k; ++a)
     if (c->row[(size_t)a * nc + om] > c->row[(size_t)h * nc + om]) h = a;
-  const int axis = widest_gap_axis(c, b, nc);
+  const int widest = widest_gap_axis(c, b, nc);
   double *par = c->row + (size_t)h * nc, *kid = c->row + (size_t)c->k * nc;
-  const double x = par[axis];
-  const double face = b->lo[axis] + cell_coord(b, axis, x) * b->dx;
-  const double room = fmin(x - face, face + b->dx - x);
   const double size = pow(par[p->offset[FLUID_J]] * par[p->offset[lay->f_V0]], 1.0 / p->dim);
-  const double delta = fmin(0.25 * size, 0.5 * room);
   par[om] *= 0.5, par[p->offset[lay->f_V0]] *= 0.5;
   memcpy(kid, par, sizeof *kid * (size_t)nc);
-  par[axis] = x - delta, kid[axis] = x + delta;
+  for (int k = 0; k < p->dim; ++k) {
+    const int axis = (widest + k) % p->dim;
+    const double x = par[axis];
+    const double face = b->lo[axis] + cell_coord(b, axis, x) * b->dx;
+    const double room = fmin(x - face, face + b->dx - x);
+    const double delta = fmin(0.25 * size, 0.5 * room);
+    double xp[MPM_MAX_DIM] = {0}, xk[MPM_MAX_DIM] = {0};
+    for (int d = 0; d < p->dim; ++d) xp[d] = xk[d] = par[d];
+    xp[axis] = x - delta, xk[axis] = x + delta;
+    if (fluid_obstacles_inside(obs, xp) || fluid_obstacles_inside(obs, xk)) continue;
+    par[axis] = xp[axis], kid[axis] = xk[axis];
+    break;
+  }
   c->id[c->k++] = id;
   return 0;
 }
@@ -289,7 +299,7 @@ static int regularise_cell(const fluid_content *fc, mpm_particles *p, const reg_
   MPM_CALL(cell_gather(c, p, perm, k));
   const mpm_gidx first = id_base + global_cell(b, c->row) * (mpm_gidx)(fc->reg_min - 1);
   for (int j = 0; c->k < fc->reg_min; ++j, e->splits++)
-    MPM_CALL(split_heaviest(c, &fc->lay, p, b, first + j));
+    MPM_CALL(split_heaviest(c, &fc->lay, p, b, &fc->obs, first + j));
   for (; c->k > fc->reg_max; e->merges++) merge_closest(c, &fc->lay, p);
   return cell_scatter(c, k, p, e);
 }

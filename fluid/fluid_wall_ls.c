@@ -217,6 +217,49 @@ static double fit_constrained(const sums *s, const layout *L, int k0, const doub
   return nAn > 0.0 ? phi * nb / nAn : 0.0;
 }
 
+/* The fitted values of one wall particle into out (see the header): the free fits, then the
+ * wall condition on both velocities. */
+static void fit_particle(const sums *s, const layout *L, int order, int no_slip, double phi,
+                         const double *nrm, double vn_floor, double *out) {
+  const int dim = L->dim, nf = L->nf;
+  int mean = order == 0;
+  if (!mean) mean = fit_free(s, L, out);
+  if (mean)
+    for (int k = 0; k < nf; ++k) out[k] = s->G0[k] / s->S0;
+  for (int k = 2 * dim; k < nf; ++k) { /* e and rho of a linear fit */
+    const double mk = s->G0[k] / s->S0;
+    if (!(out[k] > 0.5 * mk && out[k] < 2.0 * mk)) out[k] = mk;
+  }
+  for (int k0 = 0; k0 <= dim; k0 += dim) {
+    if (no_slip) {
+      for (int c = 0; c < dim; ++c) {
+        double t[MPM_MAX_DIM] = {0};
+        t[c] = 1.0;
+        out[k0 + c] = fit_constrained(s, L, k0, t, phi, nrm);
+      }
+      continue;
+    }
+    double un = 0.0;
+    for (int d = 0; d < dim; ++d) un += out[k0 + d] * nrm[d];
+    double fitted = fit_constrained(s, L, k0, nrm, fabs(phi), nrm);
+    if (phi < 0.0 && fitted < 0.0) fitted = 0.0;           /* inside the body: never deeper */
+    if (k0 == dim && fitted < vn_floor) fitted = vn_floor; /* the motion: see the header */
+    for (int d = 0; d < dim; ++d) out[k0 + d] += (fitted - un) * nrm[d];
+  }
+}
+
+/* A wall particle with no donor near (gas expanding away from a face into near vacuum): it keeps
+ * the transfer's values f, less any velocity into the body. */
+static void keep_out(const double *f, const layout *L, const double *nrm, double *out) {
+  const int dim = L->dim;
+  memcpy(out, f, sizeof *out * (size_t)L->nf);
+  for (int k0 = 0; k0 <= dim; k0 += dim) {
+    double un = 0.0;
+    for (int d = 0; d < dim; ++d) un += out[k0 + d] * nrm[d];
+    for (int d = 0; un < 0.0 && d < dim; ++d) out[k0 + d] -= un * nrm[d];
+  }
+}
+
 /* ---- setup ---------------------------------------------------------------------------------- */
 
 /* The nearest obstacle to x: its index, phi and outward normal. */
@@ -252,7 +295,7 @@ int fluid_wall_ls_init(mpm_module *m, const mpm_config *cfg, int classic) {
   MPM_CALL(mpm_config_get_real(cfg, "fluid.wall_band", &band));
   w->on = 1, w->band = band * g->dx;
   MPM_CALL(mpm_config_get_int(cfg, "fluid.wall_fit_order", &w->order));
-  fc->obs.coast = 1;
+  fc->obs.coast = 1, fc->obs.heat = 1;
   const int dim = g->dim;
   w->nf = 2 * dim + 2;
   const layout L = layout_of(dim, w->nf);
@@ -348,35 +391,13 @@ int fluid_wall_ls_apply(mpm_module *m, const double *y, double *ydot, double h) 
     sums s;
     gather(&s, w->mom, nn, &L, g, xi, fc->lp);
     double *f = w->val + (size_t)nf * i;
-    if (!(s.S0 > 0.0)) { /* no donor near: keep the transfer's values */
-      w->kind[i] = 2;
-      continue;
-    }
-    int mean = w->order == 0;
-    if (!mean) mean = fit_free(&s, &L, out);
-    if (mean)
-      for (int k = 0; k < nf; ++k) out[k] = s.G0[k] / s.S0;
-    for (int k = 2 * dim; k < nf; ++k) { /* e and rho of a linear fit: see the header */
-      const double mk = s.G0[k] / s.S0;
-      if (!(out[k] > 0.5 * mk && out[k] < 2.0 * mk)) out[k] = mk;
-    }
-    /* The wall condition on both velocities. */
     const double phi = w->geo[(size_t)(1 + dim) * i] / g->dx;
     const double *nrm = w->geo + (size_t)(1 + dim) * i + 1;
-    const int no_slip = fc->obs.ob[w->ob[i]].no_slip;
-    for (int k0 = 0; k0 <= dim; k0 += dim) {
-      double t[MPM_MAX_DIM] = {0}, un = 0.0;
-      if (no_slip) {
-        for (int c = 0; c < dim; ++c) {
-          memset(t, 0, sizeof t), t[c] = 1.0;
-          out[k0 + c] = fit_constrained(&s, &L, k0, t, phi, nrm);
-        }
-        continue;
-      }
-      for (int d = 0; d < dim; ++d) un += out[k0 + d] * nrm[d];
-      const double fitted = fit_constrained(&s, &L, k0, nrm, phi, nrm);
-      for (int d = 0; d < dim; ++d) out[k0 + d] += (fitted - un) * nrm[d];
-    }
+    if (s.S0 > 0.0)
+      fit_particle(&s, &L, w->order, fc->obs.ob[w->ob[i]].no_slip, phi, nrm,
+                   -0.5 * fmax(phi, 0.0) * g->dx / h, out);
+    else
+      keep_out(f, &L, nrm, out);
     /* Momentum to the obstacle, energy to the balance. */
     double *F = force + (size_t)dim * w->ob[i];
     double dke = 0.0;

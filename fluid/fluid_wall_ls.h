@@ -22,7 +22,12 @@
  * 0.1 % and the pressure within 4 %. A linear fit with too few donors to fix a gradient (a
  * singular system) falls back on the mean, and so does a fitted e or rho that is not positive
  * or is more than a factor 2 from the mean. Gas at rest stays at rest (every velocity moment
- * is zero), and a uniform flow along the wall is reproduced.
+ * is zero), and a uniform flow along the wall is reproduced. A wall particle with no donor near
+ * (gas expanding away from a face into near vacuum) keeps its own values, less any velocity
+ * into the body (without that, gas crept into the back of a square in a Mach 2.5 flow). The
+ * normal velocity that moves a fitted particle is bounded so that one step covers at most half
+ * its distance to the surface (a linear fit in a steep gradient, such as the wake's reverse flow
+ * onto a back face, otherwise overshot it), and a particle already inside never moves deeper.
  *
  * Held nodes. Under this treatment a constrained node that the gas barely covers
  * (fluid_obstacle.h) is not stopped: it keeps the velocity its particles deposited, projected

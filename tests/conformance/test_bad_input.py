@@ -190,6 +190,19 @@ for name, old, new, key, words in OBST_CASES:
               "reference area without speed": "reference_area"}.get(name) or new.splitlines()[-1]
     expect_error(name, text, key, words, line_of(text, needle))
 
+# The wall treatment's keys (fluid/fluid_wall_ls.c).
+LS = "\n[fluid]\nwall_treatment = least_squares\n"
+text = OBST.replace("method = usl", "method = bs32", 1) + LS
+expect_error("least_squares with an ERK pair", text, "fluid.wall_treatment", "classic update",
+             line_of(text, "wall_treatment"))
+text = open(mt.case("sod.ini")).read().replace("method = bs32", "method = usl", 1) + LS
+expect_error("least_squares without an obstacle", text, "fluid.wall_treatment", "has none",
+             line_of(text, "wall_treatment"))
+for name, key_line, key in (("wall band 0", "wall_band = 0", "fluid.wall_band"),
+                            ("wall fit order 2", "wall_fit_order = 2", "fluid.wall_fit_order")):
+    text = OBST + LS + key_line + "\n"
+    expect_error(name, text, key, None, line_of(text, key_line))
+
 # Coupling, on gas_obstacles.ini with a solid block added (the gas overlapping it does not matter:
 # every error here comes before anything runs).
 SOLID = ("\n[geometry.plate]\ntype = box\nlo = {lo}\nhi = {hi}\n\n[solid.plate]\ngeometry = plate\n"

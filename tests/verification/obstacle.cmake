@@ -1,7 +1,25 @@
 # Static obstacles: rest, momentum balance against the reported forces, seeding, 2 ranks vs 1.
 mpm_add_script_test(test_obstacles SCRIPT verification/test_obstacles.py
                     LABELS "verification;mpi" TIMEOUT 600)
-# Total energy with obstacles, usl and musl, ghost and least_squares: conserved to roundoff
-# (the obstacles' work is booked as heat; see the test's header).
+# Total energy with obstacles under least_squares, usl and musl: conserved to roundoff (the
+# obstacles' work is booked as heat; ghost does not book it: see the test's header).
 mpm_add_script_test(test_obstacles_energy SCRIPT verification/test_obstacles.py ARGS energy
                     LABELS verification TIMEOUT 300)
+# Uniform flow along a slip wall at 10 and 30 degrees to the grid (least_squares; ghost blows
+# up there). The issue's 1 % on the worst particle is not reached: an expected failure that
+# records the measured figures (the test's header).
+mpm_add_script_test(test_slanted_wall SCRIPT verification/test_slanted_wall.py
+                    LABELS verification TIMEOUT 300)
+mpm_add_script_test(test_slanted_wall_max SCRIPT verification/test_slanted_wall.py ARGS max
+                    LABELS verification TIMEOUT 300)
+set_tests_properties(test_slanted_wall_max PROPERTIES WILL_FAIL TRUE)
+# Mach 2.5 past a plate two cells thick and a square (least_squares; ghost fails there): both at
+# dx = 0.02 by default, at 0.01 and 0.005 under long; the empty cells next to the bodies are an
+# expected failure (the test's header).
+mpm_add_script_test(test_bluff_bodies SCRIPT verification/test_bluff_bodies.py ARGS fast
+                    LABELS verification TIMEOUT 300)
+mpm_add_script_test(test_bluff_bodies_empty SCRIPT verification/test_bluff_bodies.py ARGS empty
+                    LABELS verification TIMEOUT 300)
+set_tests_properties(test_bluff_bodies_empty PROPERTIES WILL_FAIL TRUE)
+mpm_add_script_test(test_bluff_bodies_long SCRIPT verification/test_bluff_bodies.py ARGS long
+                    LABELS "verification;long" TIMEOUT 3600)

@@ -1,0 +1,73 @@
+"""Cost per step of the least-squares wall treatment against the ghost treatment.
+
+Runs cases/wedge.ini (Mach 2.5, 15 degrees, to t = 1.2) under fluid.wall_treatment = ghost and
+least_squares, alternating the two (so that both see the same machine load), `--repeats` times
+each, on one rank, and reports the wall time per step and per particle-step of each and their
+ratio (median over the repeats). The two treatments take different step counts (least_squares'
+wall layer is faster and cooler, so its stable step differs), so the cost is compared per step
+and per particle-step, as the issue asks; the whole-run times are listed too.
+
+Writes bench/results/wall_treatment.{csv,json,md}. No test asserts a time.
+  /usr/bin/python3 bench/bench_wall_treatment.py [--binary build/app/mpmfsi] [--dx 0.01]
+"""
+import argparse
+import json
+import os
+import statistics
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import benchrun  # noqa: E402
+
+ap = argparse.ArgumentParser()
+ap.add_argument("--binary", default=os.path.join(benchrun.ROOT, "build", "app", "mpmfsi"))
+ap.add_argument("--dx", type=float, default=0.01)
+ap.add_argument("--repeats", type=int, default=3)
+ap.add_argument("--out", default=os.path.join(benchrun.ROOT, "bench", "results", "wall_treatment"))
+a = ap.parse_args()
+
+case = os.path.join(benchrun.ROOT, "cases", "wedge.ini")
+rows = []
+for r in range(a.repeats):
+    for treatment in ("ghost", "least_squares"):
+        s, _ = benchrun.run_case(a.binary, case, [f"grid.dx={a.dx}", "run.progress=false",
+                                                  "output.snapshots=false",
+                                                  f"fluid.wall_treatment={treatment}"], 1)
+        row = {"treatment": treatment, "repeat": r, "dx": a.dx, "steps": s["steps"],
+               "wall_s": s["wall_s"], "ms_per_step": 1e3 * s["wall_s"] / s["steps"],
+               "ns_per_particle_step": 1e9 * s["wall_s"] / s["particle_steps"]}
+        rows.append(row)
+        print(f"{treatment:14s} repeat {r}: {row['steps']} steps, {row['wall_s']:.2f} s, "
+              f"{row['ms_per_step']:.3f} ms/step, {row['ns_per_particle_step']:.1f} ns/particle-step",
+              flush=True)
+
+
+def med(t, k):
+    return statistics.median(x[k] for x in rows if x["treatment"] == t)
+
+
+summary = {k: {t: med(t, k) for t in ("ghost", "least_squares")}
+           for k in ("steps", "wall_s", "ms_per_step", "ns_per_particle_step")}
+ratio_step = summary["ms_per_step"]["least_squares"] / summary["ms_per_step"]["ghost"]
+ratio_ps = (summary["ns_per_particle_step"]["least_squares"]
+            / summary["ns_per_particle_step"]["ghost"])
+summary.update({"ratio_per_step": ratio_step, "ratio_per_particle_step": ratio_ps,
+                "dx": a.dx, "repeats": a.repeats, "target_ratio": 1.15})
+os.makedirs(os.path.dirname(a.out), exist_ok=True)
+with open(a.out + ".csv", "w") as f:
+    keys = list(rows[0])
+    f.write(",".join(keys) + "\n")
+    for row in rows:
+        f.write(",".join(str(row[k]) for k in keys) + "\n")
+with open(a.out + ".json", "w") as f:
+    json.dump(summary, f, indent=1)
+with open(a.out + ".md", "w") as f:
+    f.write(f"# Wall treatment cost: wedge, dx = {a.dx}, 1 rank, median of {a.repeats}\n\n")
+    f.write("| treatment | steps | wall time, s | ms per step | ns per particle-step |\n")
+    f.write("| --- | --- | --- | --- | --- |\n")
+    for t in ("ghost", "least_squares"):
+        f.write(f"| {t} | {summary['steps'][t]:.0f} | {summary['wall_s'][t]:.2f} | "
+                f"{summary['ms_per_step'][t]:.3f} | {summary['ns_per_particle_step'][t]:.1f} |\n")
+    f.write(f"\nleast_squares / ghost: {ratio_step:.3f} per step, {ratio_ps:.3f} per particle-step "
+            f"(target <= 1.15 per step).\n")
+print(f"least_squares / ghost: {ratio_step:.3f} per step, {ratio_ps:.3f} per particle-step")
