@@ -543,6 +543,18 @@ int fluid_obstacles_which(const fluid_obstacles *o, const double *x) {
   return -1;
 }
 
+/* Is particle i (positions x per component) in a cell near a body? Its position into xp. */
+static int near_body(const fluid_obstacles *o, const mpm_grid *g, const double *const *x,
+                     mpm_lidx i, double *xp) {
+  int gi[MPM_MAX_DIM] = {0}, in = 1;
+  for (int d = 0; d < g->dim; ++d) {
+    xp[d] = x[d][i];
+    gi[d] = mpm_shape_floor((xp[d] - g->lo[d]) / g->dx);
+    in &= gi[d] >= g->box_lo[d] && gi[d] < g->box_lo[d] + g->box_n[d];
+  }
+  return in && o->near[mpm_grid_local_index(g, gi)];
+}
+
 void fluid_obstacles_deposit(fluid_obstacles *o, const mpm_grid *grid, mpm_lidx n,
                              const double *const *x, const double *m, const double *V0,
                              const double *J, const double *vsig) {
@@ -551,14 +563,8 @@ void fluid_obstacles_deposit(fluid_obstacles *o, const mpm_grid *grid, mpm_lidx 
   double *sm = o->sm, *smp = o->sm + grid->nnodes;
   memset(sm, 0, sizeof *sm * 2 * (size_t)grid->nnodes);
   for (mpm_lidx i = 0; i < n; ++i) {
-    int gi[MPM_MAX_DIM], in = 1;
     double xp[MPM_MAX_DIM];
-    for (int d = 0; d < dim; ++d) {
-      xp[d] = x[d][i];
-      gi[d] = mpm_shape_floor((xp[d] - grid->lo[d]) / grid->dx);
-      in &= gi[d] >= grid->box_lo[d] && gi[d] < grid->box_lo[d] + grid->box_n[d];
-    }
-    if (!in || !o->near[mpm_grid_local_index(grid, gi)]) continue;
+    if (!near_body(o, grid, x, i, xp)) continue;
     double p = 0.0; /* p = -tr(V sigma) / (dim V) */
     for (int d = 0; d < dim; ++d) p -= vsig[(size_t)(d * dim + d) * n + i];
     p /= dim * V0[i] * J[i];
@@ -668,14 +674,8 @@ void fluid_obstacles_heat(const fluid_obstacles *o, const mpm_grid *grid, mpm_li
   if (o->count == 0 || !o->heat) return;
   const int dim = grid->dim;
   for (mpm_lidx i = 0; i < n; ++i) {
-    int gi[MPM_MAX_DIM], in = 1;
     double xp[MPM_MAX_DIM];
-    for (int d = 0; d < dim; ++d) {
-      xp[d] = x[d][i];
-      gi[d] = mpm_shape_floor((xp[d] - grid->lo[d]) / grid->dx);
-      in &= gi[d] >= grid->box_lo[d] && gi[d] < grid->box_lo[d] + grid->box_n[d];
-    }
-    if (!in || !o->near[mpm_grid_local_index(grid, gi)]) continue;
+    if (!near_body(o, grid, x, i, xp)) continue;
     stencil st;
     stencil_at(&st, grid, xp, o->lp);
     double heat = 0.0;
