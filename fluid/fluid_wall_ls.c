@@ -172,7 +172,7 @@ static int fit_free(const sums *s, const layout *L, double *out) {
     A[a + 1] = A[(a + 1) * n] = s->S1[a];
     for (int b = 0; b < dim; ++b) A[(a + 1) * n + b + 1] = s->S2[a][b];
   }
-  /* One factorisation, many right-hand sides: factor a copy per field (n <= 4, cheap). */
+  /* The same matrix for every field, factored again per field (order <= 4: cheap). */
   for (int k = 0; k < L->nf; ++k) {
     double Ak[16], b[4];
     memcpy(Ak, A, sizeof Ak);
