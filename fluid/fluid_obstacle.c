@@ -500,12 +500,6 @@ static int build_ghosts(fluid_obstacles *o, const mpm_grid *g) {
     o->gnode[o->gcount++] = l;
     flag_near(o, g, gi);
   }
-  for (int k = 0; !rc && k < o->count; ++k) /* the heat reaches the constrained nodes too */
-    for (mpm_lidx j = 0; j < o->ob[k].count; ++j) {
-      int gi[MPM_MAX_DIM];
-      mpm_grid_node_global(g, o->ob[k].node[j], gi);
-      flag_near(o, g, gi);
-    }
   for (int d = 0; d < dim; ++d) free(G[d]);
   if (rc) MPM_FAIL(rc, "cannot allocate the obstacles' ghost nodes");
   return 0;
@@ -585,10 +579,8 @@ int fluid_obstacles_begin(fluid_obstacles *o, mpm_grid *grid, int phase, double 
   double *sm = o->sm, *smp = o->sm + grid->nnodes, *fields[2] = {sm, smp};
   MPM_CALL(mpm_grid_halo_reverse(grid, fields, 2));
   double *rec = o->f[record ? mpm_rhs_records_begin(&o->rec, t, h) : o->rec.latest];
-  if (record) {
-    memset(rec, 0, sizeof *rec * (size_t)dim * o->count);
-    memset(o->q, 0, sizeof *o->q * (size_t)grid->nnodes);
-  }
+  if (record) memset(rec, 0, sizeof *rec * (size_t)dim * o->count);
+  if (record && o->heat) memset(o->q, 0, sizeof *o->q * (size_t)grid->nnodes);
   mpm_grid_phase *ph = &grid->phase[phase];
   for (mpm_lidx k = 0; k < o->gcount; ++k) {
     const mpm_lidx l = o->gnode[k];
@@ -644,9 +636,19 @@ int fluid_obstacles_apply(fluid_obstacles *o, mpm_grid *grid, int phase, double 
   for (int k = 0; k < o->count; ++k) {
     double *f = record ? o->f[o->rec.latest] + (size_t)dim * k : scratch;
     apply_one(&o->ob[k], &grid->phase[phase], dim, h, o->hold * mmax, o->coast, f,
-              record ? o->q : NULL);
+              record && o->heat ? o->q : NULL);
   }
   return 0;
+}
+
+void fluid_obstacles_book_heat(fluid_obstacles *o, const mpm_grid *g) {
+  o->heat = 1;
+  for (int k = 0; k < o->count; ++k) /* the heat reaches the constrained nodes too */
+    for (mpm_lidx j = 0; j < o->ob[k].count; ++j) {
+      int gi[MPM_MAX_DIM];
+      mpm_grid_node_global(g, o->ob[k].node[j], gi);
+      flag_near(o, g, gi);
+    }
 }
 
 int fluid_obstacles_work(fluid_obstacles *o, mpm_grid *grid, int phase, double h) {

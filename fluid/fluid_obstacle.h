@@ -96,7 +96,7 @@ typedef struct fluid_obstacles {
   unsigned char *gowned;
   int *gob;            /* the obstacle each ghost force belongs to (the nearest) */
   unsigned char *near; /* per box node as a cell's lower corner: a particle in it reaches a
-                          ghost node or a constrained node */
+                          ghost node or, when the heat is booked, a constrained node */
   unsigned char *own;  /* per box node: owned by this rank */
   double *sm;          /* nodal m and m p of the particles near a body (2 nnodes) */
   double *q;           /* per box node: the rate at which the obstacles put energy into the gas
@@ -133,6 +133,8 @@ int fluid_obstacles_which(const fluid_obstacles *o, const double *x);
  * add the removed momentum to the force record begun by fluid_obstacles_begin when record is set.
  */
 int fluid_obstacles_apply(fluid_obstacles *o, mpm_grid *grid, int phase, double h, int record);
+/* Book the obstacles' work as heat from now on (see Energy above). */
+void fluid_obstacles_book_heat(fluid_obstacles *o, const mpm_grid *g);
 /* After the last constraint of a recorded RHS: add the ghost forces' work on the final nodal
  * velocities (time-centred in the classic update) to the nodal energy rates q, divide them by
  * the nodal masses and copy the owners' values into the ghost nodes. Collective. */

@@ -295,7 +295,8 @@ int fluid_wall_ls_init(mpm_module *m, const mpm_config *cfg, int classic) {
   MPM_CALL(mpm_config_get_real(cfg, "fluid.wall_band", &band));
   w->on = 1, w->band = band * g->dx;
   MPM_CALL(mpm_config_get_int(cfg, "fluid.wall_fit_order", &w->order));
-  fc->obs.coast = 1, fc->obs.heat = 1;
+  fc->obs.coast = 1;
+  fluid_obstacles_book_heat(&fc->obs, g);
   const int dim = g->dim;
   w->nf = 2 * dim + 2;
   const layout L = layout_of(dim, w->nf);
