@@ -60,6 +60,14 @@ const mpm_key_spec fluid_obstacle_keys[] = {
      "free-stream speed for Cd and Cl, m/s", 1},
     {"obstacle.*.flow_direction", MPM_KEY_REALS, "1 0 0", -HUGE_VAL, HUGE_VAL, 0, 3, NULL,
      "free-stream direction (drag along it; lift along e_z x it, +y for a flow along +x)", 0},
+    {"obstacle.*.reference_pressure", MPM_KEY_REAL, NULL, 0, HUGE_VAL, 0, 0, NULL,
+     "free-stream pressure for Cp in surface_NAME.csv, Pa (with reference_area, _density and "
+     "_speed)",
+     1},
+    {"obstacle.*.surface_interval", MPM_KEY_REAL, NULL, 0, HUGE_VAL, 1, 0, NULL,
+     "2-D polygon, wedge, airfoil: write the surface pressure at the outline's vertices, averaged "
+     "over windows of this length (s), to surface_NAME.csv",
+     1},
 };
 const int fluid_obstacle_nkeys = (int)(sizeof fluid_obstacle_keys / sizeof fluid_obstacle_keys[0]);
 
@@ -281,8 +289,47 @@ static int read_reference(fluid_obstacle *ob, const reader *r) {
   MPM_CALL(get_real(r, "reference_density", &rho));
   MPM_CALL(get_real(r, "reference_speed", &u));
   ob->has_ref = 1;
+  ob->ref_area = area;
   ob->q_ref_area = 0.5 * rho * u * u * area;
   return 0;
+}
+
+/* surface_interval: the outline's vertices as surface pressure samples (fluid_surface.h). */
+static int read_surface(fluid_obstacle *ob, const reader *r, const char *shape, const char *dir) {
+  char key[KEY_LEN], path[4096];
+  double interval, p_ref = 0.0, le[2] = {0, 0}, chord = 0.0, aoa = 0.0;
+  if (!has(r, "surface_interval")) {
+    if (!has(r, "reference_pressure")) return 0;
+    make_key(key, r, "reference_pressure");
+    return mpm_config_fail(r->cfg, key,
+                           "reference_pressure is for Cp in the surface output: set "
+                           "surface_interval in [obstacle.%s] too, or remove it",
+                           r->name);
+  }
+  make_key(key, r, "surface_interval");
+  MPM_CALL(mpm_config_get_real(r->cfg, key, &interval));
+  if (r->dim != 2 || ob->sdf.kind != MPM_SDF_POLYGON)
+    return mpm_config_fail(r->cfg, key,
+                           "the surface output samples the vertices of a 2-D outline: it needs "
+                           "shape = polygon, wedge or airfoil in a 2-D domain (this is %s, %d-D)",
+                           shape, r->dim);
+  const int cp = has(r, "reference_pressure");
+  make_key(key, r, "reference_pressure");
+  if (cp && !ob->has_ref)
+    return mpm_config_fail(r->cfg, key,
+                           "Cp also needs reference_area, reference_density and "
+                           "reference_speed in [obstacle.%s]",
+                           r->name);
+  if (cp) MPM_CALL(get_real(r, "reference_pressure", &p_ref));
+  if (!strcmp(shape, "airfoil")) {
+    MPM_CALL(get_real(r, "chord", &chord));
+    MPM_CALL(get_vec(r, "leading_edge", 2, le, 2, NULL));
+    make_key(key, r, "angle_of_attack");
+    MPM_CALL(mpm_config_get_real(r->cfg, key, &aoa));
+  }
+  snprintf(path, sizeof path, "%s/surface_%s.csv", dir, ob->name);
+  return fluid_surface_build(&ob->surf, path, interval, ob->sdf.v, ob->sdf.nv, chord, le, aoa,
+                             p_ref, cp ? ob->q_ref_area / ob->ref_area : 0.0);
 }
 
 /* The obstacle must reach into the domain. */
@@ -349,7 +396,7 @@ static int find_nodes(fluid_obstacle *ob, const mpm_grid *g, double band) {
 }
 
 static int build_one(fluid_obstacle *ob, const mpm_config *cfg, const mpm_grid *g, const char *name,
-                     double band) {
+                     double band, const char *dir) {
   reader r = {cfg, name, g->dim, ""};
   const char *shape, *cond;
   char key[KEY_LEN];
@@ -364,6 +411,7 @@ static int build_one(fluid_obstacle *ob, const mpm_config *cfg, const mpm_grid *
   int rc_shape = read_shape(&ob->sdf, &r, shape);
   MPM_CALL(rc_shape ? rc_shape : rc);
   MPM_CALL(read_reference(ob, &r));
+  MPM_CALL(read_surface(ob, &r, shape, dir));
   MPM_CALL(check_overlap(ob, &r, g));
   return find_nodes(ob, g, band);
 }
@@ -523,7 +571,7 @@ int fluid_obstacles_build(fluid_obstacles *o, const mpm_config *cfg, const mpm_g
   o->count = count;
   for (int k = 0; k < 2; ++k) MPM_ALLOC(o->f[k], (size_t)grid->dim * count);
   for (int k = 0; k < count; ++k)
-    MPM_CALL(build_one(&o->ob[k], cfg, grid, names[k], band * grid->dx));
+    MPM_CALL(build_one(&o->ob[k], cfg, grid, names[k], band * grid->dx, dir));
   return build_ghosts(o, grid);
 }
 
@@ -581,6 +629,8 @@ int fluid_obstacles_begin(fluid_obstacles *o, mpm_grid *grid, int phase, double 
   double *rec = o->f[record ? mpm_rhs_records_begin(&o->rec, t, h) : o->rec.latest];
   if (record) memset(rec, 0, sizeof *rec * (size_t)dim * o->count);
   if (record && o->heat) memset(o->q, 0, sizeof *o->q * (size_t)grid->nnodes);
+  for (int k = 0; record && k < o->count; ++k)
+    if (o->ob[k].surf.n) fluid_surface_sample(&o->ob[k].surf, grid, sm, smp, o->own);
   mpm_grid_phase *ph = &grid->phase[phase];
   for (mpm_lidx k = 0; k < o->gcount; ++k) {
     const mpm_lidx l = o->gnode[k];
@@ -725,12 +775,14 @@ int fluid_obstacles_report(fluid_obstacles *o, const mpm_grid *grid, double t, d
   }
   free(f);
   if (rc != MPI_SUCCESS) MPM_FAIL(MPM_ERR_FILE, "cannot report the obstacle forces");
+  for (int k = 0; k < o->count; ++k) MPM_CALL(fluid_surface_step(&o->ob[k].surf, grid, t, h));
   return 0;
 }
 
 void fluid_obstacles_free(fluid_obstacles *o) {
   for (int k = 0; k < o->count; ++k) {
     mpm_sdf_free(&o->ob[k].sdf);
+    fluid_surface_free(&o->ob[k].surf);
     free(o->ob[k].node), free(o->ob[k].normal), free(o->ob[k].owned);
   }
   free(o->ob);

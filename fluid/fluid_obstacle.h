@@ -60,6 +60,8 @@
 #include "mpm_sdf.h"
 #include "mpm_shape.h"
 
+#include "fluid_surface.h"
+
 /* Constrained nodes with less than this fraction of the largest constrained node's mass are held
  * entirely (see Nodes above). 0.3: gas_obstacles.ini at 128 cells and the wedge run with 0.3
  * and 0.6 alike, and fail without it; gas at rest stays exactly at rest either way. */
@@ -72,6 +74,8 @@ typedef struct fluid_obstacle {
   int no_slip;
   int has_ref;             /* reference area given: write Cd and Cl */
   double q_ref_area;       /* 1/2 rho U^2 A */
+  double ref_area;         /* A */
+  fluid_surface surf;      /* surface pressure output (surface_interval), or n = 0 */
   double flow[3], lift[3]; /* unit drag and lift directions */
   mpm_lidx count;          /* constrained nodes */
   mpm_lidx *node;          /* box index */

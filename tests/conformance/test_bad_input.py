@@ -203,6 +203,22 @@ for name, key_line, key in (("wall band 0", "wall_band = 0", "fluid.wall_band"),
     text = OBST + LS + key_line + "\n"
     expect_error(name, text, key, None, line_of(text, key_line))
 
+# The surface pressure output (fluid/fluid_surface.h): vertices of a 2-D outline only; Cp needs
+# the reference values.
+POLY = ("\n[obstacle.tri]\nshape = polygon\nvertices = 0.2 0.7 0.3 0.7 0.25 0.8\n")
+for name, text, needle, key, words in (
+        ("surface output of a circle", OBST.replace("radius = 0.12", "radius = 0.12\n"
+                                                     "surface_interval = 0.1", 1),
+         "surface_interval", "obstacle.cylinder.surface_interval", "polygon, wedge or airfoil"),
+        ("reference_pressure without surface output", OBST + POLY + "reference_pressure = 1\n",
+         "reference_pressure", "obstacle.tri.reference_pressure", "set surface_interval"),
+        ("Cp without a reference area", OBST + POLY + "surface_interval = 0.1\n"
+                                                      "reference_pressure = 1\n",
+         "reference_pressure", "obstacle.tri.reference_pressure", "reference_area"),
+        ("a surface interval of 0", OBST + POLY + "surface_interval = 0\n", "surface_interval",
+         "obstacle.tri.surface_interval", None)):
+    expect_error(name, text, key, words, line_of(text, needle))
+
 # Coupling, on gas_obstacles.ini with a solid block added (the gas overlapping it does not matter:
 # every error here comes before anything runs).
 SOLID = ("\n[geometry.plate]\ntype = box\nlo = {lo}\nhi = {hi}\n\n[solid.plate]\ngeometry = plate\n"

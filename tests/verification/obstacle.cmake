@@ -23,3 +23,7 @@ mpm_add_script_test(test_bluff_bodies_empty SCRIPT verification/test_bluff_bodie
 set_tests_properties(test_bluff_bodies_empty PROPERTIES WILL_FAIL TRUE)
 mpm_add_script_test(test_bluff_bodies_long SCRIPT verification/test_bluff_bodies.py ARGS long
                     LABELS "verification;long" TIMEOUT 3600)
+# RAE 2822 (cases/rae2822.ini) and the surface pressure output: gas at rest reads p = 1 at every
+# outline point, 2 ranks as 1 (fast).
+mpm_add_script_test(test_rae2822 SCRIPT verification/test_rae2822.py
+                    LABELS "verification;mpi" TIMEOUT 300)

@@ -1,0 +1,215 @@
+"""RAE 2822: surface Cp of a run against the experiment, Cl and Cd, steadiness, plots.
+
+Reads a run directory of cases/rae2822.ini (surface_rae2822.csv, obstacles.csv and the last
+snapshot) and the experiment (../shared/validation/rae2822_case9_cp_experiment.csv), and prints
+and returns (as JSON with --json) the figures the issue asks for:
+
+- the time-mean surface Cp over the last `--windows` windows of surface_rae2822.csv (each window
+  is itself a time mean over obstacle.rae2822.surface_interval);
+- the RMS difference to the experiment, with the computed Cp interpolated linearly in x/c to the
+  experiment's stations: over the whole lower surface, and on the upper surface ahead of the
+  shock (x/c <= 0.50; the experiment's shock starts at 0.55);
+- the upper-surface shock position: the last x/c (going aft, over 0.2-0.9) where Cp rises
+  through the critical Cp* of the free stream (the sonic point), found the same way on the
+  experiment;
+- Cl and Cd: time means of obstacles.csv over the same span of time as the Cp windows;
+- steadiness: the Cl means of the last two such spans (a span = `--windows` windows each) and
+  the RMS difference between the Cp of the last window and the mean of the span before it.
+  The run is called steady when the two Cl means differ by less than 2 % and the Cp RMS by less
+  than 0.03 (the scatter of a single window on a steady run at these resolutions; see README).
+
+With --plot PNG: Cp against x/c (both surfaces, experiment as symbols); with --field PNG: the
+pressure coefficient of the last snapshot's particles around the aerofoil.
+  /usr/bin/python3 tools/rae2822.py RUN_DIR [--windows 5] [--plot cp.png] [--field p.png]
+"""
+import argparse
+import csv
+import glob
+import json
+import math
+import os
+import sys
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+EXPERIMENT = os.path.join(ROOT, "..", "shared", "validation", "rae2822_case9_cp_experiment.csv")
+MACH, GAMMA = 0.729, 1.4
+UPPER_AHEAD = 0.50  # upper-surface RMS: stations x/c <= this (the experiment's shock: 0.55-0.575)
+
+
+def cp_critical(mach=MACH, g=GAMMA):
+    """Cp at the sonic point of an isentropic expansion from the free stream."""
+    ratio = (2 + (g - 1) * mach * mach) / (g + 1)
+    return 2 / (g * mach * mach) * (ratio ** (g / (g - 1)) - 1)
+
+
+def read_rows(path):
+    with open(path) as f:
+        return list(csv.DictReader(line for line in f if not line.startswith("#")))
+
+
+def experiment():
+    sides = {"upper": [], "lower": []}
+    for r in read_rows(EXPERIMENT):
+        sides[r["surface"]].append((float(r["x_over_c"]), float(r["cp"])))
+    return {k: sorted(v) for k, v in sides.items()}
+
+
+def surface_windows(run):
+    """{t: {side: [(x/c, cp)]}} of surface_rae2822.csv, NaN points dropped."""
+    win = {}
+    for r in read_rows(os.path.join(run, "surface_rae2822.csv")):
+        cp = float(r["cp"])
+        if math.isnan(cp):
+            continue
+        win.setdefault(float(r["t"]), {}).setdefault(r["side"], {})[int(r["point"])] = (
+            float(r["coordinate"]), cp)
+    return win
+
+
+def mean_cp(win, times):
+    """Mean over the windows at times of each point's Cp, per side, sorted by x/c."""
+    out = {}
+    for side in ("upper", "lower"):
+        pts = {}
+        for t in times:
+            for i, (xc, cp) in win[t].get(side, {}).items():
+                pts.setdefault(i, [xc, []])[1].append(cp)
+        out[side] = sorted((xc, sum(c) / len(c)) for xc, c in pts.values())
+    return out
+
+
+def interp(curve, x):
+    xs = [p[0] for p in curve]
+    if x <= xs[0]:
+        return curve[0][1]
+    for k in range(1, len(curve)):
+        if x <= xs[k]:
+            x0, y0 = curve[k - 1]
+            x1, y1 = curve[k]
+            return y0 + (y1 - y0) * (x - x0) / (x1 - x0) if x1 > x0 else y1
+    return curve[-1][1]
+
+
+def rms(cp, exp, side, xmax=1.0):
+    d = [interp(cp[side], x) - c for x, c in exp[side] if x <= xmax]
+    return math.sqrt(sum(v * v for v in d) / len(d))
+
+
+def shock_position(curve, lo=0.2, hi=0.9):
+    """Last x/c in [lo, hi] where Cp rises through Cp* going aft (None if it never does)."""
+    star, found = cp_critical(), None
+    pts = [p for p in curve if lo <= p[0] <= hi]
+    for (x0, c0), (x1, c1) in zip(pts, pts[1:]):
+        if c0 < star <= c1 and c1 > c0:
+            found = x0 + (x1 - x0) * (star - c0) / (c1 - c0)
+    return found
+
+
+def force_means(run, t0, t1):
+    cl, cd = [], []
+    for r in read_rows(os.path.join(run, "obstacles.csv")):
+        t = float(r["t"])
+        if t0 < t <= t1:
+            cl.append(float(r["Cl"]))
+            cd.append(float(r["Cd"]))
+    if not cl:
+        return float("nan"), float("nan")
+    return sum(cl) / len(cl), sum(cd) / len(cd)
+
+
+def analyse(run, windows):
+    win = surface_windows(run)
+    times = sorted(win)
+    if len(times) < 2 * windows:
+        sys.exit(f"{run}: {len(times)} surface windows, need {2 * windows} (run longer or "
+                 f"lower --windows)")
+    last, before = times[-windows:], times[-2 * windows:-windows]
+    width = times[-1] - times[-2]
+    cp, cp_before, exp = mean_cp(win, last), mean_cp(win, before), experiment()
+    cp_final = mean_cp(win, times[-1:])
+    cl, cd = force_means(run, last[0] - width, last[-1])
+    cl_before, _ = force_means(run, before[0] - width, before[-1])
+    drift = math.sqrt(sum((interp(cp_final[s], x) - interp(cp_before[s], x)) ** 2
+                          for s in ("upper", "lower") for x, _ in exp[s])
+                      / sum(len(exp[s]) for s in ("upper", "lower")))
+    res = {
+        "run": run,
+        "t_from": last[0] - width, "t_to": last[-1],
+        "rms_lower": rms(cp, exp, "lower"),
+        "rms_upper_ahead": rms(cp, exp, "upper", UPPER_AHEAD),
+        "shock_x": shock_position(cp["upper"]),
+        "shock_x_experiment": shock_position(exp["upper"]),
+        "cp_star": cp_critical(),
+        "cl": cl, "cd": cd, "cl_before": cl_before,
+        "cl_change": abs(cl - cl_before) / abs(cl) if cl else float("nan"),
+        "cp_drift_rms": drift,
+    }
+    res["steady"] = res["cl_change"] < 0.02 and drift < 0.03
+    return res, cp, exp
+
+
+def plot_cp(cp, exp, res, path, label=None):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(7, 5))
+    for side, col in (("upper", "C0"), ("lower", "C3")):
+        ax.plot([p[0] for p in cp[side]], [p[1] for p in cp[side]], "-", color=col,
+                label=f"{label or 'mpmfsi'} {side}")
+        ax.plot([p[0] for p in exp[side]], [p[1] for p in exp[side]], "o", mfc="none",
+                color=col, ms=4, label=f"experiment {side}")
+    ax.axhline(res["cp_star"], color="gray", lw=0.5, ls="--", label="Cp*")
+    ax.invert_yaxis()
+    ax.set_xlabel("x/c")
+    ax.set_ylabel("Cp")
+    ax.set_title(f"RAE 2822, M 0.729, alpha 2.31 deg: Cl {res['cl']:.3f}, "
+                 f"shock {res['shock_x'] or float('nan'):.3f} c")
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+
+
+def plot_field(run, path):
+    import h5py
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    snaps = sorted(glob.glob(os.path.join(run, "snap_*.h5")))
+    with h5py.File(snaps[-1], "r") as f:
+        x, p, t = f["fluid/x"][:], f["fluid/p"][:, 0], None
+    q = 0.5 * 1.4 * MACH * MACH
+    cp = (p - 1.0) / q
+    keep = (x[:, 0] > -0.5) & (x[:, 0] < 1.7) & (abs(x[:, 1]) < 0.8)
+    fig, ax = plt.subplots(figsize=(8, 3.6))
+    sc = ax.scatter(x[keep, 0], x[keep, 1], c=cp[keep], s=1.5, cmap="jet", vmin=-1.4, vmax=1.1)
+    ax.set_aspect("equal")
+    ax.set_xlim(-0.5, 1.7)
+    ax.set_ylim(-0.8, 0.8)
+    fig.colorbar(sc, ax=ax, label="Cp of the particles")
+    ax.set_title(os.path.basename(snaps[-1]))
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("run")
+    ap.add_argument("--windows", type=int, default=5)
+    ap.add_argument("--plot")
+    ap.add_argument("--field")
+    ap.add_argument("--json", action="store_true")
+    a = ap.parse_args()
+    res, cp, exp = analyse(a.run, a.windows)
+    if a.plot:
+        plot_cp(cp, exp, res, a.plot)
+    if a.field:
+        plot_field(a.run, a.field)
+    if a.json:
+        print(json.dumps(res, indent=1))
+    else:
+        for k, v in res.items():
+            print(f"{k:20s} {v}")
+
+
+if __name__ == "__main__":
+    main()
