@@ -50,7 +50,8 @@ def read_rows(path):
 def experiment():
     sides = {"upper": [], "lower": []}
     for r in read_rows(EXPERIMENT):
-        sides[r["surface"]].append((float(r["x_over_c"]), float(r["cp"])))
+        for side in (("upper", "lower") if r["surface"] == "leading_edge" else (r["surface"],)):
+            sides[side].append((float(r["x_over_c"]), float(r["cp"])))
     return {k: sorted(v) for k, v in sides.items()}
 
 
@@ -106,15 +107,16 @@ def shock_position(curve, lo=0.2, hi=0.9):
 
 
 def force_means(run, t0, t1):
-    cl, cd = [], []
+    """Time means (each step weighted by its length) of Cl and Cd over (t0, t1]."""
+    w = cl = cd = 0.0
+    t_prev = None
     for r in read_rows(os.path.join(run, "obstacles.csv")):
         t = float(r["t"])
-        if t0 < t <= t1:
-            cl.append(float(r["Cl"]))
-            cd.append(float(r["Cd"]))
-    if not cl:
-        return float("nan"), float("nan")
-    return sum(cl) / len(cl), sum(cd) / len(cd)
+        if t_prev is not None and t0 < t <= t1:
+            h = t - t_prev
+            w, cl, cd = w + h, cl + h * float(r["Cl"]), cd + h * float(r["Cd"])
+        t_prev = t
+    return (cl / w, cd / w) if w > 0 else (float("nan"), float("nan"))
 
 
 def analyse(run, windows):
