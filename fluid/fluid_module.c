@@ -178,7 +178,7 @@ static int fluid_p2g(mpm_module *m, double t, const double *y) {
   fluid_virtual_clear(&fc->virt);
   MPM_CALL(fluid_open_p2g(fc->open, m, y, &fc->virt));
   MPM_CALL(fluid_virtual_deposit(&fc->virt, m->grid, fc->lp));
-  fluid_obstacles_deposit(&fc->obs, m->grid, n, a.x, b.m, b.V0, b.J, fc->vsig);
+  fluid_obstacles_deposit(&fc->obs, m->grid, n, a.x, b.m, b.V0, b.J, fc->vsig, b.e, fc->gas.gamma);
   mpm_timer_stop(MPM_T_P2G);
   return 0;
 }

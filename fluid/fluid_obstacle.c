@@ -2,6 +2,8 @@
  * fluid_obstacle.h). */
 #include "fluid_obstacle.h"
 
+#include "fluid_eos.h"
+
 #include "mpm_bc.h"
 #include "mpm_error.h"
 
@@ -447,7 +449,7 @@ static void stencil_at(stencil *st, const mpm_grid *g, const double *x, double l
 
 /* Stencil slot k (x fastest) as a box index, or -1 outside the box; w and grad S there. */
 static mpm_lidx stencil_node(const stencil *st, const mpm_grid *g, int k, double *w, double *grad) {
-  int gi[MPM_MAX_DIM], kd[MPM_MAX_DIM];
+  int gi[MPM_MAX_DIM] = {0}, kd[MPM_MAX_DIM] = {0};
   for (int d = 0; d < g->dim; ++d) {
     kd[d] = k % st->support, k /= st->support;
     gi[d] = st->base[d] + kd[d];
@@ -530,7 +532,7 @@ static int build_ghosts(fluid_obstacles *o, const mpm_grid *g) {
   o->gowned = rc ? NULL : malloc((size_t)count + 1);
   o->gob = rc ? NULL : malloc(sizeof *o->gob * (size_t)(count + 1));
   o->near = rc ? NULL : calloc((size_t)g->nnodes, 1);
-  o->sm = rc ? NULL : malloc(sizeof *o->sm * 2 * (size_t)g->nnodes);
+  o->sm = rc ? NULL : malloc(sizeof *o->sm * 3 * (size_t)g->nnodes);
   o->q = rc ? NULL : calloc((size_t)g->nnodes, sizeof *o->q);
   o->own = rc ? NULL : malloc((size_t)g->nnodes);
   if (!rc && !(o->gnode && o->G && o->gowned && o->gob && o->near && o->sm && o->q && o->own))
@@ -572,6 +574,9 @@ int fluid_obstacles_build(fluid_obstacles *o, const mpm_config *cfg, const mpm_g
   for (int k = 0; k < 2; ++k) MPM_ALLOC(o->f[k], (size_t)grid->dim * count);
   for (int k = 0; k < count; ++k)
     MPM_CALL(build_one(&o->ob[k], cfg, grid, names[k], band * grid->dx, dir));
+  o->nsm = 2;
+  for (int k = 0; k < count; ++k)
+    if (o->ob[k].surf.n) o->nsm = 3;
   return build_ghosts(o, grid);
 }
 
@@ -599,11 +604,11 @@ static int near_body(const fluid_obstacles *o, const mpm_grid *g, const double *
 
 void fluid_obstacles_deposit(fluid_obstacles *o, const mpm_grid *grid, mpm_lidx n,
                              const double *const *x, const double *m, const double *V0,
-                             const double *J, const double *vsig) {
+                             const double *J, const double *vsig, const double *e, double gamma) {
   if (o->count == 0) return;
   const int dim = grid->dim;
-  double *sm = o->sm, *smp = o->sm + grid->nnodes;
-  memset(sm, 0, sizeof *sm * 2 * (size_t)grid->nnodes);
+  double *sm = o->sm, *smp = o->sm + grid->nnodes, *smt = o->sm + 2 * (size_t)grid->nnodes;
+  memset(sm, 0, sizeof *sm * (size_t)o->nsm * grid->nnodes);
   for (mpm_lidx i = 0; i < n; ++i) {
     double xp[MPM_MAX_DIM];
     if (!near_body(o, grid, x, i, xp)) continue;
@@ -617,6 +622,14 @@ void fluid_obstacles_deposit(fluid_obstacles *o, const mpm_grid *grid, mpm_lidx 
       const mpm_lidx l = stencil_node(&st, grid, s, &w, NULL);
       if (l >= 0) sm[l] += w * m[i], smp[l] += w * m[i] * p;
     }
+    if (o->nsm == 3) { /* the surface output: the thermodynamic pressure, without q */
+      const double pt = fluid_pressure(gamma, m[i] / (V0[i] * J[i]), e[i]);
+      for (int s = 0; s < stencil_count(&st, dim); ++s) {
+        double w;
+        const mpm_lidx l = stencil_node(&st, grid, s, &w, NULL);
+        if (l >= 0) smt[l] += w * m[i] * pt;
+      }
+    }
   }
 }
 
@@ -624,13 +637,14 @@ int fluid_obstacles_begin(fluid_obstacles *o, mpm_grid *grid, int phase, double 
                           int record) {
   if (o->count == 0) return 0;
   const int dim = grid->dim;
-  double *sm = o->sm, *smp = o->sm + grid->nnodes, *fields[2] = {sm, smp};
-  MPM_CALL(mpm_grid_halo_reverse(grid, fields, 2));
+  double *sm = o->sm, *smp = o->sm + grid->nnodes, *smt = o->sm + 2 * (size_t)grid->nnodes;
+  double *fields[3] = {sm, smp, smt};
+  MPM_CALL(mpm_grid_halo_reverse(grid, fields, o->nsm));
   double *rec = o->f[record ? mpm_rhs_records_begin(&o->rec, t, h) : o->rec.latest];
   if (record) memset(rec, 0, sizeof *rec * (size_t)dim * o->count);
   if (record && o->heat) memset(o->q, 0, sizeof *o->q * (size_t)grid->nnodes);
   for (int k = 0; record && k < o->count; ++k)
-    if (o->ob[k].surf.n) fluid_surface_sample(&o->ob[k].surf, grid, sm, smp, o->own);
+    if (o->ob[k].surf.n) fluid_surface_sample(&o->ob[k].surf, grid, sm, smt, o->own);
   mpm_grid_phase *ph = &grid->phase[phase];
   for (mpm_lidx k = 0; k < o->gcount; ++k) {
     const mpm_lidx l = o->gnode[k];

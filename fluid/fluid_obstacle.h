@@ -102,7 +102,9 @@ typedef struct fluid_obstacles {
   unsigned char *near; /* per box node as a cell's lower corner: a particle in it reaches a
                           ghost node or, when the heat is booked, a constrained node */
   unsigned char *own;  /* per box node: owned by this rank */
-  double *sm;          /* nodal m and m p of the particles near a body (2 nnodes) */
+  double *sm;          /* nodal m and m p (p = -tr sigma / dim, with q) of the particles near
+                          a body, then m p with the thermodynamic p alone (nsm nnodes) */
+  int nsm;             /* 3 if an obstacle writes its surface pressure, else 2 */
   double *q;           /* per box node: the rate at which the obstacles put energy into the gas
                           in the latest recorded RHS (ghost work and constraint power), W, then
                           per unit nodal mass, W/kg (fluid_obstacles_work) */
@@ -120,10 +122,11 @@ extern const int fluid_obstacle_nkeys;
 int fluid_obstacles_build(fluid_obstacles *o, const mpm_config *cfg, const mpm_grid *grid, int ppc,
                           const unsigned char (*open)[2]);
 /* In P2G: deposit m and m p of the n particles near a body (positions per component, masses, V0
- * and J, and the V sigma of the stress phase, dim^2 components of n). */
+ * and J, and the V sigma of the stress phase, dim^2 components of n), and for the surface output
+ * the thermodynamic pressure from e (specific internal energy) and gamma. */
 void fluid_obstacles_deposit(fluid_obstacles *o, const mpm_grid *grid, mpm_lidx n,
                              const double *const *x, const double *m, const double *V0,
-                             const double *J, const double *vsig);
+                             const double *J, const double *vsig, const double *e, double gamma);
 /* Before the nodal update (after the reverse halo): sum the nodal pressures over the ranks,
  * add the ghost forces to f_i and, with record, start the force record of this RHS at time t.
  * Collective. */

@@ -3,10 +3,12 @@
  * to surface_NAME.csv in the output directory (2-D polygon, wedge and airfoil shapes; the points
  * are the outline's vertices). Private to fluid/.
  *
- * Sample. The pressure at a point x_s is the one the body feels: the mass-weighted nodal
- * pressure p_i = sum_p S_ip m_p p_p / sum_p S_ip m_p (-tr sigma / dim, so it includes the
- * artificial viscosity, as the force does) that the obstacles deposit for their ghosts, read
- * with the bilinear weights N_i(x_s) of the four nodes around x_s, weighted by the nodal mass:
+ * Sample. The pressure at a point x_s is the thermodynamic pressure of the gas next to it (the
+ * equation of state's p, without the artificial viscosity q, which the force on the body does
+ * include: in a noisy wake q is positive wherever the gas compresses and would bias a mean
+ * upwards): the mass-weighted nodal pressure p_i = sum_p S_ip m_p p_p / sum_p S_ip m_p that the
+ * obstacles deposit beside the ghosts' pressure, read with the bilinear weights N_i(x_s) of the
+ * four nodes around x_s, weighted by the nodal mass:
  *   p_s = sum_i N_i(x_s) m_i p_i / sum_i N_i(x_s) m_i.
  * The nodes inside the body carry no mass and drop out, so p_s is a mean over the gas particles
  * within about two cells of x_s on the gas side. It is taken from the recorded RHS of every
@@ -47,7 +49,8 @@ typedef struct fluid_surface {
 int fluid_surface_build(fluid_surface *s, const char *path, double interval, const double *xy,
                         int n, double chord, const double *le, double angle_deg, double p_ref,
                         double q_ref);
-/* The local sums of one RHS from the nodal m and m p (sm, smp) of the owned nodes (own). */
+/* The local sums of one RHS from the nodal m and m p (sm, smp: the thermodynamic p) of the
+ * owned nodes (own). */
 void fluid_surface_sample(fluid_surface *s, const mpm_grid *g, const double *sm, const double *smp,
                           const unsigned char *own);
 /* After an accepted step from t - h to t: reduce the sums, add them to the window and write the
