@@ -59,7 +59,8 @@ for dx in [float(v) for v in a.dx.split(",")]:
     res, cp, exp = rae2822.analyse(run_dir(dx), 5)
     row = {"dx": dx, "cells_per_chord": round(1 / dx), "ranks": s["ranks"], "steps": s["steps"],
            "wall_s": s["wall_s"], "particle_steps": s["particle_steps"]}
-    row.update({k: res[k] for k in ("rms_lower", "rms_upper_ahead", "shock_x", "cl", "cd",
+    row.update({k: res[k] for k in ("rms_lower", "rms_upper_ahead", "rms_lower_010_100",
+                                    "rms_upper_010_050", "shock_x", "cl", "cd",
                                     "cl_change", "cp_drift_rms", "steady", "t_from", "t_to")})
     rows.append(row)
     curves.append((dx, cp))
@@ -96,11 +97,13 @@ exp_shock = rae2822.shock_position(rae2822.experiment()["upper"])
 with open(a.out + ".md", "w") as f:
     f.write("# RAE 2822, M 0.729, alpha 2.31 deg, inviscid, least_squares\n\n")
     f.write("| dx (cells/chord) | steps | wall s (ranks) | Cp RMS lower | Cp RMS upper x/c<=0.5 | "
-            "shock x/c | Cl | Cd | steady |\n|---|---|---|---|---|---|---|---|---|\n")
+            "the same from x/c = 0.1 | shock x/c | Cl | Cd | steady |\n"
+            "|---|---|---|---|---|---|---|---|---|---|\n")
     for r in rows:
         shock = f"{r['shock_x']:.3f}" if r["shock_x"] is not None else "none"
         f.write(f"| {r['dx']} ({r['cells_per_chord']}) | {r['steps']} | {r['wall_s']:.0f} "
-                f"({r['ranks']}) | {r['rms_lower']:.3f} | {r['rms_upper_ahead']:.3f} | {shock} | "
+                f"({r['ranks']}) | {r['rms_lower']:.3f} | {r['rms_upper_ahead']:.3f} | "
+                f"{r['rms_lower_010_100']:.3f} / {r['rms_upper_010_050']:.3f} | {shock} | "
                 f"{r['cl']:.3f} | {r['cd']:.4f} | {'yes' if r['steady'] else 'no'} "
                 f"(Cl {100 * r['cl_change']:.1f} %, Cp {r['cp_drift_rms']:.3f}) |\n")
     f.write(f"\nExperiment's shock (same definition, Cp rising through Cp*): x/c = {exp_shock:.3f}. "

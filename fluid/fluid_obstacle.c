@@ -615,20 +615,17 @@ void fluid_obstacles_deposit(fluid_obstacles *o, const mpm_grid *grid, mpm_lidx 
     double p = 0.0; /* p = -tr(V sigma) / (dim V) */
     for (int d = 0; d < dim; ++d) p -= vsig[(size_t)(d * dim + d) * n + i];
     p /= dim * V0[i] * J[i];
+    /* the surface output's thermodynamic pressure, without q */
+    const int surf = o->nsm == 3;
+    const double pt = surf ? fluid_pressure(gamma, m[i] / (V0[i] * J[i]), e[i]) : 0.0;
     stencil st;
     stencil_at(&st, grid, xp, o->lp);
     for (int s = 0; s < stencil_count(&st, dim); ++s) {
       double w;
       const mpm_lidx l = stencil_node(&st, grid, s, &w, NULL);
-      if (l >= 0) sm[l] += w * m[i], smp[l] += w * m[i] * p;
-    }
-    if (o->nsm == 3) { /* the surface output: the thermodynamic pressure, without q */
-      const double pt = fluid_pressure(gamma, m[i] / (V0[i] * J[i]), e[i]);
-      for (int s = 0; s < stencil_count(&st, dim); ++s) {
-        double w;
-        const mpm_lidx l = stencil_node(&st, grid, s, &w, NULL);
-        if (l >= 0) smt[l] += w * m[i] * pt;
-      }
+      if (l < 0) continue;
+      sm[l] += w * m[i], smp[l] += w * m[i] * p;
+      if (surf) smt[l] += w * m[i] * pt;
     }
   }
 }
