@@ -32,6 +32,7 @@ ap.add_argument("--dx", default="0.04,0.028,0.02")
 ap.add_argument("--repeats", type=int, default=3)
 ap.add_argument("--reuse", action="store_true")
 ap.add_argument("--skip-cost", action="store_true")
+ap.add_argument("--keep-cost", action="store_true", help="take the cost from the JSON already there")
 ap.add_argument("--out", default=os.path.join(benchrun.ROOT, "bench", "results", "rae2822"))
 a = ap.parse_args()
 case = os.path.join(benchrun.ROOT, "cases", "rae2822.ini")
@@ -67,7 +68,10 @@ for dx in [float(v) for v in a.dx.split(",")]:
     print(json.dumps(row), flush=True)
 
 cost = None
-if not a.skip_cost:
+if a.keep_cost:
+    with open(a.out + ".json") as f:
+        cost = json.load(f)["cost"]
+elif not a.skip_cost:
     samples = []
     for r in range(a.repeats):
         for t in ("ghost", "least_squares"):

@@ -184,7 +184,7 @@ def plot_field(run, path):
     import matplotlib.pyplot as plt
     snaps = sorted(glob.glob(os.path.join(run, "snap_*.h5")))
     with h5py.File(snaps[-1], "r") as f:
-        x, p, t = f["fluid/x"][:], f["fluid/p"][:, 0], None
+        x, p, t = f["fluid/x"][:], f["fluid/p"][:, 0], float(f.attrs["time"])
     q = 0.5 * 1.4 * MACH * MACH
     cp = (p - 1.0) / q
     keep = (x[:, 0] > -0.5) & (x[:, 0] < 1.7) & (abs(x[:, 1]) < 0.8)
@@ -194,7 +194,8 @@ def plot_field(run, path):
     ax.set_xlim(-0.5, 1.7)
     ax.set_ylim(-0.8, 0.8)
     fig.colorbar(sc, ax=ax, label="Cp of the particles")
-    ax.set_title(os.path.basename(snaps[-1]))
+    ax.set_title(f"RAE 2822, M 0.729, alpha 2.31 deg: particle Cp at t = {t:g} "
+                 f"({os.path.basename(os.path.normpath(run))})")
     fig.tight_layout()
     fig.savefig(path, dpi=110)
 
