@@ -291,8 +291,8 @@ static int read_reference(fluid_obstacle *ob, const reader *r) {
   MPM_CALL(get_real(r, "reference_density", &rho));
   MPM_CALL(get_real(r, "reference_speed", &u));
   ob->has_ref = 1;
-  ob->ref_area = area;
-  ob->q_ref_area = 0.5 * rho * u * u * area;
+  ob->q_ref = 0.5 * rho * u * u;
+  ob->q_ref_area = ob->q_ref * area;
   return 0;
 }
 
@@ -331,7 +331,7 @@ static int read_surface(fluid_obstacle *ob, const reader *r, const char *shape, 
   }
   snprintf(path, sizeof path, "%s/surface_%s.csv", dir, ob->name);
   return fluid_surface_build(&ob->surf, path, interval, ob->sdf.v, ob->sdf.nv, chord, le, aoa,
-                             p_ref, cp ? ob->q_ref_area / ob->ref_area : 0.0);
+                             p_ref, cp ? ob->q_ref : 0.0);
 }
 
 /* The obstacle must reach into the domain. */
@@ -609,14 +609,13 @@ void fluid_obstacles_deposit(fluid_obstacles *o, const mpm_grid *grid, mpm_lidx 
   const int dim = grid->dim;
   double *sm = o->sm, *smp = o->sm + grid->nnodes, *smt = o->sm + 2 * (size_t)grid->nnodes;
   memset(sm, 0, sizeof *sm * (size_t)o->nsm * grid->nnodes);
+  const int surf = o->nsm == 3; /* the surface output's thermodynamic pressure, without q */
   for (mpm_lidx i = 0; i < n; ++i) {
     double xp[MPM_MAX_DIM];
     if (!near_body(o, grid, x, i, xp)) continue;
     double p = 0.0; /* p = -tr(V sigma) / (dim V) */
     for (int d = 0; d < dim; ++d) p -= vsig[(size_t)(d * dim + d) * n + i];
     p /= dim * V0[i] * J[i];
-    /* the surface output's thermodynamic pressure, without q */
-    const int surf = o->nsm == 3;
     const double pt = surf ? fluid_pressure(gamma, m[i] / (V0[i] * J[i]), e[i]) : 0.0;
     stencil st;
     stencil_at(&st, grid, xp, o->lp);

@@ -74,7 +74,7 @@ typedef struct fluid_obstacle {
   int no_slip;
   int has_ref;             /* reference area given: write Cd and Cl */
   double q_ref_area;       /* 1/2 rho U^2 A */
-  double ref_area;         /* A */
+  double q_ref;            /* 1/2 rho U^2 */
   fluid_surface surf;      /* surface pressure output (surface_interval), or n = 0 */
   double flow[3], lift[3]; /* unit drag and lift directions */
   mpm_lidx count;          /* constrained nodes */
