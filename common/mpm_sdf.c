@@ -87,24 +87,32 @@ void mpm_sdf_free(mpm_sdf *s) {
   s->nv = 0;
 }
 
-/* Distance from (x, y) to the edges, the even-odd inside flag, and the outward normal. */
+/* Distance from (x, y) to the edges, the even-odd inside flag, and the outward normal.
+ *
+ * Where the nearest point lies inside an edge (not at a vertex), the normal is that edge's
+ * outward normal, whatever the distance: the direction from the nearest point to x is the
+ * same up to roundoff, but at a point on the edge, where that distance is itself roundoff
+ * (a grid node on an edge through round coordinates: 5 * 0.02 against a vertex at y = 0.1),
+ * it points anywhere, along the edge included. A slip wall with such a normal stopped the
+ * flow along it at every node on the edge (uniform flow along a grid-aligned wall blew up). */
 static double polygon2(const mpm_sdf *s, const double *x, double *n2) {
   double best = HUGE_VAL, cx = 0, cy = 0, ex = 0, ey = 0;
-  int inside = 0;
+  int inside = 0, at_vertex = 0;
   for (int i = 0, j = s->nv - 1; i < s->nv; j = i++) {
     const double *a = &s->v[2 * j], *b = &s->v[2 * i];
     const double dx = b[0] - a[0], dy = b[1] - a[1], len2 = dx * dx + dy * dy;
     double t = len2 > 0 ? ((x[0] - a[0]) * dx + (x[1] - a[1]) * dy) / len2 : 0.0;
+    const int clamped = !(t > 0 && t < 1);
     t = t < 0 ? 0 : t > 1 ? 1 : t;
     const double px = a[0] + t * dx, py = a[1] + t * dy;
     const double d2 = (x[0] - px) * (x[0] - px) + (x[1] - py) * (x[1] - py);
-    if (d2 < best) best = d2, cx = px, cy = py, ex = dx, ey = dy;
+    if (d2 < best) best = d2, cx = px, cy = py, ex = dx, ey = dy, at_vertex = clamped;
     if ((a[1] > x[1]) != (b[1] > x[1]) && x[0] < a[0] + (x[1] - a[1]) * dx / dy) inside = !inside;
   }
   const double dist = sqrt(best), sign = inside ? -1.0 : 1.0;
-  if (dist > 0) {
+  if (dist > 0 && at_vertex) {
     n2[0] = sign * (x[0] - cx) / dist, n2[1] = sign * (x[1] - cy) / dist;
-  } else { /* on the edge: its outward normal (right of the edge if counter-clockwise) */
+  } else { /* the edge's outward normal (right of the edge if counter-clockwise) */
     const double len = sqrt(ex * ex + ey * ey);
     n2[0] = s->orient * ey / len, n2[1] = -s->orient * ex / len;
   }

@@ -384,7 +384,7 @@ int fluid_wall_ls_apply(mpm_module *m, const double *y, double *ydot, double h) 
 
   /* Fit the wall particles; book the momentum; sum the energy change. */
   double *force = fc->obs.f[fc->obs.rec.latest];
-  double bal[2] = {0.0, 0.0}; /* the fit's energy change, and sum m e of the fitted */
+  double bal[2] = {0.0, 0.0}; /* the fit's energy change, and the gas's sum m e */
   for (mpm_lidx i = 0; i < n; ++i) {
     if (w->kind[i] != 1) continue;
     double xi[MPM_MAX_DIM], out[2 * MPM_MAX_DIM + 2];
@@ -413,16 +413,21 @@ int fluid_wall_ls_apply(mpm_module *m, const double *y, double *ydot, double h) 
     bal[1] += mass[i] * out[2 * dim];
     f[2 * dim] = out[2 * dim], f[2 * dim + 1] = out[2 * dim + 1];
   }
+  for (mpm_lidx i = 0; i < n; ++i) /* every particle pays (see the header) */
+    if (w->kind[i] != 1) bal[1] += mass[i] * (y[oe + i] + h * ydot[oe + i]);
   MPM_CALL_MPI(MPI_Allreduce(MPI_IN_PLACE, bal, 2, MPI_DOUBLE, MPI_SUM, g->comm));
   const double scale = bal[1] > 0.0 ? 1.0 - bal[0] / bal[1] : 1.0;
   if (!(scale > 0.0))
     MPM_FAIL(MPM_ERR_UNPHYSICAL,
-             "the least-squares wall fit changed the total energy of the wall particles by "
-             "%.3g J, more than all their internal energy (%.3g J): the flow next to the "
-             "obstacles is not resolved; refine grid.dx or use fluid.wall_treatment = ghost",
+             "the least-squares wall fit changed the total energy of the gas by %.3g J, more "
+             "than all its internal energy (%.3g J): the flow next to the obstacles is not "
+             "resolved; refine grid.dx or use fluid.wall_treatment = ghost",
              bal[0], bal[1]);
   for (mpm_lidx i = 0; i < n; ++i) {
-    if (w->kind[i] != 1) continue;
+    if (w->kind[i] != 1) { /* e + h e' scaled; exactly as it was when the fit is neutral */
+      ydot[oe + i] += (scale - 1.0) * (y[oe + i] / h + ydot[oe + i]);
+      continue;
+    }
     const double *f = w->val + (size_t)nf * i;
     ydot[oe + i] = (scale * f[2 * dim] - y[oe + i]) / h;
     ydot[oJ + i] = (mass[i] / (f[2 * dim + 1] * V0[i]) - y[oJ + i]) / h;

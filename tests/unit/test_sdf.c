@@ -83,6 +83,38 @@ static void test_polygon(void **state) {
   mpm_sdf_free(&s);
 }
 
+/* Grid nodes on an edge through round coordinates: x = i * 0.02 is on the edge y = 0.1 only up
+ * to roundoff in the projection, so the distance is ~1e-17 and the direction from the nearest
+ * point anywhere. The normal must still be the edge's (it was +-x: a slip wall stopped the
+ * flow along it). Every node of the edge, in both orientations, and a slanted edge. */
+static void test_polygon_on_edge(void **state) {
+  (void)state;
+  mpm_sdf s;
+  const double below[] = {-0.2, 0.1, 1.2, 0.1, 1.2, -0.2, -0.2, -0.2}; /* clockwise */
+  const double ccw[] = {-0.2, -0.2, 1.2, -0.2, 1.2, 0.1, -0.2, 0.1};
+  const double *outlines[] = {below, ccw};
+  for (int k = 0; k < 2; ++k) {
+    assert_int_equal(mpm_sdf_polygon(&s, 2, outlines[k], 4, NULL), 0);
+    for (int i = 0; i <= 50; ++i) {
+      const double dx = 1.0 / 50;
+      double nrm[2];
+      const double phi = mpm_sdf_eval(&s, (double[]){i * dx, 5 * dx}, nrm);
+      if (!(fabs(phi) <= TOL && fabs(nrm[0]) <= TOL && fabs(nrm[1] - 1) <= TOL))
+        printf("node %d: phi %.3g, normal (%.17g, %.17g)\n", i, phi, nrm[0], nrm[1]);
+      assert_true(fabs(phi) <= TOL && fabs(nrm[0]) <= TOL && fabs(nrm[1] - 1) <= TOL);
+    }
+    mpm_sdf_free(&s);
+  }
+  const double t = tan(10 * M_PI / 180), c = cos(10 * M_PI / 180), sn = sin(10 * M_PI / 180);
+  const double slant[] = {-0.2, 0.1 - 0.2 * t, 1.2, 0.1 + 1.2 * t, 1.2, -0.2, -0.2, -0.2};
+  assert_int_equal(mpm_sdf_polygon(&s, 2, slant, 4, NULL), 0);
+  for (int i = 0; i <= 50; ++i) { /* points on the slanted edge, from its own parametrisation */
+    const double x = i / 50.0;
+    expect(&s, (double[]){x, 0.1 + x * t}, 0.0, (double[]){-sn, c});
+  }
+  mpm_sdf_free(&s);
+}
+
 static void test_self_intersection(void **state) {
   (void)state;
   const double bow[] = {0, 0, 1, 1, 1, 0, 0, 1}; /* a bow tie: edges 0 and 2 cross */
@@ -162,9 +194,13 @@ static void test_airfoil(void **state) {
 int main(int argc, char **argv) {
   g_airfoil = argc > 1 ? argv[1] : "cases/rae2822_coordinates.csv";
   const struct CMUnitTest tests[] = {
-      cmocka_unit_test(test_box),     cmocka_unit_test(test_ball),
-      cmocka_unit_test(test_polygon), cmocka_unit_test(test_self_intersection),
-      cmocka_unit_test(test_wedge),   cmocka_unit_test(test_airfoil),
+      cmocka_unit_test(test_box),
+      cmocka_unit_test(test_ball),
+      cmocka_unit_test(test_polygon),
+      cmocka_unit_test(test_polygon_on_edge),
+      cmocka_unit_test(test_self_intersection),
+      cmocka_unit_test(test_wedge),
+      cmocka_unit_test(test_airfoil),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
