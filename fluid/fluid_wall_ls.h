@@ -49,12 +49,13 @@
  * wall particles alone (as this treatment first did), the correction re-imposed on them the
  * very departure from the donors that the fit had just removed: uniform Mach 2.5 flow along a
  * slip wall (cases/slanted_wall.ini, dx = 0.02) kept a wall layer 6.6 % over the free
- * stream's pressure with the wall on a grid line, and 4.5 % under it at 10 degrees; taken
- * back from the wall particles and the donors, the layer was still 0.6 % hot on the grid line
- * and 1.8 % cold at 10 degrees; spread over the whole gas, its pressure is within 0.1 % on the
- * grid line (at 10 degrees the flow's other errors, a 2 % compression of the first two cells,
- * then dominate). The factor differs from 1 by about the fit's energy
- * change over the gas's internal energy, 2e-6 a step in that case.
+ * stream's pressure with the wall 0.005 cells off a grid line, and 4.5 % under it at 10
+ * degrees; taken back from the wall particles and the donors, the layer was still 0.6 % hot
+ * and 1.8 % cold; spread over the whole gas, its pressure is within 0.1 % beside the grid line
+ * (at 10 degrees the flow's other errors, a 2 % compression of the first two cells, then
+ * dominate). The factor differs from 1 by the fit's energy change over the gas's internal
+ * energy, about 2e-6 a step there; where the fit keeps changing the energy one way, the whole
+ * flow carries it (the wedge's post-shock pressure rose by 0.3-0.5 %).
  *
  * Where it acts. In the classic update (usl, musl), after G2P, on the step's new values: the
  * wall particles' rates are rewritten so that the step ends on the fitted state, and they move
