@@ -38,6 +38,7 @@ typedef struct fluid_content {
   int reg_every;             /* regularise every reg_every steps (0: never) */
   int reg_min, reg_max;      /* particles per non-empty cell after regularisation */
   int refill;                /* regularisation refills cells that expansion emptied */
+  int refill_every;          /* refill every refill_every steps (0: never) */
   int stable_local;          /* fluid.stable_step = neighbourhood (fluid_stable.c) */
   double s_local;            /* its fastest signal for this step, m/s; < 0: not yet known */
   double *cellsum;           /* its per-cell sums (3 nnodes) */
@@ -71,8 +72,9 @@ int fluid_seed(mpm_module *m, const mpm_config *cfg);
  * Collective. */
 int fluid_neighbourhood_signal(const mpm_module *m, double *smax);
 
-/* Merge and split particles so that every non-empty cell holds reg_min to reg_max of them,
- * conserving mass, momentum and total energy, when step is a multiple of reg_every. Sets
+/* Refill emptied cells when step is a multiple of refill_every, then merge and split particles
+ * so that every non-empty cell holds reg_min to reg_max of them when it is a multiple of
+ * reg_every, conserving mass, momentum and total energy. Sets
  * *changed if this rank's set changed (fluid_regularise.c). Collective. */
 int fluid_regularise(mpm_module *m, long step, int *changed);
 

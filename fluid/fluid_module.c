@@ -65,6 +65,11 @@ static const mpm_key_spec fluid_keys[] = {
      "material and obstacles) half of a neighbour's heaviest particle, conserving mass, "
      "momentum and energy, so that strong expansions and wakes keep no empty cell",
      0},
+    {"fluid.refill_every", MPM_KEY_INT, "0", 0, HUGE_VAL, 0, 0, NULL,
+     "refill every N accepted steps, apart from the merges and splits (0: with each "
+     "regularisation, every fluid.regularise_every steps); a wake that expansion empties "
+     "faster than regularise_every steps refill it keeps empty cells between refills",
+     0},
     {"fluid.regularise_min", MPM_KEY_INT, NULL, 1, HUGE_VAL, 0, 0, NULL,
      "split particles in a non-empty cell holding fewer than this (default ceil(ppc^dim / 2): "
      "refill where the gas has expanded to twice its seeding volume; 1 never splits)",
@@ -477,6 +482,14 @@ static int read_regularise(fluid_content *fc, const mpm_config *cfg, int dim) {
   fc->reg_min = (seeded + 1) / 2, fc->reg_max = 4 * seeded;
   MPM_CALL(mpm_config_get_int(cfg, "fluid.regularise_every", &fc->reg_every));
   MPM_CALL(mpm_config_get_bool(cfg, "fluid.refill", &fc->refill));
+  int every = 0;
+  MPM_CALL(mpm_config_get_int(cfg, "fluid.refill_every", &every));
+  if (every > 0 && !fc->refill)
+    return mpm_config_fail(cfg, "fluid.refill_every",
+                           "refill_every = %d asks for refills and fluid.refill = false turns "
+                           "them off; remove one of the two keys",
+                           every);
+  fc->refill_every = fc->refill ? (every > 0 ? every : fc->reg_every) : 0;
   if (mpm_config_has(cfg, kmin)) MPM_CALL(mpm_config_get_int(cfg, kmin, &fc->reg_min));
   if (mpm_config_has(cfg, kmax)) MPM_CALL(mpm_config_get_int(cfg, kmax, &fc->reg_max));
   if (fc->reg_min < fc->reg_max) return 0;
@@ -601,7 +614,7 @@ int fluid_module_create(mpm_module **mp, const mpm_config *cfg, mpm_grid *grid, 
     mpm_module_destroy(mp);
     return mpm_trace(__FILE__, __LINE__, __func__, rc);
   }
-  m->cells_every = fc->refill ? fc->reg_every : 0;
+  m->cells_every = fc->refill_every;
   m->wall_slack = 0.5;
   return 0;
 }

@@ -22,11 +22,12 @@
  * cell and no migration is needed. The first half keeps the parent's id.
  * Mass, momentum and total energy are thus unchanged up to roundoff in every event.
  *
- * Refill (fluid.refill, before the merges and splits): a cell that strong expansion has
- * emptied is refilled from its neighbours, so that the gas stays a continuum into near vacuum
- * (a double rarefaction, the wake of a bluff body) instead of tearing into clouds with empty
- * gaps, where no later split can put gas back. A target is a cell inside the domain that holds
- * no particle of any phase (the cell occupancy every phase shares on the grid, mpm_cells.h:
+ * Refill (fluid.refill, before the merges and splits; at each regularisation, or every
+ * fluid.refill_every steps on its own, the merges and splits keeping their period): a cell that
+ * strong expansion has emptied is refilled from its neighbours, so that the gas stays a continuum
+ * into near vacuum (a double rarefaction, the wake of a bluff body) instead of tearing into clouds
+ * with empty gaps, where no later split can put gas back. A target is a cell inside the domain that
+ * holds no particle of any phase (the cell occupancy every phase shares on the grid, mpm_cells.h:
  * the gas never refills another material's cells), whose centre is outside the obstacles, and
  * that has a face neighbour holding gas. Its donor is that neighbour with the most gas
  * particles (ties: the lowest global cell index, then the first direction -x, +x, -y, ...),
@@ -472,14 +473,16 @@ static void totals(const mpm_module *m, double *t) {
 
 int fluid_regularise(mpm_module *m, long step, int *changed) {
   const fluid_content *fc = m->content;
-  if (fc->reg_every <= 0 || step % fc->reg_every != 0) return 0;
+  const int merge_split = fc->reg_every > 0 && step % fc->reg_every == 0;
+  const int fill = fc->refill_every > 0 && step % fc->refill_every == 0;
+  if (!merge_split && !fill) return 0;
   mpm_particles *p = m->particles;
   reg_edit e = {0};
   double sum[13] = {0}; /* failures, splits, merges, totals before (5) and after (5) */
   double children = 0.0;
   totals(m, sum + 3);
-  if (fc->refill) MPM_CALL(refill(m, &children, changed));
-  const int rc = regularise_local(m, &e, p->id_next);
+  if (fill) MPM_CALL(refill(m, &children, changed));
+  const int rc = merge_split ? regularise_local(m, &e, p->id_next) : 0;
   sum[0] = rc != 0, sum[1] = (double)e.splits, sum[2] = (double)e.merges;
   totals(m, sum + 8);
   free(e.keep), free(e.add), free(e.add_id);

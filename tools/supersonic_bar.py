@@ -109,6 +109,20 @@ def solid_particles(path):
     return mt.particles(path, "solid")
 
 
+def bar_cells(path, sc, shape):
+    """The cells of the bar in snapshot `path`: its particles' cells, or a gas-only twin's
+    obstacle box."""
+    lo, hi, dx = sc["lo"], sc["hi"], sc["dx"]
+    S = solid_particles(path)
+    if S is not None:
+        return np.histogram2d(S["x"][:, 0], S["x"][:, 1], bins=shape,
+                              range=((lo[0], hi[0]), (lo[1], hi[1])))[0] > 0
+    xc = lo[0] + (np.arange(shape[0]) + 0.5) * dx
+    yc = lo[1] + (np.arange(shape[1]) + 0.5) * dx
+    return ((xc[:, None] > sc["bar_lo"][0]) & (xc[:, None] < sc["bar_hi"][0])
+            & (yc[None, :] > sc["bar_lo"][1]) & (yc[None, :] < sc["bar_hi"][1]))
+
+
 def main(out):
     import matplotlib
     matplotlib.use("Agg")
@@ -124,17 +138,8 @@ def main(out):
                              squeeze=False, constrained_layout=True)
     rows = []
     for ax, (t, path) in zip(axes[:, 0], shown):
-        G, S = mt.particles(path, "fluid"), solid_particles(path)
-        rho = density(G, lo, hi, dx)
-        if S is not None:  # cells of the bar: its particles, or the obstacle
-            bar = np.histogram2d(S["x"][:, 0], S["x"][:, 1], bins=rho.shape,
-                                 range=((lo[0], hi[0]), (lo[1], hi[1])))[0] > 0
-        else:
-            xc = lo[0] + (np.arange(rho.shape[0]) + 0.5) * dx
-            yc = lo[1] + (np.arange(rho.shape[1]) + 0.5) * dx
-            bar = ((xc[:, None] > sc["bar_lo"][0]) & (xc[:, None] < sc["bar_hi"][0])
-                   & (yc[None, :] > sc["bar_lo"][1]) & (yc[None, :] < sc["bar_hi"][1]))
-        so, ne = standoff(rho, sc), empty_inside(rho, bar)
+        rho, S = density(mt.particles(path, "fluid"), lo, hi, dx), solid_particles(path)
+        so, ne = standoff(rho, sc), empty_inside(rho, bar_cells(path, sc, rho.shape))
         rows.append((t, so, ne))
         im = ax.imshow(np.ma.masked_equal(rho.T, 0), origin="lower", extent=ext,
                        cmap="viridis", vmin=0, vmax=6)

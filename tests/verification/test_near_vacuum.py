@@ -49,14 +49,29 @@ EVENT = re.compile(r"regularise step (\d+): (\d+) refills, (\d+) splits, (\d+) m
                    r"\((\S+), (\S+), (\S+)\), energy (\S+) -> (\S+)")
 
 
-def run(N, refill, debug=False):
+def run(N, refill, debug=False, extra=()):
     h = 3.0 / N
-    out = mt.outdir(f"near_vacuum_N{N}_{'refill' if refill else 'none'}")
+    out = mt.outdir(f"near_vacuum_N{N}_{'refill' if refill else 'none'}{len(extra)}")
     p = mt.run(["run", mt.case("double_rarefaction.ini"), f"output.dir={out}",
                 f"grid.dx={1.0 / N}", f"domain.hi=1 {h}", f"geometry.left.hi=0.5 {h}",
                 f"geometry.right.hi=1 {h}", f"fluid.refill={'true' if refill else 'false'}",
-                "run.progress=false"] + (["run.log_level=debug"] if debug else []))
+                "run.progress=false"] + (["run.log_level=debug"] if debug else []) + list(extra))
     return out, p
+
+
+def events(p):
+    """The regularisation events of a debug run: step, refills, splits, merges, then mass,
+    momentum (3) and total energy before and after."""
+    return np.array([[float(v) for v in m.groups()] for m in EVENT.finditer(p.stderr)])
+
+
+def conservation(ev):
+    """The largest relative change per event of mass, momentum and total energy."""
+    M, E = ev[:, 4], ev[:, 12]
+    dM = float(np.abs(ev[:, 5] - M).max() / M.max())
+    dP = float(np.abs(ev[:, 9:12] - ev[:, 6:9]).max() / np.sqrt(2 * M.max() * E.max()))
+    dE = float(np.abs(ev[:, 13] - E).max() / E.max())
+    return dM, dP, dE
 
 
 def bspline2(r):
@@ -88,11 +103,8 @@ def measure(out, N):
 mode = sys.argv[1] if len(sys.argv) > 1 else "refill"
 if mode == "refill":
     out, p = run(200, True, debug=True)
-    ev = np.array([[float(v) for v in m.groups()] for m in EVENT.finditer(p.stderr)])
-    M, E = ev[:, 4], ev[:, 12]
-    dM = float(np.abs(ev[:, 5] - M).max() / M.max())
-    dP = float(np.abs(ev[:, 9:12] - ev[:, 6:9]).max() / np.sqrt(2 * M.max() * E.max()))
-    dE = float(np.abs(ev[:, 13] - E).max() / E.max())
+    ev = events(p)
+    dM, dP, dE = conservation(ev)
     check(ev[:, 1].sum() > 0, f"{len(ev)} events, {int(ev[:, 1].sum())} refills")
     check(max(dM, dP, dE) <= 1e-13, f"per event, largest change of mass {dM:.1e}, momentum "
           f"{dP:.1e} of sqrt(2 M E), total energy {dE:.1e} (each <= 1e-13)")
@@ -104,6 +116,21 @@ if mode == "refill":
               f"refill (must be 0), {empty_0} without (the control, must be > 0)")
         check(l1 < l1_0, f"N = {N}: L1 density error {l1:.4f} with refill, {l1_0:.4f} without "
               f"({mt.cost(with_refill)})")
+    # fluid.refill_every = 1 with merges and splits every 30 steps: the refills run apart from
+    # them, every step, and conserve as before.
+    out, p = run(200, True, debug=True, extra=["fluid.regularise_every=30", "fluid.refill_every=1"])
+    ev = events(p)
+    off = ev[ev[:, 0] % 30 != 0]
+    dM, dP, dE = conservation(ev)
+    l1, empty = measure(out, 200)
+    check(len(off) > 0 and off[:, 1].sum() > 0 and off[:, 2:4].sum() == 0,
+          f"refill_every = 1, regularise_every = 30: {len(off)} events between regularisations, "
+          f"{int(off[:, 1].sum())} refills, {int(off[:, 2:4].sum())} splits and merges there "
+          f"(must be 0); {len(ev) - len(off)} regularisations")
+    check(max(dM, dP, dE) <= 1e-13 and empty == 0,
+          f"refill_every = 1: per event mass {dM:.1e}, momentum {dP:.1e}, energy {dE:.1e} "
+          f"(each <= 1e-13); {empty} empty nodes inside the gas (must be 0); L1 density error "
+          f"{l1:.4f} (printed)")
 else:
     errs = []
     for N in (200, 400, 800):

@@ -20,9 +20,12 @@ mpm_add_script_test(test_supersonic_bar SCRIPT verification/test_supersonic_bar.
 mpm_add_script_test(test_supersonic_bar_standoff SCRIPT verification/test_supersonic_bar.py
                     ARGS standoff LABELS "verification;mpi" TIMEOUT 600)
 # The rigid twin: the bar rigid under each coupling scheme against the gas-only scene with a
-# static obstacle, and both against the finite-volume Euler reference (bench/results).
+# static obstacle, and both against the finite-volume Euler reference (bench/results). Label
+# long: four runs of the main job's scene, 3 minutes of the default selection's 11 on 2 cores;
+# the rigid bar's coupling to the gas is checked by default in test_coupling_rigid, the main
+# job's scene in test_supersonic_bar.
 mpm_add_script_test(test_supersonic_bar_twin SCRIPT verification/test_supersonic_bar_twin.py
-                    LABELS "verification;mpi" TIMEOUT 900)
+                    LABELS "verification;mpi;long" TIMEOUT 900)
 # The same for the traction scheme: expected failure. With the rigid bar it blows up near
 # 0.84 ms at this resolution (the guard stops it); see the test's header.
 mpm_add_script_test(test_supersonic_bar_twin_traction SCRIPT
