@@ -56,6 +56,7 @@
 
 #include "mpm_cells.h"
 #include "mpm_error.h"
+#include "mpm_log.h"
 #include "mpm_particles.h"
 
 #include <math.h>
@@ -407,6 +408,27 @@ static int refill_split(mpm_module *m, const mpm_lidx *perm, int k, const int *e
   return edit_append(ed, row, id, nc);
 }
 
+/* Has an owned cell holding gas a face neighbour that is a refill target? From the cell
+ * counts alone: most refills at every step find none, and skip the sort by cell. */
+static int any_target(const mpm_module *m, const reg_box *b) {
+  const int dim = m->grid->dim;
+  mpm_lidx total = 1;
+  for (int d = 0; d < dim; ++d) total *= b->nc[d];
+  for (mpm_lidx l = 0; l < total; ++l) {
+    int c[MPM_MAX_DIM] = {0};
+    mpm_lidx r = l;
+    for (int d = 0; d < dim; ++d) c[d] = b->c0[d] + (int)(r % b->nc[d]), r /= b->nc[d];
+    if (!(gas_count(m, c) > 0.0)) continue;
+    for (int q = 0; q < 2 * dim; ++q) {
+      int e[MPM_MAX_DIM] = {0};
+      memcpy(e, c, sizeof e);
+      e[q / 2] += q % 2 ? 1 : -1;
+      if (refill_target(m, e)) return 1;
+    }
+  }
+  return 0;
+}
+
 /* This rank's part of a refill: each owned cell holding gas gives to the targets that chose
  * it. Returns the number of children in ed->nadd. */
 static int refill_local(mpm_module *m, reg_edit *ed, mpm_gidx id_base) {
@@ -414,6 +436,7 @@ static int refill_local(mpm_module *m, reg_edit *ed, mpm_gidx id_base) {
   const mpm_grid *g = m->grid;
   reg_box b;
   box_of(&b, g);
+  if (!any_target(m, &b)) return 0;
   mpm_lidx *start = NULL, *perm = NULL, ncell = 0;
   MPM_CALL(group_by_cell(&b, p, &start, &perm, &ncell));
   int rc = 0;
@@ -480,11 +503,12 @@ int fluid_regularise(mpm_module *m, long step, int *changed) {
   reg_edit e = {0};
   double sum[13] = {0}; /* failures, splits, merges, totals before (5) and after (5) */
   double children = 0.0;
-  totals(m, sum + 3);
+  const int logged = mpm_log_get_level() >= MPM_LOG_DEBUG; /* the totals are for the log only */
+  if (logged) totals(m, sum + 3);
   if (fill) MPM_CALL(refill(m, &children, changed));
   const int rc = merge_split ? regularise_local(m, &e, p->id_next) : 0;
   sum[0] = rc != 0, sum[1] = (double)e.splits, sum[2] = (double)e.merges;
-  totals(m, sum + 8);
+  if (logged) totals(m, sum + 8);
   free(e.keep), free(e.add), free(e.add_id);
   /* One reduction: every rank learns of a failure anywhere before it goes on. */
   MPM_CALL_MPI(MPI_Allreduce(MPI_IN_PLACE, sum, 13, MPI_DOUBLE, MPI_SUM, m->grid->comm));
