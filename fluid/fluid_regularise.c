@@ -409,7 +409,8 @@ static int refill_split(mpm_module *m, const mpm_lidx *perm, int k, const int *e
 }
 
 /* Has an owned cell holding gas a face neighbour that is a refill target? From the cell
- * counts alone: most refills at every step find none, and skip the sort by cell. */
+ * counts alone, so that a refill that finds none (a flow with no near vacuum) skips the sort
+ * by cell. */
 static int any_target(const mpm_module *m, const reg_box *b) {
   const int dim = m->grid->dim;
   mpm_lidx total = 1;

@@ -109,11 +109,10 @@ def solid_particles(path):
     return mt.particles(path, "solid")
 
 
-def bar_cells(path, sc, shape):
-    """The cells of the bar in snapshot `path`: its particles' cells, or a gas-only twin's
-    obstacle box."""
+def bar_cells(S, sc, shape):
+    """The cells of the bar: its particles' cells (S, solid_particles of a snapshot), or a
+    gas-only twin's obstacle box (S None)."""
     lo, hi, dx = sc["lo"], sc["hi"], sc["dx"]
-    S = solid_particles(path)
     if S is not None:
         return np.histogram2d(S["x"][:, 0], S["x"][:, 1], bins=shape,
                               range=((lo[0], hi[0]), (lo[1], hi[1])))[0] > 0
@@ -139,7 +138,7 @@ def main(out):
     rows = []
     for ax, (t, path) in zip(axes[:, 0], shown):
         rho, S = density(mt.particles(path, "fluid"), lo, hi, dx), solid_particles(path)
-        so, ne = standoff(rho, sc), empty_inside(rho, bar_cells(path, sc, rho.shape))
+        so, ne = standoff(rho, sc), empty_inside(rho, bar_cells(S, sc, rho.shape))
         rows.append((t, so, ne))
         im = ax.imshow(np.ma.masked_equal(rho.T, 0), origin="lower", extent=ext,
                        cmap="viridis", vmin=0, vmax=6)

@@ -78,7 +78,7 @@ empty = []
 for t, path in mt.snapshots(full):
     sc = sb.scene(path)
     rho = sb.density(mt.particles(path, "fluid"), sc["lo"], sc["hi"], sc["dx"])
-    empty.append(sb.empty_inside(rho, sb.bar_cells(path, sc, rho.shape)))
+    empty.append(sb.empty_inside(rho, sb.bar_cells(sb.solid_particles(path), sc, rho.shape)))
 check(max(empty) == 0, f"empty cells inside the gas per snapshot {empty} (must be 0: refill "
       "every step keeps the wake filled)")
 mt.run(["restart", os.path.join(full, "checkpoint_000001.h5"), f"output.dir={rest}"] + common, 2)
