@@ -350,10 +350,12 @@ int mpm_grid_owner_of(const mpm_grid *g, const double *x) {
   int coords[MPM_MAX_DIM], rank, own = 1;
   for (int d = 0; d < g->dim; ++d) {
     if (!(x[d] >= g->lo[d] && x[d] < g->hi[d])) return -1; /* also rejects NaN */
-    int c = (int)floor((x[d] - g->lo[d]) / g->dx);
-    if (c >= g->ncells[d]) c = g->ncells[d] - 1; /* x just below hi may round up */
-    coords[d] = coord_of_cell(g->cell_split[d], g->nproc[d], c);
-    own &= coords[d] == g->coord[d];
+    int c = (int)((x[d] - g->lo[d]) / g->dx);              /* the floor: the quotient is >= 0 */
+    if (c >= g->ncells[d]) c = g->ncells[d] - 1;           /* x just below hi may round up */
+    const int *split = g->cell_split[d], mine = g->coord[d];
+    const int in = c >= split[mine] && c < split[mine + 1]; /* most particles stay */
+    coords[d] = in ? mine : coord_of_cell(split, g->nproc[d], c);
+    own &= in;
   }
   if (own) return g->rank; /* most particles stay: no MPI call for them */
   if (MPI_Cart_rank(g->comm, coords, &rank) != MPI_SUCCESS) return -1;

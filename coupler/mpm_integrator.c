@@ -27,16 +27,18 @@ struct mpm_integrator {
   int nmod;
   mpm_cycle cycle; /* the RHS over mod[] */
   mpm_method method;
-  int fixed; /* fixed CFL steps without error control (classic, euler, time.adaptive = false) */
+  int fixed;  /* fixed CFL steps without error control (classic, euler, time.adaptive = false) */
+  int direct; /* one stage, fixed step (classic, euler): taken here, without ERKStep */
   double rtol, atol, cfl, dt_max;
   int max_retries;
-  double h_classic; /* step of the classic update, computed by its RHS (see classic_step) */
-  double h_limit;   /* its stability-limited step at ERKStep's current state (0: no limit) */
-  int h_limit_set;  /* h_limit belongs to the current state (set by the RHS at a step's end) */
+  double h_limit;   /* fixed steps: the stability-limited step of the current state (0: none) */
+  int h_limit_set;  /* h_limit belongs to the current state (direct steps) */
+  double h_last;    /* direct steps: the last step taken (or the first step asked for) */
   double tstop;     /* stop time of the current step */
   double scale;     /* step reduction of the current retry (1 when not retrying) */
-  int fn_stale;     /* ERKStep's stored f(t_n, y_n) used another step size: re-evaluate */
-  double checked_t; /* time of the last step end whose state the classic update checked */
+  double checked_t; /* direct steps: time of the last step end whose state was checked */
+  double *work;     /* direct steps: f and the new state, each module's block in turn */
+  size_t work_cap;  /* doubles allocated in work */
   mpm_fault fault;  /* last unphysical state seen by the RHS (same on every rank) */
   int rhs_error;    /* a non-recoverable failure inside the RHS */
   long steps, rhs_evals, fails, retries;
@@ -77,6 +79,20 @@ static double *module_data(N_Vector y, int k) {
   return N_VGetArrayPointer(N_VGetSubvector_MPIManyVector(y, k));
 }
 
+static void vector_blocks(const mpm_integrator *it, N_Vector y, double **yk) {
+  for (int k = 0; k < it->nmod; ++k) yk[k] = module_data(y, k);
+}
+
+/* The accepted state: every module's state block in its particle data. */
+static void particle_blocks(const mpm_integrator *it, double **yk) {
+  for (int k = 0; k < it->nmod; ++k) yk[k] = it->mod[k]->particles->data;
+}
+
+static size_t block_length(const mpm_integrator *it, int k) {
+  const mpm_particles *p = it->mod[k]->particles;
+  return (size_t)p->nstate * (size_t)p->n;
+}
+
 /* Agree on a fault across ranks: the lowest rank that has one broadcasts it. */
 static int share_fault(mpm_integrator *it, mpm_fault *local) {
   int rank, size, who;
@@ -90,50 +106,28 @@ static int share_fault(mpm_integrator *it, mpm_fault *local) {
   return 1;
 }
 
-/* One RHS of the MPM cycle over every module's block of y. */
-static int cycle_rhs(mpm_integrator *it, N_Vector y, N_Vector ydot, double t) {
-  double *yk[MPM_MAX_MODULES], *ydk[MPM_MAX_MODULES];
-  for (int k = 0; k < it->nmod; ++k) yk[k] = module_data(y, k), ydk[k] = module_data(ydot, k);
-  return mpm_cycle_rhs(&it->cycle, t, yk, ydk, it->h_classic);
+/* Check every module's block of y (stopping at the first fault) and agree across ranks:
+ * 1 if some rank found an unphysical state (now in it->fault), 0 if none. Collective. */
+static int check_state(mpm_integrator *it, double *const *yk) {
+  mpm_fault local = {0};
+  mpm_timer_start(MPM_T_CHECK);
+  for (int k = 0; k < it->nmod && !local.set; ++k)
+    it->mod[k]->ops->check(it->mod[k], yk[k], &local);
+  const int faulty = share_fault(it, &local);
+  mpm_timer_stop(MPM_T_CHECK);
+  return faulty;
 }
 
-static int classic_limit(mpm_integrator *it, N_Vector y, double *h);
-static double classic_step(const mpm_integrator *it, double t, double h_limit);
-
-/* In the classic update ERKStep's end-of-step f is the next step's one stage, but the driver
- * nearly always changes the particles between steps (migration, inflow, outflow,
- * regularisation) and the next stop time or retry may change the step it was computed for.
- * So the end of a step only checks the new state; the next attempt finds its stability limit
- * and evaluates f from scratch (fn_stale). The RHS is a function of (t, y, h) alone (the
- * lagged strain rate is part of y), so this changes no result and halves the MPM cycles. */
+/* ERKStep's RHS (the ERK pairs): the MPM cycle with h = 0 (the method of lines) on a state
+ * that passes the modules' checks; an unphysical one is a recoverable failure. */
 static int rhs(mpm_sunreal t, N_Vector y, N_Vector ydot, void *user) {
   mpm_integrator *it = user;
-  mpm_fault local = {0};
-  const int classic = mpm_method_is_classic(it->method);
-  const int at_end = t != it->t_last; /* the end of a step, where the next one starts */
-  mpm_timer_start(MPM_T_CHECK);
-  if (classic && !at_end) {
-    if (!it->h_limit_set && classic_limit(it, y, &it->h_limit) != 0) {
-      it->rhs_error = 1;
-      return -1;
-    }
-    it->h_limit_set = 1;
-    it->h_classic = classic_step(it, t, it->h_limit);
-  }
-  /* A classic step's state was checked at the end of the step that made it (below); the
-   * particles the driver adds between steps are made valid. */
-  const int checked = classic && !at_end && it->checked_t == t;
-  for (int k = 0; k < it->nmod && !local.set && !checked; ++k)
-    it->mod[k]->ops->check(it->mod[k], module_data(y, k), &local);
-  const int faulty = !checked && share_fault(it, &local);
-  mpm_timer_stop(MPM_T_CHECK);
-  if (faulty) return 1;
-  if (classic && at_end) { /* ydot is never read: the next attempt re-evaluates */
-    it->checked_t = t, it->fn_stale = 1, it->h_limit_set = 0;
-    return 0;
-  }
+  double *yk[MPM_MAX_MODULES], *ydk[MPM_MAX_MODULES];
+  vector_blocks(it, y, yk);
+  vector_blocks(it, ydot, ydk);
+  if (check_state(it, yk)) return 1;
   it->rhs_evals++;
-  if (cycle_rhs(it, y, ydot, t) != 0) {
+  if (mpm_cycle_rhs(&it->cycle, t, yk, ydk, 0.0) != 0) {
     it->rhs_error = 1;
     return -1;
   }
@@ -141,10 +135,9 @@ static int rhs(mpm_sunreal t, N_Vector y, N_Vector ydot, void *user) {
 }
 
 /* Stability limit: min over modules and ranks of dx / (c + |v|), before the CFL fraction. */
-static int stable_step(mpm_integrator *it, N_Vector y, double *hstab) {
+static int stable_step(mpm_integrator *it, double *const *yk, double *hstab) {
   double h = HUGE_VAL;
-  for (int k = 0; k < it->nmod; ++k)
-    h = fmin(h, it->mod[k]->ops->stable_dt(it->mod[k], module_data(y, k)));
+  for (int k = 0; k < it->nmod; ++k) h = fmin(h, it->mod[k]->ops->stable_dt(it->mod[k], yk[k]));
   MPM_CALL_MPI(MPI_Allreduce(&h, hstab, 1, MPI_DOUBLE, MPI_MIN, it->comm));
   return 0;
 }
@@ -152,9 +145,10 @@ static int stable_step(mpm_integrator *it, N_Vector y, double *hstab) {
 /* For the adaptive pairs; ARKODE applies time.cfl as its CFL fraction. */
 static int estab(N_Vector y, mpm_sunreal t, mpm_sunreal *hstab, void *user) {
   (void)t;
-  double h;
+  double h, *yk[MPM_MAX_MODULES];
+  vector_blocks(user, y, yk);
   mpm_timer_start(MPM_T_CHECK);
-  const int rc = stable_step(user, y, &h);
+  const int rc = stable_step(user, yk, &h);
   mpm_timer_stop(MPM_T_CHECK);
   if (rc != 0) return -1;
   *hstab = isfinite(h) ? h : 0.0; /* 0: no limit */
@@ -163,23 +157,43 @@ static int estab(N_Vector y, mpm_sunreal t, mpm_sunreal *hstab, void *user) {
 
 /* The stability-limited fixed step (classic update, euler, non-adaptive pairs) at y: the CFL
  * fraction of the limit, capped by dt_max; 0 when nothing limits it. */
-static int classic_limit(mpm_integrator *it, N_Vector y, double *h) {
+static int classic_limit(mpm_integrator *it, double *const *yk, double *h) {
   double hs;
-  MPM_CALL(stable_step(it, y, &hs));
+  MPM_CALL(stable_step(it, yk, &hs));
   hs = fmin(it->cfl * hs, it->dt_max);
   *h = hs > 0 && isfinite(hs) ? hs : 0.0;
   return 0;
 }
 
-/* The fixed step from t: the limit (or, without one, the rest of the way to the stop time)
- * times the retry scale, capped by the stop time so that a step lands on it (and stretched to
- * it when the limit falls short by roundoff only). The classic
- * update's RHS computes it from the same (t, y) the driver uses to set the fixed step. */
-static double classic_step(const mpm_integrator *it, double t, double h_limit) {
-  const double rest = it->tstop - t, h = it->scale * (h_limit > 0 ? h_limit : rest);
+/* The fixed step from the last accepted state: its stability limit (or, without one, the
+ * rest of the way to the stop time) times the retry scale, capped by the stop time so that a
+ * step lands on it (and stretched to it when the limit falls short by roundoff only). */
+static int fixed_step(mpm_integrator *it, double *h) {
+  if (!it->h_limit_set) {
+    double *yk[MPM_MAX_MODULES];
+    particle_blocks(it, yk);
+    MPM_CALL(classic_limit(it, yk, &it->h_limit));
+    it->h_limit_set = it->direct; /* ERKStep's fixed steps: the state may have changed since */
+  }
+  const double t = it->t_last, rest = it->tstop - t;
+  const double hs = it->scale * (it->h_limit > 0 ? it->h_limit : rest);
   /* A limit a few ulps short of the rest (a staggered scheme's coupling step, t + H - t) would
    * leave a step of roundoff size. */
-  return h >= rest * (1 - 1e-12) ? rest : h;
+  *h = hs >= rest * (1 - 1e-12) ? rest : hs;
+  /* A step that does not move the time would end where it starts. From a stability limit that
+   * small, the run has blown up; from a stop time that close, a caller asked for a
+   * roundoff-sized step. */
+  if (t + *h > t) return 0;
+  if (*h < rest)
+    MPM_FAIL(MPM_ERR_UNPHYSICAL,
+             "the run blew up at t = %.6g: the stable step of the state fell to %.3g s, too "
+             "small to advance the time (speeds or wave speeds without bound); reduce "
+             "time.cfl, refine the grid, or check the scene near the fastest particles",
+             t, *h);
+  MPM_FAIL(MPM_ERR_INTERNAL,
+           "a fixed step of %.3g s from t = %.17g to the stop time %.17g does not advance the "
+           "time (roundoff): the time scheme asked for it",
+           *h, t, it->tstop);
 }
 
 #if SUNDIALS_VERSION_MAJOR < 7
@@ -228,6 +242,61 @@ static int wrap_state(mpm_integrator *it) {
   return 0;
 }
 
+/* ---- one stage, fixed step: taken here ---------------------------------------------------- */
+
+/* The classic update (usl, musl) and forward Euler are one stage with a fixed step,
+ * y_{n+1} = y_n + h f(t_n, y_n), where the classic update's f also depends on h (the grid
+ * velocity is advanced by h before G2P). Through ERKStep such a step cost a reset (the driver
+ * changes the particles between nearly all steps, and f depends on the step), an interpolant,
+ * an end-of-step RHS and some seven copies of the state, and every vector was reallocated
+ * whenever a particle entered, left, or changed rank. Here a step is one RHS, one combination
+ * h f + y (ERKStep's arithmetic, so results are bit for bit the same) and one copy. */
+
+#define MPM_RETRY (-1)
+
+/* Room for f and the new state of every module's block; grows by a quarter beyond the need. */
+static int ensure_work(mpm_integrator *it) {
+  size_t need = 0;
+  for (int k = 0; k < it->nmod; ++k) need += 2 * block_length(it, k);
+  if (need <= it->work_cap) return 0;
+  free(it->work);
+  it->work = NULL, it->work_cap = 0;
+  const size_t cap = need + need / 4;
+  MPM_ALLOC(it->work, cap);
+  it->work_cap = cap;
+  return 0;
+}
+
+/* One step of h from the accepted state (the particle data), which the previous step's end
+ * checked unless the particles changed since: the new state is checked before it replaces
+ * the old one, so a fault leaves the accepted state as it was. */
+static int direct_step(mpm_integrator *it, double h, double *t, double *h_taken) {
+  double *y[MPM_MAX_MODULES], *f[MPM_MAX_MODULES], *y1[MPM_MAX_MODULES];
+  size_t len[MPM_MAX_MODULES];
+  particle_blocks(it, y);
+  double *w = it->work;
+  for (int k = 0; k < it->nmod; ++k) {
+    len[k] = block_length(it, k);
+    f[k] = w, y1[k] = w + len[k];
+    w += 2 * len[k];
+  }
+  if (it->checked_t != it->t_last && check_state(it, y)) return MPM_RETRY;
+  it->rhs_evals++;
+  MPM_CALL(mpm_cycle_rhs(&it->cycle, it->t_last, y, f, mpm_method_is_classic(it->method) ? h : 0));
+  for (int k = 0; k < it->nmod; ++k) {
+    const double *fk = f[k], *yk = y[k];
+    double *zk = y1[k];
+    for (size_t i = 0; i < len[k]; ++i) zk[i] = h * fk[i] + yk[i];
+  }
+  if (check_state(it, y1)) return MPM_RETRY;
+  for (int k = 0; k < it->nmod; ++k)
+    if (len[k] > 0) memcpy(y[k], y1[k], len[k] * sizeof(double));
+  it->t_last = it->checked_t = it->t_last + h;
+  it->h_limit_set = 0, it->h_last = h;
+  *t = it->t_last, *h_taken = h;
+  return 0;
+}
+
 /* ---- life cycle --------------------------------------------------------------------------- */
 
 static int read_settings(mpm_integrator *it, const mpm_config *cfg) {
@@ -242,7 +311,8 @@ static int read_settings(mpm_integrator *it, const mpm_config *cfg) {
   MPM_CALL(mpm_config_get_int(cfg, "time.max_retries", &it->max_retries));
   int adaptive;
   MPM_CALL(mpm_config_get_bool(cfg, "time.adaptive", &adaptive));
-  it->fixed = !adaptive || mpm_method_is_classic(it->method) || it->method == MPM_METHOD_EULER;
+  it->direct = mpm_method_is_classic(it->method) || it->method == MPM_METHOD_EULER;
+  it->fixed = !adaptive || it->direct;
   if (it->dt_max <= 0) it->dt_max = HUGE_VAL;
   return 0;
 }
@@ -261,6 +331,7 @@ int mpm_integrator_new(mpm_integrator **itp, const mpm_config *cfg, const mpm_cy
   it->cycle = *cycle;
   it->cycle.mod = it->mod;
   it->cycle.musl = it->method == MPM_METHOD_MUSL;
+  if (it->direct) return ensure_work(it);
   if (mpm_sun_context_create(&it->comm, &it->ctx) != 0)
     MPM_FAIL(MPM_ERR_SUNDIALS, "SUNContext_Create failed");
   return wrap_state(it);
@@ -270,20 +341,10 @@ void mpm_integrator_destroy(mpm_integrator **it) {
   if (!it || !*it) return;
   if ((*it)->ark) ERKStepFree(&(*it)->ark);
   free_state(*it);
+  free((*it)->work);
   if ((*it)->ctx) SUNContext_Free(&(*it)->ctx);
   free(*it);
   *it = NULL;
-}
-
-/* The classic update: one stage, y_{n+1} = y_n + h f(t_n, y_n), with h known to f. */
-static int set_classic_table(mpm_integrator *it) {
-  ARKodeButcherTable B = ARKodeButcherTable_Alloc(1, SUNFALSE);
-  if (!B) MPM_FAIL(MPM_ERR_MEMORY, "cannot allocate a Butcher table");
-  B->A[0][0] = 0.0, B->b[0] = 1.0, B->c[0] = 0.0, B->q = 1, B->p = 0;
-  int flag = ERKStepSetTable(it->ark, B);
-  ARKodeButcherTable_Free(B);
-  MPM_CALL_SUN(flag);
-  return 0;
 }
 
 /* Ralston's second-order method with an embedded Euler step. SUNDIALS before 6.7 treats
@@ -333,9 +394,7 @@ static int configure(mpm_integrator *it, double h0) {
   MPM_CALL_SUN(ERKStepSetErrHandlerFn(it->ark, ark_errors, NULL));
 #endif
   MPM_CALL_SUN(ERKStepSetMaxNumSteps(it->ark, -1));
-  if (mpm_method_is_classic(it->method) || it->method == MPM_METHOD_EULER)
-    MPM_CALL(set_classic_table(it));
-  else if (it->method == MPM_METHOD_RALSTON21)
+  if (it->method == MPM_METHOD_RALSTON21)
     MPM_CALL(set_ralston_table(it));
   else
     MPM_CALL_SUN(ERKStepSetTableNum(it->ark, tables[it->method]));
@@ -359,31 +418,35 @@ static int configure(mpm_integrator *it, double h0) {
 }
 
 int mpm_integrator_start(mpm_integrator *it, double t, double h0) {
+  it->t_last = t;
+  it->scale = 1.0, it->fails_seen = 0, it->h_limit_set = 0;
+  it->checked_t = NAN, it->h_last = h0;
+  if (it->direct) return ensure_work(it);
   if (it->ark) ERKStepFree(&it->ark);
   MPM_CALL(wrap_state(it));
   it->ark = ERKStepCreate(rhs, t, it->y, it->ctx);
   if (!it->ark) MPM_FAIL(MPM_ERR_SUNDIALS, "ERKStepCreate failed");
-  it->t_last = t;
-  it->scale = 1.0, it->fn_stale = 0, it->fails_seen = 0, it->h_limit_set = 0;
-  it->checked_t = NAN;
   return configure(it, h0);
 }
 
 int mpm_integrator_resize(mpm_integrator *it, double t) {
-  MPM_CALL(wrap_state(it));
   it->h_limit_set = 0; /* particles moved between ranks, or were added or removed */
+  if (it->direct) return ensure_work(it);
+  MPM_CALL(wrap_state(it));
   MPM_CALL_SUN(ERKStepResize(it->ark, it->y, 1.0, t, NULL, NULL));
   return 0;
 }
 
 int mpm_integrator_cfl_step(mpm_integrator *it, double *h) {
-  double hs;
-  MPM_CALL(stable_step(it, it->y, &hs));
+  double hs, *yk[MPM_MAX_MODULES];
+  particle_blocks(it, yk);
+  MPM_CALL(stable_step(it, yk, &hs));
   *h = isfinite(hs) ? it->cfl * hs : 0.0;
   return 0;
 }
 
 double mpm_integrator_next_step(const mpm_integrator *it) {
+  if (it->direct) return it->h_last;
   mpm_sunreal h = 0;
   ERKStepGetCurrentStep(it->ark, &h);
   return h;
@@ -409,48 +472,23 @@ static int report_fault(const mpm_integrator *it, double t, int tries) {
   return MPM_ERR_UNPHYSICAL;
 }
 
-#define MPM_RETRY (-1)
-
-/* One attempt with the classic step scaled by `scale`: 0 = accepted, MPM_RETRY = an
- * unphysical stage (retry smaller), otherwise an error code. */
+/* One attempt with the step scaled by `scale`: 0 = accepted, MPM_RETRY = an unphysical stage
+ * (retry smaller), otherwise an error code. */
 static int attempt(mpm_integrator *it, double tstop, double scale, double *t, double *h) {
   mpm_sunreal tret = it->t_last;
-  if (it->fixed) {
-    /* The classic update's f depends on the step. After a step it is always re-evaluated
-     * (the end of a step only checks, see rhs); the first f, from ERKStep's setup, holds if
-     * the step it was computed with stands. The f of the other fixed-step methods does not
-     * depend on the step. The stability limit of this state is known from its first RHS,
-     * unless the particles changed since. */
-    const int classic = mpm_method_is_classic(it->method);
-    const double h_stored = it->h_classic;
-    it->tstop = tstop, it->scale = scale;
-    if (!it->h_limit_set) MPM_CALL(classic_limit(it, it->y, &it->h_limit));
-    const double hf = classic_step(it, it->t_last, it->h_limit);
-    /* A step that does not move the time would evaluate the end of the step at its start,
-     * where the state is not checked. From a stability limit that small, the run has blown up;
-     * from a stop time that close, a caller asked for a roundoff-sized step. */
-    if (!(it->t_last + hf > it->t_last)) {
-      if (hf < tstop - it->t_last)
-        MPM_FAIL(MPM_ERR_UNPHYSICAL,
-                 "the run blew up at t = %.6g: the stable step of the state fell to %.3g s, too "
-                 "small to advance the time (speeds or wave speeds without bound); reduce "
-                 "time.cfl, refine the grid, or check the scene near the fastest particles",
-                 it->t_last, hf);
-      MPM_FAIL(MPM_ERR_INTERNAL,
-               "a classic step of %.3g s from t = %.17g to the stop time %.17g does not advance "
-               "the time (roundoff): the time scheme asked for it",
-               hf, it->t_last, tstop);
-    }
-    if (classic && hf != h_stored) it->fn_stale = 1;
-    if (classic) it->h_classic = hf;
-    MPM_CALL_SUN(ERKStepSetFixedStep(it->ark, hf));
-    if (it->fn_stale) MPM_CALL_SUN(ERKStepReset(it->ark, it->t_last, it->y));
-    it->fn_stale = 0;
+  it->tstop = tstop, it->scale = scale;
+  if (it->direct) {
+    double hf;
+    MPM_CALL(fixed_step(it, &hf));
+    return direct_step(it, hf, t, h);
   }
-  /* A fixed step already lands on tstop (see classic_step). ARKODE's own stop time would
-   * replace the state it reaches by its interpolant at tstop, built with the end-of-step f,
-   * which the classic update evaluates for a step that does not exist (h = 0): that
-   * interpolated state breaks the update's conservation properties at every output time. */
+  if (it->fixed) {
+    double hf;
+    MPM_CALL(fixed_step(it, &hf));
+    MPM_CALL_SUN(ERKStepSetFixedStep(it->ark, hf));
+  }
+  /* A fixed step already lands on tstop (see fixed_step); ARKODE's stop time would replace
+   * the state it reaches by its interpolant there. */
   if (!it->fixed) MPM_CALL_SUN(ERKStepSetStopTime(it->ark, tstop));
   it->fault.set = 0;
   it->rhs_error = 0;
@@ -483,20 +521,20 @@ int mpm_integrator_step(mpm_integrator *it, double tstop, double *t, double *h) 
   for (int tries = 0;; ++tries) {
     const int rc = attempt(it, tstop, scale, t, h);
     long nfail = 0;
-    ERKStepGetNumErrTestFails(it->ark, &nfail);
+    if (it->ark) ERKStepGetNumErrTestFails(it->ark, &nfail);
     it->fails += nfail - it->fails_seen;
     it->fails_seen = nfail;
     if (rc == 0) {
       it->steps++;
-      /* The end-of-step f of a retried classic step was computed with the reduced scale. */
-      if (scale != 1.0) it->fn_stale = 1;
       return 0;
     }
     if (rc != MPM_RETRY) return mpm_trace(__FILE__, __LINE__, __func__, rc);
     /* The step ERKStep tried (it keeps it as the next step after a failure). */
     if (tries == 0) h_tried = fabs(mpm_integrator_next_step(it));
     scale *= 0.25;
-    MPM_CALL(stable_step(it, it->y, &h_cfl));
+    double *yk[MPM_MAX_MODULES];
+    particle_blocks(it, yk);
+    MPM_CALL(stable_step(it, yk, &h_cfl));
     h_cfl = isfinite(h_cfl) ? it->cfl * h_cfl : h_tried; /* no stability limit: the step tried */
     const double h_next = it->fixed ? scale * h_cfl : scale * h_tried;
     if (tries >= it->max_retries || h_next < MPM_RETRY_FLOOR * h_cfl)

@@ -1,18 +1,21 @@
-/* Time integration of the coupled modules with ARKODE's ERKStep.
+/* Time integration of the coupled modules: the ERK pairs with ARKODE's ERKStep, the one-stage
+ * methods directly.
  *
- * The ODE state is an MPIManyVector with one serial subvector per module, each wrapping the
- * state block of the module's particle set (no copy). The RHS is the MPM cycle owned by the
- * coupler: P2G of every module, reverse halo, grid update, forward halo, G2P.
+ * The ODE state is every module's state block of its particle set. For ERKStep it is an
+ * MPIManyVector with one serial subvector per module, each wrapping that block (no copy). The
+ * RHS is the MPM cycle owned by the coupler: P2G of every module, reverse halo, grid update,
+ * forward halo, G2P.
  *
- * Methods: the classic MPM update (USL, and MUSL with its second transfer) is a one-stage
- * explicit table taken with a fixed step set before every step from the stability limit;
- * the grid velocity is advanced by that step before G2P, as the classic update needs. The adaptive
- * methods are embedded ERK pairs with error control and the same stability limit.
+ * Methods: the classic MPM update (USL, and MUSL with its second transfer) and forward Euler
+ * are one stage, y += h f, with a fixed step set before every step from the stability limit;
+ * the classic update's grid velocity is advanced by that step before G2P. The integrator takes
+ * them itself, with ERKStep's arithmetic. The adaptive methods are embedded ERK pairs with
+ * error control and the same stability limit.
  *
  * Failures: an unphysical stage (NaN, J <= 0, a particle outside the domain or too far out
- * of its box) makes the RHS return a recoverable flag on every rank. ERKStep 6.4 cannot
- * retry after a recoverable explicit RHS failure, so the integrator restarts itself from the
- * last accepted state with a quarter of the step, up to max_retries times for one step or
+ * of its box), or such a state at the end of a one-stage step, is seen on every rank. ERKStep
+ * 6.4 cannot retry after a recoverable explicit RHS failure, so the integrator restarts
+ * itself (and retries a one-stage step) from the last accepted state with a quarter of the step, up to max_retries times for one step or
  * until the step falls below 1e-6 of the CFL step (a barrier no step size removes), and then
  * fails with a message that names the particle, its position and the cause. */
 #ifndef MPM_INTEGRATOR_H
@@ -45,8 +48,9 @@ int mpm_integrator_new(mpm_integrator **it, const mpm_config *cfg, const mpm_cyc
 void mpm_integrator_destroy(mpm_integrator **it);
 
 /* (Re)start the integration at (t, current particle state) with first step h0 (0: let
- * ARKODE choose). A fresh ERKStep instance each time, so a run that passes through a
- * checkpoint and a run restarted from it take the same steps. */
+ * ARKODE choose; the one-stage methods take their CFL step). A fresh ERKStep instance each
+ * time, so a run that passes through a checkpoint and a run restarted from it take the same
+ * steps. */
 int mpm_integrator_start(mpm_integrator *it, double t, double h0);
 
 /* Take one accepted step, not past tstop. *t is the new time, *h the step taken. */
@@ -59,7 +63,7 @@ int mpm_integrator_resize(mpm_integrator *it, double t);
  * nothing limits it. Collective. */
 int mpm_integrator_cfl_step(mpm_integrator *it, double *h);
 
-/* Step ARKODE would try next (for checkpoints). */
+/* Step ARKODE would try next, or the one-stage methods' last step (for checkpoints). */
 double mpm_integrator_next_step(const mpm_integrator *it);
 
 /* Counters since creation: steps, RHS evaluations, failed (error-test) steps, retries. */

@@ -109,9 +109,10 @@ static mpm_gidx global_cell(const reg_box *b, const double *x) {
   return c;
 }
 
-/* Particle indices grouped by local cell: cell l holds perm[start[l] .. start[l + 1]). */
-static int group_by_cell(const reg_box *b, const mpm_particles *p, mpm_lidx **start,
-                         mpm_lidx **perm, mpm_lidx *ncell) {
+/* Particle indices grouped by local cell: cell l holds perm[start[l] .. start[l + 1]), in
+ * index order. With a mask, only the cells l with mask[l] != 0 hold their particles. */
+static int group_by_cell(const reg_box *b, const mpm_particles *p, const unsigned char *mask,
+                         mpm_lidx **start, mpm_lidx **perm, mpm_lidx *ncell) {
   mpm_lidx nc = 1;
   for (int d = 0; d < b->dim; ++d) nc *= b->nc[d];
   *ncell = nc;
@@ -123,9 +124,13 @@ static int group_by_cell(const reg_box *b, const mpm_particles *p, mpm_lidx **st
     free(cell);
     MPM_FAIL(MPM_ERR_MEMORY, "regularise: cannot group %d particles by cell", (int)p->n);
   }
-  for (mpm_lidx i = 0; i < p->n; ++i) cell[i] = local_cell(b, p, i), (*start)[cell[i] + 2]++;
+  for (mpm_lidx i = 0; i < p->n; ++i) {
+    cell[i] = local_cell(b, p, i);
+    if (!mask || mask[cell[i]]) (*start)[cell[i] + 2]++;
+  }
   for (mpm_lidx l = 0; l < nc; ++l) (*start)[l + 2] += (*start)[l + 1];
-  for (mpm_lidx i = 0; i < p->n; ++i) (*perm)[(*start)[cell[i] + 1]++] = i;
+  for (mpm_lidx i = 0; i < p->n; ++i)
+    if (!mask || mask[cell[i]]) (*perm)[(*start)[cell[i] + 1]++] = i;
   free(cell);
   return 0;
 }
@@ -327,7 +332,7 @@ static int regularise_local(mpm_module *m, reg_edit *e, mpm_gidx id_base) {
   reg_cell c = {0};
   MPM_ALLOC(e->keep, p->n);
   memset(e->keep, 1, (size_t)p->n);
-  int rc = group_by_cell(&b, p, &start, &perm, &ncell);
+  int rc = group_by_cell(&b, p, NULL, &start, &perm, &ncell);
   for (mpm_lidx l = 0; !rc && l < ncell; ++l)
     rc =
         regularise_cell(fc, p, &b, perm + start[l], (int)(start[l + 1] - start[l]), id_base, &c, e);
@@ -343,13 +348,18 @@ static double gas_count(const mpm_module *m, const int *c) {
   return m->grid->phase[m->phase].cell_n[mpm_grid_local_index(m->grid, c)];
 }
 
-/* Global index of cell c, wrapped; -1 outside the domain. */
+/* Global index of cell c, wrapped (as mpm_cells_wrap); -1 outside the domain. */
 static mpm_gidx cell_index(const mpm_grid *g, const int *c) {
-  int w[MPM_MAX_DIM];
-  memcpy(w, c, sizeof w);
-  if (!mpm_cells_wrap(g, w)) return -1;
   mpm_gidx l = 0;
-  for (int d = g->dim - 1; d >= 0; --d) l = l * g->ncells[d] + w[d];
+  for (int d = g->dim - 1; d >= 0; --d) {
+    const int n = g->ncells[d];
+    int w = c[d];
+    if (w < 0 || w >= n) {
+      if (!g->periodic[d]) return -1;
+      w = (w % n + n) % n;
+    }
+    l = l * n + w;
+  }
   return l;
 }
 
@@ -408,26 +418,29 @@ static int refill_split(mpm_module *m, const mpm_lidx *perm, int k, const int *e
   return edit_append(ed, row, id, nc);
 }
 
-/* Has an owned cell holding gas a face neighbour that is a refill target? From the cell
- * counts alone, so that a refill that finds none (a flow with no near vacuum) skips the sort
- * by cell. */
-static int any_target(const mpm_module *m, const reg_box *b) {
+/* Mark the owned cells that give to a refill target: cells holding gas that a face
+ * neighbour, a target, chose as its donor. From the cell counts alone, so that only the
+ * donors' particles are grouped, and a refill that finds no target (a flow with no near
+ * vacuum) groups none. Returns the number of donors. */
+static mpm_lidx mark_donors(const mpm_module *m, const reg_box *b, unsigned char *mark) {
   const int dim = m->grid->dim;
-  mpm_lidx total = 1;
+  mpm_lidx total = 1, ndonor = 0;
   for (int d = 0; d < dim; ++d) total *= b->nc[d];
   for (mpm_lidx l = 0; l < total; ++l) {
     int c[MPM_MAX_DIM] = {0};
     mpm_lidx r = l;
     for (int d = 0; d < dim; ++d) c[d] = b->c0[d] + (int)(r % b->nc[d]), r /= b->nc[d];
+    mark[l] = 0;
     if (!(gas_count(m, c) > 0.0)) continue;
-    for (int q = 0; q < 2 * dim; ++q) {
+    for (int q = 0; q < 2 * dim && !mark[l]; ++q) {
       int e[MPM_MAX_DIM] = {0};
       memcpy(e, c, sizeof e);
       e[q / 2] += q % 2 ? 1 : -1;
-      if (refill_target(m, e)) return 1;
+      mark[l] = refill_target(m, e) && refill_donor(m, e) == (q ^ 1);
     }
+    ndonor += mark[l];
   }
-  return 0;
+  return ndonor;
 }
 
 /* This rank's part of a refill: each owned cell holding gas gives to the targets that chose
@@ -437,11 +450,13 @@ static int refill_local(mpm_module *m, reg_edit *ed, mpm_gidx id_base) {
   const mpm_grid *g = m->grid;
   reg_box b;
   box_of(&b, g);
-  if (!any_target(m, &b)) return 0;
-  mpm_lidx *start = NULL, *perm = NULL, ncell = 0;
-  MPM_CALL(group_by_cell(&b, p, &start, &perm, &ncell));
-  int rc = 0;
-  for (mpm_lidx l = 0; !rc && l < ncell; ++l) {
+  mpm_lidx ncell = 1;
+  for (int d = 0; d < g->dim; ++d) ncell *= b.nc[d];
+  unsigned char *donor;
+  MPM_ALLOC(donor, ncell);
+  mpm_lidx *start = NULL, *perm = NULL;
+  int rc = mark_donors(m, &b, donor) ? group_by_cell(&b, p, donor, &start, &perm, &ncell) : 0;
+  for (mpm_lidx l = 0; !rc && start && l < ncell; ++l) {
     const int k = (int)(start[l + 1] - start[l]);
     if (k == 0) continue;
     int c[MPM_MAX_DIM] = {0};
@@ -457,7 +472,7 @@ static int refill_local(mpm_module *m, reg_edit *ed, mpm_gidx id_base) {
       rc = refill_split(m, perm + start[l], k, e, id_base + cell_index(g, e), ed);
     }
   }
-  free(start), free(perm);
+  free(donor), free(start), free(perm);
   return rc;
 }
 
@@ -466,14 +481,20 @@ static int refill(mpm_module *m, double *children, int *changed) {
   mpm_particles *p = m->particles;
   reg_edit ed = {0};
   int rc = refill_local(m, &ed, p->id_next);
+  /* A child lands in a cell next to its donor's: on another rank (or across a periodic face)
+   * only at the edge of this rank's box. Migration is needed only for those. */
+  mpm_lidx away = 0;
+  for (mpm_lidx a = 0; !rc && a < ed.nadd; ++a)
+    away += mpm_grid_owner_of(m->grid, ed.add + (size_t)a * (size_t)p->ncomp + p->offset[0]) !=
+            m->grid->rank;
   if (!rc && ed.nadd) {
     MPM_ALLOC(ed.keep, p->n);
     memset(ed.keep, 1, (size_t)p->n);
     rc = edit_apply(p, &ed);
   }
-  double sum[2] = {rc != 0, (double)ed.nadd};
+  double sum[3] = {rc != 0, (double)ed.nadd, (double)away};
   free(ed.keep), free(ed.add), free(ed.add_id);
-  MPM_CALL_MPI(MPI_Allreduce(MPI_IN_PLACE, sum, 2, MPI_DOUBLE, MPI_SUM, m->grid->comm));
+  MPM_CALL_MPI(MPI_Allreduce(MPI_IN_PLACE, sum, 3, MPI_DOUBLE, MPI_SUM, m->grid->comm));
   MPM_CALL(rc);
   if (sum[0] > 0) MPM_FAIL(MPM_ERR_MEMORY, "refill: failed on another rank");
   *children = sum[1];
@@ -482,7 +503,7 @@ static int refill(mpm_module *m, double *children, int *changed) {
   for (int d = 0; d < m->grid->dim; ++d) cells *= m->grid->ncells[d];
   p->id_next += cells;
   int migrated = 0;
-  MPM_CALL(mpm_particles_migrate(p, m->grid, &migrated));
+  if (sum[2] > 0) MPM_CALL(mpm_particles_migrate(p, m->grid, &migrated));
   *changed = 1;
   return 0;
 }
