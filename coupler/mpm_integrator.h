@@ -15,9 +15,10 @@
  * Failures: an unphysical stage (NaN, J <= 0, a particle outside the domain or too far out
  * of its box), or such a state at the end of a one-stage step, is seen on every rank. ERKStep
  * 6.4 cannot retry after a recoverable explicit RHS failure, so the integrator restarts
- * itself (and retries a one-stage step) from the last accepted state with a quarter of the step, up to max_retries times for one step or
- * until the step falls below 1e-6 of the CFL step (a barrier no step size removes), and then
- * fails with a message that names the particle, its position and the cause. */
+ * itself (and retries a one-stage step) from the last accepted state with a quarter of the step, up
+ * to max_retries times for one step or until the step falls below 1e-6 of the CFL step (a barrier
+ * no step size removes), and then fails with a message that names the particle, its position and
+ * the cause. */
 #ifndef MPM_INTEGRATOR_H
 #define MPM_INTEGRATOR_H
 
