@@ -12,7 +12,9 @@ and the published simulations, and the cost of multirate against monolithic.
    and the published simulations (m2c coarse and fine; Giordano's own).
 2. Cost: runs multirate and monolithic (every step at the panel's stable step) over the first
    --cost-window seconds (default 2e-4 s: the shock reaches the panel and the panel starts to
-   move), side by side on one rank each (the same machine load; --ranks is for step 1), and
+   move), side by side on one rank each under the same load throughout (multirate, the shorter,
+   runs again while monolithic still runs; its wall is the mean of its complete runs; --ranks
+   is for step 1), and
    reports their wall times, steps and the tip displacement at the window's end.
    The ratio of the two wall times is the speed-up at the same simulated time; the tip
    difference says what it costs in accuracy there. A full monolithic run to 3 ms is about
@@ -35,6 +37,7 @@ import json
 import os
 import subprocess
 import sys
+import time
 
 import numpy as np
 
@@ -134,24 +137,47 @@ def partial(out):
 
 
 def cost_side_by_side(binary, window_s, overrides):
-    """multirate and monolithic over the first window_s seconds, started together, one rank
-    each: {scheme: (summary, tip x at the end in mm)}."""
+    """multirate and monolithic over the first window_s seconds, side by side, one rank each,
+    under the same load throughout: the shorter run (multirate) starts again whenever it ends
+    while the other still runs, and its wall time is the mean of its complete runs (the last,
+    cut short when the other ends, is dropped). Returns {scheme: (summary, tip x at the end in
+    mm)}; multirate's summary carries "wall_runs", the wall time of each complete run."""
     window = [f"time.t_end={window_s}", "output.interval=1"] + overrides
-    procs = {}
-    for scheme in ("multirate", "monolithic"):
-        wout = os.path.join(ROOT, "out", f"bench_shock_panel_{scheme}")
+
+    def start(scheme, k=0):
+        wout = os.path.join(ROOT, "out", f"bench_shock_panel_{scheme}" + (f"_{k}" if k else ""))
         cmd = [binary, "run", CASE, f"output.dir={wout}", "output.overwrite=true",
                f"coupling.time={scheme}"] + window
-        procs[scheme] = (wout, subprocess.Popen(cmd, env=ENV, stdout=subprocess.DEVNULL,
-                                                stderr=subprocess.PIPE, text=True))
-    res = {}
-    for scheme, (wout, pr) in procs.items():
+        return wout, subprocess.Popen(cmd, env=ENV, stdout=subprocess.DEVNULL,
+                                      stderr=subprocess.PIPE, text=True)
+
+    def finish(scheme, wout, pr):
         _, err = pr.communicate()
         if pr.returncode != 0:
             raise SystemExit(f"{scheme} failed ({pr.returncode}):\n{err[-2000:]}")
         with open(os.path.join(wout, "summary.json")) as f:
-            summ = json.load(f)
-        res[scheme] = (summ, tip(wout)[1][-1])
+            return json.load(f)
+
+    mono = start("monolithic")
+    mr, walls, first = start("multirate"), [], None
+    while mono[1].poll() is None:
+        if mr[1].poll() is not None:
+            summ = finish("multirate", *mr)
+            walls.append(summ["wall_s"])
+            first = first or (summ, tip(mr[0])[1][-1])
+            mr = start("multirate", len(walls))
+        time.sleep(0.5)
+    res = {"monolithic": (finish("monolithic", *mono), tip(mono[0])[1][-1])}
+    if not walls:  # multirate outlasted monolithic: wait for it
+        summ = finish("multirate", *mr)
+        walls.append(summ["wall_s"])
+        first = (summ, tip(mr[0])[1][-1])
+    else:
+        mr[1].kill()
+        mr[1].communicate()
+    first[0]["wall_runs"] = walls
+    first[0]["wall_s"] = sum(walls) / len(walls)
+    res["multirate"] = first
     return res
 
 
@@ -162,9 +188,12 @@ def cost_table(res):
     diff = abs(mr[1] - mo[1])
     lines = ["| scheme | wall (s) | coupling steps | RHS | tip x at the end (mm) |",
              "|---|---|---|---|---|"]
-    for scheme, (summ, u_end) in res.items():
-        lines.append(f"| {scheme} | {summ['wall_s']:.1f} | {summ['steps']} | {summ['rhs_evals']} | "
-                     f"{u_end:.5f} |")
+    for scheme in ("multirate", "monolithic"):
+        summ, u_end = res[scheme]
+        wall = f"{summ['wall_s']:.1f}"
+        if len(summ.get("wall_runs", [])) > 1:
+            wall += " (mean of " + ", ".join(f"{w:.1f}" for w in summ["wall_runs"]) + ")"
+        lines.append(f"| {scheme} | {wall} | {summ['steps']} | {summ['rhs_evals']} | {u_end:.5f} |")
     lines += ["", f"monolithic / multirate wall time: **{ratio:.2f}**; the tips differ by "
               f"{diff:.2e} mm ({diff / max(abs(mo[1]), 1e-300):.2%} of monolithic's)."]
     return lines, ratio, diff
@@ -176,7 +205,9 @@ def cost_only(a):
     table, ratio, diff = cost_table(res)
     lines = ["# Shock-loaded panel: multirate against monolithic over a window", "",
              f"`cases/shock_panel.ini` {' '.join(a.overrides)} to t = {a.cost_window * 1e3:.3f} ms, "
-             "both runs started together on one rank each (the same machine load).", ""] + table
+             "side by side on one rank each under the same load throughout: multirate runs again "
+             "whenever it ends before monolithic, and its wall time is the mean of its complete "
+             "runs.", ""] + table
     with open(os.path.join(RESULTS, "shock_panel_cost.md"), "w") as f:
         f.write("\n".join(lines) + "\n")
     with open(os.path.join(RESULTS, "shock_panel_cost.json"), "w") as f:

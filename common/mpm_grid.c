@@ -309,6 +309,7 @@ int mpm_grid_add_phase(mpm_grid *grid, const char *name, int *index) {
     return mpm_trace(__FILE__, __LINE__, __func__, rc);
   }
   snprintf(ph->name, sizeof ph->name, "%s", name ? name : "");
+  ph->empty_fraction = 1e-14;
   if (index) *index = grid->nphases;
   grid->nphases++;
   return 0;

@@ -46,8 +46,9 @@ typedef struct mpm_grid_phase {
    * respect to the node's position). */
   double *normal_i[MPM_MAX_DIM];
   int normals;
-  double m_max;   /* the last nodal solve's largest nodal mass over the whole grid */
-  double m_empty; /* it treated nodes with m_i <= m_empty as empty */
+  double m_max;          /* the last nodal solve's largest nodal mass over the whole grid */
+  double m_empty;        /* it treated nodes with m_i <= m_empty as empty */
+  double empty_fraction; /* m_empty / m_max: 1e-14 (roundoff) unless the module sets it */
   /* Particles per cell, at the cell's lower corner node (mpm_cells.h); NULL until counted. */
   double *cell_n;
 } mpm_grid_phase;

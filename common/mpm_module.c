@@ -35,9 +35,9 @@ int mpm_grid_phase_update(mpm_grid *grid, int phase, double h) {
     if (ph->m_i[l] > local) local = ph->m_i[l];
   MPM_CALL_MPI(MPI_Allreduce(&local, &mmax, 1, MPI_DOUBLE, MPI_MAX, grid->comm));
   /* Nodes touched only by the far tail of a stencil carry roundoff-sized mass; dividing by it
-   * would amplify noise, so they are treated as empty. */
+   * would amplify noise, so they are treated as empty (a module may raise the fraction). */
   ph->m_max = mmax;
-  const double mmin = ph->m_empty = 1e-14 * mmax;
+  const double mmin = ph->m_empty = ph->empty_fraction * mmax;
   for (int d = 0; d < grid->dim; ++d)
     node_update(grid->nnodes, ph->m_i, ph->mv_i[d], ph->f_i[d], ph->v_i[d], ph->a_i[d], mmin, h);
   return 0;

@@ -172,7 +172,10 @@ static int fixed_step(mpm_integrator *it, double *h) {
   if (!it->h_limit_set) {
     double *yk[MPM_MAX_MODULES];
     particle_blocks(it, yk);
-    MPM_CALL(classic_limit(it, yk, &it->h_limit));
+    mpm_timer_start(MPM_T_CHECK);
+    const int rc = classic_limit(it, yk, &it->h_limit);
+    mpm_timer_stop(MPM_T_CHECK);
+    MPM_CALL(rc);
     it->h_limit_set = it->direct; /* ERKStep's fixed steps: the state may have changed since */
   }
   const double t = it->t_last, rest = it->tstop - t;

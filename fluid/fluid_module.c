@@ -70,6 +70,12 @@ static const mpm_key_spec fluid_keys[] = {
      "regularisation, every fluid.regularise_every steps); a wake that expansion empties "
      "faster than regularise_every steps refill it keeps empty cells between refills",
      0},
+    {"fluid.empty_node_mass", MPM_KEY_REAL, "1e-14", 0, 1e-2, 0, 0, NULL,
+     "a gas node holding less than this fraction of the largest gas nodal mass is empty: no "
+     "velocity, no acceleration, and its force is dropped (1e-14: roundoff only). In a near "
+     "vacuum the few light particles at such nodes take huge accelerations and heat; 1e-4 "
+     "keeps them at the gas's own speeds, at the price of the momentum those nodes carry",
+     0},
     {"fluid.regularise_min", MPM_KEY_INT, NULL, 1, HUGE_VAL, 0, 0, NULL,
      "split particles in a non-empty cell holding fewer than this (default ceil(ppc^dim / 2): "
      "refill where the gas has expanded to twice its seeding volume; 1 never splits)",
@@ -561,6 +567,7 @@ static int build(mpm_module *m, const mpm_config *cfg, int seed) {
   mpm_grid *g = m->grid;
   mpm_walls walls;
   MPM_CALL(mpm_grid_add_phase(g, "fluid", &m->phase));
+  MPM_CALL(mpm_config_get_real(cfg, "fluid.empty_node_mass", &g->phase[m->phase].empty_fraction));
   MPM_CALL(read_settings(fc, cfg, g));
   MPM_CALL(mpm_walls_from_config(&walls, cfg, g->dim));
   MPM_CALL(mpm_constraints_add_walls(&fc->cons, &walls, g));

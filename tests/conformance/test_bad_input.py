@@ -104,6 +104,8 @@ GAS_CASES = [
      "fluid.refill_every", ">= 0"),
     ("refill_every with refill off", "\ngamma = 1.4",
      "\ngamma = 1.4\nrefill = false\nrefill_every = 1", "fluid.refill_every", "remove one"),
+    ("empty_node_mass above its range", "\ngamma = 1.4",
+     "\ngamma = 1.4\nempty_node_mass = 0.5", "fluid.empty_node_mass", "[0, 0.01]"),
     ("regularise_min not below regularise_max", "\ngamma = 1.4",
      "\ngamma = 1.4\nregularise_min = 8\nregularise_max = 8", "fluid.regularise_max",
      "must be below"),

@@ -8,6 +8,7 @@
  * that the forward exchange gives every ghost its owner's value. */
 #include "mpm_grid.h"
 #include "mpm_kernels.h"
+#include "mpm_module.h"
 
 #include "mpm_testing.h"
 
@@ -164,6 +165,31 @@ static void run_case(int dim, mpm_shape_kind shape) {
   }
   CHECK(ferr <= 1e-13 * pt[0], "%d-D %s: ghost masses after the forward exchange differ by %.3e",
         dim, mpm_shape_name(shape), ferr);
+  /* The nodal solve: v = mv/m + h f/m, a = f/m on nodes above the phase's empty fraction of
+   * the largest nodal mass, zero on the others (1e-14 by default; the gas may raise it). */
+  const double h = 1e-3;
+  for (int pass = 0; pass < 2; ++pass) {
+    ph->empty_fraction = pass ? 0.05 : 1e-14;
+    CHECK(mpm_grid_phase_update(g, 0, h) == 0, "nodal solve failed");
+    long nempty = 0, nbad = 0;
+    for (mpm_lidx l = 0; l < g->nnodes; ++l)
+      for (int d = 0; d < dim; ++d) {
+        const double m = ph->m_i[l], v = ph->v_i[d][l], a = ph->a_i[d][l];
+        if (m <= ph->empty_fraction * ph->m_max) {
+          nempty += m > 0 && d == 0;
+          nbad += v != 0 || a != 0;
+        } else {
+          const double ae = ph->f_i[d][l] / m, ve = ph->mv_i[d][l] / m + h * ae;
+          nbad += fabs(a - ae) > 1e-14 * fabs(ae) || fabs(v - ve) > 1e-14 * fabs(ve);
+        }
+      }
+    long sums[2] = {nempty, nbad};
+    MPI_Allreduce(MPI_IN_PLACE, sums, 2, MPI_LONG, MPI_SUM, MPI_COMM_WORLD);
+    CHECK(sums[1] == 0 && (pass == 0 || sums[0] > 0),
+          "%d-D %s: nodal solve with empty fraction %g: %ld wrong nodes, %ld nodes with mass "
+          "treated as empty",
+          dim, mpm_shape_name(shape), ph->empty_fraction, sums[1], sums[0]);
+  }
   if (g->rank == 0)
     printf("%d-D %-9s ranks %d: max relative nodal difference %.2e, conservation %.2e\n", dim,
            mpm_shape_name(shape), g->size, gmax, cons);
