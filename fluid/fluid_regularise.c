@@ -418,10 +418,11 @@ static int refill_split(mpm_module *m, const mpm_lidx *perm, int k, const int *e
   return edit_append(ed, row, id, nc);
 }
 
-/* Mark the owned cells that give to a refill target: cells holding gas that a face
- * neighbour, a target, chose as its donor. From the cell counts alone, so that only the
- * donors' particles are grouped, and a refill that finds no target (a flow with no near
- * vacuum) groups none. Returns the number of donors. */
+/* Mark the owned cells that give to refill targets: for a cell holding gas, bit q of mark is
+ * set when its face neighbour in direction q (-x, +x, -y, ...) is a target that chose it as
+ * its donor. From the cell counts alone, so that only the donors' particles are grouped, and
+ * a refill that finds no target (a flow with no near vacuum) groups none. Returns the number
+ * of donors. */
 static mpm_lidx mark_donors(const mpm_module *m, const reg_box *b, unsigned char *mark) {
   const int dim = m->grid->dim;
   mpm_lidx total = 1, ndonor = 0;
@@ -432,13 +433,13 @@ static mpm_lidx mark_donors(const mpm_module *m, const reg_box *b, unsigned char
     for (int d = 0; d < dim; ++d) c[d] = b->c0[d] + (int)(r % b->nc[d]), r /= b->nc[d];
     mark[l] = 0;
     if (!(gas_count(m, c) > 0.0)) continue;
-    for (int q = 0; q < 2 * dim && !mark[l]; ++q) {
+    for (int q = 0; q < 2 * dim; ++q) {
       int e[MPM_MAX_DIM] = {0};
       memcpy(e, c, sizeof e);
       e[q / 2] += q % 2 ? 1 : -1;
-      mark[l] = refill_target(m, e) && refill_donor(m, e) == (q ^ 1);
+      if (refill_target(m, e) && refill_donor(m, e) == (q ^ 1)) mark[l] |= 1u << q;
     }
-    ndonor += mark[l];
+    ndonor += mark[l] != 0;
   }
   return ndonor;
 }
@@ -463,12 +464,10 @@ static int refill_local(mpm_module *m, reg_edit *ed, mpm_gidx id_base) {
     mpm_lidx r = l;
     for (int d = 0; d < g->dim; ++d) c[d] = b.c0[d] + (int)(r % b.nc[d]), r /= b.nc[d];
     for (int q = 0; !rc && q < 2 * g->dim; ++q) {
+      if (!(donor[l] >> q & 1)) continue;
       int e[MPM_MAX_DIM] = {0};
       memcpy(e, c, sizeof e);
       e[q / 2] += q % 2 ? 1 : -1;
-      if (!refill_target(m, e)) continue;
-      const int back = refill_donor(m, e); /* the direction from e to its donor */
-      if (back != (q ^ 1)) continue;
       rc = refill_split(m, perm + start[l], k, e, id_base + cell_index(g, e), ed);
     }
   }

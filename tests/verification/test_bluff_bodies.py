@@ -11,13 +11,14 @@ t = 0.8 at dx = 0.02) and its wake set a step of 1e-6 s.
 
 Arguments:
   fast    the plate and the square at dx = 0.02 (default selection);
-  long    both at dx = 0.01 and 0.005;
+  long    both at dx = 0.01 and 0.005: an expected failure, the plate at 0.005 blows up at
+          t = 0.268 (found at 3028195; the same run bit for bit at e6d87d4);
   empty   both at dx = 0.02, checking that no cell within two cells of the body is empty at any
           snapshot (the issue's acceptance): not met, 0-1 empty cells per snapshot beside the
           plate's downstream corners and 0-3 at the square's (plate 0-4 and 0-5, square 0-3
           and 0-15 at dx = 0.01 and 0.005, printed by `long`), where the wake expands into near
           vacuum: an expected failure.
-Measured, t = 0.8: every run stable, no gas inside; the largest particle pressure 157 / 298 /
+Measured earlier, t = 0.8: every run stable, no gas inside; the largest particle pressure 157 / 298 /
 2.8e4 (plate, dx = 0.02 / 0.01 / 0.005) and 109 / 450 / 1.8e3 (square) against a pitot
 pressure of 8.5: a few light, hot refill particles in the wake (the near-vacuum weakness of
 issue 10), printed, not checked.
@@ -85,8 +86,13 @@ for name, dx in RUNS:
         check(max(empty) == 0, f"{label}: no empty cell within two cells of the body "
               f"(per snapshot: {empty})")
         continue
-    with open(os.path.join(out, "summary.json")) as f:
-        t_end = json.load(f)["t"]
+    summary = os.path.join(out, "summary.json")  # absent when the run stopped with an error
+    t_end = snaps[-1][0] if snaps else 0.0
+    if os.path.exists(summary):
+        with open(summary) as f:
+            t_end = json.load(f)["t"]
+    elif p.stderr:
+        print(f"{label}: {p.stderr.strip().splitlines()[-1]}")
     check(p.returncode == 0 and abs(t_end - 0.8) < 1e-9,
           f"{label}: least_squares reaches t = 0.8 (exit {p.returncode}, t = {t_end:g})")
     check(inside == 0, f"{label}: no gas inside the body over {len(snaps)} snapshots ({inside})")
