@@ -155,9 +155,9 @@ static int estab(N_Vector y, mpm_sunreal t, mpm_sunreal *hstab, void *user) {
   return 0;
 }
 
-/* The stability-limited fixed step (classic update, euler, non-adaptive pairs) at y: the CFL
+/* The stability-limited fixed step (usl, musl, euler, non-adaptive pairs) at y: the CFL
  * fraction of the limit, capped by dt_max; 0 when nothing limits it. */
-static int classic_limit(mpm_integrator *it, double *const *yk, double *h) {
+static int fixed_limit(mpm_integrator *it, double *const *yk, double *h) {
   double hs;
   MPM_CALL(stable_step(it, yk, &hs));
   hs = fmin(it->cfl * hs, it->dt_max);
@@ -173,7 +173,7 @@ static int fixed_step(mpm_integrator *it, double *h) {
     double *yk[MPM_MAX_MODULES];
     particle_blocks(it, yk);
     mpm_timer_start(MPM_T_CHECK);
-    const int rc = classic_limit(it, yk, &it->h_limit);
+    const int rc = fixed_limit(it, yk, &it->h_limit);
     mpm_timer_stop(MPM_T_CHECK);
     MPM_CALL(rc);
     it->h_limit_set = it->direct; /* ERKStep's fixed steps: the state may have changed since */
@@ -218,7 +218,7 @@ static void free_state(mpm_integrator *it) {
   memset(it->sub, 0, sizeof it->sub);
 }
 
-/* Fixed steps (the classic update, euler, time.adaptive = false) never use an error norm;
+/* ERKStep's fixed steps (the ERK pairs with time.adaptive = false) never use an error norm;
  * ARKODE 6.4 still computes one per step (a "too much accuracy" check read only for adaptive
  * steps), a full pass over the state with a global reduction. For them the state vector
  * reports a zero norm instead: an ops-table specialisation, inherited by ARKODE's clones. */
@@ -367,8 +367,8 @@ static int set_ralston_table(mpm_integrator *it) {
   return 0;
 }
 
-/* Error weights for fixed steps. These never use them, but ARKODE 6.4 recomputes them every
- * step (four passes over the state with the default function); one constant fill of each
+/* Error weights for ERKStep's fixed steps. These never use them, but ARKODE 6.4 recomputes them
+ * every step (four passes over the state with the default function); one constant fill of each
  * weight vector ARKODE allocates is all a fixed step needs. */
 static int unit_weights(N_Vector y, N_Vector ewt, void *user) {
   mpm_integrator *it = user;
