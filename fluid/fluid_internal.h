@@ -39,6 +39,8 @@ typedef struct fluid_content {
   int reg_min, reg_max;      /* particles per non-empty cell after regularisation */
   int refill;                /* regularisation refills cells that expansion emptied */
   int refill_every;          /* refill every refill_every steps (0: never) */
+  double shift;              /* particle shifting coefficient kappa (0: off; fluid_shift.c) */
+  int shift_every;           /* shift every shift_every steps */
   int stable_local;          /* fluid.stable_step = neighbourhood (fluid_stable.c) */
   double s_local;            /* its fastest signal for this step, m/s; < 0: not yet known */
   double *cellsum;           /* its per-cell sums (3 nnodes) */
@@ -77,6 +79,11 @@ int fluid_neighbourhood_signal(const mpm_module *m, double *smax);
  * reg_every, conserving mass, momentum and total energy. Sets
  * *changed if this rank's set changed (fluid_regularise.c). Collective. */
 int fluid_regularise(mpm_module *m, long step, int *changed);
+
+/* Shift the particles down the gradient of the nodal volume fraction when step is a multiple
+ * of shift_every and shift > 0; only positions change (fluid_shift.c). Sets *changed if any
+ * particle moved. Collective. */
+int fluid_shift(mpm_module *m, long step, int *changed);
 
 /* Refresh the output fields rho, p, mach, T, s from the particle data (before output). */
 void fluid_output_fields(mpm_module *m);

@@ -70,6 +70,14 @@ static const mpm_key_spec fluid_keys[] = {
      "regularisation, every fluid.regularise_every steps); a wake that expansion empties "
      "faster than regularise_every steps refill it keeps empty cells between refills",
      0},
+    {"fluid.shift", MPM_KEY_REAL, "0", 0, 0.25, 0, 0, NULL,
+     "particle shifting coefficient kappa: every fluid.shift_every steps each gas particle "
+     "moves by -kappa dx^2 grad phi, phi the nodal volume fraction of the gas, so that "
+     "particles that cluster under strong expansion spread out again (0: off; only positions "
+     "change, so mass, momentum and energy are kept exactly; see fluid/fluid_shift.c)",
+     0},
+    {"fluid.shift_every", MPM_KEY_INT, "1", 1, HUGE_VAL, 0, 0, NULL,
+     "shift the gas particles every N accepted steps (with fluid.shift > 0)", 0},
     {"fluid.empty_node_mass", MPM_KEY_REAL, "1e-14", 0, 1e-2, 0, 0, NULL,
      "a gas node holding less than this fraction of the largest gas nodal mass is empty: no "
      "velocity, no acceleration, and its force is dropped (1e-14: roundoff only). In a near "
@@ -364,7 +372,8 @@ static int fluid_post_step(mpm_module *m, double t, double h, int *changed) {
   }
   MPM_CALL(fluid_obstacles_report(&fc->obs, m->grid, t, h));
   fc->s_local = -1.0; /* a new step begins: its first stable-step estimate recomputes it */
-  return fluid_regularise(m, m->step, changed);
+  MPM_CALL(fluid_regularise(m, m->step, changed));
+  return fluid_shift(m, m->step, changed);
 }
 
 static int fluid_boundary(mpm_module *m, double t, double h, int *changed) {
@@ -520,6 +529,8 @@ static int read_settings(fluid_content *fc, const mpm_config *cfg, const mpm_gri
   MPM_CALL(mpm_config_get_real(cfg, "fluid.R", &fc->R));
   MPM_CALL(mpm_config_get_int(cfg, "fluid.ppc", &fc->ppc));
   MPM_CALL(read_regularise(fc, cfg, g->dim));
+  MPM_CALL(mpm_config_get_real(cfg, "fluid.shift", &fc->shift));
+  MPM_CALL(mpm_config_get_int(cfg, "fluid.shift_every", &fc->shift_every));
   MPM_CALL(mpm_config_get_reals(cfg, "physics.gravity", grav, 3, &nv));
   memcpy(fc->gravity, grav, sizeof grav);
   MPM_CALL(mpm_transfer_from_config(&fc->tr, cfg, "fluid.pic_fraction"));

@@ -8,7 +8,7 @@
 # sanitizers in test_halo_np*, test_migrate_np*, test_p2g_np* and test_ranks_solid), the main
 # job's scene (test_supersonic_bar, a flow case like the wedge; its rigid twin is `long`) and the
 # near-vacuum convergence
-# study (test_near_vacuum_order, an expected failure; test_near_vacuum runs the refill there),
+# study (test_near_vacuum_order; test_near_vacuum runs the refill and the shifting there),
 # and test_restart_cases (every case's restart: 3 minutes under the sanitizers; the checkpoint
 # code it runs is test_restart's, test_gas_output's and test_coupling_ranks', which do run there).
 # Also left to the plain pass are physics studies whose code other tests run under the

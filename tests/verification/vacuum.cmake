@@ -1,12 +1,10 @@
 # Gas into near vacuum: the refill of regularisation keeps every cell filled, conservatively.
 mpm_add_script_test(test_near_vacuum SCRIPT verification/test_near_vacuum.py ARGS refill
                     LABELS verification TIMEOUT 600)
-# The issue's convergence target for the double rarefaction (order >= 0.5 from 200 to 800
-# cells) is not reached: the error stays at 0.027 at every N, dominated by particle clumping
-# in the rarefaction tails. Expected failure until that is fixed; see the test's header.
+# The issue's convergence target for the double rarefaction: order >= 0.5 from 200 to 800 cells,
+# reached with particle shifting (see the test's header).
 mpm_add_script_test(test_near_vacuum_order SCRIPT verification/test_near_vacuum.py ARGS order
                     LABELS verification TIMEOUT 600)
-set_tests_properties(test_near_vacuum_order PROPERTIES WILL_FAIL TRUE)
 # The blow-up guard: a run that goes unstable stops with a clear message under every method.
 mpm_add_script_test(test_blowup_guard SCRIPT verification/test_blowup_guard.py
                     LABELS verification TIMEOUT 600)
