@@ -83,7 +83,7 @@ int fluid_regularise(mpm_module *m, long step, int *changed);
 /* Shift the particles down the gradient of the nodal volume fraction when step is a multiple
  * of shift_every and shift > 0; only positions change (fluid_shift.c). Sets *changed if any
  * particle moved. Collective. */
-int fluid_shift(mpm_module *m, long step, int *changed);
+int fluid_shift(mpm_module *m, long step, double h, int *changed);
 
 /* Refresh the output fields rho, p, mach, T, s from the particle data (before output). */
 void fluid_output_fields(mpm_module *m);

@@ -14,20 +14,13 @@ mpm_add_script_test(test_slanted_wall SCRIPT verification/test_slanted_wall.py
 mpm_add_script_test(test_slanted_wall_max SCRIPT verification/test_slanted_wall.py ARGS max
                     LABELS verification TIMEOUT 300)
 set_tests_properties(test_slanted_wall_max PROPERTIES WILL_FAIL TRUE)
-# Mach 2.5 past a plate two cells thick and a square (least_squares; ghost fails there): both at
-# dx = 0.02 by default, at 0.01 and 0.005 under long; the empty cells next to the bodies are an
-# expected failure (the test's header).
+# Mach 2.5 past a plate two cells thick and a square (least_squares; ghost fails there), with
+# refill every step and particle shifting: both at dx = 0.02 by default, at 0.01 and 0.005 under
+# long; each run reaches t = 0.8 with no gas inside the body and no empty cell next to it.
 mpm_add_script_test(test_bluff_bodies SCRIPT verification/test_bluff_bodies.py ARGS fast
                     LABELS verification TIMEOUT 300)
-mpm_add_script_test(test_bluff_bodies_empty SCRIPT verification/test_bluff_bodies.py ARGS empty
-                    LABELS verification TIMEOUT 300)
-set_tests_properties(test_bluff_bodies_empty PROPERTIES WILL_FAIL TRUE)
 mpm_add_script_test(test_bluff_bodies_long SCRIPT verification/test_bluff_bodies.py ARGS long
                     LABELS "verification;long" TIMEOUT 3600)
-# Expected to fail: the plate at dx = 0.005 blows up at t = 0.268 (the guard: total energy 1000x
-# its early value), as at e6d87d4 (bit for bit the same run); hot refill particles in front of
-# and behind the plate (README, Regularisation; issue 12's three resolutions not met).
-set_tests_properties(test_bluff_bodies_long PROPERTIES WILL_FAIL TRUE)
 # RAE 2822 (cases/rae2822.ini) and the surface pressure output: gas at rest reads p = 1 at every
 # outline point, 2 ranks as 1 (fast).
 mpm_add_script_test(test_rae2822 SCRIPT verification/test_rae2822.py
