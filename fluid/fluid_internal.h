@@ -41,6 +41,7 @@ typedef struct fluid_content {
   int refill_every;          /* refill every refill_every steps (0: never) */
   double shift;              /* particle shifting coefficient kappa (0: off; fluid_shift.c) */
   int shift_every;           /* shift every shift_every steps */
+  double shift_J;            /* only particles with J >= shift_J move */
   int stable_local;          /* fluid.stable_step = neighbourhood (fluid_stable.c) */
   double s_local;            /* its fastest signal for this step, m/s; < 0: not yet known */
   double *cellsum;           /* its per-cell sums (3 nnodes) */

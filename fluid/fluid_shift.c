@@ -24,6 +24,14 @@
  * total energy and the gas's volume are unchanged exactly. In uniform gas phi is 1 and nothing
  * moves.
  *
+ * When. With fluid.shift_expansion = J_min > 0 only particles that have expanded, J >= J_min
+ * since they were seeded, move (by default every particle moves). In uniform gas shifting only
+ * adds noise (measured on uniform Mach 2.5 flow along a slip wall: an RMS pressure deviation of
+ * 1.1 % with every particle shifted against 0.1 % without; J_min = 1.2 keeps the 0.1 %), but
+ * the hot, compressed particles in front of a thin plate need it (with J_min = 1.2 the plate of
+ * cases/plate_across.ini blew up at dx = 0.005, t = 0.24). The volume fraction counts every
+ * particle.
+ *
  * Where. At a non-periodic domain face the volume fraction is folded about the face (the
  * images of the particles beyond it are counted), so a wall or an open face does not read as
  * a void that pulls the gas across it. A particle whose stencil reaches a node holding another
@@ -201,6 +209,7 @@ int fluid_shift(mpm_module *m, long step, double h, int *changed) {
     double x[3] = {0, 0, 0}, gphi[3] = {0, 0, 0};
     for (int d = 0; d < dim; ++d) x[d] = mpm_particles_comp(p, FLUID_X, d)[i];
     stencil_at(g, fc->lp, x, &s);
+    if (J[i] < fc->shift_J) continue;
     if (near_other_phase(m, &s) || (wall && stencil_touches(&s, wall))) continue;
     stencil_gradient(&s, phi, gphi);
     double xn[3] = {0, 0, 0};

@@ -108,6 +108,8 @@ GAS_CASES = [
      "\ngamma = 1.4\nempty_node_mass = 0.5", "fluid.empty_node_mass", "[0, 0.01]"),
     ("shift above its range", "\ngamma = 1.4", "\ngamma = 1.4\nshift = 0.8", "fluid.shift",
      "[0, 0.5]"),
+    ("negative shift_expansion", "\ngamma = 1.4",
+     "\ngamma = 1.4\nshift = 0.1\nshift_expansion = -1", "fluid.shift_expansion", ">= 0"),
     ("shift_every below 1", "\ngamma = 1.4", "\ngamma = 1.4\nshift = 0.1\nshift_every = 0",
      "fluid.shift_every", ">= 1"),
     ("regularise_min not below regularise_max", "\ngamma = 1.4",

@@ -29,7 +29,8 @@ refill:
    emptied cells: lone particles shifted out fed a cascade of refills, 0.25 at 200 cells.
 order:
 4. The L1 error falls with refinement at an observed order >= 0.5 from 200 to 800 cells (the
-   issue's target). Measured 0.0239, 0.0131, 0.0079 at 200, 400, 800 cells: order 0.79.
+   issue's target). Measured 0.0239, 0.0131, 0.0079 at 200, 400, 800 cells: order 0.79
+   (0.0060 at 1600 cells: the order falls to 0.40 beyond 800).
    Without shifting (fluid.shift = 0, refill as in the case) the error stays at 0.027-0.029 at
    every N (order -0.01), dominated by the rarefaction fans' low-density tails, where the
    particles cluster a few cells apart (nodal densities of 5x the exact value next to
