@@ -206,10 +206,10 @@ int fluid_shift(mpm_module *m, long step, double h, int *changed) {
   const double cap = 0.25 * g->dx;
   long moved = 0, away = 0;
   for (mpm_lidx i = 0; i < p->n; ++i) {
+    if (J[i] < fc->shift_J) continue;
     double x[3] = {0, 0, 0}, gphi[3] = {0, 0, 0};
     for (int d = 0; d < dim; ++d) x[d] = mpm_particles_comp(p, FLUID_X, d)[i];
     stencil_at(g, fc->lp, x, &s);
-    if (J[i] < fc->shift_J) continue;
     if (near_other_phase(m, &s) || (wall && stencil_touches(&s, wall))) continue;
     stencil_gradient(&s, phi, gphi);
     double xn[3] = {0, 0, 0};
