@@ -39,6 +39,13 @@ typedef struct mpm_cycle {
   mpm_interface *iface; /* held and loaded: the interface data */
 } mpm_cycle;
 
+/* The joint cycle over these modules (every module advances, the spatial scheme acts). */
+static inline mpm_cycle mpm_cycle_joint(mpm_grid *grid, mpm_module **mod, int nmod,
+                                        mpm_coupling *coupling) {
+  return (mpm_cycle){
+      .grid = grid, .mod = mod, .nmod = nmod, .coupling = coupling, .mode = MPM_CYCLE_JOINT};
+}
+
 /* One RHS at (t, y): y[k] and ydot[k] are module k's state blocks; h is the classic step (0:
  * method of lines). */
 int mpm_cycle_rhs(const mpm_cycle *c, double t, double *const *y, double *const *ydot, double h);

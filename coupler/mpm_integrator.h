@@ -1,4 +1,5 @@
-/* Time integration of the coupled modules: the ERK pairs with ARKODE's ERKStep, the one-stage
+/* Time integration of the coupled modules: the ERK pairs with ARKODE's ERKStep (or, multirate,
+ * MRIStep with a fast partition of its own, mpm_integrator_new_multirate), the one-stage
  * methods directly.
  *
  * The ODE state is every module's state block of its particle set. For ERKStep it is an
@@ -46,6 +47,15 @@ typedef struct mpm_integrator mpm_integrator;
 /* An integrator of the modules of `cycle`, whose RHS is that cycle (copied; its musl flag is
  * set from time.method). The caller keeps the grid, modules, coupling and interface alive. */
 int mpm_integrator_new(mpm_integrator **it, const mpm_config *cfg, const mpm_cycle *cycle);
+/* A multirate integrator (ARKODE MRIStep) over the joint cycle, for the ERK pairs: module
+ * fast_k of the cycle is the fast partition, its own dynamics alone (its forces and grid
+ * update without the coupling), and the slow partition is the joint RHS less that, so the two
+ * sum to the monolithic RHS. Both take fixed steps: the slow step is time.cfl of the other
+ * modules' stability limit, the fast module substeps `substeps` times in it (0: the fewest
+ * its own limit allows) with the time method's Butcher table; table is the MRI coupling
+ * (an ARKODE_MRITableID). */
+int mpm_integrator_new_multirate(mpm_integrator **it, const mpm_config *cfg, const mpm_cycle *cycle,
+                                 int fast_k, int substeps, int table);
 void mpm_integrator_destroy(mpm_integrator **it);
 
 /* (Re)start the integration at (t, current particle state) with first step h0 (0: let
@@ -70,6 +80,9 @@ double mpm_integrator_next_step(const mpm_integrator *it);
 /* Counters since creation: steps, RHS evaluations, failed (error-test) steps, retries. */
 void mpm_integrator_counts(const mpm_integrator *it, long *steps, long *rhs, long *fails,
                            long *retries);
+
+/* Multirate: RHS evaluations of the fast module alone (in both partitions). */
+long mpm_integrator_fast_evals(const mpm_integrator *it);
 
 const char *mpm_method_name(mpm_method m);
 

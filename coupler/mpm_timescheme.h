@@ -9,7 +9,10 @@
  * of a subset of the modules (mpm_cycle.h), and decides the order of their advances and what
  * they exchange (mpm_interface.h). Built-in:
  *   monolithic  one integrator over every module, one step for both (joint cycle);
- *   staggered   one integrator per module, exchanging once per coupling step. */
+ *   staggered   one integrator per module, exchanging once per coupling step;
+ *   multirate   the fast module substeps inside the slow one's step: with the classic update
+ *               one integrator per module (mpm_partitioned.h), with an ERK pair one MRIStep
+ *               integrator over both. */
 #ifndef MPM_TIMESCHEME_H
 #define MPM_TIMESCHEME_H
 
@@ -68,6 +71,10 @@ struct mpm_timescheme {
   mpm_timescheme_between between; /* set by the step loop (may be NULL) */
   void *between_ctx;
 };
+
+/* The ops of a scheme that is one integrator (mpm_integrator.h) in ts->content
+ * (timescheme_monolithic.c); their create builds the monolithic one. */
+extern const mpm_timescheme_ops timescheme_monolithic_ops;
 
 /* The registered types, monolithic first; count in *n. */
 const mpm_timescheme_type *const *mpm_timescheme_types(int *n);

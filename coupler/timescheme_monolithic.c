@@ -1,15 +1,13 @@
 /* `monolithic`: one ARKODE integrator over the MPIManyVector of every module, one step for all
  * of them; the joint MPM cycle is its RHS, so the spatial scheme acts inside every stage. The
- * default, and the reference the partitioned schemes are measured against. */
+ * default, and the reference the partitioned schemes are measured against. Its ops (all but
+ * create) serve any scheme that is one mpm_integrator in ts->content: `multirate` with an ERK
+ * pair, whose integrator is MRIStep's (timescheme_multirate.c). */
 #include "mpm_integrator.h"
 #include "mpm_timescheme.h"
 
 static int mono_create(mpm_timescheme *ts, const mpm_config *cfg) {
-  const mpm_cycle cycle = {.grid = ts->grid,
-                           .mod = ts->mod,
-                           .nmod = ts->nmod,
-                           .coupling = ts->coupling,
-                           .mode = MPM_CYCLE_JOINT};
+  const mpm_cycle cycle = mpm_cycle_joint(ts->grid, ts->mod, ts->nmod, ts->coupling);
   mpm_integrator *it = NULL;
   const int rc = mpm_integrator_new(&it, cfg, &cycle);
   ts->content = it;
@@ -46,7 +44,7 @@ static void mono_counts(const mpm_timescheme *ts, long *steps, long *rhs, long *
   mpm_integrator_counts(ts->content, steps, rhs, fails, retries);
 }
 
-static const mpm_timescheme_ops mono_ops = {
+const mpm_timescheme_ops timescheme_monolithic_ops = {
     .create = mono_create,
     .destroy = mono_destroy,
     .start = mono_start,
@@ -60,5 +58,5 @@ static const mpm_timescheme_ops mono_ops = {
 const mpm_timescheme_type timescheme_monolithic = {
     .name = "monolithic",
     .help = "one integrator over both modules, one step for both; the default",
-    .ops = &mono_ops,
+    .ops = &timescheme_monolithic_ops,
 };

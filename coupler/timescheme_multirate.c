@@ -8,11 +8,20 @@
  * m = 1 this is the monolithic classic step (see timescheme_staggered.c, gas_first).
  *
  * Which is fast depends on the scene: a steel panel in air is the fast module (its stable step
- * is about a tenth of the air's), a soft bar in a Mach 2.5 stream the slow one. The classic
- * update only: ARKODE's MRIStep (adaptive slow and fast ERK methods) is not offered yet. */
+ * is about a tenth of the air's), a soft bar in a Mach 2.5 stream the slow one.
+ *
+ * With an ERK pair (time.method = ralston21, bs32, zonneveld43, dp54) the scheme is ARKODE's
+ * MRIStep instead (mpm_integrator_new_multirate): one integrator over both modules' state, the
+ * solid's own dynamics the fast partition and the rest (the gas and everything the coupling
+ * adds to either) the slow one, with the MRI coupling table coupling.mri_table. SUNDIALS 6.4's
+ * MRIStep takes a fixed slow step, so both partitions take fixed steps from their CFL limits
+ * (time.adaptive = false is required: the pair's error estimate is not used). The gas is always
+ * the slow partition: its particles enter, leave and change rank between steps only. */
 #include "mpm_error.h"
+#include "mpm_integrator.h"
 #include "mpm_partitioned.h"
 
+#include <arkode/arkode_mristep.h>
 #include <math.h>
 #include <string.h>
 
@@ -26,9 +35,75 @@ static const mpm_key_spec multirate_keys[] = {
      "step) or interpolated (with its linear trend since the last coupling step); both pass "
      "the same momentum",
      0},
+    {"coupling.mri_table", MPM_KEY_ENUM, "mri_gark_erk33a", 0, 0, 0, 0,
+     "mri_gark_erk33a|mis_kw3|mri_gark_erk45a",
+     "multirate with an ERK pair (MRIStep): the MRI coupling table, MRI-GARK-ERK33a (order 3), "
+     "MIS-KW3 (order 3) or MRI-GARK-ERK45a (order 4)",
+     0},
 };
 
+/* coupling.mri_table's choices, in the key's order. */
+static const ARKODE_MRITableID mri_tables[] = {ARKODE_MRI_GARK_ERK33a, ARKODE_MIS_KW3,
+                                               ARKODE_MRI_GARK_ERK45a};
+
+/* The MRIStep form: a type of its own whose ops are the one-integrator scheme's. */
+static const mpm_timescheme_type multirate_mri = {
+    .name = "multirate",
+    .help = "multirate with an ERK pair: ARKODE MRIStep",
+    .ops = &timescheme_monolithic_ops,
+};
+
+/* A key of the other form, set away from its default. */
+static int foreign_key(const mpm_config *cfg, int k, const char *why) {
+  if (!mpm_config_set_off_default(cfg, &multirate_keys[k])) return 0;
+  return mpm_config_fail(cfg, multirate_keys[k].key, "%s", why);
+}
+
+static int multirate_mri_create(mpm_timescheme *ts, const mpm_config *cfg, const char *method) {
+  if (!ts->coupling)
+    return mpm_config_fail(cfg, "coupling.time",
+                           "multirate advances a gas and a solid at their own rates, and this "
+                           "scene has no coupled pair (one phase, or coupling.scheme = none); "
+                           "remove the key or add the other phase");
+  MPM_CALL(foreign_key(cfg, 1,
+                       "is read with the classic update only: MRIStep (an ERK pair) passes the "
+                       "gas's stages to the solid itself; remove it or use time.method = usl"));
+  int adaptive;
+  MPM_CALL(mpm_config_get_bool(cfg, "time.adaptive", &adaptive));
+  if (adaptive)
+    return mpm_config_fail(cfg, "time.adaptive",
+                           "coupling.time = multirate with %s runs ARKODE MRIStep, which takes "
+                           "fixed steps (SUNDIALS 6.4): set time.adaptive = false (each "
+                           "partition then steps at time.cfl of its own stable step), or use "
+                           "coupling.time = monolithic for error control",
+                           method);
+  int substeps = 0, fast = -1;
+  if (mpm_config_has(cfg, "coupling.substeps"))
+    MPM_CALL(mpm_config_get_int(cfg, "coupling.substeps", &substeps));
+  const char *table;
+  MPM_CALL(mpm_config_get_string(cfg, "coupling.mri_table", &table));
+  static const char *const names[] = {"mri_gark_erk33a", "mis_kw3", "mri_gark_erk45a"};
+  int t = 0;
+  for (int k = 0; k < 3; ++k)
+    if (strcmp(table, names[k]) == 0) t = k;
+  for (int k = 0; k < ts->nmod; ++k)
+    if (ts->mod[k] == ts->coupling->module[MPM_ROLE_SOLID]) fast = k;
+  const mpm_cycle cycle = mpm_cycle_joint(ts->grid, ts->mod, ts->nmod, ts->coupling);
+  mpm_integrator *it = NULL;
+  const int rc = mpm_integrator_new_multirate(&it, cfg, &cycle, fast, substeps, mri_tables[t]);
+  ts->content = it;
+  ts->type = &multirate_mri;
+  return rc;
+}
+
 static int multirate_create(mpm_timescheme *ts, const mpm_config *cfg) {
+  const char *method;
+  MPM_CALL(mpm_config_get_string(cfg, "time.method", &method));
+  if (strcmp(method, "usl") != 0 && strcmp(method, "musl") != 0 && strcmp(method, "euler") != 0)
+    return multirate_mri_create(ts, cfg, method);
+  MPM_CALL(foreign_key(cfg, 2,
+                       "is read with an ERK pair only (MRIStep); the classic update subcycles "
+                       "with coupling.load: remove it or choose time.method = bs32"));
   MPM_CALL(mpm_partitioned_new(ts, cfg, "multirate"));
   mpm_partitioned *pp = ts->content;
   if (mpm_config_has(cfg, "coupling.substeps"))

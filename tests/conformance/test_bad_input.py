@@ -273,6 +273,20 @@ for name, base, body, key, words in COUPLING_CASES:
 text = FSI.replace("method = usl", "method = bs32", 1) + "\n[coupling]\ntime = staggered\n"
 expect_error("staggered with an adaptive pair", text, "time.method", "classic update",
              line_of(text, "method = bs32"))
+# Multirate with an ERK pair is MRIStep, fixed steps only: an adaptive pair is an error naming
+# time.adaptive; coupling.load is the classic form's, coupling.mri_table MRIStep's.
+ERK = FSI.replace("method = usl", "method = bs32", 1)
+text = ERK + "\n[coupling]\ntime = multirate\n"
+expect_error("multirate with an adaptive pair", text, "time.adaptive", "fixed steps", None)
+for name, base, body, key, words in (
+        ("coupling.load with MRIStep", ERK.replace("method = bs32", "method = bs32\nadaptive = false"),
+         "time = multirate\nload = interpolated", "coupling.load", "classic update only"),
+        ("coupling.mri_table with the classic update", FSI,
+         "time = multirate\nmri_table = mis_kw3", "coupling.mri_table", "ERK pair only"),
+        ("unknown MRI table", FSI, "time = multirate\nmri_table = erk33", "coupling.mri_table",
+         "mri_gark_erk33a")):
+    text = base.rstrip("\n") + "\n\n[coupling]\n" + body + "\n"
+    expect_error(name, text, key, words, line_of(text, body.splitlines()[-1]))
 # A solid inside a static obstacle of the gas (obstacle block spans 0.8-0.9 x 0.15-0.35).
 text = OBST + SOLID.format(lo="0.82 0.2", hi="0.88 0.3")
 expect_error("solid overlapping a static obstacle", text, "obstacle.block.shape",

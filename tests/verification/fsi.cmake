@@ -15,6 +15,10 @@ mpm_add_script_test(test_piperno_farhat SCRIPT verification/test_piperno_farhat.
 # reference, the momentum balance, bitwise restart of every temporal scheme, 2 ranks against 1.
 mpm_add_script_test(test_timeschemes SCRIPT verification/test_timeschemes.py
                     LABELS "verification;mpi" TIMEOUT 900)
+# Multirate with an ERK pair (ARKODE MRIStep): its coupling error's order against a fine monolithic
+# bs32 reference, its momentum balance, 2 ranks against 1.
+mpm_add_script_test(test_timeschemes_mri SCRIPT verification/test_timeschemes.py ARGS mri
+                    LABELS "verification;mpi" TIMEOUT 900)
 # Its restart checks alone, short (the sanitizer pass runs this one, not the whole study).
 mpm_add_script_test(test_timeschemes_quick SCRIPT verification/test_timeschemes.py ARGS quick
                     LABELS "verification;mpi" TIMEOUT 600)

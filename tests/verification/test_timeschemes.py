@@ -24,7 +24,21 @@ probe at its middle (probes.csv, every step).
    restarted from it on 1 rank: the last snapshots equal to the bit, and the restarted run's
    momentum balance still closes (the owed momentum is in the checkpoint).
 `quick` (the argument; for the sanitizer pass): check 4 alone, to t = 0.06 with the checkpoint at
-0.03, and on 2 ranks the restarts of staggered solid_first, strong staggered and multirate.
+0.03, and on 2 ranks the restarts of staggered solid_first, strong staggered and multirate
+(classic and MRIStep).
+
+`mri` (the argument): multirate with an ERK pair, ARKODE MRIStep (bs32 fixed steps,
+MRI-GARK-ERK33a; coupler/timescheme_multirate.c), on the same stiff piston:
+6. its coupling error against a fine monolithic bs32 reference (time.cfl = 0.05, the same
+   method of lines) falls at every halving of time.cfl = 0.4, 0.2, 0.1 (the slow step; the slab
+   substeps about five times in each) with an overall observed order of at least 1.5. Predicted:
+   the table's 3, reduced towards 2 by the MPM right-hand side, which is only once continuously
+   differentiable in the positions (the quadratic B-spline's gradient has kinks where a particle
+   crosses a cell face): monolithic bs32 itself shows 1.9 and 2.6 here. Measured 1.58 and 2.22.
+   The error stays within 5x monolithic bs32's at the same time.cfl (measured 2.3-3.6x), and is
+   printed beside the classic multirate's (first order, 0.07-0.36 % of the amplitude).
+7. its momentum balance closes to 1e-9 of the interface force, and on 2 ranks it gives 1 rank's
+   result within 10x what a 1e-15 change of the slab's velocity does on 1 rank.
 
 5. multirate on 2 ranks gives 1 rank's result: positions and velocities by id, differing by no
    more than 10 times what a 1e-15 relative change of the slab's initial velocity does on 1 rank
@@ -43,7 +57,9 @@ sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "tools"))
 import mpmtest as mt  # noqa: E402
 
 QUICK = sys.argv[1:] == ["quick"]
-check = mt.Checks("test_timeschemes_quick" if QUICK else "test_timeschemes")
+MRI = sys.argv[1:] == ["mri"]
+check = mt.Checks("test_timeschemes_quick" if QUICK else
+                  "test_timeschemes_mri" if MRI else "test_timeschemes")
 CASE = mt.case("fsi_piston.ini")
 STIFF = ["solid.slab.E=5200", "time.t_end=1.5"]
 
@@ -85,6 +101,40 @@ def largest_difference(a, b, fields=None):
 
 
 balances = []
+CFLS = (0.4, 0.2, 0.1)
+
+
+def coupling_errors(base, variants):
+    """The slab displacement's largest difference from a monolithic run at time.cfl = 0.05 with
+    the same base keys, for each (label, keys) at each of CFLS; the first label is the
+    monolithic one, the others' momentum balances go to `balances`."""
+    ref = run(f"ts_reference{'_erk' if 'time.method=bs32' in base else ''}",
+              base + ["time.cfl=0.05"])
+    t_ref, u_ref = displacement(ref)
+    amplitude = float(np.max(np.abs(u_ref)))
+    errors = {}
+    for label, args in variants:
+        errors[label] = []
+        for cfl in CFLS:
+            out = run(f"ts_{label.replace(' ', '_')}_{cfl}", base + args + [f"time.cfl={cfl}"])
+            t, u = displacement(out)
+            err = float(np.max(np.abs(np.interp(t_ref, t, u) - u_ref)))
+            errors[label].append(err)
+            if label != variants[0][0]:
+                balances.append(summary(out)["coupling_imbalance"])
+            print(f"{label}, cfl {cfl}: displacement error {err:.3e} ({err / amplitude:.2e} of the "
+                  f"amplitude {amplitude:.3e}); {mt.cost(out)}, {summary(out)['rhs_evals']} RHS")
+    return errors
+
+
+def check_order(label, e, least, why):
+    """The errors at CFLS fall at every halving, with an overall observed order >= least."""
+    orders = [math.log(e[k] / e[k + 1]) / math.log(2) for k in range(len(e) - 1)]
+    overall = math.log(e[0] / e[-1]) / math.log(CFLS[0] / CFLS[-1])
+    check(all(o > 0 for o in orders) and overall >= least,
+          f"{label}: error {', '.join(f'{x:.3e}' for x in e)} at cfl "
+          f"{', '.join(map(str, CFLS))}: orders {', '.join(f'{o:.2f}' for o in orders)}, overall "
+          f"{overall:.2f} ({why})")
 
 
 def consistency_and_convergence():
@@ -103,32 +153,11 @@ def consistency_and_convergence():
     balances.append(summary(one)["coupling_imbalance"])
 
     # 2. The coupling error against a fine monolithic reference.
-    ref = run("ts_reference", STIFF + ["time.cfl=0.05"])
-    t_ref, u_ref = displacement(ref)
-    amplitude = float(np.max(np.abs(u_ref)))
-    CFLS = (0.4, 0.2, 0.1)
-    errors = {}
-    for label, args in (("monolithic", []),
-                        ("multirate held", ["coupling.time=multirate"]),
-                        ("multirate interpolated", ["coupling.time=multirate",
-                                                    "coupling.load=interpolated"])):
-        errors[label] = []
-        for cfl in CFLS:
-            out = run(f"ts_{label.replace(' ', '_')}_{cfl}", STIFF + args + [f"time.cfl={cfl}"])
-            t, u = displacement(out)
-            err = float(np.max(np.abs(np.interp(t_ref, t, u) - u_ref)))
-            errors[label].append(err)
-            if label != "monolithic":
-                balances.append(summary(out)["coupling_imbalance"])
-            print(f"{label}, cfl {cfl}: displacement error {err:.3e} ({err / amplitude:.2%} of the "
-                  f"amplitude {amplitude:.3e}); {mt.cost(out)}, {summary(out)['rhs_evals']} RHS")
-    e = errors["multirate held"]
-    orders = [math.log(e[k] / e[k + 1]) / math.log(2) for k in range(len(e) - 1)]
-    overall = math.log(e[0] / e[-1]) / math.log(CFLS[0] / CFLS[-1])
-    check(all(o > 0 for o in orders) and overall >= 0.7,
-          f"multirate (held): error {', '.join(f'{x:.3e}' for x in e)} at cfl "
-          f"{', '.join(map(str, CFLS))}: orders {', '.join(f'{o:.2f}' for o in orders)}, overall "
-          f"{overall:.2f} (predicted 1; at least 0.7)")
+    errors = coupling_errors(STIFF, [("monolithic", []),
+                                     ("multirate held", ["coupling.time=multirate"]),
+                                     ("multirate interpolated", ["coupling.time=multirate",
+                                                                 "coupling.load=interpolated"])])
+    check_order("multirate (held)", errors["multirate held"], 0.7, "predicted 1; at least 0.7")
 
     # 3. Momentum balance.
     check(max(balances) < 1e-9, f"partitioned runs: interface momentum imbalance at most "
@@ -145,7 +174,23 @@ SCHEMES = [("monolithic", ["coupling.time=monolithic"]),
                                  "coupling.tolerance=1e-8"]),
            ("multirate held", ["coupling.time=multirate", "solid.slab.E=5200"]),
            ("multirate interpolated", ["coupling.time=multirate", "coupling.load=interpolated",
-                                       "solid.slab.E=5200"])]
+                                       "solid.slab.E=5200"]),
+           ("multirate mristep", ["coupling.time=multirate", "solid.slab.E=5200",
+                                  "time.method=bs32", "time.adaptive=false"])]
+ERK = ["time.method=bs32", "time.adaptive=false"]
+
+
+def mri_convergence():
+    errors = coupling_errors(STIFF + ERK, [("monolithic bs32", []),
+                                           ("multirate mristep", ["coupling.time=multirate"])])
+    e, m = errors["multirate mristep"], errors["monolithic bs32"]
+    check_order("multirate (MRIStep, bs32, MRI-GARK-ERK33a)", e, 1.5,
+                "at least 1.5; see the header")
+    ratio = max(a / b for a, b in zip(e, m))
+    check(ratio < 5, f"multirate (MRIStep) error at most {ratio:.1f}x monolithic bs32's at the "
+          f"same time.cfl (tolerance 5x)")
+    check(max(balances) < 1e-9, f"MRIStep runs: interface momentum imbalance at most "
+          f"{max(balances):.1e} of the interface force (tolerance 1e-9)")
 
 
 def restarts(t_half, ranks, schemes):
@@ -164,22 +209,33 @@ def restarts(t_half, ranks, schemes):
               f"imbalance after the restart {imb:.1e}")
 
 
+
+
+def two_ranks(label, extra):
+    """5 and 7: 2 ranks against 1, against what a 1e-15 change of the input does on 1 rank."""
+    args = ["solid.slab.E=5200", "coupling.time=multirate", "time.t_end=0.5"] + extra
+    name = label.replace(" ", "_")
+    one = final_particles(run(f"ts_{name}_np1", args))
+    two = final_particles(run(f"ts_{name}_np2", args + ["grid.ranks=2 1"], ranks=2))
+    nudged = final_particles(run(f"ts_{name}_nudged",
+                                 args + ["solid.slab.velocity=0.05000000000000005 0"]))
+    d = largest_difference(one, two, fields=("x", "v"))
+    scale = largest_difference(one, nudged, fields=("x", "v"))
+    check(0 < scale and d <= 10 * scale,
+          f"{label} on 2 ranks against 1 (by id, t = 0.5): largest difference {d:.1e} of the "
+          f"largest value; a 1e-15 change of the slab's velocity gives {scale:.1e} (tolerance 10x "
+          f"that: roundoff in the reductions, amplified like any perturbation of the input)")
+
+
 if QUICK:
     restarts(0.03, 1, SCHEMES)
-    restarts(0.03, 2, [SCHEMES[1], SCHEMES[4], SCHEMES[6]])
+    restarts(0.03, 2, [SCHEMES[1], SCHEMES[4], SCHEMES[6], SCHEMES[7]])
+    sys.exit(check.finish())
+if MRI:
+    mri_convergence()
+    two_ranks("multirate mristep", ERK)
     sys.exit(check.finish())
 consistency_and_convergence()
 restarts(0.3, 1, SCHEMES)
-
-# 5. 2 ranks against 1, against what a 1e-15 change of the input does on 1 rank.
-args = ["solid.slab.E=5200", "coupling.time=multirate", "time.t_end=0.5"]
-one = final_particles(run("ts_multirate_np1", args))
-two = final_particles(run("ts_multirate_np2", args + ["grid.ranks=2 1"], ranks=2))
-nudged = final_particles(run("ts_multirate_nudged", args + ["solid.slab.velocity=0.05000000000000005 0"]))
-d = largest_difference(one, two, fields=("x", "v"))
-scale = largest_difference(one, nudged, fields=("x", "v"))
-check(0 < scale and d <= 10 * scale,
-      f"multirate on 2 ranks against 1 (by id, t = 0.5): largest difference {d:.1e} of the "
-      f"largest value; a 1e-15 change of the slab's velocity gives {scale:.1e} (tolerance 10x "
-      f"that: roundoff in the reductions, amplified like any perturbation of the input)")
+two_ranks("multirate", [])
 sys.exit(check.finish())
