@@ -18,8 +18,9 @@
 # test_kernels_*, test_halo_np*, test_periodic_*, test_ballistic, test_rigid, test_traction)
 # and the gas tubes test_sod and test_strong_shock (the same gas path as test_gas_output,
 # test_gas_conservation and test_gas_boundaries). The temporal-coupling studies test_piperno_farhat
-# and test_timeschemes (1-2 minutes each in the plain pass) run there as test_timeschemes_quick:
-# every temporal scheme's held, loaded and joint cycles, checkpoint and restart, on 1 and 2 ranks.
+# and test_timeschemes (1-2 minutes each in the plain pass; test_timeschemes_mri 3 minutes, 9.5
+# under the sanitizers) run there as test_timeschemes_quick: every temporal scheme's held, loaded
+# and joint cycles and MRIStep's, checkpoint and restart, on 1 and 2 ranks.
 # The code they run is the open faces', the obstacles', the gas module's and the coupler's, which
 # test_gas_boundaries, test_obstacles, test_sod, test_coupling, test_coupling_ranks and
 # test_coupling_rigid run under the sanitizers. Also left to the plain pass (2-3 minutes each
@@ -45,5 +46,5 @@ bash "$src/tools/setup.sh" "$src/build"
 bash "$src/tools/setup.sh" "$src/build-asan" -DMPMFSI_SANITIZE=ON -DCMAKE_BUILD_TYPE=Debug \
   "-DCMAKE_C_FLAGS_DEBUG=-g -O2"
 (cd "$src/build-asan" &&
-  ctest -LE "long|benchmark" -E "^test_(blowup_guard_coupled|wedge|forward_step|fsi_waves|decomposition|supersonic_bar|supersonic_bar_standoff|near_vacuum_order|restart_cases|csm1|csm3_fast|axial_bar|cantilever3d|model_swap|ranks_solid|periodic|stability|sod|strong_shock|piperno_farhat|timeschemes|run_safety|disks|gas_shear|slanted_wall|slanted_wall_max|bluff_bodies)$" \
+  ctest -LE "long|benchmark" -E "^test_(blowup_guard_coupled|wedge|forward_step|fsi_waves|decomposition|supersonic_bar|supersonic_bar_standoff|near_vacuum_order|restart_cases|csm1|csm3_fast|axial_bar|cantilever3d|model_swap|ranks_solid|periodic|stability|sod|strong_shock|piperno_farhat|timeschemes|timeschemes_mri|run_safety|disks|gas_shear|slanted_wall|slanted_wall_max|bluff_bodies)$" \
     --output-on-failure -j 2 --timeout 1800)
