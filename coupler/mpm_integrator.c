@@ -57,7 +57,6 @@ struct mpm_integrator {
   double h_fast;               /* its substep */
   double *fast_rate;           /* module fast_k's rates alone, then the inner stages' work */
   size_t fast_cap;             /* doubles allocated in fast_rate */
-  long fast_evals;             /* RHS evaluations of the fast module alone */
 };
 
 const mpm_key_spec mpm_integrator_keys[] = {
@@ -159,7 +158,6 @@ static int rhs_slow(mpm_sunreal t, N_Vector y, N_Vector ydot, void *user) {
   if (rc != 0) return rc;
   double *yf = module_data(y, it->fast_k), *fd = module_data(ydot, it->fast_k);
   const size_t len = block_length(it, it->fast_k);
-  it->fast_evals++;
   if (mpm_cycle_rhs(&it->fast, t, &yf, &it->fast_rate, 0.0) != 0) {
     it->rhs_error = 1;
     return -1;
@@ -178,7 +176,6 @@ static int rhs_fast(mpm_sunreal t, N_Vector y, N_Vector ydot, void *user) {
   if (check_modules(it, yk, k, k + 1)) return 1;
   for (int j = 0; j < it->nmod; ++j)
     if (j != k) memset(ydk[j], 0, block_length(it, j) * sizeof(double));
-  it->fast_evals++;
   if (mpm_cycle_rhs(&it->fast, t, &yk[k], &ydk[k], 0.0) != 0) {
     it->rhs_error = 1;
     return -1;
@@ -559,7 +556,6 @@ static int inner_evolve(MRIStepInnerStepper st, mpm_sunreal t0, mpm_sunreal tout
       yk[fk] = Y;
       if (check_modules(it, yk, fk, fk + 1)) return 1;
       double *Ki = K + (size_t)i * len;
-      it->fast_evals++;
       if (mpm_cycle_rhs(&it->fast, ti, &Y, &Ki, 0.0) != 0) {
         it->rhs_error = 1;
         return -1;
@@ -666,10 +662,6 @@ double mpm_integrator_next_step(const mpm_integrator *it) {
 void mpm_integrator_counts(const mpm_integrator *it, long *steps, long *rhs_evals, long *fails,
                            long *retries) {
   *steps = it->steps, *rhs_evals = it->rhs_evals, *fails = it->fails, *retries = it->retries;
-}
-
-long mpm_integrator_fast_evals(const mpm_integrator *it) {
-  return it->fast_evals;
 }
 
 static int report_fault(const mpm_integrator *it, double t, int tries) {

@@ -81,9 +81,6 @@ double mpm_integrator_next_step(const mpm_integrator *it);
 void mpm_integrator_counts(const mpm_integrator *it, long *steps, long *rhs, long *fails,
                            long *retries);
 
-/* Multirate: RHS evaluations of the fast module alone (in both partitions). */
-long mpm_integrator_fast_evals(const mpm_integrator *it);
-
 const char *mpm_method_name(mpm_method m);
 
 /* Is m a classic MPM update (fixed CFL step known to the RHS)? */

@@ -25,6 +25,7 @@
 #include <math.h>
 #include <string.h>
 
+enum { KEY_SUBSTEPS, KEY_LOAD, KEY_MRI_TABLE }; /* multirate_keys, in order */
 static const mpm_key_spec multirate_keys[] = {
     {"coupling.substeps", MPM_KEY_INT, NULL, 1, 1e6, 0, 0, NULL,
      "multirate: substeps of the fast module in each coupling step, >= 1 (unset: the fewest its "
@@ -65,7 +66,7 @@ static int multirate_mri_create(mpm_timescheme *ts, const mpm_config *cfg, const
                            "multirate advances a gas and a solid at their own rates, and this "
                            "scene has no coupled pair (one phase, or coupling.scheme = none); "
                            "remove the key or add the other phase");
-  MPM_CALL(foreign_key(cfg, 1,
+  MPM_CALL(foreign_key(cfg, KEY_LOAD,
                        "is read with the classic update only: MRIStep (an ERK pair) passes the "
                        "gas's stages to the solid itself; remove it or use time.method = usl"));
   int adaptive;
@@ -90,9 +91,9 @@ static int multirate_mri_create(mpm_timescheme *ts, const mpm_config *cfg, const
     if (ts->mod[k] == ts->coupling->module[MPM_ROLE_SOLID]) fast = k;
   const mpm_cycle cycle = mpm_cycle_joint(ts->grid, ts->mod, ts->nmod, ts->coupling);
   mpm_integrator *it = NULL;
+  ts->type = &multirate_mri; /* from here on, also for the destroy after a failure */
   const int rc = mpm_integrator_new_multirate(&it, cfg, &cycle, fast, substeps, mri_tables[t]);
   ts->content = it;
-  ts->type = &multirate_mri;
   return rc;
 }
 
@@ -101,7 +102,7 @@ static int multirate_create(mpm_timescheme *ts, const mpm_config *cfg) {
   MPM_CALL(mpm_config_get_string(cfg, "time.method", &method));
   if (strcmp(method, "usl") != 0 && strcmp(method, "musl") != 0 && strcmp(method, "euler") != 0)
     return multirate_mri_create(ts, cfg, method);
-  MPM_CALL(foreign_key(cfg, 2,
+  MPM_CALL(foreign_key(cfg, KEY_MRI_TABLE,
                        "is read with an ERK pair only (MRIStep); the classic update subcycles "
                        "with coupling.load: remove it or choose time.method = bs32"));
   MPM_CALL(mpm_partitioned_new(ts, cfg, "multirate"));
