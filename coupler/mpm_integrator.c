@@ -505,9 +505,9 @@ static int configure(mpm_integrator *it, double h0) {
  * forcing r(t) = sum_j F_j ((t - tshift) / tscale)^j built from the slow stages. ARKStep as the
  * inner stepper would carry the whole state (the gas too, where f_fast is zero) through every
  * fast stage. Here the other modules' blocks take the forcing's exact integral, a polynomial,
- * and the fast module's block alone takes n equal steps of the time method's table; an ERK of
- * order p integrates a forcing of degree p - 1 exactly, so this is ARKStep's answer for the
- * pairs offered, without the passes over the gas. */
+ * and the fast module's block alone takes n equal steps of the time method's table (an ERK of
+ * order p integrates the gas's forcing of degree p - 1 exactly, so the gas's blocks get what
+ * ARKStep would give them), without ARKStep's passes over the gas. */
 
 /* Add w_j F_j[block k] to y for j < nF (w: the forcing's weights). */
 static void add_forcing(const mpm_integrator *it, int k, const N_Vector *F, int nF, const double *w,
