@@ -43,9 +43,13 @@ static const mpm_key_spec multirate_keys[] = {
      0},
 };
 
-/* coupling.mri_table's choices, in the key's order. */
-static const ARKODE_MRITableID mri_tables[] = {ARKODE_MRI_GARK_ERK33a, ARKODE_MIS_KW3,
-                                               ARKODE_MRI_GARK_ERK45a};
+/* coupling.mri_table's choices and their ARKODE tables. */
+static const struct {
+  const char *name;
+  ARKODE_MRITableID id;
+} mri_tables[] = {{"mri_gark_erk33a", ARKODE_MRI_GARK_ERK33a},
+                  {"mis_kw3", ARKODE_MIS_KW3},
+                  {"mri_gark_erk45a", ARKODE_MRI_GARK_ERK45a}};
 
 /* The MRIStep form: a type of its own whose ops are the one-integrator scheme's. */
 static const mpm_timescheme_type multirate_mri = {
@@ -83,16 +87,15 @@ static int multirate_mri_create(mpm_timescheme *ts, const mpm_config *cfg, const
     MPM_CALL(mpm_config_get_int(cfg, "coupling.substeps", &substeps));
   const char *table;
   MPM_CALL(mpm_config_get_string(cfg, "coupling.mri_table", &table));
-  static const char *const names[] = {"mri_gark_erk33a", "mis_kw3", "mri_gark_erk45a"};
-  int t = 0;
-  for (int k = 0; k < 3; ++k)
-    if (strcmp(table, names[k]) == 0) t = k;
+  int t = 0; /* the key's choices are checked: one matches */
+  for (int k = 0; k < (int)(sizeof mri_tables / sizeof mri_tables[0]); ++k)
+    if (strcmp(table, mri_tables[k].name) == 0) t = k;
   for (int k = 0; k < ts->nmod; ++k)
     if (ts->mod[k] == ts->coupling->module[MPM_ROLE_SOLID]) fast = k;
   const mpm_cycle cycle = mpm_cycle_joint(ts->grid, ts->mod, ts->nmod, ts->coupling);
   mpm_integrator *it = NULL;
   ts->type = &multirate_mri; /* from here on, also for the destroy after a failure */
-  const int rc = mpm_integrator_new_multirate(&it, cfg, &cycle, fast, substeps, mri_tables[t]);
+  const int rc = mpm_integrator_new_multirate(&it, cfg, &cycle, fast, substeps, mri_tables[t].id);
   ts->content = it;
   return rc;
 }
