@@ -1,21 +1,23 @@
 """Multirate with an ERK pair (ARKODE MRIStep) against monolithic, on the shock-loaded panel.
 
     /usr/bin/python3 bench/bench_multirate_mri.py [--dx DX] [--window T] [--ref-cfl C]
-                                                  [--cfl C ...] [--ranks N] [--tag T]
-                                                  [key=value ...]
+                                                  [--cfl C ...] [--mri-cfl C ...] [--ranks N]
+                                                  [--tag T] [key=value ...]
 
 The panel (cases/shock_panel.ini) is the fast module: its stable step is about a seventh of the
 air's. With time.method = bs32 (fixed steps, time.adaptive = false; the gas's PIC share off, as
 the ERK pairs require) the runs are:
   reference   monolithic at time.cfl = --ref-cfl (every step at the panel's limit);
   monolithic  at each --cfl (the panel's stable step sets every step of both modules);
-  mristep     coupling.time = multirate at each --cfl: the gas steps at time.cfl of its own
-              limit, the panel substeps inside with MRI-GARK-ERK33a coupling.
+  mristep     coupling.time = multirate at each --cfl and --mri-cfl: the gas steps at time.cfl
+              of its own limit, the panel substeps inside with MRI-GARK-ERK33a coupling.
 Error: the largest difference of the panel tip's x displacement (probes.csv, every step) from the
 reference's over the window, relative to the reference's largest |tip|. Cost: wall time, steps,
 joint RHS evaluations. The runs go one after the other, the pairs at each time.cfl back to back,
 so a pair sees about the same load; their wall-time ratio is the speed-up at that time.cfl, and
-the two errors say whether it comes at equal error.
+the two errors say whether it comes at equal error. Cost at equal error: MRIStep's wall time at
+each monolithic run's error, interpolated log-log between the MRIStep runs that bracket it
+(--mri-cfl adds MRIStep runs at smaller steps for that).
 
 key=value pairs go to every run (coupling.scheme=traction, say). Writes
 bench/results/multirate_mri<tag>.md and .json.
@@ -45,6 +47,8 @@ def parse():
     ap.add_argument("--window", type=float, default=1e-4, help="simulated time, s")
     ap.add_argument("--ref-cfl", type=float, default=0.1)
     ap.add_argument("--cfl", nargs="+", type=float, default=[0.4])
+    ap.add_argument("--mri-cfl", nargs="*", type=float, default=[],
+                    help="MRIStep alone at these time.cfl too")
     ap.add_argument("--ranks", type=int, default=1)
     ap.add_argument("--tag", default="")
     ap.add_argument("--binary", default=os.path.join(ROOT, "build", "app", "mpmfsi"))
@@ -71,19 +75,29 @@ def run(args, name, extra):
             "imbalance": s.get("coupling_imbalance"), "t": p[:, 0], "ux": p[:, 1]}
 
 
+def equal_error_wall(points, err):
+    """Wall time at error err, log-log between the two (error, wall) points around it."""
+    for (e0, w0), (e1, w1) in zip(points, points[1:]):
+        if e0 <= err <= e1 and e0 < e1:
+            f = np.log(err / e0) / np.log(e1 / e0)
+            return float(np.exp(np.log(w0) + f * np.log(w1 / w0)))
+    return None
+
+
 def main():
     args = parse()
     ref = run(args, f"reference_{args.ref_cfl:g}",
               ["coupling.time=monolithic", f"time.cfl={args.ref_cfl}"])
     scale = float(np.max(np.abs(ref["ux"])))
     rows = []
-    for cfl in args.cfl:
-        for scheme, keys in (("monolithic", ["coupling.time=monolithic"]),
-                             ("mristep", ["coupling.time=multirate"])):
-            r = run(args, f"{scheme}_{cfl:g}", keys + [f"time.cfl={cfl}"])
-            err = float(np.max(np.abs(np.interp(ref["t"], r["t"], r["ux"]) - ref["ux"])))
-            rows.append({"scheme": scheme, "cfl": cfl, "wall_s": r["wall_s"], "steps": r["steps"],
-                         "rhs": r["rhs"], "err_rel": err / scale, "imbalance": r["imbalance"]})
+    pairs = [(cfl, scheme) for cfl in args.cfl for scheme in ("monolithic", "mristep")]
+    pairs += [(cfl, "mristep") for cfl in args.mri_cfl if cfl not in args.cfl]
+    keys = {"monolithic": ["coupling.time=monolithic"], "mristep": ["coupling.time=multirate"]}
+    for cfl, scheme in pairs:
+        r = run(args, f"{scheme}_{cfl:g}", keys[scheme] + [f"time.cfl={cfl}"])
+        err = float(np.max(np.abs(np.interp(ref["t"], r["t"], r["ux"]) - ref["ux"])))
+        rows.append({"scheme": scheme, "cfl": cfl, "wall_s": r["wall_s"], "steps": r["steps"],
+                     "rhs": r["rhs"], "err_rel": err / scale, "imbalance": r["imbalance"]})
     lines = ["# Multirate (MRIStep) against monolithic: shock panel, bs32 fixed steps",
              "", f"{' '.join(args.overrides) or 'the case as it stands'}; "
              f"dx = {args.dx * 1e3:g} mm, window {args.window * 1e3:g} ms, {args.ranks} "
@@ -102,6 +116,12 @@ def main():
         lines.append(f"- time.cfl = {cfl:g}: mristep {m['wall_s'] / q['wall_s']:.2f}x cheaper "
                      f"than monolithic; tip errors {q['err_rel']:.2e} against "
                      f"{m['err_rel']:.2e}.")
+    mri = sorted((r["err_rel"], r["wall_s"]) for r in rows if r["scheme"] == "mristep")
+    for m in (r for r in rows if r["scheme"] == "monolithic"):
+        w = equal_error_wall(mri, m["err_rel"])
+        lines.append(f"- at monolithic's error at time.cfl = {m['cfl']:g} ({m['err_rel']:.2e}): "
+                     + (f"mristep would take {w:.1f} s, {m['wall_s'] / w:.2f}x cheaper "
+                        f"(interpolated)" if w else "outside mristep's measured errors"))
     text = "\n".join(lines) + "\n"
     print(text)
     os.makedirs(RESULTS, exist_ok=True)
@@ -109,7 +129,7 @@ def main():
         f.write(text)
     with open(os.path.join(RESULTS, f"multirate_mri{args.tag}.json"), "w") as f:
         json.dump({"overrides": args.overrides, "dx": args.dx, "window": args.window,
-                   "ref_cfl": args.ref_cfl,
+                   "ref_cfl": args.ref_cfl, "mri_cfl": args.mri_cfl,
                    "ranks": args.ranks, "reference_wall_s": ref["wall_s"], "rows": rows}, f,
                   indent=1)
 

@@ -150,20 +150,30 @@ int mpm_constraints_add_walls(mpm_node_constraints *c, const mpm_walls *w, const
 
 /* Faces were added axis by axis, so a corner pad node folds through the first wall into a
  * node that is still a pad node of the second wall, which then folds it inside. */
-void mpm_constraints_fold(const mpm_node_constraints *c, mpm_grid *grid, int phase) {
-  mpm_grid_phase *ph = &grid->phase[phase];
+static void fold(const mpm_node_constraints *c, int dim, double *m, double *const *mv,
+                 double *const *f) {
   for (mpm_lidx k = 0; k < c->count; ++k) {
     const mpm_lidx l = c->node[k], src = c->source[k];
     if (src < 0) continue;
-    ph->m_i[src] += ph->m_i[l];
-    ph->m_i[l] = 0.0;
-    for (int d = 0; d < grid->dim; ++d) {
+    m[src] += m[l];
+    m[l] = 0.0;
+    for (int d = 0; d < dim; ++d) {
       const double sign = (c->mask[k] >> d) & 1 ? -1.0 : 1.0;
-      ph->mv_i[d][src] += sign * ph->mv_i[d][l];
-      ph->f_i[d][src] += sign * ph->f_i[d][l];
-      ph->mv_i[d][l] = ph->f_i[d][l] = 0.0;
+      mv[d][src] += sign * mv[d][l];
+      mv[d][l] = 0.0;
+      if (f) f[d][src] += sign * f[d][l], f[d][l] = 0.0;
     }
   }
+}
+
+void mpm_constraints_fold(const mpm_node_constraints *c, mpm_grid *grid, int phase) {
+  mpm_grid_phase *ph = &grid->phase[phase];
+  fold(c, grid->dim, ph->m_i, ph->mv_i, ph->f_i);
+}
+
+void mpm_constraints_fold_momentum(const mpm_node_constraints *c, const mpm_grid *grid, double *m,
+                                   double *const *mv) {
+  fold(c, grid->dim, m, mv, NULL);
 }
 
 /* One pass per axis: a corner pad node mirrors a node that is itself a pad node of another

@@ -74,6 +74,9 @@ int mpm_constraints_add_walls(mpm_node_constraints *c, const mpm_walls *w, const
  * clear the pad nodes. Without this the nodes next to a wall miss part of their stencil and
  * the wall costs a first-order error. */
 void mpm_constraints_fold(const mpm_node_constraints *c, mpm_grid *grid, int phase);
+/* The same fold on mass and momentum arrays of the grid's box (copies of a phase's). */
+void mpm_constraints_fold_momentum(const mpm_node_constraints *c, const mpm_grid *grid, double *m,
+                                   double *const *mv);
 /* After the nodal update: hold and mirror v and a of one phase. */
 void mpm_constraints_apply(const mpm_node_constraints *c, mpm_grid *grid, int phase);
 void mpm_constraints_free(mpm_node_constraints *c);

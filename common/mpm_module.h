@@ -106,6 +106,10 @@ struct mpm_module {
   /* > 0: post_step at the steps that are multiples of this reads the cell occupancy of every
    * phase (mpm_cells.h), which the sim counts after every module's migration. */
   int cells_every;
+  /* The RHS reads what post_step commits (a lagged strain rate, a plastic history), so a
+   * step's last stage is stale once the step is accepted: the integrator's fixed steps start
+   * from a fresh first stage instead of reusing it (mpm_integrator.c). */
+  int commits_history;
 };
 
 /* Call ops->destroy and free the module; accepts NULL. */

@@ -42,6 +42,8 @@ typedef struct fluid_content {
   double shift;              /* particle shifting coefficient kappa (0: off; fluid_shift.c) */
   int shift_every;           /* shift every shift_every steps */
   double shift_J;            /* only particles with J >= shift_J move */
+  int current_rate;          /* fluid.strain_rate = current (fluid_module.c) */
+  double *sub, *zero;        /* its viscous deposit: positions and stresses, zeros (cap each) */
   int stable_local;          /* fluid.stable_step = neighbourhood (fluid_stable.c) */
   double s_local;            /* its fastest signal for this step, m/s; < 0: not yet known */
   double *cellsum;           /* its per-cell sums (3 nnodes) */

@@ -4,9 +4,10 @@
  * Per particle: dx/dt = sum S v_i, dv/dt = sum S a_i (or the FLIP/PIC/APIC update of the
  * classic step), dJ/dt = J tr L, de/dt = grid power per unit mass (below). The stress
  * deposited at P2G is the ideal-gas pressure plus the viscous and artificial viscous terms
- * of the strain rate D of the previous RHS evaluation, stored in the fields divv and D: in the
- * classic update that is the previous step's rate, i.e. the stress is updated last, as in
- * USL; the ERK pairs see the rate of the previous stage.
+ * of a strain rate D. In the classic update that is the previous step's rate, stored in the
+ * fields divv and D: the stress is updated last, as in USL. The ERK pairs take the rate of the
+ * state itself (current_rate, below), so that their RHS is a function of y alone; with
+ * fluid.strain_rate = lagged they read the fields instead, the rate of the previous step.
  *
  * Energy. Each particle's internal energy takes the work its stress does on the grid,
  * (V sigma : L) / m per unit mass, with L the gradient of the same nodal velocity that moves
@@ -55,6 +56,12 @@ static const mpm_key_spec fluid_keys[] = {
      "transfer.pic_fraction (default: that); damps the gas's particle noise without damping "
      "the solid; classic update only",
      1},
+    {"fluid.strain_rate", MPM_KEY_ENUM, "current", 0, 0, 0, 0, "current|lagged",
+     "ERK pairs: the strain rate the artificial and physical viscosity see: current (of the "
+     "state itself: a second deposit and a gather, about 1.6x the gas's work per RHS) or lagged "
+     "(of the previous step: cheaper, but it holds every ERK pair to first order in time "
+     "wherever the artificial viscosity acts); the classic update always lags",
+     0},
     {"fluid.ppc", MPM_KEY_INT, "2", 1, 8, 0, 0, NULL,
      "gas particles per cell per direction at seeding", 0},
     {"fluid.regularise_every", MPM_KEY_INT, "0", 0, HUGE_VAL, 0, 0, NULL,
@@ -156,8 +163,8 @@ static int ensure_scratch(mpm_module *m) {
   const int dim = m->grid->dim;
   if (n <= fc->cap && fc->vsig) return 0;
   free(fc->vsig), free(fc->scratch), free(fc->vnew), free(fc->Cnew), free(fc->power);
-  free(fc->tscratch);
-  fc->vnew = fc->Cnew = fc->tscratch = NULL;
+  free(fc->tscratch), free(fc->sub), free(fc->zero);
+  fc->vnew = fc->Cnew = fc->tscratch = fc->sub = fc->zero = NULL;
   fc->cap = n + n / 4 + 16;
   MPM_ALLOC(fc->vsig, (size_t)dim * dim * fc->cap);
   MPM_ALLOC(fc->scratch, (size_t)(2 * dim + dim * dim) * fc->cap);
@@ -171,42 +178,183 @@ static int ensure_scratch(mpm_module *m) {
 
 /* ---- the RHS phases ------------------------------------------------------------------------ */
 
-static int fluid_p2g(mpm_module *m, double t, const double *y) {
-  (void)t;
+/* Deposit the particles (and the open faces' and virtual particles) into the phase: m, m v and,
+ * with vsig, the forces; with b, the obstacles' ghost fields too. */
+static int deposit(mpm_module *m, const double *y, const double *vsig, const fluid_batch *b) {
   fluid_content *fc = m->content;
   const mpm_particles *p = m->particles;
   const int dim = p->dim;
   const mpm_lidx n = p->n;
-  MPM_CALL(ensure_scratch(m));
-  mpm_timer_start(MPM_T_STRESS);
-  const fluid_batch b = {.dim = dim,
-                         .n = n,
-                         .m = mpm_particles_comp(p, fc->lay.f_m, 0),
-                         .V0 = mpm_particles_comp(p, fc->lay.f_V0, 0),
-                         .J = state(p, y, FLUID_J),
-                         .e = state(p, y, FLUID_E),
-                         .divv = field(p, y, fc->lay.f_divv),
-                         .D = fc->lay.f_D >= 0 ? field(p, y, fc->lay.f_D) : NULL,
-                         .vsig = fc->vsig};
-  fluid_stress(&fc->gas, &b);
-  mpm_timer_stop(MPM_T_STRESS);
-
-  mpm_timer_start(MPM_T_P2G);
   mpm_p2g_args a = {.n = n,
-                    .m = b.m,
-                    .vsig = fc->vsig,
+                    .m = mpm_particles_comp(p, fc->lay.f_m, 0),
+                    .vsig = vsig,
                     .C = fc->tr.apic ? state(p, y, fc->lay.f_C) : NULL,
                     .lp = fc->lp};
   for (int d = 0; d < dim; ++d) {
     a.x[d] = state(p, y, FLUID_X) + (size_t)d * n;
     a.v[d] = state(p, y, FLUID_V) + (size_t)d * n;
-    a.gravity[d] = fc->gravity[d];
+    a.gravity[d] = vsig ? fc->gravity[d] : 0.0;
   }
   mpm_kernels_get(dim)->p2g(m->grid, m->phase, &a);
   fluid_virtual_clear(&fc->virt);
   MPM_CALL(fluid_open_p2g(fc->open, m, y, &fc->virt));
   MPM_CALL(fluid_virtual_deposit(&fc->virt, m->grid, fc->lp));
-  fluid_obstacles_deposit(&fc->obs, m->grid, n, a.x, b.m, b.V0, b.J, fc->vsig, b.e, fc->gas.gamma);
+  if (b)
+    fluid_obstacles_deposit(&fc->obs, m->grid, n, a.x, b->m, b->V0, b->J, vsig, b->e,
+                            fc->gas.gamma);
+  return 0;
+}
+
+/* fluid.strain_rate = current (the method of lines): the strain rate of the state y itself, for
+ * the artificial and physical viscosity, so that the RHS is a function of y alone, as an ERK
+ * pair's order and error estimate assume. The lagged rate (the previous step's) holds every
+ * ERK pair to first order in time wherever the artificial viscosity acts.
+ *
+ * The particles deposit m, m v and the pressure's force. From copies of m and m v (summed
+ * over the ranks and folded at the walls as the solve will be) the nodal velocities m v / m,
+ * constrained as the solve's are (walls, open faces, obstacles; a coupling's constraints are
+ * the coupler's and are not seen here), are interpolated back as their gradient L: tr L and
+ * sym L are this RHS's rate. Where no constraint acts that is the L of the RHS's own G2P. Only
+ * the particles with a viscous stress (in compression, or all with viscosity) then deposit it,
+ * as massless particles. The phase's v and a are scratch until the solve. Cost: about 1.6x the
+ * lagged RHS's gas work (test_gas_time_order). */
+
+static int fluid_constrain(mpm_module *m, double t, double h, mpm_pass pass);
+
+/* The nodal velocities of the deposit in the phase, into its v (a zeroed), constrained as the
+ * solve's are and copied into the ghosts. Collective. */
+static int deposit_velocity(mpm_module *m, double t) {
+  fluid_content *fc = m->content;
+  mpm_grid *g = m->grid;
+  mpm_grid_phase *ph = &g->phase[m->phase];
+  const int dim = g->dim;
+  const size_t nn = (size_t)g->nnodes;
+  double *mass = fc->node, *mv[MPM_MAX_DIM], *f[1 + MPM_MAX_DIM] = {mass};
+  memcpy(mass, ph->m_i, nn * sizeof(double));
+  for (int d = 0; d < dim; ++d) {
+    f[1 + d] = mv[d] = fc->node + (1 + d) * nn;
+    memcpy(mv[d], ph->mv_i[d], nn * sizeof(double));
+  }
+  mpm_timer_start(MPM_T_HALO);
+  MPM_CALL(mpm_grid_halo_reverse(g, f, 1 + dim));
+  mpm_timer_stop(MPM_T_HALO);
+  mpm_constraints_fold_momentum(&fc->cons, g, mass, mv);
+  double local = 0.0, mmax;
+  for (size_t l = 0; l < nn; ++l)
+    if (mass[l] > local) local = mass[l];
+  MPM_CALL_MPI(MPI_Allreduce(&local, &mmax, 1, MPI_DOUBLE, MPI_MAX, g->comm));
+  const double mmin = ph->empty_fraction * mmax;
+  for (int d = 0; d < dim; ++d)
+    for (size_t l = 0; l < nn; ++l) {
+      ph->v_i[d][l] = mass[l] > mmin ? mv[d][l] / mass[l] : 0.0;
+      ph->a_i[d][l] = 0.0;
+    }
+  /* The constraints of a pass that records nothing (walls, open faces, obstacles), which read
+   * the nodal masses: the summed copy stands in for the phase's own until the cycle sums it. */
+  double *own = ph->m_i;
+  ph->m_i = mass;
+  const int rc = fluid_constrain(m, t, 0.0, MPM_PASS_REMAP);
+  ph->m_i = own;
+  MPM_CALL(rc);
+  mpm_timer_start(MPM_T_HALO);
+  MPM_CALL(mpm_grid_halo_forward(g, ph->v_i, dim));
+  mpm_timer_stop(MPM_T_HALO);
+  return 0;
+}
+
+/* tr L into divv and sym L into D (dim*dim, may be L itself). */
+static void rate_parts(int dim, mpm_lidx n, const double *L, double *divv, double *D) {
+  for (mpm_lidx i = 0; i < n; ++i) divv[i] = L[i];
+  for (int d = 1; d < dim; ++d)
+    for (mpm_lidx i = 0; i < n; ++i) divv[i] += L[(size_t)(d * dim + d) * n + i];
+  for (int r = 0; r < dim; ++r)
+    for (int c = r; c < dim; ++c)
+      for (mpm_lidx i = 0; i < n; ++i) {
+        const double s =
+            0.5 * (L[(size_t)(r * dim + c) * n + i] + L[(size_t)(c * dim + r) * n + i]);
+        D[(size_t)(r * dim + c) * n + i] = D[(size_t)(c * dim + r) * n + i] = s;
+      }
+}
+
+/* Deposit the viscous part of V sigma (fluid_stress_viscous) of the particles that have one, as
+ * massless particles (forces only), and add it to b->vsig, which held the pressure's part. */
+static int deposit_viscous(mpm_module *m, const double *y, const fluid_batch *b) {
+  fluid_content *fc = m->content;
+  const int dim = b->dim, nk = dim * dim;
+  const mpm_lidx n = b->n;
+  const size_t cap = (size_t)fc->cap;
+  if (!fc->sub) {
+    MPM_ALLOC(fc->sub, (size_t)(dim + nk) * cap);
+    fc->zero = calloc(cap, sizeof(double));
+    if (!fc->zero) MPM_FAIL(MPM_ERR_MEMORY, "out of memory for %zu particles", cap);
+  }
+  double *xs = fc->sub, *sig = xs + (size_t)dim * cap;
+  const double *x = state(m->particles, y, FLUID_X);
+  mpm_lidx k = 0;
+  for (mpm_lidx i = 0; i < n; ++i) k += fluid_stress_viscous(&fc->gas, b, i, NULL);
+  if (k == 0) return 0;
+  double one[MPM_MAX_DIM * MPM_MAX_DIM];
+  mpm_lidx j = 0;
+  for (mpm_lidx i = 0; i < n; ++i) {
+    if (!fluid_stress_viscous(&fc->gas, b, i, one)) continue;
+    for (int d = 0; d < dim; ++d) xs[(size_t)d * cap + j] = x[(size_t)d * n + i];
+    for (int q = 0; q < nk; ++q) {
+      sig[(size_t)q * k + j] = one[q]; /* stride k: the kernel's n */
+      b->vsig[(size_t)q * n + i] += one[q];
+    }
+    ++j;
+  }
+  mpm_p2g_args a = {.n = k, .m = fc->zero, .vsig = sig, .lp = fc->lp};
+  for (int d = 0; d < dim; ++d) a.x[d] = xs + (size_t)d * cap, a.v[d] = fc->zero;
+  mpm_kernels_get(dim)->p2g(m->grid, m->phase, &a);
+  return 0;
+}
+
+static int fluid_p2g(mpm_module *m, double t, const double *y) {
+  fluid_content *fc = m->content;
+  const mpm_particles *p = m->particles;
+  const int dim = p->dim;
+  const mpm_lidx n = p->n;
+  MPM_CALL(ensure_scratch(m));
+  fluid_batch b = {.dim = dim,
+                   .n = n,
+                   .m = mpm_particles_comp(p, fc->lay.f_m, 0),
+                   .V0 = mpm_particles_comp(p, fc->lay.f_V0, 0),
+                   .J = state(p, y, FLUID_J),
+                   .e = state(p, y, FLUID_E),
+                   .divv = field(p, y, fc->lay.f_divv),
+                   .D = fc->lay.f_D >= 0 ? field(p, y, fc->lay.f_D) : NULL,
+                   .vsig = fc->vsig};
+  if (!fc->current_rate) {
+    mpm_timer_start(MPM_T_STRESS);
+    fluid_stress(&fc->gas, &b);
+    mpm_timer_stop(MPM_T_STRESS);
+    mpm_timer_start(MPM_T_P2G);
+    MPM_CALL(deposit(m, y, fc->vsig, &b));
+    mpm_timer_stop(MPM_T_P2G);
+    return 0;
+  }
+  /* The current rate (above): the pressure's deposit, the rate, the viscous deposit. */
+  mpm_timer_start(MPM_T_STRESS);
+  fluid_stress_pressure(&fc->gas, &b);
+  mpm_timer_stop(MPM_T_STRESS);
+  mpm_timer_start(MPM_T_P2G);
+  MPM_CALL(deposit(m, y, fc->vsig, NULL));
+  mpm_timer_stop(MPM_T_P2G);
+  MPM_CALL(deposit_velocity(m, t));
+  mpm_timer_start(MPM_T_G2P);
+  double *vout[MPM_MAX_DIM], *aout[MPM_MAX_DIM], *L = fc->scratch + (size_t)2 * dim * n;
+  for (int d = 0; d < dim; ++d)
+    vout[d] = fc->scratch + (size_t)d * n, aout[d] = fc->scratch + (size_t)(dim + d) * n;
+  mpm_transfer_g2p(m->grid, m->phase, p, y, fc->lp, vout, aout, L, NULL);
+  mpm_timer_stop(MPM_T_G2P);
+  rate_parts(dim, n, L, fc->power, L);
+  b.divv = fc->power, b.D = b.D ? L : NULL;
+  mpm_timer_start(MPM_T_P2G);
+  MPM_CALL(deposit_viscous(m, y, &b)); /* vsig is now the whole stress (energy rate, obstacles) */
+  const double *x[MPM_MAX_DIM];
+  for (int d = 0; d < dim; ++d) x[d] = state(p, y, FLUID_X) + (size_t)d * n;
+  fluid_obstacles_deposit(&fc->obs, m->grid, n, x, b.m, b.V0, b.J, fc->vsig, b.e, fc->gas.gamma);
   mpm_timer_stop(MPM_T_P2G);
   return 0;
 }
@@ -480,6 +628,7 @@ static void fluid_destroy(mpm_module *m) {
     fluid_wall_ls_free(&fc->wall);
     fluid_virtual_free(&fc->virt);
     free(fc->vsig), free(fc->scratch), free(fc->vnew), free(fc->Cnew), free(fc->power);
+    free(fc->sub), free(fc->zero);
     free(fc->tscratch), free(fc->node), free(fc->cellsum);
     free(fc);
   }
@@ -550,6 +699,14 @@ static int read_settings(fluid_content *fc, const mpm_config *cfg, const mpm_gri
   MPM_CALL(mpm_config_get_reals(cfg, "physics.gravity", grav, 3, &nv));
   memcpy(fc->gravity, grav, sizeof grav);
   MPM_CALL(mpm_transfer_from_config(&fc->tr, cfg, "fluid.pic_fraction"));
+  const char *rate;
+  MPM_CALL(mpm_config_get_string(cfg, "fluid.strain_rate", &rate));
+  if (fc->tr.classic && mpm_config_has(cfg, "fluid.strain_rate"))
+    return mpm_config_fail(cfg, "fluid.strain_rate",
+                           "is read with the ERK pairs only: the classic update (usl, musl) "
+                           "updates the stress last, with the rate of the step before; remove "
+                           "the key or choose time.method = bs32");
+  fc->current_rate = !fc->tr.classic && strcmp(rate, "current") == 0;
   fc->gas.l = g->dx;
   fc->lp = 0.5 / fc->ppc;
   return 0;
@@ -650,5 +807,6 @@ int fluid_module_create(mpm_module **mp, const mpm_config *cfg, mpm_grid *grid, 
   }
   m->cells_every = fc->refill_every;
   m->wall_slack = 0.5;
+  m->commits_history = !fc->tr.classic && !fc->current_rate; /* the pending strain rate */
   return 0;
 }

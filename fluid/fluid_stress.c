@@ -3,8 +3,9 @@
 
 #include "fluid_eos.h"
 
-/* -V (p + q) on the diagonal; the viscous part, if any, is added by viscous_stress. */
-static void pressure_stress(const fluid_gas *g, const fluid_batch *b) {
+/* -V (p + q) on the diagonal (q only with av); the viscous part, if any, is added by
+ * viscous_stress. */
+static void pressure_stress(const fluid_gas *g, const fluid_batch *b, int av) {
   const int dim = b->dim;
   const mpm_lidx n = b->n;
   for (int r = 0; r < dim; ++r)
@@ -15,7 +16,8 @@ static void pressure_stress(const fluid_gas *g, const fluid_batch *b) {
   for (mpm_lidx i = 0; i < n; ++i) {
     const double V = b->V0[i] * b->J[i], rho = b->m[i] / V;
     const double p = fluid_pressure(g->gamma, rho, b->e[i]);
-    const double q = fluid_av_pressure(g, rho, fluid_sound_speed(g->gamma, rho, p), b->divv[i]);
+    const double q =
+        av ? fluid_av_pressure(g, rho, fluid_sound_speed(g->gamma, rho, p), b->divv[i]) : 0.0;
     s00[i] = -V * (p + q);
   }
   for (int d = 1; d < dim; ++d) {
@@ -40,6 +42,29 @@ static void viscous_stress(const fluid_gas *g, const fluid_batch *b) {
 }
 
 void fluid_stress(const fluid_gas *g, const fluid_batch *b) {
-  pressure_stress(g, b);
+  pressure_stress(g, b, 1);
   if (g->mu > 0.0 && b->D) viscous_stress(g, b);
+}
+
+void fluid_stress_pressure(const fluid_gas *g, const fluid_batch *b) {
+  pressure_stress(g, b, 0);
+}
+
+int fluid_stress_viscous(const fluid_gas *g, const fluid_batch *b, mpm_lidx i, double *out) {
+  const int dim = b->dim;
+  const mpm_lidx n = b->n;
+  const int viscous = g->mu > 0.0 && b->D;
+  const int av = b->divv[i] < 0.0 && (g->av_lin > 0.0 || g->av_quad > 0.0);
+  if (!av && !viscous) return 0;
+  if (!out) return 1;
+  const double V = b->V0[i] * b->J[i], rho = b->m[i] / V;
+  const double c = fluid_sound_speed(g->gamma, rho, fluid_pressure(g->gamma, rho, b->e[i]));
+  const double q = av ? fluid_av_pressure(g, rho, c, b->divv[i]) : 0.0;
+  for (int r = 0; r < dim; ++r)
+    for (int k = 0; k < dim; ++k) {
+      const double D = viscous ? b->D[(size_t)(r * dim + k) * n + i] : 0.0;
+      const double dev = r == k ? D - b->divv[i] / 3.0 : D;
+      out[r * dim + k] = (r == k ? -V * q : 0.0) + (viscous ? 2.0 * g->mu * V * dev : 0.0);
+    }
+  return 1;
 }

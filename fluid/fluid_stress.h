@@ -6,7 +6,7 @@
  *   q = rho l |tr D| (c_lin c + c_quad l |tr D|)   for tr D < 0, else 0,
  *
  * with l the cell size. tr(D)/3 is the deviator of the physical 3-D rate: a 2-D run is plane
- * flow (D_zz = 0). D is the strain rate of the last RHS evaluation (see fluid_module.c). */
+ * flow (D_zz = 0). Which strain rate D is depends on the time method (fluid_module.c). */
 #ifndef FLUID_STRESS_H
 #define FLUID_STRESS_H
 
@@ -48,5 +48,10 @@ static inline double fluid_viscous_speed(const fluid_gas *g, double rho, double 
 
 /* V sigma of every particle of the batch. */
 void fluid_stress(const fluid_gas *g, const fluid_batch *b);
+/* Its pressure part alone, -V p I. */
+void fluid_stress_pressure(const fluid_gas *g, const fluid_batch *b);
+/* The rest, the artificial and physical viscous part, of particle i into out (dim*dim; NULL:
+ * only say whether there is one): 1 if it is not zero. */
+int fluid_stress_viscous(const fluid_gas *g, const fluid_batch *b, mpm_lidx i, double *out);
 
 #endif

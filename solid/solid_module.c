@@ -664,5 +664,6 @@ int solid_module_create(mpm_module **mp, const mpm_config *cfg, mpm_grid *grid, 
     mpm_module_destroy(mp);
     return mpm_trace(__FILE__, __LINE__, __func__, rc);
   }
+  m->commits_history = sc->lay.f_hist >= 0; /* the materials' commit (solid_post_step) */
   return 0;
 }

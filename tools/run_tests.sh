@@ -17,7 +17,8 @@
 # test_stability (their materials, kernels, halos and wraps: test_materials, test_j2,
 # test_kernels_*, test_halo_np*, test_periodic_*, test_ballistic, test_rigid, test_traction)
 # and the gas tubes test_sod and test_strong_shock (the same gas path as test_gas_output,
-# test_gas_conservation and test_gas_boundaries). The temporal-coupling studies test_piperno_farhat
+# test_gas_conservation and test_gas_boundaries), and the ERK pairs' time-order study
+# test_gas_time_order (its current-strain-rate path runs there in every bs32 gas test). The temporal-coupling studies test_piperno_farhat
 # and test_timeschemes (1-2 minutes each in the plain pass; test_timeschemes_mri 3 minutes, 9.5
 # under the sanitizers) run there as test_timeschemes_quick: every temporal scheme's held, loaded
 # and joint cycles and MRIStep's, checkpoint and restart, on 1 and 2 ranks.
@@ -46,5 +47,5 @@ bash "$src/tools/setup.sh" "$src/build"
 bash "$src/tools/setup.sh" "$src/build-asan" -DMPMFSI_SANITIZE=ON -DCMAKE_BUILD_TYPE=Debug \
   "-DCMAKE_C_FLAGS_DEBUG=-g -O2"
 (cd "$src/build-asan" &&
-  ctest -LE "long|benchmark" -E "^test_(blowup_guard_coupled|wedge|forward_step|fsi_waves|decomposition|supersonic_bar|supersonic_bar_standoff|near_vacuum_order|restart_cases|csm1|csm3_fast|axial_bar|cantilever3d|model_swap|ranks_solid|periodic|stability|sod|strong_shock|piperno_farhat|timeschemes|timeschemes_mri|run_safety|disks|gas_shear|slanted_wall|slanted_wall_max|bluff_bodies)$" \
+  ctest -LE "long|benchmark" -E "^test_(blowup_guard_coupled|wedge|forward_step|fsi_waves|decomposition|supersonic_bar|supersonic_bar_standoff|near_vacuum_order|restart_cases|csm1|csm3_fast|axial_bar|cantilever3d|model_swap|ranks_solid|periodic|stability|sod|strong_shock|gas_time_order|piperno_farhat|timeschemes|timeschemes_mri|run_safety|disks|gas_shear|slanted_wall|slanted_wall_max|bluff_bodies)$" \
     --output-on-failure -j 2 --timeout 1800)

@@ -108,6 +108,8 @@ GAS_CASES = [
      "\ngamma = 1.4\nempty_node_mass = 0.5", "fluid.empty_node_mass", "[0, 0.01]"),
     ("shift above its range", "\ngamma = 1.4", "\ngamma = 1.4\nshift = 0.8", "fluid.shift",
      "[0, 0.5]"),
+    ("unknown strain_rate", "\ngamma = 1.4", "\ngamma = 1.4\nstrain_rate = now",
+     "fluid.strain_rate", "current|lagged"),
     ("negative shift_expansion", "\ngamma = 1.4",
      "\ngamma = 1.4\nshift = 0.1\nshift_expansion = -1", "fluid.shift_expansion", ">= 0"),
     ("shift_every below 1", "\ngamma = 1.4", "\ngamma = 1.4\nshift = 0.1\nshift_every = 0",
@@ -130,6 +132,11 @@ for name, old, new, key, words in GAS_CASES:
     if name == "gas region outside the domain":
         line = line_of(text, "geometry = right")
     expect_error(name, text, key, words, line)
+# The strain rate of the viscosity is a choice of the ERK pairs only.
+text = GAS.replace("method = bs32", "method = usl", 1).replace(
+    "\ngamma = 1.4", "\ngamma = 1.4\nstrain_rate = lagged", 1)
+expect_error("strain_rate with the classic update", text, "fluid.strain_rate", "ERK pairs only",
+             line_of(text, "strain_rate = lagged"))
 # An obstacle in a scene without gas (it would do nothing).
 lone = BASE + "\n[obstacle.post]\nshape = box\nlo = 0.2 0.2\nhi = 0.4 0.4\n"
 expect_error("obstacle without gas", lone, "obstacle.post.shape", "no [gas.NAME]",

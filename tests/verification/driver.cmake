@@ -55,6 +55,8 @@ mpm_add_script_test(test_sod SCRIPT verification/test_sod.py LABELS "verificatio
                     TIMEOUT 600)
 mpm_add_script_test(test_sod_long SCRIPT verification/test_sod.py ARGS long
                     LABELS "verification;long" TIMEOUT 1800)
+mpm_add_script_test(test_gas_time_order SCRIPT verification/test_gas_time_order.py
+                    LABELS verification TIMEOUT 600)
 mpm_add_script_test(test_strong_shock SCRIPT verification/test_strong_shock.py
                     LABELS verification TIMEOUT 600)
 mpm_add_script_test(test_strong_shock_long SCRIPT verification/test_strong_shock.py ARGS long

@@ -20,12 +20,12 @@ the classic updates usl and musl at 200 cells the same way, that mass is constan
 walls at rest, that usl and musl conserve total energy to 1e-12 (relative; their transfer is
 exactly energy-conserving, roundoff over ~400 steps stays near 1e-14). 2 ranks (split along x,
 so the shock and the contact cross the rank boundary) vs 1: usl and musl take the same fixed
-steps, so every particle field must agree to 1e-12 relative (sums in another order); bs32's
-adaptive steps depend on the order of the global error-norm sum, and the artificial viscosity
-uses the strain rate of the previous accepted step, so a different step sequence changes the
-solution at first order in the step: the particles differ by about 3e-4 (velocity, relative;
-6e-4 over every field),
-and the check is on the measured result: L1 within 2 % and the shock within 0.1 cell.
+steps, so every particle field must agree to 1e-12 relative (sums in another order). bs32's
+adaptive steps follow the global error norm, whose sum in another order moves a step by
+roundoff; its RHS is a function of the state alone (the artificial viscosity takes the current
+strain rate, fluid.strain_rate = current), so that moves the solution by roundoff too:
+measured 9.3e-13, tolerance 1e-10. (With the strain rate of the previous step, the default
+before, the particles differed by 6e-4: the step sequence changed the solution at first order.)
 `long` adds 400 and 800 cells for every method and checks the acceptance for bs32; for usl
 and musl it checks L1 at 400 and the shock position, and prints their orders (see README:
 below 0.8, from particle noise that their exact-energy transfer turns into heat).
@@ -118,13 +118,8 @@ for method in ("usl", "musl", "bs32"):
         check(False, f"{method} 2 ranks: particle ids differ from 1 rank")
         continue
     diff, _ = mt.worst_difference(pa, pb)
-    if method == "bs32":
-        dl1, dxs = abs(b[0] - a[0]) / a[0], abs(b[1] - a[1]) * 200
-        check(dl1 <= 0.02 and dxs <= 0.1,
-              f"bs32 2 ranks vs 1: L1 {b[0]:.4e} vs {a[0]:.4e} ({100 * dl1:.2f} %, <= 2 %), shock "
-              f"{dxs:.3f} cells apart (<= 0.1); particles differ by {diff:.1e} (step sequence)")
-    else:
-        check(diff <= 1e-12, f"{method} 2 ranks vs 1, by id, every field: largest relative "
-              f"difference {diff:.1e} (<= 1e-12)")
+    tol = 1e-10 if method == "bs32" else 1e-12
+    check(diff <= tol, f"{method} 2 ranks vs 1, by id, every field: largest relative "
+          f"difference {diff:.1e} (<= {tol:g})")
 
 sys.exit(check.finish())
