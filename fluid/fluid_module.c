@@ -262,12 +262,12 @@ static int deposit_velocity(mpm_module *m, double t) {
   return 0;
 }
 
-/* tr L into divv and sym L into D (dim*dim, may be L itself). */
+/* tr L into divv and sym L into D (dim*dim, may be L itself; NULL: not wanted). */
 static void rate_parts(int dim, mpm_lidx n, const double *L, double *divv, double *D) {
   for (mpm_lidx i = 0; i < n; ++i) divv[i] = L[i];
   for (int d = 1; d < dim; ++d)
     for (mpm_lidx i = 0; i < n; ++i) divv[i] += L[(size_t)(d * dim + d) * n + i];
-  for (int r = 0; r < dim; ++r)
+  for (int r = 0; D && r < dim; ++r)
     for (int c = r; c < dim; ++c)
       for (mpm_lidx i = 0; i < n; ++i) {
         const double s =
@@ -348,8 +348,9 @@ static int fluid_p2g(mpm_module *m, double t, const double *y) {
     vout[d] = fc->scratch + (size_t)d * n, aout[d] = fc->scratch + (size_t)(dim + d) * n;
   mpm_transfer_g2p(m->grid, m->phase, p, y, fc->lp, vout, aout, L, NULL);
   mpm_timer_stop(MPM_T_G2P);
-  rate_parts(dim, n, L, fc->power, L);
-  b.divv = fc->power, b.D = b.D ? L : NULL;
+  double *D = b.D ? L : NULL; /* sym L in place */
+  rate_parts(dim, n, L, fc->power, D);
+  b.divv = fc->power, b.D = D;
   mpm_timer_start(MPM_T_P2G);
   MPM_CALL(deposit_viscous(m, y, &b)); /* vsig is now the whole stress (energy rate, obstacles) */
   const double *x[MPM_MAX_DIM];
@@ -459,20 +460,14 @@ static void volume_rate(mpm_module *m, const double *y, double *ydot, const doub
   const double *J = state(p, y, FLUID_J);
   double *Jdot = ydot + (size_t)p->offset[FLUID_J] * n;
   double *tr = in_state ? fc->scratch : mpm_particles_comp(p, fc->lay.f_pending, 0);
-  for (mpm_lidx i = 0; i < n; ++i) tr[i] = L[i];
-  for (int d = 1; d < dim; ++d)
-    for (mpm_lidx i = 0; i < n; ++i) tr[i] += L[(size_t)(d * dim + d) * n + i];
+  double *D = fc->lay.f_D < 0 ? NULL
+              : in_state      ? ydot + (size_t)p->offset[fc->lay.f_D] * n
+                              : tr + n;
+  rate_parts(dim, n, L, tr, D);
   for (mpm_lidx i = 0; i < n; ++i) Jdot[i] = J[i] * tr[i];
-  if (in_state)
-    as_rate(ydot + (size_t)p->offset[fc->lay.f_divv] * n, tr, field(p, y, fc->lay.f_divv), n, h);
-  if (fc->lay.f_D < 0) return;
-  double *D = in_state ? ydot + (size_t)p->offset[fc->lay.f_D] * n : tr + n;
-  for (int r = 0; r < dim; ++r)
-    for (int c = 0; c < dim; ++c)
-      for (mpm_lidx i = 0; i < n; ++i)
-        D[(size_t)(r * dim + c) * n + i] =
-            0.5 * (L[(size_t)(r * dim + c) * n + i] + L[(size_t)(c * dim + r) * n + i]);
-  if (in_state) as_rate(D, NULL, field(p, y, fc->lay.f_D), (size_t)dim * dim * n, h);
+  if (!in_state) return;
+  as_rate(ydot + (size_t)p->offset[fc->lay.f_divv] * n, tr, field(p, y, fc->lay.f_divv), n, h);
+  if (D) as_rate(D, NULL, field(p, y, fc->lay.f_D), (size_t)dim * dim * n, h);
 }
 
 /* Three forms of G2P: the method-of-lines RHS (h = 0): dx/dt = sum S v_i, dv/dt = sum S a_i;
