@@ -239,22 +239,16 @@ static int deposit_velocity(mpm_module *m, double t) {
   MPM_CALL(mpm_grid_halo_reverse(g, f, 1 + dim));
   mpm_timer_stop(MPM_T_HALO);
   mpm_constraints_fold_momentum(&fc->cons, g, mass, mv);
-  double local = 0.0, mmax;
-  for (size_t l = 0; l < nn; ++l)
-    if (mass[l] > local) local = mass[l];
-  MPM_CALL_MPI(MPI_Allreduce(&local, &mmax, 1, MPI_DOUBLE, MPI_MAX, g->comm));
-  const double mmin = ph->empty_fraction * mmax;
-  for (int d = 0; d < dim; ++d)
-    for (size_t l = 0; l < nn; ++l) {
-      ph->v_i[d][l] = mass[l] > mmin ? mv[d][l] / mass[l] : 0.0;
-      ph->a_i[d][l] = 0.0;
-    }
-  /* The constraints of a pass that records nothing (walls, open faces, obstacles), which read
-   * the nodal masses: the summed copy stands in for the phase's own until the cycle sums it. */
-  double *own = ph->m_i;
+  /* The solve and the constraints of a pass that records nothing (walls, open faces,
+   * obstacles) on the summed copies, which stand in for the phase's own m and m v until the
+   * cycle sums them; a = f / m of the unsummed force is scratch like v. */
+  double *own_m = ph->m_i, *own_mv[MPM_MAX_DIM];
   ph->m_i = mass;
-  const int rc = fluid_constrain(m, t, 0.0, MPM_PASS_REMAP);
-  ph->m_i = own;
+  for (int d = 0; d < dim; ++d) own_mv[d] = ph->mv_i[d], ph->mv_i[d] = mv[d];
+  int rc = mpm_grid_phase_update(g, m->phase, 0.0);
+  if (!rc) rc = fluid_constrain(m, t, 0.0, MPM_PASS_REMAP);
+  ph->m_i = own_m;
+  for (int d = 0; d < dim; ++d) ph->mv_i[d] = own_mv[d];
   MPM_CALL(rc);
   mpm_timer_start(MPM_T_HALO);
   MPM_CALL(mpm_grid_halo_forward(g, ph->v_i, dim));
