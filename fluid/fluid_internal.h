@@ -39,6 +39,7 @@ typedef struct fluid_content {
   int reg_min, reg_max;      /* particles per non-empty cell after regularisation */
   int refill;                /* regularisation refills cells that expansion emptied */
   int refill_every;          /* refill every refill_every steps (0: never) */
+  double merge_light;        /* merge particles below this share of their cell's heaviest */
   double shift;              /* particle shifting coefficient kappa (0: off; fluid_shift.c) */
   int shift_every;           /* shift every shift_every steps */
   double shift_J;            /* only particles with J >= shift_J move */

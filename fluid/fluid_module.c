@@ -78,6 +78,11 @@ static const mpm_key_spec fluid_keys[] = {
      "regularisation, every fluid.regularise_every steps); a wake that expansion empties "
      "faster than regularise_every steps refill it keeps empty cells between refills",
      0},
+    {"fluid.merge_light", MPM_KEY_REAL, "0", 0, 0.5, 0, 0, NULL,
+     "with regularisation or refill: at each of them, a gas particle lighter than this "
+     "fraction of the heaviest particle in its cell merges into that one, conserving mass, "
+     "momentum, total energy and volume (0: off); see fluid/fluid_regularise.c",
+     0},
     {"fluid.shift", MPM_KEY_REAL, "0", 0, 0.5, 0, 0, NULL,
      "particle shifting coefficient kappa: each gas particle moves down the gradient of the "
      "gas's nodal volume fraction phi at the rate kappa dx (c + |v|), so that particles that "
@@ -658,6 +663,13 @@ static int read_regularise(fluid_content *fc, const mpm_config *cfg, int dim) {
                            "them off; remove one of the two keys",
                            every);
   fc->refill_every = fc->refill ? (every > 0 ? every : fc->reg_every) : 0;
+  MPM_CALL(mpm_config_get_real(cfg, "fluid.merge_light", &fc->merge_light));
+  if (fc->merge_light > 0.0 && fc->reg_every == 0 && fc->refill_every == 0)
+    return mpm_config_fail(cfg, "fluid.merge_light",
+                           "merge_light = %g merges light particles at each regularisation or "
+                           "refill, and neither happens; set fluid.regularise_every (or "
+                           "fluid.refill_every), or remove merge_light",
+                           fc->merge_light);
   if (mpm_config_has(cfg, kmin)) MPM_CALL(mpm_config_get_int(cfg, kmin, &fc->reg_min));
   if (mpm_config_has(cfg, kmax)) MPM_CALL(mpm_config_get_int(cfg, kmax, &fc->reg_max));
   if (fc->reg_min < fc->reg_max) return 0;

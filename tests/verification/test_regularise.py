@@ -24,6 +24,12 @@ compression). Checks:
 5. Restart (usl and bs32, regularise_every = 5, checkpoint at t = 0.15): the restarted run
    ends bitwise identical by id (the event schedule is the sim's step count, which the
    checkpoint carries).
+6. Light merges (fluid.merge_light = 0.4, usl, an event every step): every event conserves as
+   in 1, the energy drifts as in 2, and after every event no particle is lighter than 0.4 of
+   the heaviest in its cell (the merges by count make such particles: the usl run of 1-3 is
+   the control, where they must be found, so that the check can fail); no cell holds more
+   than 6 particles (light merges only lower the counts) and ids stay unique. 2 ranks give 1
+   rank's result as in 4.
 """
 import os
 import re
@@ -64,21 +70,41 @@ def per_event(label, ev):
           f"momentum {dP:.1e} of sqrt(2 M E), total energy {dE:.1e} (each <= 1e-13)")
 
 
+def cells_of(P):
+    cells = np.floor(P["x"][:, :2] * 32).astype(int).clip(0, 31)
+    return cells[:, 0] + 32 * cells[:, 1]
+
+
+def light_particles(out, mu):
+    """Most particles lighter than mu times their cell's heaviest in one snapshot after t = 0."""
+    most = 0
+    for t, path in mt.snapshots(out):
+        if t == 0:
+            continue
+        P = mt.particles(path, "fluid")
+        cell, m = cells_of(P), P["m"].ravel()
+        heaviest = np.zeros(32 * 32)
+        np.maximum.at(heaviest, cell, m)
+        most = max(most, int((m < mu * heaviest[cell]).sum()))
+    return most
+
+
 def cell_counts(out):
     """Worst per-cell counts over the snapshots after t = 0 (non-empty cells), unique ids."""
     lo, hi, unique = 1 << 30, 0, True
     for t, path in mt.snapshots(out):
         P = mt.particles(path, "fluid")
         unique &= len(np.unique(P["id"])) == len(P["id"])
-        cells = np.floor(P["x"][:, :2] * 32).astype(int).clip(0, 31)
-        n = np.bincount(cells[:, 0] + 32 * cells[:, 1], minlength=32 * 32)
+        n = np.bincount(cells_of(P), minlength=32 * 32)
         lo, hi = min(lo, int(n[n > 0].min())), max(hi, int(n.max()))
     return lo, hi, unique
 
 
+outs = {}
 for label, extra in (("usl", ["time.method=usl"]), ("musl", ["time.method=musl"]),
                      ("usl apic", ["time.method=usl", "transfer.velocity=apic"])):
     out, ev = run(label, extra, 1)
+    outs[label] = out
     per_event(label, ev)
     d = np.genfromtxt(os.path.join(out, "diagnostics.csv"), delimiter=",", names=True)
     drift = float(np.abs(d["total"] - d["total"][0]).max() / d["total"][0])
@@ -92,8 +118,24 @@ for label, extra in (("usl", ["time.method=usl"]), ("musl", ["time.method=musl"]
 _, ev = run("bs32", ["time.method=bs32"], 5)
 per_event("bs32", ev)
 
+LIGHT = ["fluid.merge_light=0.4"]
+out, ev = run("usl light", ["time.method=usl"] + LIGHT, 1)
+per_event("usl light", ev)
+d = np.genfromtxt(os.path.join(out, "diagnostics.csv"), delimiter=",", names=True)
+drift = float(np.abs(d["total"] - d["total"][0]).max() / d["total"][0])
+check(drift <= 1e-12, f"usl light: total energy drift over {len(d) - 1} steps {drift:.1e} (<= 1e-12)")
+light, control = light_particles(out, 0.4), light_particles(outs["usl"], 0.4)
+check(light == 0 and control > 0, f"usl light: after events {light} particles lighter than 0.4 of "
+      f"their cell's heaviest (0), against {control} without fluid.merge_light (> 0: the control)")
+lo, hi, unique = cell_counts(out)
+check(hi <= 6 and unique, f"usl light: after events non-empty cells hold {lo} to {hi} particles "
+      f"(at most 6), ids unique: {unique}")
+print(f"info usl light: {int(d['particles'][0])} -> {int(d['particles'][-1])} particles")
+
 EVERY5 = ["fluid.regularise_every=5", "output.interval=0.1"] + FLOW
 mt.check_ranks_agree(check, CASE, EVERY5 + ["time.method=usl"], "regularise_ranks",
+                     phase="fluid")
+mt.check_ranks_agree(check, CASE, EVERY5 + ["time.method=usl"] + LIGHT, "regularise_ranks_light",
                      phase="fluid")
 for method in ("usl", "bs32"):
     # restart_difference sets time.t_end itself (a key may be given once on the command line)
