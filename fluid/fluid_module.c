@@ -80,8 +80,9 @@ static const mpm_key_spec fluid_keys[] = {
      0},
     {"fluid.merge_light", MPM_KEY_REAL, "0", 0, 0.5, 0, 0, NULL,
      "with regularisation or refill: at each of them, a gas particle lighter than this "
-     "fraction of the heaviest particle in its cell merges into that one, conserving mass, "
-     "momentum, total energy and volume (0: off); see fluid/fluid_regularise.c",
+     "fraction of the heaviest particle in its cell merges with it and the two split into "
+     "equal halves, conserving mass, momentum, total energy and volume (0: off); see "
+     "fluid/fluid_regularise.c",
      0},
     {"fluid.shift", MPM_KEY_REAL, "0", 0, 0.5, 0, 0, NULL,
      "particle shifting coefficient kappa: each gas particle moves down the gradient of the "

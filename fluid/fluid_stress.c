@@ -26,6 +26,12 @@ static void pressure_stress(const fluid_gas *g, const fluid_batch *b, int av) {
   }
 }
 
+/* Component (r, c) of V 2 mu (D - tr D / 3 I), V = V0 J, diag = (r == c). */
+static inline double viscous_part(const fluid_gas *g, double V0, double J, double D, double divv,
+                                  int diag) {
+  return 2.0 * g->mu * V0 * J * (diag ? D - divv / 3.0 : D);
+}
+
 /* V 2 mu (D - tr D / 3 I). */
 static void viscous_stress(const fluid_gas *g, const fluid_batch *b) {
   const int dim = b->dim;
@@ -34,10 +40,8 @@ static void viscous_stress(const fluid_gas *g, const fluid_batch *b) {
     for (int c = 0; c < dim; ++c) {
       const double *D = b->D + (size_t)(r * dim + c) * n;
       double *s = b->vsig + (size_t)(r * dim + c) * n;
-      for (mpm_lidx i = 0; i < n; ++i) {
-        const double dev = r == c ? D[i] - b->divv[i] / 3.0 : D[i];
-        s[i] += 2.0 * g->mu * b->V0[i] * b->J[i] * dev;
-      }
+      for (mpm_lidx i = 0; i < n; ++i)
+        s[i] += viscous_part(g, b->V0[i], b->J[i], D[i], b->divv[i], r == c);
     }
 }
 
@@ -63,8 +67,9 @@ int fluid_stress_viscous(const fluid_gas *g, const fluid_batch *b, mpm_lidx i, d
   for (int r = 0; r < dim; ++r)
     for (int k = 0; k < dim; ++k) {
       const double D = viscous ? b->D[(size_t)(r * dim + k) * n + i] : 0.0;
-      const double dev = r == k ? D - b->divv[i] / 3.0 : D;
-      out[r * dim + k] = (r == k ? -V * q : 0.0) + (viscous ? 2.0 * g->mu * V * dev : 0.0);
+      out[r * dim + k] =
+          (r == k ? -V * q : 0.0) +
+          (viscous ? viscous_part(g, b->V0[i], b->J[i], D, b->divv[i], r == k) : 0.0);
     }
   return 1;
 }
