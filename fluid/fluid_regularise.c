@@ -125,29 +125,31 @@ static mpm_gidx global_cell(const reg_box *b, const double *x) {
   return c;
 }
 
-/* Particle indices grouped by local cell: cell l holds perm[start[l] .. start[l + 1]), in
- * index order. With a mask, only the cells l with mask[l] != 0 hold their particles. */
-static int group_by_cell(const reg_box *b, const mpm_particles *p, const unsigned char *mask,
-                         mpm_lidx **start, mpm_lidx **perm, mpm_lidx *ncell) {
+/* The local cell of every particle (local_cell), or NULL on failure. */
+static mpm_lidx *cells_of(const reg_box *b, const mpm_particles *p) {
+  mpm_lidx *cell = malloc(sizeof *cell * (size_t)(p->n ? p->n : 1));
+  for (mpm_lidx i = 0; cell && i < p->n; ++i) cell[i] = local_cell(b, p, i);
+  return cell;
+}
+
+/* Particle indices grouped by local cell (cell[i]: particle i's, from cells_of): cell l holds
+ * perm[start[l] .. start[l + 1]), in index order. With a mask, only the cells l with
+ * mask[l] != 0 hold their particles. */
+static int group_by_cell(const reg_box *b, const mpm_particles *p, const mpm_lidx *cell,
+                         const unsigned char *mask, mpm_lidx **start, mpm_lidx **perm,
+                         mpm_lidx *ncell) {
   mpm_lidx nc = 1;
   for (int d = 0; d < b->dim; ++d) nc *= b->nc[d];
   *ncell = nc;
-  mpm_lidx *cell;
-  MPM_ALLOC(cell, p->n);
   *start = calloc((size_t)nc + 2, sizeof **start);
   *perm = malloc(sizeof **perm * (size_t)(p->n ? p->n : 1));
-  if (!*start || !*perm) {
-    free(cell);
+  if (!*start || !*perm)
     MPM_FAIL(MPM_ERR_MEMORY, "regularise: cannot group %d particles by cell", (int)p->n);
-  }
-  for (mpm_lidx i = 0; i < p->n; ++i) {
-    cell[i] = local_cell(b, p, i);
+  for (mpm_lidx i = 0; i < p->n; ++i)
     if (!mask || mask[cell[i]]) (*start)[cell[i] + 2]++;
-  }
   for (mpm_lidx l = 0; l < nc; ++l) (*start)[l + 2] += (*start)[l + 1];
   for (mpm_lidx i = 0; i < p->n; ++i)
     if (!mask || mask[cell[i]]) (*perm)[(*start)[cell[i] + 1]++] = i;
-  free(cell);
   return 0;
 }
 
@@ -383,25 +385,19 @@ static int edit_apply(mpm_particles *p, const reg_edit *e) {
 /* Mark the owned cells holding a particle lighter than merge_light of the cell's heaviest
  * (two passes over the particles, no grouping: a step between regularisations groups only
  * those cells). Returns their number. */
-static int light_cells(const reg_box *b, const fluid_content *fc, const mpm_particles *p,
+static int light_cells(const fluid_content *fc, const mpm_particles *p, const mpm_lidx *cell,
                        unsigned char *mask, mpm_lidx ncell, mpm_lidx *nlight) {
   const double *mass = mpm_particles_comp(p, fc->lay.f_m, 0);
-  double *heaviest = calloc((size_t)ncell, sizeof *heaviest);
-  mpm_lidx *cell = malloc(sizeof *cell * (size_t)(p->n ? p->n : 1));
-  if (!heaviest || !cell) {
-    free(heaviest), free(cell);
-    MPM_FAIL(MPM_ERR_MEMORY, "regularise: cannot mark the cells of %d particles", (int)p->n);
-  }
-  for (mpm_lidx i = 0; i < p->n; ++i) {
-    cell[i] = local_cell(b, p, i);
-    heaviest[cell[i]] = fmax(heaviest[cell[i]], mass[i]);
-  }
+  double *heaviest;
+  MPM_ALLOC(heaviest, ncell);
+  memset(heaviest, 0, sizeof *heaviest * (size_t)ncell);
+  for (mpm_lidx i = 0; i < p->n; ++i) heaviest[cell[i]] = fmax(heaviest[cell[i]], mass[i]);
   memset(mask, 0, (size_t)ncell);
   *nlight = 0;
   for (mpm_lidx i = 0; i < p->n; ++i)
     if (mass[i] < fc->merge_light * heaviest[cell[i]] && !mask[cell[i]])
       mask[cell[i]] = 1, ++*nlight;
-  free(heaviest), free(cell);
+  free(heaviest);
   return 0;
 }
 
@@ -415,21 +411,22 @@ static int regularise_local(mpm_module *m, reg_edit *e, mpm_gidx id_base, int co
   mpm_lidx *start = NULL, *perm = NULL, ncell = 1, nlight = 0;
   for (int d = 0; d < b.dim; ++d) ncell *= b.nc[d];
   reg_cell c = {0};
-  unsigned char *mask = NULL;
-  MPM_ALLOC(e->keep, p->n);
-  memset(e->keep, 1, (size_t)p->n);
-  int rc = 0;
-  if (!counts) {
-    MPM_ALLOC(mask, ncell);
-    rc = light_cells(&b, fc, p, mask, ncell, &nlight);
+  unsigned char *mask = counts ? NULL : malloc((size_t)ncell);
+  mpm_lidx *cell = cells_of(&b, p);
+  e->keep = malloc((size_t)(p->n ? p->n : 1));
+  if (!cell || !e->keep || (!counts && !mask)) {
+    free(mask), free(cell);
+    MPM_FAIL(MPM_ERR_MEMORY, "regularise: cannot group %d particles by cell", (int)p->n);
   }
-  if (!rc && (counts || nlight > 0)) rc = group_by_cell(&b, p, mask, &start, &perm, &ncell);
+  memset(e->keep, 1, (size_t)p->n);
+  int rc = counts ? 0 : light_cells(fc, p, cell, mask, ncell, &nlight);
+  if (!rc && (counts || nlight > 0)) rc = group_by_cell(&b, p, cell, mask, &start, &perm, &ncell);
   for (mpm_lidx l = 0; !rc && start && l < ncell; ++l)
     rc = regularise_cell(fc, p, &b, perm + start[l], (int)(start[l + 1] - start[l]), id_base,
                          counts, &c, e);
   /* Light merges and splits in pairs leave the count: those rows went back in place. */
   if (!rc && (e->nadd > 0 || e->drops > 0)) rc = edit_apply(p, e);
-  free(mask), free(start), free(perm), free(c.row), free(c.id), free(c.slot);
+  free(mask), free(cell), free(start), free(perm), free(c.row), free(c.id), free(c.slot);
   return rc;
 }
 
@@ -548,7 +545,15 @@ static int refill_local(mpm_module *m, reg_edit *ed, mpm_gidx id_base) {
   unsigned char *donor;
   MPM_ALLOC(donor, ncell);
   mpm_lidx *start = NULL, *perm = NULL;
-  int rc = mark_donors(m, &b, donor) ? group_by_cell(&b, p, donor, &start, &perm, &ncell) : 0;
+  mpm_lidx *cell = NULL;
+  int rc = 0;
+  if (mark_donors(m, &b, donor)) {
+    if (!(cell = cells_of(&b, p))) {
+      free(donor);
+      MPM_FAIL(MPM_ERR_MEMORY, "refill: cannot group %d particles by cell", (int)p->n);
+    }
+    rc = group_by_cell(&b, p, cell, donor, &start, &perm, &ncell);
+  }
   for (mpm_lidx l = 0; !rc && start && l < ncell; ++l) {
     const int k = (int)(start[l + 1] - start[l]);
     if (k == 0) continue;
@@ -563,7 +568,7 @@ static int refill_local(mpm_module *m, reg_edit *ed, mpm_gidx id_base) {
       rc = refill_split(m, perm + start[l], k, e, id_base + cell_index(g, e), ed);
     }
   }
-  free(donor), free(start), free(perm);
+  free(donor), free(cell), free(start), free(perm);
   return rc;
 }
 
