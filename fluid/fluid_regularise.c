@@ -42,8 +42,9 @@
  * confined to cells the gas has emptied.
  * Light merge (fluid.merge_light = mu > 0, at every refill and every regularisation, after the
  * splits and merges by count): in each cell, while the lightest particle is lighter than mu
- * times the heaviest, the two merge (the merge above) and the result splits into two equal
- * halves (the split above; the new half takes the light particle's id), so that no event leaves
+ * times the heaviest, the two merge (the merge above, but the heavier keeps its id) and the
+ * result splits into two equal halves (the split above; the new half takes the light
+ * particle's id, so the cell keeps its ids and no new id is drawn), so that no event leaves
  * a particle lighter than mu times its cell's heaviest and the cell keeps its count. (Merging
  * the light particle away instead thinned the gas where refills had been feeding it: at the
  * main job's outflow corner, at 3 mm, 23 particles were left where 103 had been, most of them
@@ -79,7 +80,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* The particles of one cell, as rows of ncomp values, sorted by id. */
+/* The particles of one cell, as rows of ncomp values, gathered in id order (a light merge's
+ * new half goes to the end). */
 typedef struct reg_cell {
   int k, cap;
   double *row;
@@ -284,8 +286,9 @@ typedef struct reg_edit {
   mpm_lidx nadd, cap;
   double *add; /* rows (row-major) of the appended particles */
   mpm_gidx *add_id;
-  long splits, merges;
-  mpm_lidx drops; /* particles dropped (keep[i] = 0) */
+  long splits, merges; /* by count and light merges (merges), by count (splits) */
+  long light;          /* light merges (each split again in place) */
+  mpm_lidx drops;      /* particles dropped (keep[i] = 0) */
 } reg_edit;
 
 static int edit_append(reg_edit *e, const double *row, mpm_gidx id, int nc) {
@@ -326,10 +329,11 @@ static int has_light(const fluid_content *fc, const mpm_particles *p, const mpm_
   return lo < fc->merge_light * hi;
 }
 
-/* While the lightest row is lighter than merge_light of the heaviest (ties: the first in id
- * order), merge the two and split the result into two equal halves (split_heaviest; the new half
- * takes the light row's id). Each pass leaves one light row fewer: both halves weigh more than
- * half the old heaviest, so at least merge_light of any row. */
+/* While the lightest row is lighter than merge_light of the heaviest (ties: the first row;
+ * the rows start in id order), merge the two and split the result into two equal halves
+ * (split_heaviest; the new half takes the light row's id). Each pass leaves one light row fewer:
+ * both halves weigh more than half the old heaviest, so at least merge_light (at most 0.5, the
+ * key's bound) of any row. Counted as merges only: the split draws no new id. */
 static int merge_light(reg_cell *c, const fluid_content *fc, const mpm_particles *p,
                        const reg_box *b, reg_edit *e) {
   const int nc = p->ncomp, om = p->offset[fc->lay.f_m];
@@ -348,7 +352,7 @@ static int merge_light(reg_cell *c, const fluid_content *fc, const mpm_particles
     memmove(c->id + l, c->id + l + 1, sizeof *c->id * (size_t)(c->k - l - 1));
     c->k--;
     MPM_CALL(split_heaviest(c, &fc->lay, p, b, &fc->obs, id));
-    e->merges++, e->splits++;
+    e->merges++, e->light++;
   }
   return 0;
 }
@@ -383,8 +387,8 @@ static int edit_apply(mpm_particles *p, const reg_edit *e) {
 }
 
 /* Mark the owned cells holding a particle lighter than merge_light of the cell's heaviest
- * (two passes over the particles, no grouping: a step between regularisations groups only
- * those cells). Returns their number. */
+ * (two passes over the particles: on a refill-only event only these cells are grouped). Their
+ * number goes to *nlight. */
 static int light_cells(const fluid_content *fc, const mpm_particles *p, const mpm_lidx *cell,
                        unsigned char *mask, mpm_lidx ncell, mpm_lidx *nlight) {
   const double *mass = mpm_particles_comp(p, fc->lay.f_m, 0);
@@ -638,7 +642,7 @@ int fluid_regularise(mpm_module *m, long step, int *changed) {
     for (int d = 0; d < m->grid->dim; ++d) cells *= m->grid->ncells[d];
     p->id_next += cells * (mpm_gidx)(fc->reg_min - 1);
   }
-  if (e.splits || e.merges) *changed = 1;
+  if (e.splits || e.merges || e.light) *changed = 1;
   mpm_log(MPM_LOG_DEBUG,
           "regularise step %ld: %.0f refills, %.0f splits, %.0f merges; mass %.17g -> %.17g, "
           "momentum (%.17g, %.17g, %.17g) -> (%.17g, %.17g, %.17g), energy %.17g -> %.17g",

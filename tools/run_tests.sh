@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Install, build and run the default test selection (everything but the `long` and `benchmark`
-# labels), each test once, in one of two builds:
+# labels), each test once in one of two builds (except the unit tests, a few seconds, and the
+# checkpoint fuzz, which run in both):
 #
 # - build-asan/ (-O2 with asserts, AddressSanitizer, LeakSanitizer and UBSan) runs every test
 #   whose run there costs at most a few minutes: the unit, conformance and MPI tests, the input
@@ -49,7 +50,7 @@ BOTH="checkpoint_integrity"
 bash "$src/tools/setup.sh" "$src/build"
 (cd "$src/build" &&
   ctest -LE "long|benchmark" -R "^test_(${PLAIN_ONLY}|${BOTH})$" --output-on-failure -j 2 \
-    --timeout 900)
+    --timeout 900 && ctest -L unit --output-on-failure -j 2)
 # -O2 (asserts on): the sanitizers instrument every access at any level, and -O2 keeps the
 # pass short: test_regularise takes 38 s against 53 s at -O1 and 88 s at -O0.
 bash "$src/tools/setup.sh" "$src/build-asan" -DMPMFSI_SANITIZE=ON -DCMAKE_BUILD_TYPE=Debug \

@@ -21,12 +21,12 @@ compression). Checks:
    snapshot follows an event); ids stay unique; splits and merges both happened.
 4. 2 ranks vs 1 (usl, regularise_every = 5): the same particle ids (new ids do not depend on
    the ranks), every field within 1e-12 relative (sums in another order; as test_sod).
-5. Restart (usl and bs32, regularise_every = 5, checkpoint at t = 0.15): the restarted run
-   ends bitwise identical by id (the event schedule is the sim's step count, which the
-   checkpoint carries).
+5. Restart (usl and bs32, and usl with light merges, regularise_every = 5, checkpoint at
+   t = 0.15): the restarted run ends bitwise identical by id (the event schedule is the sim's
+   step count, which the checkpoint carries).
 6. Light merges (fluid.merge_light = 0.4, usl, an event every step): every event conserves as
-   in 1, the energy drifts as in 2, and after every event no particle is lighter than 0.4 of
-   the heaviest in its cell (the merges by count make such particles: the usl run of 1-3 is
+   in 1, the energy drifts as in 2, and at every snapshot (each follows an event) no particle
+   is lighter than 0.4 of the heaviest in its cell (the merges by count make such particles: the usl run of 1-3 is
    the control, where they must be found, so that the check can fail); every non-empty cell
    still holds 3 to 6 particles (a light merge splits the pair again: it keeps the count) and
    ids stay unique. 2 ranks give 1 rank's result as in 4.
@@ -137,12 +137,14 @@ mt.check_ranks_agree(check, CASE, EVERY5 + ["time.method=usl"], "regularise_rank
                      phase="fluid")
 mt.check_ranks_agree(check, CASE, EVERY5 + ["time.method=usl"] + LIGHT, "regularise_ranks_light",
                      phase="fluid")
-for method in ("usl", "bs32"):
+for label, extra in (("usl", ["time.method=usl"]), ("bs32", ["time.method=bs32"]),
+                     ("usl light", ["time.method=usl"] + LIGHT)):
     # restart_difference sets time.t_end itself (a key may be given once on the command line)
-    args = [a for a in EVERY5 if not a.startswith("time.t_end=")] + [f"time.method={method}"]
+    args = [a for a in EVERY5 if not a.startswith("time.t_end=")] + extra
     same_ids, worst, _ = mt.restart_difference(CASE, args, T,
-                                               f"regularise_restart_{method}", phase="fluid")
-    check(same_ids and worst == 0.0, f"{method}: restart at t = {T / 2:g} ends bitwise identical "
+                                               f"regularise_restart_{label.replace(' ', '_')}",
+                                               phase="fluid")
+    check(same_ids and worst == 0.0, f"{label}: restart at t = {T / 2:g} ends bitwise identical "
           f"by id (ids equal: {same_ids}, largest difference {worst:.1e})")
 
 sys.exit(check.finish())
