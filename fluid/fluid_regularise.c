@@ -208,6 +208,14 @@ static double dist2(const double *a, const double *b, int dim) {
   return s;
 }
 
+/* Row i leaves the cell; the rows after it move up. */
+static void remove_row(reg_cell *c, int i, int nc) {
+  memmove(c->row + (size_t)i * nc, c->row + (size_t)(i + 1) * nc,
+          sizeof *c->row * (size_t)(c->k - i - 1) * nc);
+  memmove(c->id + i, c->id + i + 1, sizeof *c->id * (size_t)(c->k - i - 1));
+  c->k--;
+}
+
 /* Merge the closest pair of rows; the later row (higher id) goes. */
 static void merge_closest(reg_cell *c, const fluid_layout *lay, const mpm_particles *p) {
   const int nc = p->ncomp;
@@ -219,10 +227,7 @@ static void merge_closest(reg_cell *c, const fluid_layout *lay, const mpm_partic
       if (s < best) best = s, ia = a, ib = b;
     }
   merge_rows(lay, p, c->row + (size_t)ia * nc, c->row + (size_t)ib * nc);
-  memmove(c->row + (size_t)ib * nc, c->row + (size_t)(ib + 1) * nc,
-          sizeof *c->row * (size_t)(c->k - ib - 1) * nc);
-  memmove(c->id + ib, c->id + ib + 1, sizeof *c->id * (size_t)(c->k - ib - 1));
-  c->k--;
+  remove_row(c, ib, nc);
 }
 
 /* The axis along which the rows leave the widest gap, cyclically across the cell. */
@@ -347,10 +352,7 @@ static int merge_light(reg_cell *c, const fluid_content *fc, const mpm_particles
     if (!(c->row[(size_t)l * nc + om] < fc->merge_light * c->row[(size_t)h * nc + om])) return 0;
     const mpm_gidx id = c->id[l];
     merge_rows(&fc->lay, p, c->row + (size_t)h * nc, c->row + (size_t)l * nc);
-    memmove(c->row + (size_t)l * nc, c->row + (size_t)(l + 1) * nc,
-            sizeof *c->row * (size_t)(c->k - l - 1) * nc);
-    memmove(c->id + l, c->id + l + 1, sizeof *c->id * (size_t)(c->k - l - 1));
-    c->k--;
+    remove_row(c, l, nc);
     MPM_CALL(split_heaviest(c, &fc->lay, p, b, &fc->obs, id));
     e->merges++, e->light++;
   }
