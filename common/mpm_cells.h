@@ -10,6 +10,7 @@
 
 #include "mpm_grid.h"
 #include "mpm_particles.h"
+#include "mpm_shape.h"
 
 /* Count the particles of p (all on the ranks that own their cells: call after migration) per
  * cell into grid->phase[phase].cell_n, owned cells and ghost cells. Collective. */
@@ -17,7 +18,7 @@ int mpm_cells_count(mpm_grid *grid, int phase, const mpm_particles *p);
 
 /* Global cell coordinate of x along d, clamped into the domain (as mpm_grid_owner_of). */
 static inline int mpm_cells_coord(const mpm_grid *g, int d, double x) {
-  const int c = (int)floor((x - g->lo[d]) / g->dx);
+  const int c = mpm_shape_floor((x - g->lo[d]) / g->dx);
   return c < 0 ? 0 : c >= g->ncells[d] ? g->ncells[d] - 1 : c;
 }
 

@@ -13,8 +13,11 @@
   X(MPM_T_STRESS, "stress")                                                                        \
   X(MPM_T_COUPLING, "coupling")                                                                    \
   X(MPM_T_CHECK, "check")                                                                          \
+  X(MPM_T_STABLE, "stable")                                                                        \
   X(MPM_T_DIAG, "diagnostics")                                                                     \
+  X(MPM_T_BOUNDARY, "boundary")                                                                    \
   X(MPM_T_MIGRATE, "migrate")                                                                      \
+  X(MPM_T_POST, "post_step")                                                                       \
   X(MPM_T_IO, "io")                                                                                \
   X(MPM_T_TOTAL, "total")
 

@@ -203,9 +203,9 @@ static int estab(N_Vector y, mpm_sunreal t, mpm_sunreal *hstab, void *user) {
   (void)t;
   double h, *yk[MPM_MAX_MODULES];
   vector_blocks(user, y, yk);
-  mpm_timer_start(MPM_T_CHECK);
+  mpm_timer_start(MPM_T_STABLE);
   const int rc = stable_step(user, yk, &h);
-  mpm_timer_stop(MPM_T_CHECK);
+  mpm_timer_stop(MPM_T_STABLE);
   if (rc != 0) return -1;
   *hstab = isfinite(h) ? h : 0.0; /* 0: no limit */
   return 0;
@@ -228,9 +228,9 @@ static int fixed_step(mpm_integrator *it, double *h) {
   if (!it->h_limit_set) {
     double *yk[MPM_MAX_MODULES];
     particle_blocks(it, yk);
-    mpm_timer_start(MPM_T_CHECK);
+    mpm_timer_start(MPM_T_STABLE);
     const int rc = fixed_limit(it, yk, &it->h_limit);
-    mpm_timer_stop(MPM_T_CHECK);
+    mpm_timer_stop(MPM_T_STABLE);
     MPM_CALL(rc);
     it->h_limit_set = it->direct; /* ERKStep's fixed steps: the state may have changed since */
   }

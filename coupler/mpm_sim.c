@@ -519,25 +519,30 @@ static int diagnostics(mpm_sim *s, double dt) {
 static int between_substeps(void *ctx, mpm_module *m, double t, double h, int *changed) {
   mpm_sim *s = ctx;
   int migrated = 0;
-  mpm_timer_start(MPM_T_MIGRATE);
+  mpm_timer_start(MPM_T_BOUNDARY);
   int rc = m->ops->boundary ? m->ops->boundary(m, t, h, changed) : 0;
+  mpm_timer_stop(MPM_T_BOUNDARY);
+  mpm_timer_start(MPM_T_MIGRATE);
   if (!rc) rc = mpm_particles_migrate(m->particles, s->grid, &migrated);
   mpm_timer_stop(MPM_T_MIGRATE);
   *changed |= migrated;
   return rc;
 }
 
-/* Between steps: particles enter and leave through the boundary, move to their owners and
- * are sorted now and then; the cells' occupancy is counted when a module asks for it; the
- * modules do their post-step work; the integrator is told. */
+/* Between steps: particles enter and leave through the boundary (timer phase `boundary`), move
+ * to their owners and are sorted now and then (`migrate`); the cells' occupancy is counted when
+ * a module asks for it, the modules do their post-step work and the integrator is told
+ * (`post_step`). */
 static int after_step(mpm_sim *s, double h) {
   int changed[SIM_MAX_MODULES] = {0}, changed_any = 0, want_cells = 0;
-  mpm_timer_start(MPM_T_MIGRATE);
   for (int k = 0; k < s->nmod; ++k) {
     mpm_module *m = s->mod[k];
     int migrated = 0;
     m->step = s->step;
+    mpm_timer_start(MPM_T_BOUNDARY);
     if (m->ops->boundary) MPM_CALL(m->ops->boundary(m, s->t, h, &changed[k]));
+    mpm_timer_stop(MPM_T_BOUNDARY);
+    mpm_timer_start(MPM_T_MIGRATE);
     MPM_CALL(mpm_particles_migrate(m->particles, s->grid, &migrated));
     changed[k] |= migrated;
     if (s->sort_every > 0 && s->step % s->sort_every == 0) {
@@ -545,7 +550,9 @@ static int after_step(mpm_sim *s, double h) {
       changed[k] = 1;
     }
     want_cells |= m->cells_every > 0 && s->step % m->cells_every == 0;
+    mpm_timer_stop(MPM_T_MIGRATE);
   }
+  mpm_timer_start(MPM_T_POST);
   for (int k = 0; want_cells && k < s->nmod; ++k)
     MPM_CALL(mpm_cells_count(s->grid, s->mod[k]->phase, s->mod[k]->particles));
   for (int k = 0; k < s->nmod; ++k) {
@@ -556,7 +563,7 @@ static int after_step(mpm_sim *s, double h) {
   /* A module's own changes may be local to a rank; the resize is collective. */
   MPM_CALL_MPI(MPI_Allreduce(MPI_IN_PLACE, &changed_any, 1, MPI_INT, MPI_LOR, s->comm));
   if (changed_any) MPM_CALL(mpm_timescheme_resize(s->it, s->t));
-  mpm_timer_stop(MPM_T_MIGRATE);
+  mpm_timer_stop(MPM_T_POST);
   return 0;
 }
 

@@ -47,7 +47,7 @@ typedef struct fluid_content {
   double *sub, *zero;        /* its viscous deposit: positions and stresses, zeros (cap each) */
   int stable_local;          /* fluid.stable_step = neighbourhood (fluid_stable.c) */
   double s_local;            /* its fastest signal for this step, m/s; < 0: not yet known */
-  double *cellsum;           /* its per-cell sums (3 nnodes) */
+  double *cellsum;           /* its per-cell sums and their block sums (6 nnodes) */
   mpm_lidx cap;              /* capacity of the particle scratch arrays */
   double *vsig;              /* V sigma deposited by this RHS (dim^2 cap) */
   double *scratch;           /* G2P output v, a, L ((2 dim + dim^2) cap) */

@@ -691,7 +691,7 @@ static int read_settings(fluid_content *fc, const mpm_config *cfg, const mpm_gri
   const char *stable;
   MPM_CALL(mpm_config_get_string(cfg, "fluid.stable_step", &stable));
   fc->stable_local = strcmp(stable, "neighbourhood") == 0, fc->s_local = -1.0;
-  if (fc->stable_local) MPM_ALLOC(fc->cellsum, 3 * (size_t)g->nnodes);
+  if (fc->stable_local) MPM_ALLOC(fc->cellsum, 6 * (size_t)g->nnodes);
   MPM_CALL(mpm_config_get_real(cfg, "fluid.R", &fc->R));
   MPM_CALL(mpm_config_get_int(cfg, "fluid.ppc", &fc->ppc));
   MPM_CALL(read_regularise(fc, cfg, g->dim));

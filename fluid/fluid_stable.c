@@ -57,14 +57,41 @@ static void deposit(const mpm_module *m, double *const *sum) {
   }
 }
 
+/* out = the sum of in over the three nodes l - 1, l, l + 1 along axis d of the box (0 on the
+ * box's first and last layer along d, which have no neighbour there). */
+static void box_sum_axis(const mpm_grid *g, int d, const double *in, double *out) {
+  mpm_lidx stride = 1;
+  for (int k = 0; k < d; ++k) stride *= g->box_n[k];
+  const int n = g->box_n[d];
+  const mpm_lidx outer = g->nnodes / (stride * n);
+  for (mpm_lidx o = 0; o < outer; ++o) {
+    double *r = out + o * stride * n;
+    const double *a = in + o * stride * n;
+    for (mpm_lidx j = 0; j < stride; ++j) r[j] = r[(n - 1) * stride + j] = 0.0;
+    for (int i = 1; i < n - 1; ++i)
+      for (mpm_lidx j = 0; j < stride; ++j) {
+        const mpm_lidx l = i * stride + j;
+        r[l] = a[l - stride] + a[l] + a[l + stride];
+      }
+  }
+}
+
 int fluid_neighbourhood_signal(const mpm_module *m, double *smax) {
   fluid_content *fc = m->content;
   mpm_grid *g = m->grid;
   const size_t nn = (size_t)g->nnodes;
   double *sum[3] = {fc->cellsum, fc->cellsum + nn, fc->cellsum + 2 * nn};
+  double *tmp[3] = {fc->cellsum + 3 * nn, fc->cellsum + 4 * nn, fc->cellsum + 5 * nn};
   memset(fc->cellsum, 0, sizeof *fc->cellsum * 3 * nn);
   deposit(m, sum);
   MPM_CALL(mpm_grid_halo_forward(g, sum, 3));
+  /* The 3^dim block sums, one axis at a time (the halo holds the cells around the box). */
+  for (int d = 0; d < g->dim; ++d)
+    for (int j = 0; j < 3; ++j) {
+      box_sum_axis(g, d, sum[j], tmp[j]);
+      double *t = sum[j];
+      sum[j] = tmp[j], tmp[j] = t;
+    }
   int lo[MPM_MAX_DIM] = {0}, n[MPM_MAX_DIM] = {1, 1, 1};
   mpm_lidx total = 1;
   for (int d = 0; d < g->dim; ++d) {
@@ -77,14 +104,8 @@ int fluid_neighbourhood_signal(const mpm_module *m, double *smax) {
     int c[MPM_MAX_DIM] = {0};
     mpm_lidx r = k;
     for (int d = 0; d < g->dim; ++d) c[d] = lo[d] + (int)(r % n[d]), r /= n[d];
-    double s[3] = {0, 0, 0};
-    for (int o = 0; o < (g->dim == 3 ? 27 : 9); ++o) { /* the 3^dim block around c */
-      int q[MPM_MAX_DIM] = {0};
-      for (int d = 0, w = o; d < g->dim; ++d, w /= 3) q[d] = c[d] + w % 3 - 1;
-      const mpm_lidx l = mpm_grid_local_index(g, q);
-      for (int j = 0; j < 3; ++j) s[j] += sum[j][l];
-    }
-    if (s[0] > 0.0) best = fmax(best, sqrt(s[1] / s[0]) + s[2] / s[0]);
+    const mpm_lidx l = mpm_grid_local_index(g, c);
+    if (sum[0][l] > 0.0) best = fmax(best, sqrt(sum[1][l] / sum[0][l]) + sum[2][l] / sum[0][l]);
   }
   *smax = best;
   return 0;
