@@ -37,22 +37,8 @@ static int velocity_after_solve(mpm_coupling *c, double t, double h, mpm_pass pa
  * which is recorded as the gas's force on the solid. */
 static int velocity_after_constrain(mpm_coupling *c, double t, double h, mpm_pass pass) {
   (void)t, (void)pass;
-  const mpm_grid_phase *s = mpm_coupling_phase(c, MPM_ROLE_SOLID);
-  const mpm_grid_phase *g = mpm_coupling_phase(c, MPM_ROLE_FLUID);
-  const int dim = c->grid->dim;
-  for (mpm_lidx l = 0; l < c->grid->nnodes; ++l) {
-    if (!mpm_coupling_shared(c, l)) continue;
-    int differ = 0;
-    double v[MPM_MAX_DIM], a[MPM_MAX_DIM], f[MPM_MAX_DIM];
-    for (int d = 0; d < dim; ++d) {
-      v[d] = s->v_i[d][l], a[d] = s->a_i[d][l];
-      differ |= v[d] != g->v_i[d][l] || (h == 0 && a[d] != g->a_i[d][l]);
-    }
-    if (!differ) continue;
-    mpm_coupling_exchange_force(c, MPM_ROLE_FLUID, l, v, a, h, f);
-    for (int d = 0; d < dim; ++d) f[d] = -f[d];
-    mpm_coupling_record_force(c, MPM_ROLE_SOLID, l, f, v);
-  }
+  for (mpm_lidx l = 0; l < c->grid->nnodes; ++l)
+    if (mpm_coupling_shared(c, l)) mpm_coupling_follow_solid(c, l, h);
   return 0;
 }
 

@@ -105,6 +105,10 @@ static int build(mpm_coupling *c, const mpm_config *cfg, mpm_module **mods, int 
     c->nbodies = nb;
     for (int d = 0; d < g->dim; ++d) MPM_ALLOC(c->da[d], g->nnodes);
   }
+  for (int d = 0; c->type->needs & MPM_COUPLING_HOLDS && d < g->dim; ++d) {
+    MPM_ALLOC(c->held_v[d], g->nnodes);
+    MPM_ALLOC(c->held_a[d], g->nnodes);
+  }
   if (c->type->ops->create) MPM_CALL(c->type->ops->create(c, cfg));
   if (c->type->ops->setup) MPM_CALL(c->type->ops->setup(c));
   return 0;
@@ -179,7 +183,7 @@ void mpm_coupling_destroy(mpm_coupling **cp) {
   mpm_coupling *c = *cp;
   if (c->type->ops->destroy) c->type->ops->destroy(c);
   free(c->owned);
-  for (int d = 0; d < MPM_MAX_DIM; ++d) free(c->da[d]);
+  for (int d = 0; d < MPM_MAX_DIM; ++d) free(c->da[d]), free(c->held_v[d]), free(c->held_a[d]);
   free(c);
   *cp = NULL;
 }
@@ -214,11 +218,34 @@ int mpm_coupling_before_solve(mpm_coupling *c, double t, double h, mpm_pass pass
 }
 
 int mpm_coupling_after_solve(mpm_coupling *c, double t, double h, mpm_pass pass) {
-  return c ? run_hook(c, c->type->ops->after_solve, t, h, pass) : 0;
+  if (!c) return 0;
+  MPM_CALL(run_hook(c, c->type->ops->after_solve, t, h, pass));
+  if (!(c->type->needs & MPM_COUPLING_HOLDS)) return 0;
+  const mpm_grid_phase *s = mpm_coupling_phase(c, MPM_ROLE_SOLID);
+  const size_t bytes = sizeof(double) * (size_t)c->grid->nnodes;
+  for (int d = 0; d < c->grid->dim; ++d)
+    memcpy(c->held_v[d], s->v_i[d], bytes), memcpy(c->held_a[d], s->a_i[d], bytes);
+  return 0;
+}
+
+/* MPM_COUPLING_HOLDS: the gas takes the solid's velocity wherever the solid's own constraints
+ * changed it since after_solve. */
+static int follow_held(mpm_coupling *c, double t, double h, mpm_pass pass) {
+  (void)t, (void)pass;
+  const mpm_grid_phase *s = mpm_coupling_phase(c, MPM_ROLE_SOLID);
+  for (mpm_lidx l = 0; l < c->grid->nnodes; ++l) {
+    if (!mpm_coupling_shared(c, l)) continue;
+    int held = 0;
+    for (int d = 0; d < c->grid->dim; ++d)
+      held |= s->v_i[d][l] != c->held_v[d][l] || (h == 0 && s->a_i[d][l] != c->held_a[d][l]);
+    if (held) mpm_coupling_follow_solid(c, l, h);
+  }
+  return 0;
 }
 
 int mpm_coupling_after_constrain(mpm_coupling *c, double t, double h, mpm_pass pass) {
   if (!c) return 0;
+  if (c->type->needs & MPM_COUPLING_HOLDS) MPM_CALL(run_hook(c, follow_held, t, h, pass));
   MPM_CALL(run_hook(c, c->type->ops->after_constrain, t, h, pass));
   if (pass != MPM_PASS_FIRST) return 0;
   /* Interpenetration: gas mass on the owned nodes inside the solid, those with at least 90 %
@@ -273,6 +300,22 @@ void mpm_coupling_record_force(mpm_coupling *c, mpm_role role, mpm_lidx l, const
   for (int d = 0; d < c->grid->dim; ++d) r->force[role][d] += f[d], r->power[role] += f[d] * v[d];
 }
 
+void mpm_coupling_follow_solid(mpm_coupling *c, mpm_lidx l, double h) {
+  const mpm_grid_phase *s = mpm_coupling_phase(c, MPM_ROLE_SOLID);
+  const mpm_grid_phase *g = mpm_coupling_phase(c, MPM_ROLE_FLUID);
+  const int dim = c->grid->dim;
+  int differ = 0;
+  double v[MPM_MAX_DIM], a[MPM_MAX_DIM], f[MPM_MAX_DIM];
+  for (int d = 0; d < dim; ++d) {
+    v[d] = s->v_i[d][l], a[d] = s->a_i[d][l];
+    differ |= v[d] != g->v_i[d][l] || (h == 0 && a[d] != g->a_i[d][l]);
+  }
+  if (!differ) return;
+  mpm_coupling_exchange_force(c, MPM_ROLE_FLUID, l, v, a, h, f);
+  for (int d = 0; d < dim; ++d) f[d] = -f[d];
+  mpm_coupling_record_force(c, MPM_ROLE_SOLID, l, f, v);
+}
+
 int mpm_coupling_apply_load(mpm_coupling *c, double t, double h, const double *const *load) {
   mpm_timer_start(MPM_T_COUPLING);
   begin_record(c, t, h);
@@ -307,16 +350,20 @@ int mpm_coupling_body_loads(mpm_coupling *c, const double *y_solid) {
   return rc;
 }
 
-int mpm_coupling_solid_normal(const mpm_coupling *c, mpm_lidx l, double *n) {
+int mpm_coupling_solid_surface(const mpm_coupling *c, mpm_lidx l, double kappa, double *n) {
   const mpm_grid_phase *ph = &c->grid->phase[c->phase[MPM_ROLE_SOLID]];
   const int dim = c->grid->dim;
   double len = 0.0;
   for (int d = 0; d < dim; ++d) len += ph->normal_i[d][l] * ph->normal_i[d][l];
   len = sqrt(len);
-  /* A gradient below roundoff of m / dx: the node is deep inside or alone. */
-  if (!(len > 1e-12 * ph->m_i[l] / c->grid->dx)) return 0;
+  if (!(len > kappa * ph->m_i[l] / c->grid->dx)) return 0;
   for (int d = 0; d < dim; ++d) n[d] = ph->normal_i[d][l] / len;
   return 1;
+}
+
+int mpm_coupling_solid_normal(const mpm_coupling *c, mpm_lidx l, double *n) {
+  /* A gradient below roundoff of m / dx: the node is deep inside or alone. */
+  return mpm_coupling_solid_surface(c, l, 1e-12, n);
 }
 
 int mpm_coupling_step_record(mpm_coupling *c, double t, mpm_coupling_record *out) {

@@ -35,8 +35,13 @@
 
 typedef struct mpm_coupling mpm_coupling;
 
-/* What a scheme needs deposited: the solid's mass gradient (for interface normals). */
-enum { MPM_COUPLING_NORMALS = 1 };
+/* What a scheme needs: the solid's mass gradient deposited (for interface normals); the gas held
+ * to the solid's constraints (after the modules' constraints, wherever the solid's own clamp or
+ * rigid body changed its velocity at a shared node, the gas takes the solid's velocity there:
+ * mpm_coupling_follow_solid). A scheme that holds the gas along the normal alone needs the
+ * latter: at a clamped root on a wall the solid's normal points into the wall, and the gas slid
+ * through the root along it. */
+enum { MPM_COUPLING_NORMALS = 1, MPM_COUPLING_HOLDS = 2 };
 
 typedef struct mpm_coupling_ops {
   /* Read the scheme's own keys, allocate its content. Optional. */
@@ -86,7 +91,9 @@ struct mpm_coupling {
                                          MPM_COUPLING_MAX_BODIES: the resultant only) */
   const char *body_name[MPM_COUPLING_MAX_BODIES];
   double *da[MPM_MAX_DIM]; /* with nbodies: the solid's interface acceleration per node */
-  mpm_interface *capture;  /* non-NULL: what the solid is given goes there instead (held) */
+  double *held_v[MPM_MAX_DIM], *held_a[MPM_MAX_DIM]; /* MPM_COUPLING_HOLDS: the solid's v and a
+                                                        as after_solve left them */
+  mpm_interface *capture; /* non-NULL: what the solid is given goes there instead (held) */
 };
 
 /* The registered types, `none` first; count in *n. */
@@ -138,6 +145,12 @@ void mpm_coupling_exchange(mpm_coupling *c, mpm_role role, mpm_lidx l, const dou
 void mpm_coupling_exchange_force(mpm_coupling *c, mpm_role role, mpm_lidx l, const double *v,
                                  const double *a, double h, double *f);
 
+/* After the modules' constraints: where the solid's constraint (a clamp, a rigid body) has
+ * changed its velocity at shared node l, the gas takes the solid's velocity and acceleration
+ * there (the shared field obeys both), as an external constraint, and the solid's constraint
+ * takes the reaction, recorded as the gas's force on the solid. Does nothing where they agree. */
+void mpm_coupling_follow_solid(mpm_coupling *c, mpm_lidx l, double h);
+
 /* Record, without changing any field, that phase role received force f (dim values) at node l
  * and moves there with velocity v: the reaction a constraint takes for a phase (a clamped or
  * rigid solid holding the gas) counts as interface force. */
@@ -163,6 +176,11 @@ static inline mpm_grid_phase *mpm_coupling_phase(const mpm_coupling *c, mpm_role
 /* The unit outward normal of the solid at node l from its deposited mass gradient, or 0 if
  * the gradient vanishes there. */
 int mpm_coupling_solid_normal(const mpm_coupling *c, mpm_lidx l, double *n);
+
+/* The same, but 0 also where the normal is not resolved: |grad m_s| dx < kappa m_s, a node
+ * inside the solid (for a straight face the nodes on it give 1.5 with the quadratic B-spline and
+ * two particles per cell, the nodes a cell or more inside 0.1-0.5). */
+int mpm_coupling_solid_surface(const mpm_coupling *c, mpm_lidx l, double kappa, double *n);
 
 /* ---- the interface report (coupling.csv) --------------------------------------------------- */
 
