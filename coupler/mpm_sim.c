@@ -622,6 +622,20 @@ static int write_summary(mpm_sim *s, double wall) {
   return 0;
 }
 
+/* The blow-up guard after an accepted step; a run it stops leaves its last state as one more
+ * snapshot (the series stays valid: it is written like any other), to show where it failed. */
+static int guard(mpm_sim *s, double dt, double tstop) {
+  const int rc =
+      mpm_guard_check(&s->guard, s->t, s->step, dt, s->t >= tstop * (1 - 1e-14), s->energy);
+  if (!rc) return 0;
+  if (s->snapshots && write_snapshot(s) == 0)
+    mpm_log(MPM_LOG_ERROR,
+            "the state where the run stopped (t = %.6g, step %ld) is snapshot %ld "
+            "of %s/series.xmf",
+            s->t, s->step, (long)mpm_output_count(s->out) - 1, s->dir);
+  return mpm_trace(__FILE__, __LINE__, __func__, rc);
+}
+
 int mpm_sim_run(mpm_sim *s) {
   char path[4096];
   MPM_CALL(open_outputs(s));
@@ -655,7 +669,7 @@ int mpm_sim_run(mpm_sim *s) {
     s->step++;
     MPM_CALL(after_step(s, dt));
     MPM_CALL(diagnostics(s, dt));
-    MPM_CALL(mpm_guard_check(&s->guard, s->t, s->step, dt, s->t >= tstop * (1 - 1e-14), s->energy));
+    MPM_CALL(guard(s, dt, tstop));
     progress(s, dt, wall0, 0);
     if (s->t >= t_out * (1 - 1e-14)) {
       if (s->snapshots) MPM_CALL(write_snapshot(s));

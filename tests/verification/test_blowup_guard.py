@@ -9,7 +9,8 @@ elastic waves, energy 6.25e-8 J, no energy enters), 20 time units.
    (test_stability: usl grows 2.4e4-fold at 0.9): the energy growth criterion stops it with a
    message naming time.energy_growth, before t_end, exit status non-zero, and the last row of
    diagnostics.csv is within one step's growth of the limit (< 1e4 x the start): it did not
-   run on.
+   run on. The state where it stopped is the last snapshot of series.xmf (at the stop time),
+   and an error line names it.
 2. forward Euler at 0.9 (an explicit method without error control, ERK fixed step): the same.
 3. The adaptive pair bs32 (error-controlled): it does not blow up on this bar, so the step
    collapse criterion is exercised with the error control itself: at rtol = 1e-12 its steps
@@ -58,33 +59,42 @@ def run(label, extra):
     base = [a for a in BAR if a.split("=", 1)[0] not in keys]
     p = mt.run(["run", mt.case("axial_bar.ini"), f"output.dir={out}"] + base + extra, check=False)
     d = np.genfromtxt(os.path.join(out, "diagnostics.csv"), delimiter=",", names=True)
-    return p, d
+    return p, d, out
 
 
 def bar_sections():
     """Sections 1-4: the axial bar."""
-    for label, extra in (("usl", ["time.method=usl", "time.cfl=0.95"]),
+    for label, extra in (("usl", ["time.method=usl", "time.cfl=0.95", "output.snapshots=true",
+                                  "output.interval=5"]),
                          ("euler", ["time.method=euler", "time.cfl=0.9"])):
-        p, d = run(label, extra)
-        msg = error_line(p.stderr)
-        check(p.returncode != 0 and "blew up" in msg and "time.energy_growth" in msg,
-              f"{label}: stopped with status {p.returncode}: {msg.strip()[:160]}")
+        p, d, out = run(label, extra)
+        msg = [l for l in p.stderr.splitlines() if l.startswith("error:")]
+        check(p.returncode != 0 and msg and "blew up" in msg[0] and "time.energy_growth" in msg[0],
+              f"{label}: stopped with status {p.returncode}: {msg[0].strip()[:160] if msg else ''}")
         check(d["t"][-1] < 20 and d["total"][-1] < 1e4 * E0,
               f"{label}: last row t = {d['t'][-1]:.3g} (< 20), energy {d['total'][-1] / E0:.3g} x "
               "the start (< 1e4: stopped at the limit, did not run on)")
+        if label != "usl":
+            continue
+        # The state where it stopped is one more snapshot of the series, and the log says so.
+        snaps = mt.snapshots(out)
+        check(len(snaps) >= 2 and abs(snaps[-1][0] - d["t"][-1]) <= 1e-12 * d["t"][-1]
+              and os.path.exists(snaps[-1][1]) and "series.xmf" in msg[-1],
+              f"usl: the last snapshot of series.xmf at t = {snaps[-1][0]:.6g}, the stop time "
+              f"{d['t'][-1]:.6g}; the log: {msg[-1].strip()[:120]}")
 
     slow = ["time.method=bs32", "time.rtol=1e-12", "time.atol=1e-18", "time.t_end=2"]
-    p, d = run("bs32_collapse", slow + ["time.collapse_ratio=0.2"])
+    p, d, out = run("bs32_collapse", slow + ["time.collapse_ratio=0.2"])
     msg = error_line(p.stderr)
     check(p.returncode != 0 and "blew up" in msg and "time.collapse_ratio" in msg,
           f"bs32, ratio 0.2: stopped with status {p.returncode} after {len(d) - 1} steps: "
           f"{msg.strip()[:160]}")
     check(len(d) - 1 == 100, f"bs32, ratio 0.2: stopped at step {len(d) - 1} (the 100th collapsed "
           "step in a row)")
-    p, d = run("bs32_slow", slow)
+    p, d, out = run("bs32_slow", slow)
     check(p.returncode == 0, f"bs32 at rtol 1e-12, default ratio 1e-4: completes (status "
           f"{p.returncode}, {len(d) - 1} steps)")
-    p, d = run("bs32_default", ["time.method=bs32"])
+    p, d, out = run("bs32_default", ["time.method=bs32"])
     check(p.returncode == 0 and abs(d["t"][-1] - 20) < 1e-9,
           f"bs32 with default settings: completes to t = {d['t'][-1]:.6g} (status {p.returncode})")
 
