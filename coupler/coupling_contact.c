@@ -108,7 +108,7 @@ const mpm_coupling_type coupling_contact = {
     .name = "contact",
     .help = "separate fields, a normal-only interaction where the phases approach: free slip, "
             "no interpenetration, separation allowed; coupling.friction for Coulomb friction",
-    .needs = MPM_COUPLING_NORMALS | MPM_COUPLING_HOLDS,
+    .needs = MPM_COUPLING_NORMALS,
     .keys = contact_keys,
     .nkeys = (int)(sizeof contact_keys / sizeof contact_keys[0]),
     .ops = &contact_ops,

@@ -38,9 +38,11 @@ typedef struct mpm_coupling mpm_coupling;
 /* What a scheme needs: the solid's mass gradient deposited (for interface normals); the gas held
  * to the solid's constraints (after the modules' constraints, wherever the solid's own clamp or
  * rigid body changed its velocity at a shared node, the gas takes the solid's velocity there:
- * mpm_coupling_follow_solid). A scheme that holds the gas along the normal alone needs the
+ * mpm_coupling_follow_solid). `traction`, which holds the gas along the normal alone, needs the
  * latter: at a clamped root on a wall the solid's normal points into the wall, and the gas slid
- * through the root along it. */
+ * through the root along it. `contact` does not take it: on the main job at 2 mm it trapped gas
+ * in the clamped root, where its step fell to 5e-9 s by 2.5 ms (43 000 steps, against 30 188
+ * for the whole run without it). */
 enum { MPM_COUPLING_NORMALS = 1, MPM_COUPLING_HOLDS = 2 };
 
 typedef struct mpm_coupling_ops {
