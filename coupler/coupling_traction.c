@@ -1,6 +1,7 @@
 /* `traction`: the seed paper's explicit procedure. The phases solve separately; the gas sees
- * the solid as a moving slip wall, and the force that wall exerts on the gas goes back to the
- * solid as an equal and opposite nodal force.
+ * the solid's surface as a moving slip wall, and the force that wall exerts on the gas goes
+ * back to the solid as an equal and opposite nodal force. (Inside the solid, and where the
+ * solid's clamp or rigid body holds a node, the gas is held in every direction: below.)
  *
  * At a shared node with the solid's outward normal n (from its mass gradient) the gas's normal
  * velocity is held to the wall's, as a static obstacle holds it to zero (fluid_obstacle.h), and
@@ -28,9 +29,11 @@
  * centre of mass, as under `velocity`. In a bar three cells thick the nodes in its middle see
  * gas from both faces and a normal of roundoff direction; holding the gas only along it let the
  * gas through. Where the solid's clamp or rigid body holds a shared node, the gas takes the
- * solid's velocity there (MPM_COUPLING_HOLDS). On the main job (cases/supersonic_bar.ini, 4 mm)
- * the two together cut the gas particles within a quarter cell of a bar particle from 27-73 to
- * 5-14, and the run, which blew up at 1.85-2.11 ms, completes. */
+ * solid's velocity there (MPM_COUPLING_HOLDS), and on a domain wall the normal loses its
+ * component across the wall (mpm_coupling_solid_surface). On the main job
+ * (cases/supersonic_bar.ini, 4 mm) these cut the gas particles within a quarter cell of a bar
+ * particle from 27-73 to 4-11 (0.5-1.5 ms): they had come in through the clamped root along the
+ * floor. The run still blows up, at the outflow's floor corner. */
 #include "mpm_coupling.h"
 
 /* |grad m_s| dx / m_s below which a shared node counts as inside the solid. */
@@ -82,9 +85,9 @@ static const mpm_coupling_ops traction_ops = {
 
 const mpm_coupling_type coupling_traction = {
     .name = "traction",
-    .help = "separate solves; the gas sees the solid as a moving slip wall and its load goes "
-            "back to the solid as an equal and opposite nodal force: the seed paper's explicit "
-            "procedure",
+    .help = "separate solves; the gas sees the solid's surface as a moving slip wall and its "
+            "load goes back to the solid as an equal and opposite nodal force: the seed paper's "
+            "explicit procedure",
     .needs = MPM_COUPLING_NORMALS | MPM_COUPLING_HOLDS,
     .ops = &traction_ops,
 };

@@ -38,7 +38,7 @@ static int velocity_after_solve(mpm_coupling *c, double t, double h, mpm_pass pa
 static int velocity_after_constrain(mpm_coupling *c, double t, double h, mpm_pass pass) {
   (void)t, (void)pass;
   for (mpm_lidx l = 0; l < c->grid->nnodes; ++l)
-    if (mpm_coupling_shared(c, l)) mpm_coupling_follow_solid(c, l, h);
+    if (mpm_coupling_shared(c, l)) mpm_coupling_follow_solid(c, l, h, MPM_ALL_AXES);
   return 0;
 }
 

@@ -2,6 +2,7 @@
  * mpm_coupling.h). */
 #include "mpm_coupling.h"
 
+#include "mpm_bc.h"
 #include "mpm_error.h"
 #include "mpm_timer.h"
 
@@ -96,8 +97,23 @@ static int build(mpm_coupling *c, const mpm_config *cfg, mpm_module **mods, int 
   MPM_ALLOC(c->owned, g->nnodes);
   for (mpm_lidx l = 0; l < g->nnodes; ++l)
     c->owned[l] = (unsigned char)mpm_grid_node_is_owned(g, l);
-  if (c->type->needs & MPM_COUPLING_NORMALS) /* the schemes read the solid's normal only */
+  if (c->type->needs & MPM_COUPLING_NORMALS) { /* the schemes read the solid's normal only */
     g->phase[c->phase[MPM_ROLE_SOLID]].normals = 1;
+    mpm_walls w;
+    MPM_CALL(mpm_walls_from_config(&w, cfg, g->dim));
+    MPM_ALLOC(c->wall_axes, g->nnodes);
+    for (mpm_lidx l = 0; l < g->nnodes; ++l) {
+      int gi[MPM_MAX_DIM];
+      mpm_grid_node_global(g, l, gi);
+      c->wall_axes[l] = 0;
+      for (int d = 0; d < g->dim; ++d)
+        for (int side = 0; side < 2; ++side) {
+          const mpm_wall k = w.face[d][side];
+          if ((k == MPM_WALL_SLIP || k == MPM_WALL_NO_SLIP) && gi[d] == (side ? g->ncells[d] : 0))
+            c->wall_axes[l] |= (unsigned char)(1u << d);
+        }
+    }
+  }
   const mpm_module *solid = c->module[MPM_ROLE_SOLID];
   const int nb =
       solid->ops->bodies ? solid->ops->bodies(solid, c->body_name, MPM_COUPLING_MAX_BODIES) : 1;
@@ -182,7 +198,7 @@ void mpm_coupling_destroy(mpm_coupling **cp) {
   if (!cp || !*cp) return;
   mpm_coupling *c = *cp;
   if (c->type->ops->destroy) c->type->ops->destroy(c);
-  free(c->owned);
+  free(c->owned), free(c->wall_axes);
   for (int d = 0; d < MPM_MAX_DIM; ++d) free(c->da[d]), free(c->held_v[d]), free(c->held_a[d]);
   free(c);
   *cp = NULL;
@@ -217,10 +233,9 @@ int mpm_coupling_before_solve(mpm_coupling *c, double t, double h, mpm_pass pass
   return run_hook(c, c->type->ops->before_solve, t, h, pass);
 }
 
-int mpm_coupling_after_solve(mpm_coupling *c, double t, double h, mpm_pass pass) {
-  if (!c) return 0;
-  MPM_CALL(run_hook(c, c->type->ops->after_solve, t, h, pass));
-  if (!(c->type->needs & MPM_COUPLING_HOLDS)) return 0;
+/* MPM_COUPLING_HOLDS: the solid's nodal v and a as the scheme's after_solve left them. */
+static int save_held(mpm_coupling *c, double t, double h, mpm_pass pass) {
+  (void)t, (void)h, (void)pass;
   const mpm_grid_phase *s = mpm_coupling_phase(c, MPM_ROLE_SOLID);
   const size_t bytes = sizeof(double) * (size_t)c->grid->nnodes;
   for (int d = 0; d < c->grid->dim; ++d)
@@ -228,17 +243,25 @@ int mpm_coupling_after_solve(mpm_coupling *c, double t, double h, mpm_pass pass)
   return 0;
 }
 
-/* MPM_COUPLING_HOLDS: the gas takes the solid's velocity wherever the solid's own constraints
- * changed it since after_solve. */
+int mpm_coupling_after_solve(mpm_coupling *c, double t, double h, mpm_pass pass) {
+  if (!c) return 0;
+  MPM_CALL(run_hook(c, c->type->ops->after_solve, t, h, pass));
+  if (c->type->needs & MPM_COUPLING_HOLDS) MPM_CALL(run_hook(c, save_held, t, h, pass));
+  return 0;
+}
+
+/* MPM_COUPLING_HOLDS: the gas takes the solid's velocity in the components the solid's own
+ * constraints changed since after_solve. */
 static int follow_held(mpm_coupling *c, double t, double h, mpm_pass pass) {
   (void)t, (void)pass;
   const mpm_grid_phase *s = mpm_coupling_phase(c, MPM_ROLE_SOLID);
   for (mpm_lidx l = 0; l < c->grid->nnodes; ++l) {
     if (!mpm_coupling_shared(c, l)) continue;
-    int held = 0;
+    unsigned held = 0;
     for (int d = 0; d < c->grid->dim; ++d)
-      held |= s->v_i[d][l] != c->held_v[d][l] || (h == 0 && s->a_i[d][l] != c->held_a[d][l]);
-    if (held) mpm_coupling_follow_solid(c, l, h);
+      if (s->v_i[d][l] != c->held_v[d][l] || (h == 0 && s->a_i[d][l] != c->held_a[d][l]))
+        held |= 1u << d;
+    if (held) mpm_coupling_follow_solid(c, l, h, held);
   }
   return 0;
 }
@@ -300,14 +323,15 @@ void mpm_coupling_record_force(mpm_coupling *c, mpm_role role, mpm_lidx l, const
   for (int d = 0; d < c->grid->dim; ++d) r->force[role][d] += f[d], r->power[role] += f[d] * v[d];
 }
 
-void mpm_coupling_follow_solid(mpm_coupling *c, mpm_lidx l, double h) {
+void mpm_coupling_follow_solid(mpm_coupling *c, mpm_lidx l, double h, unsigned axes) {
   const mpm_grid_phase *s = mpm_coupling_phase(c, MPM_ROLE_SOLID);
   const mpm_grid_phase *g = mpm_coupling_phase(c, MPM_ROLE_FLUID);
   const int dim = c->grid->dim;
   int differ = 0;
   double v[MPM_MAX_DIM], a[MPM_MAX_DIM], f[MPM_MAX_DIM];
   for (int d = 0; d < dim; ++d) {
-    v[d] = s->v_i[d][l], a[d] = s->a_i[d][l];
+    const mpm_grid_phase *from = axes >> d & 1u ? s : g;
+    v[d] = from->v_i[d][l], a[d] = from->a_i[d][l];
     differ |= v[d] != g->v_i[d][l] || (h == 0 && a[d] != g->a_i[d][l]);
   }
   if (!differ) return;
@@ -350,20 +374,33 @@ int mpm_coupling_body_loads(mpm_coupling *c, const double *y_solid) {
   return rc;
 }
 
-int mpm_coupling_solid_surface(const mpm_coupling *c, mpm_lidx l, double kappa, double *n) {
+/* The solid's mass gradient at node l, less its component across a wall the node lies on if
+ * `walls`; its length in *len. */
+static void solid_gradient(const mpm_coupling *c, mpm_lidx l, int walls, double *g, double *len) {
   const mpm_grid_phase *ph = &c->grid->phase[c->phase[MPM_ROLE_SOLID]];
-  const int dim = c->grid->dim;
-  double len = 0.0;
-  for (int d = 0; d < dim; ++d) len += ph->normal_i[d][l] * ph->normal_i[d][l];
-  len = sqrt(len);
-  if (!(len > kappa * ph->m_i[l] / c->grid->dx)) return 0;
-  for (int d = 0; d < dim; ++d) n[d] = ph->normal_i[d][l] / len;
+  *len = 0.0;
+  for (int d = 0; d < c->grid->dim; ++d) {
+    g[d] = walls && c->wall_axes[l] >> d & 1u ? 0.0 : ph->normal_i[d][l];
+    *len += g[d] * g[d];
+  }
+  *len = sqrt(*len);
+}
+
+int mpm_coupling_solid_surface(const mpm_coupling *c, mpm_lidx l, double kappa, double *n) {
+  double g[MPM_MAX_DIM], len;
+  solid_gradient(c, l, 1, g, &len);
+  if (!(len > kappa * c->grid->phase[c->phase[MPM_ROLE_SOLID]].m_i[l] / c->grid->dx)) return 0;
+  for (int d = 0; d < c->grid->dim; ++d) n[d] = g[d] / len;
   return 1;
 }
 
 int mpm_coupling_solid_normal(const mpm_coupling *c, mpm_lidx l, double *n) {
+  double g[MPM_MAX_DIM], len;
+  solid_gradient(c, l, 0, g, &len);
   /* A gradient below roundoff of m / dx: the node is deep inside or alone. */
-  return mpm_coupling_solid_surface(c, l, 1e-12, n);
+  if (!(len > 1e-12 * c->grid->phase[c->phase[MPM_ROLE_SOLID]].m_i[l] / c->grid->dx)) return 0;
+  for (int d = 0; d < c->grid->dim; ++d) n[d] = g[d] / len;
+  return 1;
 }
 
 int mpm_coupling_step_record(mpm_coupling *c, double t, mpm_coupling_record *out) {

@@ -628,7 +628,9 @@ static int guard(mpm_sim *s, double dt, double tstop) {
   const int rc =
       mpm_guard_check(&s->guard, s->t, s->step, dt, s->t >= tstop * (1 - 1e-14), s->energy);
   if (!rc) return 0;
-  if (s->snapshots && write_snapshot(s) == 0)
+  /* Only the guard's verdict, which every rank reaches alike from reduced values: a local
+   * failure (no memory) must not enter the collective write on one rank. */
+  if (rc == MPM_ERR_UNPHYSICAL && s->snapshots && write_snapshot(s) == 0)
     mpm_log(MPM_LOG_ERROR,
             "the state where the run stopped (t = %.6g, step %ld) is snapshot %ld "
             "of %s/series.xmf",

@@ -49,8 +49,10 @@ E0 = 6.25e-8
 
 
 def error_line(text):
+    """The first error line: the one that says why the run stopped (a run the guard stops adds
+    one naming its last snapshot)."""
     lines = [l for l in text.splitlines() if l.startswith("error:")]
-    return lines[-1] if lines else ""
+    return lines[0] if lines else ""
 
 
 def run(label, extra):
