@@ -374,33 +374,29 @@ int mpm_coupling_body_loads(mpm_coupling *c, const double *y_solid) {
   return rc;
 }
 
-/* The solid's mass gradient at node l, less its component across a wall the node lies on if
- * `walls`; its length in *len. */
-static void solid_gradient(const mpm_coupling *c, mpm_lidx l, int walls, double *g, double *len) {
+/* The unit normal from the solid's mass gradient at node l (less its component across a wall
+ * the node lies on, if `walls`), or 0 where the gradient is below kappa m_s / dx. */
+static int unit_normal(const mpm_coupling *c, mpm_lidx l, int walls, double kappa, double *n) {
   const mpm_grid_phase *ph = &c->grid->phase[c->phase[MPM_ROLE_SOLID]];
-  *len = 0.0;
-  for (int d = 0; d < c->grid->dim; ++d) {
+  const int dim = c->grid->dim;
+  double g[MPM_MAX_DIM], len = 0.0;
+  for (int d = 0; d < dim; ++d) {
     g[d] = walls && c->wall_axes[l] >> d & 1u ? 0.0 : ph->normal_i[d][l];
-    *len += g[d] * g[d];
+    len += g[d] * g[d];
   }
-  *len = sqrt(*len);
+  len = sqrt(len);
+  if (!(len > kappa * ph->m_i[l] / c->grid->dx)) return 0;
+  for (int d = 0; d < dim; ++d) n[d] = g[d] / len;
+  return 1;
 }
 
 int mpm_coupling_solid_surface(const mpm_coupling *c, mpm_lidx l, double kappa, double *n) {
-  double g[MPM_MAX_DIM], len;
-  solid_gradient(c, l, 1, g, &len);
-  if (!(len > kappa * c->grid->phase[c->phase[MPM_ROLE_SOLID]].m_i[l] / c->grid->dx)) return 0;
-  for (int d = 0; d < c->grid->dim; ++d) n[d] = g[d] / len;
-  return 1;
+  return unit_normal(c, l, 1, kappa, n);
 }
 
 int mpm_coupling_solid_normal(const mpm_coupling *c, mpm_lidx l, double *n) {
-  double g[MPM_MAX_DIM], len;
-  solid_gradient(c, l, 0, g, &len);
   /* A gradient below roundoff of m / dx: the node is deep inside or alone. */
-  if (!(len > 1e-12 * c->grid->phase[c->phase[MPM_ROLE_SOLID]].m_i[l] / c->grid->dx)) return 0;
-  for (int d = 0; d < c->grid->dim; ++d) n[d] = g[d] / len;
-  return 1;
+  return unit_normal(c, l, 0, 1e-12, n);
 }
 
 int mpm_coupling_step_record(mpm_coupling *c, double t, mpm_coupling_record *out) {
