@@ -49,6 +49,11 @@ typedef struct mpm_grid_phase {
   double m_max;          /* the last nodal solve's largest nodal mass over the whole grid */
   double m_empty;        /* it treated nodes with m_i <= m_empty as empty */
   double empty_fraction; /* m_empty / m_max: 1e-14 (roundoff) unless the module sets it */
+  /* A module may also treat as empty the nodes lighter than light_fraction times the mean
+   * nodal mass of the phase (over the owned nodes that hold any of it; 0: off). The mean, not
+   * the largest, so that one spuriously compressed node cannot empty the rest. */
+  double light_fraction;
+  double m_mean; /* that mean, at the last nodal solve (when light_fraction > 0) */
   /* Particles per cell, at the cell's lower corner node (mpm_cells.h); NULL until counted. */
   double *cell_n;
 } mpm_grid_phase;

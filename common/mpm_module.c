@@ -37,7 +37,16 @@ int mpm_grid_phase_update(mpm_grid *grid, int phase, double h) {
   /* Nodes touched only by the far tail of a stencil carry roundoff-sized mass; dividing by it
    * would amplify noise, so they are treated as empty (a module may raise the fraction). */
   ph->m_max = mmax;
-  const double mmin = ph->m_empty = ph->empty_fraction * mmax;
+  double mmin = ph->empty_fraction * mmax;
+  if (ph->light_fraction > 0.0) {
+    double sum[2] = {0.0, 0.0}, all[2]; /* mass and count over the owned nodes with mass */
+    for (mpm_lidx l = 0; l < grid->nnodes; ++l)
+      if (ph->m_i[l] > mmin && mpm_grid_node_is_owned(grid, l)) sum[0] += ph->m_i[l], sum[1] += 1.0;
+    MPM_CALL_MPI(MPI_Allreduce(sum, all, 2, MPI_DOUBLE, MPI_SUM, grid->comm));
+    ph->m_mean = all[1] > 0.0 ? all[0] / all[1] : 0.0;
+    mmin = fmax(mmin, ph->light_fraction * ph->m_mean);
+  }
+  ph->m_empty = mmin;
   for (int d = 0; d < grid->dim; ++d)
     node_update(grid->nnodes, ph->m_i, ph->mv_i[d], ph->f_i[d], ph->v_i[d], ph->a_i[d], mmin, h);
   return 0;

@@ -31,6 +31,7 @@ typedef struct fluid_content {
   mpm_transfer tr;
   double gravity[MPM_MAX_DIM];
   mpm_node_constraints cons; /* wall nodes */
+  mpm_walls walls;           /* the domain's faces */
   fluid_open *open;          /* open faces (inflow, outflow, far field), or NULL */
   fluid_virtual virt;        /* virtual particles of the open faces and obstacles */
   fluid_obstacles obs;       /* static obstacles (fluid_obstacle.h) */

@@ -106,6 +106,11 @@ static const mpm_key_spec fluid_keys[] = {
      "vacuum the few light particles at such nodes take huge accelerations and heat; 1e-4 "
      "keeps them at the gas's own speeds, at the price of the momentum those nodes carry",
      0},
+    {"fluid.light_node_mass", MPM_KEY_REAL, "0", 0, 0.5, 0, 0, NULL,
+     "a gas node holding less than this fraction of the mean gas nodal mass (over the nodes "
+     "holding gas) is empty too, as for empty_node_mass (0: off). Relative to the mean, so a "
+     "spuriously compressed node elsewhere does not empty ordinary ones",
+     0},
     {"fluid.regularise_min", MPM_KEY_INT, NULL, 1, HUGE_VAL, 0, 0, NULL,
      "split particles in a non-empty cell holding fewer than this (default ceil(ppc^dim / 2): "
      "refill where the gas has expanded to twice its seeding volume; 1 never splits)",
@@ -754,9 +759,11 @@ static int build(mpm_module *m, const mpm_config *cfg, int seed) {
   mpm_walls walls;
   MPM_CALL(mpm_grid_add_phase(g, "fluid", &m->phase));
   MPM_CALL(mpm_config_get_real(cfg, "fluid.empty_node_mass", &g->phase[m->phase].empty_fraction));
+  MPM_CALL(mpm_config_get_real(cfg, "fluid.light_node_mass", &g->phase[m->phase].light_fraction));
   MPM_CALL(read_settings(fc, cfg, g));
   MPM_CALL(mpm_walls_from_config(&walls, cfg, g->dim));
   MPM_CALL(mpm_constraints_add_walls(&fc->cons, &walls, g));
+  fc->walls = walls;
   MPM_CALL(fluid_open_new(&fc->open, m, cfg, &walls, fc->gas.gamma, fc->ppc));
   MPM_CALL(fluid_obstacles_build(&fc->obs, cfg, g, fc->ppc, (const unsigned char(*)[2])m->open));
   MPM_CALL(fluid_wall_ls_init(m, cfg, fc->tr.classic));

@@ -110,6 +110,8 @@ GAS_CASES = [
      "fluid.merge_light", "regularise_every"),
     ("empty_node_mass above its range", "\ngamma = 1.4",
      "\ngamma = 1.4\nempty_node_mass = 0.5", "fluid.empty_node_mass", "[0, 0.01]"),
+    ("light_node_mass above its range", "\ngamma = 1.4",
+     "\ngamma = 1.4\nlight_node_mass = 0.8", "fluid.light_node_mass", "[0, 0.5]"),
     ("shift above its range", "\ngamma = 1.4", "\ngamma = 1.4\nshift = 0.8", "fluid.shift",
      "[0, 0.5]"),
     ("unknown strain_rate", "\ngamma = 1.4", "\ngamma = 1.4\nstrain_rate = now",

@@ -166,16 +166,28 @@ static void run_case(int dim, mpm_shape_kind shape) {
   CHECK(ferr <= 1e-13 * pt[0], "%d-D %s: ghost masses after the forward exchange differ by %.3e",
         dim, mpm_shape_name(shape), ferr);
   /* The nodal solve: v = mv/m + h f/m, a = f/m on nodes above the phase's empty fraction of
-   * the largest nodal mass, zero on the others (1e-14 by default; the gas may raise it). */
+   * the largest nodal mass (and, in the third pass, above its light fraction of the mean
+   * nodal mass), zero on the others (1e-14 by default; the gas may raise both). The mean is
+   * the serial grid's, over the nodes with mass, on any number of ranks. */
+  double rsum = 0.0, rcount = 0.0, rmax = 0.0;
+  for (mpm_lidx l = 0; l < ref->nnodes; ++l) rmax = fmax(rmax, ref->phase[0].m_i[l]);
+  for (mpm_lidx l = 0; l < ref->nnodes; ++l)
+    if (ref->phase[0].m_i[l] > 1e-14 * rmax) rsum += ref->phase[0].m_i[l], rcount += 1.0;
   const double h = 1e-3;
-  for (int pass = 0; pass < 2; ++pass) {
-    ph->empty_fraction = pass ? 0.05 : 1e-14;
+  for (int pass = 0; pass < 3; ++pass) {
+    ph->empty_fraction = pass == 1 ? 0.05 : 1e-14;
+    ph->light_fraction = pass == 2 ? 0.3 : 0.0;
     CHECK(mpm_grid_phase_update(g, 0, h) == 0, "nodal solve failed");
+    if (pass == 2)
+      CHECK(fabs(ph->m_mean - rsum / rcount) <= 1e-13 * ph->m_mean,
+            "%d-D %s: mean nodal mass %.15g, serial %.15g", dim, mpm_shape_name(shape), ph->m_mean,
+            rsum / rcount);
+    const double mmin = fmax(ph->empty_fraction * ph->m_max, ph->light_fraction * ph->m_mean);
     long nempty = 0, nbad = 0;
     for (mpm_lidx l = 0; l < g->nnodes; ++l)
       for (int d = 0; d < dim; ++d) {
         const double m = ph->m_i[l], v = ph->v_i[d][l], a = ph->a_i[d][l];
-        if (m <= ph->empty_fraction * ph->m_max) {
+        if (m <= mmin) {
           nempty += m > 0 && d == 0;
           nbad += v != 0 || a != 0;
         } else {
@@ -186,9 +198,9 @@ static void run_case(int dim, mpm_shape_kind shape) {
     long sums[2] = {nempty, nbad};
     MPI_Allreduce(MPI_IN_PLACE, sums, 2, MPI_LONG, MPI_SUM, MPI_COMM_WORLD);
     CHECK(sums[1] == 0 && (pass == 0 || sums[0] > 0),
-          "%d-D %s: nodal solve with empty fraction %g: %ld wrong nodes, %ld nodes with mass "
-          "treated as empty",
-          dim, mpm_shape_name(shape), ph->empty_fraction, sums[1], sums[0]);
+          "%d-D %s: nodal solve with empty fraction %g, light fraction %g: %ld wrong nodes, "
+          "%ld nodes with mass treated as empty",
+          dim, mpm_shape_name(shape), ph->empty_fraction, ph->light_fraction, sums[1], sums[0]);
   }
   if (g->rank == 0)
     printf("%d-D %-9s ranks %d: max relative nodal difference %.2e, conservation %.2e\n", dim,
