@@ -175,7 +175,11 @@ void fluid_classic_transfer(mpm_module *m, const double *y, double h, const flui
       xp[d] = y[(size_t)(p->offset[FLUID_X] + d) * n + i], vF[d] = v[d] + h * acc[d];
     if (!fc->tr.apic && wall_keep(fc, g, xp, vF, keep))
       for (int d = 0; d < dim; ++d) {
-        const double damped = vn[d] - (1.0 - keep[d]) * (1.0 - fc->tr.pic) * vF[d];
+        double damped = vn[d] - (1.0 - keep[d]) * (1.0 - fc->tr.pic) * vF[d];
+        /* With a PIC share the blend may already point elsewhere: never push it further or
+         * past zero, so the heat is never negative (with FLIP alone, damped = keep vn). */
+        if (damped * vn[d] <= 0.0) damped = 0.0;
+        if (fabs(damped) > fabs(vn[d])) damped = vn[d];
         o->heat[i] += 0.5 * (vn[d] * vn[d] - damped * damped);
         vn[d] = damped;
       }
