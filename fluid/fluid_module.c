@@ -518,7 +518,8 @@ static int fluid_g2p(mpm_module *m, double t, const double *y, double *ydot, dou
   return 0;
 }
 
-/* After an accepted step: commit the ERK pairs' pending strain rate, then shift and regularise. */
+/* After an accepted step: commit the ERK pairs' pending strain rate and apply their wall rule,
+ * then shift and regularise. */
 static int fluid_post_step(mpm_module *m, double t, double h, int *changed) {
   fluid_content *fc = m->content;
   const mpm_particles *p = m->particles;
@@ -528,6 +529,7 @@ static int fluid_post_step(mpm_module *m, double t, double h, int *changed) {
            sizeof(double) * count);
   }
   MPM_CALL(fluid_obstacles_report(&fc->obs, m->grid, t, h));
+  if (!fc->tr.classic && !fc->tr.apic) *changed |= fluid_wall_rule_mol(m);
   fc->s_local = -1.0; /* a new step begins: its first stable-step estimate recomputes it */
   /* Shift first, then refill from the counts after the shift: a refill child keeps its cell,
    * and no shift empties a cell the refill just filled. */
@@ -589,7 +591,9 @@ static int fluid_check(const mpm_module *m, const double *y, mpm_fault *fault) {
   if (mpm_module_check_positions(m, y, fault)) return 1;
   const mpm_particles *p = m->particles;
   const double *J = state(p, y, FLUID_J), *e = state(p, y, FLUID_E);
-  for (mpm_lidx i = 0; i < p->n; ++i) {
+  int bad = 0; /* one pass without jumps, as mpm_module_check_positions */
+  for (mpm_lidx i = 0; i < p->n; ++i) bad |= (J[i] <= 0.0) | (e[i] <= 0.0);
+  for (mpm_lidx i = 0; bad && i < p->n; ++i) {
     if (J[i] <= 0.0)
       return mpm_fault_at(fault, p, y, i, "the gas volume collapsed (J = %.3g <= 0)", J[i]);
     if (e[i] <= 0.0)

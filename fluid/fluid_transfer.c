@@ -36,7 +36,12 @@
  * reads from the held nodes. A wall only pushes, so a particle moving away from it keeps its
  * velocity: damping that too (or pulling the particle towards sum S v^{n+1} both ways) took
  * 4 % (2 %) off the lift on the wedge's ramp, whose flow turns up at the floor. The kinetic
- * energy removed becomes the particle's heat, so the identities above still hold. */
+ * energy removed becomes the particle's heat, so the identities above still hold.
+ *
+ * The ERK pairs' method of lines has the same blind spot (dv/dt = sum S a_i), so after each
+ * of their accepted steps fluid_wall_rule_mol scales the velocity into a wall face in the same
+ * way (there is no PIC share there), once per step as in the classic update, the kinetic
+ * energy removed again becoming heat. */
 #include "fluid_internal.h"
 
 #include "mpm_kernels.h"
@@ -185,4 +190,26 @@ void fluid_classic_transfer(mpm_module *m, const double *y, double h, const flui
       }
     for (int d = 0; d < dim; ++d) o->vnew[d][i] = vn[d];
   }
+}
+
+int fluid_wall_rule_mol(mpm_module *m) {
+  const fluid_content *fc = m->content;
+  const mpm_particles *p = m->particles;
+  const mpm_grid *g = m->grid;
+  const int dim = p->dim;
+  double *e = mpm_particles_comp(p, FLUID_E, 0);
+  int any = 0;
+  for (mpm_lidx i = 0; i < p->n; ++i) {
+    double xp[MPM_MAX_DIM], v[MPM_MAX_DIM], keep[MPM_MAX_DIM];
+    for (int d = 0; d < dim; ++d)
+      xp[d] = mpm_particles_comp(p, FLUID_X, d)[i], v[d] = mpm_particles_comp(p, FLUID_V, d)[i];
+    if (!wall_keep(fc, g, xp, v, keep)) continue;
+    for (int d = 0; d < dim; ++d) {
+      const double vn = keep[d] * v[d];
+      e[i] += 0.5 * (v[d] * v[d] - vn * vn);
+      mpm_particles_comp(p, FLUID_V, d)[i] = vn;
+    }
+    any = 1;
+  }
+  return any;
 }

@@ -47,7 +47,7 @@ import supersonic_bar as sb  # noqa: E402
 check = mt.Checks("test_supersonic_bar")
 CASE = mt.case("supersonic_bar.ini")
 T = 0.0008
-ARGS = ["grid.dx=0.004", "geometry.base.hi=0.106 0.004", "output.interval=0.0004",
+ARGS = ["grid.dx=0.004", "output.interval=0.0004",
         "run.progress=false"]
 
 MODE = sys.argv[1] if len(sys.argv) > 1 else "smoke"

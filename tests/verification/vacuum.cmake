@@ -17,6 +17,10 @@ mpm_add_script_test(test_supersonic_bar SCRIPT verification/test_supersonic_bar.
 # Its bow shock, structurally: detached, and not at the inflow (see the header).
 mpm_add_script_test(test_supersonic_bar_standoff SCRIPT verification/test_supersonic_bar.py
                     ARGS standoff LABELS "verification;mpi" TIMEOUT 600)
+# The main job's bar alone: its first bending period converges to the Timoshenko value with
+# the case's clamp (the clamp once moved the root with dx).
+mpm_add_script_test(test_bar_clamp SCRIPT verification/test_bar_clamp.py LABELS verification
+                    TIMEOUT 300)
 # The rigid twin: the bar rigid under each coupling scheme against the gas-only scene with a
 # static obstacle, and both against the finite-volume Euler reference (bench/results). Label
 # long: four runs of the main job's scene, 3 minutes of the default selection's 11 on 2 cores;
