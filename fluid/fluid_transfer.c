@@ -200,7 +200,7 @@ int fluid_wall_rule_mol(mpm_module *m) {
   double *e = mpm_particles_comp(p, FLUID_E, 0);
   int any = 0;
   for (mpm_lidx i = 0; i < p->n; ++i) {
-    double xp[MPM_MAX_DIM], v[MPM_MAX_DIM], keep[MPM_MAX_DIM];
+    double xp[MPM_MAX_DIM] = {0}, v[MPM_MAX_DIM] = {0}, keep[MPM_MAX_DIM];
     for (int d = 0; d < dim; ++d)
       xp[d] = mpm_particles_comp(p, FLUID_X, d)[i], v[d] = mpm_particles_comp(p, FLUID_V, d)[i];
     if (!wall_keep(fc, g, xp, v, keep)) continue;
