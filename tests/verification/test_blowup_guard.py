@@ -20,7 +20,8 @@ elastic waves, energy 6.25e-8 J, no energy enters), 20 time units.
 4. A healthy run with default settings (bs32, default tolerances) completes: the guard does
    not fire on ordinary runs.
 5. The partitioned time schemes, where the guard sees coupling steps only: the main job's scene
-   at 6 mm (cases/supersonic_bar.ini, to 1 ms) with `traction` blows up under `multirate`
+   at 6 mm (cases/supersonic_bar.ini as it was then, to 1 ms; the keys that restore it are in
+   coupled_sections) with `traction` blows up under `multirate`
    (held and interpolated loads, usl) and with `contact` under `multirate` with musl, all at
    time.cfl = 0.4 (found by the ablation sweep). The gas is the fast module there: its stable step
    collapses inside one coupling step. Each run must stop with status 1 and one "blew up"
@@ -103,13 +104,18 @@ def bar_sections():
 
 def coupled_sections():
     """Section 5: blow-ups inside a coupling step."""
-    # Refill at each regularisation only (fluid.refill_every = 0) and no light nodes
-    # (fluid.light_node_mass = 0), as the case was when these blow-ups were found: with the
-    # case's refill at every step `contact multirate musl` runs to 1 ms without blowing up, and
-    # with its light_node_mass = 0.05 all three do.
+    # The scene as it was when these blow-ups were found: refill at each regularisation only
+    # (fluid.refill_every = 0), no light nodes (fluid.light_node_mass = 0), the single-particle
+    # stable step and the old clamp (the bar's lowest 1.5 mm). With the case's refill at every
+    # step `contact multirate musl` runs to 1 ms without blowing up, and with its
+    # light_node_mass = 0.05 all three do; with its neighbourhood step all three stop earlier on
+    # a state check instead (a particle's J < 0 after 8 retries: status 1 and one clear line,
+    # but not the guard this section tests); with its floor clamp and the single-particle step
+    # all three complete.
     main = ["grid.dx=0.006", "time.t_end=0.001", "output.interval=1e9", "coupling.time=multirate",
             "time.cfl=0.4", "run.progress=false", "fluid.refill_every=0",
-            "fluid.light_node_mass=0"]
+            "fluid.light_node_mass=0", "fluid.stable_step=particle",
+            "geometry.base.hi=0.106 0.0015"]
     for label, extra in (("traction multirate held",
                           ["coupling.scheme=traction", "coupling.load=held"]),
                          ("traction multirate interpolated",
