@@ -76,12 +76,20 @@ def measure(out):
 
 
 def tip_hist(r):
-    """A row's tip history on T_HIST (rows measured before it was kept: from the output)."""
+    """A row's tip history on T_HIST; None for a row stored without one (measured before the
+    history was kept) whose output folder is gone."""
     if "tip_hist" not in r:
-        pr = np.genfromtxt(os.path.join(OUT, r["name"], "probes.csv"), delimiter=",",
-                           names=True)
+        path = os.path.join(OUT, r["name"], "probes.csv")
+        if not os.path.exists(path):
+            return None
+        pr = np.genfromtxt(path, delimiter=",", names=True)
         r["tip_hist"] = np.interp(T_HIST, pr["t"], pr["tip_ux"]).tolist()
     return np.array(r["tip_hist"])
+
+
+def rms(a, b):
+    """1e3 times the RMS difference of two tip histories (mm); None if either is missing."""
+    return None if a is None or b is None else 1e3 * float(np.sqrt(np.mean((a - b)**2)))
 
 
 def stop_message(log, out, code):
@@ -166,11 +174,10 @@ def successive(rows):
     for key in sorted({(r["scheme"], r["method"]) for r in rows if r["ok"]}):
         runs = sorted((r for r in rows if r["ok"] and (r["scheme"], r["method"]) == key),
                       key=lambda r: -r["dx"])
-        d = [1e3 * float(np.sqrt(np.mean((tip_hist(a) - tip_hist(b))**2)))
-             for a, b in zip(runs, runs[1:])]
+        d = [rms(tip_hist(a), tip_hist(b)) for a, b in zip(runs, runs[1:])]
         for k, (a, b) in enumerate(zip(runs, runs[1:])):
             order = (observed_order([r["dx"] for r in runs[k - 1:k + 2]], d[k - 1:k + 1])
-                     if k > 0 else None)
+                     if k > 0 and None not in d[k - 1:k + 1] else None)
             out.append([key[0], key[1], f"{1e3 * a['dx']:g} - {1e3 * b['dx']:g}", d[k],
                         1e3 * abs(a["tip_ux_1p5ms"] - b["tip_ux_1p5ms"]),
                         1e3 * abs(at(a["standoff"], 0.003) - at(b["standoff"], 0.003)),
@@ -201,9 +208,10 @@ def report(rows):
             if f is not None and f is not r:
                 e["tip_err_mm"] = 1e3 * abs(r["tip_ux_1p5ms"] - f["tip_ux_1p5ms"])
                 e["standoff_err_mm"] = 1e3 * abs(so3 - at(f["standoff"], 0.003))
-                d = tip_hist(r) - tip_hist(f)
-                e["tip_hist_rms_err_mm"] = 1e3 * float(np.sqrt(np.mean(d**2)))
-                e["tip_hist_max_err_mm"] = 1e3 * float(np.abs(d).max())
+                a, b = tip_hist(r), tip_hist(f)
+                e["tip_hist_rms_err_mm"] = rms(a, b)
+                if a is not None and b is not None:
+                    e["tip_hist_max_err_mm"] = 1e3 * float(np.abs(a - b).max())
         else:
             e["message"] = r["message"]
         table.append(e)
@@ -257,7 +265,8 @@ def report(rows):
         if not pts:
             continue
         w = [e["wall_s"] for e in pts]
-        axes[0].loglog(w, [max(e["tip_hist_rms_err_mm"], 1e-3) for e in pts], mark + "-",
+        axes[0].loglog(w, [max(e.get("tip_hist_rms_err_mm") or np.nan, 1e-3) for e in pts],
+                       mark + "-",
                        label=f"{scheme} {method}")
         axes[1].loglog(w, [max(e["standoff_err_mm"], 1e-2) for e in pts], mark + "-",
                        label=f"{scheme} {method}")
