@@ -116,7 +116,11 @@ typedef struct {
 } sbuf;
 
 static void sb_add(sbuf *b, const char *s, size_t n) {
-  if (b->failed) return;
+  /* (No text is half the address space long; saying so spares -O3 a bound it cannot prove.) */
+  if (b->failed || n > PTRDIFF_MAX / 2) {
+    b->failed = 1;
+    return;
+  }
   if (b->len + n + 1 > b->cap) {
     size_t cap = b->cap ? b->cap : 64;
     while (cap < b->len + n + 1) cap *= 2;
@@ -1316,10 +1320,10 @@ int mpm_config_set_off_default(const mpm_config *cfg, const mpm_key_spec *sp) {
   if (!mpm_config_has(cfg, sp->key)) return 0;
   if (!sp->def) return 1;
   if (sp->type == MPM_KEY_REAL || sp->type == MPM_KEY_INT) {
-    double v;
+    double v = 0.0;
     return mpm_config_get_real(cfg, sp->key, &v) != 0 || v != strtod(sp->def, NULL);
   }
-  const char *v;
+  const char *v = NULL;
   return mpm_config_get_string(cfg, sp->key, &v) != 0 || strcmp(v, sp->def) != 0;
 }
 

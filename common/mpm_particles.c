@@ -7,6 +7,8 @@
  *   id and data always change together. The block replaced is kept as the spare and reused
  *   by the next replacement that fits in it (block_get()): a pointer into the block is
  *   valid only until the next edit, migration or sort.
+ * - A derived field (mpm_particles_set_derived) is not moved by an edit or a sort: its values
+ *   are undefined after one until the module that owns it fills it again.
  * - Ids are unique over all ranks and never reused: id_next exceeds every id handed out
  *   and is equal on every rank (inject() advances it by the global count on every rank).
  * - Migration first wraps positions that left through a periodic face back into [lo, hi)
@@ -37,8 +39,8 @@ static int check_fields(int dim, const mpm_field_desc *fields, int nfields, int 
   if (fields[0].ncomp != dim || fields[1].ncomp != dim)
     MPM_FAIL(MPM_ERR_INPUT, "particles: fields 0 and 1 (x and v) need %d components", dim);
   for (int f = 0; f < nfields; ++f) {
-    if (!fields[f].name || !fields[f].name[0] || fields[f].ncomp < 1)
-      MPM_FAIL(MPM_ERR_INPUT, "particles: field %d needs a name and at least one component", f);
+    if (!fields[f].name || !fields[f].name[0] || fields[f].ncomp < 1 || fields[f].ncomp > 9)
+      MPM_FAIL(MPM_ERR_INPUT, "particles: field %d needs a name and 1 to 9 components", f);
     for (int e = 0; e < f; ++e)
       if (strcmp(fields[e].name, fields[f].name) == 0)
         MPM_FAIL(MPM_ERR_INPUT, "particles: field '%s' is listed twice", fields[f].name);
@@ -134,10 +136,26 @@ static mpm_lidx count_kept(const mpm_particles *p, const unsigned char *keep) {
   return k;
 }
 
+/* The components an edit or a sort moves, those of the fields that are not derived, into
+ * comp; returns their number. */
+static int moved_components(const mpm_particles *p, int *comp) {
+  int n = 0;
+  for (int f = 0; f < p->nfields; ++f)
+    for (int c = 0; !(p->derived >> f & 1u) && c < p->field[f].ncomp; ++c)
+      comp[n++] = p->offset[f] + c;
+  return n;
+}
+
+void mpm_particles_set_derived(mpm_particles *p, int f) {
+  if (f >= 0 && f < p->nfields) p->derived |= 1u << f;
+}
+
 /* Copy the kept particles, in order, to the front of a block whose components are nnew
  * apart. Runs of kept particles go by memcpy: an edit or a migration keeps nearly all. */
 static void copy_kept(const mpm_particles *p, const unsigned char *keep, mpm_lidx nnew,
                       mpm_gidx *id, double *data) {
+  int comp[MPM_PARTICLES_MAX_COMPONENTS];
+  const int nmoved = moved_components(p, comp);
   mpm_lidx k = 0;
   for (mpm_lidx i = 0; i < p->n;) {
     mpm_lidx j = i;
@@ -145,9 +163,11 @@ static void copy_kept(const mpm_particles *p, const unsigned char *keep, mpm_lid
     const size_t run = (size_t)(j - i);
     if (run) {
       memcpy(id + k, p->id + i, run * sizeof *id);
-      for (int c = 0; c < p->ncomp; ++c)
-        memcpy(data + (size_t)c * (size_t)nnew + (size_t)k, p->data + (size_t)c * (size_t)p->n + i,
+      for (int q = 0; q < nmoved; ++q) {
+        const size_t c = (size_t)comp[q];
+        memcpy(data + c * (size_t)nnew + (size_t)k, p->data + c * (size_t)p->n + i,
                run * sizeof *data);
+      }
     }
     k += (mpm_lidx)run;
     for (i = j; i < p->n && keep && !keep[i];) ++i; /* the dropped run */
@@ -427,7 +447,10 @@ static int apply_permutation(mpm_particles *p, const mpm_lidx *perm) {
   mpm_lidx cap;
   MPM_CALL(block_get(p, p->n, &id, &data, &cap));
   for (mpm_lidx k = 0; k < p->n; ++k) id[k] = p->id[perm[k]];
-  for (int c = 0; c < p->ncomp; ++c) {
+  int comp[MPM_PARTICLES_MAX_COMPONENTS];
+  const int nmoved = moved_components(p, comp);
+  for (int q = 0; q < nmoved; ++q) {
+    const int c = comp[q];
     const double *src = p->data + (size_t)c * (size_t)p->n;
     double *dst = data + (size_t)c * (size_t)p->n;
     for (mpm_lidx k = 0; k < p->n; ++k) dst[k] = src[perm[k]];

@@ -19,6 +19,8 @@
 #include <stddef.h>
 
 #define MPM_PARTICLES_MAX_FIELDS 16
+/* Components of all fields at most (a field has at most dim^2 = 9). */
+#define MPM_PARTICLES_MAX_COMPONENTS (MPM_PARTICLES_MAX_FIELDS * 9)
 
 typedef struct mpm_field_desc {
   const char *name;
@@ -53,6 +55,7 @@ typedef struct mpm_particles {
   double *spare_data;
   mpm_gidx id_next;                                /* next free global id; equal on every rank */
   mpm_field_range range[MPM_PARTICLES_MAX_FIELDS]; /* all reals unless the module narrows it */
+  unsigned derived; /* bit f: field f is derived (mpm_particles_set_derived) */
 } mpm_particles;
 
 /* A set with no particles. The first nstate_fields fields are the state; fields 0 and 1
@@ -91,6 +94,11 @@ int mpm_particles_sort(mpm_particles *p, const mpm_grid *grid);
 /* Narrow the valid values of field f (see mpm_field_range); the module that owns the set
  * says what its fields mean. */
 void mpm_particles_set_range(mpm_particles *p, int f, double lo, double hi, int flags);
+
+/* Mark field f as derived: the module recomputes it from the other fields before every use
+ * (an output field, filled just before a snapshot), so its values need not survive an edit, a
+ * sort or a migration, and those leave them undefined instead of moving them. */
+void mpm_particles_set_derived(mpm_particles *p, int f);
 
 /* Check n particles given as ids and component-major data (stride n) in p's layout: every
  * id >= 0 (ids beyond id_next are legal: the gas's inflow hands out its own ranges) and

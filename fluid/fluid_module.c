@@ -752,7 +752,11 @@ static int particles_new(mpm_particles **p, int dim, fluid_layout *lay, int apic
   lay->f_mach = nf, f[nf++] = (mpm_field_desc){"mach", 1};
   lay->f_T = nf, f[nf++] = (mpm_field_desc){"T", 1};
   lay->f_s = nf, f[nf++] = (mpm_field_desc){"s", 1};
-  return mpm_particles_new(p, dim, f, nf, nstate);
+  MPM_CALL(mpm_particles_new(p, dim, f, nf, nstate));
+  /* The output fields are filled just before a snapshot (fluid_output.c): edits, sorts and
+   * migrations need not move them. */
+  for (int k = lay->f_rho; k <= lay->f_s; ++k) mpm_particles_set_derived(*p, k);
+  return 0;
 }
 
 static int build(mpm_module *m, const mpm_config *cfg, int seed) {

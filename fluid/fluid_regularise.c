@@ -134,6 +134,23 @@ static mpm_lidx *cells_of(const reg_box *b, const mpm_particles *p) {
   return cell;
 }
 
+/* The local cells of the particles (cells_of), found once per event: the refill's donors and
+ * the merges that follow read the same map, which the refill extends by its children. cell is
+ * NULL until some pass needs it; valid for particles [0, n) as they are. */
+typedef struct reg_cellmap {
+  mpm_lidx *cell;
+  mpm_lidx n;
+} reg_cellmap;
+
+/* The map of the set as it is now (computed if absent or stale), or NULL on failure. */
+static const mpm_lidx *cellmap_get(reg_cellmap *map, const reg_box *b, const mpm_particles *p) {
+  if (map->cell && map->n == p->n) return map->cell;
+  free(map->cell);
+  map->cell = cells_of(b, p);
+  map->n = map->cell ? p->n : 0;
+  return map->cell;
+}
+
 /* Particle indices grouped by local cell (cell[i]: particle i's, from cells_of): cell l holds
  * perm[start[l] .. start[l + 1]), in index order. With a mask, only the cells l with
  * mask[l] != 0 hold their particles. */
@@ -409,7 +426,8 @@ static int light_cells(const fluid_content *fc, const mpm_particles *p, const mp
 
 /* The local part of one event: with counts, every cell's light merges and count rules; without,
  * the light merges of the cells that need one. */
-static int regularise_local(mpm_module *m, reg_edit *e, mpm_gidx id_base, int counts) {
+static int regularise_local(mpm_module *m, reg_edit *e, mpm_gidx id_base, int counts,
+                            reg_cellmap *map) {
   const fluid_content *fc = m->content;
   mpm_particles *p = m->particles;
   reg_box b;
@@ -418,10 +436,10 @@ static int regularise_local(mpm_module *m, reg_edit *e, mpm_gidx id_base, int co
   for (int d = 0; d < b.dim; ++d) ncell *= b.nc[d];
   reg_cell c = {0};
   unsigned char *mask = counts ? NULL : malloc((size_t)ncell);
-  mpm_lidx *cell = cells_of(&b, p);
+  const mpm_lidx *cell = cellmap_get(map, &b, p);
   e->keep = malloc((size_t)(p->n ? p->n : 1));
   if (!cell || !e->keep || (!counts && !mask)) {
-    free(mask), free(cell);
+    free(mask);
     MPM_FAIL(MPM_ERR_MEMORY, "regularise: cannot group %d particles by cell", (int)p->n);
   }
   memset(e->keep, 1, (size_t)p->n);
@@ -432,7 +450,7 @@ static int regularise_local(mpm_module *m, reg_edit *e, mpm_gidx id_base, int co
                          counts, &c, e);
   /* Light merges and splits in pairs leave the count: those rows went back in place. */
   if (!rc && (e->nadd > 0 || e->drops > 0)) rc = edit_apply(p, e);
-  free(mask), free(cell), free(start), free(perm), free(c.row), free(c.id), free(c.slot);
+  free(mask), free(start), free(perm), free(c.row), free(c.id), free(c.slot);
   return rc;
 }
 
@@ -519,16 +537,26 @@ static int refill_split(mpm_module *m, const mpm_lidx *perm, int k, const int *e
  * a refill that finds no target (a flow with no near vacuum) groups none. Returns the number
  * of donors. */
 static mpm_lidx mark_donors(const mpm_module *m, const reg_box *b, unsigned char *mark) {
-  const int dim = m->grid->dim;
-  mpm_lidx total = 1, ndonor = 0;
+  const mpm_grid *g = m->grid;
+  const int dim = g->dim;
+  mpm_lidx total = 1, ndonor = 0, stride[MPM_MAX_DIM] = {1, 1, 1};
   for (int d = 0; d < dim; ++d) total *= b->nc[d];
+  for (int d = 1; d < dim; ++d) stride[d] = stride[d - 1] * g->box_n[d - 1];
   for (mpm_lidx l = 0; l < total; ++l) {
     int c[MPM_MAX_DIM] = {0};
     mpm_lidx r = l;
     for (int d = 0; d < dim; ++d) c[d] = b->c0[d] + (int)(r % b->nc[d]), r /= b->nc[d];
     mark[l] = 0;
     if (!(gas_count(m, c) > 0.0)) continue;
+    const mpm_lidx lc = mpm_grid_local_index(g, c);
     for (int q = 0; q < 2 * dim; ++q) {
+      /* Most neighbours hold particles and so are no target: a look at the counts in the box
+       * (the ghost layers hold the cells next to the owned ones) rejects them first. */
+      const mpm_lidx le = lc + (q % 2 ? stride[q / 2] : -stride[q / 2]);
+      int occupied = 0;
+      for (int k = 0; k < g->nphases && !occupied; ++k)
+        occupied = g->phase[k].cell_n && g->phase[k].cell_n[le] > 0.0;
+      if (occupied) continue;
       int e[MPM_MAX_DIM] = {0};
       memcpy(e, c, sizeof e);
       e[q / 2] += q % 2 ? 1 : -1;
@@ -541,7 +569,7 @@ static mpm_lidx mark_donors(const mpm_module *m, const reg_box *b, unsigned char
 
 /* This rank's part of a refill: each owned cell holding gas gives to the targets that chose
  * it. Returns the number of children in ed->nadd. */
-static int refill_local(mpm_module *m, reg_edit *ed, mpm_gidx id_base) {
+static int refill_local(mpm_module *m, reg_edit *ed, mpm_gidx id_base, reg_cellmap *map) {
   mpm_particles *p = m->particles;
   const mpm_grid *g = m->grid;
   reg_box b;
@@ -551,10 +579,10 @@ static int refill_local(mpm_module *m, reg_edit *ed, mpm_gidx id_base) {
   unsigned char *donor;
   MPM_ALLOC(donor, ncell);
   mpm_lidx *start = NULL, *perm = NULL;
-  mpm_lidx *cell = NULL;
   int rc = 0;
   if (mark_donors(m, &b, donor)) {
-    if (!(cell = cells_of(&b, p))) {
+    const mpm_lidx *cell = cellmap_get(map, &b, p);
+    if (!cell) {
       free(donor);
       MPM_FAIL(MPM_ERR_MEMORY, "refill: cannot group %d particles by cell", (int)p->n);
     }
@@ -574,15 +602,15 @@ static int refill_local(mpm_module *m, reg_edit *ed, mpm_gidx id_base) {
       rc = refill_split(m, perm + start[l], k, e, id_base + cell_index(g, e), ed);
     }
   }
-  free(donor), free(cell), free(start), free(perm);
+  free(donor), free(start), free(perm);
   return rc;
 }
 
 /* One refill over all ranks: split, append, migrate. Returns the global number of children. */
-static int refill(mpm_module *m, double *children, int *changed) {
+static int refill(mpm_module *m, double *children, int *changed, reg_cellmap *map) {
   mpm_particles *p = m->particles;
   reg_edit ed = {0};
-  int rc = refill_local(m, &ed, p->id_next);
+  int rc = refill_local(m, &ed, p->id_next, map);
   /* A child lands in a cell next to its donor's: on another rank (or across a periodic face)
    * only at the edge of this rank's box. Migration is needed only for those. */
   mpm_lidx away = 0;
@@ -592,7 +620,19 @@ static int refill(mpm_module *m, double *children, int *changed) {
   if (!rc && ed.nadd) {
     MPM_ALLOC(ed.keep, p->n);
     memset(ed.keep, 1, (size_t)p->n);
+    const mpm_lidx n0 = p->n;
     rc = edit_apply(p, &ed);
+    /* The children follow the kept particles: extend the map by their cells (a child bound
+     * for another rank is migrated below, which makes the map stale anyway). */
+    mpm_lidx *grown = !rc && map->cell && map->n == n0 && !away
+                          ? realloc(map->cell, sizeof *map->cell * (size_t)p->n)
+                          : NULL;
+    if (grown) {
+      reg_box b;
+      box_of(&b, m->grid);
+      for (mpm_lidx i = n0; i < p->n; ++i) grown[i] = local_cell(&b, p, i);
+      map->cell = grown, map->n = p->n;
+    }
   }
   double sum[3] = {rc != 0, (double)ed.nadd, (double)away};
   free(ed.keep), free(ed.add), free(ed.add_id);
@@ -605,7 +645,10 @@ static int refill(mpm_module *m, double *children, int *changed) {
   for (int d = 0; d < m->grid->dim; ++d) cells *= m->grid->ncells[d];
   p->id_next += cells;
   int migrated = 0;
-  if (sum[2] > 0) MPM_CALL(mpm_particles_migrate(p, m->grid, &migrated));
+  if (sum[2] > 0) { /* the set changes on every rank that sends or receives: drop the map */
+    free(map->cell), map->cell = NULL, map->n = 0;
+    MPM_CALL(mpm_particles_migrate(p, m->grid, &migrated));
+  }
   *changed = 1;
   return 0;
 }
@@ -629,9 +672,11 @@ int fluid_regularise(mpm_module *m, long step, int *changed) {
   double children = 0.0;
   const int logged = mpm_log_get_level() >= MPM_LOG_DEBUG; /* the totals are for the log only */
   if (logged) totals(m, sum + 3);
-  if (fill) MPM_CALL(refill(m, &children, changed));
+  reg_cellmap map = {0};
+  int rc = fill ? refill(m, &children, changed, &map) : 0;
   const int light = fc->merge_light > 0.0;
-  const int rc = merge_split || light ? regularise_local(m, &e, p->id_next, merge_split) : 0;
+  if (!rc && (merge_split || light)) rc = regularise_local(m, &e, p->id_next, merge_split, &map);
+  free(map.cell);
   sum[0] = rc != 0, sum[1] = (double)e.splits, sum[2] = (double)e.merges;
   if (logged) totals(m, sum + 8);
   free(e.keep), free(e.add), free(e.add_id);

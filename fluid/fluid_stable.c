@@ -49,7 +49,7 @@ static void deposit(const mpm_module *m, double *const *sum) {
       v2 += v * v;
       c[d] = mpm_cells_coord(g, d, mpm_particles_comp(p, FLUID_X, d)[i]);
     }
-    const double rho = mass[i] / (V0[i] * J[i]);
+    const double rho = fc->gas.mu > 0.0 ? mass[i] / (V0[i] * J[i]) : 1.0; /* only mu needs it */
     const double cs = sqrt(gamma * (gamma - 1.0) * fabs(e[i]));
     const double s = cs + fluid_viscous_speed(&fc->gas, rho, cs, divv[i], dx);
     const mpm_lidx l = mpm_grid_local_index(g, c);

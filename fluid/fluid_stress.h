@@ -41,7 +41,7 @@ static inline double fluid_av_pressure(const fluid_gas *g, double rho, double c,
  * physical ((4/3) mu / rho) viscous terms, the explicit diffusion limit written as a speed. */
 static inline double fluid_viscous_speed(const fluid_gas *g, double rho, double c, double divv,
                                          double dx) {
-  double nu = 4.0 / 3.0 * g->mu / rho;
+  double nu = g->mu > 0.0 ? 4.0 / 3.0 * g->mu / rho : 0.0; /* (rho is only read if mu > 0) */
   if (divv < 0.0) nu += g->l * (g->av_lin * c - g->av_quad * g->l * divv);
   return 2.0 * nu / dx;
 }

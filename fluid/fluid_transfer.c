@@ -115,29 +115,56 @@ static double new_velocity(const fluid_content *fc, int dim, double h, const dou
   return heat;
 }
 
+/* The wall faces the rule of the file comment acts on (slip and no-slip), each with the band
+ * of positions its nodes reach, found once per pass: most particles are far from every wall,
+ * and a comparison with the band's edges rejects them without the division below. */
+typedef struct wall_face {
+  int ax, side, no_slip, F; /* F: the face's node index along ax */
+  double lo, hi;            /* a particle outside (lo, hi) along ax has no weight on it */
+} wall_face;
+
+typedef struct wall_faces {
+  int n;
+  wall_face f[2 * MPM_MAX_DIM];
+} wall_faces;
+
+static void wall_faces_of(const fluid_content *fc, const mpm_grid *g, wall_faces *w) {
+  /* The band is a little wider than the reach, so that roundoff in the comparison never
+   * rejects a particle the exact test in wall_keep would keep. */
+  const double reach = (0.5 * mpm_shape_support(g->shape) + fc->lp) * (1.0 + 1e-9) * g->dx;
+  w->n = 0;
+  for (int ax = 0; ax < g->dim; ++ax)
+    for (int side = 0; side < 2; ++side) {
+      const mpm_wall k = fc->walls.face[ax][side];
+      if (k != MPM_WALL_SLIP && k != MPM_WALL_NO_SLIP) continue;
+      const int F = side ? g->ncells[ax] : 0;
+      const double x = g->lo[ax] + F * g->dx;
+      w->f[w->n++] = (wall_face){ax, side, k == MPM_WALL_NO_SLIP, F, x - reach, x + reach};
+    }
+}
+
 /* The wall rule of the file comment: into keep[d], the factor on the FLIP share of velocity
  * component d of a particle at xp (1 away from the walls). Returns whether any is below 1. */
-static int wall_keep(const fluid_content *fc, const mpm_grid *g, const double *xp, const double *vF,
-                     double *keep) {
+static int wall_keep(const fluid_content *fc, const mpm_grid *g, const wall_faces *w,
+                     const double *xp, const double *vF, double *keep) {
   const int dim = g->dim;
   const double reach = 0.5 * mpm_shape_support(g->shape) + fc->lp;
   int any = 0;
   for (int d = 0; d < dim; ++d) keep[d] = 1.0;
-  for (int ax = 0; ax < dim; ++ax)
-    for (int side = 0; side < 2; ++side) {
-      const mpm_wall k = fc->walls.face[ax][side];
-      if (k != MPM_WALL_SLIP && k != MPM_WALL_NO_SLIP) continue;
-      const int F = side ? g->ncells[ax] : 0; /* the face's node index along ax */
-      const double xi = (xp[ax] - g->lo[ax]) / g->dx;
-      if (fabs(xi - F) >= reach) continue;
-      double w[MPM_SHAPE_MAX_SUPPORT], dw[MPM_SHAPE_MAX_SUPPORT];
-      const int s = F - mpm_shape_1d(g->shape, xi, fc->lp, w, dw);
-      if (s < 0 || s >= MPM_SHAPE_MAX_SUPPORT || w[s] <= 0.0) continue;
-      for (int d = 0; d < dim; ++d) {
-        const int into = side ? vF[d] > 0.0 : vF[d] < 0.0; /* the normal: only into the wall */
-        if ((d == ax && into) || (d != ax && k == MPM_WALL_NO_SLIP)) keep[d] *= 1.0 - w[s], any = 1;
-      }
+  for (int q = 0; q < w->n; ++q) {
+    const wall_face *f = &w->f[q];
+    const int ax = f->ax;
+    if (!(xp[ax] > f->lo && xp[ax] < f->hi)) continue;
+    const double xi = (xp[ax] - g->lo[ax]) / g->dx;
+    if (fabs(xi - f->F) >= reach) continue;
+    double wt[MPM_SHAPE_MAX_SUPPORT], dw[MPM_SHAPE_MAX_SUPPORT];
+    const int s = f->F - mpm_shape_1d(g->shape, xi, fc->lp, wt, dw);
+    if (s < 0 || s >= MPM_SHAPE_MAX_SUPPORT || wt[s] <= 0.0) continue;
+    for (int d = 0; d < dim; ++d) {
+      const int into = f->side ? vF[d] > 0.0 : vF[d] < 0.0; /* the normal: only into the wall */
+      if ((d == ax && into) || (d != ax && f->no_slip)) keep[d] *= 1.0 - wt[s], any = 1;
     }
+  }
   return any;
 }
 
@@ -156,6 +183,8 @@ void fluid_classic_transfer(mpm_module *m, const double *y, double h, const flui
   }
   for (int j = 0; j < 3; ++j) sc[j] = fc->tscratch + (size_t)(dim + j) * n;
   mpm_g2p_args a = {.n = n, .lp = fc->lp, .L_out = o->L, .C_out = o->C};
+  wall_faces w;
+  wall_faces_of(fc, g, &w);
   for (int d = 0; d < dim; ++d) {
     a.x[d] = y + (size_t)(p->offset[FLUID_X] + d) * n;
     a.v_i[d] = vbar[d];
@@ -178,7 +207,7 @@ void fluid_classic_transfer(mpm_module *m, const double *y, double h, const flui
     double xp[MPM_MAX_DIM], vF[MPM_MAX_DIM], keep[MPM_MAX_DIM];
     for (int d = 0; d < dim; ++d)
       xp[d] = y[(size_t)(p->offset[FLUID_X] + d) * n + i], vF[d] = v[d] + h * acc[d];
-    if (!fc->tr.apic && wall_keep(fc, g, xp, vF, keep))
+    if (!fc->tr.apic && wall_keep(fc, g, &w, xp, vF, keep))
       for (int d = 0; d < dim; ++d) {
         double damped = vn[d] - (1.0 - keep[d]) * (1.0 - fc->tr.pic) * vF[d];
         /* With a PIC share the blend may already point elsewhere: never push it further or
@@ -198,12 +227,14 @@ int fluid_wall_rule_mol(mpm_module *m) {
   const mpm_grid *g = m->grid;
   const int dim = p->dim;
   double *e = mpm_particles_comp(p, FLUID_E, 0);
+  wall_faces w;
+  wall_faces_of(fc, g, &w);
   int any = 0;
-  for (mpm_lidx i = 0; i < p->n; ++i) {
+  for (mpm_lidx i = 0; w.n > 0 && i < p->n; ++i) {
     double xp[MPM_MAX_DIM] = {0}, v[MPM_MAX_DIM] = {0}, keep[MPM_MAX_DIM];
     for (int d = 0; d < dim; ++d)
       xp[d] = mpm_particles_comp(p, FLUID_X, d)[i], v[d] = mpm_particles_comp(p, FLUID_V, d)[i];
-    if (!wall_keep(fc, g, xp, v, keep)) continue;
+    if (!wall_keep(fc, g, &w, xp, v, keep)) continue;
     for (int d = 0; d < dim; ++d) {
       const double vn = keep[d] * v[d];
       e[i] += 0.5 * (v[d] * v[d] - vn * vn);
