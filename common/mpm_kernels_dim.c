@@ -202,12 +202,17 @@ static void DIMFN(p2g)(mpm_grid *g, int phase, const mpm_p2g_args *a) {
 /* ---- G2P ---------------------------------------------------------------------------------- */
 
 /* With apic_b (a literal) the loop also sums S v_i (x_i - x_p)^T, the B-spline APIC moment:
- * C_p = D^-1 times that sum, from sum_i S (x_i - x_p)(x_i - x_p)^T = D I. */
+ * C_p = D^-1 times that sum, from sum_i S (x_i - x_p)(x_i - x_p)^T = D I. nsc is the number
+ * of extra scalars when it is a literal (0 or 1, the common cases: the sums then stay in
+ * registers), or -1 to read it from a. */
 MPM_INLINE void DIMFN(g2p_loop)(const DIMFN(lattice) * L, const mpm_g2p_args *a,
-                                mpm_shape_kind kind, int apic_b) {
+                                mpm_shape_kind kind, int apic_b, int nsc) {
   enum { D = MPM_DIM };
   const int S = SUPPORT(kind);
   const size_t n = (size_t)a->n;
+  const int nscalar = nsc >= 0 ? nsc : a->nscalar;
+  const double *restrict s_i[MPM_KERNELS_MAX_SCALARS] = {NULL};
+  for (int q = 0; q < nscalar; ++q) s_i[q] = a->s_i[q];
   const double Dinv = (kind == MPM_SHAPE_CUBIC ? 3.0 : 4.0) * L->inv_dx * L->inv_dx;
   const double *restrict xp[D], *restrict vi[D], *restrict ai[D];
   double *restrict vout[D], *restrict aout[D];
@@ -251,9 +256,9 @@ MPM_INLINE void DIMFN(g2p_loop)(const DIMFN(lattice) * L, const mpm_g2p_args *a,
             if (apic_b) sr[d] += wrx[i] * vn;
           }
         const double wyz = wy[j] * wz, dwyz = dwy[j] * wz;
-        for (int q = 0; q < a->nscalar; ++q) { /* extra nodal scalars (rare: a runtime count) */
+        for (int q = 0; q < nscalar; ++q) { /* extra nodal scalars */
           double ss = 0.0;
-          for (int i = 0; i < S; ++i) ss += wx[i] * a->s_i[q][row + i];
+          for (int i = 0; i < S; ++i) ss += wx[i] * s_i[q][row + i];
           sc[q] += wyz * ss;
         }
         for (int d = 0; d < D; ++d) {
@@ -275,7 +280,7 @@ MPM_INLINE void DIMFN(g2p_loop)(const DIMFN(lattice) * L, const mpm_g2p_args *a,
       }
     }
     for (int d = 0; d < D; ++d) vout[d][p] = v[d], aout[d][p] = acc[d];
-    for (int q = 0; q < a->nscalar; ++q) a->s_out[q][p] = sc[q];
+    for (int q = 0; q < nscalar; ++q) a->s_out[q][p] = sc[q];
     if (Lout)
       for (int r = 0; r < D; ++r)
         for (int c = 0; c < D; ++c) Lout[(size_t)(r * D + c) * n + p] = Lg[r][c];
@@ -302,22 +307,26 @@ static void DIMFN(g2p)(const mpm_grid *g, const mpm_g2p_args *a) {
   const int apic_b = a->C_out != NULL;
   switch (g->shape) {
   case MPM_SHAPE_LINEAR:
-    DIMFN(g2p_loop)(&L, a, MPM_SHAPE_LINEAR, 0);
+    DIMFN(g2p_loop)(&L, a, MPM_SHAPE_LINEAR, 0, -1);
     break;
   case MPM_SHAPE_GIMP:
-    DIMFN(g2p_loop)(&L, a, MPM_SHAPE_GIMP, 0);
+    DIMFN(g2p_loop)(&L, a, MPM_SHAPE_GIMP, 0, -1);
     break;
-  case MPM_SHAPE_QUADRATIC:
+  case MPM_SHAPE_QUADRATIC: /* the gas's FLIP update reads one scalar (fluid_transfer.c) */
     if (apic_b)
-      DIMFN(g2p_loop)(&L, a, MPM_SHAPE_QUADRATIC, 1);
+      DIMFN(g2p_loop)(&L, a, MPM_SHAPE_QUADRATIC, 1, -1);
+    else if (a->nscalar == 1)
+      DIMFN(g2p_loop)(&L, a, MPM_SHAPE_QUADRATIC, 0, 1);
+    else if (a->nscalar == 0)
+      DIMFN(g2p_loop)(&L, a, MPM_SHAPE_QUADRATIC, 0, 0);
     else
-      DIMFN(g2p_loop)(&L, a, MPM_SHAPE_QUADRATIC, 0);
+      DIMFN(g2p_loop)(&L, a, MPM_SHAPE_QUADRATIC, 0, -1);
     break;
   default:
     if (apic_b)
-      DIMFN(g2p_loop)(&L, a, MPM_SHAPE_CUBIC, 1);
+      DIMFN(g2p_loop)(&L, a, MPM_SHAPE_CUBIC, 1, -1);
     else
-      DIMFN(g2p_loop)(&L, a, MPM_SHAPE_CUBIC, 0);
+      DIMFN(g2p_loop)(&L, a, MPM_SHAPE_CUBIC, 0, -1);
     break;
   }
 }
