@@ -3,6 +3,7 @@
 
 #include "mpm_error.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -68,7 +69,12 @@ int mpm_module_check_positions(const mpm_module *m, const double *y, mpm_fault *
   const mpm_particles *p = m->particles;
   const mpm_grid *g = m->grid;
   const mpm_lidx n = p->n;
-  for (size_t k = 0; k < (size_t)p->nstate * (size_t)n; ++k)
+  /* One pass without jumps (|y| <= DBL_MAX is false for NaN and Inf alike); the culprit is
+   * found only when there is one. */
+  const size_t total = (size_t)p->nstate * (size_t)n;
+  int nonfinite = 0;
+  for (size_t k = 0; k < total; ++k) nonfinite |= !(fabs(y[k]) <= DBL_MAX);
+  for (size_t k = 0; nonfinite && k < total; ++k)
     if (!isfinite(y[k]))
       return mpm_fault_at(fault, p, y, (mpm_lidx)(k % (size_t)(n ? n : 1)),
                           "a state value is not finite (NaN or Inf)");
@@ -82,9 +88,11 @@ int mpm_module_check_positions(const mpm_module *m, const double *y, mpm_fault *
     const int c = g->coord[d];
     const double near_lo = g->lo[d] + (g->cell_split[d][c] - 1) * g->dx;
     const double near_hi = g->lo[d] + (g->cell_split[d][c + 1] + 1) * g->dx;
-    int bad = 0; /* one pass without jumps; the culprit is found only when there is one */
-    for (mpm_lidx i = 0; i < n; ++i)
-      bad |= (!g->periodic[d] && !(x[i] >= lo && x[i] < hi)) | !(x[i] >= near_lo && x[i] < near_hi);
+    /* One pass without jumps, as above; a periodic axis has no domain bounds to check. */
+    const double lo_b = g->periodic[d] ? near_lo : fmax(lo, near_lo);
+    const double hi_b = g->periodic[d] ? near_hi : fmin(hi, near_hi);
+    int bad = 0;
+    for (mpm_lidx i = 0; i < n; ++i) bad |= !(x[i] >= lo_b && x[i] < hi_b);
     for (mpm_lidx i = 0; bad && i < n; ++i) {
       if (!g->periodic[d] && !(x[i] >= lo && x[i] < hi))
         return mpm_fault_at(fault, p, y, i, "the particle left the domain");

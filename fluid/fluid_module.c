@@ -591,7 +591,9 @@ static int fluid_check(const mpm_module *m, const double *y, mpm_fault *fault) {
   if (mpm_module_check_positions(m, y, fault)) return 1;
   const mpm_particles *p = m->particles;
   const double *J = state(p, y, FLUID_J), *e = state(p, y, FLUID_E);
-  for (mpm_lidx i = 0; i < p->n; ++i) {
+  int bad = 0; /* one pass without jumps first (the values are finite: checked above) */
+  for (mpm_lidx i = 0; i < p->n; ++i) bad |= (J[i] <= 0.0) | (e[i] <= 0.0);
+  for (mpm_lidx i = 0; bad && i < p->n; ++i) {
     if (J[i] <= 0.0)
       return mpm_fault_at(fault, p, y, i, "the gas volume collapsed (J = %.3g <= 0)", J[i]);
     if (e[i] <= 0.0)

@@ -110,15 +110,26 @@ static int cell_coord(const reg_box *b, int d, double x) {
   return mpm_cells_coord(b->g, d, x);
 }
 
-/* Local cell index of particle i (clamped into the box: after migration it is inside). */
-static mpm_lidx local_cell(const reg_box *b, const mpm_particles *p, mpm_lidx i) {
+/* Local cell index of the particle at x (clamped into the box: after migration it is inside). */
+static mpm_lidx local_cell(const reg_box *b, const double *x) {
   mpm_lidx l = 0;
   for (int d = b->dim - 1; d >= 0; --d) {
-    int c = cell_coord(b, d, mpm_particles_comp(p, 0, d)[i]) - b->c0[d];
+    int c = cell_coord(b, d, x[d]) - b->c0[d];
     c = c < 0 ? 0 : c >= b->nc[d] ? b->nc[d] - 1 : c;
     l = l * b->nc[d] + c;
   }
   return l;
+}
+
+/* The local cells of particles [from, p->n) into cell[from ..]. */
+static void cells_from(const reg_box *b, const mpm_particles *p, mpm_lidx from, mpm_lidx *cell) {
+  const double *x[MPM_MAX_DIM] = {NULL}; /* (read once: cell may alias the block) */
+  for (int d = 0; d < b->dim; ++d) x[d] = mpm_particles_comp(p, 0, d);
+  for (mpm_lidx i = from; i < p->n; ++i) {
+    double xi[MPM_MAX_DIM] = {0};
+    for (int d = 0; d < b->dim; ++d) xi[d] = x[d][i];
+    cell[i] = local_cell(b, xi);
+  }
 }
 
 static mpm_gidx global_cell(const reg_box *b, const double *x) {
@@ -130,7 +141,7 @@ static mpm_gidx global_cell(const reg_box *b, const double *x) {
 /* The local cell of every particle (local_cell), or NULL on failure. */
 static mpm_lidx *cells_of(const reg_box *b, const mpm_particles *p) {
   mpm_lidx *cell = malloc(sizeof *cell * (size_t)(p->n ? p->n : 1));
-  for (mpm_lidx i = 0; cell && i < p->n; ++i) cell[i] = local_cell(b, p, i);
+  if (cell) cells_from(b, p, 0, cell);
   return cell;
 }
 
@@ -630,7 +641,7 @@ static int refill(mpm_module *m, double *children, int *changed, reg_cellmap *ma
     if (grown) {
       reg_box b;
       box_of(&b, m->grid);
-      for (mpm_lidx i = n0; i < p->n; ++i) grown[i] = local_cell(&b, p, i);
+      cells_from(&b, p, n0, grown);
       map->cell = grown, map->n = p->n;
     }
   }

@@ -41,13 +41,15 @@ static void deposit(const mpm_module *m, double *const *sum) {
   const double *V0 = mpm_particles_comp(p, fc->lay.f_V0, 0);
   const double *divv = mpm_particles_comp(p, fc->lay.f_divv, 0);
   const double *J = mpm_particles_comp(p, FLUID_J, 0), *e = mpm_particles_comp(p, FLUID_E, 0);
+  const double *x[MPM_MAX_DIM], *vel[MPM_MAX_DIM]; /* (read once: sum may alias the block) */
+  for (int d = 0; d < g->dim; ++d)
+    x[d] = mpm_particles_comp(p, FLUID_X, d), vel[d] = mpm_particles_comp(p, FLUID_V, d);
   for (mpm_lidx i = 0; i < p->n; ++i) {
     int c[MPM_MAX_DIM] = {0};
     double v2 = 0.0;
     for (int d = 0; d < g->dim; ++d) {
-      const double v = mpm_particles_comp(p, FLUID_V, d)[i];
-      v2 += v * v;
-      c[d] = mpm_cells_coord(g, d, mpm_particles_comp(p, FLUID_X, d)[i]);
+      v2 += vel[d][i] * vel[d][i];
+      c[d] = mpm_cells_coord(g, d, x[d][i]);
     }
     const double rho = fc->gas.mu > 0.0 ? mass[i] / (V0[i] * J[i]) : 1.0; /* only mu needs it */
     const double cs = sqrt(gamma * (gamma - 1.0) * fabs(e[i]));
