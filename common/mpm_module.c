@@ -29,6 +29,23 @@ static void node_update(mpm_lidx nn, const double *restrict m, const double *res
   }
 }
 
+/* Mass and number of the owned nodes with m_i > mmin, into sum[0] and sum[1]: the owned
+ * block of the box row by row (in index order, as a loop over the box would add them). */
+static void owned_mass(const mpm_grid *g, const double *m, double mmin, double *sum) {
+  int lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
+  mpm_lidx stride[3] = {1, 0, 0};
+  for (int d = 0; d < g->dim; ++d) {
+    lo[d] = g->own_lo[d] - g->box_lo[d], hi[d] = g->own_hi[d] - g->box_lo[d];
+    if (d > 0) stride[d] = stride[d - 1] * g->box_n[d - 1];
+  }
+  for (int k = lo[2]; k < hi[2]; ++k)
+    for (int j = lo[1]; j < hi[1]; ++j) {
+      const double *row = m + k * stride[2] + j * stride[1];
+      for (int i = lo[0]; i < hi[0]; ++i)
+        if (row[i] > mmin) sum[0] += row[i], sum[1] += 1.0;
+    }
+}
+
 int mpm_grid_phase_update(mpm_grid *grid, int phase, double h) {
   mpm_grid_phase *ph = &grid->phase[phase];
   double local = 0.0, mmax;
@@ -41,8 +58,7 @@ int mpm_grid_phase_update(mpm_grid *grid, int phase, double h) {
   double mmin = ph->empty_fraction * mmax;
   if (ph->light_fraction > 0.0) {
     double sum[2] = {0.0, 0.0}, all[2]; /* mass and count over the owned nodes with mass */
-    for (mpm_lidx l = 0; l < grid->nnodes; ++l)
-      if (ph->m_i[l] > mmin && mpm_grid_node_is_owned(grid, l)) sum[0] += ph->m_i[l], sum[1] += 1.0;
+    owned_mass(grid, ph->m_i, mmin, sum);
     MPM_CALL_MPI(MPI_Allreduce(sum, all, 2, MPI_DOUBLE, MPI_SUM, grid->comm));
     ph->m_mean = all[1] > 0.0 ? all[0] / all[1] : 0.0;
     mmin = fmax(mmin, ph->light_fraction * ph->m_mean);
