@@ -622,20 +622,25 @@ static int write_summary(mpm_sim *s, double wall) {
   return 0;
 }
 
-/* The blow-up guard after an accepted step; a run it stops leaves its last state as one more
- * snapshot (the series stays valid: it is written like any other), to show where it failed. */
-static int guard(mpm_sim *s, double dt, double tstop) {
-  const int rc =
-      mpm_guard_check(&s->guard, s->t, s->step, dt, s->t >= tstop * (1 - 1e-14), s->energy);
-  if (!rc) return 0;
-  /* Only the guard's verdict, which every rank reaches alike from reduced values: a local
-   * failure (no memory) must not enter the collective write on one rank. */
+/* A run stopped as unphysical (the blow-up guard, or a step that failed its state checks or
+ * its stability limit) leaves its last accepted state as one more snapshot (the series stays
+ * valid: it is written like any other), to show where it failed. Only on that verdict, which
+ * every rank reaches alike from reduced values: a local failure (no memory) must not enter the
+ * collective write on one rank. */
+static int stopped(mpm_sim *s, int rc) {
   if (rc == MPM_ERR_UNPHYSICAL && s->snapshots && write_snapshot(s) == 0)
     mpm_log(MPM_LOG_ERROR,
             "the state where the run stopped (t = %.6g, step %ld) is snapshot %ld "
             "of %s/series.xmf",
             s->t, s->step, (long)mpm_output_count(s->out) - 1, s->dir);
   return mpm_trace(__FILE__, __LINE__, __func__, rc);
+}
+
+/* The blow-up guard after an accepted step. */
+static int guard(mpm_sim *s, double dt, double tstop) {
+  const int rc =
+      mpm_guard_check(&s->guard, s->t, s->step, dt, s->t >= tstop * (1 - 1e-14), s->energy);
+  return rc ? stopped(s, rc) : 0;
 }
 
 int mpm_sim_run(mpm_sim *s) {
@@ -667,7 +672,8 @@ int mpm_sim_run(mpm_sim *s) {
   while (s->t < t_stop) {
     const double t_out = fmin(s->out_next * s->out_interval, s->t_end);
     const double t_ckpt = s->ckpt_next * s->ckpt_interval, tstop = fmin(t_out, t_ckpt);
-    MPM_CALL(mpm_timescheme_step(s->it, tstop, &s->t, &dt));
+    const int rc = mpm_timescheme_step(s->it, tstop, &s->t, &dt);
+    if (rc) return stopped(s, rc); /* the state is the last accepted step's */
     s->step++;
     MPM_CALL(after_step(s, dt));
     MPM_CALL(diagnostics(s, dt));
