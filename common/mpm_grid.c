@@ -269,6 +269,7 @@ static void phase_free(mpm_grid_phase *ph) {
     free(ph->a_i[d]), free(ph->normal_i[d]);
   }
   free(ph->cell_n);
+  free(ph->shadow);
   memset(ph, 0, sizeof *ph);
 }
 

@@ -56,6 +56,9 @@ typedef struct mpm_grid_phase {
   double m_mean; /* that mean, at the last nodal solve (when light_fraction > 0) */
   /* Particles per cell, at the cell's lower corner node (mpm_cells.h); NULL until counted. */
   double *cell_n;
+  /* Room for a copy of m, m v, f (and the mass gradient): the coupler's velocity preview works
+   * on it (coupler/mpm_cycle.c); NULL until first needed. */
+  double *shadow;
 } mpm_grid_phase;
 
 typedef struct mpm_grid {

@@ -3,7 +3,8 @@
  * exposes the phases of an MPM right-hand side; the coupler decides their order and owns the
  * nodal solve between a module's forces and its constraints (coupler/mpm_cycle.c):
  *
- *   zero grid phase -> p2g -> halo reverse -> forces -> [coupling: before_solve] -> solve
+ *   zero grid phase -> p2g [-> velocity preview -> p2g_rate] -> halo reverse -> forces
+ *   -> [coupling: before_solve] -> solve
  *   -> [coupling: after_solve] -> constrain -> [coupling: after_constrain] -> halo forward
  *   -> [MUSL: remap -> the same grid pass with pass = MPM_PASS_REMAP] -> g2p
  *
@@ -45,6 +46,13 @@ typedef enum { MPM_ROLE_SOLID, MPM_ROLE_FLUID, MPM_ROLE_COUNT } mpm_role;
 
 typedef struct mpm_module_ops {
   int (*p2g)(mpm_module *m, double t, const double *y);
+  /* The part of the deposit that reads the nodal velocity (the gas's current strain rate, for
+   * its viscous stresses), method of lines only (h = 0: the solve's velocity m v / m does not
+   * depend on the forces). After every module's p2g the coupler previews the solve on copies
+   * of the deposits: the grid pass with the coupling scheme and every module's constraints
+   * acting (as MUSL's remap pass: nothing is recorded), which leaves in each phase's v_i, ghosts
+   * included, the velocity the solve will give; this op then adds to the deposit. Optional. */
+  int (*p2g_rate)(mpm_module *m, double t, const double *y);
   /* After the reverse halo: complete this phase's nodal forces (fold mirrored pad nodes into
    * walls, damping, ghost and boundary forces). h is the classic step (0: method of lines). */
   int (*forces)(mpm_module *m, double t, double h, mpm_pass pass);

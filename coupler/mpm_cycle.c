@@ -4,6 +4,9 @@
 #include "mpm_error.h"
 #include "mpm_timer.h"
 
+#include <stdlib.h>
+#include <string.h>
+
 #define CYCLE_MAX_FIELDS (4 * (2 + 3 * MPM_MAX_DIM))
 
 /* Sum the ghosts into the owners (reverse: m, mv, f and the mass gradient where a scheme asks
@@ -65,11 +68,66 @@ static int grid_pass(const mpm_cycle *c, double t, double h, mpm_pass pass) {
   return halo(c, 0);
 }
 
-int mpm_cycle_deposit(const mpm_cycle *c, double t, double *const *y) {
+/* ---- the velocity preview (mpm_module.h, p2g_rate) ---------------------------------------- */
+
+enum { DEPOSIT_MAX = 1 + 3 * MPM_MAX_DIM };
+
+/* The arrays a deposit fills in phase ph: m, m v, f and, where it is deposited, the mass
+ * gradient. Returns their number. */
+static int deposit_arrays(mpm_grid_phase *ph, int dim, double **slot[DEPOSIT_MAX]) {
+  int n = 0;
+  slot[n++] = &ph->m_i;
+  for (int d = 0; d < dim; ++d) slot[n++] = &ph->mv_i[d], slot[n++] = &ph->f_i[d];
+  for (int d = 0; ph->normals && d < dim; ++d) slot[n++] = &ph->normal_i[d];
+  return n;
+}
+
+/* Preview the solve of this deposit at h = 0 and let the modules that read it complete their
+ * deposits. The grid pass (as MUSL's remap: nothing is recorded) runs on copies of the
+ * deposits in the phases' shadows, so that the deposits themselves are summed and solved once,
+ * by the pass that follows; it leaves the velocity of the solve in every phase's v_i. A held
+ * partner's phase is restored from the interface by either pass alike. */
+static int preview(const mpm_cycle *c, double t, double *const *y) {
+  int need = 0;
+  for (int k = 0; k < c->nmod; ++k) need |= c->mod[k]->ops->p2g_rate != NULL;
+  if (!need) return 0;
+  const int dim = c->grid->dim;
+  const size_t nn = (size_t)c->grid->nnodes;
+  double **slot[MPM_MAX_MODULES][DEPOSIT_MAX], *own[MPM_MAX_MODULES][DEPOSIT_MAX];
+  int ns[MPM_MAX_MODULES];
+  for (int k = 0; k < c->nmod; ++k) {
+    mpm_grid_phase *ph = &c->grid->phase[c->mod[k]->phase];
+    ns[k] = deposit_arrays(ph, dim, slot[k]);
+    if (!ph->shadow) MPM_ALLOC(ph->shadow, DEPOSIT_MAX * nn);
+    for (int j = 0; j < ns[k]; ++j) {
+      own[k][j] = *slot[k][j];
+      memcpy(ph->shadow + j * nn, own[k][j], nn * sizeof(double));
+      *slot[k][j] = ph->shadow + j * nn;
+    }
+  }
+  const int rc = grid_pass(c, t, 0.0, MPM_PASS_REMAP);
+  for (int k = 0; k < c->nmod; ++k)
+    for (int j = 0; j < ns[k]; ++j) *slot[k][j] = own[k][j];
+  MPM_CALL(rc);
+  for (int k = 0; k < c->nmod; ++k)
+    if (c->mod[k]->ops->p2g_rate) MPM_CALL(c->mod[k]->ops->p2g_rate(c->mod[k], t, y[k]));
+  return 0;
+}
+
+/* Every module's deposit at (t, y), with the velocity preview where a module asks for it. */
+static int deposit(const mpm_cycle *c, double t, double *const *y) {
   for (int k = 0; k < c->nmod; ++k) {
     mpm_grid_phase_zero(c->grid, c->mod[k]->phase);
     MPM_CALL(c->mod[k]->ops->p2g(c->mod[k], t, y[k]));
   }
+  return preview(c, t, y);
+}
+
+int mpm_cycle_deposit(const mpm_cycle *c, double t, double *const *y) {
+  /* The module deposits alone: its preview sees its own constraints, no coupling. */
+  mpm_cycle alone = *c;
+  alone.coupling = NULL, alone.mode = MPM_CYCLE_JOINT, alone.musl = 0;
+  MPM_CALL(deposit(&alone, t, y));
   MPM_CALL(halo(c, 1));
   for (int k = 0; k < c->nmod; ++k)
     MPM_CALL(c->mod[k]->ops->forces(c->mod[k], t, 0.0, MPM_PASS_FIRST));
@@ -77,10 +135,7 @@ int mpm_cycle_deposit(const mpm_cycle *c, double t, double *const *y) {
 }
 
 int mpm_cycle_rhs(const mpm_cycle *c, double t, double *const *y, double *const *ydot, double h) {
-  for (int k = 0; k < c->nmod; ++k) {
-    mpm_grid_phase_zero(c->grid, c->mod[k]->phase);
-    MPM_CALL(c->mod[k]->ops->p2g(c->mod[k], t, y[k]));
-  }
+  MPM_CALL(deposit(c, t, y));
   MPM_CALL(grid_pass(c, t, h, MPM_PASS_FIRST));
   for (int k = 0; c->coupling && k < c->nmod; ++k)
     if (c->mod[k] == c->coupling->module[MPM_ROLE_SOLID])

@@ -1,6 +1,8 @@
 /* The MPM cycle: one right-hand side of the coupled modules, the algorithm on one screen.
  *
  *   for each module: zero its phase, p2g
+ *   [a module with p2g_rate: the grid pass (remap, h = 0) on copies of the deposits, then
+ *    p2g_rate, which reads the velocity it leaves (mpm_module.h)]
  *   grid pass (first):  halo reverse -> forces -> [held: restore] -> coupling before_solve
  *                       -> solve -> coupling after_solve (or, loaded: the load) -> constrain
  *                       -> coupling after_constrain -> halo forward
@@ -27,6 +29,9 @@
 #include "mpm_interface.h"
 #include "mpm_module.h"
 
+/* Modules one cycle (and one integrator) advances at most. */
+#define MPM_MAX_MODULES 4
+
 typedef enum { MPM_CYCLE_JOINT, MPM_CYCLE_HELD, MPM_CYCLE_LOADED } mpm_cycle_mode;
 
 typedef struct mpm_cycle {
@@ -50,9 +55,9 @@ static inline mpm_cycle mpm_cycle_joint(mpm_grid *grid, mpm_module **mod, int nm
  * method of lines). */
 int mpm_cycle_rhs(const mpm_cycle *c, double t, double *const *y, double *const *ydot, double h);
 
-/* The first half of a cycle, for a module about to be held: zero its phase, P2G from y,
- * reverse halo and its forces (first pass). Its nodal fields then hold what
- * mpm_interface_hold saves. Collective. */
+/* The first half of a cycle, for a module about to be held: zero its phase, P2G from y (its
+ * velocity preview without the coupling), reverse halo and its forces (first pass). Its nodal
+ * fields then hold what mpm_interface_hold saves. Collective. */
 int mpm_cycle_deposit(const mpm_cycle *c, double t, double *const *y);
 
 #endif

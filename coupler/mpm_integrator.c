@@ -16,8 +16,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define MPM_MAX_MODULES 4
-
 struct mpm_integrator {
   MPI_Comm comm;
   SUNContext ctx;

@@ -55,8 +55,9 @@ typedef struct fluid_content {
   double *vnew;              /* MUSL: the particles' new velocities (dim cap) */
   double *Cnew;              /* MUSL with APIC: their new affine velocities (dim^2 cap) */
   double *power;             /* de/dt of each particle (cap) */
-  double *tscratch; /* the classic transfer's a_p, scalars and APIC terms (see ensure_scratch) */
-  double *node;     /* nodal scratch: time-centred velocity and scalars ((dim + 3) nnodes) */
+  double *tscratch;   /* the classic transfer's a_p, scalars and APIC terms (see ensure_scratch) */
+  double *node;       /* nodal scratch: time-centred velocity and scalars ((dim + 3) nnodes) */
+  mpm_module_ops ops; /* the module's ops: p2g_rate only with the current strain rate */
 } fluid_content;
 
 /* What the classic step's transfer gives each particle (component-major, stride n). */

@@ -221,51 +221,19 @@ static int deposit(mpm_module *m, const double *y, const double *vsig, const flu
  * pair's order and error estimate assume. The lagged rate (the previous step's) holds every
  * ERK pair to first order in time wherever the artificial viscosity acts.
  *
- * The particles deposit m, m v and the pressure's force. From copies of m and m v (summed
- * over the ranks and folded at the walls as the solve will be) the nodal velocities m v / m,
- * constrained as the solve's are (walls, open faces, obstacles; a coupling's constraints are
- * the coupler's and are not seen here), are interpolated back as their gradient L: tr L and
- * sym L are this RHS's rate. Where no constraint acts that is the L of the RHS's own G2P. Only
- * the particles with a viscous stress (in compression, or all with viscosity) then deposit it,
- * as massless particles. The phase's v and a are scratch until the solve. Cost: about 1.6x the
- * lagged RHS's gas work (test_gas_time_order). */
-
-static int fluid_constrain(mpm_module *m, double t, double h, mpm_pass pass);
-
-/* The nodal velocities of the deposit in the phase, into its v (a zeroed), constrained as the
- * solve's are and copied into the ghosts. Collective. */
-static int deposit_velocity(mpm_module *m, double t) {
-  fluid_content *fc = m->content;
-  mpm_grid *g = m->grid;
-  mpm_grid_phase *ph = &g->phase[m->phase];
-  const int dim = g->dim;
-  const size_t nn = (size_t)g->nnodes;
-  double *mass = fc->node, *mv[MPM_MAX_DIM], *f[1 + MPM_MAX_DIM] = {mass};
-  memcpy(mass, ph->m_i, nn * sizeof(double));
-  for (int d = 0; d < dim; ++d) {
-    f[1 + d] = mv[d] = fc->node + (1 + d) * nn;
-    memcpy(mv[d], ph->mv_i[d], nn * sizeof(double));
-  }
-  mpm_timer_start(MPM_T_HALO);
-  MPM_CALL(mpm_grid_halo_reverse(g, f, 1 + dim));
-  mpm_timer_stop(MPM_T_HALO);
-  mpm_constraints_fold_momentum(&fc->cons, g, mass, mv);
-  /* The solve and the constraints of a pass that records nothing (walls, open faces,
-   * obstacles) on the summed copies, which stand in for the phase's own m and m v until the
-   * cycle sums them; a = f / m of the unsummed force is scratch like v. */
-  double *own_m = ph->m_i, *own_mv[MPM_MAX_DIM];
-  ph->m_i = mass;
-  for (int d = 0; d < dim; ++d) own_mv[d] = ph->mv_i[d], ph->mv_i[d] = mv[d];
-  int rc = mpm_grid_phase_update(g, m->phase, 0.0);
-  if (!rc) rc = fluid_constrain(m, t, 0.0, MPM_PASS_REMAP);
-  ph->m_i = own_m;
-  for (int d = 0; d < dim; ++d) ph->mv_i[d] = own_mv[d];
-  MPM_CALL(rc);
-  mpm_timer_start(MPM_T_HALO);
-  MPM_CALL(mpm_grid_halo_forward(g, ph->v_i, dim));
-  mpm_timer_stop(MPM_T_HALO);
-  return 0;
-}
+ * The particles deposit m, m v and the pressure's force (p2g). The coupler then previews the
+ * solve (mpm_module.h, p2g_rate): from copies of the deposits, summed over the ranks, with the
+ * walls, open faces and obstacles, the coupling scheme and the other modules' constraints
+ * acting as in the solve, it leaves in the phase's v the nodal velocity m v / m that the RHS's
+ * own G2P will read. Its gradient L, interpolated back, is this RHS's rate: tr L and sym L
+ * (p2g_rate). Only the particles with a viscous stress (in compression, or all with viscosity)
+ * then deposit it, as massless particles. The rate is thus the one the energy equation's work
+ * (V sigma : L) / m reads, so the artificial viscosity only ever heats. (A preview of the gas
+ * alone, before the coupling, put compression where the shared velocity of the `velocity`
+ * scheme expands the gas behind the main job's bar: there the artificial pressure did negative
+ * work, up to -1.3e10 J/kg/s, and emptied particles of their internal energy under bs32.) The
+ * phase's v and a are scratch until the solve. Cost: about 1.6x the lagged RHS's gas work
+ * (test_gas_time_order), and the coupler's preview pass. */
 
 /* tr L into divv and sym L into D (dim*dim, may be L itself; NULL: not wanted). */
 static void rate_parts(int dim, mpm_lidx n, const double *L, double *divv, double *D) {
@@ -316,6 +284,7 @@ static int deposit_viscous(mpm_module *m, const double *y, const fluid_batch *b)
 }
 
 static int fluid_p2g(mpm_module *m, double t, const double *y) {
+  (void)t;
   fluid_content *fc = m->content;
   const mpm_particles *p = m->particles;
   const int dim = p->dim;
@@ -339,14 +308,31 @@ static int fluid_p2g(mpm_module *m, double t, const double *y) {
     mpm_timer_stop(MPM_T_P2G);
     return 0;
   }
-  /* The current rate (above): the pressure's deposit, the rate, the viscous deposit. */
+  /* The current rate (above): the pressure's deposit; p2g_rate adds the viscous one. */
   mpm_timer_start(MPM_T_STRESS);
   fluid_stress_pressure(&fc->gas, &b);
   mpm_timer_stop(MPM_T_STRESS);
   mpm_timer_start(MPM_T_P2G);
   MPM_CALL(deposit(m, y, fc->vsig, NULL));
   mpm_timer_stop(MPM_T_P2G);
-  MPM_CALL(deposit_velocity(m, t));
+  return 0;
+}
+
+/* The current rate from the previewed nodal velocity (above), and the viscous deposit. */
+static int fluid_p2g_rate(mpm_module *m, double t, const double *y) {
+  (void)t;
+  fluid_content *fc = m->content;
+  const mpm_particles *p = m->particles;
+  const int dim = p->dim;
+  const mpm_lidx n = p->n;
+  fluid_batch b = {.dim = dim,
+                   .n = n,
+                   .m = mpm_particles_comp(p, fc->lay.f_m, 0),
+                   .V0 = mpm_particles_comp(p, fc->lay.f_V0, 0),
+                   .J = state(p, y, FLUID_J),
+                   .e = state(p, y, FLUID_E),
+                   .D = fc->lay.f_D >= 0 ? field(p, y, fc->lay.f_D) : NULL,
+                   .vsig = fc->vsig};
   mpm_timer_start(MPM_T_G2P);
   double *vout[MPM_MAX_DIM], *aout[MPM_MAX_DIM], *L = fc->scratch + (size_t)2 * dim * n;
   for (int d = 0; d < dim; ++d)
@@ -829,6 +815,9 @@ int fluid_module_create(mpm_module **mp, const mpm_config *cfg, mpm_grid *grid, 
     mpm_module_destroy(mp);
     return mpm_trace(__FILE__, __LINE__, __func__, rc);
   }
+  fc->ops = fluid_ops;
+  if (fc->current_rate) fc->ops.p2g_rate = fluid_p2g_rate;
+  m->ops = &fc->ops;
   m->cells_every = fc->refill_every;
   m->wall_slack = 0.5;
   m->commits_history = !fc->tr.classic && !fc->current_rate; /* the pending strain rate */
