@@ -283,22 +283,26 @@ static int deposit_viscous(mpm_module *m, const double *y, const fluid_batch *b)
   return 0;
 }
 
+/* The stress batch of the state y: its fields and the lagged rate (divv, D). */
+static fluid_batch batch_of(const mpm_module *m, const double *y) {
+  const fluid_content *fc = m->content;
+  const mpm_particles *p = m->particles;
+  return (fluid_batch){.dim = p->dim,
+                       .n = p->n,
+                       .m = mpm_particles_comp(p, fc->lay.f_m, 0),
+                       .V0 = mpm_particles_comp(p, fc->lay.f_V0, 0),
+                       .J = state(p, y, FLUID_J),
+                       .e = state(p, y, FLUID_E),
+                       .divv = field(p, y, fc->lay.f_divv),
+                       .D = fc->lay.f_D >= 0 ? field(p, y, fc->lay.f_D) : NULL,
+                       .vsig = fc->vsig};
+}
+
 static int fluid_p2g(mpm_module *m, double t, const double *y) {
   (void)t;
   fluid_content *fc = m->content;
-  const mpm_particles *p = m->particles;
-  const int dim = p->dim;
-  const mpm_lidx n = p->n;
   MPM_CALL(ensure_scratch(m));
-  fluid_batch b = {.dim = dim,
-                   .n = n,
-                   .m = mpm_particles_comp(p, fc->lay.f_m, 0),
-                   .V0 = mpm_particles_comp(p, fc->lay.f_V0, 0),
-                   .J = state(p, y, FLUID_J),
-                   .e = state(p, y, FLUID_E),
-                   .divv = field(p, y, fc->lay.f_divv),
-                   .D = fc->lay.f_D >= 0 ? field(p, y, fc->lay.f_D) : NULL,
-                   .vsig = fc->vsig};
+  fluid_batch b = batch_of(m, y);
   if (!fc->current_rate) {
     mpm_timer_start(MPM_T_STRESS);
     fluid_stress(&fc->gas, &b);
@@ -325,14 +329,7 @@ static int fluid_p2g_rate(mpm_module *m, double t, const double *y) {
   const mpm_particles *p = m->particles;
   const int dim = p->dim;
   const mpm_lidx n = p->n;
-  fluid_batch b = {.dim = dim,
-                   .n = n,
-                   .m = mpm_particles_comp(p, fc->lay.f_m, 0),
-                   .V0 = mpm_particles_comp(p, fc->lay.f_V0, 0),
-                   .J = state(p, y, FLUID_J),
-                   .e = state(p, y, FLUID_E),
-                   .D = fc->lay.f_D >= 0 ? field(p, y, fc->lay.f_D) : NULL,
-                   .vsig = fc->vsig};
+  fluid_batch b = batch_of(m, y); /* its divv and D are replaced below */
   mpm_timer_start(MPM_T_G2P);
   double *vout[MPM_MAX_DIM], *aout[MPM_MAX_DIM], *L = fc->scratch + (size_t)2 * dim * n;
   for (int d = 0; d < dim; ++d)
