@@ -481,6 +481,7 @@ static int fluid_g2p(mpm_module *m, double t, const double *y, double *ydot, dou
   if (!(h > 0)) {
     mpm_transfer_g2p(m->grid, m->phase, p, y, fc->lp, xdot, vdot, L, NULL);
     energy_rate(m, L, NULL, h);
+    if (!fc->tr.apic) fluid_wall_rate_mol(m, y, vdot, fc->power);
   } else if (!fc->tr.musl) {
     fluid_step_out o = {.C = Cdot};
     for (int d = 0; d < dim; ++d) o.vhat[d] = xdot[d], o.vnew[d] = vdot[d];
@@ -501,8 +502,8 @@ static int fluid_g2p(mpm_module *m, double t, const double *y, double *ydot, dou
   return 0;
 }
 
-/* After an accepted step: commit the ERK pairs' pending strain rate and apply their wall rule,
- * then shift and regularise. */
+/* After an accepted step: commit the ERK pairs' pending strain rate, then shift and
+ * regularise. */
 static int fluid_post_step(mpm_module *m, double t, double h, int *changed) {
   fluid_content *fc = m->content;
   const mpm_particles *p = m->particles;
@@ -512,7 +513,6 @@ static int fluid_post_step(mpm_module *m, double t, double h, int *changed) {
            sizeof(double) * count);
   }
   MPM_CALL(fluid_obstacles_report(&fc->obs, m->grid, t, h));
-  if (!fc->tr.classic && !fc->tr.apic) *changed |= fluid_wall_rule_mol(m);
   fc->s_local = -1.0; /* a new step begins: its first stable-step estimate recomputes it */
   /* Shift first, then refill from the counts after the shift: a refill child keeps its cell,
    * and no shift empties a cell the refill just filled. */

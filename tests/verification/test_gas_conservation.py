@@ -30,7 +30,8 @@ On 2 ranks the pulse with slip walls and shifting gives what 1 rank gives, by pa
 1e-12 relative (sums in another order).
 Uniform gas moving into the slip floor: the first particle layer stops moving into it (the
 wall rule of fluid/fluid_transfer.c; without it FLIP keeps 0.34-0.38 of the speed into the
-floor, bs32 0.75), and total energy holds to 1e-12 (usl) and 1e-6 (bs32).
+floor, bs32 0.75; bs32 within 0.05, its rule a relaxation at 2 c / dx), and total energy holds
+to 1e-12 (usl) and 1e-6 (bs32).
 """
 import os
 import sys
@@ -121,18 +122,24 @@ def ranks():
 ranks()
 
 
-def into_the_floor(method, e_tol):
+def into_the_floor(method, v_tol, e_tol):
     """Uniform gas at p = 1 moving at 0.5 into the slip floor of the closed box (usl, FLIP, 54
-    steps to t = 0.2; bs32, 145 steps). A wall holds its nodes' normal velocity at v = a = 0, so FLIP alone never
-    takes back the velocity into the wall of the layer on it (measured without the wall rule of
-    fluid/fluid_transfer.c: 0.34-0.38 of the initial speed into the floor at every snapshot from
-    t = 0.05 on). With it no particle of the first layer may move into the floor faster than
-    1e-3 of the initial speed from t = 0.05 on (measured: none moves into it; the layer moves
-    away at up to 0.087 of it, the rebound, which the rule leaves alone: a wall only pushes), and
-    total energy must still hold to 1e-12 (the kinetic energy taken out becomes heat). The same
-    under bs32, whose method of lines has the same blind spot (measured without its form of the
-    rule, applied after each accepted step: 0.75 of the speed into the floor; with it none),
-    with its energy tolerance time.rtol = 1e-6 (above; measured 8.5e-8)."""
+    steps to t = 0.2; bs32, 145 steps). A wall holds its nodes' normal velocity at v = a = 0, so
+    FLIP alone never takes back the velocity into the wall of the layer on it (measured without
+    the wall rule of fluid/fluid_transfer.c: 0.34-0.38 of the initial speed into the floor at
+    every snapshot from t = 0.05 on). With it no particle of the first layer may move into the
+    floor faster than v_tol of the initial speed from t = 0.05 on, and total energy must still
+    hold to e_tol (the kinetic energy taken out becomes heat).
+    usl: v_tol = 1e-3 (the rule scales the velocity into the wall by 1 - w every step;
+    measured: none moves into it; the layer moves away at up to 0.09 of it, the rebound, which
+    the rule leaves alone: a wall only pushes), e_tol = 1e-12.
+    bs32: its method of lines has the same blind spot (measured without its rule: 0.75 of the
+    speed into the floor). Its rule is a relaxation in the right-hand side at 2 c / dx times the
+    face weight, so the first layer follows the gas around it within a fraction of a cell's
+    acoustic time instead of being zeroed every step: v_tol = 0.05, a third of the ringing of
+    the shock's wake in the half-cell layers just above it (0.08-0.17 of the speed there, both
+    methods alike; measured in the first layer 0.012). e_tol = time.rtol = 1e-6 (above;
+    measured 7.4e-8)."""
     out = mt.outdir("gas_box_into_floor_" + method)
     mt.run(["run", CASE, f"output.dir={out}", "run.progress=false", "time.t_end=0.2",
             "output.interval=0.05", "gas.air.pressure_field=1", "gas.air.velocity=0 -0.5",
@@ -144,14 +151,14 @@ def into_the_floor(method, e_tol):
         into, away = max(into, float(-vy.min()) / 0.5), max(away, float(vy.max()) / 0.5)
     d = np.genfromtxt(os.path.join(out, "diagnostics.csv"), delimiter=",", names=True)
     dE = float(np.abs(d["total"] - d["total"][0]).max() / d["total"][0])
-    check(into <= 1e-3, f"{method}, gas moving into a slip floor: the first layer's velocity into it from "
-          f"t = 0.05 on, at most {max(into, 0.0):.1e} of the initial speed (<= 1e-3; away from "
-          f"it {away:.2f}, the rebound)")
+    check(into <= v_tol, f"{method}, gas moving into a slip floor: the first layer's velocity into "
+          f"it from t = 0.05 on, at most {max(into, 0.0):.1e} of the initial speed (<= {v_tol:g}; "
+          f"away from it {away:.2f}, the rebound)")
     check(dE <= e_tol, f"{method}, gas moving into a slip floor: total energy drift {dE:.1e} "
           f"(<= {e_tol:g})")
 
 
-into_the_floor("usl", 1e-12)
-into_the_floor("bs32", 1e-6)
+into_the_floor("usl", 1e-3, 1e-12)
+into_the_floor("bs32", 0.05, 1e-6)
 
 sys.exit(check.finish())
