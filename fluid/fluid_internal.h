@@ -72,7 +72,7 @@ typedef struct fluid_step_out {
 /* G2P of the classic step h after the grid update (fluid_transfer.c). */
 void fluid_classic_transfer(mpm_module *m, const double *y, double h, const fluid_step_out *o);
 /* The wall rule for the method of lines (fluid_transfer.c), in the right-hand side of state y:
- * relaxes the particles' velocity into a wall face at (1 - keep) c / dx, subtracting from
+ * relaxes the particles' velocity into a wall face at (1 - keep) 2 c / dx, subtracting from
  * vdot, and adds the kinetic energy removed to power (de/dt). */
 void fluid_wall_rate_mol(const mpm_module *m, const double *y, double *const *vdot, double *power);
 

@@ -41,15 +41,21 @@
  * The ERK pairs' method of lines has the same blind spot (dv/dt = sum S a_i). There the rule
  * is a rate in the right-hand side (fluid_wall_rate_mol), so that the right-hand side stays a
  * function of the state alone and the pairs keep their order: the velocity into a wall face
- * relaxes at the rate (1 - keep) c / dx, one cell's acoustic time scaled by the same weight,
- * and de/dt takes the kinetic energy it removes. Applied instead as the classic scaling after
- * each accepted step, it made the damping depend on the step: the piston's coupling error under
- * MRIStep fell at order 0.27 instead of 2 (test_timeschemes_mri). The rate is continuous in
- * the state (the weight is a B-spline of the position, and the normal term vanishes as the
- * velocity into the face does), with a kink in its derivative where that velocity changes
- * sign: a step across it has a local error of order h^3, and a particle crosses a finite
- * number of times, so the pairs' global orders are kept. It is explicit-stable: h c / dx is
- * at most the CFL number. */
+ * relaxes at the rate (1 - keep) 2 c / dx, twice a cell's acoustic rate scaled by the same
+ * weight, and de/dt takes the kinetic energy it removes (at c / dx the first layer of
+ * test_gas_conservation's floor case kept 0.12 of the speed into the floor at t = 0.05; at
+ * 2 c / dx 0.003, and at most 0.012 later, below the ringing of the layers above it). Applied
+ * instead as the classic scaling after each accepted step, it made the damping depend on the step:
+ * the piston's coupling error under MRIStep fell at order 0.27 instead of 2 (test_timeschemes_mri).
+ * The rate is Lipschitz in the state (the weight is a B-spline of the position, and the normal
+ * term vanishes as the velocity into the face does), with a kink in its derivative where that
+ * velocity changes sign: a step across it errs at O(h^2) locally, and a particle crosses a finite
+ * number of times, so the global error keeps order 2 but higher orders are not guaranteed (as
+ * with the B-spline's kinks in the positions; measured 1.96-2.98 for bs32 on the piston). It is
+ * explicit-stable: h c / dx is at most time.cfl < 1 and 1 - keep < 1, so h times the rate stays
+ * below 2 time.cfl < 2, the end of euler's and ralston21's real stability interval (bs32's ends at
+ * -2.5); with fluid.stable_step = neighbourhood a hot particle's own c may exceed the
+ * neighbourhood's signal speed, and there the bound is the neighbourhood's. */
 #include "fluid_internal.h"
 
 #include "mpm_kernels.h"

@@ -23,12 +23,13 @@ def outdir(name):
     return tempfile.mkdtemp(prefix=name + "_", dir=".")
 
 
-def run(args, ranks=1, check=True):
-    """Run `mpmfsi args...`; returns the CompletedProcess (stdout, stderr as text)."""
+def run(args, ranks=1, check=True, timeout=1200):
+    """Run `mpmfsi args...`; returns the CompletedProcess (stdout, stderr as text). A run
+    longer than timeout seconds raises (the ctest TIMEOUT of a long test may allow more)."""
     cmd = [BIN] + list(args)
     if ranks > 1:
         cmd = [MPIEXEC, "-n", str(ranks)] + cmd
-    p = subprocess.run(cmd, capture_output=True, text=True, timeout=1200)
+    p = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
     if check and p.returncode != 0:
         sys.stderr.write(p.stdout + p.stderr)
         raise SystemExit(f"command failed ({p.returncode}): {' '.join(cmd)}")

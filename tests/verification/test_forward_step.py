@@ -24,7 +24,7 @@ check = mt.Checks("test_forward_step" + ("_long" if LONG else ""))
 DX, T_END = (0.0125, 4.0) if LONG else (0.025, 1.0)
 out = mt.outdir("forward_step")
 p = mt.run(["run", mt.case("forward_step.ini"), f"output.dir={out}", f"grid.dx={DX}",
-            f"time.t_end={T_END}", "run.progress=false"], check=False)
+            f"time.t_end={T_END}", "run.progress=false"], check=False, timeout=3300)
 check(p.returncode == 0, f"dx = {DX}: the run reaches t = {T_END:g} (exit {p.returncode}) "
       f"{p.stderr.strip().splitlines()[-1] if p.stderr.strip() else ''}")
 snaps = mt.snapshots(out)

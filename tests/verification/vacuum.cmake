@@ -14,6 +14,9 @@ mpm_add_script_test(test_blowup_guard_coupled SCRIPT verification/test_blowup_gu
 # The main job's scene, coarse and short: runs, balances, bow shock, tip, restart.
 mpm_add_script_test(test_supersonic_bar SCRIPT verification/test_supersonic_bar.py
                     LABELS "verification;mpi" TIMEOUT 600)
+# The same scene under bs32 (4 mm, 0.3 ms): it completes and its step does not collapse.
+mpm_add_script_test(test_supersonic_bar_bs32 SCRIPT verification/test_supersonic_bar.py
+                    ARGS bs32 LABELS "verification;mpi" TIMEOUT 600)
 # Its bow shock, structurally: detached, and not at the inflow (see the header).
 mpm_add_script_test(test_supersonic_bar_standoff SCRIPT verification/test_supersonic_bar.py
                     ARGS standoff LABELS "verification;mpi" TIMEOUT 600)
