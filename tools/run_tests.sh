@@ -40,7 +40,8 @@
 # Idempotent.
 set -euo pipefail
 src=$(cd "$(dirname "$0")/.." && pwd)
-PLAIN_ONLY="wedge|forward_step|supersonic_bar|supersonic_bar_standoff|near_vacuum_order"
+PLAIN_ONLY="wedge|forward_step|supersonic_bar|supersonic_bar_standoff|supersonic_bar_bs32"
+PLAIN_ONLY+="|near_vacuum_order"
 PLAIN_ONLY+="|slanted_wall|slanted_wall_max|bluff_bodies|sod|strong_shock|gas_time_order|gas_shear"
 PLAIN_ONLY+="|fsi_waves|piperno_farhat|timeschemes|timeschemes_mri|blowup_guard_coupled"
 PLAIN_ONLY+="|csm1|csm3_fast|axial_bar|cantilever3d|model_swap|ranks_solid|periodic|stability|disks"
