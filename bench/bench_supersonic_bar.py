@@ -12,12 +12,14 @@ resolutions, and the error of each run against the finest `usl` run of the same 
 
 Usage (from the repository root, after building):
   /usr/bin/python3 bench/bench_supersonic_bar.py [--dx 0.004,0.003,0.002]
-      [--schemes velocity,contact,traction] [--methods usl] [--ranks 2] [--timeout 1800]
-      [--report]
+      [--schemes velocity,contact,traction] [--methods usl] [--cfl 0.8] [--ranks 2]
+      [--timeout 1800] [--report]
 Rows accumulate in bench/results/supersonic_bar_runs.json; a run whose row is there is not
 repeated (an interrupted sweep resumes where it stopped; delete a row to redo it). Each run's
 output stays in out/bench_supersonic_bar/<name>. The table (.md, .csv) and the plot (.png)
-are rewritten from all rows; the page keeps whatever follows its NOTES line. Wall times on a
+are rewritten from all rows; the page keeps whatever follows its NOTES line. Every run is
+given its time.cfl on the command line (--cfl, default the case's); rows stored before the
+step was recorded were run at 0.4, the case's value then, and are read as such. Wall times on a
 shared 2-core machine are noisy: compare within one invocation.
 """
 import argparse
@@ -49,8 +51,11 @@ T_TIP = 0.0015
 T_HIST = np.linspace(0.0, 0.003, 301)  # the tip history is kept on this grid (10 us)
 
 
-def name_of(scheme, method, dx):
-    return f"{scheme}_{method}_dx{dx * 1e3:g}mm"
+CFL_BEFORE = 0.4  # time.cfl of the rows stored before each row recorded its own
+
+
+def name_of(scheme, method, dx, cfl):
+    return f"{scheme}_{method}_dx{dx * 1e3:g}mm_cfl{cfl:g}"
 
 
 def measure(out):
@@ -106,12 +111,12 @@ def stop_message(log, out, code):
         return f"exit code {code}"
 
 
-def run_one(scheme, method, dx, ranks, timeout):
-    name = name_of(scheme, method, dx)
+def run_one(scheme, method, dx, cfl, ranks, timeout):
+    name = name_of(scheme, method, dx, cfl)
     out = os.path.join(OUT, name)
     cmd = [os.environ["MPMFSI_BIN"], "run", CASE, f"output.dir={out}", "output.overwrite=true",
            f"grid.dx={dx}", f"coupling.scheme={scheme}", f"time.method={method}",
-           "run.progress=false"]
+           f"time.cfl={cfl}", "run.progress=false"]
     if ranks > 1:
         cmd = ["mpiexec", "-n", str(ranks)] + cmd
     t0 = time.time()
@@ -123,8 +128,8 @@ def run_one(scheme, method, dx, ranks, timeout):
         proc.send_signal(signal.SIGTERM)
         stdout, stderr = proc.communicate()
     p = subprocess.CompletedProcess(cmd, proc.returncode, stdout, stderr)
-    row = {"name": name, "scheme": scheme, "method": method, "dx": dx, "ranks": ranks,
-           "ok": p.returncode == 0}
+    row = {"name": name, "scheme": scheme, "method": method, "dx": dx, "cfl": cfl,
+           "ranks": ranks, "ok": p.returncode == 0}
     if p.returncode != 0:
         row["message"] = stop_message(p.stdout + p.stderr, out, p.returncode)
         row["wall_s"] = time.time() - t0
@@ -134,10 +139,17 @@ def run_one(scheme, method, dx, ranks, timeout):
 
 
 def load():
-    if os.path.exists(STORE):
-        with open(STORE) as f:
-            return json.load(f)
-    return []
+    """The stored rows; one stored before rows recorded their time.cfl gets CFL_BEFORE, and
+    its name the suffix name_of gives."""
+    if not os.path.exists(STORE):
+        return []
+    with open(STORE) as f:
+        rows = json.load(f)
+    for r in rows:
+        if "cfl" not in r:
+            r["cfl"] = CFL_BEFORE
+            r["name"] = name_of(r["scheme"], r["method"], r["dx"], CFL_BEFORE)
+    return rows
 
 
 def at(series, t):
@@ -168,17 +180,18 @@ def observed_order(h, d):
 
 
 def successive(rows):
-    """Per scheme and method, the differences between runs at successive dx (finest last),
-    with the observed order of the tip history's differences over each three runs."""
+    """Per scheme, method and time.cfl, the differences between runs at successive dx (finest
+    last), with the observed order of the tip history's differences over each three runs."""
     out = []
-    for key in sorted({(r["scheme"], r["method"]) for r in rows if r["ok"]}):
-        runs = sorted((r for r in rows if r["ok"] and (r["scheme"], r["method"]) == key),
+    for key in sorted({(r["scheme"], r["method"], r["cfl"]) for r in rows if r["ok"]}):
+        runs = sorted((r for r in rows
+                       if r["ok"] and (r["scheme"], r["method"], r["cfl"]) == key),
                       key=lambda r: -r["dx"])
         d = [rms(tip_hist(a), tip_hist(b)) for a, b in zip(runs, runs[1:])]
         for k, (a, b) in enumerate(zip(runs, runs[1:])):
             order = (observed_order([r["dx"] for r in runs[k - 1:k + 2]], d[k - 1:k + 1])
                      if k > 0 and None not in d[k - 1:k + 1] else None)
-            out.append([key[0], key[1], f"{1e3 * a['dx']:g} - {1e3 * b['dx']:g}", d[k],
+            out.append([key[0], key[1], key[2], f"{1e3 * a['dx']:g} - {1e3 * b['dx']:g}", d[k],
                         1e3 * abs(a["tip_ux_1p5ms"] - b["tip_ux_1p5ms"]),
                         1e3 * abs(at(a["standoff"], 0.003) - at(b["standoff"], 0.003)),
                         1e3 * abs(standoff_mean(a) - standoff_mean(b)), order])
@@ -187,14 +200,16 @@ def successive(rows):
 
 def report(rows):
     ok = [r for r in rows if r["ok"]]
-    ref = {}  # per scheme: the finest usl run
+    ref = {}  # per scheme: the finest usl run (of those, the smallest step)
     for r in ok:
-        if r["method"] == "usl" and (r["scheme"] not in ref or r["dx"] < ref[r["scheme"]]["dx"]):
+        f = ref.get(r["scheme"])
+        if r["method"] == "usl" and (f is None or (r["dx"], r["cfl"]) < (f["dx"], f["cfl"])):
             ref[r["scheme"]] = r
     table = []
-    for r in sorted(rows, key=lambda r: (r["scheme"], r["method"], -r["dx"])):
+    for r in sorted(rows, key=lambda r: (r["scheme"], r["method"], -r["cfl"], -r["dx"])):
         e = {"name": r["name"], "scheme": r["scheme"], "method": r["method"],
-             "dx_mm": 1e3 * r["dx"], "ok": r["ok"], "wall_s": round(r["wall_s"], 1)}
+             "dx_mm": 1e3 * r["dx"], "cfl": r["cfl"], "ok": r["ok"],
+             "wall_s": round(r["wall_s"], 1)}
         if r["ok"]:
             f = ref.get(r["scheme"])
             so3, so15 = at(r["standoff"], 0.003), at(r["standoff"], 0.0015)
@@ -215,7 +230,7 @@ def report(rows):
         else:
             e["message"] = r["message"]
         table.append(e)
-    cols = ["scheme", "method", "dx_mm", "ok", "wall_s", "steps", "Mps_per_s",
+    cols = ["scheme", "method", "dx_mm", "cfl", "ok", "wall_s", "steps", "Mps_per_s",
             "standoff_1p5ms_mm", "standoff_3ms_mm", "standoff_mean_mm", "tip_ux_1p5ms_mm", "tip_ux_max_mm",
             "empty_cells_max", "imbalance", "coupling_work_J", "tip_err_mm", "standoff_err_mm",
             "tip_hist_rms_err_mm", "tip_hist_max_err_mm", "message"]
@@ -237,20 +252,22 @@ def report(rows):
         f.write("# supersonic_bar: refinement and work-precision (bench/bench_supersonic_bar.py)"
                 "\n\nStand-off: bow shock to the bar's upstream face (tools/supersonic_bar.py); "
                 "standoff_mean: over the snapshots from 1.5 to 3 ms; "
-                "tip: probes.csv at 1.5 ms; errors against the finest usl run of the same "
-                "scheme (tip_hist: the RMS and the largest difference of the tip's ux(t) over "
+                "tip: probes.csv at 1.5 ms; cfl: time.cfl; errors against the finest usl run "
+                "of the same scheme, at its smallest time.cfl (tip_hist: the RMS and the "
+                "largest difference of the tip's ux(t) over "
                 "0-3 ms); empty cells: the most, over the snapshots, of cells without gas whose "
                 "four neighbours hold gas. Wall times on the shared 2-core machine, 2 ranks.\n\n")
         f.write("| " + " | ".join(cols) + " |\n|" + "---|" * len(cols) + "\n")
         for e in table:
             f.write("| " + " | ".join(fmt(e.get(c)) for c in cols) + " |\n")
         f.write("\nSuccessive differences (each run against the next finer one of the same "
-                "scheme and method): tip history RMS over 0-3 ms, tip at 1.5 ms, stand-off at "
+                "scheme, method and time.cfl): tip history RMS over 0-3 ms, tip at 1.5 ms, "
+                "stand-off at "
                 "3 ms and its mean over 1.5-3 ms; and the observed order p of the tip history's differences over this "
                 "and the coarser pair (the p for which they are those of an error C dx^p).\n\n"
-                "| scheme | method | dx_mm | tip_hist_rms_diff_mm | tip_1p5ms_diff_mm | "
+                "| scheme | method | cfl | dx_mm | tip_hist_rms_diff_mm | tip_1p5ms_diff_mm | "
                 "standoff_3ms_diff_mm | standoff_mean_diff_mm | order |\n"
-                "|---|---|---|---|---|---|---|---|\n")
+                "|---|---|---|---|---|---|---|---|---|\n")
         for line in successive(rows):
             f.write("| " + " | ".join(fmt(v) for v in line) + " |\n")
         f.write("\n<!-- NOTES -->" + notes)
@@ -258,18 +275,17 @@ def report(rows):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     fig, axes = plt.subplots(1, 2, figsize=(10, 4))
-    for (scheme, method), mark in zip(sorted({(e["scheme"], e["method"]) for e in table}),
-                                      "osd^v<>"):
-        pts = [e for e in table if e["scheme"] == scheme and e["method"] == method
+    keys = sorted({(e["scheme"], e["method"], e["cfl"]) for e in table})
+    for (scheme, method, cfl), mark in zip(keys, "osd^v<>ph*x+"):
+        pts = [e for e in table if (e["scheme"], e["method"], e["cfl"]) == (scheme, method, cfl)
                and "tip_err_mm" in e]
         if not pts:
             continue
         w = [e["wall_s"] for e in pts]
         axes[0].loglog(w, [max(e.get("tip_hist_rms_err_mm") or np.nan, 1e-3) for e in pts],
-                       mark + "-",
-                       label=f"{scheme} {method}")
+                       mark + "-", label=f"{scheme} {method} cfl {cfl:g}")
         axes[1].loglog(w, [max(e["standoff_err_mm"], 1e-2) for e in pts], mark + "-",
-                       label=f"{scheme} {method}")
+                       label=f"{scheme} {method} cfl {cfl:g}")
     axes[0].set_ylabel("tip ux(t) - finest, RMS over 0-3 ms, mm")
     axes[1].set_ylabel("|stand-off(3 ms) - finest|, mm")
     for ax in axes:
@@ -281,26 +297,37 @@ def report(rows):
     print(f"wrote {PAGE}.md, .csv, .png")
 
 
+def case_cfl():
+    """time.cfl as the case file sets it (mpmfsi's default, 0.4, if it does not)."""
+    import configparser
+    c = configparser.ConfigParser(inline_comment_prefixes=("#", ";"))
+    c.read(CASE)
+    return c.getfloat("time", "cfl", fallback=0.4)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--dx", default="0.004,0.003,0.002")
     ap.add_argument("--schemes", default="velocity,contact,traction")
     ap.add_argument("--methods", default="usl")
+    ap.add_argument("--cfl", type=float, default=None,
+                    help="time.cfl of every run (default: the case's)")
     ap.add_argument("--ranks", type=int, default=2)
     ap.add_argument("--timeout", type=float, default=1800,
                     help="wall seconds a run may take before it is stopped (recorded as such)")
     ap.add_argument("--report", action="store_true", help="only rewrite the table and plot")
     a = ap.parse_args()
     rows = load()
+    cfl = a.cfl if a.cfl is not None else case_cfl()
     if not a.report:
         todo = [(s, m, float(d)) for s in a.schemes.split(",") for m in a.methods.split(",")
                 for d in a.dx.split(",")]
         for k, (s, m, d) in enumerate(todo):
-            if any(r["name"] == name_of(s, m, d) for r in rows):
-                print(f"[{k + 1}/{len(todo)}] {name_of(s, m, d)}: done before, kept")
+            if any(r["name"] == name_of(s, m, d, cfl) for r in rows):
+                print(f"[{k + 1}/{len(todo)}] {name_of(s, m, d, cfl)}: done before, kept")
                 continue
-            print(f"[{k + 1}/{len(todo)}] {name_of(s, m, d)} ...", flush=True)
-            row = run_one(s, m, d, a.ranks, a.timeout)
+            print(f"[{k + 1}/{len(todo)}] {name_of(s, m, d, cfl)} ...", flush=True)
+            row = run_one(s, m, d, cfl, a.ranks, a.timeout)
             rows = [r for r in load() if r["name"] != row["name"]] + [row]
             os.makedirs(RESULTS, exist_ok=True)
             with open(STORE + ".tmp", "w") as f:
