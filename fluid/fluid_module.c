@@ -757,13 +757,6 @@ static int build(mpm_module *m, const mpm_config *cfg, int seed) {
   fc->walls = walls;
   MPM_CALL(fluid_open_new(&fc->open, m, cfg, &walls, fc->gas.gamma, fc->ppc));
   MPM_CALL(fluid_obstacles_build(&fc->obs, cfg, g, fc->ppc, (const unsigned char(*)[2])m->open));
-  if (fc->obs.count > 0 && g->phase[m->phase].light_fraction > 0.0)
-    return mpm_config_fail(cfg, "fluid.light_node_mass",
-                           "light_node_mass = %g cannot be used with an [obstacle.*]: the "
-                           "obstacle books its ghost pressure force at nodes the rule would "
-                           "leave without force, so its drag and lift would be wrong; remove "
-                           "light_node_mass or the obstacle",
-                           g->phase[m->phase].light_fraction);
   MPM_CALL(fluid_wall_ls_init(m, cfg, fc->tr.classic));
   fc->virt.phase = -1;
   if (fluid_open_uses_virtual(fc->open)) MPM_CALL(fluid_virtual_init(&fc->virt, g));

@@ -555,6 +555,31 @@ static int build_ghosts(fluid_obstacles *o, const mpm_grid *g) {
   return 0;
 }
 
+/* The owned nodes of the bodies' reach, each once: the constrained nodes of every obstacle
+ * (the first that constrains a node owns it), then the ghost nodes of none. */
+static int build_reach(fluid_obstacles *o, const mpm_grid *g) {
+  int *mark;
+  MPM_ALLOC(mark, g->nnodes);
+  for (mpm_lidx l = 0; l < g->nnodes; ++l) mark[l] = -1;
+  for (int k = 0; k < o->count; ++k)
+    for (mpm_lidx j = 0; j < o->ob[k].count; ++j)
+      if (o->ob[k].owned[j] && mark[o->ob[k].node[j]] < 0) mark[o->ob[k].node[j]] = k;
+  for (mpm_lidx k = 0; k < o->gcount; ++k)
+    if (o->gowned[k] && mark[o->gnode[k]] < 0) mark[o->gnode[k]] = o->gob[k];
+  mpm_lidx n = 0;
+  for (mpm_lidx l = 0; l < g->nnodes; ++l) n += mark[l] >= 0;
+  o->lnode = malloc(sizeof *o->lnode * (size_t)(n + 1));
+  o->lob = malloc(sizeof *o->lob * (size_t)(n + 1));
+  if (!o->lnode || !o->lob) {
+    free(mark);
+    MPM_FAIL_OOM((double)n * (sizeof *o->lnode + sizeof *o->lob));
+  }
+  for (mpm_lidx l = 0; l < g->nnodes; ++l)
+    if (mark[l] >= 0) o->lnode[o->lcount] = l, o->lob[o->lcount++] = mark[l];
+  free(mark);
+  return 0;
+}
+
 int fluid_obstacles_build(fluid_obstacles *o, const mpm_config *cfg, const mpm_grid *grid, int ppc,
                           const unsigned char (*open)[2]) {
   const char *const *names;
@@ -577,7 +602,8 @@ int fluid_obstacles_build(fluid_obstacles *o, const mpm_config *cfg, const mpm_g
   o->nsm = 2;
   for (int k = 0; k < count; ++k)
     if (o->ob[k].surf.n) o->nsm = 3;
-  return build_ghosts(o, grid);
+  MPM_CALL(build_ghosts(o, grid));
+  return build_reach(o, grid);
 }
 
 int fluid_obstacles_inside(const fluid_obstacles *o, const double *x) {
@@ -693,6 +719,12 @@ int fluid_obstacles_apply(fluid_obstacles *o, mpm_grid *grid, int phase, double 
     for (mpm_lidx j = 0; j < o->ob[k].count; ++j)
       if (ph->m_i[o->ob[k].node[j]] > mmax) mmax = ph->m_i[o->ob[k].node[j]];
   MPM_CALL_MPI(MPI_Allreduce(MPI_IN_PLACE, &mmax, 1, MPI_DOUBLE, MPI_MAX, grid->comm));
+  for (mpm_lidx k = 0; record && k < o->lcount; ++k) { /* empty or light: the body took f_i */
+    const mpm_lidx l = o->lnode[k];
+    if (!(ph->m_i[l] > 0.0) || ph->m_i[l] > ph->m_empty) continue;
+    double *f = o->f[o->rec.latest] + (size_t)dim * o->lob[k];
+    for (int d = 0; d < dim; ++d) f[d] += ph->f_i[d][l];
+  }
   for (int k = 0; k < o->count; ++k) {
     double *f = record ? o->f[o->rec.latest] + (size_t)dim * k : scratch;
     apply_one(&o->ob[k], &grid->phase[phase], dim, h, o->hold * mmax, o->coast, f,
@@ -797,8 +829,8 @@ void fluid_obstacles_free(fluid_obstacles *o) {
   }
   free(o->ob);
   free(o->f[0]), free(o->f[1]);
-  free(o->gnode), free(o->G), free(o->gowned), free(o->gob), free(o->near), free(o->sm), free(o->q),
-      free(o->own);
+  free(o->gnode), free(o->G), free(o->gowned), free(o->gob), free(o->lnode), free(o->lob),
+      free(o->near), free(o->sm), free(o->q), free(o->own);
   mpm_diag_close(&o->csv);
   memset(o, 0, sizeof *o);
 }

@@ -28,7 +28,14 @@
  * changes the gas's momentum, summed over the nodes each rank owns and reduced over the ranks:
  *   method of lines (h = 0):  F = sum_i m_i (a_i - a_i') - sum_i p_i G_i,
  *   classic update (h > 0):   F = sum_i m_i (v_i - v_i') / h - sum_i p_i G_i,
- * where ' marks the constrained values (a_i includes the ghost force). In the classic update the
+ * where ' marks the constrained values (a_i includes the ghost force). A node of a body's reach
+ * (constrained, or loaded by its ghosts) whose mass is at or below the phase's m_empty (empty,
+ * or light under fluid.light_node_mass) took a_i = 0 in the nodal update: its whole force f_i
+ * (gas and ghost) never reached the gas, while the gas's other nodes took the partners of its
+ * internal forces, so the body took it: F gains sum f_i over those nodes. Without that a light
+ * rule at the bodies' edges, whose nodes the gas only partly covers, breaks the balance below
+ * (test_obstacles: by 9.4e-3 of the pulse's momentum scale with light_node_mass = 0.3); light
+ * nodes away from every body stay the light rule's own loss. In the classic update the
  * constraint is an impulse: the acceleration takes the velocity change too, a_i' = a_i +
  * (v_i' - v_i) / h, so FLIP (which adds h sum S a_i'), PIC and APIC (which take sum S v_i')
  * all see the same change, and over a step P(t + h) - P(t) = -h F exactly, with P the gas
@@ -99,6 +106,9 @@ typedef struct fluid_obstacles {
   double *G;       /* sum V grad S of the ghosts (dim per node) */
   unsigned char *gowned;
   int *gob;            /* the obstacle each ghost force belongs to (the nearest) */
+  mpm_lidx lcount;     /* owned nodes in the bodies' reach (constrained or ghost), each once */
+  mpm_lidx *lnode;     /* box index: an empty or light one hands its force to the body */
+  int *lob;            /* the obstacle it belongs to */
   unsigned char *near; /* per box node as a cell's lower corner: a particle in it reaches a
                           ghost node or, when the heat is booked, a constrained node */
   unsigned char *own;  /* per box node: owned by this rank */
@@ -137,8 +147,8 @@ int fluid_obstacles_inside(const fluid_obstacles *o, const double *x);
 /* The index of the first obstacle that contains x, or -1. */
 int fluid_obstacles_which(const fluid_obstacles *o, const double *x);
 /* Constrain the obstacle nodes of phase after a nodal update with step h (0: method of lines);
- * add the removed momentum to the force record begun by fluid_obstacles_begin when record is set.
- */
+ * with record, add the removed momentum and the forces of the empty or light nodes of the bodies'
+ * reach (see Force above) to the force record begun by fluid_obstacles_begin. */
 int fluid_obstacles_apply(fluid_obstacles *o, mpm_grid *grid, int phase, double h, int record);
 /* Book the obstacles' work as heat from now on (see Energy above). */
 void fluid_obstacles_book_heat(fluid_obstacles *o, const mpm_grid *g);

@@ -228,11 +228,6 @@ for name, key_line, key in (("wall band 0", "wall_band = 0", "fluid.wall_band"),
     text = OBST + LS + key_line + "\n"
     expect_error(name, text, key, None, line_of(text, key_line))
 
-# Light nodes beside an obstacle: its force booking assumes every node it loads takes the force.
-text = OBST + "\n[fluid]\nlight_node_mass = 0.05\n"
-expect_error("light_node_mass with an obstacle", text, "fluid.light_node_mass", "obstacle",
-             line_of(text, "light_node_mass"))
-
 # The surface pressure output (fluid/fluid_surface.h): vertices of a 2-D outline only; Cp needs
 # the reference values.
 POLY = ("\n[obstacle.tri]\nshape = polygon\nvertices = 0.2 0.7 0.3 0.7 0.25 0.8\n")
