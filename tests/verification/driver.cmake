@@ -98,6 +98,10 @@ mpm_add_script_test(test_wedge_long SCRIPT verification/test_wedge.py ARGS long
 mpm_add_script_test(test_wedge_ghost_long SCRIPT verification/test_wedge.py ARGS ghost_long
                     LABELS "verification;long" TIMEOUT 1800)
 set_tests_properties(test_wedge_ghost_long PROPERTIES WILL_FAIL TRUE)
+# The same with the light-node rule (fluid.light_node_mass = 0.05): the trapped gas's nodes take
+# no force and the run completes.
+mpm_add_script_test(test_wedge_ghost_light_long SCRIPT verification/test_wedge.py
+                    ARGS ghost_light_long LABELS "verification;long" TIMEOUT 1800)
 # Woodward-Colella forward step: to t = 4 at dx = 1/80 under long; the first unit of time at
 # dx = 1/40 in the default selection.
 mpm_add_script_test(test_forward_step SCRIPT verification/test_forward_step.py
