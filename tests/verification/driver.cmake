@@ -115,3 +115,5 @@ mpm_add_script_test(test_coupling_rigid SCRIPT verification/test_coupling_rigid.
 # The gas's stable-step estimates: particle against neighbourhood, checked against the formulas.
 mpm_add_script_test(test_stable_step SCRIPT verification/test_stable_step.py
                     LABELS "verification;mpi" TIMEOUT 600)
+mpm_add_script_test(test_pic_rate SCRIPT verification/test_pic_rate.py LABELS verification
+                    TIMEOUT 300)
