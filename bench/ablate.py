@@ -117,6 +117,33 @@ def history(out, quantity):
     return col, np.array([float(r["t"]) for r in rows]), np.array([float(r[col]) for r in rows])
 
 
+# The reference's time scheme, given whatever the case file sets: until 2026-11-29 it was left
+# to the case, so the shock panel's references (coupling.time = multirate in its file) were
+# multirate runs at the reference step, not monolithic ones.
+REFERENCE = ["coupling.time=monolithic", "time.method=usl"]
+
+
+def reference_key(args):
+    """What a reference run depends on: the overrides, its scheme and step, the ranks and the
+    binary (its path, size and modification time, so that a rebuilt binary counts as
+    another)."""
+    st = os.stat(args.binary)
+    return {"overrides": args.overrides, "reference": REFERENCE, "ref_cfl": args.ref_cfl,
+            "ranks": args.ranks, "binary": [os.path.abspath(args.binary), st.st_size, st.st_mtime]}
+
+
+def reference_current(args, out):
+    """Is the reference in out finished and made as this sweep would make it? A reference left
+    by another binary or other overrides is run again (a resumed sweep kept such a stale one)."""
+    try:
+        with open(os.path.join(out, "reference.json")) as f:
+            key = json.load(f)
+    except (OSError, ValueError):
+        return False
+    return os.path.exists(os.path.join(out, "summary.json")) and key == json.loads(
+        json.dumps(reference_key(args)))
+
+
 def combos(args):
     for spatial in args.spatial:
         for temporal, variant, keys in VARIANTS:
@@ -145,6 +172,14 @@ def load_rows(path):
         return {}
     with open(path) as f:
         return {r["name"]: r for r in csv.DictReader(f)}
+
+
+def rewrite_rows(path, rows):
+    with open(path, "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=FIELDS)
+        w.writeheader()
+        for r in rows:
+            w.writerow(r)
 
 
 def append_row(path, row):
@@ -242,7 +277,9 @@ def main():
     args.case = os.path.abspath(args.case)
     name = os.path.splitext(os.path.basename(args.case))[0]
     outdir = os.path.abspath(args.out or os.path.join(HERE, "results", f"ablate_{name}"))
-    scratch = os.path.join(ROOT, "out", "ablate", name)  # the runs' own output, not committed
+    # The runs' own output, not committed: one folder per results folder, so that two sweeps of
+    # one case (another --out) never share runs or references.
+    scratch = os.path.join(ROOT, "out", "ablate", os.path.basename(outdir))
     os.makedirs(scratch, exist_ok=True)
     os.makedirs(outdir, exist_ok=True)
     table = os.path.join(outdir, "runs.csv")
@@ -251,12 +288,23 @@ def main():
     for spatial in args.spatial:
         out = os.path.join(scratch, f"reference-{spatial}")
         status, msg, _ = ("ok", "", None)
-        if args.report_only and not os.path.exists(os.path.join(out, "summary.json")):
-            continue
-        if not os.path.exists(os.path.join(out, "summary.json")):
+        if args.report_only:
+            if not os.path.exists(os.path.join(out, "summary.json")):
+                continue
+        elif not reference_current(args, out):
             print(f"reference for {spatial} (monolithic usl, cfl {args.ref_cfl:g}) ...", flush=True)
-            status, msg, _ = run(args, out, [f"coupling.scheme={spatial}", "time.method=usl",
-                                            f"time.cfl={args.ref_cfl}"])
+            status, msg, _ = run(args, out, REFERENCE + [f"coupling.scheme={spatial}",
+                                                         f"time.cfl={args.ref_cfl}"])
+            if status == "ok":
+                with open(os.path.join(out, "reference.json"), "w") as f:
+                    json.dump(reference_key(args), f)
+            stale = [n for n, r in done.items() if r["spatial"] == spatial]
+            if stale:  # their errors were taken against the reference just replaced
+                print(f"  {len(stale)} {spatial} row(s) of runs.csv were measured against "
+                      "another reference: they are run again")
+                for n in stale:
+                    del done[n]
+                rewrite_rows(table, done.values())
         if status != "ok":
             print(f"  reference for {spatial} failed ({status}: {msg}); its runs are skipped")
             continue
