@@ -19,10 +19,11 @@ MRIStep, fixed steps: time.adaptive = false); `contact` with the classic update 
 restriction). Coupling steps: time.cfl in --cfl. --skip leaves out runs by name (shell
 patterns), --skip-variants whole variants.
 
-Results go to --out (default bench/results/ablate_<case>; the runs' own output to
-out/ablate/<case>/): runs.csv (one row per run, written as
+Results go to --out (default bench/results/ablate_<case>; the runs' own output to --scratch,
+default out/ablate/<the results folder's name>/): runs.csv (one row per run, written as
 each run ends: an interrupted sweep resumes without redoing finished runs; delete a row to redo
-it), ablation.md (the table and the findings' figures), and plots: error against wall time,
+it; a reference run again, because the binary or the overrides changed, redoes its scheme's
+rows), ablation.md (the table and the findings' figures), and plots: error against wall time,
 and the interface energy against the coupling step. --ranks 2 runs every run on 2 ranks. The
 sweep prints progress and its own wall time.
 """
@@ -32,6 +33,7 @@ import fnmatch
 import json
 import math
 import os
+import shutil
 import subprocess
 import sys
 import time
@@ -78,6 +80,8 @@ def parse():
     ap.add_argument("--ranks", type=int, default=1)
     ap.add_argument("--timeout", type=float, default=1800, help="s per run")
     ap.add_argument("--out", default=None)
+    ap.add_argument("--scratch", default=None, help="the runs' own output (default "
+                    "out/ablate/<the results folder's name>)")
     ap.add_argument("--binary", default=os.path.join(ROOT, "build", "app", "mpmfsi"))
     ap.add_argument("--report-only", action="store_true",
                     help="make no run: write the table and plot from runs.csv as it stands")
@@ -127,9 +131,10 @@ def reference_key(args):
     """What a reference run depends on: the overrides, its scheme and step, the ranks and the
     binary (its path, size and modification time, so that a rebuilt binary counts as
     another)."""
-    st = os.stat(args.binary)
+    path = os.path.abspath(shutil.which(args.binary) or args.binary)
+    st = os.stat(path)
     return {"overrides": args.overrides, "reference": REFERENCE, "ref_cfl": args.ref_cfl,
-            "ranks": args.ranks, "binary": [os.path.abspath(args.binary), st.st_size, st.st_mtime]}
+            "ranks": args.ranks, "binary": [path, st.st_size, st.st_mtime]}
 
 
 def reference_current(args, out):
@@ -279,7 +284,8 @@ def main():
     outdir = os.path.abspath(args.out or os.path.join(HERE, "results", f"ablate_{name}"))
     # The runs' own output, not committed: one folder per results folder, so that two sweeps of
     # one case (another --out) never share runs or references.
-    scratch = os.path.join(ROOT, "out", "ablate", os.path.basename(outdir))
+    scratch = os.path.abspath(args.scratch or os.path.join(ROOT, "out", "ablate",
+                                                           os.path.basename(outdir)))
     os.makedirs(scratch, exist_ok=True)
     os.makedirs(outdir, exist_ok=True)
     table = os.path.join(outdir, "runs.csv")
