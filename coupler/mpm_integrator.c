@@ -182,7 +182,8 @@ static int rhs_fast(mpm_sunreal t, N_Vector y, N_Vector ydot, void *user) {
 }
 
 /* Stability limit: min over modules (all, or all but module `skip`) and ranks of
- * dx / (c + |v|), before the CFL fraction. */
+ * dx / (c + |v|), before the CFL fraction; each of those modules learns its own limit times the
+ * CFL fraction as its h_alone (mpm_module.h). */
 static int stable_step_of(mpm_integrator *it, double *const *yk, int skip, double *hstab) {
   double h[MPM_MAX_MODULES];
   for (int k = 0; k < it->nmod; ++k)
