@@ -145,8 +145,7 @@ def reference_current(args, out):
             key = json.load(f)
     except (OSError, ValueError):
         return False
-    return os.path.exists(os.path.join(out, "summary.json")) and key == json.loads(
-        json.dumps(reference_key(args)))
+    return os.path.exists(os.path.join(out, "summary.json")) and key == reference_key(args)
 
 
 def combos(args):

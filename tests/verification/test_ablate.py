@@ -43,7 +43,7 @@ def probes(folder):
         return f.read()
 
 
-first = sweep([])
+sweep([])
 ref = os.path.join(scratch, "reference-velocity")
 mono = mt.outdir("ablate_monolithic")
 mt.run(["run", CASE, f"output.dir={mono}", "output.interval=1e9", "coupling.scheme=velocity",

@@ -12,9 +12,9 @@ and the two at 3 dx / 4 from a node equal weights, with opposite velocities): th
 rest, FLIP keeps the particles' velocities, and only the PIC share changes them, by the factor
 (1 - a_h) a step. U = 1e-6 c, so neither the heat the share makes (U^2 / 2 per unit mass) nor
 |v| in the signal c + |v| moves the step by more than 1e-6 (at U = 1e-3 c the step grew by
-4e-4 as |v| decayed, and the decay differed from the formula by 4e-5). The artificial viscosity is off:
-its linear term acts at any compression, a roundoff-sized one included, and adds c to the
-signal, so the gas's own step would halve from one step to the next at random.
+4e-4 as |v| decayed, and the decay differed from the formula by 4e-5). The artificial
+viscosity is off: its linear term acts at any compression, a roundoff-sized one included, and
+adds c to the signal, so the gas's own step would halve from one step to the next at random.
 
 1. At the gas's own step (usl, time.cfl = 0.4, a = 0.1) the particles' RMS velocity after
    t = 0.05 is U 0.9^(t / h_alone), h_alone the run's step (diagnostics.csv), within 1e-6
