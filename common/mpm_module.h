@@ -67,7 +67,8 @@ typedef struct mpm_module_ops {
   void (*sums)(const mpm_module *m, mpm_module_sums *s);
   /* Between accepted steps, before migration: particles leave through outflow faces and
    * enter through inflow faces. t is the time reached and h the step just taken. Sets
-   * *changed to 1 if the particle set changed (count or order). Optional. */
+   * *changed to 1 if the particle set changed (count or order). The migration always follows,
+   * so the op may leave its edit to it (mpm_particles_edit_deferred). Optional. */
   int (*boundary)(mpm_module *m, double t, double h, int *changed);
   /* After an accepted step and migration (history updates, regularisation, reports); every
    * particle sits on the rank that owns its cell. Same arguments as boundary. Optional. */

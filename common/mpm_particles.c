@@ -88,6 +88,7 @@ void mpm_particles_destroy(mpm_particles **p) {
   for (int f = 0; f < (*p)->nfields; ++f) free((char *)(*p)->field[f].name);
   free((*p)->id), free((*p)->spare_id);
   free((*p)->data), free((*p)->spare_data);
+  free((*p)->later.keep), free((*p)->later.id), free((*p)->later.data);
   free(*p);
   *p = NULL;
 }
@@ -174,8 +175,8 @@ static void copy_kept(const mpm_particles *p, const unsigned char *keep, mpm_lid
   }
 }
 
-int mpm_particles_edit(mpm_particles *p, const unsigned char *keep, mpm_lidx nadd,
-                       const mpm_gidx *add_id, const double *add_data) {
+static int edit_now(mpm_particles *p, const unsigned char *keep, mpm_lidx nadd,
+                    const mpm_gidx *add_id, const double *add_data) {
   if (nadd < 0 || (nadd > 0 && (!add_id || !add_data)))
     MPM_FAIL(MPM_ERR_INPUT, "particles: cannot add %d particles without ids and data", (int)nadd);
   const mpm_lidx kept = count_kept(p, keep);
@@ -193,6 +194,45 @@ int mpm_particles_edit(mpm_particles *p, const unsigned char *keep, mpm_lidx nad
     memcpy(data + (size_t)c * (size_t)nnew + (size_t)kept, add_data + (size_t)c * (size_t)nadd,
            (size_t)nadd * sizeof *data);
   install(p, nnew, id, data, cap);
+  return 0;
+}
+
+/* A call that reads or changes the set while a deferred edit waits for its migration. */
+static int fail_if_deferred(const mpm_particles *p, const char *what) {
+  if (p->later.set)
+    MPM_FAIL(MPM_ERR_INTERNAL,
+             "particles: %s while a deferred edit waits for the next migration (a module's "
+             "boundary step must be followed by mpm_particles_migrate)",
+             what);
+  return 0;
+}
+
+int mpm_particles_edit(mpm_particles *p, const unsigned char *keep, mpm_lidx nadd,
+                       const mpm_gidx *add_id, const double *add_data) {
+  MPM_CALL(fail_if_deferred(p, "an edit"));
+  return edit_now(p, keep, nadd, add_id, add_data);
+}
+
+static void later_clear(mpm_particles *p) {
+  free(p->later.keep), free(p->later.id), free(p->later.data);
+  memset(&p->later, 0, sizeof p->later);
+}
+
+int mpm_particles_edit_deferred(mpm_particles *p, unsigned char *keep, mpm_lidx nadd,
+                                mpm_gidx *add_id, double *add_data) {
+  const char *bad = p->later.set ? "another deferred edit is still pending"
+                    : nadd < 0 || (nadd > 0 && (!add_id || !add_data))
+                        ? "particles to add without ids or data"
+                    : (int64_t)count_kept(p, keep) + nadd > INT32_MAX
+                        ? "the particles would exceed the local index range"
+                        : NULL;
+  if (bad) {
+    const int code = p->later.set ? MPM_ERR_INTERNAL : MPM_ERR_INPUT;
+    free(keep), free(add_id), free(add_data);
+    MPM_FAIL(code, "particles: cannot defer an edit: %s", bad);
+  }
+  p->later.set = 1, p->later.keep = keep, p->later.nadd = nadd;
+  p->later.id = add_id, p->later.data = add_data;
   return 0;
 }
 
@@ -262,17 +302,36 @@ static void format_point(char *buf, size_t len, const double *x, int dim) {
            x[0], dim > 1 ? x[1] : 0.0, dim > 2 ? x[2] : 0.0);
 }
 
+/* The particles a migration distributes: the set's own, then the additions of a deferred edit
+ * (mpm_particles_edit_deferred), whose dropped particles take no part. */
+static mpm_lidx src_count(const mpm_particles *p) {
+  return p->n + (p->later.set ? p->later.nadd : 0);
+}
+
+static int src_dropped(const mpm_particles *p, mpm_lidx i) {
+  return i < p->n && p->later.keep && !p->later.keep[i];
+}
+
+static double *src_value(const mpm_particles *p, mpm_lidx i, int c) {
+  return i < p->n ? p->data + (size_t)c * (size_t)p->n + i
+                  : p->later.data + (size_t)c * (size_t)p->later.nadd + (i - p->n);
+}
+
+static mpm_gidx src_id(const mpm_particles *p, mpm_lidx i) {
+  return i < p->n ? p->id[i] : p->later.id[i - p->n];
+}
+
 static int report_outside(const mpm_particles *p, const mpm_grid *g, mpm_lidx i, mpm_lidx nout) {
   char at[128], lo[128], hi[128];
   double x[MPM_MAX_DIM] = {0};
-  for (int d = 0; d < p->dim; ++d) x[d] = mpm_particles_comp(p, 0, d)[i];
+  for (int d = 0; d < p->dim; ++d) x[d] = *src_value(p, i, d);
   format_point(at, sizeof at, x, p->dim);
   format_point(lo, sizeof lo, g->lo, g->dim);
   format_point(hi, sizeof hi, g->hi, g->dim);
   MPM_FAIL(MPM_ERR_UNPHYSICAL,
            "particle %" PRId64 " at %s left the domain [%s, %s] (%d particle(s) outside on this "
            "rank); reduce the time step or check the boundary conditions that hold it in",
-           p->id[i], at, lo, hi, (int)nout);
+           src_id(p, i), at, lo, hi, (int)nout);
 }
 
 /* Wrap positions across periodic faces; returns how many particles moved. */
@@ -281,26 +340,48 @@ static mpm_lidx wrap_positions(mpm_particles *p, const mpm_grid *g) {
   int any = 0;
   for (int d = 0; d < g->dim; ++d) any |= g->periodic[d];
   if (!any) return 0; /* no pass over the particles when nothing can wrap */
-  for (mpm_lidx i = 0; i < p->n; ++i) {
+  for (mpm_lidx i = 0; i < src_count(p); ++i) {
     double x[MPM_MAX_DIM];
-    for (int d = 0; d < p->dim; ++d) x[d] = mpm_particles_comp(p, 0, d)[i];
+    if (src_dropped(p, i)) continue;
+    for (int d = 0; d < p->dim; ++d) x[d] = *src_value(p, i, d);
     if (!mpm_grid_wrap(g, x)) continue;
-    for (int d = 0; d < p->dim; ++d) mpm_particles_comp(p, 0, d)[i] = x[d];
+    for (int d = 0; d < p->dim; ++d) *src_value(p, i, d) = x[d];
     nwrap++;
   }
   return nwrap;
 }
 
-/* Owner of every particle; fails naming the first particle outside the domain. */
+/* Owner of every particle (a dropped one: -2, neither kept nor sent); fails naming the first
+ * particle outside the domain. Most particles stay: one that lies inside this rank's cells by
+ * more than a millionth of a cell along every axis is its own without mpm_grid_owner_of's
+ * division (the margin is far above the division's roundoff, so the two tests never
+ * disagree); the rest, near a rank face, ask it. */
 static int find_owners(const mpm_particles *p, const mpm_grid *g, migration *m) {
   mpm_lidx nout = 0, first = -1;
-  for (mpm_lidx i = 0; i < p->n; ++i) {
+  double in_lo[MPM_MAX_DIM], in_hi[MPM_MAX_DIM];
+  for (int d = 0; d < p->dim; ++d) {
+    const int *split = g->cell_split[d], c = g->coord[d];
+    in_lo[d] = g->lo[d] + (split[c] + 1e-6) * g->dx;
+    in_hi[d] = g->lo[d] + (split[c + 1] - 1e-6) * g->dx;
+  }
+  const double *xp[MPM_MAX_DIM] = {NULL};
+  for (int d = 0; d < p->dim; ++d) xp[d] = mpm_particles_comp(p, 0, d);
+  for (mpm_lidx i = 0; i < src_count(p); ++i) {
+    if (src_dropped(p, i)) {
+      m->dest[i] = -2, m->keep[i] = 0;
+      continue;
+    }
     double x[MPM_MAX_DIM];
-    for (int d = 0; d < p->dim; ++d) x[d] = mpm_particles_comp(p, 0, d)[i];
-    m->dest[i] = mpm_grid_owner_of(g, x);
+    int inside = 1;
+    for (int d = 0; d < p->dim; ++d) {
+      x[d] = i < p->n ? xp[d][i] : *src_value(p, i, d);
+      inside &= x[d] > in_lo[d] && x[d] < in_hi[d]; /* false for NaN */
+    }
+    m->dest[i] = inside ? g->rank : mpm_grid_owner_of(g, x);
     if (m->dest[i] < 0 && nout++ == 0) first = i;
     m->keep[i] = m->dest[i] == g->rank;
-    m->nmove += m->dest[i] != g->rank;
+    m->nmove += m->dest[i] != g->rank && m->dest[i] >= 0;
+    m->nkeep += m->keep[i];
   }
   return nout ? report_outside(p, g, first, nout) : 0;
 }
@@ -313,11 +394,12 @@ static void prefix_sum(const int *count, int *displ, int n) {
 /* Pack the movers by destination rank, in particle order within each destination. */
 static void pack_movers(const mpm_particles *p, const mpm_grid *g, migration *m) {
   const size_t rec = 1 + (size_t)p->ncomp;
-  for (mpm_lidx i = 0; i < p->n; ++i) {
-    if (m->keep[i]) continue;
+  for (mpm_lidx i = 0; i < src_count(p); ++i) {
+    if (m->keep[i] || m->dest[i] < 0) continue;
     double *r = m->sendbuf + (size_t)m->displ[m->dest[i]]++ * rec;
-    memcpy(r, &p->id[i], sizeof *r);
-    for (int c = 0; c < p->ncomp; ++c) r[1 + c] = p->data[(size_t)c * (size_t)p->n + i];
+    const mpm_gidx id = src_id(p, i);
+    memcpy(r, &id, sizeof *r);
+    for (int c = 0; c < p->ncomp; ++c) r[1 + c] = *src_value(p, i, c);
   }
   prefix_sum(m->count, m->displ, g->size); /* packing advanced displ; restore it */
 }
@@ -325,14 +407,15 @@ static void pack_movers(const mpm_particles *p, const mpm_grid *g, migration *m)
 /* Everything before the first collective: owners, send counts and the packed movers. */
 static int plan_sends(const mpm_particles *p, const mpm_grid *g, migration *m) {
   int rc = 0;
-  m->dest = try_alloc((size_t)p->n, sizeof *m->dest, &rc);
-  m->keep = try_alloc((size_t)p->n, sizeof *m->keep, &rc);
+  const mpm_lidx n = src_count(p);
+  m->dest = try_alloc((size_t)n, sizeof *m->dest, &rc);
+  m->keep = try_alloc((size_t)n, sizeof *m->keep, &rc);
   m->count = try_alloc(2 * (size_t)g->size, sizeof *m->count, &rc);
   m->displ = try_alloc(2 * (size_t)g->size, sizeof *m->displ, &rc);
   if (rc) return rc;
   MPM_CALL(find_owners(p, g, m));
-  m->nkeep = p->n - m->nmove;
-  for (mpm_lidx i = 0; i < p->n; ++i) m->count[m->dest[i]] += !m->keep[i];
+  for (mpm_lidx i = 0; i < n; ++i)
+    if (m->dest[i] >= 0) m->count[m->dest[i]] += !m->keep[i];
   prefix_sum(m->count, m->displ, g->size);
   m->sendbuf = try_alloc((size_t)m->nmove * (1 + (size_t)p->ncomp), sizeof(double), &rc);
   if (rc) return rc;
@@ -370,10 +453,18 @@ static int alltoallv_records(const mpm_particles *p, const mpm_grid *g, migratio
   return 0;
 }
 
-/* Kept particles first, in order, then the arrivals in source rank order. */
+/* Kept particles first, in order (a deferred edit's additions after the set's own), then the
+ * arrivals in source rank order. */
 static void assemble(mpm_particles *p, migration *m) {
   const size_t rec = 1 + (size_t)p->ncomp, nnew = (size_t)(m->nkeep + m->nrecv);
   copy_kept(p, m->keep, (mpm_lidx)nnew, m->id, m->data);
+  size_t k = (size_t)count_kept(p, m->keep);
+  for (mpm_lidx i = p->n; i < src_count(p); ++i) {
+    if (!m->keep[i]) continue;
+    m->id[k] = src_id(p, i);
+    for (int c = 0; c < p->ncomp; ++c) m->data[(size_t)c * nnew + k] = *src_value(p, i, c);
+    ++k;
+  }
   for (mpm_lidx j = 0; j < m->nrecv; ++j) {
     const double *r = m->recvbuf + (size_t)j * rec;
     const size_t i = (size_t)(m->nkeep + j);
@@ -411,9 +502,12 @@ int mpm_particles_migrate(mpm_particles *p, const mpm_grid *grid, int *changed) 
   if (!rc && status[1]) {
     rc = exchange(p, grid, &m);
     if (changed) *changed = !rc;
-  } else if (!rc && changed) {
-    *changed = status[2]; /* the state changed in place: an integrator must hear of it */
+  } else if (!rc) {
+    /* Nothing moves: a deferred edit is applied on its own. Its caller reported the change. */
+    if (p->later.set) rc = edit_now(p, p->later.keep, p->later.nadd, p->later.id, p->later.data);
+    if (changed) *changed = status[2]; /* the state changed in place: an integrator must hear */
   }
+  later_clear(p);
   migration_free(&m);
   MPM_CALL(rc);
   return 0;
@@ -475,6 +569,7 @@ static int sort_passes(mpm_particles *p, const mpm_grid *g, int *cell, mpm_lidx 
 }
 
 int mpm_particles_sort(mpm_particles *p, const mpm_grid *grid) {
+  MPM_CALL(fail_if_deferred(p, "a sort"));
   if (p->n < 2) return 0;
   int maxcells = 0, *cell = NULL, rc = 0;
   mpm_lidx *perm = NULL, *tmp = NULL, *start = NULL;

@@ -56,6 +56,15 @@ typedef struct mpm_particles {
   mpm_gidx id_next;                                /* next free global id; equal on every rank */
   mpm_field_range range[MPM_PARTICLES_MAX_FIELDS]; /* all reals unless the module narrows it */
   unsigned derived; /* bit f: field f is derived (mpm_particles_set_derived) */
+  /* An edit recorded by mpm_particles_edit_deferred for the next migration (owned buffers;
+   * set while one is pending). */
+  struct {
+    int set;
+    unsigned char *keep; /* p->n flags, or NULL: keep all */
+    mpm_lidx nadd;
+    mpm_gidx *id;
+    double *data; /* component-major, stride nadd */
+  } later;
 } mpm_particles;
 
 /* A set with no particles. The first nstate_fields fields are the state; fields 0 and 1
@@ -76,6 +85,16 @@ int mpm_particles_find(const mpm_particles *p, const char *name);
  * ones with ids add_id and data add_data (component-major: ncomp * nadd). Local. */
 int mpm_particles_edit(mpm_particles *p, const unsigned char *keep, mpm_lidx nadd,
                        const mpm_gidx *add_id, const double *add_data);
+
+/* mpm_particles_edit, recorded now and applied by the next mpm_particles_migrate in the same
+ * rebuild of the block as the migration itself: a set that changes at a boundary and then
+ * migrates at every step is rebuilt once instead of twice, with the particles in the order the
+ * edit and the migration one after the other give. Takes ownership of keep (p->n flags, or
+ * NULL), add_id and add_data (nadd particles, component-major with stride nadd), all from
+ * malloc. Nothing may read or change the set until the migration: the other editing calls
+ * fail while an edit is pending. Local. */
+int mpm_particles_edit_deferred(mpm_particles *p, unsigned char *keep, mpm_lidx nadd,
+                                mpm_gidx *add_id, double *add_data);
 
 /* Append nadd particles with fresh global ids (collective: ids are numbered in rank
  * order from id_next). */

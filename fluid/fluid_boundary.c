@@ -733,8 +733,12 @@ int fluid_open_exchange(fluid_open *o, mpm_module *m, double t, double h, int *c
     }
     for (int c = 1; !rc && c < p->ncomp && q < nadd; ++c) /* to stride q: points in bodies */
       memmove(data + (size_t)c * q, data + (size_t)c * nadd, sizeof(double) * (size_t)q);
-    if (!rc) rc = mpm_particles_edit(p, keep, q, id, data);
-    free(data), free(id);
+    if (rc) {
+      free(data), free(id);
+    } else { /* applied by the migration that follows every boundary step: one rebuild */
+      rc = mpm_particles_edit_deferred(p, keep, q, id, data);
+      keep = NULL; /* the set's now */
+    }
     *changed = 1;
   }
   for (int k = 0; k < o->nfaces; ++k) { /* the refills' id ranges, on every rank */

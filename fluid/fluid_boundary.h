@@ -34,7 +34,8 @@ int fluid_open_forces(fluid_open *open, mpm_module *m, double t);
  * velocity; beyond the other open faces, extrapolate the face node linearly. */
 void fluid_open_hold(const fluid_open *open, mpm_module *m);
 /* Between steps (the boundary op): remove particles that left through an open face and inject
- * the free-stream layers that entered during the step h that ended at t. Local. */
+ * the free-stream layers that entered during the step h that ended at t, as an edit deferred
+ * to the migration that follows. Local. */
 int fluid_open_exchange(fluid_open *open, mpm_module *m, double t, double h, int *changed);
 
 /* Between steps: a gas particle that ended a step beyond a wall face (by less than the

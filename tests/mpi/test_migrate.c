@@ -10,6 +10,10 @@
  *   count, the id multiset (sum of ids and of their squares), ownership of every particle and
  *   every value (a function of the id; the position is recomputed from the walk) are checked,
  *   and at the end rank 0 checks that the gathered ids are exactly 0 .. N-1;
+ * - deferred edit: an edit left to the next migration (mpm_particles_edit_deferred) gives the
+ *   same set, particle for particle and bit for bit, as the edit followed by the migration,
+ *   whether or not anything moves between ranks; any other edit or a sort while one is
+ *   pending fails;
  * - a particle outside the domain makes migrate fail with MPM_ERR_UNPHYSICAL on every rank.
  * The walk is a hash of (id, step), so it does not depend on where a particle lives. */
 #include "mpm_particles.h"
@@ -311,6 +315,78 @@ static void test_migrate(int dim) {
   mpm_grid_destroy(&g);
 }
 
+/* Do a and b hold the same particles in the same order, every non-derived value equal? */
+static int same_sets(const mpm_particles *a, const mpm_particles *b) {
+  if (a->n != b->n) return 0;
+  for (mpm_lidx i = 0; i < a->n; ++i)
+    if (a->id[i] != b->id[i]) return 0;
+  for (int f = 0; f < a->nfields; ++f)
+    for (int c = 0; !(a->derived >> f & 1u) && c < a->field[f].ncomp; ++c)
+      if (memcmp(mpm_particles_comp(a, f, c), mpm_particles_comp(b, f, c),
+                 sizeof(double) * (size_t)a->n) != 0)
+        return 0;
+  return 1;
+}
+
+/* The edit of one step: drop every fifth particle (by id) and add three new ones, placed by
+ * the walk anywhere in the domain (so some belong to other ranks). Fills keep (p->n), id and
+ * data (component-major, stride 3), all from malloc. */
+static void step_edit(const mpm_particles *p, const mpm_grid *g, int step, unsigned char **keep,
+                      mpm_gidx **id, double **data) {
+  enum { NADD = 3 };
+  *keep = malloc((size_t)p->n + 1);
+  *id = malloc(sizeof **id * NADD);
+  *data = calloc((size_t)p->ncomp * NADD, sizeof **data);
+  for (mpm_lidx i = 0; i < p->n; ++i) (*keep)[i] = p->id[i] % 5 != step % 5;
+  for (int k = 0; k < NADD; ++k) {
+    (*id)[k] = 100000 + 1000 * (mpm_gidx)step + 10 * (mpm_gidx)g_rank + k;
+    double x[3];
+    walk_position(g, (*id)[k], 0, x);
+    for (int d = 0; d < p->dim; ++d) (*data)[(size_t)d * NADD + (size_t)k] = x[d];
+    for (int f = 1; f < p->nfields; ++f)
+      for (int c = 0; c < p->field[f].ncomp; ++c)
+        (*data)[(size_t)(p->offset[f] + c) * NADD + (size_t)k] = value_of((*id)[k], f, c);
+  }
+}
+
+static void test_deferred(int dim) {
+  mpm_particles *a = new_set(dim), *b = new_set(dim);
+  mpm_grid *g = new_grid(dim);
+  mpm_particles_set_derived(a, 3), mpm_particles_set_derived(b, 3); /* s: not carried */
+  const mpm_lidx n = NPART / g_size + (g_rank < NPART % g_size);
+  inject(a, n), inject(b, n);
+  for (mpm_lidx i = 0; i < n; ++i) set_particle(a, g, i, 0), set_particle(b, g, i, 0);
+  int changed = -1;
+  CHECK(mpm_particles_migrate(a, g, &changed) == 0 && mpm_particles_migrate(b, g, &changed) == 0,
+        "settle");
+  for (int step = 1; step <= 6; ++step) {
+    /* Steps 1-3 walk (particles cross rank faces); steps 4-6 do not, so the migration moves
+     * nothing and applies the deferred edit on its own (apart from the new particles). */
+    if (step <= 3) walk(a, g, step), walk(b, g, step);
+    unsigned char *keep;
+    mpm_gidx *id;
+    double *data;
+    step_edit(a, g, step, &keep, &id, &data);
+    CHECK(mpm_particles_edit(a, keep, 3, id, data) == 0, "edit at step %d", step);
+    free(keep), free(id), free(data);
+    CHECK(mpm_particles_migrate(a, g, &changed) == 0, "migrate a at step %d", step);
+    step_edit(b, g, step, &keep, &id, &data);
+    CHECK(mpm_particles_edit_deferred(b, keep, 3, id, data) == 0, "deferred at step %d", step);
+    if (step == 2) { /* misuse while pending: an error, and the set untouched */
+      const mpm_lidx n0 = b->n;
+      CHECK(mpm_particles_edit(b, NULL, 0, NULL, NULL) == MPM_ERR_INTERNAL && b->n == n0,
+            "edit while deferred");
+      CHECK(mpm_particles_sort(b, g) == MPM_ERR_INTERNAL, "sort while deferred");
+    }
+    CHECK(mpm_particles_migrate(b, g, &changed) == 0 && !b->later.set, "migrate b at step %d",
+          step);
+    CHECK(same_sets(a, b), "step %d: deferred edit and migration differ from edit, migration",
+          step);
+  }
+  mpm_particles_destroy(&a), mpm_particles_destroy(&b);
+  mpm_grid_destroy(&g);
+}
+
 /* One rank holds a particle at x (outside the domain); every rank must get the error. */
 static void expect_unphysical(int dim, int bad_rank, double bad_x) {
   mpm_particles *p = new_set(dim);
@@ -341,6 +417,7 @@ int main(int argc, char **argv) {
     test_inject(dim);
     test_sort(dim);
     test_migrate(dim);
+    test_deferred(dim);
     test_errors(dim);
   }
   mpm_test_finish("test_migrate");
