@@ -57,59 +57,94 @@
 #include <string.h>
 
 /* The 1-D weights of a particle's stencil along each axis and the box index of its first
- * node (a dummy third axis of weight 1 in 2-D). */
+ * node (a dummy third axis of weight 1 in 2-D), and the cell holding the particle. */
 typedef struct shift_stencil {
   int sup, nz;
-  mpm_lidx first, sy, sz;
+  mpm_lidx first, sy, sz, cell; /* cell: box index of its lower corner node */
+  int cc[3];                    /* the cell's global coordinates */
   double w[3][MPM_SHAPE_MAX_SUPPORT], dw[3][MPM_SHAPE_MAX_SUPPORT];
 } shift_stencil;
 
-static void stencil_at(const mpm_grid *g, double lp, const double *x, shift_stencil *s) {
+/* The stencil at x; the weights' derivatives only if with_dw (the deposit reads none). The
+ * cell is mpm_cells_coord's, from the same quotient (x - lo) / dx. */
+static void stencil_at(const mpm_grid *g, double lp, const double *x, int with_dw,
+                       shift_stencil *s) {
   double xi[3] = {0, 0, 0};
   int base[3] = {0, 0, 0};
-  for (int d = 0; d < g->dim; ++d) xi[d] = (x[d] - g->lo[d]) / g->dx;
-  mpm_shape_eval(g->shape, g->dim, xi, lp, base, s->w, s->dw);
-  for (int d = 0; d < g->dim; ++d)
-    for (int k = 0; k < MPM_SHAPE_MAX_SUPPORT; ++k) s->dw[d][k] /= g->dx;
-  if (g->dim == 2) s->w[2][0] = 1.0, s->dw[2][0] = 0.0;
   s->sup = mpm_shape_support(g->shape), s->nz = g->dim == 3 ? s->sup : 1;
+  for (int d = 0; d < g->dim; ++d) {
+    xi[d] = (x[d] - g->lo[d]) / g->dx;
+    const int c = mpm_shape_floor(xi[d]);
+    s->cc[d] = c < 0 ? 0 : c >= g->ncells[d] ? g->ncells[d] - 1 : c;
+  }
+  s->cc[2] = g->dim == 3 ? s->cc[2] : 0;
+  mpm_shape_eval(g->shape, g->dim, xi, lp, base, s->w, s->dw);
+  for (int d = 0; with_dw && d < g->dim; ++d)
+    for (int k = 0; k < s->sup; ++k) s->dw[d][k] /= g->dx;
+  if (g->dim == 2) s->w[2][0] = 1.0, s->dw[2][0] = 0.0;
   s->sy = g->box_n[0], s->sz = (mpm_lidx)g->box_n[0] * g->box_n[1];
   s->first = mpm_grid_local_index(g, base);
+  s->cell = mpm_grid_local_index(g, s->cc);
 }
 
+/* The loops below take the stencil's extent as arguments, so that the 2-D quadratic case,
+ * called with literals (SHIFT_DISPATCH), is unrolled; the sums are the same either way. */
+#define SHIFT_INLINE static inline __attribute__((always_inline))
+#define SHIFT_DISPATCH(call, s)                                                                    \
+  ((s)->sup == 3 && (s)->nz == 1 ? call(3, 1) : call((s)->sup, (s)->nz))
+
 /* Add S_i(x_p) V to phi at every node of the stencil. */
-static void stencil_deposit(const shift_stencil *s, double V, double *phi) {
-  for (int c = 0; c < s->nz; ++c)
-    for (int b = 0; b < s->sup; ++b) {
+SHIFT_INLINE void deposit_n(const shift_stencil *s, double V, double *phi, int sup, int nz) {
+  for (int c = 0; c < nz; ++c)
+    for (int b = 0; b < sup; ++b) {
       double *row = phi + s->first + b * s->sy + c * s->sz;
       const double wbc = s->w[1][b] * s->w[2][c] * V;
-      for (int a = 0; a < s->sup; ++a) row[a] += s->w[0][a] * wbc;
+      for (int a = 0; a < sup; ++a) row[a] += s->w[0][a] * wbc;
     }
 }
 
+static void stencil_deposit(const shift_stencil *s, double V, double *phi) {
+#define DEPOSIT(sup, nz) deposit_n(s, V, phi, sup, nz)
+  SHIFT_DISPATCH(DEPOSIT, s);
+#undef DEPOSIT
+}
+
 /* sum_i phi_i grad S_i(x_p). */
-static void stencil_gradient(const shift_stencil *s, const double *phi, double *grad) {
+SHIFT_INLINE void gradient_n(const shift_stencil *s, const double *phi, double *grad, int sup,
+                             int nz) {
   grad[0] = grad[1] = grad[2] = 0.0;
-  for (int c = 0; c < s->nz; ++c)
-    for (int b = 0; b < s->sup; ++b) {
+  for (int c = 0; c < nz; ++c)
+    for (int b = 0; b < sup; ++b) {
       const double *row = phi + s->first + b * s->sy + c * s->sz;
       double r0 = 0.0, r1 = 0.0;
-      for (int a = 0; a < s->sup; ++a) r0 += row[a] * s->dw[0][a], r1 += row[a] * s->w[0][a];
+      for (int a = 0; a < sup; ++a) r0 += row[a] * s->dw[0][a], r1 += row[a] * s->w[0][a];
       grad[0] += r0 * s->w[1][b] * s->w[2][c];
       grad[1] += r1 * s->dw[1][b] * s->w[2][c];
       grad[2] += r1 * s->w[1][b] * s->dw[2][c];
     }
 }
 
+static void stencil_gradient(const shift_stencil *s, const double *phi, double *grad) {
+#define GRADIENT(sup, nz) gradient_n(s, phi, grad, sup, nz)
+  SHIFT_DISPATCH(GRADIENT, s);
+#undef GRADIENT
+}
+
 /* Does the stencil reach a node where the nodal array mk is positive? */
-static int stencil_touches(const shift_stencil *s, const double *mk) {
-  for (int c = 0; c < s->nz; ++c)
-    for (int b = 0; b < s->sup; ++b) {
+SHIFT_INLINE int touches_n(const shift_stencil *s, const double *mk, int sup, int nz) {
+  int any = 0;
+  for (int c = 0; c < nz; ++c)
+    for (int b = 0; b < sup; ++b) {
       const double *row = mk + s->first + b * s->sy + c * s->sz;
-      for (int a = 0; a < s->sup; ++a)
-        if (row[a] > 0.0) return 1;
+      for (int a = 0; a < sup; ++a) any |= row[a] > 0.0;
     }
-  return 0;
+  return any;
+}
+
+static int stencil_touches(const shift_stencil *s, const double *mk) {
+#define TOUCHES(sup, nz) touches_n(s, mk, sup, nz)
+  return SHIFT_DISPATCH(TOUCHES, s);
+#undef TOUCHES
 }
 
 /* Fold phi about the domain faces this rank holds: phi(j) + phi(-j) at both, j counted from
@@ -154,13 +189,6 @@ static int inside_domain(const mpm_grid *g, double *x) {
   return 1;
 }
 
-/* Box index of the node at the lower corner of x's cell, where a cell's count is kept. */
-static mpm_lidx cell_node(const mpm_grid *g, const double *x) {
-  int c[3] = {0, 0, 0};
-  for (int d = 0; d < g->dim; ++d) c[d] = mpm_cells_coord(g, d, x[d]);
-  return mpm_grid_local_index(g, c);
-}
-
 /* Is x in a cell this rank owns? */
 static int owns_cell(const mpm_grid *g, const double *x) {
   for (int d = 0; d < g->dim; ++d) {
@@ -185,9 +213,9 @@ int fluid_shift(mpm_module *m, long step, double h, int *changed) {
   for (mpm_lidx i = 0; i < p->n; ++i) {
     double x[3] = {0, 0, 0};
     for (int d = 0; d < dim; ++d) x[d] = mpm_particles_comp(p, FLUID_X, d)[i];
-    stencil_at(g, fc->lp, x, &s);
+    stencil_at(g, fc->lp, x, 0, &s);
     stencil_deposit(&s, J[i] * V0[i], phi);
-    count[cell_node(g, x)] += 1.0;
+    count[s.cell] += 1.0;
   }
   MPM_CALL(mpm_grid_halo_reverse(g, &phi, 1));
   fold_faces(g, phi);
@@ -209,11 +237,11 @@ int fluid_shift(mpm_module *m, long step, double h, int *changed) {
     if (J[i] < fc->shift_J) continue;
     double x[3] = {0, 0, 0}, gphi[3] = {0, 0, 0};
     for (int d = 0; d < dim; ++d) x[d] = mpm_particles_comp(p, FLUID_X, d)[i];
-    stencil_at(g, fc->lp, x, &s);
+    stencil_at(g, fc->lp, x, 1, &s);
     if (near_other_phase(m, &s) || (wall && stencil_touches(&s, wall))) continue;
     stencil_gradient(&s, phi, gphi);
     double xn[3] = {0, 0, 0};
-    const int alone = count[cell_node(g, x)] < 2.0;
+    const int alone = count[s.cell] < 2.0;
     double v2 = 0.0;
     for (int d = 0; d < dim; ++d)
       v2 += mpm_particles_comp(p, FLUID_V, d)[i] * mpm_particles_comp(p, FLUID_V, d)[i];
@@ -221,7 +249,7 @@ int fluid_shift(mpm_module *m, long step, double h, int *changed) {
     for (int d = 0; d < dim; ++d) {
       xn[d] = x[d] + fmax(-cap, fmin(cap, -reach * gphi[d]));
       if (alone) { /* a particle alone in its cell stays in it: no shift empties a cell */
-        const double face = g->lo[d] + mpm_cells_coord(g, d, x[d]) * g->dx, eps = 1e-9 * g->dx;
+        const double face = g->lo[d] + s.cc[d] * g->dx, eps = 1e-9 * g->dx;
         xn[d] = fmin(fmax(xn[d], face + eps), face + g->dx - eps);
       }
     }
