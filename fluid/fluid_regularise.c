@@ -425,7 +425,8 @@ static int light_cells(const fluid_content *fc, const mpm_particles *p, const mp
   double *heaviest;
   MPM_ALLOC(heaviest, ncell);
   memset(heaviest, 0, sizeof *heaviest * (size_t)ncell);
-  for (mpm_lidx i = 0; i < p->n; ++i) heaviest[cell[i]] = fmax(heaviest[cell[i]], mass[i]);
+  for (mpm_lidx i = 0; i < p->n; ++i) /* (not fmax, a call: the same for any mass, NaN too) */
+    if (mass[i] > heaviest[cell[i]]) heaviest[cell[i]] = mass[i];
   memset(mask, 0, (size_t)ncell);
   *nlight = 0;
   for (mpm_lidx i = 0; i < p->n; ++i)

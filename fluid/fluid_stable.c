@@ -107,7 +107,9 @@ int fluid_neighbourhood_signal(const mpm_module *m, double *smax) {
     mpm_lidx r = k;
     for (int d = 0; d < g->dim; ++d) c[d] = lo[d] + (int)(r % n[d]), r /= n[d];
     const mpm_lidx l = mpm_grid_local_index(g, c);
-    if (sum[0][l] > 0.0) best = fmax(best, sqrt(sum[1][l] / sum[0][l]) + sum[2][l] / sum[0][l]);
+    if (!(sum[0][l] > 0.0)) continue;
+    const double s = sqrt(sum[1][l] / sum[0][l]) + sum[2][l] / sum[0][l];
+    if (s > best) best = s; /* fmax's result, NaN included, without its call */
   }
   *smax = best;
   return 0;
