@@ -72,12 +72,12 @@ static void stencil_at(const mpm_grid *g, double lp, const double *x, int with_d
   double xi[3] = {0, 0, 0};
   int base[3] = {0, 0, 0};
   s->sup = mpm_shape_support(g->shape), s->nz = g->dim == 3 ? s->sup : 1;
+  s->cc[2] = 0;
   for (int d = 0; d < g->dim; ++d) {
     xi[d] = (x[d] - g->lo[d]) / g->dx;
     const int c = mpm_shape_floor(xi[d]);
     s->cc[d] = c < 0 ? 0 : c >= g->ncells[d] ? g->ncells[d] - 1 : c;
   }
-  s->cc[2] = g->dim == 3 ? s->cc[2] : 0;
   mpm_shape_eval(g->shape, g->dim, xi, lp, base, s->w, s->dw);
   for (int d = 0; with_dw && d < g->dim; ++d)
     for (int k = 0; k < s->sup; ++k) s->dw[d][k] /= g->dx;
