@@ -340,7 +340,8 @@ void mpm_coupling_follow_solid(mpm_coupling *c, mpm_lidx l, double h, unsigned a
   mpm_coupling_record_force(c, MPM_ROLE_SOLID, l, f, v);
 }
 
-int mpm_coupling_apply_load(mpm_coupling *c, double t, double h, const double *const *load) {
+int mpm_coupling_apply_load(mpm_coupling *c, double t, double h, const double *const *load,
+                            const double *m_start) {
   mpm_timer_start(MPM_T_COUPLING);
   begin_record(c, t, h);
   c->recording = 1;
@@ -348,10 +349,11 @@ int mpm_coupling_apply_load(mpm_coupling *c, double t, double h, const double *c
   const int dim = c->grid->dim;
   for (mpm_lidx l = 0; l < c->grid->nnodes; ++l) {
     if (!mpm_coupling_has_mass(c, MPM_ROLE_SOLID, l)) continue;
+    const double m = m_start[l] > s->m_i[l] ? m_start[l] : s->m_i[l];
     double v[MPM_MAX_DIM], a[MPM_MAX_DIM];
     int any = 0;
     for (int d = 0; d < dim; ++d) {
-      const double q = load[d][l] / s->m_i[l];
+      const double q = load[d][l] / m;
       any |= q != 0.0;
       v[d] = s->v_i[d][l] + h * q, a[d] = s->a_i[d][l] + q;
     }

@@ -119,11 +119,13 @@ int mpm_coupling_before_solve(mpm_coupling *c, double t, double h, mpm_pass pass
 int mpm_coupling_after_solve(mpm_coupling *c, double t, double h, mpm_pass pass);
 int mpm_coupling_after_constrain(mpm_coupling *c, double t, double h, mpm_pass pass);
 
-/* A staggered scheme's load (mpm_interface.h): after the solid's solve, add load (N per box
- * node, dim arrays) to the solid wherever it has mass, as an exchange (recorded as the
- * interface force on the solid; in the classic update as the impulse h load). Starts this RHS's
- * record like before_solve. */
-int mpm_coupling_apply_load(mpm_coupling *c, double t, double h, const double *const *load);
+/* A staggered scheme's load (mpm_interface.h): after the solid's solve, accelerate the solid
+ * wherever it has mass by load (N per box node, dim arrays) over the larger of its nodal mass
+ * and m_start (the light-node rule of mpm_interface.h), as an exchange (recorded as the
+ * interface force on the solid: load m / max(m, m_start); in the classic update as the
+ * impulse h times that). Starts this RHS's record like before_solve. */
+int mpm_coupling_apply_load(mpm_coupling *c, double t, double h, const double *const *load,
+                            const double *m_start);
 
 /* While ifc is set (the first pass of a held or loaded cycle), every exchange into the solid and
  * every force recorded for it is also added to ifc->capture: what the gas gave the held solid,

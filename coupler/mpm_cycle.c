@@ -40,7 +40,8 @@ static mpm_module *held(const mpm_cycle *c) {
 static int interact(const mpm_cycle *c, double t, double hs, mpm_pass pass) {
   if (c->mode != MPM_CYCLE_LOADED) return mpm_coupling_after_solve(c->coupling, t, hs, pass);
   if (pass != MPM_PASS_FIRST) return 0;
-  return mpm_coupling_apply_load(c->coupling, t, hs, mpm_interface_load_at(c->iface, t, hs));
+  return mpm_coupling_apply_load(c->coupling, t, hs, mpm_interface_load_at(c->iface, t, hs),
+                                 mpm_interface_mass_start(c->iface));
 }
 
 /* The grid work between the transfers. The solve takes the step only in the first pass. */

@@ -14,6 +14,7 @@ int mpm_interface_new(mpm_interface **ifcp, mpm_grid *grid, int phase) {
   ifc->grid = grid, ifc->phase = phase;
   const size_t nn = (size_t)grid->nnodes;
   MPM_ALLOC(ifc->m, nn);
+  MPM_ALLOC(ifc->m_start, nn);
   for (int d = 0; d < grid->dim; ++d) {
     MPM_ALLOC(ifc->mv[d], nn);
     MPM_ALLOC(ifc->f[d], nn);
@@ -28,7 +29,7 @@ int mpm_interface_new(mpm_interface **ifcp, mpm_grid *grid, int phase) {
 void mpm_interface_destroy(mpm_interface **ifcp) {
   if (!ifcp || !*ifcp) return;
   mpm_interface *ifc = *ifcp;
-  free(ifc->m);
+  free(ifc->m), free(ifc->m_start);
   for (int d = 0; d < MPM_MAX_DIM; ++d) {
     free(ifc->mv[d]), free(ifc->f[d]), free(ifc->normal[d]);
     free(ifc->capture[d]), free(ifc->impulse[d]), free(ifc->load[d]);
@@ -95,6 +96,7 @@ void mpm_interface_load(mpm_interface *ifc, double t0, double H, int interpolate
     }
   ifc->t_mid = t0 + 0.5 * H;
   ifc->span_prev = trend ? H : 0.0;
+  ifc->start_due = 1;
 }
 
 const double *const *mpm_interface_load_at(mpm_interface *ifc, double t, double h) {
@@ -104,6 +106,14 @@ const double *const *mpm_interface_load_at(mpm_interface *ifc, double t, double 
     for (mpm_lidx l = 0; l < ifc->grid->nnodes; ++l)
       ifc->now[d][l] = ifc->load[d][l] + s * ifc->trend[d][l];
   return (const double *const *)ifc->now;
+}
+
+const double *mpm_interface_mass_start(mpm_interface *ifc) {
+  if (ifc->start_due)
+    memcpy(ifc->m_start, ifc->grid->phase[ifc->phase].m_i,
+           sizeof(double) * (size_t)ifc->grid->nnodes);
+  ifc->start_due = 0;
+  return ifc->m_start;
 }
 
 void mpm_interface_owed(const mpm_interface *ifc, const unsigned char *owned, double *J) {

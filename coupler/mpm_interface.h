@@ -19,6 +19,16 @@
  * the gas gave up, or it stays owed: the interface balances to roundoff, whatever the order of
  * the advances and the substeps.
  *
+ * Light nodes. A node's load never accelerates it faster than it would have accelerated the
+ * node's mass at the start of the advance: the load is divided by the larger of the node's mass
+ * now and then (`m_start`), and what that leaves undelivered stays owed. The solid's particles
+ * move during the advance, and a node at the edge of their stencils can lose nearly all its
+ * mass (a B-spline weight falls quadratically to zero there): dividing the load by what is left
+ * gave such a node velocities of 1e6 m/s, and through the weight's gradient, which falls only
+ * linearly, strain rates that put joules into the panel in one coupling step (the shock panel,
+ * multirate at time.cfl = 0.4, until 2026-11-29). With m substeps = 1 the mass never changes
+ * within the advance, so the rule changes nothing there.
+ *
  * Only owned nodes matter: a cycle acts on every box node, but the forward halo overwrites the
  * ghosts, and the balance counts owners only. Invariant: the arrays span the grid's box nodes,
  * which never change during a run. */
@@ -40,6 +50,8 @@ typedef struct mpm_interface {
   double *prev[MPM_MAX_DIM];    /* the load of the advance before, and its length */
   double span_prev;
   double *now[MPM_MAX_DIM]; /* load + trend (t - t_mid) for one RHS */
+  double *m_start;          /* the solid's nodal mass at the first RHS of its current advance */
+  int start_due;            /* m_start is taken at the next loaded RHS */
 } mpm_interface;
 
 int mpm_interface_new(mpm_interface **ifc, mpm_grid *grid, int phase);
@@ -69,6 +81,10 @@ void mpm_interface_load(mpm_interface *ifc, double t0, double H, int interpolate
 /* The load of a solid RHS at t with classic step h (the trend at the step's midpoint; h = 0:
  * at t). */
 const double *const *mpm_interface_load_at(mpm_interface *ifc, double t, double h);
+/* The solid's nodal mass at the start of its advance (the light-node rule above): the first
+ * call after mpm_interface_load takes it from the solid's phase as it is now (after a loaded
+ * RHS's deposit and reverse halo), later calls return it. */
+const double *mpm_interface_mass_start(mpm_interface *ifc);
 /* The momentum owed to the solid on the nodes this rank owns (dim values; the caller reduces):
  * the gas gave it up, the solid has not yet received it. */
 void mpm_interface_owed(const mpm_interface *ifc, const unsigned char *owned, double *J);

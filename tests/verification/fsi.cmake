@@ -12,7 +12,8 @@ mpm_add_script_test(test_fsi_waves_long SCRIPT verification/test_fsi_waves.py AR
 mpm_add_script_test(test_piperno_farhat SCRIPT verification/test_piperno_farhat.py
                     LABELS "verification;mpi" TIMEOUT 900)
 # Temporal coupling: multirate = monolithic at one substep, its coupling error against a fine
-# reference, the momentum balance, bitwise restart of every temporal scheme, 2 ranks against 1.
+# reference, the momentum balance, the light-node rule on the shock panel (2 ranks, ~15 s), bitwise
+# restart of every temporal scheme, 2 ranks against 1.
 mpm_add_script_test(test_timeschemes SCRIPT verification/test_timeschemes.py
                     LABELS "verification;mpi" TIMEOUT 900)
 # Multirate with an ERK pair (ARKODE MRIStep): its coupling error's order against a fine monolithic
