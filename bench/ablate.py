@@ -26,6 +26,19 @@ it; a reference run again, because the binary or the overrides changed, redoes i
 rows), ablation.md (the table and the findings' figures), and plots: error against wall time,
 and the interface energy against the coupling step. --ranks 2 runs every run on 2 ranks. The
 sweep prints progress and its own wall time.
+
+Cost at equal error: for every run that is not monolithic, ablation.md gives the wall time
+monolithic (the same spatial scheme and time method) would need for the same error,
+interpolated log-log between the two monolithic runs whose errors bracket it (extrapolated
+from the nearest two where none does, and marked so, by at most a factor 1.5 in error), and
+the ratio of the two.
+
+Noise: the wall times of one run each are as noisy as the machine (on a shared 2-core machine
+the same run took 20.7 and 26.6 s minutes apart). --repeat N runs the sweep N times over, in
+rounds (every combination once per round, so a slow spell touches all of them alike), and
+reports the median of each combination's wall times, all of which runs.csv keeps (`walls`).
+A repeated run must take the same number of steps as the first (the runs are deterministic);
+a resumed sweep finishes the rounds it has not made.
 """
 import argparse
 import csv
@@ -46,7 +59,7 @@ from benchrun import ENV, ROOT  # noqa: E402
 
 FIELDS = ["name", "spatial", "temporal", "variant", "method", "cfl", "status", "wall_s",
           "steps", "rhs_evals", "err_max", "err_rms", "err_rel", "W_net", "W_rel",
-          "imbalance", "message"]
+          "imbalance", "message", "walls"]
 VARIANTS = [("monolithic", "", []),
             ("staggered", "solid_first", ["coupling.order=solid_first"]),
             ("staggered", "gas_first", ["coupling.order=gas_first"]),
@@ -87,6 +100,9 @@ def parse():
                     help="make no run: write the table and plot from runs.csv as it stands")
     ap.add_argument("--sweep-s", type=float, default=None,
                     help="with every run already in runs.csv: the sweep's wall time to report")
+    ap.add_argument("--repeat", type=int, default=1,
+                    help="run every combination this many times, in rounds, and report the "
+                         "median wall time (default 1)")
     return ap.parse_args()
 
 
@@ -195,6 +211,82 @@ def append_row(path, row):
         w.writerow(row)
 
 
+def walls_of(row):
+    """The wall times a row holds: its `walls` list, or its one wall_s (a row written before
+    --repeat)."""
+    if row.get("walls"):
+        return [float(w) for w in row["walls"].split(";")]
+    return [float(row["wall_s"])] if row.get("wall_s") not in (None, "") else []
+
+
+def repeat_rounds(args, todo, done, table, scratch):
+    """Rounds 2 .. --repeat: each stable combination once more per round, until it has
+    --repeat wall times; wall_s becomes their median. Returns the number of runs made."""
+    made = 0
+    for rnd in range(2, args.repeat + 1):
+        due = [c for c in todo if c[0] in done and done[c[0]]["status"] == "ok"
+               and len(walls_of(done[c[0]])) < rnd]
+        for k, (rname, *_rest, extra) in enumerate(due, 1):
+            row = done[rname]
+            out = os.path.join(scratch, rname + "-repeat")
+            status, msg, s = run(args, out, extra)
+            made += 1
+            shutil.rmtree(out, ignore_errors=True)
+            if status != "ok" or int(s["steps"]) != int(row["steps"]):
+                raise SystemExit(f"{rname}, round {rnd}: {status} {msg} (steps "
+                                 f"{s['steps'] if s else '-'} against {row['steps']}): the runs "
+                                 "are not repeatable; check the machine and the binary")
+            walls = walls_of(row) + [float(s["wall_s"])]
+            row["walls"] = ";".join(f"{w:.6g}" for w in walls)
+            row["wall_s"] = float(np.median(walls))
+            rewrite_rows(table, done.values())
+            print(f"[round {rnd}, {k}/{len(due)}] {rname}: {s['wall_s']:.1f} s (median of "
+                  f"{len(walls)}: {row['wall_s']:.1f} s)", flush=True)
+    return made
+
+
+# How far (a factor in error) the cost at equal error is extrapolated beyond the monolithic runs.
+EXTRAPOLATE = 1.5
+
+
+def equal_error(rows):
+    """Lines of ablation.md: each non-monolithic run's cost against monolithic's at its error."""
+    mono = {}
+    for r in rows:
+        if r["temporal"] == "monolithic":
+            mono.setdefault((r["spatial"], r["method"]), []).append(
+                (float(r["err_max"]), float(r["wall_s"])))
+    lines = []
+    for r in rows:
+        ref = sorted(mono.get((r["spatial"], r["method"]), []))
+        if r["temporal"] == "monolithic" or len(ref) < 2:
+            continue
+        e, t = float(r["err_max"]), float(r["wall_s"])
+        # the bracketing pair by error, else the nearest two
+        k = next((j for j in range(len(ref) - 1) if ref[j][0] <= e <= ref[j + 1][0]), None)
+        extrap = k is None
+        if extrap:
+            k = 0 if e < ref[0][0] else len(ref) - 2
+        (e1, t1), (e2, t2) = ref[k], ref[k + 1]
+        if not (e1 > 0 and e2 > 0 and e1 != e2 and e > 0):
+            continue
+        if extrap and not ref[0][0] / EXTRAPOLATE <= e <= ref[-1][0] * EXTRAPOLATE:
+            lines.append(f"| {r['name']} | {fmt(e)} | {fmt(t, '.2f')} | beyond monolithic's "
+                         f"errors ({fmt(ref[0][0])} to {fmt(ref[-1][0])}) by more than "
+                         f"{EXTRAPOLATE:g}x | |")
+            continue
+        s = (math.log(e) - math.log(e1)) / (math.log(e2) - math.log(e1))
+        tm = math.exp(math.log(t1) + s * (math.log(t2) - math.log(t1)))
+        lines.append(f"| {r['name']} | {fmt(e)} | {fmt(t, '.2f')} | {fmt(tm, '.1f')}"
+                     f"{' (extrapolated)' if extrap else ''} | {tm / t:.2f} |")
+    if not lines:
+        return []
+    return ["", "Cost at equal error: monolithic's wall time at each run's error (the same spatial "
+            "scheme and time method; log-log between the monolithic runs that bracket it):", "",
+            "| run | error max | wall (s) | monolithic at that error (s) | ratio |",
+            "|---|---|---|---|---|"] + lines
+
+
 def fmt(x, spec=".3g"):
     try:
         v = float(x)
@@ -205,6 +297,7 @@ def fmt(x, spec=".3g"):
 
 def report(args, rows, outdir, col, sweep_s, nruns):
     ok = [r for r in rows if r["status"] == "ok"]
+    nrep = max((len(walls_of(r)) for r in ok), default=1)
     lines = [f"# Coupling ablation: {os.path.basename(args.case)}", "",
              f"Quantity: `{col}` (probes.csv); error against a monolithic usl run at time.cfl = "
              f"{args.ref_cfl:g} with the same spatial scheme; {args.ranks} rank(s); overrides: "
@@ -212,7 +305,9 @@ def report(args, rows, outdir, col, sweep_s, nruns):
              + (f"This sweep's wall time {sweep_s:.0f} s for {nruns} runs made in it "
                 f"({sweep_s / max(nruns, 1):.1f} s each); " if sweep_s > 0 else "")
              + f"{'the' if sweep_s > 0 else 'The'} {len(rows)} runs' own wall times sum to "
-             f"{sum(float(r['wall_s'] or 0) for r in rows):.0f} s (references not included).", "",
+             f"{sum(sum(walls_of(r)) for r in rows):.0f} s (references not included)"
+             + (f"; wall times are the median of {nrep} runs each, made in rounds"
+                if nrep > 1 else "") + ".", "",
              "| run | status | wall (s) | steps | RHS | error max | error RMS | error / max | "
              "W_net (J) | W_net rel. | imbalance |",
              "|---|---|---|---|---|---|---|---|---|---|---|"]
@@ -233,6 +328,7 @@ def report(args, rows, outdir, col, sweep_s, nruns):
         lines += ["", "Least error at each coupling step:"]
         lines += [f"- {k[0]}, cfl {k[1]}: {v['name']} ({fmt(v['err_max'])} in "
                   f"{fmt(v['wall_s'], '.2f')} s)" for k, v in sorted(best.items())]
+        lines += equal_error(ok)
     with open(os.path.join(outdir, "ablation.md"), "w") as f:
         f.write("\n".join(lines) + "\n")
     plot(ok, outdir, col)
@@ -325,13 +421,15 @@ def main():
         made += 1
         row = dict(name=rname, spatial=spatial, temporal=temporal, variant=variant, method=method,
                    cfl=cfl, status=status, message=msg, wall_s="", steps="", rhs_evals="",
-                   err_max="", err_rms="", err_rel="", W_net="", W_rel="", imbalance="")
+                   err_max="", err_rms="", err_rel="", W_net="", W_rel="", imbalance="",
+                   walls="")
         if s:
             col, tr, ur = refs[spatial]
             _, t, u = history(out, col)
             diff = np.interp(tr, t, u) - ur
             scale = max(float(np.max(np.abs(ur))), 1e-300)
-            row.update(wall_s=s["wall_s"], steps=s["steps"], rhs_evals=s["rhs_evals"],
+            row.update(wall_s=s["wall_s"], walls=f"{s['wall_s']:.6g}", steps=s["steps"],
+                   rhs_evals=s["rhs_evals"],
                        err_max=float(np.max(np.abs(diff))),
                        err_rms=float(np.sqrt(np.mean(diff**2))),
                        err_rel=float(np.max(np.abs(diff))) / scale, W_net=s["coupling_work"],
@@ -344,6 +442,8 @@ def main():
         err = f", error {row['err_max']:.3g}" if s else ""
         print(f"[{k}/{len(todo)}] {rname}: {status} in {time.time() - t_run:.1f} s{err} "
               f"(sweep {elapsed:.0f} s, ETA {eta:.0f} s)", flush=True)
+    if args.repeat > 1 and not args.report_only:
+        made += repeat_rounds(args, todo, done, table, scratch)
     rows = [done[c[0]] for c in todo if c[0] in done]
     if len(rows) < len(todo):
         print(f"{len(todo) - len(rows)} of {len(todo)} runs not made yet: the table is partial")

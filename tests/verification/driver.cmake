@@ -117,5 +117,7 @@ mpm_add_script_test(test_stable_step SCRIPT verification/test_stable_step.py
                     LABELS "verification;mpi" TIMEOUT 600)
 mpm_add_script_test(test_pic_rate SCRIPT verification/test_pic_rate.py LABELS verification
                     TIMEOUT 300)
+# The ablation harness: its reference is monolithic and current, --repeat's rounds and medians,
+# and the cost at equal error on made-up rows.
 mpm_add_script_test(test_ablate SCRIPT verification/test_ablate.py LABELS conformance
                     TIMEOUT 300)

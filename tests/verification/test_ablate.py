@@ -10,7 +10,16 @@ coupling.time = multirate, which the harness's reference inherited until 2026-11
 2. The same sweep again reuses the reference and the finished row: nothing is run.
 3. The same sweep with one more override runs the reference again (the overrides changed) and
    redoes the row measured against the old one.
+4. --repeat 2 makes a second round: the finished row is run once more (the same steps), runs.csv
+   keeps both wall times and reports their median.
+5. ablation.md gives each multirate run's cost at equal error: monolithic's wall time
+   interpolated log-log to its error between the monolithic runs that bracket it (or
+   extrapolated, marked, by at most 1.5x in error), and the ratio. Checked on made-up rows whose
+   answers are known (--report-only: nothing runs).
 """
+import csv
+import math
+import statistics
 import os
 import subprocess
 import sys
@@ -26,11 +35,11 @@ work = os.path.abspath(mt.outdir("ablate"))
 res, scratch = os.path.join(work, "results"), os.path.join(work, "runs")
 
 
-def sweep(extra):
+def sweep(extra, options=("--temporal", "monolithic", "--cfl", "0.4")):
     cmd = [sys.executable, os.path.join(SOURCE, "bench", "ablate.py"), CASE] + COMMON + extra + [
-        "--spatial", "velocity", "--temporal", "monolithic", "--methods", "usl", "--cfl", "0.4",
-        "--ref-cfl", "0.2", "--out", res, "--scratch", scratch, "--binary",
-        os.path.abspath(mt.BIN) if os.path.sep in mt.BIN else mt.BIN]
+        "--spatial", "velocity", "--methods", "usl", "--ref-cfl", "0.2", "--out", res,
+        "--scratch", scratch, "--binary",
+        os.path.abspath(mt.BIN) if os.path.sep in mt.BIN else mt.BIN] + list(options)
     p = subprocess.run(cmd, capture_output=True, text=True, timeout=600)
     if p.returncode != 0:
         sys.stderr.write(p.stdout + p.stderr)
@@ -61,4 +70,58 @@ changed = sweep(["fluid.regularise_every=0"])
 check("reference for velocity" in changed and "run again" in changed and "[1/1]" in changed,
       "one more override: the reference is run again and the row measured against the old one "
       "is redone")
+
+
+def rows():
+    with open(os.path.join(res, "runs.csv")) as f:
+        return {r["name"]: r for r in csv.DictReader(f)}
+
+
+NAME = "velocity-monolithic-usl-0.4"
+steps = rows()[NAME]["steps"]
+twice = sweep(["fluid.regularise_every=0", "--repeat", "2"])
+r = rows()[NAME]
+walls = [float(w) for w in r["walls"].split(";")]
+check("[round 2, 1/1]" in twice and "[1/1]" not in twice and len(walls) == 2
+      and abs(float(r["wall_s"]) - statistics.median(walls)) <= 1e-9 * max(walls)
+      and r["steps"] == steps,
+      f"--repeat 2: the finished row runs once more ({r['walls']} s, median {r['wall_s']} s; "
+      f"{r['steps']} steps both times)")
+# 5: a table of made-up rows (no run), reported with --report-only against the reference above.
+made_up = os.path.join(work, "made_up")
+os.makedirs(made_up)
+FIELDS = ["name", "spatial", "temporal", "variant", "method", "cfl", "status", "wall_s", "steps",
+          "rhs_evals", "err_max", "err_rms", "err_rel", "W_net", "W_rel", "imbalance", "message",
+          "walls"]
+ROWS = [("monolithic", "", 0.4, 1e-4, 10.0), ("monolithic", "", 0.2, 5e-5, 20.0),
+        ("monolithic", "", 0.1, 2.5e-5, 40.0),
+        ("multirate", "held", 0.4, 1.2e-4, 2.0),  # beyond the coarsest by 1.2x: extrapolated
+        ("multirate", "held", 0.2, 1e-4 / math.sqrt(2), 2.0),  # between 0.4 and 0.2
+        ("multirate", "held", 0.1, 1e-3, 1.0)]  # 10x beyond: no figure
+with open(os.path.join(made_up, "runs.csv"), "w", newline="") as f:
+    w = csv.DictWriter(f, fieldnames=FIELDS)
+    w.writeheader()
+    for temporal, variant, cfl, err, wall in ROWS:
+        name = f"velocity-{temporal}{'-' + variant if variant else ''}-usl-{cfl:g}"
+        w.writerow(dict(name=name, spatial="velocity", temporal=temporal, variant=variant,
+                        method="usl", cfl=cfl, status="ok", wall_s=wall, steps=1, rhs_evals=1,
+                        err_max=err, err_rms=err, err_rel=err, W_net=0, W_rel="", imbalance=0,
+                        message="", walls=f"{wall:g}"))
+subprocess.run([sys.executable, os.path.join(SOURCE, "bench", "ablate.py"), CASE] + COMMON
+               + ["fluid.regularise_every=0", "--spatial", "velocity", "--methods", "usl",
+                  "--ref-cfl", "0.2", "--out", made_up, "--scratch", scratch, "--report-only",
+                  "--temporal", "monolithic", "multirate", "--skip-variants", "interpolated",
+                  "mristep", "--cfl", "0.4", "0.2", "0.1"], check=True, capture_output=True,
+               timeout=600)
+with open(os.path.join(made_up, "ablation.md")) as f:
+    md = f.read()
+want = ["| velocity-multirate-held-usl-0.4 | 0.00012 | 2.00 | 8.3 (extrapolated) | 4.17 |",
+        "| velocity-multirate-held-usl-0.2 | 7.07e-05 | 2.00 | 14.1 | 7.07 |",
+        "| velocity-multirate-held-usl-0.1 | 0.001 | 1.00 | beyond monolithic's errors (2.5e-05 "
+        "to 0.0001) by more than 1.5x | |"]
+missing = [x for x in want if x not in md]
+check(not missing, "the cost at equal error of made-up multirate rows: monolithic's time "
+      "interpolated log-log to their errors (t ~ 1/error between the made-up monolithic rows: "
+      "14.1 s at 1e-4/sqrt 2, 7.07x), extrapolated and marked at 1.2x beyond (4.17x), none at 10x"
+      + (f"; missing: {missing}" if missing else ""))
 sys.exit(check.finish())
