@@ -224,6 +224,7 @@ text = open(mt.case("sod.ini")).read().replace("method = bs32", "method = usl", 
 expect_error("least_squares without an obstacle", text, "fluid.wall_treatment", "has none",
              line_of(text, "wall_treatment"))
 for name, key_line, key in (("wall band 0", "wall_band = 0", "fluid.wall_band"),
+                            ("wall blend -1", "wall_blend = -1", "fluid.wall_blend"),
                             ("wall fit order 2", "wall_fit_order = 2", "fluid.wall_fit_order")):
     text = OBST + LS + key_line + "\n"
     expect_error(name, text, key, None, line_of(text, key_line))
