@@ -16,7 +16,7 @@
 # - gas flow cases: test_wedge, test_forward_step (7 minutes under the sanitizers, 33 s
 #   without), the main job's scene test_supersonic_bar and its stand-off study, the
 #   near-vacuum convergence study test_near_vacuum_order (test_near_vacuum runs the refill and
-#   the shifting there), the wall-treatment flow cases test_slanted_wall, test_slanted_wall_max
+#   the shifting there), the wall-treatment flow cases test_slanted_wall
 #   and test_bluff_bodies (45-100 s each under the sanitizers; the least-squares fit runs there
 #   in test_obstacles and test_obstacles_energy), the gas tubes test_sod, test_strong_shock and
 #   the ERK pairs' time-order study test_gas_time_order (test_gas_output, test_gas_conservation,
@@ -42,7 +42,7 @@ set -euo pipefail
 src=$(cd "$(dirname "$0")/.." && pwd)
 PLAIN_ONLY="wedge|forward_step|supersonic_bar|supersonic_bar_standoff|supersonic_bar_bs32"
 PLAIN_ONLY+="|near_vacuum_order"
-PLAIN_ONLY+="|slanted_wall|slanted_wall_max|bluff_bodies|sod|strong_shock|gas_time_order|gas_shear"
+PLAIN_ONLY+="|slanted_wall|bluff_bodies|sod|strong_shock|gas_time_order|gas_shear"
 PLAIN_ONLY+="|fsi_waves|piperno_farhat|timeschemes|timeschemes_mri|blowup_guard_coupled"
 PLAIN_ONLY+="|csm1|csm3_fast|axial_bar|cantilever3d|model_swap|ranks_solid|periodic|stability|disks"
 PLAIN_ONLY+="|decomposition|restart_cases|run_safety"
