@@ -312,10 +312,11 @@ int fluid_wall_ls_init(mpm_module *m, const mpm_config *cfg, int classic) {
   MPM_ALLOC(w->mom, (size_t)w->nmom * g->nnodes);
   MPM_ALLOC(w->mom_ptr, w->nmom);
   for (int k = 0; k < w->nmom; ++k) w->mom_ptr[k] = w->mom + (size_t)k * g->nnodes;
-  /* A donor reaches a wall particle's fit if a node is within a stencil of both: donors lie
-   * within band + 2 stencil radii of a body; a cell is near if its centre is within that and
-   * half a cell diagonal. */
-  const double reach = w->band + (mpm_shape_support(g->shape) + 0.5 * sqrt((double)dim)) * g->dx;
+  /* A donor reaches a fitted particle's fit if a node is within a stencil of both: donors lie
+   * within band + blend + 2 stencil radii of a body; a cell is near if its centre is within
+   * that and half a cell diagonal. */
+  const double reach =
+      w->band + w->blend + (mpm_shape_support(g->shape) + 0.5 * sqrt((double)dim)) * g->dx;
   MPM_ALLOC(w->reach, g->nnodes);
   for (mpm_lidx l = 0; l < g->nnodes; ++l) {
     int gi[MPM_MAX_DIM];

@@ -91,7 +91,7 @@ typedef struct fluid_wall_ls {
   double *mom;          /* nmom * nnodes */
   double **mom_ptr;     /* nmom pointers into mom, for the halo exchanges */
   mpm_lidx cap;         /* capacity of the per-particle arrays */
-  signed char *kind;    /* -1 far, 0 donor, 1 wall particle */
+  signed char *kind;    /* -1 far, 0 donor, 1 wall particle, 2 both (the blend) */
   int *ob;              /* wall particle: the nearest obstacle */
   double *geo;          /* wall particle: phi and the outward normal (1 + dim) */
   double *val;          /* new field values (nf per particle) */
