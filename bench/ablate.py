@@ -55,7 +55,7 @@ import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
-from benchrun import ENV, ROOT  # noqa: E402
+from benchrun import ENV, ROOT, loglog  # noqa: E402
 
 FIELDS = ["name", "spatial", "temporal", "variant", "method", "cfl", "status", "wall_s",
           "steps", "rhs_evals", "err_max", "err_rms", "err_rel", "W_net", "W_rel",
@@ -267,7 +267,7 @@ def equal_error(rows):
         extrap = k is None
         if extrap:
             k = 0 if e < ref[0][0] else len(ref) - 2
-        (e1, t1), (e2, t2) = ref[k], ref[k + 1]
+        (e1, _), (e2, _) = ref[k], ref[k + 1]
         if not (e1 > 0 and e2 > 0 and e1 != e2 and e > 0):
             continue
         if extrap and not ref[0][0] / EXTRAPOLATE <= e <= ref[-1][0] * EXTRAPOLATE:
@@ -275,8 +275,7 @@ def equal_error(rows):
                          f"errors ({fmt(ref[0][0])} to {fmt(ref[-1][0])}) by more than "
                          f"{EXTRAPOLATE:g}x | |")
             continue
-        s = (math.log(e) - math.log(e1)) / (math.log(e2) - math.log(e1))
-        tm = math.exp(math.log(t1) + s * (math.log(t2) - math.log(t1)))
+        tm = loglog(e, ref[k], ref[k + 1])
         lines.append(f"| {r['name']} | {fmt(e)} | {fmt(t, '.2f')} | {fmt(tm, '.1f')}"
                      f"{' (extrapolated)' if extrap else ''} | {tm / t:.2f} |")
     if not lines:

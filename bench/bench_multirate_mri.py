@@ -33,7 +33,7 @@ import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
-from benchrun import ENV, ROOT  # noqa: E402
+from benchrun import ENV, ROOT, loglog  # noqa: E402
 
 CASE = os.path.join(ROOT, "cases", "shock_panel.ini")
 RESULTS = os.path.join(HERE, "results")
@@ -77,10 +77,9 @@ def run(args, name, extra):
 
 def equal_error_wall(points, err):
     """Wall time at error err, log-log between the two (error, wall) points around it."""
-    for (e0, w0), (e1, w1) in zip(points, points[1:]):
-        if e0 <= err <= e1 and e0 < e1:
-            f = np.log(err / e0) / np.log(e1 / e0)
-            return float(np.exp(np.log(w0) + f * np.log(w1 / w0)))
+    for p0, p1 in zip(points, points[1:]):
+        if p0[0] <= err <= p1[0] and p0[0] < p1[0]:
+            return loglog(err, p0, p1)
     return None
 
 

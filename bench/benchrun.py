@@ -1,7 +1,9 @@
-"""What the throughput drivers share: run mpmfsi (under mpiexec for more than one rank) in a
-scratch output folder and read back its summary.json and timers.csv."""
+"""What the bench drivers share: run mpmfsi (under mpiexec for more than one rank) in a
+scratch output folder and read back its summary.json and timers.csv; the log-log interpolation
+of a cost at equal error."""
 import csv
 import json
+import math
 import os
 import subprocess
 import tempfile
@@ -24,3 +26,10 @@ def run_case(binary, case, overrides, ranks):
         with open(os.path.join(out, "timers.csv")) as f:
             timers = {r["phase"]: float(r["mean_s"]) for r in csv.DictReader(f)}
     return summary, timers
+
+
+def loglog(x, p0, p1):
+    """y at x on the straight line through the points p0 = (x0, y0), p1 = (x1, y1) in log-log
+    (a wall time at a given error between two runs; x0 != x1, all positive)."""
+    (x0, y0), (x1, y1) = p0, p1
+    return math.exp(math.log(y0) + math.log(x / x0) / math.log(x1 / x0) * math.log(y1 / y0))
