@@ -110,13 +110,14 @@ struct mpm_module {
    * without a fault; the module's boundary op returns it between steps (the gas, whose
    * particles are pressed into the corners of walls and bodies; 0 elsewhere). */
   double wall_slack;
-  /* The step this module would take alone: time.cfl times its own stability limit, the
+  /* This module's own stability limit (dx / (c + |v|) or its estimate, before time.cfl), the
    * minimum over the ranks, as the integrator last estimated it (at the start of each step of
    * the classic update); 0 until then or without a limit. A module whose per-step operations
-   * stand for a rate (the gas's PIC share) scales them by h / h_alone, so that another module
-   * setting a smaller step (a stiff solid under monolithic coupling), a retry or a step cut
-   * short at an output time changes what they do per unit time by nothing. */
-  double h_alone;
+   * stand for a rate (the gas's PIC share) scales them by h over a fixed fraction of it, so
+   * that another module setting a smaller step (a stiff solid under monolithic coupling), a
+   * retry, a step cut short at an output time or another time.cfl changes what they do per
+   * unit time by nothing. */
+  double h_limit;
   long step; /* accepted steps of the run (a restart continues the count); set by the sim
               * before boundary and post_step */
   /* > 0: post_step at the steps that are multiples of this reads the cell occupancy of every

@@ -182,18 +182,18 @@ static int rhs_fast(mpm_sunreal t, N_Vector y, N_Vector ydot, void *user) {
 }
 
 /* Stability limit: min over modules (all, or all but module `skip`) and ranks of
- * dx / (c + |v|), before the CFL fraction; each of those modules learns its own limit times the
- * CFL fraction as its h_alone (mpm_module.h). */
+ * dx / (c + |v|), before the CFL fraction; each of those modules learns its own limit as its
+ * h_limit (mpm_module.h). */
 static int stable_step_of(mpm_integrator *it, double *const *yk, int skip, double *hstab) {
   double h[MPM_MAX_MODULES];
   for (int k = 0; k < it->nmod; ++k)
     h[k] = k != skip ? it->mod[k]->ops->stable_dt(it->mod[k], yk[k]) : HUGE_VAL;
-  /* Every module's own limit over the ranks (one reduction), for its h_alone. */
+  /* Every module's own limit over the ranks (one reduction), for its h_limit. */
   MPM_CALL_MPI(MPI_Allreduce(MPI_IN_PLACE, h, it->nmod, MPI_DOUBLE, MPI_MIN, it->comm));
   *hstab = HUGE_VAL;
   for (int k = 0; k < it->nmod; ++k) {
     *hstab = fmin(*hstab, h[k]);
-    if (k != skip) it->mod[k]->h_alone = isfinite(h[k]) ? it->cfl * h[k] : 0.0;
+    if (k != skip) it->mod[k]->h_limit = isfinite(h[k]) ? h[k] : 0.0;
   }
   return 0;
 }

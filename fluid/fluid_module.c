@@ -53,9 +53,10 @@ static const mpm_key_spec fluid_keys[] = {
      "quadratic artificial viscosity coefficient c_quad (see av_linear)", 0},
     {"fluid.pic_fraction", MPM_KEY_REAL, NULL, 0, 1, 0, 0, NULL,
      "the gas's own PIC share of the particle velocity update, in place of "
-     "transfer.pic_fraction (default: that), for a step at the gas's own stable step (a "
-     "shorter one takes the share that damps as much per unit time); damps the gas's particle "
-     "noise without damping the solid; classic update only",
+     "transfer.pic_fraction (default: that), for a step at the gas's own stable step at "
+     "time.cfl = 0.4 (any other step takes the share that damps as much per unit time, so "
+     "neither time.cfl nor a stiffer module's step changes the damping); damps the gas's "
+     "particle noise without damping the solid; classic update only",
      1},
     {"fluid.strain_rate", MPM_KEY_ENUM, "current", 0, 0, 0, 0, "current|lagged",
      "ERK pairs: the strain rate the artificial and physical viscosity see: current (of the "

@@ -57,17 +57,27 @@
  * -2.5); with fluid.stable_step = neighbourhood a hot particle's own c may exceed the
  * neighbourhood's signal speed, and there the bound is the neighbourhood's.
  *
- * The PIC share as a rate. fluid.pic_fraction a is the share of a step the gas takes at its own
- * stable step, h_alone (time.cfl of its limit: mpm_module.h). Blended at a per step whatever
- * the step, PIC damps the particles' departure from the grid velocity by (1 - a)^(t / h), so
- * a gas stepped at a tenth of its own step, beside a stiff solid under monolithic coupling, was
- * damped ten times as fast as the same gas under multirate, and the two schemes solved
- * different gases: on the shock-loaded panel at 1 mm (the gas's steps seven times the panel's)
- * their tips differed by 28 % at 0.1 ms; with the rate, by 3 % (test_pic_rate checks the rate
- * itself). A step h < h_alone now takes a_h = 1 - (1 - a)^(h / h_alone), the share that
- * damps as much per unit time (a step within roundoff of h_alone takes a itself, so a gas that
- * sets its own step is blended exactly as before). The heat shares above hold for any blend,
- * so the energy balance is unchanged. (Particle shifting is a rate already: fluid_shift.c.) */
+ * The PIC share as a rate. fluid.pic_fraction a is the share of a step of h_pic = 0.4 h_limit,
+ * the step the gas takes alone at time.cfl = 0.4 (mpmfsi's default), h_limit its own stability
+ * limit (mpm_module.h). A step h takes a_h = 1 - (1 - a)^(h / h_pic), the share that damps as
+ * much per unit time, whatever sets the step (a step within roundoff of h_pic takes a itself).
+ * Blended at a per step, PIC damps the particles' departure from the grid velocity by
+ * (1 - a)^(t / h), so the gas's damping followed its step, not its physics:
+ * - beside a stiff solid under monolithic coupling, at a tenth of its own step, the gas was
+ *   damped ten times as fast as under multirate, and the two schemes solved different gases
+ *   (the shock-loaded panel at 1 mm, the gas's steps seven times the panel's: tips 28 % apart at
+ *   0.1 ms; 3 % with the rate);
+ * - stated at the gas's own step at the run's time.cfl (the rate's first form, until
+ *   2026-11-29), halving time.cfl still doubled the damping per unit time, and the solution
+ *   did not converge as the step fell: on the panel at 1 mm (monolithic, usl) the tip at 0.3 ms
+ *   was 555, 578, 617 and 766 um at time.cfl 0.4, 0.2, 0.1 and 0.025, each halving moving it
+ *   more than the one before; the tip history's error against time.cfl = 0.05 fell at order
+ *   0.3 (1.22e-4, 0.99e-4 m at 0.4, 0.2), and at order 1.04 without the share (1.30e-5,
+ *   0.63e-5 m).
+ * test_pic_rate checks the rate itself, at a quarter of the gas's step and at another time.cfl.
+ * A gas that sets its own step at time.cfl = 0.4 is blended exactly as before. The heat shares
+ * above hold for any blend, so the energy balance is unchanged. (Particle shifting is a rate
+ * already: fluid_shift.c.) */
 #include "fluid_internal.h"
 
 #include "mpm_kernels.h"
@@ -75,10 +85,13 @@
 #include <math.h>
 #include <string.h>
 
+/* The time.cfl at whose step fluid.pic_fraction is stated (see the file comment). */
+#define FLUID_PIC_CFL 0.4
+
 /* The PIC share of a step of size h (see the file comment). */
 static double pic_share(const mpm_module *m, double pic, double h) {
-  const double r = m->h_alone > 0.0 ? h / m->h_alone : 1.0;
-  if (!(pic > 0.0 && pic < 1.0) || r >= 1.0 - 1e-12) return pic;
+  const double r = m->h_limit > 0.0 ? h / (FLUID_PIC_CFL * m->h_limit) : 1.0;
+  if (!(pic > 0.0 && pic < 1.0) || fabs(r - 1.0) <= 1e-12) return pic;
   return -expm1(r * log1p(-pic));
 }
 
