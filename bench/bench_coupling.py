@@ -39,12 +39,11 @@ import os
 import resource
 import shutil
 import statistics
-import subprocess
 import sys
 import tempfile
 import time
 
-from benchrun import ROOT, run_case  # noqa: E402
+from benchrun import ROOT, git, run_case  # noqa: E402
 
 # Phases that do not nest (coupling runs inside grid, so it is left out of the sum for other).
 PHASES = ["p2g", "stress", "grid", "g2p", "halo", "check", "stable", "boundary", "migrate",
@@ -96,14 +95,6 @@ def run_once(scheme, ranks):
             "coupling_share": split["coupling"] / total,
             "coupling_imbalance": summary.get("coupling_imbalance", 0.0),
             **{f"t_{k}": v for k, v in split.items()}}
-
-
-def git(*args):
-    try:
-        return subprocess.run(["git", "-C", ROOT] + list(args), capture_output=True, text=True,
-                              check=True).stdout.strip()
-    except (OSError, subprocess.CalledProcessError):
-        return "unknown"
 
 
 def snapshot(tmp):

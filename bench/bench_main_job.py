@@ -29,7 +29,7 @@ import sys
 import tempfile
 import time
 
-from benchrun import ROOT
+from benchrun import ROOT, git
 
 TARGET_S = 60.0
 FIELDS = ["date", "commit", "round", "command_s", "run_s", "steps", "particle_steps",
@@ -48,12 +48,6 @@ def own_cpu_seconds():
     """CPU seconds used by finished children of this process (the run and its ranks)."""
     r = os.times()
     return r.children_user + r.children_system
-
-
-def commit():
-    p = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], capture_output=True,
-                       text=True)
-    return p.stdout.strip() or "unknown"
 
 
 def one_run(k, out):
@@ -128,7 +122,7 @@ def main():
         with open(a.out + ".json") as f:
             rows = json.load(f)
     date = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M")
-    c = commit()
+    c = git("rev-parse", "--short", "HEAD")
     with tempfile.TemporaryDirectory(prefix="main_job_") as scratch:
         for k in range(a.repeat):
             r = one_run(k, os.path.join(scratch, f"run{k}"))

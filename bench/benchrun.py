@@ -13,6 +13,15 @@ ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIR
            OMPI_MCA_btl_vader_single_copy_mechanism="none", OMPI_MCA_mpi_yield_when_idle="1")
 
 
+def git(*args):
+    """`git args` in the repository, its output stripped; "unknown" where git cannot tell."""
+    try:
+        return subprocess.run(["git", "-C", ROOT] + list(args), capture_output=True, text=True,
+                              check=True).stdout.strip()
+    except (OSError, subprocess.CalledProcessError):
+        return "unknown"
+
+
 def run_case(binary, case, overrides, ranks):
     """Run `binary run case output.dir=... overrides` on ranks; returns (summary, timers) with
     timers the mean seconds per phase."""
