@@ -14,7 +14,10 @@ imbalance, and whether it stayed stable (exit 0, no blow-up) or failed, with the
 Combinations: temporal `monolithic` with usl, musl and bs32; `staggered` with coupling.order =
 solid_first, gas_first, parallel, and solid_first strongly coupled (`strong`: sub-iterations to a
 relative interface residual of 1e-6, at most 60, Aitken relaxation), and `multirate` with coupling.load = held, interpolated, each
-with usl and musl (the subcycled classic update), and `multirate` `mristep` with bs32 (ARKODE
+with usl and musl (the subcycled classic update), `multirate` `lag` (coupling.slow_substeps = 0:
+both modules at the fast one's rate, the fast one held over the coupling step, so that its error
+is multirate's coupling lag alone and the rest of `held`'s is the slow module's own step; an
+ablation, as costly as monolithic), and `multirate` `mristep` with bs32 (ARKODE
 MRIStep, fixed steps: time.adaptive = false); `contact` with the classic update only (its own
 restriction). Coupling steps: time.cfl in --cfl. --skip leaves out runs by name (shell
 patterns), --skip-variants whole variants.
@@ -68,6 +71,7 @@ VARIANTS = [("monolithic", "", []),
                                      "coupling.tolerance=1e-6"]),
             ("multirate", "held", ["coupling.load=held"]),
             ("multirate", "interpolated", ["coupling.load=interpolated"]),
+            ("multirate", "lag", ["coupling.slow_substeps=0"]),
             ("multirate", "mristep", ["time.adaptive=false"])]
 
 
@@ -79,7 +83,7 @@ def parse():
     ap.add_argument("--temporal", nargs="+", default=["monolithic", "staggered", "multirate"])
     ap.add_argument("--skip-variants", nargs="+", default=[],
                     help="variants to leave out (solid_first, gas_first, parallel, strong, held, "
-                         "interpolated, mristep)")
+                         "interpolated, lag, mristep)")
     ap.add_argument("--skip", nargs="+", default=[], metavar="PATTERN",
                     help="run names to leave out, as shell patterns (e.g. '*-monolithic-bs32-*': "
                          "monolithic bs32 at a stiff solid's step costs most of a sweep)")

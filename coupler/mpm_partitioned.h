@@ -28,6 +28,7 @@ typedef struct mpm_partitioned {
   /* The scheme's own settings, read by its create. */
   int order;    /* staggered: the order of the advances */
   int substeps; /* multirate: substeps of the fast module per coupling step (0: from the ratio) */
+  int slow_substeps;         /* multirate: of the slow module (0: as many as the fast module) */
   int interpolate;           /* multirate: the solid's substeps see a linear trend of the load */
   struct mpm_strong *strong; /* staggered: sub-iterations (NULL: none) */
   long steps;

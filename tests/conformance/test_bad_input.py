@@ -279,6 +279,10 @@ COUPLING_CASES = [
      "coupling.tolerance", "must be in (0, 1]"),
     ("iterations with multirate", FSI, "time = multirate\niterations = 5",
      "coupling.iterations", "key of the staggered time scheme"),
+    ("negative slow substeps", FSI, "time = multirate\nslow_substeps = -1",
+     "coupling.slow_substeps", "must be in [0, 1000000]"),
+    ("slow substeps with another time scheme", FSI, "time = staggered\nslow_substeps = 0",
+     "coupling.slow_substeps", "key of the multirate time scheme"),
 ]
 for name, base, body, key, words in COUPLING_CASES:
     text = base.rstrip("\n") + "\n\n[coupling]\n" + body + "\n"
@@ -295,6 +299,9 @@ expect_error("multirate with an adaptive pair", text, "time.adaptive", "fixed st
 for name, base, body, key, words in (
         ("coupling.load with MRIStep", ERK.replace("method = bs32", "method = bs32\nadaptive = false"),
          "time = multirate\nload = interpolated", "coupling.load", "classic update only"),
+        ("coupling.slow_substeps with MRIStep",
+         ERK.replace("method = bs32", "method = bs32\nadaptive = false"),
+         "time = multirate\nslow_substeps = 0", "coupling.slow_substeps", "classic update only"),
         ("coupling.mri_table with the classic update", FSI,
          "time = multirate\nmri_table = mis_kw3", "coupling.mri_table", "ERK pair only"),
         ("unknown MRI table", FSI, "time = multirate\nmri_table = erk33", "coupling.mri_table",

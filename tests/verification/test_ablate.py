@@ -110,7 +110,7 @@ with open(os.path.join(made_up, "runs.csv"), "w", newline="") as f:
 subprocess.run([sys.executable, os.path.join(SOURCE, "bench", "ablate.py"), CASE] + COMMON
                + ["fluid.regularise_every=0", "--spatial", "velocity", "--methods", "usl",
                   "--ref-cfl", "0.2", "--out", made_up, "--scratch", scratch, "--report-only",
-                  "--temporal", "monolithic", "multirate", "--skip-variants", "interpolated",
+                  "--temporal", "monolithic", "multirate", "--skip-variants", "interpolated", "lag",
                   "mristep", "--cfl", "0.4", "0.2", "0.1"], check=True, capture_output=True,
                timeout=600)
 with open(os.path.join(made_up, "ablation.md")) as f:
