@@ -20,7 +20,7 @@ probe at its middle (probes.csv, every step).
    coupling step: the coupling lag alone, predicted first order at least) falls with an overall
    order of at least 0.7 as well (measured 2.20 then 1.58, 1.89 overall: the lag's first-order
    part is small here); its share of the held run's error is printed (measured 0.21, 0.10,
-   0.06: the rest is the gas's own step, seven times monolithic's).
+   0.06: the rest is the gas's own step, several times monolithic's).
 3. Every partitioned run balances the interface momentum to 1e-9 of the interface force
    (summary.json; the owed momentum included).
 4. Restart is bitwise for every temporal scheme: staggered (solid_first, gas_first, parallel,
