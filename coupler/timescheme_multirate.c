@@ -9,10 +9,11 @@
  *
  * An ablation of multirate's own error: with coupling.slow_substeps = n the slow module, too,
  * takes n substeps of H / n against the fast one held at the start of the coupling step (0: as
- * many as the fast module). At n = 0 both modules step at the fast module's rate and the held
- * partner is all that is left of multirate, so the difference from monolithic at the same step
- * is the coupling lag alone, and the rest of multirate's error is the slow module's own step.
- * (On the shock panel at 1 mm the lag is the smaller part: bench/results/README.md.)
+ * many as the fast module). At n = 0 both modules step at the fast module's rate, and what
+ * separates the run from monolithic at the same step is the held partner, the coupling lag
+ * (and the step loop's work between steps, the gas's shifting for one, which every partitioned
+ * scheme does once per coupling step); the rest of multirate's error is the slow module's own
+ * step. On the shock panel at 1 mm the lag is the smaller part (README, Temporal coupling).
  *
  * Which is fast depends on the scene: a steel panel in air is the fast module (its stable step
  * is about a tenth of the air's), a soft bar in a Mach 2.5 stream the slow one.
@@ -40,8 +41,8 @@ static const mpm_key_spec multirate_keys[] = {
      1},
     {"coupling.slow_substeps", MPM_KEY_INT, "1", 0, 1e6, 0, 0, NULL,
      "multirate, classic update: substeps of the slow module in each coupling step, against the "
-     "fast one held (1: one step, multirate itself; 0: as many as the fast module, which leaves "
-     "the coupling lag as multirate's only error: an ablation, not a saving)",
+     "fast one held (1: one step, multirate itself; 0: as many as the fast module, an ablation: "
+     "the coupling lag without the slow module's own step error)",
      0},
     {"coupling.load", MPM_KEY_ENUM, "held", 0, 0, 0, 0, "held|interpolated",
      "multirate: how the solid's substeps see the gas's load: held (constant over the coupling "
