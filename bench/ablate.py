@@ -12,15 +12,16 @@ records its wall time, steps and RHS evaluations, the interface energy the coupl
 imbalance, and whether it stayed stable (exit 0, no blow-up) or failed, with the message.
 
 Combinations: temporal `monolithic` with usl, musl and bs32; `staggered` with coupling.order =
-solid_first, gas_first, parallel, and solid_first strongly coupled (`strong`: sub-iterations to a
-relative interface residual of 1e-6, at most 60, Aitken relaxation), and `multirate` with coupling.load = held, interpolated, each
-with usl and musl (the subcycled classic update), `multirate` `lag` (coupling.slow_substeps = 0:
-both modules at the fast one's rate, the fast one held over the coupling step: what separates
-it from monolithic is the coupling lag (and the work between steps, done once per coupling
-step), and the rest of `held`'s error is the slow module's own step; an ablation), and `multirate` `mristep` with bs32 (ARKODE
-MRIStep, fixed steps: time.adaptive = false); `contact` with the classic update only (its own
-restriction). Coupling steps: time.cfl in --cfl. --skip leaves out runs by name (shell
-patterns), --skip-variants whole variants.
+solid_first, gas_first, parallel, and solid_first strongly coupled (`strong`: sub-iterations to
+a relative interface residual of 1e-6, at most 60, Aitken relaxation), and `multirate` with
+coupling.load = held, interpolated, each with usl and musl (the subcycled classic update),
+`multirate` `lag` (coupling.slow_substeps = 0: both modules at the fast one's rate, the fast one
+held over the coupling step: what separates it from monolithic is the coupling lag (and the work
+between steps, done once per coupling step), and the rest of `held`'s error is the slow module's
+own step; an ablation), and `multirate` `mristep` with bs32 (ARKODE MRIStep, fixed steps:
+time.adaptive = false); `contact` with the classic update only (its own restriction). Coupling
+steps: time.cfl in --cfl. --skip leaves out runs by name (shell patterns), --skip-variants whole
+variants.
 
 Results go to --out (default bench/results/ablate_<case>; the runs' own output to --scratch,
 default out/ablate/<the results folder's name>/): runs.csv (one row per run, written as
