@@ -33,7 +33,7 @@ void mpm_interface_destroy(mpm_interface **ifcp) {
   for (int d = 0; d < MPM_MAX_DIM; ++d) {
     free(ifc->mv[d]), free(ifc->f[d]), free(ifc->normal[d]);
     free(ifc->capture[d]), free(ifc->impulse[d]), free(ifc->load[d]);
-    free(ifc->trend[d]), free(ifc->prev[d]), free(ifc->now[d]);
+    free(ifc->trend[d]), free(ifc->prev[d]), free(ifc->now[d]), free(ifc->moved[d]);
   }
   free(ifc);
   *ifcp = NULL;
@@ -114,6 +114,55 @@ const double *mpm_interface_mass_start(mpm_interface *ifc) {
            sizeof(double) * (size_t)ifc->grid->nnodes);
   ifc->start_due = 0;
   return ifc->m_start;
+}
+
+/* The node of the 3^dim block around l (within the box) with the most mass m; l itself on a tie. */
+static mpm_lidx heaviest_neighbour(const mpm_grid *g, const double *m, mpm_lidx l) {
+  const int dim = g->dim;
+  int c[MPM_MAX_DIM];
+  mpm_lidx stride[MPM_MAX_DIM], r = l;
+  for (int d = 0; d < dim; ++d) {
+    stride[d] = d ? stride[d - 1] * g->box_n[d - 1] : 1;
+    c[d] = (int)(r % g->box_n[d]), r /= g->box_n[d];
+  }
+  mpm_lidx best = l;
+  int nb = 1;
+  for (int d = 0; d < dim; ++d) nb *= 3;
+  for (int k = 0; k < nb; ++k) {
+    mpm_lidx j = l;
+    int inside = 1;
+    for (int d = 0, q = k; d < dim; ++d, q /= 3) {
+      const int o = q % 3 - 1;
+      inside &= c[d] + o >= 0 && c[d] + o < g->box_n[d];
+      j += o * stride[d];
+    }
+    if (inside && m[j] > m[best]) best = j;
+  }
+  return best;
+}
+
+int mpm_interface_rehome(mpm_interface *ifc, const unsigned char *owned) {
+  mpm_grid *g = ifc->grid;
+  const int dim = g->dim;
+  const mpm_lidx nn = g->nnodes;
+  const double *m = g->phase[ifc->phase].m_i;
+  for (int d = 0; d < dim; ++d) {
+    if (!ifc->moved[d]) MPM_ALLOC(ifc->moved[d], nn);
+    memset(ifc->moved[d], 0, sizeof(double) * (size_t)nn);
+  }
+  for (mpm_lidx l = 0; l < nn; ++l) {
+    if (!owned[l] || !(m[l] < ifc->m_start[l] || m[l] == 0.0)) continue;
+    int any = 0;
+    for (int d = 0; d < dim; ++d) any |= ifc->impulse[d][l] != 0.0;
+    const mpm_lidx j = any ? heaviest_neighbour(g, m, l) : l;
+    if (j == l) continue;
+    for (int d = 0; d < dim; ++d) ifc->moved[d][j] += ifc->impulse[d][l], ifc->impulse[d][l] = 0.0;
+  }
+  MPM_CALL(mpm_grid_halo_reverse(g, ifc->moved, dim));
+  for (int d = 0; d < dim; ++d)
+    for (mpm_lidx l = 0; l < nn; ++l)
+      if (owned[l]) ifc->impulse[d][l] += ifc->moved[d][l];
+  return 0;
 }
 
 void mpm_interface_owed(const mpm_interface *ifc, const unsigned char *owned, double *J) {

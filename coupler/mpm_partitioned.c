@@ -147,7 +147,8 @@ int mpm_partitioned_advance_solid_under(mpm_timescheme *ts, double t0, double t1
   mpm_interface_load(pp->ifc, t0, t1 - t0, pp->interpolate);
   for (int d = 0; q && d < ts->grid->dim; ++d)
     for (mpm_lidx l = 0; l < ts->grid->nnodes; ++l) pp->ifc->load[d][l] += q[d][l];
-  return advance(ts, pp->it_solid, MPM_ROLE_SOLID, t0, t1, n);
+  MPM_CALL(advance(ts, pp->it_solid, MPM_ROLE_SOLID, t0, t1, n));
+  return mpm_interface_rehome(pp->ifc, ts->coupling->owned);
 }
 
 int mpm_partitioned_end(mpm_timescheme *ts, double t0, double t1) {
