@@ -154,7 +154,8 @@ int mpm_interface_rehome(mpm_interface *ifc, const unsigned char *owned) {
     if (!owned[l] || !(m[l] < ifc->m_start[l] || m[l] == 0.0)) continue;
     int any = 0;
     for (int d = 0; d < dim; ++d) any |= ifc->impulse[d][l] != 0.0;
-    const mpm_lidx j = any ? heaviest_neighbour(g, m, l) : l;
+    if (!any) continue;
+    const mpm_lidx j = heaviest_neighbour(g, m, l);
     if (j == l) continue;
     for (int d = 0; d < dim; ++d) ifc->moved[d][j] += ifc->impulse[d][l], ifc->impulse[d][l] = 0.0;
   }
