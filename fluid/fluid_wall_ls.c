@@ -269,6 +269,10 @@ static void keep_out(const double *f, const layout *L, const double *nrm, double
 
 /* ---- setup ---------------------------------------------------------------------------------- */
 
+/* What a cell (w->reach, by its lower corner node) holds: no particle near a body, donors only,
+ * or particles that may be fitted (their phi decides). */
+enum { REACH_FAR = 0, REACH_DONOR = 1, REACH_MAY_FIT = 2 };
+
 /* The nearest obstacle to x: its index, phi and outward normal. */
 static int nearest(const fluid_obstacles *o, const double *x, double *phi, double *normal) {
   int best = -1;
@@ -324,9 +328,46 @@ int fluid_wall_ls_init(mpm_module *m, const mpm_config *cfg, int classic) {
     mpm_grid_node_global(g, l, gi);
     for (int d = 0; d < dim; ++d) xc[d] = g->lo[d] + (gi[d] + 0.5) * g->dx;
     nearest(&fc->obs, xc, &phi, nrm);
-    w->reach[l] = phi < reach;
+    w->reach[l] = phi < reach ? REACH_MAY_FIT : REACH_FAR;
+    /* Every point of the cell lies within half a diagonal of its centre, and phi is a distance
+     * (1-Lipschitz): a cell whose centre is that much beyond the fitted particles, and a hair
+     * more for the roundoff of phi, holds donors only, and its particles need no phi. */
+    if (phi < reach && phi - 0.5 * sqrt((double)dim) * g->dx > w->band + w->blend + 1e-9 * g->dx)
+      w->reach[l] = REACH_DONOR;
+  }
+  /* The moments live on the nodes within a stencil of a reach cell, all inside the bodies'
+   * bounding box grown by reach and two cells: only that block of the box is cleared at each
+   * step. The block is a global one (the same nodes on every rank), so no ghost node outside it
+   * ever holds a moment for the halo exchanges to carry; along a periodic axis it is the whole
+   * box. */
+  for (int d = 0; d < dim; ++d) {
+    double lo = HUGE_VAL, hi = -HUGE_VAL;
+    for (int k = 0; k < fc->obs.count; ++k)
+      lo = fmin(lo, fc->obs.ob[k].sdf.lo[d]), hi = fmax(hi, fc->obs.ob[k].sdf.hi[d]);
+    const double b0 = g->box_lo[d], b1 = g->box_lo[d] + g->box_n[d];
+    double i0 = floor((lo - reach - g->lo[d]) / g->dx) - 2,
+           i1 = ceil((hi + reach - g->lo[d]) / g->dx) + 3;
+    if (g->periodic[d]) i0 = b0, i1 = b1;
+    i0 = fmin(fmax(i0, b0), b1), i1 = fmin(fmax(i1, i0), b1);
+    w->clear_lo[d] = (int)i0, w->clear_n[d] = (int)(i1 - i0);
   }
   return 0;
+}
+
+/* Zero the moments on the block of nodes they can reach (see fluid_wall_ls_init). */
+static void clear_moments(fluid_wall_ls *w, const mpm_grid *g) {
+  const int dim = g->dim;
+  mpm_lidx rows = 1;
+  for (int d = 1; d < dim; ++d) rows *= w->clear_n[d];
+  if (rows == 0 || w->clear_n[0] == 0) return;
+  for (mpm_lidx r = 0; r < rows; ++r) {
+    int gi[MPM_MAX_DIM] = {w->clear_lo[0]};
+    for (int d = 1, q = (int)r; d < dim; q /= w->clear_n[d], ++d)
+      gi[d] = w->clear_lo[d] + q % w->clear_n[d];
+    const mpm_lidx l = mpm_grid_local_index(g, gi);
+    for (int k = 0; k < w->nmom; ++k)
+      memset(w->mom_ptr[k] + l, 0, sizeof *w->mom * (size_t)w->clear_n[0]);
+  }
 }
 
 static int ensure(fluid_wall_ls *w, mpm_lidx n, int dim) {
@@ -362,7 +403,7 @@ int fluid_wall_ls_apply(mpm_module *m, const double *y, double *ydot, double h) 
   const double *V0 = mpm_particles_comp(p, fc->lay.f_V0, 0);
   const size_t ox = (size_t)p->offset[FLUID_X] * n, ov = (size_t)p->offset[FLUID_V] * n;
   const size_t oJ = (size_t)p->offset[FLUID_J] * n, oe = (size_t)p->offset[FLUID_E] * n;
-  memset(w->mom, 0, sizeof *w->mom * (size_t)w->nmom * nn);
+  clear_moments(w, g);
 
   /* Classify, and deposit the donors' new values. */
   for (mpm_lidx i = 0; i < n; ++i) {
@@ -375,9 +416,10 @@ int fluid_wall_ls_apply(mpm_module *m, const double *y, double *ydot, double h) 
       in &= gi[d] >= g->box_lo[d] && gi[d] < g->box_lo[d] + g->box_n[d];
     }
     w->kind[i] = -1;
-    if (!in || !w->reach[mpm_grid_local_index(g, gi)]) continue;
+    const int r = in ? w->reach[mpm_grid_local_index(g, gi)] : REACH_FAR;
+    if (r == REACH_FAR) continue;
     double *geo = w->geo + (size_t)(1 + dim) * i, *f = w->val + (size_t)nf * i;
-    w->ob[i] = nearest(&fc->obs, x, &geo[0], geo + 1);
+    if (r == REACH_MAY_FIT) w->ob[i] = nearest(&fc->obs, x, &geo[0], geo + 1);
     const double J1 = y[oJ + i] + h * ydot[oJ + i], V = V0[i] * J1;
     for (int d = 0; d < dim; ++d) {
       f[d] = y[ov + (size_t)d * n + i] + h * ydot[ov + (size_t)d * n + i];
@@ -385,7 +427,7 @@ int fluid_wall_ls_apply(mpm_module *m, const double *y, double *ydot, double h) 
     }
     f[2 * dim] = y[oe + i] + h * ydot[oe + i];
     f[2 * dim + 1] = mass[i] / V;
-    w->kind[i] = geo[0] < w->band ? 1 : geo[0] < w->band + w->blend ? 2 : 0;
+    w->kind[i] = r == REACH_DONOR ? 0 : geo[0] < w->band ? 1 : geo[0] < w->band + w->blend ? 2 : 0;
     if (w->kind[i] != 1) deposit(w->mom, nn, &L, g, xi, fc->lp, V, f);
   }
   MPM_CALL(mpm_grid_halo_reverse(g, w->mom_ptr, w->nmom));
@@ -426,8 +468,10 @@ int fluid_wall_ls_apply(mpm_module *m, const double *y, double *ydot, double h) 
     bal[1] += mass[i] * out[2 * dim];
     f[2 * dim] = out[2 * dim], f[2 * dim + 1] = out[2 * dim + 1];
   }
+  double me = bal[1];              /* a register, not the array that MPI takes */
   for (mpm_lidx i = 0; i < n; ++i) /* every particle pays (see the header) */
-    if (w->kind[i] < 1) bal[1] += mass[i] * (y[oe + i] + h * ydot[oe + i]);
+    if (w->kind[i] < 1) me += mass[i] * (y[oe + i] + h * ydot[oe + i]);
+  bal[1] = me;
   MPM_CALL_MPI(MPI_Allreduce(MPI_IN_PLACE, bal, 2, MPI_DOUBLE, MPI_SUM, g->comm));
   const double scale = bal[1] > 0.0 ? 1.0 - bal[0] / bal[1] : 1.0;
   if (!(scale > 0.0))

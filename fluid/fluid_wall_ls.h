@@ -85,16 +85,17 @@ typedef struct fluid_wall_ls {
   int order;            /* of the free fits: 0 (weighted mean) or 1 (linear) */
   double band;          /* wall particles: phi < band, m */
   double blend;         /* band <= phi < band + blend: part fitted, part donors, m */
-  unsigned char *reach; /* per box node as a cell's lower corner: the cell is near a body */
+  unsigned char *reach; /* per box node as a cell's lower corner: far, donors only, or may fit */
   int nf;               /* fitted fields: v (dim), vhat (dim), e, rho */
   int nmom;             /* nodal moment arrays */
   double *mom;          /* nmom * nnodes */
-  double **mom_ptr;     /* nmom pointers into mom, for the halo exchanges */
-  mpm_lidx cap;         /* capacity of the per-particle arrays */
-  signed char *kind;    /* -1 far, 0 donor, 1 wall particle, 2 both (the blend) */
-  int *ob;              /* wall particle: the nearest obstacle */
-  double *geo;          /* wall particle: phi and the outward normal (1 + dim) */
-  double *val;          /* new field values (nf per particle) */
+  int clear_lo[MPM_MAX_DIM], clear_n[MPM_MAX_DIM]; /* the block of box nodes they reach */
+  double **mom_ptr;  /* nmom pointers into mom, for the halo exchanges */
+  mpm_lidx cap;      /* capacity of the per-particle arrays */
+  signed char *kind; /* -1 far, 0 donor, 1 wall particle, 2 both (the blend) */
+  int *ob;           /* wall particle: the nearest obstacle */
+  double *geo;       /* wall particle: phi and the outward normal (1 + dim) */
+  double *val;       /* new field values (nf per particle) */
 } fluid_wall_ls;
 
 extern const mpm_key_spec fluid_wall_keys[];
