@@ -428,7 +428,7 @@ static void flag_near(fluid_obstacles *o, const mpm_grid *g, const int *gi) {
       c[d] = gi[d] - 2 + r % span;
       ok &= c[d] >= g->box_lo[d] && c[d] < g->box_lo[d] + g->box_n[d];
     }
-    if (ok) o->near[mpm_grid_local_index(g, c)] = 1;
+    if (ok) o->near[mpm_grid_local_index(g, c)] = o->listed[mpm_grid_local_index(g, c)] = 1;
   }
 }
 
@@ -532,10 +532,12 @@ static int build_ghosts(fluid_obstacles *o, const mpm_grid *g) {
   o->gowned = rc ? NULL : malloc((size_t)count + 1);
   o->gob = rc ? NULL : malloc(sizeof *o->gob * (size_t)(count + 1));
   o->near = rc ? NULL : calloc((size_t)g->nnodes, 1);
+  o->listed = rc ? NULL : calloc((size_t)g->nnodes, 1);
   o->sm = rc ? NULL : malloc(sizeof *o->sm * 3 * (size_t)g->nnodes);
   o->q = rc ? NULL : calloc((size_t)g->nnodes, sizeof *o->q);
   o->own = rc ? NULL : malloc((size_t)g->nnodes);
-  if (!rc && !(o->gnode && o->G && o->gowned && o->gob && o->near && o->sm && o->q && o->own))
+  if (!rc &&
+      !(o->gnode && o->G && o->gowned && o->gob && o->near && o->listed && o->sm && o->q && o->own))
     rc = MPM_ERR_MEMORY;
   for (mpm_lidx l = 0; !rc && l < g->nnodes; ++l)
     o->own[l] = (unsigned char)mpm_grid_node_is_owned(g, l);
@@ -616,16 +618,45 @@ int fluid_obstacles_which(const fluid_obstacles *o, const double *x) {
   return -1;
 }
 
-/* Is particle i (positions x per component) in a cell near a body? Its position into xp. */
-static int near_body(const fluid_obstacles *o, const mpm_grid *g, const double *const *x,
-                     mpm_lidx i, double *xp) {
+/* The cell of particle i (positions x per component): the box index of its lower corner, or -1
+ * outside the box. Its position into xp. */
+static mpm_lidx cell_of(const mpm_grid *g, const double *const *x, mpm_lidx i, double *xp) {
   int gi[MPM_MAX_DIM] = {0}, in = 1;
   for (int d = 0; d < g->dim; ++d) {
     xp[d] = x[d][i];
     gi[d] = mpm_shape_floor((xp[d] - g->lo[d]) / g->dx);
     in &= gi[d] >= g->box_lo[d] && gi[d] < g->box_lo[d] + g->box_n[d];
   }
-  return in && o->near[mpm_grid_local_index(g, gi)];
+  return in ? mpm_grid_local_index(g, gi) : -1;
+}
+
+void fluid_obstacles_list_cells(fluid_obstacles *o, const mpm_grid *grid,
+                                const unsigned char *flag) {
+  for (mpm_lidx l = 0; o->listed && l < grid->nnodes; ++l) o->listed[l] |= flag[l] != 0;
+}
+
+const mpm_lidx *fluid_obstacles_listed(const fluid_obstacles *o, const double *x0, mpm_lidx n,
+                                       mpm_lidx *count, const mpm_lidx **cells) {
+  if (!o->list_x || o->list_x != x0 || o->list_n != n) return NULL;
+  *count = o->nlist, *cells = o->list_cell;
+  return o->list;
+}
+
+void fluid_obstacles_list_done(fluid_obstacles *o) {
+  o->list_x = NULL;
+}
+
+/* Room for n entries in the list; 0 if there is none (the list is then not kept). */
+static int list_reserve(fluid_obstacles *o, mpm_lidx n) {
+  if (n <= o->list_cap) return 1;
+  const mpm_lidx cap = n + n / 4 + 16;
+  mpm_lidx *a = realloc(o->list, sizeof *a * (size_t)cap);
+  if (a) o->list = a;
+  mpm_lidx *b = a ? realloc(o->list_cell, sizeof *b * (size_t)cap) : NULL;
+  if (b) o->list_cell = b;
+  if (!(a && b)) return 0;
+  o->list_cap = cap;
+  return 1;
 }
 
 void fluid_obstacles_deposit(fluid_obstacles *o, const mpm_grid *grid, mpm_lidx n,
@@ -636,9 +667,14 @@ void fluid_obstacles_deposit(fluid_obstacles *o, const mpm_grid *grid, mpm_lidx 
   double *sm = o->sm, *smp = o->sm + grid->nnodes, *smt = o->sm + 2 * (size_t)grid->nnodes;
   memset(sm, 0, sizeof *sm * (size_t)o->nsm * grid->nnodes);
   const int surf = o->nsm == 3; /* the surface output's thermodynamic pressure, without q */
+  const int keep = list_reserve(o, n);
+  o->nlist = 0, o->list_x = keep ? x[0] : NULL, o->list_n = n;
   for (mpm_lidx i = 0; i < n; ++i) {
     double xp[MPM_MAX_DIM];
-    if (!near_body(o, grid, x, i, xp)) continue;
+    const mpm_lidx c = cell_of(grid, x, i, xp);
+    if (c < 0 || !o->listed[c]) continue;
+    if (keep) o->list[o->nlist] = i, o->list_cell[o->nlist++] = c;
+    if (!o->near[c]) continue;
     double p = 0.0; /* p = -tr(V sigma) / (dim V) */
     for (int d = 0; d < dim; ++d) p -= vsig[(size_t)(d * dim + d) * n + i];
     p /= dim * V0[i] * J[i];
@@ -767,9 +803,13 @@ void fluid_obstacles_heat(const fluid_obstacles *o, const mpm_grid *grid, mpm_li
                           const double *const *x, const double *e, double h, double *power) {
   if (o->count == 0 || !o->heat) return;
   const int dim = grid->dim;
-  for (mpm_lidx i = 0; i < n; ++i) {
+  mpm_lidx nl = n;
+  const mpm_lidx *cells = NULL, *list = fluid_obstacles_listed(o, x[0], n, &nl, &cells);
+  for (mpm_lidx k = 0; k < nl; ++k) {
     double xp[MPM_MAX_DIM];
-    if (!near_body(o, grid, x, i, xp)) continue;
+    const mpm_lidx i = list ? list[k] : k, c = list ? cells[k] : cell_of(grid, x, i, xp);
+    if (c < 0 || !o->near[c]) continue;
+    for (int d = 0; list && d < dim; ++d) xp[d] = x[d][i];
     stencil st;
     stencil_at(&st, grid, xp, o->lp);
     double heat = 0.0;
@@ -830,7 +870,8 @@ void fluid_obstacles_free(fluid_obstacles *o) {
   free(o->ob);
   free(o->f[0]), free(o->f[1]);
   free(o->gnode), free(o->G), free(o->gowned), free(o->gob), free(o->lnode), free(o->lob),
-      free(o->near), free(o->sm), free(o->q), free(o->own);
+      free(o->near), free(o->listed), free(o->list), free(o->list_cell), free(o->sm), free(o->q),
+      free(o->own);
   mpm_diag_close(&o->csv);
   memset(o, 0, sizeof *o);
 }

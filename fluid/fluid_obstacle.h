@@ -105,20 +105,27 @@ typedef struct fluid_obstacles {
   mpm_lidx *gnode; /* box index */
   double *G;       /* sum V grad S of the ghosts (dim per node) */
   unsigned char *gowned;
-  int *gob;            /* the obstacle each ghost force belongs to (the nearest) */
-  mpm_lidx lcount;     /* owned nodes in the bodies' reach (constrained or ghost), each once */
-  mpm_lidx *lnode;     /* box index: an empty or light one hands its force to the body */
-  int *lob;            /* the obstacle it belongs to */
-  unsigned char *near; /* per box node as a cell's lower corner: a particle in it reaches a
-                          ghost node or, when the heat is booked, a constrained node */
-  unsigned char *own;  /* per box node: owned by this rank */
-  double *sm;          /* nodal m and m p (p = -tr sigma / dim, with q) of the particles near
-                          a body, then m p with the thermodynamic p alone (nsm nnodes) */
-  int nsm;             /* 3 if an obstacle writes its surface pressure, else 2 */
-  double *q;           /* per box node: the rate at which the obstacles put energy into the gas
-                          in the latest recorded RHS (ghost work and constraint power), W, then
-                          per unit nodal mass, W/kg (fluid_obstacles_work) */
-  char path[4096];     /* obstacles.csv */
+  int *gob;                 /* the obstacle each ghost force belongs to (the nearest) */
+  mpm_lidx lcount;          /* owned nodes in the bodies' reach (constrained or ghost), each once */
+  mpm_lidx *lnode;          /* box index: an empty or light one hands its force to the body */
+  int *lob;                 /* the obstacle it belongs to */
+  unsigned char *near;      /* per box node as a cell's lower corner: a particle in it reaches a
+                               ghost node or, when the heat is booked, a constrained node */
+  unsigned char *listed;    /* per box node as a cell's lower corner: near, or in another pass's
+                               reach (fluid_obstacles_list_cells) */
+  mpm_lidx nlist, list_cap; /* the particles in listed cells at the latest deposit: */
+  mpm_lidx *list;           /* their indices, ascending, */
+  mpm_lidx *list_cell;      /* and cells (box index of the lower corner) */
+  const double *list_x;     /* the positions they were found at (x[0]; NULL: no list) */
+  mpm_lidx list_n;          /* and the particle count */
+  unsigned char *own;       /* per box node: owned by this rank */
+  double *sm;               /* nodal m and m p (p = -tr sigma / dim, with q) of the particles near
+                               a body, then m p with the thermodynamic p alone (nsm nnodes) */
+  int nsm;                  /* 3 if an obstacle writes its surface pressure, else 2 */
+  double *q;                /* per box node: the rate at which the obstacles put energy into the gas
+                               in the latest recorded RHS (ghost work and constraint power), W, then
+                               per unit nodal mass, W/kg (fluid_obstacles_work) */
+  char path[4096];          /* obstacles.csv */
   mpm_diag *csv;
 } fluid_obstacles;
 
@@ -152,6 +159,19 @@ int fluid_obstacles_which(const fluid_obstacles *o, const double *x);
 int fluid_obstacles_apply(fluid_obstacles *o, mpm_grid *grid, int phase, double h, int record);
 /* Book the obstacles' work as heat from now on (see Energy above). */
 void fluid_obstacles_book_heat(fluid_obstacles *o, const mpm_grid *g);
+/* The particles near a body. fluid_obstacles_deposit() goes over every particle and lists those
+ * in a listed cell (near, or added here by another pass that visits the particles near the
+ * bodies, fluid_wall_ls), with their cells, so that the later passes of the same RHS visit the
+ * list instead of every particle. Add the cells flagged (nonzero) in flag (per box node as a
+ * cell's lower corner) to the listed ones. */
+void fluid_obstacles_list_cells(fluid_obstacles *o, const mpm_grid *grid,
+                                const unsigned char *flag);
+/* The list of the latest deposit if it was made at the positions x[0] of n particles (count and
+ * cells into *count and *cells), else NULL: the caller then goes over every particle. */
+const mpm_lidx *fluid_obstacles_listed(const fluid_obstacles *o, const double *x0, mpm_lidx n,
+                                       mpm_lidx *count, const mpm_lidx **cells);
+/* The RHS is done with the list (the positions may change before the next deposit). */
+void fluid_obstacles_list_done(fluid_obstacles *o);
 /* After the last constraint of a recorded RHS: add the ghost forces' work on the final nodal
  * velocities (time-centred in the classic update) to the nodal energy rates q, divide them by
  * the nodal masses and copy the owners' values into the ghost nodes. Collective. */

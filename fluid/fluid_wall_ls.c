@@ -71,24 +71,30 @@ static int spd_solve(int n, double *A, double *b, double tol) {
 
 /* ---- the moments ---------------------------------------------------------------------------- */
 
-/* Index layout of the nodal moments, r in cells: M0, M1[dim], M2[dim (dim + 1) / 2] (a <= b),
- * then per field F0, F1[dim]. */
+/* Index layout of one node's moments, r in cells: M0, M1[dim], M2[dim (dim + 1) / 2] (a <= b),
+ * then per field F0 and, for the first ng fields, F1[dim]. A linear fit needs every field's F1;
+ * the constant one (fluid.wall_fit_order = 0) only the velocities' (the normal component is
+ * always linear), so e and rho carry F0 alone. A node's moments are contiguous (nmom values at
+ * mom + l nmom): a donor adds to the nmom values of each of its stencil's nodes, a few cache
+ * lines per node where one array per moment took one line per moment. */
 typedef struct layout {
-  int dim, nf, m1, m2, f0;
+  int dim, nf, ng, m1, m2, f0, nmom;
 } layout;
 
-static layout layout_of(int dim, int nf) {
-  layout L = {.dim = dim, .nf = nf, .m1 = 1, .m2 = 1 + dim};
+static int f_index(const layout *L, int f) {
+  return f < L->ng ? L->f0 + f * (1 + L->dim) : L->f0 + L->ng * (1 + L->dim) + (f - L->ng);
+}
+
+static layout layout_of(int dim, int nf, int order) {
+  layout L = {.dim = dim, .nf = nf, .ng = order ? nf : 2 * dim, .m1 = 1, .m2 = 1 + dim};
   L.f0 = L.m2 + dim * (dim + 1) / 2;
+  L.nmom = f_index(&L, nf);
   return L;
 }
 static int m2_index(const layout *L, int a, int b) { /* a <= b */
   int k = L->m2;
   for (int r = 0; r < a; ++r) k += L->dim - r;
   return k + b - a;
-}
-static int f_index(const layout *L, int f) {
-  return L->f0 + f * (1 + L->dim);
 }
 
 /* The weighted sums of one wall particle, gathered from the nodal moments. */
@@ -97,76 +103,97 @@ typedef struct sums {
   double G0[2 * MPM_MAX_DIM + 2], G1[2 * MPM_MAX_DIM + 2][MPM_MAX_DIM];
 } sums;
 
-/* Visit the stencil of a point at xi (cells): fn(l, w, d) for every box node l, with d its
- * offset x_i - x in cells. */
-#define FOR_STENCIL(g, xi, lp, BODY)                                                               \
+/* Visit the stencil of a point at xi (cells): BODY for every box node L_, with W its weight and
+ * D its offset x_i - x in cells. The node's index along each axis advances as an odometer (an
+ * integer division per node and axis cost more than the body). DIM is g->dim; deposit and
+ * gather pass it as a literal (MPM_INLINE), so that the loops over the axes unroll and the
+ * offsets stay in registers: with a run-time dim, the offsets written one by one and read back
+ * as a pair stalled the deposit on every store (store forwarding). */
+#define MPM_INLINE static inline __attribute__((always_inline))
+#define NO_SLP     __attribute__((optimize("no-tree-vectorize")))
+#define FOR_STENCIL(g, DIM, xi, lp, BODY)                                                          \
   do {                                                                                             \
-    int base_[MPM_MAX_DIM], sup_ = mpm_shape_support((g)->shape);                                  \
+    int base_[MPM_MAX_DIM], kd_[MPM_MAX_DIM] = {0}, sup_ = mpm_shape_support((g)->shape);          \
     double w_[MPM_MAX_DIM][MPM_SHAPE_MAX_SUPPORT], dw_[MPM_MAX_DIM][MPM_SHAPE_MAX_SUPPORT];        \
-    mpm_shape_eval((g)->shape, (g)->dim, xi, lp, base_, w_, dw_);                                  \
-    const int cnt_ = (g)->dim == 2 ? sup_ * sup_ : sup_ * sup_ * sup_;                             \
+    mpm_shape_eval((g)->shape, DIM, xi, lp, base_, w_, dw_);                                       \
+    const int cnt_ = (DIM) == 2 ? sup_ * sup_ : sup_ * sup_ * sup_;                                \
     for (int s_ = 0; s_ < cnt_; ++s_) {                                                            \
-      int gi_[MPM_MAX_DIM], k_ = s_, in_ = 1;                                                      \
+      int gi_[MPM_MAX_DIM], in_ = 1;                                                               \
       double W = 1.0, D[MPM_MAX_DIM];                                                              \
-      for (int d_ = 0; d_ < (g)->dim; ++d_) {                                                      \
-        const int kd_ = k_ % sup_;                                                                 \
-        k_ /= sup_;                                                                                \
-        gi_[d_] = base_[d_] + kd_;                                                                 \
+      for (int d_ = 0; d_ < (DIM); ++d_) {                                                         \
+        gi_[d_] = base_[d_] + kd_[d_];                                                             \
         in_ &= gi_[d_] >= (g)->box_lo[d_] && gi_[d_] < (g)->box_lo[d_] + (g)->box_n[d_];           \
-        W *= w_[d_][kd_];                                                                          \
+        W *= w_[d_][kd_[d_]];                                                                      \
         D[d_] = gi_[d_] - (xi)[d_];                                                                \
       }                                                                                            \
+      for (int d_ = 0; d_ < (DIM) && ++kd_[d_] == sup_; ++d_) kd_[d_] = 0;                         \
       if (!in_ || W == 0.0) continue;                                                              \
       const mpm_lidx L_ = mpm_grid_local_index(g, gi_);                                            \
       BODY                                                                                         \
     }                                                                                              \
   } while (0)
 
-static void deposit(double *mom, mpm_lidx nn, const layout *L, const mpm_grid *g, const double *xi,
-                    double lp, double V, const double *f) {
-  const int dim = L->dim;
-  FOR_STENCIL(g, xi, lp, {
+MPM_INLINE NO_SLP void deposit_dim(const int dim, double *mom, const layout *L, const mpm_grid *g,
+                                   const double *xi, double lp, double V, const double *f) {
+  FOR_STENCIL(g, dim, xi, lp, {
     const double w = W * V;
+    double *M = mom + (size_t)L_ * L->nmom;
     double r[MPM_MAX_DIM];
     for (int a = 0; a < dim; ++a) r[a] = -D[a]; /* x_q - x_i */
-    mom[L_] += w;
+    M[0] += w;
     for (int a = 0; a < dim; ++a) {
-      mom[(size_t)(L->m1 + a) * nn + L_] += w * r[a];
-      for (int b = a; b < dim; ++b) mom[(size_t)m2_index(L, a, b) * nn + L_] += w * r[a] * r[b];
+      M[L->m1 + a] += w * r[a];
+      for (int b = a; b < dim; ++b) M[m2_index(L, a, b)] += w * r[a] * r[b];
     }
     for (int k = 0; k < L->nf; ++k) {
       const int i0 = f_index(L, k);
-      mom[(size_t)i0 * nn + L_] += w * f[k];
-      for (int a = 0; a < dim; ++a) mom[(size_t)(i0 + 1 + a) * nn + L_] += w * f[k] * r[a];
+      M[i0] += w * f[k];
+      for (int a = 0; k < L->ng && a < dim; ++a) M[i0 + 1 + a] += w * f[k] * r[a];
     }
   });
 }
 
-static void gather(sums *s, const double *mom, mpm_lidx nn, const layout *L, const mpm_grid *g,
-                   const double *xi, double lp) {
-  const int dim = L->dim;
+MPM_INLINE void gather_dim(const int dim, sums *s, const double *mom, const layout *L,
+                           const mpm_grid *g, const double *xi, double lp) {
   memset(s, 0, sizeof *s);
-  FOR_STENCIL(g, xi, lp, {
-    const double m0 = mom[L_];
+  FOR_STENCIL(g, dim, xi, lp, {
+    const double *M = mom + (size_t)L_ * L->nmom;
+    const double m0 = M[0];
     double m1[MPM_MAX_DIM];
-    for (int a = 0; a < dim; ++a) m1[a] = mom[(size_t)(L->m1 + a) * nn + L_];
+    for (int a = 0; a < dim; ++a) m1[a] = M[L->m1 + a];
     s->S0 += W * m0;
     for (int a = 0; a < dim; ++a) {
       s->S1[a] += W * (m1[a] + D[a] * m0);
       for (int b = a; b < dim; ++b)
-        s->S2[a][b] += W * (mom[(size_t)m2_index(L, a, b) * nn + L_] + m1[a] * D[b] + D[a] * m1[b] +
-                            D[a] * D[b] * m0);
+        s->S2[a][b] += W * (M[m2_index(L, a, b)] + m1[a] * D[b] + D[a] * m1[b] + D[a] * D[b] * m0);
     }
     for (int k = 0; k < L->nf; ++k) {
       const int i0 = f_index(L, k);
-      const double f0 = mom[(size_t)i0 * nn + L_];
+      const double f0 = M[i0];
       s->G0[k] += W * f0;
-      for (int a = 0; a < dim; ++a)
-        s->G1[k][a] += W * (mom[(size_t)(i0 + 1 + a) * nn + L_] + D[a] * f0);
+      for (int a = 0; k < L->ng && a < dim; ++a) s->G1[k][a] += W * (M[i0 + 1 + a] + D[a] * f0);
     }
   });
   for (int a = 0; a < dim; ++a)
     for (int b = 0; b < a; ++b) s->S2[a][b] = s->S2[b][a];
+}
+
+/* Add a donor's moments to its stencil's nodes (value f, volume V). */
+static NO_SLP void deposit(double *mom, const layout *L, const mpm_grid *g, const double *xi,
+                           double lp, double V, const double *f) {
+  if (L->dim == 2)
+    deposit_dim(2, mom, L, g, xi, lp, V, f);
+  else
+    deposit_dim(3, mom, L, g, xi, lp, V, f);
+}
+
+/* A wall particle's weighted sums, from its stencil's nodes. */
+static void gather(sums *s, const double *mom, const layout *L, const mpm_grid *g, const double *xi,
+                   double lp) {
+  if (L->dim == 2)
+    gather_dim(2, s, mom, L, g, xi, lp);
+  else
+    gather_dim(3, s, mom, L, g, xi, lp);
 }
 
 /* The unconstrained fits a + g . r of every field at r = 0 into out (nf values); 1 if singular
@@ -311,11 +338,12 @@ int fluid_wall_ls_init(mpm_module *m, const mpm_config *cfg, int classic) {
   fluid_obstacles_book_heat(&fc->obs, g);
   const int dim = g->dim;
   w->nf = 2 * dim + 2;
-  const layout L = layout_of(dim, w->nf);
-  w->nmom = f_index(&L, w->nf);
+  const layout L = layout_of(dim, w->nf, w->order);
+  w->nmom = L.nmom;
   MPM_ALLOC(w->mom, (size_t)w->nmom * g->nnodes);
-  MPM_ALLOC(w->mom_ptr, w->nmom);
-  for (int k = 0; k < w->nmom; ++k) w->mom_ptr[k] = w->mom + (size_t)k * g->nnodes;
+  MPM_ALLOC(w->halo, (size_t)w->nmom * g->nnodes);
+  MPM_ALLOC(w->halo_ptr, w->nmom);
+  for (int k = 0; k < w->nmom; ++k) w->halo_ptr[k] = w->halo + (size_t)k * g->nnodes;
   /* A donor reaches a fitted particle's fit if a node is within a stencil of both: donors lie
    * within band + blend + 2 stencil radii of a body; a cell is near if its centre is within
    * that and half a cell diagonal. */
@@ -335,6 +363,7 @@ int fluid_wall_ls_init(mpm_module *m, const mpm_config *cfg, int classic) {
     if (phi < reach && phi - 0.5 * sqrt((double)dim) * g->dx > w->band + w->blend + 1e-9 * g->dx)
       w->reach[l] = REACH_DONOR;
   }
+  fluid_obstacles_list_cells(&fc->obs, g, w->reach);
   /* The moments live on the nodes within a stencil of a reach cell, all inside the bodies'
    * bounding box grown by reach and two cells: only that block of the box is cleared at each
    * step. The block is a global one (the same nodes on every rank), so no ghost node outside it
@@ -350,23 +379,38 @@ int fluid_wall_ls_init(mpm_module *m, const mpm_config *cfg, int classic) {
     if (g->periodic[d]) i0 = b0, i1 = b1;
     i0 = fmin(fmax(i0, b0), b1), i1 = fmin(fmax(i1, i0), b1);
     w->clear_lo[d] = (int)i0, w->clear_n[d] = (int)(i1 - i0);
+    w->exchange |= g->nbr[d][0] != MPI_PROC_NULL || g->nbr[d][1] != MPI_PROC_NULL;
   }
   return 0;
 }
 
-/* Zero the moments on the block of nodes they can reach (see fluid_wall_ls_init). */
-static void clear_moments(fluid_wall_ls *w, const mpm_grid *g) {
-  const int dim = g->dim;
+/* What to do with each row of the block of nodes the moments reach (see fluid_wall_ls_init). */
+enum { BLOCK_CLEAR, BLOCK_TO_HALO, BLOCK_FROM_HALO };
+
+/* Over the block, row by row (x fastest): clear the moments, or copy them to the halo
+ * exchange's arrays (one per moment) or back. */
+static void block_rows(fluid_wall_ls *w, const mpm_grid *g, int what) {
+  const int dim = g->dim, nx = w->clear_n[0], nm = w->nmom;
   mpm_lidx rows = 1;
   for (int d = 1; d < dim; ++d) rows *= w->clear_n[d];
-  if (rows == 0 || w->clear_n[0] == 0) return;
+  if (rows == 0 || nx == 0) return;
   for (mpm_lidx r = 0; r < rows; ++r) {
     int gi[MPM_MAX_DIM] = {w->clear_lo[0]};
     for (int d = 1, q = (int)r; d < dim; q /= w->clear_n[d], ++d)
       gi[d] = w->clear_lo[d] + q % w->clear_n[d];
-    const mpm_lidx l = mpm_grid_local_index(g, gi);
-    for (int k = 0; k < w->nmom; ++k)
-      memset(w->mom_ptr[k] + l, 0, sizeof *w->mom * (size_t)w->clear_n[0]);
+    const mpm_lidx l0 = mpm_grid_local_index(g, gi);
+    double *M = w->mom + (size_t)l0 * nm;
+    if (what == BLOCK_CLEAR) {
+      memset(M, 0, sizeof *M * (size_t)nx * nm);
+      continue;
+    }
+    for (int k = 0; k < nm; ++k)
+      for (int i = 0; i < nx; ++i) {
+        if (what == BLOCK_TO_HALO)
+          w->halo_ptr[k][l0 + i] = M[(size_t)i * nm + k];
+        else
+          M[(size_t)i * nm + k] = w->halo_ptr[k][l0 + i];
+      }
   }
 }
 
@@ -396,17 +440,22 @@ int fluid_wall_ls_apply(mpm_module *m, const double *y, double *ydot, double h) 
   const mpm_particles *p = m->particles;
   mpm_grid *g = m->grid;
   const int dim = g->dim, nf = w->nf;
-  const mpm_lidx n = p->n, nn = g->nnodes;
-  const layout L = layout_of(dim, nf);
+  const mpm_lidx n = p->n;
+  const layout L = layout_of(dim, nf, w->order);
   MPM_CALL(ensure(w, n, dim));
   const double *mass = mpm_particles_comp(p, fc->lay.f_m, 0);
   const double *V0 = mpm_particles_comp(p, fc->lay.f_V0, 0);
   const size_t ox = (size_t)p->offset[FLUID_X] * n, ov = (size_t)p->offset[FLUID_V] * n;
   const size_t oJ = (size_t)p->offset[FLUID_J] * n, oe = (size_t)p->offset[FLUID_E] * n;
-  clear_moments(w, g);
+  block_rows(w, g, BLOCK_CLEAR);
 
-  /* Classify, and deposit the donors' new values. */
-  for (mpm_lidx i = 0; i < n; ++i) {
+  /* Classify, and deposit the donors' new values: the particles near a body that the obstacles'
+   * deposit listed in this RHS (every one if there is no list). */
+  mpm_lidx nl = n;
+  const mpm_lidx *cells, *list = fluid_obstacles_listed(&fc->obs, y + ox, n, &nl, &cells);
+  if (list) memset(w->kind, -1, (size_t)n);
+  for (mpm_lidx k = 0; k < nl; ++k) {
+    const mpm_lidx i = list ? list[k] : k;
     double x[MPM_MAX_DIM], xi[MPM_MAX_DIM];
     int gi[MPM_MAX_DIM], in = 1;
     for (int d = 0; d < dim; ++d) {
@@ -428,20 +477,28 @@ int fluid_wall_ls_apply(mpm_module *m, const double *y, double *ydot, double h) 
     f[2 * dim] = y[oe + i] + h * ydot[oe + i];
     f[2 * dim + 1] = mass[i] / V;
     w->kind[i] = r == REACH_DONOR ? 0 : geo[0] < w->band ? 1 : geo[0] < w->band + w->blend ? 2 : 0;
-    if (w->kind[i] != 1) deposit(w->mom, nn, &L, g, xi, fc->lp, V, f);
+    if (w->kind[i] != 1) deposit(w->mom, &L, g, xi, fc->lp, V, f);
   }
-  MPM_CALL(mpm_grid_halo_reverse(g, w->mom_ptr, w->nmom));
-  MPM_CALL(mpm_grid_halo_forward(g, w->mom_ptr, w->nmom));
+  /* The halo exchanges take one array per moment: the block goes through them. The arrays are
+   * zero outside the block (calloc), which no rank ever writes. A box with no neighbour (one
+   * rank, no periodic axis) has nothing to exchange. */
+  if (w->exchange) {
+    block_rows(w, g, BLOCK_TO_HALO);
+    MPM_CALL(mpm_grid_halo_reverse(g, w->halo_ptr, w->nmom));
+    MPM_CALL(mpm_grid_halo_forward(g, w->halo_ptr, w->nmom));
+    block_rows(w, g, BLOCK_FROM_HALO);
+  }
 
   /* Fit the wall particles; book the momentum; sum the energy change. */
   double *force = fc->obs.f[fc->obs.rec.latest];
   double bal[2] = {0.0, 0.0}; /* the fit's energy change, and the gas's sum m e */
-  for (mpm_lidx i = 0; i < n; ++i) {
+  for (mpm_lidx k = 0; k < nl; ++k) {
+    const mpm_lidx i = list ? list[k] : k;
     if (w->kind[i] < 1) continue;
     double xi[MPM_MAX_DIM], out[2 * MPM_MAX_DIM + 2];
     for (int d = 0; d < dim; ++d) xi[d] = (y[ox + (size_t)d * n + i] - g->lo[d]) / g->dx;
     sums s;
-    gather(&s, w->mom, nn, &L, g, xi, fc->lp);
+    gather(&s, w->mom, &L, g, xi, fc->lp);
     double *f = w->val + (size_t)nf * i;
     const double phi = w->geo[(size_t)(1 + dim) * i] / g->dx;
     const double *nrm = w->geo + (size_t)(1 + dim) * i + 1;
@@ -493,7 +550,7 @@ int fluid_wall_ls_apply(mpm_module *m, const double *y, double *ydot, double h) 
 }
 
 void fluid_wall_ls_free(fluid_wall_ls *w) {
-  free(w->reach), free(w->mom), free(w->mom_ptr);
+  free(w->reach), free(w->mom), free(w->halo), free(w->halo_ptr);
   free(w->kind), free(w->ob), free(w->geo), free(w->val);
   memset(w, 0, sizeof *w);
 }

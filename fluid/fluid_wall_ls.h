@@ -87,10 +87,12 @@ typedef struct fluid_wall_ls {
   double blend;         /* band <= phi < band + blend: part fitted, part donors, m */
   unsigned char *reach; /* per box node as a cell's lower corner: far, donors only, or may fit */
   int nf;               /* fitted fields: v (dim), vhat (dim), e, rho */
-  int nmom;             /* nodal moment arrays */
-  double *mom;          /* nmom * nnodes */
+  int nmom;             /* moments per node */
+  double *mom;          /* nnodes * nmom: a node's moments together */
   int clear_lo[MPM_MAX_DIM], clear_n[MPM_MAX_DIM]; /* the block of box nodes they reach */
-  double **mom_ptr;  /* nmom pointers into mom, for the halo exchanges */
+  int exchange;      /* the box has a neighbour: the moments go through the halo exchanges */
+  double *halo;      /* nmom * nnodes: the same, one array per moment, for the exchanges */
+  double **halo_ptr; /* nmom pointers into halo */
   mpm_lidx cap;      /* capacity of the per-particle arrays */
   signed char *kind; /* -1 far, 0 donor, 1 wall particle, 2 both (the blend) */
   int *ob;           /* wall particle: the nearest obstacle */
