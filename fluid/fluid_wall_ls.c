@@ -133,9 +133,11 @@ typedef struct sums {
     }                                                                                              \
   } while (0)
 
-MPM_INLINE NO_SLP void deposit_dim(const int dim, double *mom, const layout *L, const mpm_grid *g,
-                                   const double *xi, double lp, double V, const double *f) {
+MPM_INLINE NO_SLP void deposit_dim(const int dim, double *mom, const double *need, const layout *L,
+                                   const mpm_grid *g, const double *xi, double lp, double V,
+                                   const double *f) {
   FOR_STENCIL(g, dim, xi, lp, {
+    if (need[L_] == 0.0) continue;
     const double w = W * V;
     double *M = mom + (size_t)L_ * L->nmom;
     double r[MPM_MAX_DIM];
@@ -178,13 +180,22 @@ MPM_INLINE void gather_dim(const int dim, sums *s, const double *mom, const layo
     for (int b = 0; b < a; ++b) s->S2[a][b] = s->S2[b][a];
 }
 
-/* Add a donor's moments to its stencil's nodes (value f, volume V). */
-static NO_SLP void deposit(double *mom, const layout *L, const mpm_grid *g, const double *xi,
-                           double lp, double V, const double *f) {
+/* Add a donor's moments (value f, volume V) to those of its stencil's nodes that a fitted
+ * particle reads (need, mark_need): the others are never gathered. */
+static NO_SLP void deposit(double *mom, const double *need, const layout *L, const mpm_grid *g,
+                           const double *xi, double lp, double V, const double *f) {
   if (L->dim == 2)
-    deposit_dim(2, mom, L, g, xi, lp, V, f);
+    deposit_dim(2, mom, need, L, g, xi, lp, V, f);
   else
-    deposit_dim(3, mom, L, g, xi, lp, V, f);
+    deposit_dim(3, mom, need, L, g, xi, lp, V, f);
+}
+
+/* Flag the nodes a fitted particle at xi gathers from: only they need the donors' moments. */
+static void mark_need(double *need, const mpm_grid *g, const double *xi, double lp) {
+  FOR_STENCIL(g, g->dim, xi, lp, {
+    (void)D;
+    need[L_] = 1.0;
+  });
 }
 
 /* A wall particle's weighted sums, from its stencil's nodes. */
@@ -342,6 +353,7 @@ int fluid_wall_ls_init(mpm_module *m, const mpm_config *cfg, int classic) {
   w->nmom = L.nmom;
   MPM_ALLOC(w->mom, (size_t)w->nmom * g->nnodes);
   MPM_ALLOC(w->halo, (size_t)w->nmom * g->nnodes);
+  MPM_ALLOC(w->need, g->nnodes);
   MPM_ALLOC(w->halo_ptr, w->nmom);
   for (int k = 0; k < w->nmom; ++k) w->halo_ptr[k] = w->halo + (size_t)k * g->nnodes;
   /* A donor reaches a fitted particle's fit if a node is within a stencil of both: donors lie
@@ -402,6 +414,7 @@ static void block_rows(fluid_wall_ls *w, const mpm_grid *g, int what) {
     double *M = w->mom + (size_t)l0 * nm;
     if (what == BLOCK_CLEAR) {
       memset(M, 0, sizeof *M * (size_t)nx * nm);
+      memset(w->need + l0, 0, sizeof *w->need * (size_t)nx);
       continue;
     }
     for (int k = 0; k < nm; ++k)
@@ -449,8 +462,9 @@ int fluid_wall_ls_apply(mpm_module *m, const double *y, double *ydot, double h) 
   const size_t oJ = (size_t)p->offset[FLUID_J] * n, oe = (size_t)p->offset[FLUID_E] * n;
   block_rows(w, g, BLOCK_CLEAR);
 
-  /* Classify, and deposit the donors' new values: the particles near a body that the obstacles'
-   * deposit listed in this RHS (every one if there is no list). */
+  /* Classify the particles near a body that the obstacles' deposit listed in this RHS (every
+   * one if there is no list) and flag the nodes the fitted ones read; then deposit the donors'
+   * new values on those nodes. */
   mpm_lidx nl = n;
   const mpm_lidx *cells, *list = fluid_obstacles_listed(&fc->obs, y + ox, n, &nl, &cells);
   if (list) memset(w->kind, -1, (size_t)n);
@@ -477,7 +491,19 @@ int fluid_wall_ls_apply(mpm_module *m, const double *y, double *ydot, double h) 
     f[2 * dim] = y[oe + i] + h * ydot[oe + i];
     f[2 * dim + 1] = mass[i] / V;
     w->kind[i] = r == REACH_DONOR ? 0 : geo[0] < w->band ? 1 : geo[0] < w->band + w->blend ? 2 : 0;
-    if (w->kind[i] != 1) deposit(w->mom, &L, g, xi, fc->lp, V, f);
+    if (w->kind[i] > 0) mark_need(w->need, g, xi, fc->lp);
+  }
+  if (w->exchange) { /* a node one rank's fitted particle reads takes every rank's donors */
+    MPM_CALL(mpm_grid_halo_reverse(g, &w->need, 1));
+    MPM_CALL(mpm_grid_halo_forward(g, &w->need, 1));
+  }
+  for (mpm_lidx k = 0; k < nl; ++k) {
+    const mpm_lidx i = list ? list[k] : k;
+    if (w->kind[i] != 0 && w->kind[i] != 2) continue;
+    double xi[MPM_MAX_DIM];
+    for (int d = 0; d < dim; ++d) xi[d] = (y[ox + (size_t)d * n + i] - g->lo[d]) / g->dx;
+    const double V = V0[i] * (y[oJ + i] + h * ydot[oJ + i]);
+    deposit(w->mom, w->need, &L, g, xi, fc->lp, V, w->val + (size_t)nf * i);
   }
   /* The halo exchanges take one array per moment: the block goes through them. The arrays are
    * zero outside the block (calloc), which no rank ever writes. A box with no neighbour (one
@@ -550,7 +576,7 @@ int fluid_wall_ls_apply(mpm_module *m, const double *y, double *ydot, double h) 
 }
 
 void fluid_wall_ls_free(fluid_wall_ls *w) {
-  free(w->reach), free(w->mom), free(w->halo), free(w->halo_ptr);
+  free(w->reach), free(w->mom), free(w->halo), free(w->halo_ptr), free(w->need);
   free(w->kind), free(w->ob), free(w->geo), free(w->val);
   memset(w, 0, sizeof *w);
 }

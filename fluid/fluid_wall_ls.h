@@ -91,6 +91,7 @@ typedef struct fluid_wall_ls {
   double *mom;          /* nnodes * nmom: a node's moments together */
   int clear_lo[MPM_MAX_DIM], clear_n[MPM_MAX_DIM]; /* the block of box nodes they reach */
   int exchange;      /* the box has a neighbour: the moments go through the halo exchanges */
+  double *need;      /* per box node: a fitted particle reads it (nonzero), this step */
   double *halo;      /* nmom * nnodes: the same, one array per moment, for the exchanges */
   double **halo_ptr; /* nmom pointers into halo */
   mpm_lidx cap;      /* capacity of the per-particle arrays */

@@ -1,6 +1,9 @@
 # Static obstacles: rest, momentum balance against the reported forces, seeding, 2 ranks vs 1.
 mpm_add_script_test(test_obstacles SCRIPT verification/test_obstacles.py
                     LABELS "verification;mpi" TIMEOUT 600)
+# least_squares in 3-D (a sphere and a box): rest, momentum balance, total energy, 2 ranks vs 1.
+mpm_add_script_test(test_obstacles_3d SCRIPT verification/test_obstacles.py ARGS 3d
+                    LABELS "verification;mpi" TIMEOUT 300)
 # Total energy with obstacles under least_squares, usl and musl: conserved to roundoff (the
 # obstacles' work is booked as heat; ghost does not book it: see the test's header).
 mpm_add_script_test(test_obstacles_energy SCRIPT verification/test_obstacles.py ARGS energy
