@@ -75,8 +75,8 @@ static int spd_solve(int n, double *A, double *b, double tol) {
  * then per field F0 and, for the first ng fields, F1[dim]. A linear fit needs every field's F1;
  * the constant one (fluid.wall_fit_order = 0) only the velocities' (the normal component is
  * always linear), so e and rho carry F0 alone. A node's moments are contiguous (nmom values at
- * mom + l nmom): a donor adds to the nmom values of each of its stencil's nodes, a few cache
- * lines per node where one array per moment took one line per moment. */
+ * mom + l nmom), so that a donor's deposit and a wall particle's gather read and write one run
+ * of memory per node; the halo exchanges take them one array per moment (block_rows). */
 typedef struct layout {
   int dim, nf, ng, m1, m2, f0, nmom;
 } layout;
@@ -104,13 +104,14 @@ typedef struct sums {
 } sums;
 
 /* Visit the stencil of a point at xi (cells): BODY for every box node L_, with W its weight and
- * D its offset x_i - x in cells. The node's index along each axis advances as an odometer (an
- * integer division per node and axis cost more than the body). DIM is g->dim; deposit and
- * gather pass it as a literal (MPM_INLINE), so that the loops over the axes unroll and the
- * offsets stay in registers: with a run-time dim, the offsets written one by one and read back
- * as a pair stalled the deposit on every store (store forwarding). */
-#define MPM_INLINE static inline __attribute__((always_inline))
-#define NO_SLP     __attribute__((optimize("no-tree-vectorize")))
+ * D its offset x_i - x in cells. The node's index along each axis advances as an odometer
+ * rather than by an integer division per node and axis. DIM is g->dim; deposit and gather pass
+ * it as a literal (MPM_INLINE), so that the loops over the axes unroll. The deposit is compiled
+ * without the vectoriser (NO_VECTORIZE): it packed each node's offsets into a pair read from the
+ * stack just after writing them one at a time, a failed store forward at every node, which
+ * made the donors' deposit the largest part of the treatment's cost on the wedge (profiled). */
+#define MPM_INLINE   static inline __attribute__((always_inline))
+#define NO_VECTORIZE __attribute__((optimize("no-tree-vectorize")))
 #define FOR_STENCIL(g, DIM, xi, lp, BODY)                                                          \
   do {                                                                                             \
     int base_[MPM_MAX_DIM], kd_[MPM_MAX_DIM] = {0}, sup_ = mpm_shape_support((g)->shape);          \
@@ -133,9 +134,9 @@ typedef struct sums {
     }                                                                                              \
   } while (0)
 
-MPM_INLINE NO_SLP void deposit_dim(const int dim, double *mom, const double *need, const layout *L,
-                                   const mpm_grid *g, const double *xi, double lp, double V,
-                                   const double *f) {
+MPM_INLINE NO_VECTORIZE void deposit_dim(const int dim, double *mom, const double *need,
+                                         const layout *L, const mpm_grid *g, const double *xi,
+                                         double lp, double V, const double *f) {
   FOR_STENCIL(g, dim, xi, lp, {
     if (need[L_] == 0.0) continue;
     const double w = W * V;
@@ -182,8 +183,9 @@ MPM_INLINE void gather_dim(const int dim, sums *s, const double *mom, const layo
 
 /* Add a donor's moments (value f, volume V) to those of its stencil's nodes that a fitted
  * particle reads (need, mark_need): the others are never gathered. */
-static NO_SLP void deposit(double *mom, const double *need, const layout *L, const mpm_grid *g,
-                           const double *xi, double lp, double V, const double *f) {
+static NO_VECTORIZE void deposit(double *mom, const double *need, const layout *L,
+                                 const mpm_grid *g, const double *xi, double lp, double V,
+                                 const double *f) {
   if (L->dim == 2)
     deposit_dim(2, mom, need, L, g, xi, lp, V, f);
   else
