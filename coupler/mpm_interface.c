@@ -1,6 +1,7 @@
 /* The interface data of a staggered time scheme (see mpm_interface.h). */
 #include "mpm_interface.h"
 
+#include "mpm_bc.h"
 #include "mpm_error.h"
 
 #include <math.h>
@@ -119,24 +120,19 @@ const double *mpm_interface_mass_start(mpm_interface *ifc) {
 /* The node of the 3^dim block around l (within the box) with the most mass m; l itself on a tie. */
 static mpm_lidx heaviest_neighbour(const mpm_grid *g, const double *m, mpm_lidx l) {
   const int dim = g->dim;
-  int c[MPM_MAX_DIM];
-  mpm_lidx stride[MPM_MAX_DIM], r = l;
-  for (int d = 0; d < dim; ++d) {
-    stride[d] = d ? stride[d - 1] * g->box_n[d - 1] : 1;
-    c[d] = (int)(r % g->box_n[d]), r /= g->box_n[d];
-  }
-  mpm_lidx best = l;
-  int nb = 1;
+  int gi[MPM_MAX_DIM], nb = 1;
+  mpm_grid_node_global(g, l, gi);
   for (int d = 0; d < dim; ++d) nb *= 3;
+  mpm_lidx best = l;
   for (int k = 0; k < nb; ++k) {
-    mpm_lidx j = l;
-    int inside = 1;
+    int gj[MPM_MAX_DIM], inside = 1;
     for (int d = 0, q = k; d < dim; ++d, q /= 3) {
-      const int o = q % 3 - 1;
-      inside &= c[d] + o >= 0 && c[d] + o < g->box_n[d];
-      j += o * stride[d];
+      gj[d] = gi[d] + q % 3 - 1;
+      inside &= gj[d] >= g->box_lo[d] && gj[d] < g->box_lo[d] + g->box_n[d];
     }
-    if (inside && m[j] > m[best]) best = j;
+    if (!inside) continue;
+    const mpm_lidx j = mpm_grid_local_index(g, gj);
+    if (m[j] > m[best]) best = j;
   }
   return best;
 }
