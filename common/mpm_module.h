@@ -20,6 +20,7 @@
 #include "mpm_config.h"
 #include "mpm_grid.h"
 #include "mpm_particles.h"
+#include "mpm_wall.h"
 
 /* What went wrong with a particle, for recoverable RHS errors and the final message. */
 typedef struct mpm_fault {
@@ -93,6 +94,11 @@ typedef struct mpm_module_ops {
   /* Refresh fields derived for output only (a gas's pressure, Mach number, ...) before a
    * snapshot or checkpoint is written. Optional. */
   int (*output)(mpm_module *m);
+  /* Take a moving wall that a coupling scheme offers in another module's place (mpm_wall.h; the
+   * table must outlive the module): *taken = 1 if the module uses it, 0 if not. After the
+   * coupling is built the sim calls it once more with src = NULL: a module that needs a wall
+   * and was given none fails there with an input error. Optional. */
+  int (*attach_wall)(mpm_module *m, const mpm_config *cfg, const mpm_wall_source *src, int *taken);
 } mpm_module_ops;
 
 struct mpm_module {

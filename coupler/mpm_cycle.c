@@ -148,8 +148,13 @@ int mpm_cycle_rhs(const mpm_cycle *c, double t, double *const *y, double *const 
     mpm_timer_stop(MPM_T_P2G);
     MPM_CALL(grid_pass(c, t, h, MPM_PASS_REMAP));
   }
+  /* The gas first: a wall a coupling scheme gave it (mpm_wall.h) hands what the gas's G2P
+   * exchanged there to the solid's nodes before the solid's G2P reads them. */
   mpm_timer_start(MPM_T_G2P);
-  for (int k = 0; k < c->nmod; ++k) MPM_CALL(c->mod[k]->ops->g2p(c->mod[k], t, y[k], ydot[k], h));
+  for (int pass = 0; pass < 2; ++pass)
+    for (int k = 0; k < c->nmod; ++k)
+      if ((c->mod[k]->role == MPM_ROLE_FLUID) == (pass == 0))
+        MPM_CALL(c->mod[k]->ops->g2p(c->mod[k], t, y[k], ydot[k], h));
   mpm_timer_stop(MPM_T_G2P);
   return 0;
 }

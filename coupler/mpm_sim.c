@@ -224,7 +224,15 @@ static int build_modules(mpm_sim *s, int seed) {
     return mpm_config_fail(s->cfg, "solid",
                            "the case defines neither bodies nor gas: add a [solid.NAME] or a "
                            "[gas.NAME] section");
-  return mpm_coupling_new(&s->coupling, s->cfg, s->grid, s->mod, s->nmod);
+  MPM_CALL(mpm_coupling_new(&s->coupling, s->cfg, s->grid, s->mod, s->nmod));
+  /* The walls a coupling scheme offers are attached: a module that needs one and has none says
+   * so now (mpm_module.h). */
+  for (int k = 0; k < s->nmod; ++k) {
+    int taken;
+    if (s->mod[k]->ops->attach_wall)
+      MPM_CALL(s->mod[k]->ops->attach_wall(s->mod[k], s->cfg, NULL, &taken));
+  }
+  return 0;
 }
 
 static const char *const g_diag_cols[] = {"t",       "step",     "dt",    "particles",

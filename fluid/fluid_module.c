@@ -639,6 +639,7 @@ static const mpm_module_ops fluid_ops = {
     .remap = fluid_remap,
     .output = fluid_output,
     .reserved = fluid_reserved,
+    .attach_wall = fluid_wall_ls_attach,
 };
 
 /* ---- construction -------------------------------------------------------------------------- */

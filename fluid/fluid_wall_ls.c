@@ -10,10 +10,11 @@
 
 const mpm_key_spec fluid_wall_keys[] = {
     {"fluid.wall_treatment", MPM_KEY_ENUM, "ghost", 0, 0, 0, 0, "ghost|least_squares",
-     "gas next to [obstacle] surfaces: ghost (ghost pressure and held nodes) or least_squares "
-     "(the particles within fluid.wall_band take a least-squares fit over the particles "
-     "behind them, with the wall condition imposed; classic update only; see "
-     "fluid/fluid_wall_ls.h)",
+     "gas next to [obstacle] surfaces and, under coupling.scheme = traction, next to the "
+     "solid: ghost (ghost pressure and held nodes) or least_squares (the particles within "
+     "fluid.wall_band take a least-squares fit over the particles behind them, with the wall "
+     "condition imposed; classic update only, and at a traction interface usl with "
+     "coupling.time = monolithic; see fluid/fluid_wall_ls.h)",
      0},
     {"fluid.wall_band", MPM_KEY_REAL, "1", 0, 3, 1, 0, NULL,
      "least_squares: particles closer to an obstacle than this many cells are fitted, in "
@@ -234,15 +235,17 @@ static int fit_free(const sums *s, const layout *L, double *out) {
   return 0;
 }
 
-/* The fit u . t ~ c . (x - x_w) of the velocity field starting at field k0 along the unit
- * vector t, zero on the surface point x_w = x_p - phi n (phi, n in cells): its value at x_p. */
+/* The fit u . t - u0 ~ c . (x - x_w) of the velocity field starting at field k0 along the unit
+ * vector t, with u0 the wall's velocity along t: zero relative velocity on the surface point
+ * x_w = x_p - phi n (phi, n in cells). Its value u . t at x_p. */
 static double fit_constrained(const sums *s, const layout *L, int k0, const double *t, double phi,
-                              const double *n) {
+                              const double *n, double u0) {
   const int dim = L->dim;
   double A[9] = {0}, b[3] = {0};
   for (int a = 0; a < dim; ++a) {
     double ga = 0.0, g0 = 0.0;
     for (int f = 0; f < dim; ++f) ga += t[f] * s->G1[k0 + f][a], g0 += t[f] * s->G0[k0 + f];
+    ga -= u0 * s->S1[a], g0 -= u0 * s->S0;
     b[a] = ga + phi * n[a] * g0;
     for (int c = 0; c < dim; ++c)
       A[a * dim + c] =
@@ -253,7 +256,7 @@ static double fit_constrained(const sums *s, const layout *L, int k0, const doub
   if (!spd_solve(dim, An, bn, SINGULAR)) {
     double cn = 0.0;
     for (int a = 0; a < dim; ++a) cn += bn[a] * n[a];
-    return phi * cn;
+    return u0 + phi * cn;
   }
   /* Donors on a line: vary along the normal only. */
   double nAn = 0.0, nb = 0.0;
@@ -261,13 +264,14 @@ static double fit_constrained(const sums *s, const layout *L, int k0, const doub
     nb += n[a] * b[a];
     for (int c = 0; c < dim; ++c) nAn += n[a] * A[a * dim + c] * n[c];
   }
-  return nAn > 0.0 ? phi * nb / nAn : 0.0;
+  return u0 + (nAn > 0.0 ? phi * nb / nAn : 0.0);
 }
 
 /* The fitted values of one wall particle into out (see the header): the free fits, then the
- * wall condition on both velocities. */
+ * wall condition on both velocities, relative to the wall's normal velocity vw_n (0 for a static
+ * obstacle; a no_slip wall is static). */
 static void fit_particle(const sums *s, const layout *L, int order, int no_slip, double phi,
-                         const double *nrm, double vn_floor, double *out) {
+                         const double *nrm, double vw_n, double vn_floor, double *out) {
   const int dim = L->dim, nf = L->nf;
   int mean = order == 0;
   if (!mean) mean = fit_free(s, L, out);
@@ -282,26 +286,28 @@ static void fit_particle(const sums *s, const layout *L, int order, int no_slip,
       for (int c = 0; c < dim; ++c) {
         double t[MPM_MAX_DIM] = {0};
         t[c] = 1.0;
-        out[k0 + c] = fit_constrained(s, L, k0, t, phi, nrm);
+        out[k0 + c] = fit_constrained(s, L, k0, t, phi, nrm, 0.0);
       }
       continue;
     }
     double un = 0.0;
     for (int d = 0; d < dim; ++d) un += out[k0 + d] * nrm[d];
-    double fitted = fit_constrained(s, L, k0, nrm, fabs(phi), nrm);
-    if (phi < 0.0 && fitted < 0.0) fitted = 0.0;           /* inside the body: never deeper */
-    if (k0 == dim && fitted < vn_floor) fitted = vn_floor; /* the motion: see the header */
+    double rel = fit_constrained(s, L, k0, nrm, fabs(phi), nrm, vw_n) - vw_n;
+    if (phi < 0.0 && rel < 0.0) rel = 0.0;           /* inside the body: never deeper */
+    if (k0 == dim && rel < vn_floor) rel = vn_floor; /* the motion: see the header */
+    const double fitted = vw_n + rel;
     for (int d = 0; d < dim; ++d) out[k0 + d] += (fitted - un) * nrm[d];
   }
 }
 
 /* A wall particle with no donor near (gas expanding away from a face into near vacuum): it keeps
- * the transfer's values f, less any velocity into the body. */
-static void keep_out(const double *f, const layout *L, const double *nrm, double *out) {
+ * the transfer's values f, less any velocity into the body (relative to the wall's, vw_n). */
+static void keep_out(const double *f, const layout *L, const double *nrm, double vw_n,
+                     double *out) {
   const int dim = L->dim;
   memcpy(out, f, sizeof *out * (size_t)L->nf);
   for (int k0 = 0; k0 <= dim; k0 += dim) {
-    double un = 0.0;
+    double un = -vw_n;
     for (int d = 0; d < dim; ++d) un += out[k0 + d] * nrm[d];
     for (int d = 0; un < 0.0 && d < dim; ++d) out[k0 + d] -= un * nrm[d];
   }
@@ -313,16 +319,23 @@ static void keep_out(const double *f, const layout *L, const double *nrm, double
  * or particles that may be fitted (their phi decides). */
 enum { REACH_FAR = 0, REACH_DONOR = 1, REACH_MAY_FIT = 2 };
 
-/* The nearest obstacle to x: its index, phi and outward normal. */
-static int nearest(const fluid_obstacles *o, const double *x, double *phi, double *normal) {
+/* The nearest obstacle to x: its index, phi and outward normal (dim values). */
+static int nearest(const fluid_obstacles *o, int dim, const double *x, double *phi,
+                   double *normal) {
   int best = -1;
   double nb[MPM_MAX_DIM];
   *phi = HUGE_VAL;
   for (int k = 0; k < o->count; ++k) {
     const double f = mpm_sdf_eval(&o->ob[k].sdf, x, nb);
-    if (f < *phi) *phi = f, best = k, memcpy(normal, nb, sizeof nb);
+    if (f < *phi) *phi = f, best = k, memcpy(normal, nb, sizeof *nb * (size_t)dim);
   }
   return best;
+}
+
+/* How far from a wall a donor may lie and still reach a fitted particle's fit: a node within a
+ * stencil of both, and half a cell diagonal for a cell's centre. */
+static double reach_of(const fluid_wall_ls *w, const mpm_grid *g) {
+  return w->band + w->blend + (mpm_shape_support(g->shape) + 0.5 * sqrt((double)g->dim)) * g->dx;
 }
 
 int fluid_wall_ls_init(mpm_module *m, const mpm_config *cfg, int classic) {
@@ -337,18 +350,15 @@ int fluid_wall_ls_init(mpm_module *m, const mpm_config *cfg, int classic) {
     return mpm_config_fail(cfg, "fluid.wall_treatment",
                            "least_squares needs the classic update (time.method = usl or musl): "
                            "its fit is not part of an adaptive pair's error control");
-  if (fc->obs.count == 0)
-    return mpm_config_fail(cfg, "fluid.wall_treatment",
-                           "least_squares acts on [obstacle.NAME] surfaces and this scene has "
-                           "none (domain walls keep their mirror rules): remove the key or add "
-                           "an obstacle");
   double band, blend;
   MPM_CALL(mpm_config_get_real(cfg, "fluid.wall_band", &band));
   MPM_CALL(mpm_config_get_real(cfg, "fluid.wall_blend", &blend));
   w->on = 1, w->band = band * g->dx, w->blend = blend * g->dx;
   MPM_CALL(mpm_config_get_int(cfg, "fluid.wall_fit_order", &w->order));
-  fc->obs.coast = 1;
-  fluid_obstacles_book_heat(&fc->obs, g);
+  if (fc->obs.count > 0) {
+    fc->obs.coast = 1;
+    fluid_obstacles_book_heat(&fc->obs, g);
+  }
   const int dim = g->dim;
   w->nf = 2 * dim + 2;
   const layout L = layout_of(dim, w->nf, w->order);
@@ -361,15 +371,17 @@ int fluid_wall_ls_init(mpm_module *m, const mpm_config *cfg, int classic) {
   /* A donor reaches a fitted particle's fit if a node is within a stencil of both: donors lie
    * within band + blend + 2 stencil radii of a body; a cell is near if its centre is within
    * that and half a cell diagonal. */
-  const double reach =
-      w->band + w->blend + (mpm_shape_support(g->shape) + 0.5 * sqrt((double)dim)) * g->dx;
+  const double reach = reach_of(w, g);
+  for (int d = 0; d < dim; ++d)
+    w->exchange |= g->nbr[d][0] != MPI_PROC_NULL || g->nbr[d][1] != MPI_PROC_NULL;
+  if (fc->obs.count == 0) return 0; /* a moving wall may come (fluid_wall_ls_attach) */
   MPM_ALLOC(w->reach, g->nnodes);
   for (mpm_lidx l = 0; l < g->nnodes; ++l) {
     int gi[MPM_MAX_DIM];
     double xc[MPM_MAX_DIM], phi, nrm[MPM_MAX_DIM];
     mpm_grid_node_global(g, l, gi);
     for (int d = 0; d < dim; ++d) xc[d] = g->lo[d] + (gi[d] + 0.5) * g->dx;
-    nearest(&fc->obs, xc, &phi, nrm);
+    nearest(&fc->obs, dim, xc, &phi, nrm);
     w->reach[l] = phi < reach ? REACH_MAY_FIT : REACH_FAR;
     /* Every point of the cell lies within half a diagonal of its centre, and phi is a distance
      * (1-Lipschitz): a cell whose centre is that much beyond the fitted particles, and a hair
@@ -393,8 +405,30 @@ int fluid_wall_ls_init(mpm_module *m, const mpm_config *cfg, int classic) {
     if (g->periodic[d]) i0 = b0, i1 = b1;
     i0 = fmin(fmax(i0, b0), b1), i1 = fmin(fmax(i1, i0), b1);
     w->clear_lo[d] = (int)i0, w->clear_n[d] = (int)(i1 - i0);
-    w->exchange |= g->nbr[d][0] != MPI_PROC_NULL || g->nbr[d][1] != MPI_PROC_NULL;
   }
+  return 0;
+}
+
+int fluid_wall_ls_attach(mpm_module *m, const mpm_config *cfg, const mpm_wall_source *src,
+                         int *taken) {
+  fluid_content *fc = m->content;
+  fluid_wall_ls *w = &fc->wall;
+  const mpm_grid *g = m->grid;
+  *taken = 0;
+  if (!w->on) return 0;
+  if (!src) {
+    if (fc->obs.count == 0 && !w->src)
+      return mpm_config_fail(cfg, "fluid.wall_treatment",
+                             "least_squares acts on [obstacle.NAME] surfaces and on a solid's "
+                             "surface under coupling.scheme = traction, and this scene has "
+                             "neither (domain walls keep their mirror rules): remove the key, "
+                             "or add an obstacle or a traction interface");
+    return 0;
+  }
+  w->src = src, *taken = 1;
+  MPM_ALLOC(w->near_src, g->nnodes);
+  /* The wall moves: the moments may live anywhere in the box. */
+  for (int d = 0; d < g->dim; ++d) w->clear_lo[d] = g->box_lo[d], w->clear_n[d] = g->box_n[d];
   return 0;
 }
 
@@ -435,7 +469,7 @@ static int ensure(fluid_wall_ls *w, mpm_lidx n, int dim) {
   free(w->kind), free(w->ob), free(w->geo), free(w->val);
   w->kind = malloc((size_t)cap);
   w->ob = malloc(sizeof *w->ob * (size_t)cap);
-  w->geo = malloc(sizeof *w->geo * (size_t)(1 + dim) * cap);
+  w->geo = malloc(sizeof *w->geo * (size_t)(1 + 2 * dim) * cap);
   w->val = malloc(sizeof *w->val * (size_t)w->nf * cap);
   w->cap = cap;
   if (!(w->kind && w->ob && w->geo && w->val)) {
@@ -462,13 +496,19 @@ int fluid_wall_ls_apply(mpm_module *m, const double *y, double *ydot, double h) 
   const double *V0 = mpm_particles_comp(p, fc->lay.f_V0, 0);
   const size_t ox = (size_t)p->offset[FLUID_X] * n, ov = (size_t)p->offset[FLUID_V] * n;
   const size_t oJ = (size_t)p->offset[FLUID_J] * n, oe = (size_t)p->offset[FLUID_E] * n;
+  const int gs = 1 + 2 * dim; /* geo per particle */
   block_rows(w, g, BLOCK_CLEAR);
+  if (w->src) {
+    memset(w->near_src, 0, (size_t)g->nnodes);
+    MPM_CALL(w->src->prepare(w->src->ctx, h, reach_of(w, g), w->near_src));
+  }
 
   /* Classify the particles near a body that the obstacles' deposit listed in this RHS (every
    * one if there is no list) and flag the nodes the fitted ones read; then deposit the donors'
    * new values on those nodes. */
   mpm_lidx nl = n;
   const mpm_lidx *cells, *list = fluid_obstacles_listed(&fc->obs, y + ox, n, &nl, &cells);
+  if (w->src) list = NULL, nl = n; /* the list knows the obstacles only */
   if (list) memset(w->kind, -1, (size_t)n);
   for (mpm_lidx k = 0; k < nl; ++k) {
     const mpm_lidx i = list ? list[k] : k;
@@ -481,10 +521,20 @@ int fluid_wall_ls_apply(mpm_module *m, const double *y, double *ydot, double h) 
       in &= gi[d] >= g->box_lo[d] && gi[d] < g->box_lo[d] + g->box_n[d];
     }
     w->kind[i] = -1;
-    const int r = in ? w->reach[mpm_grid_local_index(g, gi)] : REACH_FAR;
-    if (r == REACH_FAR) continue;
-    double *geo = w->geo + (size_t)(1 + dim) * i, *f = w->val + (size_t)nf * i;
-    if (r == REACH_MAY_FIT) w->ob[i] = nearest(&fc->obs, x, &geo[0], geo + 1);
+    const mpm_lidx cell = in ? mpm_grid_local_index(g, gi) : 0;
+    const int r = in && w->reach ? w->reach[cell] : REACH_FAR;
+    const int moving = in && w->src && w->near_src[cell];
+    if (r == REACH_FAR && !moving) continue;
+    double *geo = w->geo + (size_t)gs * i, *f = w->val + (size_t)nf * i;
+    geo[0] = HUGE_VAL;
+    if (r == REACH_MAY_FIT) w->ob[i] = nearest(&fc->obs, dim, x, &geo[0], geo + 1);
+    for (int d = 0; d < dim; ++d) geo[1 + dim + d] = 0.0; /* a static wall */
+    double phi, nrm[MPM_MAX_DIM], vw[MPM_MAX_DIM];
+    if (moving && w->src->at(w->src->ctx, x, w->band + w->blend, &phi, nrm, vw) && phi < geo[0]) {
+      w->ob[i] = -1, geo[0] = phi;
+      memcpy(geo + 1, nrm, sizeof *nrm * (size_t)dim);
+      memcpy(geo + 1 + dim, vw, sizeof *vw * (size_t)dim);
+    }
     const double J1 = y[oJ + i] + h * ydot[oJ + i], V = V0[i] * J1;
     for (int d = 0; d < dim; ++d) {
       f[d] = y[ov + (size_t)d * n + i] + h * ydot[ov + (size_t)d * n + i];
@@ -492,7 +542,7 @@ int fluid_wall_ls_apply(mpm_module *m, const double *y, double *ydot, double h) 
     }
     f[2 * dim] = y[oe + i] + h * ydot[oe + i];
     f[2 * dim + 1] = mass[i] / V;
-    w->kind[i] = r == REACH_DONOR ? 0 : geo[0] < w->band ? 1 : geo[0] < w->band + w->blend ? 2 : 0;
+    w->kind[i] = geo[0] < w->band ? 1 : geo[0] < w->band + w->blend ? 2 : 0;
     if (w->kind[i] > 0) mark_need(w->need, g, xi, fc->lp);
   }
   if (w->exchange) { /* a node one rank's fitted particle reads takes every rank's donors */
@@ -528,31 +578,42 @@ int fluid_wall_ls_apply(mpm_module *m, const double *y, double *ydot, double h) 
     sums s;
     gather(&s, w->mom, &L, g, xi, fc->lp);
     double *f = w->val + (size_t)nf * i;
-    const double phi = w->geo[(size_t)(1 + dim) * i] / g->dx;
-    const double *nrm = w->geo + (size_t)(1 + dim) * i + 1;
+    const double *geo = w->geo + (size_t)gs * i, *nrm = geo + 1, *vw = geo + 1 + dim;
+    const double phi = geo[0] / g->dx;
+    double vw_n = 0.0;
+    for (int d = 0; d < dim; ++d) vw_n += vw[d] * nrm[d];
+    const int no_slip = w->ob[i] >= 0 && fc->obs.ob[w->ob[i]].no_slip;
     if (s.S0 > 0.0)
-      fit_particle(&s, &L, w->order, fc->obs.ob[w->ob[i]].no_slip, phi, nrm,
-                   -0.5 * fmax(phi, 0.0) * g->dx / h, out);
+      fit_particle(&s, &L, w->order, no_slip, phi, nrm, vw_n, -0.5 * fmax(phi, 0.0) * g->dx / h,
+                   out);
     else
-      keep_out(f, &L, nrm, out);
+      keep_out(f, &L, nrm, vw_n, out);
     if (w->kind[i] == 2) { /* the blend: part fit, part its own */
       const double b = (w->band + w->blend - phi * g->dx) / w->blend;
       for (int k = 0; k < nf; ++k) out[k] = b * out[k] + (1.0 - b) * f[k];
     }
-    /* Momentum to the obstacle, energy to the balance. */
-    double *F = force + (size_t)dim * w->ob[i];
-    double dke = 0.0;
+    /* Momentum to the obstacle or the moving wall, energy to the balance: a moving wall's work
+     * J . v_w stays with the gas, the rest is given back as heat. */
+    double dke = 0.0, J[MPM_MAX_DIM], work = 0.0;
     for (int d = 0; d < dim; ++d) {
       const double v0 = y[ov + (size_t)d * n + i];
-      F[d] -= mass[i] * (out[d] - f[d]) / h;
+      J[d] = mass[i] * (out[d] - f[d]);
       dke += 0.5 * (out[d] * out[d] - f[d] * f[d]);
       ydot[ov + (size_t)d * n + i] = (out[d] - v0) / h;
       ydot[ox + (size_t)d * n + i] = out[dim + d];
     }
-    bal[0] += mass[i] * (dke + out[2 * dim] - f[2 * dim]);
+    if (w->ob[i] >= 0)
+      for (int d = 0; d < dim; ++d) force[(size_t)dim * w->ob[i] + d] -= J[d] / h;
+    else {
+      double x[MPM_MAX_DIM];
+      for (int d = 0; d < dim; ++d) x[d] = y[ox + (size_t)d * n + i];
+      work = w->src->impulse(w->src->ctx, x, J);
+    }
+    bal[0] += mass[i] * (dke + out[2 * dim] - f[2 * dim]) - work;
     bal[1] += mass[i] * out[2 * dim];
     f[2 * dim] = out[2 * dim], f[2 * dim + 1] = out[2 * dim + 1];
   }
+  if (w->src) MPM_CALL(w->src->finish(w->src->ctx));
   double me = bal[1];              /* a register, not the array that MPI takes */
   for (mpm_lidx i = 0; i < n; ++i) /* every particle pays (see the header) */
     if (w->kind[i] < 1) me += mass[i] * (y[oe + i] + h * ydot[oe + i]);
@@ -578,7 +639,7 @@ int fluid_wall_ls_apply(mpm_module *m, const double *y, double *ydot, double h) 
 }
 
 void fluid_wall_ls_free(fluid_wall_ls *w) {
-  free(w->reach), free(w->mom), free(w->halo), free(w->halo_ptr), free(w->need);
+  free(w->reach), free(w->mom), free(w->halo), free(w->halo_ptr), free(w->need), free(w->near_src);
   free(w->kind), free(w->ob), free(w->geo), free(w->val);
   memset(w, 0, sizeof *w);
 }

@@ -3,11 +3,11 @@
  * from a weighted least-squares fit over the interior particles near them, with the wall
  * condition imposed, instead of from the held nodes alone. Private to fluid/.
  *
- * Who is who. A particle closer to an obstacle than fluid.wall_band cells (phi < band dx) is a
- * wall particle; every other particle near a body is a donor. Particles far from every body are
- * neither and cost one lookup. With fluid.wall_blend = b > 0, a particle between the band and b
- * cells beyond it is both: a donor, and fitted in part, its new values w fit + (1 - w) own with
- * w falling linearly from 1 at the band's edge to 0 at b beyond it.
+ * Who is who. A particle closer to an obstacle (or a moving wall, below) than fluid.wall_band cells
+ * (phi < band dx) is a wall particle; every other particle near a body is a donor. Particles far
+ * from every body are neither and cost one lookup. With fluid.wall_blend = b > 0, a particle
+ * between the band and b cells beyond it is both: a donor, and fitted in part, its new values w fit
+ * + (1 - w) own with w falling linearly from 1 at the band's edge to 0 at b beyond it.
  *
  * Why blend. With a sharp edge the particle rows just outside the band are the worst of the
  * flow: uniform Mach 2.5 flow along a slip wall at 10 and 30 degrees to the grid (cases/
@@ -69,6 +69,19 @@
  * energy, about 2e-6 a step there; where the fit keeps changing the energy one way, the whole
  * flow carries it (the wedge's post-shock pressure rose by 0.3-0.5 %).
  *
+ * A moving wall. A coupling scheme may give the gas a moving wall (common/mpm_wall.h): under
+ * coupling.scheme = traction, the solid's surface (coupler/mpm_solid_wall.h). Its cells are
+ * flagged afresh at every step; a particle near both a static obstacle and the moving wall takes
+ * the nearer. The wall condition is then zero normal velocity relative to the wall's, (u - v_w)
+ * . n = 0 on the surface: the normal fit is made on u . n - v_w . n, and the motion bound, the
+ * keep-out rule and "never deeper" act on the relative normal velocity. The fit's impulses J go
+ * to the wall (the solid's nodes) instead of an obstacle's force record, and the wall's work
+ * (which the source returns) stays with the gas: only the rest of the fit's energy change is
+ * given back as heat. On the 1-D piston (cases/fsi_gas_piston.ini, a slab at 0.5 into gas at
+ * rest, dx = 0.01) the gas's first layer next to the slab is at -0.3 % of the exact post-shock
+ * pressure and -1.6 % of its density; ghost (traction's held nodes alone) leaves it at -36 % and
+ * -27 % (tests/verification/test_traction_ls.py).
+ *
  * Where it acts. In the classic update (usl, musl), after G2P, on the step's new values: the
  * wall particles' rates are rewritten so that the step ends on the fitted state, and they move
  * with the fitted transport velocity. The method-of-lines pairs would need a projection
@@ -96,9 +109,11 @@ typedef struct fluid_wall_ls {
   double **halo_ptr; /* nmom pointers into halo */
   mpm_lidx cap;      /* capacity of the per-particle arrays */
   signed char *kind; /* -1 far, 0 donor, 1 wall particle, 2 both (the blend) */
-  int *ob;           /* wall particle: the nearest obstacle */
-  double *geo;       /* wall particle: phi and the outward normal (1 + dim) */
-  double *val;       /* new field values (nf per particle) */
+  int *ob;           /* wall particle: the nearest obstacle, or -1 for the moving wall */
+  double *geo; /* wall particle: phi, the outward normal and the wall's velocity (1 + 2 dim) */
+  const mpm_wall_source *src; /* a moving wall a coupling scheme gave the gas (mpm_wall.h) */
+  unsigned char *near_src;    /* per box node as a cell's lower corner: near that wall, this step */
+  double *val;                /* new field values (nf per particle) */
 } fluid_wall_ls;
 
 extern const mpm_key_spec fluid_wall_keys[];
@@ -107,6 +122,11 @@ extern const int fluid_wall_nkeys;
 /* Read fluid.wall_treatment and fluid.wall_band and, for least_squares, mark the cells near the
  * obstacles. classic: the module runs the classic update. */
 int fluid_wall_ls_init(mpm_module *m, const mpm_config *cfg, int classic);
+/* Take the moving wall src (the module's attach_wall op; see mpm_module.h): *taken = 1 under
+ * least_squares. src = NULL ends the attaching: least_squares with neither an obstacle nor a
+ * wall is an input error. */
+int fluid_wall_ls_attach(mpm_module *m, const mpm_config *cfg, const mpm_wall_source *src,
+                         int *taken);
 /* After the classic step's G2P (rates in ydot over h from the state y): fit the wall
  * particles and rewrite their rates. Collective. */
 int fluid_wall_ls_apply(mpm_module *m, const double *y, double *ydot, double h);

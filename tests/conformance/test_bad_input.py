@@ -221,7 +221,7 @@ text = OBST.replace("method = usl", "method = bs32", 1) + LS
 expect_error("least_squares with an ERK pair", text, "fluid.wall_treatment", "classic update",
              line_of(text, "wall_treatment"))
 text = open(mt.case("sod.ini")).read().replace("method = bs32", "method = usl", 1) + LS
-expect_error("least_squares without an obstacle", text, "fluid.wall_treatment", "has none",
+expect_error("least_squares without an obstacle", text, "fluid.wall_treatment", "has neither",
              line_of(text, "wall_treatment"))
 for name, key_line, key in (("wall band 0", "wall_band = 0", "fluid.wall_band"),
                             ("wall blend -1", "wall_blend = -1", "fluid.wall_blend"),

@@ -25,3 +25,8 @@ mpm_add_script_test(test_timeschemes_mri SCRIPT verification/test_timeschemes.py
 # Its restart checks alone, short (the sanitizer pass runs this one, not the whole study).
 mpm_add_script_test(test_timeschemes_quick SCRIPT verification/test_timeschemes.py ARGS quick
                     LABELS "verification;mpi" TIMEOUT 600)
+# The least-squares wall at a moving traction interface (cases/fsi_gas_piston.ini): a slab
+# driven into gas at rest against the exact piston shock, ghost and least_squares side by side,
+# usl and musl; the interface balance, 2 ranks against 1, input errors (~10 s).
+mpm_add_script_test(test_traction_ls SCRIPT verification/test_traction_ls.py
+                    LABELS "verification;mpi" TIMEOUT 300)

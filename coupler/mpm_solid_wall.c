@@ -1,0 +1,339 @@
+/* The solid's surface as a moving wall for the gas (see mpm_solid_wall.h). */
+#include "mpm_solid_wall.h"
+
+#include "mpm_error.h"
+#include "mpm_shape.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+struct mpm_solid_wall {
+  mpm_coupling *c;
+  mpm_wall_source src;
+  double h;
+  double *nod;                           /* (1 + dim) nnodes: the solid's m_i and mass gradient */
+  double *nod_ptr[1 + MPM_MAX_DIM];      /* into nod, complete on every box node */
+  double *J[MPM_MAX_DIM];                /* per box node: the momentum the solid takes, N s */
+  int f_V0;                              /* the solid's reference volume field */
+  int n, cap;                            /* gathered solid particles */
+  double *gx;                            /* their positions and half-widths, (dim + 1) each */
+  int *counts, *displs;                  /* per rank, for the gather */
+  int blo[MPM_MAX_DIM], bn[MPM_MAX_DIM]; /* the bucket lattice: cells of dx over the particles */
+  int *start, *order;                    /* cell b holds order[start[b] .. start[b + 1]) */
+  size_t bcap;
+};
+
+/* ---- the gathered particles --------------------------------------------------------------- */
+
+static int gather(mpm_solid_wall *w) {
+  const mpm_grid *g = w->c->grid;
+  const mpm_particles *p = w->c->module[MPM_ROLE_SOLID]->particles;
+  const int dim = g->dim, stride = dim + 1;
+  const int mine = (int)p->n * stride;
+  MPM_CALL_MPI(MPI_Allgather(&mine, 1, MPI_INT, w->counts, 1, MPI_INT, g->comm));
+  int total = 0;
+  for (int r = 0; r < g->size; ++r) w->displs[r] = total, total += w->counts[r];
+  if (total > w->cap) {
+    free(w->gx), free(w->order);
+    w->cap = total + total / 4 + stride;
+    w->gx = malloc(sizeof *w->gx * (size_t)w->cap);
+    w->order = malloc(sizeof *w->order * (size_t)(w->cap / stride + 1));
+    if (!w->gx || !w->order)
+      MPM_FAIL(MPM_ERR_MEMORY, "cannot gather %d solid particles for the interface wall",
+               total / stride);
+  }
+  double *local = w->gx + w->displs[g->rank];
+  const double *V0 = mpm_particles_comp(p, w->f_V0, 0);
+  for (mpm_lidx i = 0; i < p->n; ++i) {
+    for (int d = 0; d < dim; ++d) local[(size_t)i * stride + d] = mpm_particles_comp(p, 0, d)[i];
+    local[(size_t)i * stride + dim] = 0.5 * pow(V0[i], 1.0 / dim);
+  }
+  MPM_CALL_MPI(MPI_Allgatherv(MPI_IN_PLACE, 0, MPI_DOUBLE, w->gx, w->counts, w->displs, MPI_DOUBLE,
+                              g->comm));
+  w->n = total / stride;
+  return 0;
+}
+
+/* The bucket cell of x, clamped to the lattice. */
+static int bucket_of(const mpm_solid_wall *w, const double *x, int *b) {
+  const mpm_grid *g = w->c->grid;
+  int k = 0;
+  for (int d = g->dim - 1; d >= 0; --d) {
+    b[d] = mpm_shape_floor((x[d] - g->lo[d]) / g->dx) - w->blo[d];
+    b[d] = b[d] < 0 ? 0 : b[d] >= w->bn[d] ? w->bn[d] - 1 : b[d];
+    k = k * w->bn[d] + b[d];
+  }
+  return k;
+}
+
+/* Sort the gathered particles by cell over their bounding box (a counting sort). */
+static int bucket(mpm_solid_wall *w) {
+  const mpm_grid *g = w->c->grid;
+  const int dim = g->dim, stride = dim + 1;
+  size_t cells = 1;
+  for (int d = 0; d < dim; ++d) {
+    double lo = HUGE_VAL, hi = -HUGE_VAL;
+    for (int q = 0; q < w->n; ++q) {
+      lo = fmin(lo, w->gx[(size_t)q * stride + d]);
+      hi = fmax(hi, w->gx[(size_t)q * stride + d]);
+    }
+    if (w->n == 0) lo = hi = g->lo[d];
+    w->blo[d] = mpm_shape_floor((lo - g->lo[d]) / g->dx);
+    w->bn[d] = mpm_shape_floor((hi - g->lo[d]) / g->dx) - w->blo[d] + 1;
+    cells *= (size_t)w->bn[d];
+  }
+  if (cells + 1 > w->bcap) {
+    free(w->start);
+    w->bcap = cells + 1;
+    MPM_ALLOC(w->start, w->bcap);
+  }
+  memset(w->start, 0, sizeof *w->start * (cells + 1));
+  int b[MPM_MAX_DIM];
+  for (int q = 0; q < w->n; ++q) w->start[bucket_of(w, w->gx + (size_t)q * stride, b) + 1]++;
+  for (size_t k = 0; k < cells; ++k) w->start[k + 1] += w->start[k];
+  for (int q = 0; q < w->n; ++q)
+    w->order[w->start[bucket_of(w, w->gx + (size_t)q * stride, b)]++] = q;
+  for (size_t k = cells; k > 0; --k) w->start[k] = w->start[k - 1];
+  w->start[0] = 0;
+  return 0;
+}
+
+/* ---- the source's calls ------------------------------------------------------------------- */
+
+static int wall_prepare(void *ctx, double h, double reach, unsigned char *cells) {
+  mpm_solid_wall *w = ctx;
+  mpm_grid *g = w->c->grid;
+  const mpm_grid_phase *s = mpm_coupling_phase(w->c, MPM_ROLE_SOLID);
+  const int dim = g->dim;
+  const size_t bytes = sizeof(double) * (size_t)g->nnodes;
+  w->h = h;
+  memcpy(w->nod_ptr[0], s->m_i, bytes);
+  for (int d = 0; d < dim; ++d) {
+    memcpy(w->nod_ptr[1 + d], s->normal_i[d], bytes);
+    memset(w->J[d], 0, bytes);
+  }
+  MPM_CALL(mpm_grid_halo_forward(g, w->nod_ptr, 1 + dim)); /* owners hold the sums */
+  MPM_CALL(gather(w));
+  MPM_CALL(bucket(w));
+  /* The cells within reach of a solid particle (its centre, plus its half-width). */
+  const int stride = dim + 1;
+  for (int q = 0; q < w->n; ++q) {
+    const double *xq = w->gx + (size_t)q * stride;
+    const int span = (int)ceil((reach + xq[dim]) / g->dx);
+    int lo[MPM_MAX_DIM], n[MPM_MAX_DIM], count = 1;
+    for (int d = 0; d < dim; ++d) {
+      const int c = mpm_shape_floor((xq[d] - g->lo[d]) / g->dx);
+      lo[d] = MPM_MAX(c - span, g->box_lo[d]);
+      n[d] = MPM_MIN(c + span + 1, g->box_lo[d] + g->box_n[d]) - lo[d];
+      if (n[d] <= 0) count = 0;
+      count *= n[d] > 0 ? n[d] : 0;
+    }
+    for (int k = 0; k < count; ++k) {
+      int gi[MPM_MAX_DIM];
+      for (int d = 0, r = k; d < dim; r /= n[d], ++d) gi[d] = lo[d] + r % n[d];
+      cells[mpm_grid_local_index(g, gi)] = 1;
+    }
+  }
+  return 0;
+}
+
+/* The solid's nodal sums at x over its stencil: sum S m, sum S m v, sum S grad m; 0 if x's
+ * stencil leaves the box. */
+static int nodal_at(const mpm_solid_wall *w, const double *x, double *m, double *mv, double *gm) {
+  const mpm_grid *g = w->c->grid;
+  const mpm_grid_phase *s = mpm_coupling_phase(w->c, MPM_ROLE_SOLID);
+  const int dim = g->dim, sup = mpm_shape_support(g->shape);
+  int base[MPM_MAX_DIM];
+  double xi[MPM_MAX_DIM], wt[MPM_MAX_DIM][MPM_SHAPE_MAX_SUPPORT],
+      dw[MPM_MAX_DIM][MPM_SHAPE_MAX_SUPPORT];
+  for (int d = 0; d < dim; ++d) xi[d] = (x[d] - g->lo[d]) / g->dx;
+  mpm_shape_eval(g->shape, dim, xi, 0.0, base, wt, dw);
+  *m = 0.0;
+  for (int d = 0; d < dim; ++d) mv[d] = gm[d] = 0.0;
+  const int count = dim == 2 ? sup * sup : sup * sup * sup;
+  for (int k = 0; k < count; ++k) {
+    int gi[MPM_MAX_DIM];
+    double W = 1.0;
+    for (int d = 0, r = k; d < dim; r /= sup, ++d) {
+      gi[d] = base[d] + r % sup;
+      if (gi[d] < g->box_lo[d] || gi[d] >= g->box_lo[d] + g->box_n[d]) return 0;
+      W *= wt[d][r % sup];
+    }
+    const mpm_lidx l = mpm_grid_local_index(g, gi);
+    const double ml = w->nod_ptr[0][l];
+    *m += W * ml;
+    for (int d = 0; d < dim; ++d) mv[d] += W * ml * s->v_i[d][l], gm[d] += W * w->nod_ptr[1 + d][l];
+  }
+  return 1;
+}
+
+static int wall_at(void *ctx, const double *x, double range, double *phi, double *n, double *v) {
+  const mpm_solid_wall *w = ctx;
+  const mpm_grid *g = w->c->grid;
+  const int dim = g->dim, stride = dim + 1;
+  double m, mv[MPM_MAX_DIM], gm[MPM_MAX_DIM], len = 0.0;
+  if (!nodal_at(w, x, &m, mv, gm) || !(m > 0.0)) return 0;
+  for (int d = 0; d < dim; ++d) len += gm[d] * gm[d];
+  len = sqrt(len);
+  if (!(len > 0.0)) return 0;
+  for (int d = 0; d < dim; ++d) n[d] = gm[d] / len, v[d] = mv[d] / m;
+  /* The particles within range + dx: the cells within that many of x's cell. */
+  const double R = range + g->dx;
+  const int span = (int)ceil(R / g->dx);
+  int b[MPM_MAX_DIM], lo[MPM_MAX_DIM], hi[MPM_MAX_DIM], count = 1;
+  bucket_of(w, x, b);
+  for (int d = 0; d < dim; ++d) {
+    const int c = mpm_shape_floor((x[d] - g->lo[d]) / g->dx) - w->blo[d];
+    lo[d] = MPM_MAX(c - span, 0), hi[d] = MPM_MIN(c + span + 1, w->bn[d]);
+    if (hi[d] <= lo[d]) return 0;
+    count *= hi[d] - lo[d];
+  }
+  int found = 0;
+  double best = HUGE_VAL;
+  for (int k = 0; k < count; ++k) {
+    int cell = 0;
+    for (int d = dim - 1; d >= 0; --d) {
+      int r = k;
+      for (int e = 0; e < d; ++e) r /= hi[e] - lo[e];
+      cell = cell * w->bn[d] + lo[d] + r % (hi[d] - lo[d]);
+    }
+    for (int j = w->start[cell]; j < w->start[cell + 1]; ++j) {
+      const double *xq = w->gx + (size_t)w->order[j] * stride;
+      double r2 = 0.0, dn = 0.0;
+      for (int d = 0; d < dim; ++d)
+        r2 += (x[d] - xq[d]) * (x[d] - xq[d]), dn += (x[d] - xq[d]) * n[d];
+      if (r2 > R * R) continue;
+      found = 1;
+      best = fmin(best, dn - xq[dim]);
+    }
+  }
+  *phi = best;
+  return found;
+}
+
+static double wall_impulse(void *ctx, const double *x, const double *J) {
+  mpm_solid_wall *w = ctx;
+  mpm_coupling *c = w->c;
+  const mpm_grid *g = c->grid;
+  const mpm_grid_phase *s = mpm_coupling_phase(c, MPM_ROLE_SOLID);
+  const int dim = g->dim, sup = mpm_shape_support(g->shape);
+  const double h = w->h;
+  int base[MPM_MAX_DIM];
+  double xi[MPM_MAX_DIM], wt[MPM_MAX_DIM][MPM_SHAPE_MAX_SUPPORT],
+      dw[MPM_MAX_DIM][MPM_SHAPE_MAX_SUPPORT];
+  for (int d = 0; d < dim; ++d) xi[d] = (x[d] - g->lo[d]) / g->dx;
+  mpm_shape_eval(g->shape, dim, xi, 0.0, base, wt, dw);
+  const int count = dim == 2 ? sup * sup : sup * sup * sup;
+  mpm_lidx node[64];
+  double share[64], sum = 0.0, work = 0.0;
+  for (int k = 0; k < count; ++k) { /* wall_at found the stencil inside the box, with mass */
+    int gi[MPM_MAX_DIM];
+    double W = 1.0;
+    for (int d = 0, r = k; d < dim; r /= sup, ++d) gi[d] = base[d] + r % sup, W *= wt[d][r % sup];
+    node[k] = mpm_grid_local_index(g, gi);
+    share[k] = W * w->nod_ptr[0][node[k]];
+    sum += share[k];
+  }
+  /* The work at the nodes' time-centred velocity v - h a / 2, as the solid's exchange counts
+   * it (wall_finish): what the gas gains the solid loses, less the impulse's own sum J^2 / 2m. */
+  for (int k = 0; k < count; ++k)
+    for (int d = 0; share[k] > 0.0 && d < dim; ++d) {
+      const double Jk = J[d] * (share[k] / sum);
+      w->J[d][node[k]] -= Jk;
+      work += Jk * (s->v_i[d][node[k]] - 0.5 * h * s->a_i[d][node[k]]);
+    }
+  mpm_coupling_record *r = &c->rec[c->which.latest];
+  for (int d = 0; d < dim; ++d) r->force[MPM_ROLE_FLUID][d] += J[d] / h;
+  r->power[MPM_ROLE_FLUID] += work / h;
+  return work;
+}
+
+static int wall_finish(void *ctx) {
+  mpm_solid_wall *w = ctx;
+  mpm_coupling *c = w->c;
+  mpm_grid *g = c->grid;
+  mpm_grid_phase *s = mpm_coupling_phase(c, MPM_ROLE_SOLID);
+  const int dim = g->dim;
+  MPM_CALL(mpm_grid_halo_reverse(g, w->J, dim));
+  /* An impulse: a' = a + J / (m h), v' = v + J / m. The force is recorded as J / h itself, not
+   * as m (v' - v) / h, whose cancellation (J / m is small against v) costs digits. The power is
+   * time-centred, as in mpm_impulse_apply. */
+  const double h = w->h;
+  c->recording = 1;
+  for (mpm_lidx l = 0; l < g->nnodes; ++l) {
+    if (!c->owned[l] || !(s->m_i[l] > 0.0)) continue;
+    double f[MPM_MAX_DIM], vc[MPM_MAX_DIM];
+    int any = 0;
+    for (int d = 0; d < dim; ++d) {
+      const double v0 = s->v_i[d][l], a0 = s->a_i[d][l], dv = w->J[d][l] / s->m_i[l];
+      any |= w->J[d][l] != 0.0;
+      f[d] = w->J[d][l] / h;
+      vc[d] = 0.5 * (v0 - h * a0 + v0 + dv);
+      s->v_i[d][l] = v0 + dv, s->a_i[d][l] = a0 + dv / h;
+    }
+    if (any) mpm_coupling_record_force(c, MPM_ROLE_SOLID, l, f, vc);
+  }
+  c->recording = 0;
+  double *f[2 * MPM_MAX_DIM];
+  for (int d = 0; d < dim; ++d) f[2 * d] = s->v_i[d], f[2 * d + 1] = s->a_i[d];
+  return mpm_grid_halo_forward(g, f, 2 * dim);
+}
+
+/* ---- construction ------------------------------------------------------------------------- */
+
+void mpm_solid_wall_free(mpm_solid_wall **wp) {
+  if (!wp || !*wp) return;
+  mpm_solid_wall *w = *wp;
+  free(w->nod);
+  for (int d = 0; d < MPM_MAX_DIM; ++d) free(w->J[d]);
+  free(w->gx), free(w->order), free(w->start), free(w->counts), free(w->displs);
+  free(w);
+  *wp = NULL;
+}
+
+int mpm_solid_wall_offer(mpm_coupling *c, const mpm_config *cfg, mpm_solid_wall **wp) {
+  *wp = NULL;
+  mpm_module *gas = c->module[MPM_ROLE_FLUID];
+  const mpm_module *solid = c->module[MPM_ROLE_SOLID];
+  if (!gas->ops->attach_wall) return 0;
+  mpm_solid_wall *w;
+  MPM_ALLOC(w, 1);
+  *wp = w;
+  const mpm_grid *g = c->grid;
+  w->c = c;
+  w->f_V0 = mpm_particles_find(solid->particles, "V0");
+  MPM_ALLOC(w->nod, (size_t)(1 + g->dim) * g->nnodes);
+  for (int k = 0; k <= g->dim; ++k) w->nod_ptr[k] = w->nod + (size_t)k * g->nnodes;
+  for (int d = 0; d < g->dim; ++d) MPM_ALLOC(w->J[d], g->nnodes);
+  MPM_ALLOC(w->counts, g->size);
+  MPM_ALLOC(w->displs, g->size);
+  w->src = (mpm_wall_source){.ctx = w,
+                             .prepare = wall_prepare,
+                             .at = wall_at,
+                             .impulse = wall_impulse,
+                             .finish = wall_finish};
+  if (w->f_V0 < 0) MPM_FAIL(MPM_ERR_INTERNAL, "the solid module has no V0 field");
+  int taken = 0;
+  MPM_CALL(gas->ops->attach_wall(gas, cfg, &w->src, &taken));
+  if (!taken) {
+    mpm_solid_wall_free(wp);
+    return 0;
+  }
+  const char *time, *method;
+  MPM_CALL(mpm_config_get_string(cfg, "time.method", &method));
+  if (strcmp(method, "musl") == 0)
+    return mpm_config_fail(cfg, "time.method",
+                           "the least-squares wall at a traction interface needs time.method = "
+                           "usl: under musl the solid's remap fixes its particles' velocities "
+                           "before the gas's G2P fits the wall, so the fit's impulses would not "
+                           "reach the solid; use usl, or fluid.wall_treatment = ghost");
+  MPM_CALL(mpm_config_get_string(cfg, "coupling.time", &time));
+  if (strcmp(time, "monolithic") != 0)
+    return mpm_config_fail(
+        cfg, mpm_config_has(cfg, "coupling.time") ? "coupling.time" : "fluid.wall_treatment",
+        "the least-squares wall at a traction interface acts in the gas's "
+        "G2P and needs the solid solved in the same cycle: use "
+        "coupling.time = monolithic, or fluid.wall_treatment = ghost");
+  return 0;
+}
