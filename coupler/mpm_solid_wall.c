@@ -1,6 +1,7 @@
 /* The solid's surface as a moving wall for the gas (see mpm_solid_wall.h). */
 #include "mpm_solid_wall.h"
 
+#include "mpm_bc.h"
 #include "mpm_error.h"
 #include "mpm_shape.h"
 
@@ -22,6 +23,8 @@ struct mpm_solid_wall {
   int blo[MPM_MAX_DIM], bn[MPM_MAX_DIM]; /* the bucket lattice: cells of dx over the particles */
   int *start, *order;                    /* cell b holds order[start[b] .. start[b + 1]) */
   size_t bcap;
+  unsigned char *mark; /* the box grown by the reach, for mark_near */
+  size_t mcap;
 };
 
 /* ---- the gathered particles --------------------------------------------------------------- */
@@ -101,6 +104,61 @@ static int bucket(mpm_solid_wall *w) {
 
 /* ---- the source's calls ------------------------------------------------------------------- */
 
+/* Flag the box cells within span cells along every axis of a cell that holds a solid particle:
+ * the particles' cells are marked on the box grown by span, which is then dilated along each
+ * axis in turn by a forward and a backward sweep (the cost follows the cells, not the particle
+ * count). */
+static int mark_near(mpm_solid_wall *w, int span, unsigned char *cells) {
+  const mpm_grid *g = w->c->grid;
+  const int dim = g->dim, stride = dim + 1;
+  int lo[MPM_MAX_DIM], n[MPM_MAX_DIM], nmax = 0;
+  size_t total = 1, step[MPM_MAX_DIM];
+  for (int d = 0; d < dim; ++d) {
+    lo[d] = g->box_lo[d] - span, n[d] = g->box_n[d] + 2 * span;
+    step[d] = total, total *= (size_t)n[d], nmax = MPM_MAX(nmax, n[d]);
+  }
+  if (total + (size_t)nmax > w->mcap) {
+    free(w->mark);
+    w->mcap = total + (size_t)nmax;
+    MPM_ALLOC(w->mark, w->mcap);
+  }
+  unsigned char *m = w->mark, *line = w->mark + total;
+  memset(m, 0, total);
+  for (int q = 0; q < w->n; ++q) {
+    size_t k = 0;
+    int in = 1;
+    for (int d = 0; d < dim; ++d) {
+      const int c = mpm_shape_floor((w->gx[(size_t)q * stride + d] - g->lo[d]) / g->dx) - lo[d];
+      in &= c >= 0 && c < n[d];
+      k += (size_t)(in ? c : 0) * step[d];
+    }
+    if (in) m[k] = 1;
+  }
+  for (int a = 0; a < dim; ++a) /* every line along axis a */
+    for (size_t first = 0; first < total; ++first) {
+      if ((first / step[a]) % (size_t)n[a] != 0) continue;
+      for (int i = 0; i < n[a]; ++i) line[i] = m[first + (size_t)i * step[a]];
+      int last = -2 * span - 1;
+      for (int i = 0; i < n[a]; ++i) {
+        if (line[i]) last = i;
+        m[first + (size_t)i * step[a]] = i - last <= span;
+      }
+      last = n[a] + 2 * span + 1;
+      for (int i = n[a] - 1; i >= 0; --i) {
+        if (line[i]) last = i;
+        m[first + (size_t)i * step[a]] |= last - i <= span;
+      }
+    }
+  for (mpm_lidx l = 0; l < g->nnodes; ++l) {
+    int gi[MPM_MAX_DIM];
+    size_t k = 0;
+    mpm_grid_node_global(g, l, gi);
+    for (int d = 0; d < dim; ++d) k += (size_t)(gi[d] - lo[d]) * step[d];
+    if (m[k]) cells[l] = 1;
+  }
+  return 0;
+}
+
 static int wall_prepare(void *ctx, double h, double reach, unsigned char *cells) {
   mpm_solid_wall *w = ctx;
   mpm_grid *g = w->c->grid;
@@ -117,25 +175,9 @@ static int wall_prepare(void *ctx, double h, double reach, unsigned char *cells)
   MPM_CALL(gather(w));
   MPM_CALL(bucket(w));
   /* The cells within reach of a solid particle (its centre, plus its half-width). */
-  const int stride = dim + 1;
-  for (int q = 0; q < w->n; ++q) {
-    const double *xq = w->gx + (size_t)q * stride;
-    const int span = (int)ceil((reach + xq[dim]) / g->dx);
-    int lo[MPM_MAX_DIM], n[MPM_MAX_DIM], count = 1;
-    for (int d = 0; d < dim; ++d) {
-      const int c = mpm_shape_floor((xq[d] - g->lo[d]) / g->dx);
-      lo[d] = MPM_MAX(c - span, g->box_lo[d]);
-      n[d] = MPM_MIN(c + span + 1, g->box_lo[d] + g->box_n[d]) - lo[d];
-      if (n[d] <= 0) count = 0;
-      count *= n[d] > 0 ? n[d] : 0;
-    }
-    for (int k = 0; k < count; ++k) {
-      int gi[MPM_MAX_DIM];
-      for (int d = 0, r = k; d < dim; r /= n[d], ++d) gi[d] = lo[d] + r % n[d];
-      cells[mpm_grid_local_index(g, gi)] = 1;
-    }
-  }
-  return 0;
+  double rmax = 0.0;
+  for (int q = 0; q < w->n; ++q) rmax = fmax(rmax, w->gx[(size_t)q * (dim + 1) + dim]);
+  return mark_near(w, (int)ceil((reach + rmax) / g->dx), cells);
 }
 
 /* The solid's nodal sums at x over its stencil: sum S m, sum S m v, sum S grad m; 0 if x's
@@ -181,8 +223,7 @@ static int wall_at(void *ctx, const double *x, double range, double *phi, double
   /* The particles within range + dx: the cells within that many of x's cell. */
   const double R = range + g->dx;
   const int span = (int)ceil(R / g->dx);
-  int b[MPM_MAX_DIM], lo[MPM_MAX_DIM], hi[MPM_MAX_DIM], count = 1;
-  bucket_of(w, x, b);
+  int lo[MPM_MAX_DIM], hi[MPM_MAX_DIM], count = 1;
   for (int d = 0; d < dim; ++d) {
     const int c = mpm_shape_floor((x[d] - g->lo[d]) / g->dx) - w->blo[d];
     lo[d] = MPM_MAX(c - span, 0), hi[d] = MPM_MIN(c + span + 1, w->bn[d]);
@@ -287,7 +328,7 @@ void mpm_solid_wall_free(mpm_solid_wall **wp) {
   mpm_solid_wall *w = *wp;
   free(w->nod);
   for (int d = 0; d < MPM_MAX_DIM; ++d) free(w->J[d]);
-  free(w->gx), free(w->order), free(w->start), free(w->counts), free(w->displs);
+  free(w->gx), free(w->order), free(w->start), free(w->counts), free(w->displs), free(w->mark);
   free(w);
   *wp = NULL;
 }
