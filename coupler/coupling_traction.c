@@ -91,10 +91,10 @@ static int traction_after_solve(mpm_coupling *c, double t, double h, mpm_pass pa
 /* Under the gas's least-squares wall treatment the gas particles next to the solid take the
  * fit against the solid's surface as a moving wall (mpm_solid_wall.h). */
 static int traction_create(mpm_coupling *c, const mpm_config *cfg) {
-  mpm_solid_wall *w;
-  MPM_CALL(mpm_solid_wall_offer(c, cfg, &w));
-  c->content = w;
-  return 0;
+  mpm_solid_wall *w = NULL;
+  const int rc = mpm_solid_wall_offer(c, cfg, &w);
+  c->content = w; /* traction_destroy frees it, after an input error too */
+  return rc;
 }
 
 static void traction_destroy(mpm_coupling *c) {
