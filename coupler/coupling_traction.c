@@ -27,9 +27,10 @@
  * Under fluid.wall_treatment = least_squares the gas particles next to the solid also take the
  * gas's least-squares wall fit, against the solid's surface as a moving wall
  * (mpm_solid_wall.h): their velocity, internal energy and density come from the gas particles
- * behind them instead of from the held nodes alone, and the fit's impulses go to the solid's
- * nodes. On the 1-D piston (cases/fsi_gas_piston.ini) that lifts the first gas layer from 36 %
- * under the post-shock pressure to within 0.3 % of it.
+ * behind them instead of from the held nodes alone (their normal velocity stays the held
+ * nodes'), and the fit's impulses go to the solid's nodes. On the 1-D piston
+ * (cases/fsi_gas_piston.ini) that lifts the first gas layer from 36 % under the post-shock
+ * pressure to within 1 % of it.
  *
  * Inside the solid the normal means nothing: where |grad m_s| dx < 0.5 m_s (a node a cell or
  * more inside; the nodes on a straight face give 1.5) the phases share the velocity of their

@@ -588,6 +588,11 @@ int fluid_wall_ls_apply(mpm_module *m, const double *y, double *ydot, double h) 
                    out);
     else
       keep_out(f, &L, nrm, vw_n, out);
+    if (w->ob[i] < 0) { /* a moving wall: the new velocity keeps its own normal component */
+      double fitted = 0.0, own = 0.0;
+      for (int d = 0; d < dim; ++d) fitted += out[d] * nrm[d], own += f[d] * nrm[d];
+      for (int d = 0; d < dim; ++d) out[d] += (own - fitted) * nrm[d];
+    }
     if (w->kind[i] == 2) { /* the blend: part fit, part its own */
       const double b = (w->band + w->blend - phi * g->dx) / w->blend;
       for (int k = 0; k < nf; ++k) out[k] = b * out[k] + (1.0 - b) * f[k];
