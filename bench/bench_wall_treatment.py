@@ -12,9 +12,14 @@ Cases (--case):
   rae2822  cases/rae2822.ini (M 0.729) at its dx = 0.04 unless --dx, to t = 2 unless --t-end:
            ghost blows up there at t = 2.4, so the comparison is over the start of the run,
            the impulsive start and the first chord lengths of flow, not its steady state.
+  supersonic_bar  the main job under coupling.scheme = traction at dx = 0.004 unless --dx, to
+           t = 1.5 ms unless --t-end: the least-squares wall at the moving gas-solid interface
+           (coupler/mpm_solid_wall.h) against traction's held nodes alone.
 
-Writes bench/results/wall_treatment{,_rae2822}.{csv,json,md}. No test asserts a time.
-  /usr/bin/python3 bench/bench_wall_treatment.py [--case wedge|rae2822] [--binary B] [--dx DX]
+Writes bench/results/wall_treatment{,_rae2822,_supersonic_bar}.{csv,json,md}. No test asserts a
+time.
+  /usr/bin/python3 bench/bench_wall_treatment.py [--case wedge|rae2822|supersonic_bar]
+                   [--binary B] [--dx DX]
 """
 import argparse
 import json
@@ -27,22 +32,25 @@ import benchrun  # noqa: E402
 
 ap = argparse.ArgumentParser()
 ap.add_argument("--binary", default=os.path.join(benchrun.ROOT, "build", "app", "mpmfsi"))
-ap.add_argument("--case", choices=("wedge", "rae2822"), default="wedge")
+ap.add_argument("--case", choices=("wedge", "rae2822", "supersonic_bar"), default="wedge")
 ap.add_argument("--dx", type=float, help="grid.dx (default: wedge 0.01, rae2822 the case's 0.04)")
 ap.add_argument("--t-end", type=float, help="time.t_end (default: wedge the case's, rae2822 2)")
 ap.add_argument("--repeats", type=int, default=3)
 ap.add_argument("--out", help="output stem (default bench/results/wall_treatment[_rae2822])")
 a = ap.parse_args()
+DEFAULTS = {"wedge": (0.01, None), "rae2822": (0.04, 2.0), "supersonic_bar": (0.004, 0.0015)}
 if a.dx is None:
-    a.dx = 0.01 if a.case == "wedge" else 0.04
-if a.t_end is None and a.case == "rae2822":
-    a.t_end = 2.0
+    a.dx = DEFAULTS[a.case][0]
+if a.t_end is None:
+    a.t_end = DEFAULTS[a.case][1]
 if a.out is None:
     a.out = os.path.join(benchrun.ROOT, "bench", "results",
                          "wall_treatment" + ("" if a.case == "wedge" else "_" + a.case))
 
 case = os.path.join(benchrun.ROOT, "cases", a.case + ".ini")
 extra = [] if a.t_end is None else [f"time.t_end={a.t_end:g}"]
+if a.case == "supersonic_bar":
+    extra.append("coupling.scheme=traction")
 rows = []
 for r in range(a.repeats):
     for treatment in ("ghost", "least_squares"):

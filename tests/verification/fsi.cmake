@@ -27,6 +27,7 @@ mpm_add_script_test(test_timeschemes_quick SCRIPT verification/test_timeschemes.
                     LABELS "verification;mpi" TIMEOUT 600)
 # The least-squares wall at a moving traction interface (cases/fsi_gas_piston.ini): a slab
 # driven into gas at rest against the exact piston shock, ghost and least_squares side by side,
-# usl and musl; the interface balance, 2 ranks against 1, input errors (~10 s).
+# usl; the interface balance, 2 ranks against 1; fsi_box (a block with corners) under traction
+# with least_squares: momentum, energy, 3 ranks against 1; input errors (~10 s).
 mpm_add_script_test(test_traction_ls SCRIPT verification/test_traction_ls.py
                     LABELS "verification;mpi" TIMEOUT 300)
