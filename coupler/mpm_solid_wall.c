@@ -29,7 +29,25 @@ struct mpm_solid_wall {
 
 /* ---- the gathered particles --------------------------------------------------------------- */
 
-static int gather(mpm_solid_wall *w) {
+/* Room for count values of gx (and count / stride particles in order), keeping what they hold. */
+static int ensure(mpm_solid_wall *w, int count, int stride) {
+  if (count <= w->cap) return 0;
+  const int cap = count + count / 4 + stride;
+  double *gx = realloc(w->gx, sizeof *gx * (size_t)cap);
+  if (gx) w->gx = gx;
+  int *order = realloc(w->order, sizeof *order * (size_t)(cap / stride + 1));
+  if (order) w->order = order;
+  if (!gx || !order)
+    MPM_FAIL(MPM_ERR_MEMORY, "cannot gather %d solid particles for the interface wall",
+             count / stride);
+  w->cap = cap;
+  return 0;
+}
+
+/* Every solid particle on every rank, and along a periodic axis the images (shifted by the
+ * period) of those within margin of a face, so that a search near the seam sees the solid
+ * across it. */
+static int gather(mpm_solid_wall *w, double margin) {
   const mpm_grid *g = w->c->grid;
   const mpm_particles *p = w->c->module[MPM_ROLE_SOLID]->particles;
   const int dim = g->dim, stride = dim + 1;
@@ -37,15 +55,7 @@ static int gather(mpm_solid_wall *w) {
   MPM_CALL_MPI(MPI_Allgather(&mine, 1, MPI_INT, w->counts, 1, MPI_INT, g->comm));
   int total = 0;
   for (int r = 0; r < g->size; ++r) w->displs[r] = total, total += w->counts[r];
-  if (total > w->cap) {
-    free(w->gx), free(w->order);
-    w->cap = total + total / 4 + stride;
-    w->gx = malloc(sizeof *w->gx * (size_t)w->cap);
-    w->order = malloc(sizeof *w->order * (size_t)(w->cap / stride + 1));
-    if (!w->gx || !w->order)
-      MPM_FAIL(MPM_ERR_MEMORY, "cannot gather %d solid particles for the interface wall",
-               total / stride);
-  }
+  MPM_CALL(ensure(w, total, stride));
   double *local = w->gx + w->displs[g->rank];
   const double *V0 = mpm_particles_comp(p, w->f_V0, 0);
   for (mpm_lidx i = 0; i < p->n; ++i) {
@@ -55,6 +65,26 @@ static int gather(mpm_solid_wall *w) {
   MPM_CALL_MPI(MPI_Allgatherv(MPI_IN_PLACE, 0, MPI_DOUBLE, w->gx, w->counts, w->displs, MPI_DOUBLE,
                               g->comm));
   w->n = total / stride;
+  for (int d = 0; d < dim; ++d) { /* images along each periodic axis, of images too (corners) */
+    if (!g->periodic[d]) continue;
+    const double L = g->hi[d] - g->lo[d];
+    int extra = 0;
+    for (int q = 0; q < w->n; ++q) {
+      const double x = w->gx[(size_t)q * stride + d];
+      extra += (x < g->lo[d] + margin) + (x > g->hi[d] - margin);
+    }
+    MPM_CALL(ensure(w, (w->n + extra) * stride, stride));
+    const int n0 = w->n;
+    for (int q = 0; q < n0; ++q) {
+      const double *xq = w->gx + (size_t)q * stride;
+      for (int side = 0; side < 2; ++side) {
+        if (side ? !(xq[d] > g->hi[d] - margin) : !(xq[d] < g->lo[d] + margin)) continue;
+        double *img = w->gx + (size_t)w->n++ * stride;
+        memcpy(img, xq, sizeof *img * (size_t)stride);
+        img[d] += side ? -L : L;
+      }
+    }
+  }
   return 0;
 }
 
@@ -88,8 +118,9 @@ static int bucket(mpm_solid_wall *w) {
   }
   if (cells + 1 > w->bcap) {
     free(w->start);
+    w->bcap = 0;
+    MPM_ALLOC(w->start, cells + 1);
     w->bcap = cells + 1;
-    MPM_ALLOC(w->start, w->bcap);
   }
   memset(w->start, 0, sizeof *w->start * (cells + 1));
   int b[MPM_MAX_DIM];
@@ -119,8 +150,9 @@ static int mark_near(mpm_solid_wall *w, int span, unsigned char *cells) {
   }
   if (total + (size_t)nmax > w->mcap) {
     free(w->mark);
+    w->mcap = 0;
+    MPM_ALLOC(w->mark, total + (size_t)nmax);
     w->mcap = total + (size_t)nmax;
-    MPM_ALLOC(w->mark, w->mcap);
   }
   unsigned char *m = w->mark, *line = w->mark + total;
   memset(m, 0, total);
@@ -172,7 +204,9 @@ static int wall_prepare(void *ctx, double h, double reach, unsigned char *cells)
     memset(w->J[d], 0, bytes);
   }
   MPM_CALL(mpm_grid_halo_forward(g, w->nod_ptr, 1 + dim)); /* owners hold the sums */
-  MPM_CALL(gather(w));
+  /* A search reaches range + dx <= reach + dx from a gas particle, which may lie a cell beyond
+   * its rank's cells; the marking reaches reach + the half-width. */
+  MPM_CALL(gather(w, reach + 3.0 * g->dx));
   MPM_CALL(bucket(w));
   /* The cells within reach of a solid particle (its centre, plus its half-width). */
   double rmax = 0.0;
@@ -299,7 +333,10 @@ static int wall_finish(void *ctx) {
   MPM_CALL(mpm_grid_halo_reverse(g, w->J, dim));
   /* An impulse: a' = a + J / (m h), v' = v + J / m. The force is recorded as J / h itself, not
    * as m (v' - v) / h, whose cancellation (J / m is small against v) costs digits. The power is
-   * time-centred, as in mpm_impulse_apply. */
+   * time-centred, as in mpm_impulse_apply. A component that the solid's own constraint set
+   * (a wall face, a clamp, a rigid body: it differs from what the nodal solve and the scheme
+   * gave, MPM_COUPLING_HOLDS) keeps its value: the constraint takes the impulse, which is still
+   * the gas's load on the solid (as mpm_coupling_follow_solid books it). */
   const double h = w->h;
   c->recording = 1;
   for (mpm_lidx l = 0; l < g->nnodes; ++l) {
@@ -307,7 +344,9 @@ static int wall_finish(void *ctx) {
     double f[MPM_MAX_DIM], vc[MPM_MAX_DIM];
     int any = 0;
     for (int d = 0; d < dim; ++d) {
-      const double v0 = s->v_i[d][l], a0 = s->a_i[d][l], dv = w->J[d][l] / s->m_i[l];
+      const double v0 = s->v_i[d][l], a0 = s->a_i[d][l];
+      const int held = c->held_v[d] && (v0 != c->held_v[d][l] || a0 != c->held_a[d][l]);
+      const double dv = held ? 0.0 : w->J[d][l] / s->m_i[l];
       any |= w->J[d][l] != 0.0;
       f[d] = w->J[d][l] / h;
       vc[d] = 0.5 * (v0 - h * a0 + v0 + dv);
@@ -361,6 +400,8 @@ int mpm_solid_wall_offer(mpm_coupling *c, const mpm_config *cfg, mpm_solid_wall 
     mpm_solid_wall_free(wp);
     return 0;
   }
+  /* Refused below after the gas took it: the gas then holds a table that traction_destroy
+   * frees, harmless since the run stops at the input error. */
   const char *time, *method;
   MPM_CALL(mpm_config_get_string(cfg, "time.method", &method));
   if (strcmp(method, "musl") == 0)

@@ -2,7 +2,8 @@
  * the gas's least-squares wall treatment (fluid.wall_treatment = least_squares) the interface.
  *
  * Where the wall is. Every solid particle is gathered on every rank at each G2P (positions, and
- * a half-width r_q = V0^(1/dim) / 2) and bucketed by cell. At a point x the outward normal n is
+ * a half-width r_q = V0^(1/dim) / 2), with its images across a periodic face when it lies within
+ * reach of one, and bucketed by cell. At a point x the outward normal n is
  * the solid's mass gradient interpolated at x (the grid's shape functions, normalised), the
  * wall's velocity is the solid's nodal velocity interpolated with mass weights (the velocity
  * of the nodal solve just made, which `traction` has set to the common normal velocity at the
@@ -15,6 +16,10 @@
  * ranks and applied to the solid's nodal velocities and accelerations as an exchange
  * (mpm_coupling.h) before the solid's G2P, which the cycle runs after the gas's: the interface
  * record books -J / h on the solid and J / h on the gas, so the exchange balances to roundoff.
+ * A component that the solid's own constraint set (a wall face, a clamp, a rigid body) keeps
+ * its value: the constraint takes that share, as it takes the held gas's under
+ * MPM_COUPLING_HOLDS (without that, a review measured floor nodes of a panel on a slip floor
+ * moving into the floor at 9e-5 against the panel's 3.5e-3).
  * The gas's energy changes by J . v (the wall's work; the fit's remainder goes back to the gas
  * as heat), booked as the gas's interface power; the solid's power is that of its exchange.
  *
@@ -24,7 +29,9 @@
  * sets its particles' velocities before the gas's G2P: the impulses would not reach them;
  * measured on cases/fsi_gas_piston.ini, the slab's momentum then missed 0.46 % of its recorded
  * interface impulse; refused at input). The per-body split of the interface force (several
- * [solid.NAME] bodies) does not include the fit's share. */
+ * [solid.NAME] bodies) does not include the fit's share. Every rank holds every solid particle:
+ * a solid of millions of particles would want only those near the gas, gathered by
+ * neighbourhood. */
 #ifndef MPM_SOLID_WALL_H
 #define MPM_SOLID_WALL_H
 
