@@ -166,9 +166,9 @@ static int mark_near(mpm_solid_wall *w, int span, unsigned char *cells) {
     }
     if (in) m[k] = 1;
   }
-  for (int a = 0; a < dim; ++a) /* every line along axis a */
-    for (size_t first = 0; first < total; ++first) {
-      if ((first / step[a]) % (size_t)n[a] != 0) continue;
+  for (int a = 0; a < dim; ++a) /* every line along axis a: o runs over the other axes */
+    for (size_t o = 0; o < total / (size_t)n[a]; ++o) {
+      const size_t first = o / step[a] * step[a] * (size_t)n[a] + o % step[a];
       for (int i = 0; i < n[a]; ++i) line[i] = m[first + (size_t)i * step[a]];
       int last = -2 * span - 1;
       for (int i = 0; i < n[a]; ++i) {
@@ -191,7 +191,8 @@ static int mark_near(mpm_solid_wall *w, int span, unsigned char *cells) {
   return 0;
 }
 
-static int wall_prepare(void *ctx, double h, double reach, unsigned char *cells) {
+static int wall_prepare(void *ctx, double h, double reach, unsigned char *cells, double *lo,
+                        double *hi) {
   mpm_solid_wall *w = ctx;
   mpm_grid *g = w->c->grid;
   const mpm_grid_phase *s = mpm_coupling_phase(w->c, MPM_ROLE_SOLID);
@@ -210,7 +211,13 @@ static int wall_prepare(void *ctx, double h, double reach, unsigned char *cells)
   MPM_CALL(bucket(w));
   /* The cells within reach of a solid particle (its centre, plus its half-width). */
   double rmax = 0.0;
-  for (int q = 0; q < w->n; ++q) rmax = fmax(rmax, w->gx[(size_t)q * (dim + 1) + dim]);
+  for (int d = 0; d < dim; ++d) lo[d] = HUGE_VAL, hi[d] = -HUGE_VAL;
+  for (int q = 0; q < w->n; ++q) {
+    const double *xq = w->gx + (size_t)q * (dim + 1);
+    rmax = fmax(rmax, xq[dim]);
+    for (int d = 0; d < dim; ++d)
+      lo[d] = fmin(lo[d], xq[d] - xq[dim]), hi[d] = fmax(hi[d], xq[d] + xq[dim]);
+  }
   return mark_near(w, (int)ceil((reach + rmax) / g->dx), cells);
 }
 

@@ -332,6 +332,21 @@ static int nearest(const fluid_obstacles *o, int dim, const double *x, double *p
   return best;
 }
 
+/* The block of box nodes (lower corner blo, extent bn) within reach and two cells of the
+ * physical box [lo, hi]: the same global nodes on every rank, clipped to this rank's box; along
+ * a periodic axis the whole box. An empty box (lo > hi) gives an empty block. */
+static void block_of(const mpm_grid *g, const double *lo, const double *hi, double reach, int *blo,
+                     int *bn) {
+  for (int d = 0; d < g->dim; ++d) {
+    const double b0 = g->box_lo[d], b1 = g->box_lo[d] + g->box_n[d];
+    double i0 = floor((lo[d] - reach - g->lo[d]) / g->dx) - 2,
+           i1 = ceil((hi[d] + reach - g->lo[d]) / g->dx) + 3;
+    if (g->periodic[d]) i0 = b0, i1 = b1;
+    i0 = fmin(fmax(i0, b0), b1), i1 = fmin(fmax(i1, i0), b1);
+    blo[d] = (int)i0, bn[d] = (int)(i1 - i0);
+  }
+}
+
 /* How far from a wall a donor may lie and still reach a fitted particle's fit: a node within a
  * stencil of both, and half a cell diagonal for a cell's centre. */
 static double reach_of(const fluid_wall_ls *w, const mpm_grid *g) {
@@ -395,17 +410,15 @@ int fluid_wall_ls_init(mpm_module *m, const mpm_config *cfg, int classic) {
    * step. The block is a global one (the same nodes on every rank), so no ghost node outside it
    * ever holds a moment for the halo exchanges to carry; along a periodic axis it is the whole
    * box. */
+  double lo[MPM_MAX_DIM], hi[MPM_MAX_DIM];
   for (int d = 0; d < dim; ++d) {
-    double lo = HUGE_VAL, hi = -HUGE_VAL;
+    lo[d] = HUGE_VAL, hi[d] = -HUGE_VAL;
     for (int k = 0; k < fc->obs.count; ++k)
-      lo = fmin(lo, fc->obs.ob[k].sdf.lo[d]), hi = fmax(hi, fc->obs.ob[k].sdf.hi[d]);
-    const double b0 = g->box_lo[d], b1 = g->box_lo[d] + g->box_n[d];
-    double i0 = floor((lo - reach - g->lo[d]) / g->dx) - 2,
-           i1 = ceil((hi + reach - g->lo[d]) / g->dx) + 3;
-    if (g->periodic[d]) i0 = b0, i1 = b1;
-    i0 = fmin(fmax(i0, b0), b1), i1 = fmin(fmax(i1, i0), b1);
-    w->clear_lo[d] = (int)i0, w->clear_n[d] = (int)(i1 - i0);
+      lo[d] = fmin(lo[d], fc->obs.ob[k].sdf.lo[d]), hi[d] = fmax(hi[d], fc->obs.ob[k].sdf.hi[d]);
   }
+  block_of(g, lo, hi, reach, w->obs_lo, w->obs_n);
+  memcpy(w->clear_lo, w->obs_lo, sizeof w->clear_lo),
+      memcpy(w->clear_n, w->obs_n, sizeof w->clear_n);
   return 0;
 }
 
@@ -427,8 +440,6 @@ int fluid_wall_ls_attach(mpm_module *m, const mpm_config *cfg, const mpm_wall_so
   }
   w->src = src, *taken = 1;
   MPM_ALLOC(w->near_src, g->nnodes);
-  /* The wall moves: the moments may live anywhere in the box. */
-  for (int d = 0; d < g->dim; ++d) w->clear_lo[d] = g->box_lo[d], w->clear_n[d] = g->box_n[d];
   return 0;
 }
 
@@ -482,6 +493,35 @@ static int ensure(fluid_wall_ls *w, mpm_lidx n, int dim) {
 
 /* ---- the step ------------------------------------------------------------------------------- */
 
+/* A moving wall: flag its cells for this step and make the block of the moments the union of
+ * the obstacles' and the wall's. Where the block moved, every moment, flag and halo value is
+ * cleared once (outside the block nothing else clears them: stale values there would circulate
+ * through the halo exchanges). Collective. */
+static int moving_block(fluid_wall_ls *w, const mpm_grid *g, double h) {
+  const int dim = g->dim;
+  double lo[MPM_MAX_DIM], hi[MPM_MAX_DIM];
+  int blo[MPM_MAX_DIM], bn[MPM_MAX_DIM], changed = 0;
+  memset(w->near_src, 0, (size_t)g->nnodes);
+  MPM_CALL(w->src->prepare(w->src->ctx, h, reach_of(w, g), w->near_src, lo, hi));
+  block_of(g, lo, hi, reach_of(w, g), blo, bn);
+  for (int d = 0; d < dim; ++d) {
+    if (w->obs_n[d] > 0 && bn[d] > 0) {
+      const int e0 = MPM_MIN(blo[d], w->obs_lo[d]);
+      const int e1 = MPM_MAX(blo[d] + bn[d], w->obs_lo[d] + w->obs_n[d]);
+      blo[d] = e0, bn[d] = e1 - e0;
+    } else if (w->obs_n[d] > 0) {
+      blo[d] = w->obs_lo[d], bn[d] = w->obs_n[d];
+    }
+  }
+  for (int d = 0; d < dim; ++d) changed |= blo[d] != w->clear_lo[d] || bn[d] != w->clear_n[d];
+  if (!changed) return 0;
+  memset(w->mom, 0, sizeof *w->mom * (size_t)w->nmom * g->nnodes);
+  memset(w->halo, 0, sizeof *w->halo * (size_t)w->nmom * g->nnodes);
+  memset(w->need, 0, sizeof *w->need * (size_t)g->nnodes);
+  memcpy(w->clear_lo, blo, sizeof blo), memcpy(w->clear_n, bn, sizeof bn);
+  return 0;
+}
+
 int fluid_wall_ls_apply(mpm_module *m, const double *y, double *ydot, double h) {
   fluid_content *fc = m->content;
   fluid_wall_ls *w = &fc->wall;
@@ -497,11 +537,8 @@ int fluid_wall_ls_apply(mpm_module *m, const double *y, double *ydot, double h) 
   const size_t ox = (size_t)p->offset[FLUID_X] * n, ov = (size_t)p->offset[FLUID_V] * n;
   const size_t oJ = (size_t)p->offset[FLUID_J] * n, oe = (size_t)p->offset[FLUID_E] * n;
   const int gs = 1 + 2 * dim; /* geo per particle */
+  if (w->src) MPM_CALL(moving_block(w, g, h));
   block_rows(w, g, BLOCK_CLEAR);
-  if (w->src) {
-    memset(w->near_src, 0, (size_t)g->nnodes);
-    MPM_CALL(w->src->prepare(w->src->ctx, h, reach_of(w, g), w->near_src));
-  }
 
   /* Classify the particles near a body that the obstacles' deposit listed in this RHS (every
    * one if there is no list) and flag the nodes the fitted ones read; then deposit the donors'

@@ -110,6 +110,7 @@ typedef struct fluid_wall_ls {
   int nmom;             /* moments per node */
   double *mom;          /* nnodes * nmom: a node's moments together */
   int clear_lo[MPM_MAX_DIM], clear_n[MPM_MAX_DIM]; /* the block of box nodes they reach */
+  int obs_lo[MPM_MAX_DIM], obs_n[MPM_MAX_DIM];     /* the obstacles' part of it */
   int exchange;      /* the box has a neighbour: the moments go through the halo exchanges */
   double *need;      /* per box node: a fitted particle reads it (nonzero), this step */
   double *halo;      /* nmom * nnodes: the same, one array per moment, for the exchanges */
