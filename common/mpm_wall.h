@@ -17,11 +17,12 @@
 
 typedef struct mpm_wall_source {
   void *ctx;
-  /* Flag (set to nonzero) every cell of this rank's box (by its lower corner node, box index)
-   * that holds points within reach (m) of the wall, and give the wall's bounding box [lo, hi]
-   * (dim values, m; the same on every rank; lo > hi if there is no wall); h is the step.
-   * Collective. */
-  int (*prepare)(void *ctx, double h, double reach, unsigned char *cells, double *lo, double *hi);
+  /* Flag the cells of this rank's box (by their lower corner node, box index) that hold points
+   * within reach (m) of the wall: 1, or 2 where `at` may find the wall within range (m) of such
+   * a point (elsewhere it finds none); and give the wall's bounding box [lo, hi] (dim values, m;
+   * the same on every rank; lo > hi if there is no wall); h is the step. Collective. */
+  int (*prepare)(void *ctx, double h, double reach, double range, unsigned char *cells, double *lo,
+                 double *hi);
   /* At x: 1, with the signed distance phi (m; > 0 outside the wall's body), the unit outward
    * normal n and the wall's velocity v, if a wall surface lies within range (m) of x; else 0. */
   int (*at)(void *ctx, const double *x, double range, double *phi, double *n, double *v);

@@ -139,7 +139,7 @@ static int bucket(mpm_solid_wall *w) {
  * the particles' cells are marked on the box grown by span, which is then dilated along each
  * axis in turn by a forward and a backward sweep (the cost follows the cells, not the particle
  * count). */
-static int mark_near(mpm_solid_wall *w, int span, unsigned char *cells) {
+static int mark_near(mpm_solid_wall *w, int span, unsigned char value, unsigned char *cells) {
   const mpm_grid *g = w->c->grid;
   const int dim = g->dim, stride = dim + 1;
   int lo[MPM_MAX_DIM], n[MPM_MAX_DIM], nmax = 0;
@@ -186,13 +186,13 @@ static int mark_near(mpm_solid_wall *w, int span, unsigned char *cells) {
     size_t k = 0;
     mpm_grid_node_global(g, l, gi);
     for (int d = 0; d < dim; ++d) k += (size_t)(gi[d] - lo[d]) * step[d];
-    if (m[k]) cells[l] = 1;
+    if (m[k] && cells[l] < value) cells[l] = value;
   }
   return 0;
 }
 
-static int wall_prepare(void *ctx, double h, double reach, unsigned char *cells, double *lo,
-                        double *hi) {
+static int wall_prepare(void *ctx, double h, double reach, double range, unsigned char *cells,
+                        double *lo, double *hi) {
   mpm_solid_wall *w = ctx;
   mpm_grid *g = w->c->grid;
   const mpm_grid_phase *s = mpm_coupling_phase(w->c, MPM_ROLE_SOLID);
@@ -218,7 +218,10 @@ static int wall_prepare(void *ctx, double h, double reach, unsigned char *cells,
     for (int d = 0; d < dim; ++d)
       lo[d] = fmin(lo[d], xq[d] - xq[dim]), hi[d] = fmax(hi[d], xq[d] + xq[dim]);
   }
-  return mark_near(w, (int)ceil((reach + rmax) / g->dx), cells);
+  /* wall_at looks at the particles within range + dx: a point whose cell is more than that
+   * many cells, and one, from every particle's cell finds none. */
+  MPM_CALL(mark_near(w, (int)ceil((reach + rmax) / g->dx), 1, cells));
+  return mark_near(w, (int)ceil((range + g->dx) / g->dx) + 1, 2, cells);
 }
 
 /* The solid's nodal sums at x over its stencil: sum S m, sum S m v, sum S grad m; 0 if x's

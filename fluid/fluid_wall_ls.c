@@ -502,7 +502,8 @@ static int moving_block(fluid_wall_ls *w, const mpm_grid *g, double h) {
   double lo[MPM_MAX_DIM], hi[MPM_MAX_DIM];
   int blo[MPM_MAX_DIM], bn[MPM_MAX_DIM], changed = 0;
   memset(w->near_src, 0, (size_t)g->nnodes);
-  MPM_CALL(w->src->prepare(w->src->ctx, h, reach_of(w, g), w->near_src, lo, hi));
+  MPM_CALL(
+      w->src->prepare(w->src->ctx, h, reach_of(w, g), w->band + w->blend, w->near_src, lo, hi));
   block_of(g, lo, hi, reach_of(w, g), blo, bn);
   for (int d = 0; d < dim; ++d) {
     if (w->obs_n[d] > 0 && bn[d] > 0) {
@@ -560,14 +561,15 @@ int fluid_wall_ls_apply(mpm_module *m, const double *y, double *ydot, double h) 
     w->kind[i] = -1;
     const mpm_lidx cell = in ? mpm_grid_local_index(g, gi) : 0;
     const int r = in && w->reach ? w->reach[cell] : REACH_FAR;
-    const int moving = in && w->src && w->near_src[cell];
+    const int moving = in && w->src ? w->near_src[cell] : 0;
     if (r == REACH_FAR && !moving) continue;
     double *geo = w->geo + (size_t)gs * i, *f = w->val + (size_t)nf * i;
     geo[0] = HUGE_VAL;
     if (r == REACH_MAY_FIT) w->ob[i] = nearest(&fc->obs, dim, x, &geo[0], geo + 1);
     for (int d = 0; d < dim; ++d) geo[1 + dim + d] = 0.0; /* a static wall */
     double phi, nrm[MPM_MAX_DIM], vw[MPM_MAX_DIM];
-    if (moving && w->src->at(w->src->ctx, x, w->band + w->blend, &phi, nrm, vw) && phi < geo[0]) {
+    if (moving == 2 && w->src->at(w->src->ctx, x, w->band + w->blend, &phi, nrm, vw) &&
+        phi < geo[0]) {
       w->ob[i] = -1, geo[0] = phi;
       memcpy(geo + 1, nrm, sizeof *nrm * (size_t)dim);
       memcpy(geo + 1 + dim, vw, sizeof *vw * (size_t)dim);

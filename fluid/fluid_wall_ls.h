@@ -120,7 +120,8 @@ typedef struct fluid_wall_ls {
   int *ob;           /* wall particle: the nearest obstacle, or -1 for the moving wall */
   double *geo; /* wall particle: phi, the outward normal and the wall's velocity (1 + 2 dim) */
   const mpm_wall_source *src; /* a moving wall a coupling scheme gave the gas (mpm_wall.h) */
-  unsigned char *near_src;    /* per box node as a cell's lower corner: near that wall, this step */
+  unsigned char *near_src;    /* per box node as a cell's lower corner: near that wall (1), where it
+                                 may    be fitted (2), this step (mpm_wall.h) */
   double *val;                /* new field values (nf per particle) */
 } fluid_wall_ls;
 
