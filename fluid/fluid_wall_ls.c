@@ -417,8 +417,8 @@ int fluid_wall_ls_init(mpm_module *m, const mpm_config *cfg, int classic) {
       lo[d] = fmin(lo[d], fc->obs.ob[k].sdf.lo[d]), hi[d] = fmax(hi[d], fc->obs.ob[k].sdf.hi[d]);
   }
   block_of(g, lo, hi, reach, w->obs_lo, w->obs_n);
-  memcpy(w->clear_lo, w->obs_lo, sizeof w->clear_lo),
-      memcpy(w->clear_n, w->obs_n, sizeof w->clear_n);
+  memcpy(w->clear_lo, w->obs_lo, sizeof w->clear_lo);
+  memcpy(w->clear_n, w->obs_n, sizeof w->clear_n);
   return 0;
 }
 
@@ -519,7 +519,8 @@ static int moving_block(fluid_wall_ls *w, const mpm_grid *g, double h) {
   memset(w->mom, 0, sizeof *w->mom * (size_t)w->nmom * g->nnodes);
   memset(w->halo, 0, sizeof *w->halo * (size_t)w->nmom * g->nnodes);
   memset(w->need, 0, sizeof *w->need * (size_t)g->nnodes);
-  memcpy(w->clear_lo, blo, sizeof blo), memcpy(w->clear_n, bn, sizeof bn);
+  memcpy(w->clear_lo, blo, sizeof blo);
+  memcpy(w->clear_n, bn, sizeof bn);
   return 0;
 }
 
