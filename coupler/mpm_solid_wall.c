@@ -224,19 +224,16 @@ static int wall_prepare(void *ctx, double h, double reach, double range, unsigne
   return mark_near(w, (int)ceil((range + g->dx) / g->dx) + 1, 2, cells);
 }
 
-/* The solid's nodal sums at x over its stencil: sum S m, sum S m v, sum S grad m; 0 if x's
- * stencil leaves the box. */
-static int nodal_at(const mpm_solid_wall *w, const double *x, double *m, double *mv, double *gm) {
-  const mpm_grid *g = w->c->grid;
-  const mpm_grid_phase *s = mpm_coupling_phase(w->c, MPM_ROLE_SOLID);
+/* The nodes of the stencil of x (box indices) and their weights, at most 64; their count, or 0
+ * if the stencil leaves the box. */
+enum { STENCIL_MAX = 64 };
+static int stencil(const mpm_grid *g, const double *x, mpm_lidx *node, double *weight) {
   const int dim = g->dim, sup = mpm_shape_support(g->shape);
   int base[MPM_MAX_DIM];
   double xi[MPM_MAX_DIM], wt[MPM_MAX_DIM][MPM_SHAPE_MAX_SUPPORT],
       dw[MPM_MAX_DIM][MPM_SHAPE_MAX_SUPPORT];
   for (int d = 0; d < dim; ++d) xi[d] = (x[d] - g->lo[d]) / g->dx;
   mpm_shape_eval(g->shape, dim, xi, 0.0, base, wt, dw);
-  *m = 0.0;
-  for (int d = 0; d < dim; ++d) mv[d] = gm[d] = 0.0;
   const int count = dim == 2 ? sup * sup : sup * sup * sup;
   for (int k = 0; k < count; ++k) {
     int gi[MPM_MAX_DIM];
@@ -246,12 +243,30 @@ static int nodal_at(const mpm_solid_wall *w, const double *x, double *m, double 
       if (gi[d] < g->box_lo[d] || gi[d] >= g->box_lo[d] + g->box_n[d]) return 0;
       W *= wt[d][r % sup];
     }
-    const mpm_lidx l = mpm_grid_local_index(g, gi);
-    const double ml = w->nod_ptr[0][l];
-    *m += W * ml;
-    for (int d = 0; d < dim; ++d) mv[d] += W * ml * s->v_i[d][l], gm[d] += W * w->nod_ptr[1 + d][l];
+    node[k] = mpm_grid_local_index(g, gi), weight[k] = W;
   }
-  return 1;
+  return count;
+}
+
+/* The solid's nodal sums at x over its stencil: sum S m, sum S m v, sum S grad m; 0 if x's
+ * stencil leaves the box. */
+static int nodal_at(const mpm_solid_wall *w, const double *x, double *m, double *mv, double *gm) {
+  const mpm_grid *g = w->c->grid;
+  const mpm_grid_phase *s = mpm_coupling_phase(w->c, MPM_ROLE_SOLID);
+  const int dim = g->dim;
+  mpm_lidx node[STENCIL_MAX];
+  double W[STENCIL_MAX];
+  const int count = stencil(g, x, node, W);
+  *m = 0.0;
+  for (int d = 0; d < dim; ++d) mv[d] = gm[d] = 0.0;
+  for (int k = 0; k < count; ++k) {
+    const mpm_lidx l = node[k];
+    const double ml = w->nod_ptr[0][l];
+    *m += W[k] * ml;
+    for (int d = 0; d < dim; ++d)
+      mv[d] += W[k] * ml * s->v_i[d][l], gm[d] += W[k] * w->nod_ptr[1 + d][l];
+  }
+  return count > 0;
 }
 
 static int wall_at(void *ctx, const double *x, double range, double *phi, double *n, double *v) {
@@ -302,24 +317,12 @@ static double wall_impulse(void *ctx, const double *x, const double *J) {
   mpm_coupling *c = w->c;
   const mpm_grid *g = c->grid;
   const mpm_grid_phase *s = mpm_coupling_phase(c, MPM_ROLE_SOLID);
-  const int dim = g->dim, sup = mpm_shape_support(g->shape);
+  const int dim = g->dim;
   const double h = w->h;
-  int base[MPM_MAX_DIM];
-  double xi[MPM_MAX_DIM], wt[MPM_MAX_DIM][MPM_SHAPE_MAX_SUPPORT],
-      dw[MPM_MAX_DIM][MPM_SHAPE_MAX_SUPPORT];
-  for (int d = 0; d < dim; ++d) xi[d] = (x[d] - g->lo[d]) / g->dx;
-  mpm_shape_eval(g->shape, dim, xi, 0.0, base, wt, dw);
-  const int count = dim == 2 ? sup * sup : sup * sup * sup;
-  mpm_lidx node[64];
-  double share[64], sum = 0.0, work = 0.0;
-  for (int k = 0; k < count; ++k) { /* wall_at found the stencil inside the box, with mass */
-    int gi[MPM_MAX_DIM];
-    double W = 1.0;
-    for (int d = 0, r = k; d < dim; r /= sup, ++d) gi[d] = base[d] + r % sup, W *= wt[d][r % sup];
-    node[k] = mpm_grid_local_index(g, gi);
-    share[k] = W * w->nod_ptr[0][node[k]];
-    sum += share[k];
-  }
+  mpm_lidx node[STENCIL_MAX];
+  double share[STENCIL_MAX], sum = 0.0, work = 0.0;
+  const int count = stencil(g, x, node, share); /* wall_at found it inside the box, with mass */
+  for (int k = 0; k < count; ++k) share[k] *= w->nod_ptr[0][node[k]], sum += share[k];
   /* The work at the nodes' time-centred velocity v - h a / 2, as the solid's exchange counts
    * it (wall_finish): what the gas gains the solid loses, less the impulse's own sum J^2 / 2m. */
   for (int k = 0; k < count; ++k)
