@@ -89,13 +89,13 @@ static int gather(mpm_solid_wall *w, double margin) {
 }
 
 /* The bucket cell of x, clamped to the lattice. */
-static int bucket_of(const mpm_solid_wall *w, const double *x, int *b) {
+static int bucket_of(const mpm_solid_wall *w, const double *x) {
   const mpm_grid *g = w->c->grid;
   int k = 0;
   for (int d = g->dim - 1; d >= 0; --d) {
-    b[d] = mpm_shape_floor((x[d] - g->lo[d]) / g->dx) - w->blo[d];
-    b[d] = b[d] < 0 ? 0 : b[d] >= w->bn[d] ? w->bn[d] - 1 : b[d];
-    k = k * w->bn[d] + b[d];
+    int b = mpm_shape_floor((x[d] - g->lo[d]) / g->dx) - w->blo[d];
+    b = b < 0 ? 0 : b >= w->bn[d] ? w->bn[d] - 1 : b;
+    k = k * w->bn[d] + b;
   }
   return k;
 }
@@ -123,11 +123,9 @@ static int bucket(mpm_solid_wall *w) {
     w->bcap = cells + 1;
   }
   memset(w->start, 0, sizeof *w->start * (cells + 1));
-  int b[MPM_MAX_DIM];
-  for (int q = 0; q < w->n; ++q) w->start[bucket_of(w, w->gx + (size_t)q * stride, b) + 1]++;
+  for (int q = 0; q < w->n; ++q) w->start[bucket_of(w, w->gx + (size_t)q * stride) + 1]++;
   for (size_t k = 0; k < cells; ++k) w->start[k + 1] += w->start[k];
-  for (int q = 0; q < w->n; ++q)
-    w->order[w->start[bucket_of(w, w->gx + (size_t)q * stride, b)]++] = q;
+  for (int q = 0; q < w->n; ++q) w->order[w->start[bucket_of(w, w->gx + (size_t)q * stride)]++] = q;
   for (size_t k = cells; k > 0; --k) w->start[k] = w->start[k - 1];
   w->start[0] = 0;
   return 0;
