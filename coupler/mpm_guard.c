@@ -7,7 +7,7 @@
 #include <stdlib.h>
 
 const mpm_key_spec mpm_guard_keys[] = {
-    {"time.collapse_ratio", MPM_KEY_REAL, "1e-4", 0, 1, 0, 0, NULL,
+    {"time.collapse_ratio", MPM_KEY_REAL, "1e-3", 0, 1, 0, 0, NULL,
      "blow-up guard: stop when the step stays below this fraction of the starting state's CFL "
      "step for time.collapse_steps steps in a row (0: never)",
      0},
