@@ -27,6 +27,9 @@ void fluid_open_destroy(fluid_open **open);
 int fluid_open_p2g(fluid_open *open, mpm_module *m, const double *y, fluid_virtual *virt);
 /* Does a face continue the particle columns (so the module needs virtual particles)? */
 int fluid_open_uses_virtual(const fluid_open *open);
+/* freestream.exterior = gauge: add the gauge points' forces (deposited by fluid_open_p2g) at
+ * the nodes whose stencil crosses a face, after the gas's reverse halo. Collective. */
+int fluid_open_gauge_forces(fluid_open *open, mpm_module *m);
 /* Before the nodal update (first pass only) at time t: add the force of the exterior
  * lattice of the inflow faces to the nodal forces. */
 int fluid_open_forces(fluid_open *open, mpm_module *m, double t);

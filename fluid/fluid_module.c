@@ -359,6 +359,7 @@ static int fluid_forces(mpm_module *m, double t, double h, mpm_pass pass) {
   if (first) {
     MPM_CALL(fluid_obstacles_begin(&fc->obs, m->grid, m->phase, t, h, 1));
     MPM_CALL(fluid_virtual_forces(&fc->virt, m->grid, m->phase, NULL, 0));
+    MPM_CALL(fluid_open_gauge_forces(fc->open, m));
   }
   mpm_constraints_fold(&fc->cons, m->grid, m->phase);
   if (first) MPM_CALL(fluid_open_forces(fc->open, m, t));

@@ -121,3 +121,7 @@ mpm_add_script_test(test_pic_rate SCRIPT verification/test_pic_rate.py LABELS ve
 # and the cost at equal error on made-up rows.
 mpm_add_script_test(test_ablate SCRIPT verification/test_ablate.py LABELS conformance
                     TIMEOUT 300)
+# Far-field faces under mixed flow: freestream.exterior = gauge holds the entering characteristic
+# where copies let it drift; an off state relaxes; 2 ranks vs 1; bad input (~70 s).
+mpm_add_script_test(test_farfield_gauge SCRIPT verification/test_farfield_gauge.py
+                    LABELS "verification;mpi" TIMEOUT 600)
