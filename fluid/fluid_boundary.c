@@ -91,7 +91,8 @@ const mpm_key_spec fluid_boundary_keys[] = {
      "how the outflow, subsonic_outflow, subsonic_inflow and farfield faces stand in for the "
      "gas beyond them: copies (virtual particles continuing the particle columns) or gauge "
      "(the nodes within a stencil of the face feel the particles' pressure less the boundary "
-     "pressure, which holds the far field when mixed flow crosses the face; see "
+     "pressure, which holds the far field when mixed flow crosses the face, but blew up on "
+     "RAE 2822 at 50 cells per chord when a vortex crossed the face; see "
      "fluid/fluid_boundary.c)",
      0},
 };
@@ -494,7 +495,11 @@ static int continue_columns(const fluid_open *o, const open_face *f, const mpm_m
  * measured and not kept: p_b from each particle's own state (0.023, but an acoustic pulse
  * leaving through the face reflected R = -0.18: the nodes there felt p - p_b = (w- - w-_inf)
  * / 2, no longer the wave's gradient), and from the column's mean state within reach (0.028,
- * R = -0.135: the mean lags the wave); with the outermost particle R = -0.023, as the copies'. */
+ * R = -0.135: the mean lags the wave); with the outermost particle R = -0.023, as the copies'.
+ * Not cured: a particle here whose pressure falls below p_b (a vortex core) is under tension,
+ * p - p_b < 0, and as it expands its point's J V0 p_b pulls harder. On cases/rae2822.ini at
+ * dx = 0.02 the starting vortex crossing the outflow face blew the run up at t = 6.65
+ * (particles at J = 20-50 there); at dx = 0.04 and 0.028 the case ran to its end. */
 static int gauge_points(fluid_open *o, const mpm_module *m, const double *y) {
   const mpm_particles *p = m->particles;
   const mpm_grid *g = m->grid;
