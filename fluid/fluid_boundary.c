@@ -132,8 +132,6 @@ struct fluid_open {
   fluid_virtual gpts; /* the gauge points, in a grid phase of their own */
   mpm_lidx nnear;     /* box nodes whose stencil crosses such a face */
   mpm_lidx *near;     /* their indices */
-  double *gpb, *gdep; /* per particle: its gauge pressure and depth (cap gcap each) */
-  mpm_lidx gcap;
   mpm_lidx cand_cap;
   struct column_entry *cand; /* near-face particles of the faces, by face and column */
 };
