@@ -95,6 +95,14 @@ const mpm_key_spec fluid_boundary_keys[] = {
      "RAE 2822 at 50 cells per chord when a vortex crossed the face; see "
      "fluid/fluid_boundary.c)",
      0},
+    {"freestream.sponge", MPM_KEY_REAL, "0", 0, HUGE_VAL, 0, 0, NULL,
+     "thickness, m, of an absorbing layer inside every farfield face that relaxes the gas's "
+     "incoming characteristic towards the free stream's (0: none; see fluid/fluid_boundary.c)",
+     0},
+    {"freestream.sponge_rate", MPM_KEY_REAL, NULL, 0, HUGE_VAL, 1, 0, NULL,
+     "the sponge's relaxation rate at the face, 1/s (default 3 c_inf / freestream.sponge: a "
+     "wave crossing the layer at the sound speed is damped by e^-1)",
+     1},
 };
 const int fluid_boundary_nkeys = (int)(sizeof fluid_boundary_keys / sizeof fluid_boundary_keys[0]);
 
@@ -127,8 +135,9 @@ struct fluid_open {
   double rho, p, v[MPM_MAX_DIM], e, c, Z, p_back; /* free stream */
   double gamma;
   int ppc;
-  int columns; /* a face continues the particle columns (all but inflow) */
-  int gauge;   /* freestream.exterior = gauge: those faces act through gauge points instead */
+  double sponge, sponge_rate; /* the farfield faces' absorbing layer: thickness (0: none), rate */
+  int columns;                /* a face continues the particle columns (all but inflow) */
+  int gauge; /* freestream.exterior = gauge: those faces act through gauge points instead */
   fluid_virtual gpts; /* the gauge points, in a grid phase of their own */
   mpm_lidx nnear;     /* box nodes whose stencil crosses such a face */
   mpm_lidx *near;     /* their indices */
@@ -272,6 +281,29 @@ static int read_freestream(fluid_open *o, const mpm_config *cfg, const mpm_walls
   return 0;
 }
 
+/* freestream.sponge and sponge_rate (the rate defaults to 3 c_inf / thickness, so that a wave
+ * crossing the layer at the sound speed is damped by about e^-1), checked against the faces
+ * whether or not there is an open face: a sponge that nothing reads is an input error. */
+static int read_sponge(fluid_open *o, const mpm_config *cfg, const mpm_walls *walls, int dim) {
+  int farfield = 0;
+  for (int d = 0; d < dim; ++d)
+    for (int s = 0; s < 2; ++s) farfield |= walls->face[d][s] == MPM_WALL_FARFIELD;
+  MPM_CALL(mpm_config_get_real(cfg, "freestream.sponge", &o->sponge));
+  if (o->sponge > 0 && !farfield)
+    return mpm_config_fail(cfg, "freestream.sponge",
+                           "acts inside farfield faces, and this case has none: make the open "
+                           "faces farfield, or set it to 0");
+  if (!mpm_config_has(cfg, "freestream.sponge_rate")) {
+    o->sponge_rate = o->sponge > 0 ? 3.0 * o->c / o->sponge : 0.0;
+    return 0;
+  }
+  if (!(o->sponge > 0))
+    return mpm_config_fail(cfg, "freestream.sponge_rate",
+                           "is set but freestream.sponge (the layer's thickness) is 0: set "
+                           "both, or remove sponge_rate");
+  return mpm_config_get_real(cfg, "freestream.sponge_rate", &o->sponge_rate);
+}
+
 /* Face kinds against the free stream: an inflow face needs gas that enters. */
 static int check_face(const fluid_open *o, const open_face *f, const mpm_config *cfg) {
   const double un = f->sign * o->v[f->axis];
@@ -298,13 +330,17 @@ int fluid_open_new(fluid_open **openp, mpm_module *m, const mpm_config *cfg, con
   int any = 0;
   for (int d = 0; d < g->dim; ++d)
     for (int s = 0; s < 2; ++s) any |= mpm_wall_is_open_gas(walls->face[d][s]);
-  if (!any) return 0;
+  if (!any) { /* no free stream to relax towards; read_sponge refuses a sponge */
+    fluid_open none = {0};
+    return read_sponge(&none, cfg, walls, g->dim);
+  }
   fluid_open *o;
   MPM_ALLOC(o, 1);
   *openp = o;
   o->ppc = ppc;
   o->gamma = gamma;
   MPM_CALL(read_freestream(o, cfg, walls, g->dim, gamma));
+  MPM_CALL(read_sponge(o, cfg, walls, g->dim));
   o->gpts.phase = -1;
   const char *exterior;
   MPM_CALL(mpm_config_get_string(cfg, "freestream.exterior", &exterior));
@@ -590,6 +626,58 @@ void fluid_open_hold(const fluid_open *o, mpm_module *m) {
         ph->v_i[d][l] = ph->v_i[d][src] + b * (ph->v_i[d][src] - ph->v_i[d][in]);
         ph->a_i[d][l] = ph->a_i[d][src] + b * (ph->a_i[d][src] - ph->a_i[d][in]);
       }
+    }
+  }
+}
+
+/* ---- the sponge ------------------------------------------------------------------------------ */
+
+/* freestream.sponge = L: within L of a farfield face, the incoming characteristic
+ * w = p - Z u.n (n outward, Z = rho c the particle's own impedance) relaxes towards the free
+ * stream's, p_inf - Z u_inf.n, at the rate s(d) = s0 (1 - d/L)^2 (d the depth inside the face,
+ * s0 = freestream.sponge_rate): the source adds dp/dt = s dw/2 and du.n/dt = -s dw/(2 Z), which
+ * leave the outgoing characteristic p + Z u.n alone, and changes the density isentropically
+ * (drho/dt = (dp/dt)/c^2, through J; de/dt = p/rho^2 drho/dt), so the entropy and the
+ * tangential velocity that the flow carries out pass untouched.
+ * Why. The face itself sets only the one incoming characteristic of its boundary state; when
+ * a noisy, mixed flow (the wake of a lifting aerofoil) crosses it, its virtual copies overlap the
+ * gas's own particles and the gas next to the face drifts off the free stream, and with it the
+ * whole tunnel (see README, Open faces). The layer imposes the same characteristic over a
+ * depth instead of at a face, as a rate on each particle, with no reference to the copies.
+ * It is a source of momentum and energy (that of the waves it absorbs): a run with a sponge
+ * does not conserve them, as a run with open faces does not. Local. */
+void fluid_open_sponge(const fluid_open *o, const mpm_module *m, const double *y, double *ydot) {
+  if (!o || !(o->sponge > 0)) return;
+  const fluid_content *fc = m->content;
+  const mpm_particles *p = m->particles;
+  const mpm_grid *g = m->grid;
+  const int dim = g->dim;
+  const mpm_lidx n = p->n;
+  const double *mass = mpm_particles_comp(p, fc->lay.f_m, 0);
+  const double *V0 = mpm_particles_comp(p, fc->lay.f_V0, 0);
+  const size_t ox = (size_t)p->offset[FLUID_X] * n, ov = (size_t)p->offset[FLUID_V] * n;
+  const size_t oJ = (size_t)p->offset[FLUID_J] * n, oe = (size_t)p->offset[FLUID_E] * n;
+  for (int k = 0; k < o->nfaces; ++k) {
+    const open_face *f = &o->face[k];
+    if (f->kind != MPM_WALL_FARFIELD) continue;
+    const int a = f->axis;
+    const double un_inf = f->sign * o->v[a];
+    for (mpm_lidx i = 0; i < n; ++i) {
+      double x[MPM_MAX_DIM];
+      for (int d = 0; d < dim; ++d) x[d] = y[ox + (size_t)d * n + i];
+      const double dep = fmax(depth(g, f, x), 0.0);
+      if (dep >= o->sponge) continue;
+      const double r = 1.0 - dep / o->sponge, s = o->sponge_rate * r * r;
+      const double J = y[oJ + i], e = y[oe + i], rho = mass[i] / (V0[i] * J);
+      const double pr = fluid_pressure(o->gamma, rho, e);
+      if (!(pr > 0.0)) continue;
+      const double c = fluid_sound_speed(o->gamma, rho, pr), Z = rho * c;
+      const double un = f->sign * y[ov + (size_t)a * n + i];
+      const double dw = (o->p - Z * un_inf) - (pr - Z * un);
+      const double pdot = 0.5 * s * dw, rhodot = pdot / (c * c);
+      ydot[ov + (size_t)a * n + i] -= f->sign * 0.5 * s * dw / Z;
+      ydot[oJ + i] -= J * rhodot / rho;
+      ydot[oe + i] += pr / (rho * rho) * rhodot;
     }
   }
 }

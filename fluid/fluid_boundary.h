@@ -36,6 +36,9 @@ int fluid_open_forces(fluid_open *open, mpm_module *m, double t);
 /* After the nodal update: hold the nodes on and beyond an inflow face at the free-stream
  * velocity; beyond the other open faces, extrapolate the face node linearly. */
 void fluid_open_hold(const fluid_open *open, mpm_module *m);
+/* freestream.sponge: add the absorbing layer's rates to ydot (the state's rates at y, in any
+ * form of the step) for the particles within its thickness of a farfield face. Local. */
+void fluid_open_sponge(const fluid_open *open, const mpm_module *m, const double *y, double *ydot);
 /* Between steps (the boundary op): remove particles that left through an open face and inject
  * the free-stream layers that entered during the step h that ended at t, as an edit deferred
  * to the migration that follows. Local. */

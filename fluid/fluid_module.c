@@ -502,6 +502,7 @@ static int fluid_g2p(mpm_module *m, double t, const double *y, double *ydot, dou
   fluid_obstacles_heat(&fc->obs, m->grid, n, pos, state(p, y, FLUID_E), h, fc->power);
   memcpy(ydot + (size_t)p->offset[FLUID_E] * n, fc->power, sizeof(double) * (size_t)n);
   if (h > 0) MPM_CALL(fluid_wall_ls_apply(m, y, ydot, h));
+  fluid_open_sponge(fc->open, m, y, ydot);
   fluid_obstacles_list_done(&fc->obs);
   return 0;
 }

@@ -51,7 +51,7 @@ def rest():
     mt.run(["run", CASE, f"output.dir={out}", "run.progress=false", "output.snapshots=false",
             "domain.lo=-0.5 -0.5", "domain.hi=1.5 0.5", "geometry.air.lo=-0.5 -0.5",
             "geometry.air.hi=1.5 0.5", "gas.air.velocity=0 0", "freestream.velocity=0 0",
-            "time.t_end=0.05", "obstacle.rae2822.surface_interval=0.01"]
+            "time.t_end=0.05", "obstacle.rae2822.surface_interval=0.01", "freestream.sponge=0"]
            + [f"boundary.{f}=slip" for f in ("x_lo", "x_hi", "y_lo", "y_hi")])
     s = surface(out)
     times = np.unique(s["t"])
