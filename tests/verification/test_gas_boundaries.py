@@ -55,6 +55,15 @@ def run(case, name, args, ranks=1):
 
 # 1. Uniform flow.
 SPONGE = 0.25  # freestream.sponge, m: a quarter of the channel, ten cells (the pulse's below too)
+
+
+def face_args(exterior):
+    """The keys of a face variant: copies, gauge (freestream.exterior) or sponge (copies with
+    the absorbing layer)."""
+    if exterior == "sponge":
+        return [f"freestream.sponge={SPONGE}"]
+    return [f"freestream.exterior={exterior}"]
+
 FLOWS = [("inflow", "outflow", 2.0, "usl", "copies"), ("inflow", "outflow", 2.0, "bs32", "copies"),
          ("subsonic_inflow", "subsonic_outflow", 0.5, "usl", "copies"),
          ("farfield", "farfield", 0.5, "usl", "copies"), ("farfield", "farfield", 0.5, "bs32", "copies"),
@@ -66,7 +75,7 @@ FLOWS = [("inflow", "outflow", 2.0, "usl", "copies"), ("inflow", "outflow", 2.0,
          ("farfield", "farfield", 2.0, "usl", "sponge")]
 for lo, hi, u, method, exterior in FLOWS:
     t_end = 2.0 / u
-    extra = [f"freestream.exterior={exterior}"] if exterior != "sponge" else [f"freestream.sponge={SPONGE}"]
+    extra = face_args(exterior)
     method = f"{method}, {exterior}" if exterior != "copies" else method
     out = run(CHANNEL, f"uniform_{lo}_{u:g}_{method.replace(', ', '_')}",
               [f"boundary.x_lo={lo}", f"boundary.x_hi={hi}", f"freestream.velocity={u} 0",
@@ -125,7 +134,7 @@ def extreme(path, select):
 for face, lo, hi, exterior in (("farfield", -0.05, 0.05, "copies"), ("slip", 0.7, 10, "copies"),
                                ("subsonic_outflow", -10, -0.7, "copies"),
                                ("farfield", -0.05, 0.05, "gauge"), ("farfield", -0.05, 0.05, "sponge")):
-    extra = [f"freestream.exterior={exterior}"] if exterior != "sponge" else [f"freestream.sponge={SPONGE}"]
+    extra = face_args(exterior)
     out = run(PULSE, f"pulse_{face}_{exterior}", [f"boundary.x_lo={face}", f"boundary.x_hi={face}"] + extra)
     face = f"{face} ({exterior})" if exterior != "copies" else face
     snaps = mt.snapshots(out)
