@@ -63,6 +63,7 @@ for dx in [float(v) for v in a.dx.split(",")]:
     row.update({k: res[k] for k in ("rms_lower", "rms_upper_ahead", "rms_lower_010_100",
                                     "rms_upper_010_050", "shock_x", "cl", "cd",
                                     "cl_change", "cp_drift_rms", "steady", "t_from", "t_to")})
+    row.update({k: v for k, v in res.items() if k.startswith("ref_")})
     rows.append(row)
     curves.append((dx, cp))
     print(json.dumps(row), flush=True)
@@ -112,6 +113,18 @@ with open(a.out + ".md", "w") as f:
                 f"(Cl {100 * r['cl_change']:.1f} %, Cp {r['cp_drift_rms']:.3f}) |\n")
     f.write(f"\nExperiment's shock (same definition, Cp rising through Cp*): x/c = {exp_shock:.3f}. "
             "Targets: RMS lower <= 0.05, upper ahead <= 0.08, shock within 0.08 c.\n")
+    if "ref_rms_upper" in rows[0]:
+        f.write("\nAgainst the inviscid reference (Euler on a body-fitted grid, "
+                "[rae2822_euler.md](rae2822_euler.md); RMS at stations every 0.01 c):\n\n"
+                "| cells per chord | upper, x/c 0.01-0.99 | lower | nose (0.01-0.1): upper / "
+                "lower | upper 0.1-0.5 | lower 0.1-0.99 | shock x/c (reference's) |\n"
+                "|---|---|---|---|---|---|---|\n")
+        for r in rows:
+            f.write(f"| {r['cells_per_chord']} | {r['ref_rms_upper']:.3f} | "
+                    f"{r['ref_rms_lower']:.3f} | {r['ref_rms_upper_nose']:.3f} / "
+                    f"{r['ref_rms_lower_nose']:.3f} | {r['ref_rms_upper_010_050']:.3f} | "
+                    f"{r['ref_rms_lower_010']:.3f} | {r['shock_x']:.3f} "
+                    f"({r['ref_shock_x']:.3f}) |\n")
     if cost:
         m = cost["median"]
         f.write(f"\nCost at dx = 0.04, 1 rank, t in [0, 1], median of {a.repeats}: ghost "
@@ -131,6 +144,11 @@ for k, (dx, cp) in enumerate(curves):
 for side, mk in (("upper", "o"), ("lower", "s")):
     ax.plot([p[0] for p in exp[side]], [p[1] for p in exp[side]], mk, mfc="none", color="k",
             ms=4, label=f"experiment {side}")
+if os.path.exists(rae2822.REFERENCE):
+    ref = rae2822.reference()
+    for side in ("upper", "lower"):
+        ax.plot([p[0] for p in ref[side]], [p[1] for p in ref[side]], "-", color="k", lw=0.7,
+                label="Euler, body-fitted grid" if side == "upper" else None)
 ax.axhline(rae2822.cp_critical(), color="gray", lw=0.5, ls=":", label="Cp*")
 ax.invert_yaxis()
 ax.set_xlabel("x/c")

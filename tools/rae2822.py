@@ -18,6 +18,12 @@ and returns (as JSON with --json) the figures the issue asks for:
   the RMS difference between the Cp of the last window and the mean of the span before it.
   The run is called steady when the two Cl means differ by less than 2 % and the Cp RMS by less
   than 0.03 (the scatter of a single window on a steady run at these resolutions; see README).
+- against the inviscid reference (bench/results/rae2822_euler_cp.csv, if there), the model's
+  own answer on a body-fitted grid: the RMS difference at stations every 0.01 c on each surface
+  (x/c 0.01-0.99), round the nose (0.01-0.1), on the upper surface ahead of the shock (0.1-0.5)
+  and on the lower one behind the nose (0.1-0.99), and the reference's shock position. This
+  separates the gas module's error, which refinement should shrink, from the inviscid model's
+  against the experiment, which it cannot.
 
 With --plot PNG: Cp against x/c (both surfaces, experiment as symbols); with --field PNG: the
 pressure coefficient of the last snapshot's particles around the aerofoil.
@@ -33,6 +39,9 @@ import sys
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 EXPERIMENT = os.path.join(ROOT, "..", "shared", "validation", "rae2822_case9_cp_experiment.csv")
+# The converged inviscid solution at the case's M and alpha (tools/euler_aerofoil.py on a
+# body-fitted grid; see bench/results/rae2822_euler.md)
+REFERENCE = os.path.join(ROOT, "bench", "results", "rae2822_euler_cp.csv")
 MACH, GAMMA = 0.729, 1.4
 UPPER_AHEAD = 0.50  # upper-surface RMS: stations x/c <= this (the experiment's shock: 0.55-0.575)
 
@@ -54,6 +63,21 @@ def experiment():
         for side in (("upper", "lower") if r["surface"] == "leading_edge" else (r["surface"],)):
             sides[side].append((float(r["x_over_c"]), float(r["cp"])))
     return {k: sorted(v) for k, v in sides.items()}
+
+
+def reference(path=REFERENCE):
+    """{side: [(x/c, cp)]} of an inviscid reference written by tools/euler_aerofoil.py."""
+    sides = {"upper": [], "lower": []}
+    for r in read_rows(path):
+        sides[r["side"]].append((float(r["x_over_c"]), float(r["cp"])))
+    return {k: sorted(v) for k, v in sides.items()}
+
+
+def rms_against(cp, ref, side, xmin, xmax=0.99, step=0.01):
+    """RMS difference of two Cp curves on one side at evenly spaced x/c stations."""
+    n = int(round((xmax - xmin) / step)) + 1
+    d = [interp(cp[side], x) - interp(ref[side], x) for x in (xmin + k * step for k in range(n))]
+    return math.sqrt(sum(v * v for v in d) / n)
 
 
 def surface_windows(run):
@@ -153,6 +177,14 @@ def analyse(run, windows):
         "cp_drift_rms": drift,
     }
     res["steady"] = res["cl_change"] < 0.02 and drift < 0.03
+    if os.path.exists(REFERENCE):  # against the inviscid solution, stations every 0.01 c
+        ref = reference()
+        for side in ("upper", "lower"):
+            res[f"ref_rms_{side}"] = rms_against(cp, ref, side, 0.01)
+            res[f"ref_rms_{side}_nose"] = rms_against(cp, ref, side, 0.01, 0.1)
+        res["ref_rms_upper_010_050"] = rms_against(cp, ref, "upper", 0.1, UPPER_AHEAD)
+        res["ref_rms_lower_010"] = rms_against(cp, ref, "lower", 0.1)
+        res["ref_shock_x"] = shock_position(ref["upper"])
     return res, cp, exp
 
 
@@ -166,6 +198,11 @@ def plot_cp(cp, exp, res, path, label=None):
                 label=f"{label or 'mpmfsi'} {side}")
         ax.plot([p[0] for p in exp[side]], [p[1] for p in exp[side]], "o", mfc="none",
                 color=col, ms=4, label=f"experiment {side}")
+    if os.path.exists(REFERENCE):
+        ref = reference()
+        for side in ("upper", "lower"):
+            ax.plot([p[0] for p in ref[side]], [p[1] for p in ref[side]], "-", color="k", lw=0.6,
+                    label="Euler, body-fitted" if side == "upper" else None)
     ax.axhline(res["cp_star"], color="gray", lw=0.5, ls="--", label="Cp*")
     ax.invert_yaxis()
     ax.set_xlabel("x/c")

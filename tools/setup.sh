@@ -8,7 +8,7 @@ shift || true
 
 packages=(build-essential cmake pkg-config libopenmpi-dev openmpi-bin libhdf5-openmpi-dev
           hdf5-tools libsundials-dev libinih-dev libmatheval-dev libcmocka-dev python3-h5py python3-numpy
-          python3-matplotlib libxml2-utils)
+          python3-matplotlib python3-scipy libxml2-utils)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

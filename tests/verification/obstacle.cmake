@@ -31,3 +31,7 @@ mpm_add_script_test(test_rae2822_long SCRIPT verification/test_rae2822.py ARGS l
 mpm_add_script_test(test_rae2822_targets SCRIPT verification/test_rae2822.py ARGS targets
                     LABELS "verification;long;mpi" TIMEOUT 3600)
 set_tests_properties(test_rae2822_targets PROPERTIES WILL_FAIL TRUE)
+# The inviscid reference those figures are also measured against (tools/euler_aerofoil.py): its
+# coarsest grid against its finest, and a symmetric aerofoil without lift (about 90 s, numpy).
+mpm_add_script_test(test_euler_reference SCRIPT verification/test_euler_reference.py
+                    LABELS verification TIMEOUT 600)

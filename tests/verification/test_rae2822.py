@@ -26,7 +26,9 @@ definition: Cp rising through Cp*), and a steady state (Cl of the last two 5-win
 bench/results/rae2822.md): the shock is within 0.08 c and Cl steady since 2026-11-30 (the case's
 wall_blend and far-field sponge), but the nose (radius 0.008 c, a fifth of a cell here) is not
 resolved, which alone keeps both RMS figures far above their targets (0.33 and 0.65; 0.11 and
-0.11 behind x/c = 0.1), and the Cp of the last window moves by 0.057 RMS.
+0.11 behind x/c = 0.1), and the Cp of the last window moves by 0.057 RMS. Nor can any inviscid
+run meet the RMS targets: the converged Euler solution on a body-fitted grid is itself 0.072 and
+0.164 from the experiment (tools/euler_aerofoil.py, bench/results/rae2822_euler.md).
 """
 import os
 import sys
