@@ -62,14 +62,15 @@ rows = []
 for ni, nj, wall in GRIDS:
     res, cp_path = run(f"rae2822_{ni}x{nj}", ["--ni", str(ni), "--nj", str(nj), "--wall",
                                               str(wall)])
-    cp = rae2822.reference(cp_path)
-    res.update({
-        "rms_lower": rae2822.rms(cp, exp, "lower"),
-        "rms_upper_ahead": rae2822.rms(cp, exp, "upper", rae2822.UPPER_AHEAD),
-        "rms_lower_010_100": rae2822.rms(cp, exp, "lower", 1.0, 0.1),
-        "rms_upper_010_050": rae2822.rms(cp, exp, "upper", rae2822.UPPER_AHEAD, 0.1),
-        "shock_x": rae2822.shock_position(cp["upper"]),
-    })
+    for column, tail in (("cp", ""), ("cp_cell", "_cell")):
+        cp = rae2822.reference(cp_path, column)
+        res.update({
+            "rms_lower" + tail: rae2822.rms(cp, exp, "lower"),
+            "rms_upper_ahead" + tail: rae2822.rms(cp, exp, "upper", rae2822.UPPER_AHEAD),
+            "rms_lower_010_100" + tail: rae2822.rms(cp, exp, "lower", 1.0, 0.1),
+            "rms_upper_010_050" + tail: rae2822.rms(cp, exp, "upper", rae2822.UPPER_AHEAD, 0.1),
+            "shock_x" + tail: rae2822.shock_position(cp["upper"]),
+        })
     rows.append(res)
     print(json.dumps(res), flush=True)
 finest = os.path.join(a.work, f"rae2822_{GRIDS[-1][0]}x{GRIDS[-1][1]}_cp.csv")
@@ -100,19 +101,26 @@ with open(a.out + ".json", "w") as f:
     json.dump({"rae2822": rows, "checks": checks}, f, indent=1)
 with open(a.out + ".md", "w") as f:
     f.write("# RAE 2822, M 0.729, alpha 2.31 deg: the inviscid reference (Euler, O-grid)\n\n"
+            "Each figure twice: with the wall pressure extrapolated linearly from the first two "
+            "cells (the reference's Cp), and with the first cell's own (the one the wall flux "
+            "uses).\n\n"
             "| grid (cells) | first cell (c) | iterations | wall s | Cl | Cd | shock x/c | "
             "Cp RMS lower (target 0.05) | upper x/c <= 0.5 (0.08) | from x/c = 0.1: lower / "
             "upper | RMS to the finest grid (the reference): upper / lower |\n"
             "|---|---|---|---|---|---|---|---|---|---|---|\n")
     for r in rows:
         f.write(f"| {r['ni']} x {r['nj']} | {r['wall']} | {r['iterations']} | "
-                f"{r['wall_time']:.0f} | {r['cl']:.4f} | {r['cd']:.4f} | {r['shock_x']:.3f} | "
-                f"{r['rms_lower']:.3f} | {r['rms_upper_ahead']:.3f} | "
-                f"{r['rms_lower_010_100']:.3f} / {r['rms_upper_010_050']:.3f} | "
+                f"{r['wall_time']:.0f} | {r['cl']:.4f}; {r['cl_cell']:.4f} | {r['cd']:.4f}; "
+                f"{r['cd_cell']:.4f} | {r['shock_x']:.3f}; {r['shock_x_cell']:.3f} | "
+                f"{r['rms_lower']:.3f}; {r['rms_lower_cell']:.3f} | {r['rms_upper_ahead']:.3f}; "
+                f"{r['rms_upper_ahead_cell']:.3f} | {r['rms_lower_010_100']:.3f} / "
+                f"{r['rms_upper_010_050']:.3f}; {r['rms_lower_010_100_cell']:.3f} / "
+                f"{r['rms_upper_010_050_cell']:.3f} | "
                 f"{r['to_finest_upper']:.3f} / {r['to_finest_lower']:.3f} |\n")
     f.write(f"\nExperiment's shock (the same definition): x/c = "
             f"{rae2822.shock_position(exp['upper']):.3f}.\n\nThe solver's checks:\n\n")
     for c in checks:
-        f.write(f"- {c['case']}, {c['ni']} x {c['nj']}: Cl {c['cl']:.4f}, Cd {c['cd']:.5f}"
+        f.write(f"- {c['case']}, {c['ni']} x {c['nj']}: Cl {c['cl']:.4f}, Cd {c['cd']:.5f} "
+                f"(first cell's pressure: Cl {c['cl_cell']:.4f}, Cd {c['cd_cell']:.5f})"
                 + (f"; panel method: {c['panel']}" if "panel" in c else "") + "\n")
 print(open(a.out + ".md").read())

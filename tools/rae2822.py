@@ -65,11 +65,12 @@ def experiment():
     return {k: sorted(v) for k, v in sides.items()}
 
 
-def reference(path=REFERENCE):
-    """{side: [(x/c, cp)]} of an inviscid reference written by tools/euler_aerofoil.py."""
+def reference(path=REFERENCE, column="cp"):
+    """{side: [(x/c, cp)]} of an inviscid reference written by tools/euler_aerofoil.py (column
+    cp_cell: the first cell's pressure instead of the wall's extrapolation)."""
     sides = {"upper": [], "lower": []}
     for r in read_rows(path):
-        sides[r["side"]].append((float(r["x_over_c"]), float(r["cp"])))
+        sides[r["side"]].append((float(r["x_over_c"]), float(r[column])))
     return {k: sorted(v) for k, v in sides.items()}
 
 
