@@ -323,6 +323,10 @@ class Solver:
 
 
 def solve(outline, mach, alpha, ni, nj, wall, radius, iters, tol, cfl, log=True):
+    """March from the free stream until the RMS density residual has fallen to tol times its
+    value at iteration 100 (checked every 100) or iters have run. Returns the solver, the mesh,
+    Cl, Cd and the wall pressure (extrapolated), the history (iteration, residual drop, Cl, Cd)
+    and the wall time."""
     mesh = Mesh(make_grid(outline, ni, nj, wall, radius))
     s = Solver(mesh, mach, alpha, cfl)
     t0 = time.time()
