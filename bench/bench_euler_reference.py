@@ -63,14 +63,7 @@ for ni, nj, wall in GRIDS:
     res, cp_path = run(f"rae2822_{ni}x{nj}", ["--ni", str(ni), "--nj", str(nj), "--wall",
                                               str(wall)])
     for column, tail in (("cp", ""), ("cp_cell", "_cell")):
-        cp = rae2822.reference(cp_path, column)
-        res.update({
-            "rms_lower" + tail: rae2822.rms(cp, exp, "lower"),
-            "rms_upper_ahead" + tail: rae2822.rms(cp, exp, "upper", rae2822.UPPER_AHEAD),
-            "rms_lower_010_100" + tail: rae2822.rms(cp, exp, "lower", 1.0, 0.1),
-            "rms_upper_010_050" + tail: rae2822.rms(cp, exp, "upper", rae2822.UPPER_AHEAD, 0.1),
-            "shock_x" + tail: rae2822.shock_position(cp["upper"]),
-        })
+        res.update(rae2822.against_experiment(rae2822.reference(cp_path, column), exp, tail))
     rows.append(res)
     print(json.dumps(res), flush=True)
 finest = os.path.join(a.work, f"rae2822_{GRIDS[-1][0]}x{GRIDS[-1][1]}_cp.csv")

@@ -352,6 +352,12 @@ def solve(outline, mach, alpha, ni, nj, wall, radius, iters, tol, cfl, log=True)
     return s, mesh, cl, cd, pw, hist, time.time() - t0
 
 
+def sides(mesh):
+    """Each wall face's side: upper from the trailing edge to the leading edge (the least x),
+    lower after it."""
+    return np.where(np.arange(mesh.ni) < int(np.argmin(mesh.X[:, 0, 0])), "upper", "lower")
+
+
 def main():
     root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
@@ -375,9 +381,7 @@ def main():
                                             a.radius, a.iters, a.tol, a.cfl)
     cl_cell, cd_cell, pw_cell = s.loads(cell=True)
     cp, cp_cell = (pw - s.p0) / s.q, (pw_cell - s.p0) / s.q
-    xm = mesh.wall_mid
-    i_le = int(np.argmin(mesh.X[:, 0, 0]))
-    side = np.where(np.arange(mesh.ni) < i_le, "upper", "lower")
+    xm, side = mesh.wall_mid, sides(mesh)
     res = {"mach": a.mach, "alpha": a.alpha, "ni": a.ni, "nj": a.nj, "wall": a.wall,
            "radius": a.radius, "iterations": hist[-1][0], "residual_drop": hist[-1][1],
            "cl": cl, "cd": cd, "cl_cell": cl_cell, "cd_cell": cd_cell, "wall_time": wall}

@@ -35,9 +35,8 @@ s, mesh, cl, cd, pw, hist, wall = E.solve(E.read_outline(mt.case("rae2822_coordi
                                           0.729, 2.31, 192, 64, 0.002, 40.0, 20000, 1e-5, 2.5,
                                           log=False)
 cp = {"upper": [], "lower": []}
-i_le = int(mesh.X[:, 0, 0].argmin())
-for k in range(mesh.ni):
-    cp["upper" if k < i_le else "lower"].append((mesh.wall_mid[k, 0], (pw[k] - s.p0) / s.q))
+for x, side, p in zip(mesh.wall_mid[:, 0], E.sides(mesh), pw):
+    cp[side].append((x, (p - s.p0) / s.q))
 cp = {k: sorted(v) for k, v in cp.items()}
 print(f"192 x 64: {hist[-1][0]} iterations, {wall:.0f} s, Cl {cl:.4f} (reference "
       f"{refrun['cl']:.4f}), Cd {cd:.5f} (reference {refrun['cd']:.5f})")
