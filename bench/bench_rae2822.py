@@ -144,11 +144,7 @@ for k, (dx, cp) in enumerate(curves):
 for side, mk in (("upper", "o"), ("lower", "s")):
     ax.plot([p[0] for p in exp[side]], [p[1] for p in exp[side]], mk, mfc="none", color="k",
             ms=4, label=f"experiment {side}")
-if os.path.exists(rae2822.REFERENCE):
-    ref = rae2822.reference()
-    for side in ("upper", "lower"):
-        ax.plot([p[0] for p in ref[side]], [p[1] for p in ref[side]], "-", color="k", lw=0.7,
-                label="Euler, body-fitted grid" if side == "upper" else None)
+rae2822.plot_reference(ax)
 ax.axhline(rae2822.cp_critical(), color="gray", lw=0.5, ls=":", label="Cp*")
 ax.invert_yaxis()
 ax.set_xlabel("x/c")

@@ -175,6 +175,28 @@ def flux(W, p, S):
     return np.stack([rho * un, W[1] * un + p * S[0], W[2] * un + p * S[1], (W[3] + p) * un])
 
 
+def face_fluxes(W, p, S):
+    """The JST flux through faces with area vectors S, each between cells -1 and 0 of the four
+    consecutive cells whose states W and pressures p are given (cells -2, -1, 0, +1): the
+    central flux less the blended dissipation of (rho, rho u, rho v, rho H), scaled by the
+    face's spectral radius; and that radius."""
+    u = [w[1] / w[0] for w in W]
+    v = [w[2] / w[0] for w in W]
+    c = [np.sqrt(GAMMA * np.maximum(pk, 1e-12) / w[0]) for w, pk in zip(W, p)]
+    H = [np.concatenate([w[:3], (w[3] + pk)[None]]) for w, pk in zip(W, p)]
+    F = 0.5 * (flux(W[1], p[1], S) + flux(W[2], p[2], S))
+    # the pressure sensor of cells -1 and 0 (cell -1's reads cell -2 and 0; cell 0's, cell +1)
+    nu_m = np.abs(p[2] - 2 * p[1] + p[0]) / (p[2] + 2 * p[1] + p[0])
+    nu_0 = np.abs(p[3] - 2 * p[2] + p[1]) / (p[3] + 2 * p[2] + p[1])
+    e2 = K2 * np.maximum(nu_m, nu_0)
+    e4 = np.maximum(0.0, K4 - e2)
+    lam = 0.5 * (np.abs(u[1] * S[0] + v[1] * S[1]) + np.abs(u[2] * S[0] + v[2] * S[1])) \
+        + 0.5 * (c[1] + c[2]) * np.hypot(*S)
+    d1 = H[2] - H[1]
+    d3 = H[3] - 3 * H[2] + 3 * H[1] - H[0]
+    return F - lam * (e2 * d1 - e4 * d3), lam
+
+
 class Solver:
     """The conserved state W (rho, rho u, rho v, rho E) per cell, non-dimensional: free-stream
     density 1 and speed of sound 1, so p = 1/gamma and the speed is the Mach number."""
@@ -245,54 +267,24 @@ class Solver:
         """Sum of the outgoing fluxes of each cell, and the local time step."""
         m = self.m
         P = self.padded(W)
-        rho, u, v, p = primitive(P)
-        c = np.sqrt(GAMMA * np.maximum(p, 1e-12) / rho)
-        H = P.copy()
-        H[3] = P[3] + p  # dissipate rho H
+        p = primitive(P)[3]
         # --- j direction (faces 0..nj between padded cells f+1 and f+2)
-        S = m.Sj
         nf = m.nj + 1
-        L, R = P[:, :, 1:nf + 1], P[:, :, 2:nf + 2]
-        pL, pR = p[:, 1:nf + 1], p[:, 2:nf + 2]
-        F = 0.5 * (flux(L, pL, S) + flux(R, pR, S))
-        nu = np.abs(p[:, 2:] - 2 * p[:, 1:-1] + p[:, :-2]) / (p[:, 2:] + 2 * p[:, 1:-1] + p[:, :-2])
-        nu = np.pad(nu, ((0, 0), (1, 1)), mode="edge")
-        e2 = K2 * np.maximum(nu[:, 1:nf + 1], nu[:, 2:nf + 2])
-        e4 = np.maximum(0.0, K4 - e2)
-        area = np.hypot(*S)
-        lam = 0.5 * (np.abs(u[:, 1:nf + 1] * S[0] + v[:, 1:nf + 1] * S[1])
-                     + np.abs(u[:, 2:nf + 2] * S[0] + v[:, 2:nf + 2] * S[1])) \
-            + 0.5 * (c[:, 1:nf + 1] + c[:, 2:nf + 2]) * area
-        d1 = H[:, :, 2:nf + 2] - H[:, :, 1:nf + 1]
-        d3 = H[:, :, 3:nf + 3] - 3 * H[:, :, 2:nf + 2] + 3 * H[:, :, 1:nf + 1] - H[:, :, 0:nf]
-        F -= lam * (e2 * d1 - e4 * d3)
+        F, lam = face_fluxes([P[:, :, k:k + nf] for k in range(4)],
+                             [p[:, k:k + nf] for k in range(4)], m.Sj)
         # the wall: the pressure alone
         pw = p[:, 2]
         F[:, :, 0] = 0.0
-        F[1, :, 0] = pw * S[0, :, 0]
-        F[2, :, 0] = pw * S[1, :, 0]
+        F[1, :, 0] = pw * m.Sj[0, :, 0]
+        F[2, :, 0] = pw * m.Sj[1, :, 0]
         Rj = F[:, :, 1:] - F[:, :, :-1]
         lamj = 0.5 * (lam[:, 1:] + lam[:, :-1])
         # --- i direction (periodic; face i between cells i-1 and i)
-        Wc, pc, uc, vc, cc = P[:, :, 2:-2], p[:, 2:-2], u[:, 2:-2], v[:, 2:-2], c[:, 2:-2]
-        Hc = H[:, :, 2:-2]
-        S = m.Si
-
-        def sh(a, k):
-            return np.roll(a, k, axis=-2)
-
-        G = 0.5 * (flux(sh(Wc, 1), sh(pc, 1), S) + flux(Wc, pc, S))
-        nu = np.abs(sh(pc, -1) - 2 * pc + sh(pc, 1)) / (sh(pc, -1) + 2 * pc + sh(pc, 1))
-        e2 = K2 * np.maximum(nu, sh(nu, 1))
-        e4 = np.maximum(0.0, K4 - e2)
-        area = np.hypot(*S)
-        lam = 0.5 * (np.abs(uc * S[0] + vc * S[1]) + np.abs(sh(uc, 1) * S[0] + sh(vc, 1) * S[1])) \
-            + 0.5 * (cc + sh(cc, 1)) * area
-        d1 = Hc - sh(Hc, 1)
-        d3 = sh(Hc, -1) - 3 * Hc + 3 * sh(Hc, 1) - sh(Hc, 2)
-        G -= lam * (e2 * d1 - e4 * d3)
-        Ri = sh(G, -1) - G
-        lami = 0.5 * (lam + sh(lam, -1))
+        Wc, pc = P[:, :, 2:-2], p[:, 2:-2]
+        G, lam = face_fluxes([np.roll(Wc, k, axis=-2) for k in (2, 1, 0, -1)],
+                             [np.roll(pc, k, axis=-2) for k in (2, 1, 0, -1)], m.Si)
+        Ri = np.roll(G, -1, axis=-2) - G
+        lami = 0.5 * (lam + np.roll(lam, -1, axis=-2))
         dt = self.cfl * m.vol / (lami + lamj)
         return Ri + Rj, dt, pw
 

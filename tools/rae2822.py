@@ -196,6 +196,16 @@ def analyse(run, windows):
     return res, cp, exp
 
 
+def plot_reference(ax):
+    """The inviscid reference's Cp, both surfaces, as a thin black line (if it is there)."""
+    if not os.path.exists(REFERENCE):
+        return
+    ref = reference()
+    for side in ("upper", "lower"):
+        ax.plot([p[0] for p in ref[side]], [p[1] for p in ref[side]], "-", color="k", lw=0.7,
+                label="Euler, body-fitted grid" if side == "upper" else None)
+
+
 def plot_cp(cp, exp, res, path, label=None):
     import matplotlib
     matplotlib.use("Agg")
@@ -206,11 +216,7 @@ def plot_cp(cp, exp, res, path, label=None):
                 label=f"{label or 'mpmfsi'} {side}")
         ax.plot([p[0] for p in exp[side]], [p[1] for p in exp[side]], "o", mfc="none",
                 color=col, ms=4, label=f"experiment {side}")
-    if os.path.exists(REFERENCE):
-        ref = reference()
-        for side in ("upper", "lower"):
-            ax.plot([p[0] for p in ref[side]], [p[1] for p in ref[side]], "-", color="k", lw=0.6,
-                    label="Euler, body-fitted" if side == "upper" else None)
+    plot_reference(ax)
     ax.axhline(res["cp_star"], color="gray", lw=0.5, ls="--", label="Cp*")
     ax.invert_yaxis()
     ax.set_xlabel("x/c")
