@@ -14,6 +14,26 @@ MPIEXEC = os.environ.get("MPIEXEC", "mpiexec")
 SOURCE = os.environ.get("MPMFSI_SOURCE_DIR", os.path.join(os.path.dirname(__file__), "..", ".."))
 
 
+def _scratch_cwd():
+    """Keep run folders out of the source tree: ctest runs the drivers in the build tree, and a
+    driver started by hand from a tracked folder of the checkout moves to out/tests/ (ignored
+    by git), so that the folders its runs create (dir=".") never land beside tracked files."""
+    here, top = os.path.realpath(os.getcwd()), os.path.realpath(SOURCE)
+    rel = os.path.relpath(here, top)
+    if rel.startswith(".."):
+        return  # outside the checkout: the caller chose the place
+    first = rel.split(os.sep)[0]
+    if first.startswith(("build", "out")):
+        return  # already in an ignored build or output folder
+    scratch = os.path.join(top, "out", "tests")
+    os.makedirs(scratch, exist_ok=True)
+    os.chdir(scratch)
+    sys.stderr.write(f"mpmtest: writing run folders under {scratch}\n")
+
+
+_scratch_cwd()
+
+
 def case(name):
     return os.path.join(SOURCE, "cases", name)
 
