@@ -206,8 +206,61 @@ static void render_field(strbuf *b, const char *file, const mpm_xdmf_phase *ph, 
   sb_printf(b, "            </Attribute>\n");
 }
 
+/* XDMF has no component names, and ParaView numbers the components of a Matrix 0 .. n-1. So
+ * each component of a tensor or history field is listed again as a one-column attribute of
+ * its own name, a HyperSlab selecting that column of the field's dataset: nothing is stored
+ * twice, and all three readers read it. Tensors (dim x dim components, row-major) give
+ * NAME_xx NAME_xy ...; the fields below have names of their own. */
+typedef struct named_components {
+  const char *field;
+  int ncomp;
+  const char *name[8];
+} named_components;
+
+static const named_components g_named[] = {
+    /* solid_j2.c's history: the symmetric Cp^-1 = Fp^-1 Fp^-T (3 x 3 also in plane strain),
+     * then the equivalent plastic strain alpha */
+    {"hist",
+     7,
+     {"Cp_inv_xx", "Cp_inv_yy", "Cp_inv_zz", "Cp_inv_xy", "Cp_inv_yz", "Cp_inv_xz", "eps_p_eq"}},
+};
+
+/* The name of component c of field f, in buf; 0 if its components are not named. */
+static int component_name(const mpm_xdmf_field *f, int dim, int c, char *buf, size_t size) {
+  for (size_t k = 0; k < sizeof g_named / sizeof g_named[0]; ++k)
+    if (strcmp(f->name, g_named[k].field) == 0 && f->ncomp == g_named[k].ncomp)
+      return snprintf(buf, size, "%s", g_named[k].name[c]), 1;
+  if (f->ncomp != dim * dim) return 0;
+  snprintf(buf, size, "%s_%c%c", f->name, "xyz"[c / dim], "xyz"[c % dim]);
+  return 1;
+}
+
+/* Column c of field f as a one-column attribute (HyperSlab: start, stride, count). */
+static void render_components(strbuf *b, const char *file, const mpm_xdmf_phase *ph, int f,
+                              int dim) {
+  const mpm_xdmf_field *fld = &ph->field[f];
+  char name[96], dims[64];
+  snprintf(dims, sizeof dims, "%" PRId64 " %d", ph->n, fld->ncomp);
+  for (int c = 0; c < fld->ncomp && component_name(fld, dim, c, name, sizeof name); ++c) {
+    sb_printf(b, "            <Attribute Name=\"");
+    sb_escaped(b, name);
+    sb_printf(b, "\" AttributeType=\"Matrix\" Center=\"Node\">\n");
+    sb_printf(b,
+              "              <DataItem ItemType=\"HyperSlab\" Dimensions=\"%" PRId64
+              " 1\" Type=\"HyperSlab\">\n",
+              ph->n);
+    sb_printf(b,
+              "                <DataItem Dimensions=\"3 2\" NumberType=\"Int\" "
+              "Format=\"XML\">0 %d 1 1 %" PRId64 " 1</DataItem>\n",
+              c, ph->n);
+    data_item(b, "                ", dims, "Float", file, ph->name, fld->name);
+    sb_printf(b, "              </DataItem>\n"
+                 "            </Attribute>\n");
+  }
+}
+
 /* Attributes in this order: the colour field, the other fields as stored (velocity first),
- * the id (a one-column Matrix: never the active scalars). */
+ * the named components, the id (a one-column Matrix: never the active scalars). */
 static void render_phase(strbuf *b, const char *file, const mpm_xdmf_phase *ph, int dim,
                          double time) {
   char dims[64];
@@ -227,6 +280,7 @@ static void render_phase(strbuf *b, const char *file, const mpm_xdmf_phase *ph, 
   if (colour > 0) render_field(b, file, ph, colour, dim, 1);
   for (int f = 1; f < ph->nfields; ++f)
     if (f != colour) render_field(b, file, ph, f, dim, 0);
+  for (int f = 1; f < ph->nfields; ++f) render_components(b, file, ph, f, dim);
   sb_printf(b, "            <Attribute Name=\"id\" AttributeType=\"Matrix\" Center=\"Node\">\n");
   snprintf(dims, sizeof dims, "%" PRId64 " 1", ph->n);
   data_item(b, "              ", dims, "Int", file, ph->name, "id");

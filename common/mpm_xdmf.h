@@ -26,18 +26,27 @@
  * - Particles: a Polyvertex topology of N one-point cells whose connectivity 0 .. N-1 is
  *   the dataset /MPM_XDMF_VERTICES/<phase> of the snapshot. Without it Xdmf3 makes no cells
  *   and ParaView's default Surface representation draws nothing.
- * - Colouring: ParaView colours a new source by the active scalars when all blocks that
- *   have some agree, and the readers make the first Scalar attribute active. So a phase
- *   lists its colour field first (the first of mpm_xdmf.c's colour fields it has: gas
- *   `rho`) as the only Scalar attribute; its other one-component fields (and id) are
- *   one-column Matrix attributes, which ParaView reads the same but never makes active, and
- *   the velocity follows. A phase without a colour field (a solid) so leaves the gas's
- *   colouring in place and is drawn in the solid colour. (Xdmf3ReaderS draws all phases as
- *   one dataset, which keeps only the fields every phase has: v, m, V0, id.)
+ * - Colouring: ParaView colours a new source by the active scalars, and the readers make the
+ *   first Scalar attribute active. So a phase lists its colour field first (the first of
+ *   mpm_xdmf.c's colour fields it has: `rho`) as the only Scalar attribute; its other
+ *   one-component fields (and id) are one-column Matrix attributes, which ParaView reads the
+ *   same but never makes active, and the velocity follows. Every phase must have it:
+ *   Xdmf3ReaderS, which OpenDataFile picks, gives the phases as pieces of one dataset, and
+ *   ParaView's geometry filter merges them keeping only the fields every piece has. With rho
+ *   in the gas only it was dropped and the whole picture drawn in one colour, white (checked
+ *   by tests/verification/test_paraview.py). The output layer therefore writes a solid's
+ *   density too (mpm_output.c); at t = 0 the bar (1000 kg/m^3) then stands out from the air.
+ *   What XDMF cannot carry (a colour range, a map, the solid drawn on top) is in view.py,
+ *   which every run writes beside the index (tools/paraview_view.py).
  * - Tensors: dim x dim fields are row-major (T_xx T_xy T_yx T_yy in 2-D), and ParaView numbers
  *   the components 0 .. ncomp-1 in that order. 9 components are a Tensor (3-D), other counts
- *   (2-D tensors) a Matrix. Padding 2-D tensors to 3 x 3 in the index would need an XDMF
- *   Function or HyperSlab, which VTK's Xdmf3 reader cannot read.
+ *   (2-D tensors) a Matrix. Each component is also listed by name (F_xx ..., and for
+ *   solid_j2.c's history hist: Cp_inv_xx yy zz xy yz xz, eps_p_eq) as a one-column Matrix
+ *   whose DataItem is an XDMF HyperSlab of the field's dataset (nothing is stored twice).
+ *   XDMFReader reads these; VTK's Xdmf3 readers skip them (they print "Skipping unrecognized
+ *   array type" on the terminal, nothing in the GUI) and keep the numbered field. Xdmf3's own
+ *   subset syntax (file:/path|start:stride:count:dims) is read by Xdmf3 but is an error in
+ *   XDMFReader, so it is not used.
  * - Grid phases are a 3DCoRectMesh (a 2-D lattice one node thick, because VTK's XDMF 2
  *   reader places a 2DCoRectMesh in the y-z plane and mis-sizes the selection of its
  *   2-component node vectors). The output layer keeps them in an index of their own
