@@ -3,12 +3,21 @@
  *   mpmfsi run CASE [key=value ...]       run a case
  *   mpmfsi check CASE [key=value ...]     validate a case and print the resolved configuration
  *   mpmfsi restart CHECKPOINT [key=value ...]   continue a run from a checkpoint
+ *   mpmfsi keys [SECTION] [--markdown]    list every case-file key
+ *   mpmfsi version | --version            the version, git revision and library versions
+ *   mpmfsi help [COMMAND] | -h | --help   the usage, or one command's help (also COMMAND -h)
+ *
+ * Help and version go to stdout with exit 0, on rank 0 only, and need neither a case file
+ * nor MPI (without_mpi). No command at all is a usage error, as for git: the usage on stderr,
+ * exit 2 (a script that passes an empty command must not look successful). The texts are in
+ * cli_help.c, the key listing in cli_keys.c.
  *
  * Exit codes: 0 success, 1 a failure during the run, 2 bad input (nothing was run), 3 stopped
  * by SIGTERM or SIGINT (a final checkpoint was written; restart from it to go on). Input
  * errors and unphysical states are found identically on every rank, so they end the run
  * cleanly; any other failure aborts all ranks so that none is left waiting in a collective
  * call. */
+#include "cli.h"
 #include "mpm_config.h"
 #include "mpm_error.h"
 #include "mpm_h5.h"
@@ -23,16 +32,6 @@
 #if defined(__SANITIZE_ADDRESS__)
 #include <sanitizer/lsan_interface.h>
 #endif
-
-static void usage(void) {
-  mpm_log(MPM_LOG_INFO,
-          "usage:\n"
-          "  mpmfsi run CASE [key=value ...]          run a case file\n"
-          "  mpmfsi check CASE [key=value ...]        validate it and print the resolved "
-          "configuration\n"
-          "  mpmfsi restart CHECKPOINT [key=value ...] continue a run (e.g. time.t_end=2)\n"
-          "Every case-file key can be overridden on the command line as section.key=value.");
-}
 
 static int apply_overrides(mpm_config *cfg, int argc, char **argv) {
   int rc = 0;
@@ -221,6 +220,13 @@ static int run(const char *cmd, const char *path, int argc, char **argv) {
   int rc = mpm_config_new(&cfg, MPI_COMM_WORLD);
   /* Whatever stops the case from loading (a missing file too) is bad input: exit 2. */
   if (!rc && load_config(cfg, cmd, path, argc, argv) != 0) rc = MPM_ERR_INPUT;
+  if (!rc && strcmp(cmd, "check") != 0) {
+    /* First in run.log: which code made the results that follow. */
+    int size;
+    MPI_Comm_size(MPI_COMM_WORLD, &size);
+    mpm_log(MPM_LOG_INFO, "%s: %s %s on %d rank%s", cli_version(), cmd, path, size,
+            size > 1 ? "s" : "");
+  }
   if (!rc)
     rc = strcmp(cmd, "restart") == 0 ? mpm_sim_restart(&sim, cfg, path) : mpm_sim_create(&sim, cfg);
   /* check builds everything a run needs (so every input error shows), then stops. */
@@ -233,7 +239,80 @@ static int run(const char *cmd, const char *path, int argc, char **argv) {
   return rc;
 }
 
+/* This process's rank as its launcher numbers it, read before MPI starts (0 when not
+ * started by mpiexec, srun or another PMI launcher), so that help and version print once. */
+static int launcher_rank(void) {
+  static const char *const var[] = {"OMPI_COMM_WORLD_RANK", "PMIX_RANK", "PMI_RANK",
+                                    "SLURM_PROCID"};
+  for (size_t k = 0; k < sizeof var / sizeof var[0]; ++k) {
+    const char *v = getenv(var[k]);
+    if (v && *v) return atoi(v);
+  }
+  return 0;
+}
+
+/* help [COMMAND] on stdout; an unknown COMMAND is a usage error. */
+static int help(const char *command, int print) {
+  if (command && !cli_is_command(command)) {
+    if (print)
+      fprintf(stderr, "mpmfsi help: '%s' is not a command; the commands are " CLI_COMMANDS "\n",
+              command);
+    return MPM_ERR_INPUT;
+  }
+  if (print && command) cli_help(stdout, command);
+  if (print && !command) cli_usage(stdout);
+  return 0;
+}
+
+/* run, check or restart without its file: say which file is missing. */
+static int missing_file(const char *cmd, int print) {
+  const int ck = strcmp(cmd, "restart") == 0;
+  if (print)
+    fprintf(stderr,
+            "mpmfsi %s: no %s given; usage: mpmfsi %s %s [key=value ...] (mpmfsi help %s)\n", cmd,
+            ck ? "checkpoint" : "case file", cmd, ck ? "CHECKPOINT" : "CASE", cmd);
+  return MPM_ERR_INPUT;
+}
+
+/* What needs neither a case nor MPI: the usage, help, version and usage errors. They answer
+ * at once, without the second MPI takes to start, and print on rank 0 only when launched on
+ * several ranks (each rank decides alike, from the same arguments). Returns 1 with *rc set
+ * when the command line is one of them; 0 for keys and for run, check and restart with their
+ * file. */
+static int without_mpi(int argc, char **argv, int *rc) {
+  const int print = launcher_rank() == 0;
+  if (argc < 2) { /* a usage error, as for git: the usage on stderr */
+    if (print) cli_usage(stderr);
+    return *rc = MPM_ERR_INPUT, 1;
+  }
+  const char *cmd = argv[1];
+  if (cli_is_help_flag(cmd)) return *rc = help(argc > 2 ? argv[2] : NULL, print), 1;
+  if (strcmp(cmd, "--version") == 0) cmd = "version";
+  if (!cli_is_command(cmd)) {
+    if (print)
+      fprintf(stderr,
+              "mpmfsi: '%s' is not a command; the commands are " CLI_COMMANDS " (mpmfsi help)\n",
+              cmd);
+    return *rc = MPM_ERR_INPUT, 1;
+  }
+  /* "mpmfsi run --help" asks for help: no case file of that name is looked for. */
+  if (argc > 2 && cli_is_help_flag(argv[2])) return *rc = help(cmd, print), 1;
+  if (strcmp(cmd, "help") == 0) return *rc = help(argc > 2 ? argv[2] : NULL, print), 1;
+  if (strcmp(cmd, "version") == 0) {
+    if (print) cli_print_version(stdout); /* MPI allows its version queries before MPI_Init */
+    return *rc = 0, 1;
+  }
+  if (strcmp(cmd, "keys") != 0 && argc < 3) return *rc = missing_file(cmd, print), 1;
+  return 0;
+}
+
+static int exit_status(int rc) {
+  return rc == 0 ? 0 : rc == MPM_ERR_INPUT ? 2 : rc == MPM_ERR_INTERRUPTED ? 3 : 1;
+}
+
 int main(int argc, char **argv) {
+  int rc;
+  if (without_mpi(argc, argv, &rc)) return exit_status(rc);
 #if defined(__SANITIZE_ADDRESS__)
   __lsan_disable(); /* Open MPI's start-up keeps, and loses, blocks of its own: not ours */
 #endif
@@ -242,18 +321,10 @@ int main(int argc, char **argv) {
   __lsan_enable();
 #endif
   mpm_log_init(MPI_COMM_WORLD, MPM_LOG_INFO, 0);
-  int rc;
-  const int known = argc >= 3 && (strcmp(argv[1], "run") == 0 || strcmp(argv[1], "check") == 0 ||
-                                  strcmp(argv[1], "restart") == 0);
-  if (!known) {
-    usage();
-    rc = argc >= 2 && (strcmp(argv[1], "-h") == 0 || strcmp(argv[1], "--help") == 0 ||
-                       strcmp(argv[1], "help") == 0)
-             ? 0
-             : MPM_ERR_INPUT;
-  } else {
+  if (strcmp(argv[1], "keys") == 0)
+    rc = cli_keys(argc - 2, argv + 2);
+  else
     rc = run(argv[1], argv[2], argc - 3, argv + 3);
-  }
   /* Input errors and unphysical states are detected on every rank alike: end cleanly. */
   if (rc != 0 && rc != MPM_ERR_INPUT && rc != MPM_ERR_UNPHYSICAL && rc != MPM_ERR_INTERRUPTED) {
     mpm_log_all(MPM_LOG_DEBUG, "mpmfsi failed: %s", mpm_error_string(rc));
@@ -267,5 +338,5 @@ int main(int argc, char **argv) {
   __lsan_do_leak_check();
 #endif
   MPI_Finalize();
-  return rc == 0 ? 0 : rc == MPM_ERR_INPUT ? 2 : rc == MPM_ERR_INTERRUPTED ? 3 : 1;
+  return exit_status(rc);
 }

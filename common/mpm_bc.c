@@ -15,12 +15,12 @@
   "farfield (non-reflecting; all with the [freestream] state)"
 
 const mpm_key_spec mpm_bc_keys[] = {
-    {"boundary.x_lo", MPM_KEY_ENUM, "none", 0, 0, 0, 0, WALL_CHOICES, WALL_HELP, 0},
-    {"boundary.x_hi", MPM_KEY_ENUM, "none", 0, 0, 0, 0, WALL_CHOICES, WALL_HELP, 0},
-    {"boundary.y_lo", MPM_KEY_ENUM, "none", 0, 0, 0, 0, WALL_CHOICES, WALL_HELP, 0},
-    {"boundary.y_hi", MPM_KEY_ENUM, "none", 0, 0, 0, 0, WALL_CHOICES, WALL_HELP, 0},
-    {"boundary.z_lo", MPM_KEY_ENUM, "none", 0, 0, 0, 0, WALL_CHOICES, WALL_HELP, 0},
-    {"boundary.z_hi", MPM_KEY_ENUM, "none", 0, 0, 0, 0, WALL_CHOICES, WALL_HELP, 0},
+    {"boundary.x_lo", MPM_KEY_ENUM, "none", 0, 0, 0, 0, WALL_CHOICES, WALL_HELP, 0, NULL},
+    {"boundary.x_hi", MPM_KEY_ENUM, "none", 0, 0, 0, 0, WALL_CHOICES, WALL_HELP, 0, NULL},
+    {"boundary.y_lo", MPM_KEY_ENUM, "none", 0, 0, 0, 0, WALL_CHOICES, WALL_HELP, 0, NULL},
+    {"boundary.y_hi", MPM_KEY_ENUM, "none", 0, 0, 0, 0, WALL_CHOICES, WALL_HELP, 0, NULL},
+    {"boundary.z_lo", MPM_KEY_ENUM, "none", 0, 0, 0, 0, WALL_CHOICES, WALL_HELP, 0, NULL},
+    {"boundary.z_hi", MPM_KEY_ENUM, "none", 0, 0, 0, 0, WALL_CHOICES, WALL_HELP, 0, NULL},
 };
 const int mpm_bc_nkeys = (int)(sizeof mpm_bc_keys / sizeof mpm_bc_keys[0]);
 

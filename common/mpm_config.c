@@ -623,6 +623,33 @@ int mpm_config_add_schema(mpm_config *cfg, const mpm_key_spec *specs, int n) {
   return 0;
 }
 
+const mpm_key_spec *mpm_config_spec(const mpm_config *cfg, size_t k) {
+  return k < cfg->nspecs ? cfg->specs[k] : NULL;
+}
+
+const char *mpm_config_type_name(mpm_key_type type) {
+  static const char *const name[] = {"real",   "int",   "bool",  "text",
+                                     "choice", "reals", "names", "path"};
+  return (unsigned)type < sizeof name / sizeof name[0] ? name[type] : "?";
+}
+
+void mpm_config_allowed_text(const mpm_key_spec *sp, char *buf, size_t n) {
+  const int ranged =
+      sp->type == MPM_KEY_REAL || sp->type == MPM_KEY_INT || sp->type == MPM_KEY_REALS;
+  /* An unbounded real range reads "finite" in messages; here that says nothing. */
+  const int bounded = has_range(sp) && (isfinite(sp->min) || isfinite(sp->max));
+  shown r = {""};
+  if (ranged && bounded) r = range_text(sp);
+  const char *range = r.s;
+  if (sp->type == MPM_KEY_ENUM)
+    snprintf(buf, n, "%s", sp->choices ? sp->choices : "");
+  else if (sp->type == MPM_KEY_REALS && sp->max_count > 0)
+    snprintf(buf, n, "%s%sat most %d value%s", range, *range ? ", " : "", sp->max_count,
+             sp->max_count > 1 ? "s" : "");
+  else
+    snprintf(buf, n, "%s", range);
+}
+
 /* ---- entries ------------------------------------------------------------------------- */
 
 /* Where an entry comes from. */

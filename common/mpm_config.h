@@ -39,6 +39,9 @@ typedef struct mpm_key_spec {
   const char *help;    /* one line: meaning, unit, what a sensible value is */
   int optional;        /* with def == NULL: 1 = may stay unset (its consumer checks
                           mpm_config_has), 0 = required in every section in use */
+  const char *unit;    /* SI unit of the value ("m", "kg/m^3"), "-" for a dimensionless
+                          number, NULL for text, names, choices and paths. The last member, so
+                          that tables written before it need no change. */
 } mpm_key_spec;
 
 typedef struct mpm_config mpm_config;
@@ -48,6 +51,15 @@ void mpm_config_destroy(mpm_config **cfg);
 
 /* Add n specs (the table must outlive cfg). */
 int mpm_config_add_schema(mpm_config *cfg, const mpm_key_spec *specs, int n);
+
+/* The schema in the order it was added (for `mpmfsi keys`): the spec number k, NULL past the
+ * last one. */
+const mpm_key_spec *mpm_config_spec(const mpm_config *cfg, size_t k);
+/* A spec's type as a word ("real", "int", "bool", "text", "choice", "reals", "names", "path"). */
+const char *mpm_config_type_name(mpm_key_type type);
+/* What values a spec allows, as validation states it: "> 0", "in [0, 1]", "a|b|c", at most
+ * 3 values; "" when any value of its type is allowed. Truncated to the buffer. */
+void mpm_config_allowed_text(const mpm_key_spec *sp, char *buf, size_t n);
 
 /* Read a case file: rank 0 reads it, every rank parses the same text. A missing or
  * unreadable file, one that is no regular file (a folder, device or FIFO) or larger than

@@ -123,10 +123,10 @@ static int choose_nproc(mpm_grid *g, int size, const int *nproc) {
     all = all && fixed[d] > 0;
   }
   if (all ? given != size : size % given != 0)
-    FAIL_INPUT("grid: the requested ranks per direction (product %d) do not fit the %d ranks "
+    FAIL_INPUT("grid: the requested ranks per direction (product %d) do not fit the %d rank%s "
                "of the run; give counts whose product is the number of ranks, or 0 to let MPI "
                "choose",
-               given, size);
+               given, size, size == 1 ? "" : "s");
   double cost = HUGE_VAL;
   layout_search(g, size, fixed, 0, dims, g->nproc, &cost);
   if (cost < HUGE_VAL) return 0;
@@ -139,10 +139,11 @@ static int choose_nproc(mpm_grid *g, int size, const int *nproc) {
   }
   if (fit)
     FAIL_INPUT("grid: no layout of %d ranks leaves every rank the %d cells per split direction "
-               "that the %s shape needs (the grid has %d x %d%s cells); run on at most %d ranks "
+               "that the %s shape needs (the grid has %d x %d%s cells); run on at most %d rank%s "
                "(grid.ranks = %d %d%s), or refine the grid",
                size, g->ghost, mpm_shape_name(g->shape), g->ncells[0], g->ncells[1],
-               g->dim == 3 ? " x ..." : "", fit, best[0], best[1], g->dim == 3 ? " ..." : "");
+               g->dim == 3 ? " x ..." : "", fit, fit == 1 ? "" : "s", best[0], best[1],
+               g->dim == 3 ? " ..." : "");
   for (int d = 0; d < g->dim; ++d) g->nproc[d] = fixed[d];
   MPM_CALL_MPI(MPI_Dims_create(size, g->dim, g->nproc)); /* check_cells_per_rank says why */
   return 0;

@@ -30,10 +30,19 @@ struct mpm_rundir {
 
 /* What mpmfsi writes into an output folder, by exact name pattern. Anything else in the
  * folder belongs to the user (post-processing too) and is never touched. */
-static const char *const g_ours[] = {
-    "snap_[0-9]*.h5",  "checkpoint_[0-9]*.h5", "checkpoint_final.h5", "series.xmf", "grid.xmf",
-    "diagnostics.csv", "coupling.csv",         "probes.csv",          "timers.csv", "summary.json",
-    RUNID_NAME};
+static const char *const g_ours[] = {"snap_[0-9]*.h5",
+                                     "checkpoint_[0-9]*.h5",
+                                     "checkpoint_final.h5",
+                                     "series.xmf",
+                                     "grid.xmf",
+                                     "diagnostics.csv",
+                                     "coupling.csv",
+                                     "probes.csv",
+                                     "timers.csv",
+                                     "summary.json",
+                                     RUNID_NAME,
+                                     "run.log",
+                                     "view.py"};
 
 /* 1: a result; 2: a leftover of an interrupted write (a result's name + ".tmp"); 0: not ours. */
 static int is_ours(const char *name) {

@@ -22,7 +22,8 @@
 
 static const mpm_key_spec contact_keys[] = {
     {"coupling.friction", MPM_KEY_REAL, "0", 0, HUGE_VAL, 0, 0, NULL,
-     "contact: Coulomb friction coefficient between the solid and the gas, >= 0 (0: free slip)", 0},
+     "contact: Coulomb friction coefficient between the solid and the gas, >= 0 (0: free slip)", 0,
+     "-"},
 };
 
 typedef struct {

@@ -9,17 +9,17 @@ const mpm_key_spec mpm_budget_keys[] = {
     {"run.max_steps", MPM_KEY_REAL, "1e8", 1, HUGE_VAL, 0, 0, NULL,
      "refuse a run whose estimated step count (time to run / starting stable step) is larger; "
      "raise it for a run that really needs more",
-     0},
+     0, "-"},
     {"output.max_gb", MPM_KEY_REAL, "100", 0, HUGE_VAL, 0, 0, NULL,
      "refuse a run whose estimated snapshots and checkpoints exceed this many GB; raise it "
      "for a run that really writes more",
-     0},
+     0, "GB"},
     {"output.max_files", MPM_KEY_REAL, "100000", 1, HUGE_VAL, 0, 0, NULL,
-     "refuse a run that would write more snapshots and checkpoints than this", 0},
+     "refuse a run that would write more snapshots and checkpoints than this", 0, "-"},
 };
 const int mpm_budget_nkeys = (int)(sizeof mpm_budget_keys / sizeof mpm_budget_keys[0]);
 
-int mpm_budget_check(const mpm_config *cfg, const mpm_budget *b) {
+int mpm_budget_check(const mpm_config *cfg, const mpm_budget *b, double *estimate) {
   double max_steps, max_gb, max_files;
   MPM_CALL(mpm_config_get_real(cfg, "run.max_steps", &max_steps));
   MPM_CALL(mpm_config_get_real(cfg, "output.max_gb", &max_gb));
@@ -58,9 +58,10 @@ int mpm_budget_check(const mpm_config *cfg, const mpm_budget *b) {
                            "output.interval or output.checkpoint_interval, or raise "
                            "run.max_steps if you mean it",
                            steps, nout + nck, max_steps);
+  *estimate = steps;
   mpm_log(MPM_LOG_INFO,
-          "estimate: about %.3g steps (starting stable step %.6g s), %.3g snapshots and %.3g "
-          "checkpoints, %.3g GB",
-          steps, b->h0, nsnap, nckpt, gb);
+          "estimate: about %.3g steps (starting stable step %.6g s; refined after the first "
+          "steps), %.3g snapshot%s and %.3g checkpoint%s, %.3g GB",
+          steps, b->h0, nsnap, nsnap == 1 ? "" : "s", nckpt, nckpt == 1 ? "" : "s", gb);
   return 0;
 }

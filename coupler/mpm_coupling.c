@@ -16,7 +16,7 @@ static char g_choices[256];
 static char g_help[1024];
 
 static mpm_key_spec g_scheme_key[] = {
-    {"coupling.scheme", MPM_KEY_ENUM, "velocity", 0, 0, 0, 0, g_choices, g_help, 0},
+    {"coupling.scheme", MPM_KEY_ENUM, "velocity", 0, 0, 0, 0, g_choices, g_help, 0, NULL},
 };
 
 int mpm_coupling_add_schema(mpm_config *cfg) {

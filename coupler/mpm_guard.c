@@ -10,14 +10,14 @@ const mpm_key_spec mpm_guard_keys[] = {
     {"time.collapse_ratio", MPM_KEY_REAL, "1e-3", 0, 1, 0, 0, NULL,
      "blow-up guard: stop when the step stays below this fraction of the starting state's CFL "
      "step for time.collapse_steps steps in a row (0: never)",
-     0},
+     0, "-"},
     {"time.collapse_steps", MPM_KEY_INT, "100", 1, HUGE_VAL, 0, 0, NULL,
-     "blow-up guard: how many steps in a row the step must stay collapsed", 0},
+     "blow-up guard: how many steps in a row the step must stay collapsed", 0, "-"},
     {"time.energy_growth", MPM_KEY_REAL, "1000", 0, HUGE_VAL, 0, 0, NULL,
      "blow-up guard: stop when the total energy exceeds this multiple of the largest total "
      "energy of the first half of the steps taken (0: never; a non-finite energy always stops "
      "the run)",
-     0},
+     0, "-"},
 };
 const int mpm_guard_nkeys = (int)(sizeof mpm_guard_keys / sizeof mpm_guard_keys[0]);
 

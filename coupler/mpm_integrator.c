@@ -58,22 +58,24 @@ struct mpm_integrator {
 };
 
 const mpm_key_spec mpm_integrator_keys[] = {
-    {"time.t_end", MPM_KEY_REAL, NULL, 0, HUGE_VAL, 1, 0, NULL, "end time of the run, s", 0},
+    {"time.t_end", MPM_KEY_REAL, NULL, 0, HUGE_VAL, 1, 0, NULL, "end time of the run, s", 0, "s"},
     {"time.method", MPM_KEY_ENUM, "bs32", 0, 0, 0, 0,
      "usl|musl|euler|ralston21|bs32|zonneveld43|dp54",
-     "time method: usl or musl (classic MPM, fixed CFL step) or an adaptive embedded ERK pair", 0},
-    {"time.rtol", MPM_KEY_REAL, "1e-6", 0, 1, 1, 0, NULL, "relative tolerance (adaptive)", 0},
+     "time method: usl or musl (classic MPM, fixed CFL step) or an adaptive embedded ERK pair", 0,
+     NULL},
+    {"time.rtol", MPM_KEY_REAL, "1e-6", 0, 1, 1, 0, NULL, "relative tolerance (adaptive)", 0, "-"},
     {"time.atol", MPM_KEY_REAL, "1e-9", 0, HUGE_VAL, 1, 0, NULL,
-     "absolute tolerance (adaptive), in state units (m, m/s, 1)", 0},
+     "absolute tolerance (adaptive), in state units (m, m/s, 1)", 0, "m, m/s, -"},
     {"time.cfl", MPM_KEY_REAL, "0.4", 0, 0.999, 1, 0, NULL,
-     "fraction of the stable step dx / (c + |v|) allowed, below 1", 0},
-    {"time.dt_max", MPM_KEY_REAL, "0", 0, HUGE_VAL, 0, 0, NULL, "largest step, s (0: no limit)", 0},
+     "fraction of the stable step dx / (c + |v|) allowed, below 1", 0, "-"},
+    {"time.dt_max", MPM_KEY_REAL, "0", 0, HUGE_VAL, 0, 0, NULL, "largest step, s (0: no limit)", 0,
+     "s"},
     {"time.adaptive", MPM_KEY_BOOL, "true", 0, 0, 0, 0, NULL,
      "false: the ERK pairs take a fixed step, time.cfl of the stability limit, without error "
      "control (for stability studies; usl, musl and euler always do)",
-     0},
+     0, NULL},
     {"time.max_retries", MPM_KEY_INT, "8", 0, 100, 0, 0, NULL,
-     "restarts with a 4x smaller step after an unphysical stage before the run stops", 0},
+     "restarts with a 4x smaller step after an unphysical stage before the run stops", 0, "-"},
 };
 const int mpm_integrator_nkeys = (int)(sizeof mpm_integrator_keys / sizeof mpm_integrator_keys[0]);
 

@@ -9,9 +9,10 @@
 
 const mpm_key_spec mpm_probe_keys[] = {
     {"probe.*.point", MPM_KEY_REALS, NULL, -HUGE_VAL, HUGE_VAL, 0, 3, NULL,
-     "follow the particle nearest to this point at t = 0 (probes.csv: displacement, velocity)", 0},
+     "follow the particle nearest to this point at t = 0 (probes.csv: displacement, velocity)", 0,
+     "m"},
     {"probe.*.phase", MPM_KEY_ENUM, "solid", 0, 0, 0, 0, "solid|fluid",
-     "whose particle the probe follows", 0},
+     "whose particle the probe follows", 0, NULL},
 };
 const int mpm_probe_nkeys = (int)(sizeof mpm_probe_keys / sizeof mpm_probe_keys[0]);
 

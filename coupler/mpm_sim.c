@@ -24,9 +24,13 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 #include <unistd.h>
 
 #define SIM_MAX_MODULES 4
+/* The estimate of the step count is refined after this many steps (see refine_estimate). */
+#define ESTIMATE_AFTER 20
+enum { PROGRESS_OFF, PROGRESS_LOG, PROGRESS_LIVE };
 
 struct mpm_sim {
   MPI_Comm comm;
@@ -49,6 +53,8 @@ struct mpm_sim {
   mpm_probes probes;
   mpm_diag *probe_csv;       /* probes.csv, with probes only */
   double coupling_work;      /* cumulative energy the coupling created (J; < 0: destroyed) */
+  double coupling_crossed;   /* energy that crossed the interface: int max(|P_s|, |P_f|) dt */
+  double solid_peak;         /* the solid's largest total energy so far (J) */
   double coupling_imbalance; /* largest |F_solid + F_fluid + d owed/dt| / max(|F_s|, |F_f|) */
   double owed[MPM_MAX_DIM];  /* interface momentum the solid has yet to receive (staggered) */
   char body_cols[MPM_COUPLING_MAX_BODIES][MPM_MAX_DIM][80]; /* coupling.csv column names */
@@ -57,64 +63,74 @@ struct mpm_sim {
   double out_interval, ckpt_interval;
   long out_next, ckpt_next; /* index k of the next output / checkpoint at time k * interval */
   long ckpt_number;         /* the number in the next checkpoint_NNNNNN.h5 */
-  int sort_every, snapshots, grid_fields, progress, overwrite, truncate;
+  int sort_every, snapshots, grid_fields, overwrite, truncate;
+  int progress; /* PROGRESS_OFF, _LOG or _LIVE (run.progress resolved) */
   const char *dir;
   double particle_steps;
-  double progress_interval; /* s of wall time between progress log lines (not a terminal) */
+  double progress_interval;        /* s of wall time between progress lines (log; run.log) */
+  double progress_last;            /* wall time of the last progress line (log) or redraw (live) */
+  double progress_logged;          /* wall time of the last progress line in run.log (live) */
+  double estimate;                 /* the expected step count of the run from t (0: none yet) */
+  double dt_first[ESTIMATE_AFTER]; /* the first steps' sizes, for the refined estimate */
+  long step0;                      /* the step the run (or restart) started at */
 };
 
 static const mpm_key_spec sim_keys[] = {
-    {"run.name", MPM_KEY_STRING, "mpmfsi", 0, 0, 0, 0, NULL, "name of the run", 0},
+    {"run.name", MPM_KEY_STRING, "mpmfsi", 0, 0, 0, 0, NULL, "name of the run", 0, NULL},
     {"run.log_level", MPM_KEY_ENUM, "info", 0, 0, 0, 0, "error|warn|info|debug|trace",
-     "how much to log; debug also prints the traceback of a failure", 0},
-    {"run.log_all_ranks", MPM_KEY_BOOL, "false", 0, 0, 0, 0, NULL, "log on every rank", 0},
-    {"run.progress", MPM_KEY_BOOL, "true", 0, 0, 0, 0, NULL,
-     "show progress: a live line with ETA when stderr is a terminal, otherwise a log line "
-     "every run.progress_interval seconds",
-     0},
+     "how much to log; debug also prints the traceback of a failure", 0, NULL},
+    {"run.log_all_ranks", MPM_KEY_BOOL, "false", 0, 0, 0, 0, NULL, "log on every rank", 0, NULL},
+    {"run.progress", MPM_KEY_ENUM, "auto", 0, 0, 0, 0, "auto|live|log|off|true|false",
+     "how to show progress: live = a line on the terminal redrawn twice a second (step, t, "
+     "%, dt, wall, ETA); log = a progress line every run.progress_interval seconds; auto = "
+     "live when the user watches a terminal (stderr is one, or under mpiexec/mpirun started "
+     "from one, the launcher's stderr is), else log; off = none. true = auto, false = off",
+     0, NULL},
     {"run.progress_interval", MPM_KEY_REAL, "60", 0, HUGE_VAL, 0, 0, NULL,
-     "wall-clock seconds between progress log lines when stderr is not a terminal", 0},
+     "wall-clock seconds between progress lines on a console that is not a terminal, and in "
+     "run.log",
+     0, "s"},
     {"run.sort_every", MPM_KEY_INT, "20", 0, 1e9, 0, 0, NULL,
-     "sort particles by cell every N steps (0: never)", 0},
-    {"domain.dim", MPM_KEY_INT, "2", 2, 3, 0, 0, NULL, "spatial dimension, 2 or 3", 0},
-    {"domain.lo", MPM_KEY_REALS, NULL, -HUGE_VAL, HUGE_VAL, 0, 3, NULL, "lower corner, m", 0},
-    {"domain.hi", MPM_KEY_REALS, NULL, -HUGE_VAL, HUGE_VAL, 0, 3, NULL, "upper corner, m", 0},
+     "sort particles by cell every N steps (0: never)", 0, "-"},
+    {"domain.dim", MPM_KEY_INT, "2", 2, 3, 0, 0, NULL, "spatial dimension, 2 or 3", 0, "-"},
+    {"domain.lo", MPM_KEY_REALS, NULL, -HUGE_VAL, HUGE_VAL, 0, 3, NULL, "lower corner, m", 0, "m"},
+    {"domain.hi", MPM_KEY_REALS, NULL, -HUGE_VAL, HUGE_VAL, 0, 3, NULL, "upper corner, m", 0, "m"},
     {"grid.dx", MPM_KEY_REAL, NULL, 0, HUGE_VAL, 1, 0, NULL,
-     "cell size, m; the domain must be a whole number of cells", 0},
+     "cell size, m; the domain must be a whole number of cells", 0, "m"},
     {"grid.shape", MPM_KEY_ENUM, "quadratic", 0, 0, 0, 0, "linear|gimp|quadratic|cubic",
-     "shape function", 0},
+     "shape function", 0, NULL},
     {"grid.ranks", MPM_KEY_REALS, "0 0 0", 0, 65536, 0, 3, NULL,
-     "MPI ranks per direction (0: let MPI choose)", 0},
+     "MPI ranks per direction (0: let MPI choose)", 0, "-"},
     {"physics.gravity", MPM_KEY_REALS, "0 0 0", -HUGE_VAL, HUGE_VAL, 0, 3, NULL,
-     "body acceleration, m/s^2", 0},
+     "body acceleration, m/s^2", 0, "m/s^2"},
     {"transfer.velocity", MPM_KEY_ENUM, "flip", 0, 0, 0, 0, "flip|apic",
      "particle velocity transfer: flip (FLIP/PIC blend, see pic_fraction) or apic (affine "
      "particle-in-cell: PIC with an affine velocity per particle; classic update only)",
-     0},
+     0, NULL},
     {"transfer.pic_fraction", MPM_KEY_REAL, "0", 0, 1, 0, 0, NULL,
      "PIC share of the particle velocity update: 0 = FLIP (no numerical dissipation), 1 = "
      "PIC (smooth, dissipative); classic update only",
-     0},
+     0, "-"},
     {"physics.damping", MPM_KEY_REAL, "0", 0, HUGE_VAL, 0, 0, NULL,
      "mass-proportional damping rate alpha, 1/s (amplitudes decay as exp(-alpha t / 2)); "
      "for quasi-static problems",
-     0},
-    {"output.dir", MPM_KEY_STRING, "out", 0, 0, 0, 0, NULL, "output folder", 0},
+     0, "1/s"},
+    {"output.dir", MPM_KEY_STRING, "out", 0, 0, 0, 0, NULL, "output folder", 0, NULL},
     {"output.interval", MPM_KEY_REAL, "0", 0, HUGE_VAL, 0, 0, NULL,
-     "time between snapshots, s (0: t_end / 10)", 0},
-    {"output.snapshots", MPM_KEY_BOOL, "true", 0, 0, 0, 0, NULL, "write HDF5 snapshots", 0},
+     "time between snapshots, s (0: t_end / 10)", 0, "s"},
+    {"output.snapshots", MPM_KEY_BOOL, "true", 0, 0, 0, 0, NULL, "write HDF5 snapshots", 0, NULL},
     {"output.grid_fields", MPM_KEY_BOOL, "false", 0, 0, 0, 0, NULL,
-     "add nodal mass and velocity to the snapshots", 0},
+     "add nodal mass and velocity to the snapshots", 0, NULL},
     {"output.checkpoint_interval", MPM_KEY_REAL, "0", 0, HUGE_VAL, 0, 0, NULL,
-     "time between checkpoints, s (0: only at the end)", 0},
+     "time between checkpoints, s (0: only at the end)", 0, "s"},
     {"output.overwrite", MPM_KEY_BOOL, "false", 0, 0, 0, 0, NULL,
      "delete the results of an earlier run found in output.dir before writing (otherwise "
      "such a folder is refused)",
-     0},
+     0, NULL},
     {"output.truncate", MPM_KEY_BOOL, "false", 0, 0, 0, 0, NULL,
      "restart in the checkpoint's own folder although it holds later results: cut the run "
      "back to the checkpoint (its later snapshots and checkpoints are deleted)",
-     0},
+     0, NULL},
 };
 
 int mpm_sim_add_schema(mpm_config *cfg) {
@@ -189,9 +205,25 @@ static int build_grid(mpm_sim *s) {
   }
   MPM_CALL(mpm_grid_new_periodic(&s->grid, s->comm, dim, lo, hi, dx, mpm_shape_parse(shape), nproc,
                                  periodic));
-  mpm_log(MPM_LOG_INFO, "grid: %d-D, %d x %d%s cells of %g, %s, %d ranks (%d x %d%s)", dim,
+  mpm_log(MPM_LOG_INFO, "grid: %d-D, %d x %d%s cells of %g, %s, %d rank%s (%d x %d%s)", dim,
           s->grid->ncells[0], s->grid->ncells[1], dim == 3 ? " x ..." : "", dx, shape, s->size,
-          s->grid->nproc[0], s->grid->nproc[1], dim == 3 ? " x ..." : "");
+          s->size == 1 ? "" : "s", s->grid->nproc[0], s->grid->nproc[1], dim == 3 ? " x ..." : "");
+  return 0;
+}
+
+/* run.progress: auto is live when the user watches a terminal (mpm_log_console_is_terminal:
+ * stderr, or the MPI launcher's stderr), so that ctest, CI and files never receive \r lines. */
+static int read_progress(mpm_sim *s) {
+  const char *mode;
+  MPM_CALL(mpm_config_get_string(s->cfg, "run.progress", &mode));
+  if (strcmp(mode, "off") == 0 || strcmp(mode, "false") == 0)
+    s->progress = PROGRESS_OFF;
+  else if (strcmp(mode, "log") == 0)
+    s->progress = PROGRESS_LOG;
+  else if (strcmp(mode, "live") == 0)
+    s->progress = PROGRESS_LIVE;
+  else /* auto, true */
+    s->progress = mpm_log_console_is_terminal() ? PROGRESS_LIVE : PROGRESS_LOG;
   return 0;
 }
 
@@ -200,7 +232,7 @@ static int read_run_settings(mpm_sim *s) {
   MPM_CALL(mpm_config_get_real(s->cfg, "output.interval", &s->out_interval));
   MPM_CALL(mpm_config_get_real(s->cfg, "output.checkpoint_interval", &s->ckpt_interval));
   MPM_CALL(mpm_config_get_int(s->cfg, "run.sort_every", &s->sort_every));
-  MPM_CALL(mpm_config_get_bool(s->cfg, "run.progress", &s->progress));
+  MPM_CALL(read_progress(s));
   MPM_CALL(mpm_config_get_real(s->cfg, "run.progress_interval", &s->progress_interval));
   MPM_CALL(mpm_config_get_bool(s->cfg, "output.snapshots", &s->snapshots));
   MPM_CALL(mpm_config_get_bool(s->cfg, "output.grid_fields", &s->grid_fields));
@@ -251,6 +283,19 @@ static const char *const g_coupling_cols3[] = {
     "Fz_fluid", "P_solid", "P_fluid", "P_net",    "W_net",    "gas_inside", "E_solid",  "E_fluid"};
 #define NCOUPLING(dim) ((dim) == 2 ? 14 : 16)
 
+/* run.log: what rank 0 logged so far (held since the start) and from now on. A restart in
+ * place appends after a separator naming the checkpoint and the time. */
+static void open_log(mpm_sim *s, int append) {
+  char path[4096], sep[4400], when[64] = "?";
+  const time_t now = time(NULL);
+  struct tm tm;
+  if (gmtime_r(&now, &tm)) strftime(when, sizeof when, "%Y-%m-%d %H:%M:%S UTC", &tm);
+  snprintf(path, sizeof path, "%s/run.log", s->dir);
+  snprintf(sep, sizeof sep, "==== restart from %s (t = %.6g, step %ld), %s ====",
+           s->checkpoint ? s->checkpoint : "?", s->t, s->step, when);
+  mpm_log_file_open(path, append, sep);
+}
+
 /* Claim the output folder (see mpm_rundir.h), then open the outputs in it: continued from the
  * checkpoint's time when the run carries on its folder's record, new otherwise. */
 static int open_outputs(mpm_sim *s) {
@@ -259,6 +304,7 @@ static int open_outputs(mpm_sim *s) {
   const mpm_rundir_request req = {s->dir,        s->overwrite, s->truncate,
                                   s->checkpoint, s->t,         s->run_id};
   MPM_CALL(mpm_rundir_claim(&s->rundir, s->comm, &req, &append, &s->run_id, &s->ckpt_number));
+  open_log(s, append);
   MPM_CALL(mpm_config_resolved_text(s->cfg, &s->config_text));
   MPM_CALL(mpm_output_new(&s->out, s->comm, s->dir, s->config_text, s->grid->dim, append, s->t));
   snprintf(path, sizeof path, "%s/diagnostics.csv", s->dir);
@@ -319,7 +365,7 @@ static int check_budget(mpm_sim *s) {
   mpm_budget b = {s->t, s->t_end, 0, s->out_interval, s->ckpt_interval, s->snapshots, 0};
   MPM_CALL(mpm_timescheme_cfl_step(s->it, &b.h0));
   MPM_CALL(output_bytes(s, &b.bytes));
-  return mpm_budget_check(s->cfg, &b);
+  return mpm_budget_check(s->cfg, &b, &s->estimate);
 }
 
 static int between_substeps(void *ctx, mpm_module *m, double t, double h, int *changed);
@@ -349,6 +395,9 @@ int mpm_sim_restart(mpm_sim **sp, mpm_config *cfg, const char *path) {
   /* Checkpoints from before the coupler have no coupling work: it was zero. */
   if (!rc && s->coupling) rc = mpm_checkpoint_attr(ck, "coupling_work", &s->coupling_work);
   if (!rc) mpm_checkpoint_attr_optional(ck, "run_id", &s->run_id); /* 0: from before run ids */
+  /* The summary's scale of the coupling work (0: a checkpoint from before it was kept). */
+  if (!rc) mpm_checkpoint_attr_optional(ck, "coupling_crossed", &s->coupling_crossed);
+  if (!rc) mpm_checkpoint_attr_optional(ck, "solid_peak", &s->solid_peak);
   if (!rc && !(s->checkpoint = strdup(path))) rc = MPM_ERR_MEMORY;
   for (int k = 0; !rc && k < s->nmod; ++k)
     rc = mpm_checkpoint_read_particles(ck, s->mod[k]->name, s->mod[k]->particles);
@@ -397,6 +446,7 @@ void mpm_sim_destroy(mpm_sim **sp) {
   mpm_guard_free(&s->guard);
   mpm_grid_destroy(&s->grid);
   mpm_rundir_release(&s->rundir);
+  mpm_log_file_close();
   free(s->checkpoint);
   free(s->config_text);
   free(s);
@@ -433,9 +483,11 @@ static int write_checkpoint(mpm_sim *s, const char *path) {
   mpm_particles *own = NULL;
   MPM_CALL(mpm_timescheme_save(s->it, &own, &names[s->nmod]));
   p[s->nmod] = own;
-  enum { NA = 5, MAXA = NA + MPM_PROBE_MAX * (1 + MPM_MAX_DIM) };
-  const char *attr[MAXA] = {"t", "step", "h_next", "coupling_work", "run_id"};
-  double val[MAXA] = {s->t, (double)s->step, s->h_next, s->coupling_work, s->run_id};
+  enum { NA = 7, MAXA = NA + MPM_PROBE_MAX * (1 + MPM_MAX_DIM) };
+  const char *attr[MAXA] = {
+      "t", "step", "h_next", "coupling_work", "run_id", "coupling_crossed", "solid_peak"};
+  double val[MAXA] = {s->t,      (double)s->step,     s->h_next,    s->coupling_work,
+                      s->run_id, s->coupling_crossed, s->solid_peak};
   const int na = NA + mpm_probes_attrs(&s->probes, attr + NA, val + NA, MAXA - NA);
   mpm_timer_start(MPM_T_IO);
   int rc = mpm_checkpoint_write(s->comm, path, s->config_text, attr, val, na, p, names,
@@ -457,6 +509,10 @@ static int coupling_row(mpm_sim *s, double dt, const double *energy) {
   double row[NCOUPLING(3) + MPM_MAX_DIM * MPM_COUPLING_MAX_BODIES], fs = 0, ff = 0, fsum = 0;
   int c = 0;
   if (dt > 0) s->coupling_work += dt * net;
+  /* What crossed: the work of the interface force on the side that gave the energy up (the
+   * larger in size; the other side received that less what the coupling destroyed). */
+  if (dt > 0) s->coupling_crossed += dt * fmax(fabs(r.power[S]), fabs(r.power[F]));
+  s->solid_peak = fmax(s->solid_peak, energy[S]);
   row[c++] = s->t, row[c++] = (double)s->step, row[c++] = dt;
   for (int d = 0; d < dim; ++d) row[c++] = r.force[S][d];
   for (int d = 0; d < dim; ++d) row[c++] = r.force[F][d];
@@ -575,28 +631,72 @@ static int after_step(mpm_sim *s, double h) {
   return 0;
 }
 
-/* Progress: a live line on a terminal; otherwise (a batch job, a pipe) a log line every
- * progress_interval seconds of wall time, so that a long run is never silent. */
+/* The step count, refined once the run has taken ESTIMATE_AFTER steps. The starting state's
+ * stable step (the budget's estimate, mpm_budget.h) is often not the step the run settles to:
+ * the artificial viscosity that limits the step at a shock needs the velocity divergence,
+ * which is zero in a state at rest or in uniform flow and appears with the first step (Sod
+ * and the main job settle to 0.3 and 0.5 of it within a few steps); an adaptive pair starts
+ * from a tiny step and its error control may keep it below the stability limit. Neither is
+ * known before the run. The model: the rest of the run goes at the median step of the latest
+ * half of those steps (the median ignores the steps cut short at output times and the
+ * adaptive pairs' first steps), plus one step per output time left. */
+static void refine_estimate(mpm_sim *s, double dt) {
+  const long k = s->step - s->step0;
+  if (k >= 1 && k <= ESTIMATE_AFTER) s->dt_first[k - 1] = dt;
+  if (k != ESTIMATE_AFTER || s->t >= s->t_end) return;
+  double h[ESTIMATE_AFTER / 2];
+  const int n = ESTIMATE_AFTER / 2;
+  memcpy(h, s->dt_first + ESTIMATE_AFTER - n, sizeof h);
+  for (int i = 1; i < n; ++i) /* insertion sort: ten numbers */
+    for (int j = i; j > 0 && h[j] < h[j - 1]; --j) {
+      const double x = h[j];
+      h[j] = h[j - 1], h[j - 1] = x;
+    }
+  const double med = 0.5 * (h[(n - 1) / 2] + h[n / 2]), span = s->t_end - s->t;
+  if (!(med > 0)) return;
+  const double nout = floor(span / s->out_interval * (1 + 1e-12));
+  const double before = s->estimate;
+  s->estimate = (double)k + span / med + nout;
+  mpm_log(MPM_LOG_INFO,
+          "estimate after %ld steps: about %.3g steps in all (the step has settled to %.3g s; "
+          "the estimate before the run was %.3g)",
+          k, s->estimate, med, before);
+}
+
+/* Progress, rank 0. Live (run.progress, read_progress): a line on the terminal redrawn at most
+ * twice a second, ended with a newline at the end (mpm_log clears it before any other line),
+ * and a progress line in run.log every progress_interval seconds. Log: that line on the
+ * console as well, so that a batch job or a pipe is never silent for long. The ETA is the
+ * measured rate: wall time so far over the simulated time reached. */
 static void progress(mpm_sim *s, double dt, double wall0, int final) {
-  static double last = -HUGE_VAL;
-  if (!s->progress || s->rank != 0) return;
-  const int tty = isatty(STDERR_FILENO);
-  const double now = MPI_Wtime();
-  if (last == -HUGE_VAL) last = wall0;
-  if (!final && now - last < (tty ? 0.5 : s->progress_interval)) return;
-  if (final && !tty) return;
-  last = now;
-  const double frac = s->t / s->t_end, eta = frac > 0 ? (now - wall0) * (1 - frac) / frac : 0;
-  if (!tty) {
-    mpm_log(MPM_LOG_INFO,
-            "progress: step %ld, t = %.6g (%.1f%%), dt = %.3g, %.0f s wall, ETA %.0f s", s->step,
-            s->t, 100 * frac, dt, now - wall0, eta);
-    return;
+  if (s->progress == PROGRESS_OFF || s->rank != 0) return;
+  const int live = s->progress == PROGRESS_LIVE;
+  const double now = MPI_Wtime(), wall = now - wall0;
+  const double frac = s->t / s->t_end, eta = frac > 0 ? wall * (1 - frac) / frac : 0;
+  /* Before 1 % of the run the rate is that of the first steps (an adaptive pair's tiny ones,
+   * the start-up's I/O): no ETA yet. */
+  char eta_s[32] = "ETA ?";
+  if (frac >= 0.01) snprintf(eta_s, sizeof eta_s, "ETA %.0f s", eta);
+  if (s->progress_last == 0) s->progress_last = s->progress_logged = wall0;
+  const int log_due = now - s->progress_logged >= s->progress_interval && !final;
+  if (log_due) {
+    s->progress_logged = s->progress_last = now;
+    if (live)
+      mpm_log_record(MPM_LOG_INFO,
+                     "progress: step %ld, t = %.6g (%.1f%%), dt = %.3g, %.0f s wall, ETA %.0f s",
+                     s->step, s->t, 100 * frac, dt, wall, eta);
+    else
+      mpm_log(MPM_LOG_INFO,
+              "progress: step %ld, t = %.6g (%.1f%%), dt = %.3g, %.0f s wall, ETA %.0f s", s->step,
+              s->t, 100 * frac, dt, wall, eta);
   }
-  fprintf(stderr, "\rstep %8ld  t = %-11.5g dt = %-10.3g %5.1f%%  ETA %6.0f s  ", s->step, s->t, dt,
-          100 * frac, eta);
-  if (final) fputc('\n', stderr);
-  fflush(stderr);
+  if (!live || (!final && now - s->progress_last < 0.5 && !log_due)) return;
+  s->progress_last = now;
+  char of[32] = "";
+  if (s->estimate > 0) snprintf(of, sizeof of, " of ~%.0f", s->estimate + (double)s->step0);
+  mpm_log_status("step %ld%s  t = %.5g (%.1f%%)  dt = %.3g  wall %.0f s  %s", s->step, of, s->t,
+                 100 * frac, dt, wall, eta_s);
+  if (final) mpm_log_status_end();
 }
 
 static int write_summary(mpm_sim *s, double wall) {
@@ -609,11 +709,20 @@ static int write_summary(mpm_sim *s, double wall) {
           "done: t = %.6g, %ld steps (%ld rhs evaluations, %ld error-test failures, %ld "
           "retries), %.3f s wall, %.3g particle-steps/s",
           s->t, steps, rhs, fails, retries, wall, s->particle_steps / wall);
+  /* The coupling's energy error on the scale of what it moves: the energy that crossed the
+   * interface, the solid's peak energy (that of the body it drives) and the total energy. */
+  const double rel_crossed = s->coupling_crossed > 0 ? s->coupling_work / s->coupling_crossed : 0;
+  const double rel_solid = s->solid_peak > 0 ? s->coupling_work / s->solid_peak : 0;
+  const double rel_total = s->energy > 0 ? s->coupling_work / s->energy : 0;
   if (s->coupling)
-    mpm_log(MPM_LOG_INFO,
-            "coupling %s: interface momentum imbalance at most %.2g of the interface force; "
-            "energy created by the coupling %.6g J",
-            s->coupling->type->name, s->coupling_imbalance, s->coupling_work);
+    mpm_log(
+        MPM_LOG_INFO,
+        "coupling %s: interface momentum imbalance at most %.2g of the interface force; "
+        "energy created by the coupling %.6g J (%.3g %% of the %.3g J that crossed the "
+        "interface, %.3g %% of the solid's peak energy %.3g J, %.3g %% of the total energy %.3g "
+        "J)",
+        s->coupling->type->name, s->coupling_imbalance, s->coupling_work, 100 * rel_crossed,
+        s->coupling_crossed, 100 * rel_solid, s->solid_peak, 100 * rel_total, s->energy);
   if (s->rank != 0) return 0;
   snprintf(path, sizeof path, "%s/summary.json", s->dir);
   FILE *f = fopen(path, "w");
@@ -622,10 +731,14 @@ static int write_summary(mpm_sim *s, double wall) {
           "{\"t\": %.17g, \"steps\": %ld, \"rhs_evals\": %ld, \"error_test_fails\": %ld, "
           "\"retries\": %ld, \"wall_s\": %.6f, \"ranks\": %d, \"particle_steps\": %.17g, "
           "\"particle_steps_per_s\": %.6g, \"coupling\": \"%s\", "
-          "\"coupling_imbalance\": %.6g, \"coupling_work\": %.17g}\n",
+          "\"coupling_imbalance\": %.6g, \"coupling_work\": %.17g, "
+          "\"coupling_crossed\": %.17g, \"coupling_work_of_crossed\": %.6g, "
+          "\"solid_energy_peak\": %.17g, \"coupling_work_of_solid\": %.6g, "
+          "\"coupling_work_of_total\": %.6g, \"steps_estimated\": %.17g}\n",
           s->t, steps, rhs, fails, retries, wall, s->size, s->particle_steps,
           s->particle_steps / wall, s->coupling ? s->coupling->type->name : "none",
-          s->coupling_imbalance, s->coupling_work);
+          s->coupling_imbalance, s->coupling_work, s->coupling_crossed, rel_crossed, s->solid_peak,
+          rel_solid, rel_total, s->estimate);
   fclose(f);
   return 0;
 }
@@ -654,6 +767,7 @@ static int guard(mpm_sim *s, double dt, double tstop) {
 int mpm_sim_run(mpm_sim *s) {
   char path[4096];
   MPM_CALL(open_outputs(s));
+  s->step0 = s->step;
   mpm_timer_reset();
   mpm_timer_start(MPM_T_TOTAL);
   const double wall0 = MPI_Wtime();
@@ -683,6 +797,7 @@ int mpm_sim_run(mpm_sim *s) {
     const int rc = mpm_timescheme_step(s->it, tstop, &s->t, &dt);
     if (rc) return stopped(s, rc); /* the state is the last accepted step's */
     s->step++;
+    refine_estimate(s, dt);
     MPM_CALL(after_step(s, dt));
     MPM_CALL(diagnostics(s, dt));
     MPM_CALL(guard(s, dt, tstop));

@@ -12,7 +12,7 @@
 static char g_choices[256];
 static char g_help[1024];
 static mpm_key_spec g_time_key[] = {
-    {"coupling.time", MPM_KEY_ENUM, "monolithic", 0, 0, 0, 0, g_choices, g_help, 0},
+    {"coupling.time", MPM_KEY_ENUM, "monolithic", 0, 0, 0, 0, g_choices, g_help, 0, NULL},
 };
 
 int mpm_timescheme_add_schema(mpm_config *cfg) {

@@ -38,22 +38,22 @@ static const mpm_key_spec multirate_keys[] = {
     {"coupling.substeps", MPM_KEY_INT, NULL, 1, 1e6, 0, 0, NULL,
      "multirate: substeps of the fast module in each coupling step, >= 1 (unset: the fewest its "
      "own stable step allows; 1: the monolithic step)",
-     1},
+     1, "-"},
     {"coupling.slow_substeps", MPM_KEY_INT, "1", 0, 1e6, 0, 0, NULL,
      "multirate, classic update: substeps of the slow module in each coupling step, against the "
      "fast one held (1: one step, multirate itself; 0: as many as the fast module, an ablation: "
      "the coupling lag without the slow module's own step error)",
-     0},
+     0, "-"},
     {"coupling.load", MPM_KEY_ENUM, "held", 0, 0, 0, 0, "held|interpolated",
      "multirate: how the solid's substeps see the gas's load: held (constant over the coupling "
      "step) or interpolated (with its linear trend since the last coupling step); both pass "
      "the same momentum",
-     0},
+     0, NULL},
     {"coupling.mri_table", MPM_KEY_ENUM, "mri_gark_erk33a", 0, 0, 0, 0,
      "mri_gark_erk33a|mis_kw3|mri_gark_erk45a",
      "multirate with an ERK pair (MRIStep): the MRI coupling table, MRI-GARK-ERK33a (order 3), "
      "MIS-KW3 (order 3) or MRI-GARK-ERK45a (order 4)",
-     0},
+     0, NULL},
 };
 
 /* coupling.mri_table's choices and their ARKODE tables. */

@@ -33,19 +33,19 @@ static const mpm_key_spec staggered_keys[] = {
      "staggered: the order of the advances in a coupling step: solid_first (the conventional "
      "serial staggered scheme: the solid under the gas's last load, then the gas), gas_first, "
      "or parallel (both from the state at the start of the step)",
-     0},
+     0, NULL},
     {"coupling.iterations", MPM_KEY_INT, "1", 1, 1000, 0, 0, NULL,
      "staggered solid_first: the most sub-iterations in a coupling step (1: none, the weak "
      "scheme; > 1: strong coupling, with coupling.tolerance)",
-     0},
+     0, "-"},
     {"coupling.tolerance", MPM_KEY_REAL, NULL, 0, 1, 1, 0, NULL,
      "staggered with coupling.iterations > 1: the sub-iterations stop when the interface load's "
      "residual is this fraction of the load (2-norms over the nodes), e.g. 1e-6",
-     1},
+     1, "-"},
     {"coupling.relaxation", MPM_KEY_REAL, "0.5", 0, 1, 1, 0, NULL,
      "staggered with coupling.iterations > 1: the relaxation factor of the first sub-iteration "
      "in (0, 1]; Aitken's rule sets the later ones",
-     0},
+     0, "-"},
 };
 
 typedef enum { ORDER_SOLID_FIRST, ORDER_GAS_FIRST, ORDER_PARALLEL } stag_order;

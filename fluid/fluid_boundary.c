@@ -80,13 +80,13 @@
 
 const mpm_key_spec fluid_boundary_keys[] = {
     {"freestream.density", MPM_KEY_REAL, NULL, 0, HUGE_VAL, 1, 0, NULL,
-     "free-stream density, kg/m^3, for inflow, subsonic_inflow and farfield faces", 1},
+     "free-stream density, kg/m^3, for inflow, subsonic_inflow and farfield faces", 1, "kg/m^3"},
     {"freestream.pressure", MPM_KEY_REAL, NULL, 0, HUGE_VAL, 1, 0, NULL,
-     "free-stream pressure, Pa, for the open gas faces", 1},
+     "free-stream pressure, Pa, for the open gas faces", 1, "Pa"},
     {"freestream.velocity", MPM_KEY_REALS, "0 0 0", -HUGE_VAL, HUGE_VAL, 0, 3, NULL,
-     "free-stream velocity, m/s (dim values)", 0},
+     "free-stream velocity, m/s (dim values)", 0, "m/s"},
     {"freestream.back_pressure", MPM_KEY_REAL, NULL, 0, HUGE_VAL, 1, 0, NULL,
-     "exit pressure of subsonic_outflow faces, Pa (default: freestream.pressure)", 1},
+     "exit pressure of subsonic_outflow faces, Pa (default: freestream.pressure)", 1, "Pa"},
     {"freestream.exterior", MPM_KEY_ENUM, "copies", 0, 0, 0, 0, "copies|gauge",
      "how the outflow, subsonic_outflow, subsonic_inflow and farfield faces stand in for the "
      "gas beyond them: copies (virtual particles continuing the particle columns) or gauge "
@@ -94,15 +94,15 @@ const mpm_key_spec fluid_boundary_keys[] = {
      "pressure, which holds the far field when mixed flow crosses the face, but blew up on "
      "RAE 2822 at 50 cells per chord when a vortex crossed the face; see "
      "fluid/fluid_boundary.c)",
-     0},
+     0, NULL},
     {"freestream.sponge", MPM_KEY_REAL, "0", 0, HUGE_VAL, 0, 0, NULL,
      "thickness, m, of an absorbing layer inside every farfield face that relaxes the gas's "
      "incoming characteristic towards the free stream's (0: none; see fluid/fluid_boundary.c)",
-     0},
+     0, "m"},
     {"freestream.sponge_rate", MPM_KEY_REAL, NULL, 0, HUGE_VAL, 1, 0, NULL,
      "the sponge's relaxation rate at the face, 1/s (default 3 c_inf / freestream.sponge: a "
      "wave crossing the layer at the sound speed is damped by e^-1)",
-     1},
+     1, "1/s"},
 };
 const int fluid_boundary_nkeys = (int)(sizeof fluid_boundary_keys / sizeof fluid_boundary_keys[0]);
 

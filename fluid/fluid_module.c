@@ -40,52 +40,53 @@
 
 static const mpm_key_spec fluid_keys[] = {
     {"fluid.gamma", MPM_KEY_REAL, "1.4", 1, HUGE_VAL, 1, 0, NULL,
-     "ratio of specific heats c_p / c_v of the ideal gas, > 1 (air: 1.4)", 0},
+     "ratio of specific heats c_p / c_v of the ideal gas, > 1 (air: 1.4)", 0, "-"},
     {"fluid.R", MPM_KEY_REAL, "287.05", 0, HUGE_VAL, 1, 0, NULL,
-     "specific gas constant, J/(kg K), for the temperature and entropy output (air: 287.05)", 0},
+     "specific gas constant, J/(kg K), for the temperature and entropy output (air: 287.05)", 0,
+     "J/(kg K)"},
     {"fluid.viscosity", MPM_KEY_REAL, "0", 0, HUGE_VAL, 0, 0, NULL,
-     "dynamic viscosity mu, Pa s (0: inviscid; air: 1.8e-5)", 0},
+     "dynamic viscosity mu, Pa s (0: inviscid; air: 1.8e-5)", 0, "Pa s"},
     {"fluid.av_linear", MPM_KEY_REAL, "0.5", 0, HUGE_VAL, 0, 0, NULL,
      "linear artificial viscosity coefficient c_lin: q = rho l |tr D| (c_lin c + c_quad l "
      "|tr D|) in compression, l = grid.dx",
-     0},
+     0, "-"},
     {"fluid.av_quadratic", MPM_KEY_REAL, "2", 0, HUGE_VAL, 0, 0, NULL,
-     "quadratic artificial viscosity coefficient c_quad (see av_linear)", 0},
+     "quadratic artificial viscosity coefficient c_quad (see av_linear)", 0, "-"},
     {"fluid.pic_fraction", MPM_KEY_REAL, NULL, 0, 1, 0, 0, NULL,
      "the gas's own PIC share of the particle velocity update, in place of "
      "transfer.pic_fraction (default: that), for a step at the gas's own stable step at "
      "time.cfl = 0.4 (any other step takes the share that damps as much per unit time, so "
      "neither time.cfl nor a stiffer module's step changes the damping); damps the gas's "
      "particle noise without damping the solid; classic update only",
-     1},
+     1, "-"},
     {"fluid.strain_rate", MPM_KEY_ENUM, "current", 0, 0, 0, 0, "current|lagged",
      "ERK pairs: the strain rate the artificial and physical viscosity see: current (of the "
      "state itself: a second deposit and a gather, about 1.6x the gas's work per RHS) or lagged "
      "(of the previous step: cheaper, but it holds every ERK pair to first order in time "
      "wherever the artificial viscosity acts); the classic update always lags",
-     0},
+     0, NULL},
     {"fluid.ppc", MPM_KEY_INT, "2", 1, 8, 0, 0, NULL,
-     "gas particles per cell per direction at seeding", 0},
+     "gas particles per cell per direction at seeding", 0, "-"},
     {"fluid.regularise_every", MPM_KEY_INT, "0", 0, HUGE_VAL, 0, 0, NULL,
      "merge and split gas particles every N accepted steps, conserving mass, momentum and "
      "total energy (0: never; the seed paper uses 30)",
-     0},
+     0, "-"},
     {"fluid.refill", MPM_KEY_BOOL, "true", 0, 0, 0, 0, NULL,
      "with regularisation: give every empty cell next to the gas (and free of other "
      "material and obstacles) half of a neighbour's heaviest particle, conserving mass, "
      "momentum and energy, so that strong expansions and wakes keep no empty cell",
-     0},
+     0, NULL},
     {"fluid.refill_every", MPM_KEY_INT, "0", 0, HUGE_VAL, 0, 0, NULL,
      "refill every N accepted steps, apart from the merges and splits (0: with each "
      "regularisation, every fluid.regularise_every steps); a wake that expansion empties "
      "faster than regularise_every steps refill it keeps empty cells between refills",
-     0},
+     0, "-"},
     {"fluid.merge_light", MPM_KEY_REAL, "0", 0, 0.5, 0, 0, NULL,
      "with regularisation or refill: at each of them, a gas particle lighter than this "
      "fraction of the heaviest particle in its cell merges with it and the two split into "
      "equal halves, conserving mass, momentum, total energy and volume (0: off); see "
      "fluid/fluid_regularise.c",
-     0},
+     0, "-"},
     {"fluid.shift", MPM_KEY_REAL, "0", 0, 0.5, 0, 0, NULL,
      "particle shifting coefficient kappa: each gas particle moves down the gradient of the "
      "gas's nodal volume fraction phi at the rate kappa dx (c + |v|), so that particles that "
@@ -93,60 +94,60 @@ static const mpm_key_spec fluid_keys[] = {
      "at most 0.5: 0.5 was already erratic on the double rarefaction; "
      "only positions change, so mass, momentum and energy are kept exactly; see "
      "fluid/fluid_shift.c)",
-     0},
+     0, "-"},
     {"fluid.shift_expansion", MPM_KEY_REAL, "0", 0, HUGE_VAL, 0, 0, NULL,
      "with fluid.shift: only particles whose volume has grown by at least this factor since "
      "seeding (J >= this) move (0: every particle). 1.2 keeps uniform flow free of the noise "
      "shifting adds there, but the thin plate of cases/plate_across.ini then blew up at "
      "dx = 0.005: shifting its compressed particles is what keeps it stable",
-     0},
+     0, "-"},
     {"fluid.shift_every", MPM_KEY_INT, "1", 1, HUGE_VAL, 0, 0, NULL,
-     "shift the gas particles every N accepted steps (with fluid.shift > 0)", 0},
+     "shift the gas particles every N accepted steps (with fluid.shift > 0)", 0, "-"},
     {"fluid.empty_node_mass", MPM_KEY_REAL, "1e-14", 0, 1e-2, 0, 0, NULL,
      "a gas node holding less than this fraction of the largest gas nodal mass is empty: no "
      "velocity, no acceleration, and its force is dropped (1e-14: roundoff only). In a near "
      "vacuum the few light particles at such nodes take huge accelerations and heat; 1e-4 "
      "keeps them at the gas's own speeds, at the price of the momentum those nodes carry",
-     0},
+     0, "-"},
     {"fluid.light_node_mass", MPM_KEY_REAL, "0", 0, 0.5, 0, 0, NULL,
      "a gas node holding less than this fraction of the mean gas nodal mass (over the nodes "
      "holding gas) is empty too, as for empty_node_mass (0: off). Relative to the mean, so a "
      "spuriously compressed node elsewhere does not empty ordinary ones",
-     0},
+     0, "-"},
     {"fluid.regularise_min", MPM_KEY_INT, NULL, 1, HUGE_VAL, 0, 0, NULL,
      "split particles in a non-empty cell holding fewer than this (default ceil(ppc^dim / 2): "
      "refill where the gas has expanded to twice its seeding volume; 1 never splits)",
-     1},
+     1, "-"},
     {"fluid.stable_step", MPM_KEY_ENUM, "particle", 0, 0, 0, 0, "particle|neighbourhood",
      "how the gas's stable step is estimated: particle (the fastest single particle) or "
      "neighbourhood (mass-weighted over the 3^dim cells around each cell, so that light "
      "refill particles in a wake do not set the step; see fluid/fluid_stable.c; it blew up "
      "the main job at 2 mm, so particle stays the default)",
-     0},
+     0, NULL},
     {"fluid.regularise_max", MPM_KEY_INT, NULL, 2, HUGE_VAL, 0, 0, NULL,
      "merge particles in a cell holding more than this (default 4 ppc^dim: only where the "
      "gas is compressed fourfold, beyond the 2-3x of the usual shocks); > regularise_min",
-     1},
+     1, "-"},
     {"gas.*.geometry", MPM_KEY_STRING, NULL, 0, 0, 0, 0, NULL,
      "name of the [geometry.NAME] region the gas fills (where regions overlap, the first "
      "[gas] section in the file wins)",
-     0},
+     0, NULL},
     {"gas.*.density", MPM_KEY_REAL, NULL, 0, HUGE_VAL, 1, 0, NULL,
-     "initial density, kg/m^3 (or density_field)", 1},
+     "initial density, kg/m^3 (or density_field)", 1, "kg/m^3"},
     {"gas.*.pressure", MPM_KEY_REAL, NULL, 0, HUGE_VAL, 1, 0, NULL,
-     "initial pressure, Pa (or pressure_field)", 1},
+     "initial pressure, Pa (or pressure_field)", 1, "Pa"},
     {"gas.*.velocity", MPM_KEY_REALS, "0 0 0", -HUGE_VAL, HUGE_VAL, 0, 3, NULL,
-     "initial velocity, m/s (dim values; extra values are ignored)", 0},
+     "initial velocity, m/s (dim values; extra values are ignored)", 0, "m/s"},
     {"gas.*.density_field", MPM_KEY_STRING, NULL, 0, 0, 0, 0, NULL,
      "initial density as an expression in x, y, z (e.g. 1 + 0.1*exp(-x^2/0.01)), instead of "
      "density",
-     1},
+     1, "kg/m^3"},
     {"gas.*.pressure_field", MPM_KEY_STRING, NULL, 0, 0, 0, 0, NULL,
-     "initial pressure as an expression in x, y, z, instead of pressure", 1},
+     "initial pressure as an expression in x, y, z, instead of pressure", 1, "Pa"},
     {"gas.*.velocity_field", MPM_KEY_STRING, NULL, 0, 0, 0, 0, NULL,
      "initial velocity as expressions in x, y, z, one per component separated by ';', "
      "instead of velocity",
-     1},
+     1, "m/s"},
 };
 
 int fluid_add_schema(mpm_config *cfg) {

@@ -15,24 +15,24 @@ const mpm_key_spec fluid_wall_keys[] = {
      "fluid.wall_band take a least-squares fit over the particles behind them, with the wall "
      "condition imposed; classic update only, and at a traction interface usl with "
      "coupling.time = monolithic; see fluid/fluid_wall_ls.h)",
-     0},
+     0, NULL},
     {"fluid.wall_band", MPM_KEY_REAL, "1", 0, 3, 1, 0, NULL,
      "least_squares: particles closer to an obstacle than this many cells are fitted, in "
      "(0, 3]",
-     0},
+     0, "dx"},
     {"fluid.wall_blend", MPM_KEY_REAL, "0", 0, 3, 0, 0, NULL,
      "least_squares: particles between fluid.wall_band and wall_band + this many cells take "
      "the fit in part, fully at the band's edge and not at all this far beyond it, and stay "
      "donors (0: none, a sharp edge). 1 keeps uniform flow along a wall slanted to the grid "
      "within 0.6 % (0: 2.5-4.2 %, on the particle rows just outside the band) and moves the "
      "Mach 2.5 wedge's shock 0.44 degrees steeper (fluid/fluid_wall_ls.h)",
-     0},
+     0, "dx"},
     {"fluid.wall_fit_order", MPM_KEY_INT, "0", 0, 1, 0, 0, NULL,
      "least_squares: order of the fit of the tangential velocity, e and rho: 0 (the donors' "
      "weighted mean) or 1 (linear; it extrapolates the gradients next to the wall: the "
      "wedge's wall layer ran 10-57 % over the post-shock pressure); the normal velocity is "
      "always linear and zero on the surface",
-     0},
+     0, "-"},
 };
 const int fluid_wall_nkeys = (int)(sizeof fluid_wall_keys / sizeof fluid_wall_keys[0]);
 

@@ -29,32 +29,34 @@
 
 static mpm_key_spec solid_keys[] = {
     {"solid.*.geometry", MPM_KEY_STRING, NULL, 0, 0, 0, 0, NULL,
-     "name of the [geometry.NAME] region the body fills", 0},
+     "name of the [geometry.NAME] region the body fills", 0, NULL},
     {"solid.*.material", MPM_KEY_ENUM, NULL, 0, 0, 0, 0, NULL, /* set from the registry */
-     "material model of the body", 0},
-    {"solid.*.density", MPM_KEY_REAL, NULL, 0, HUGE_VAL, 1, 0, NULL, "mass density, kg/m^3", 0},
+     "material model of the body", 0, NULL},
+    {"solid.*.density", MPM_KEY_REAL, NULL, 0, HUGE_VAL, 1, 0, NULL, "mass density, kg/m^3", 0,
+     "kg/m^3"},
     {"solid.*.E", MPM_KEY_REAL, NULL, 0, HUGE_VAL, 1, 0, NULL,
-     "Young's modulus, Pa (elastic models)", 1},
-    {"solid.*.nu", MPM_KEY_REAL, "0.3", 0, 0.4999, 0, 0, NULL, "Poisson's ratio, [0, 0.5)", 0},
+     "Young's modulus, Pa (elastic models)", 1, "Pa"},
+    {"solid.*.nu", MPM_KEY_REAL, "0.3", 0, 0.4999, 0, 0, NULL, "Poisson's ratio, [0, 0.5)", 0, "-"},
     {"solid.*.velocity", MPM_KEY_REALS, "0 0 0", -HUGE_VAL, HUGE_VAL, 0, 3, NULL,
-     "initial velocity, m/s (dim values; extra values are ignored)", 0},
+     "initial velocity, m/s (dim values; extra values are ignored)", 0, "m/s"},
     {"solid.*.velocity_field", MPM_KEY_STRING, NULL, 0, 0, 0, 0, NULL,
      "initial velocity as expressions in x, y, z, one per component separated by ';' "
      "(e.g. 0.1*sin(pi*x/50); 0), instead of velocity",
-     1},
-    {"solid.*.ppc", MPM_KEY_INT, "2", 1, 8, 0, 0, NULL, "particles per cell per direction", 0},
+     1, "m/s"},
+    {"solid.*.ppc", MPM_KEY_INT, "2", 1, 8, 0, 0, NULL, "particles per cell per direction", 0, "-"},
     {"solid.*.sigma_y", MPM_KEY_REAL, NULL, 0, HUGE_VAL, 1, 0, NULL,
-     "initial yield stress, Pa (plastic models)", 1},
+     "initial yield stress, Pa (plastic models)", 1, "Pa"},
     {"solid.*.hardening", MPM_KEY_REAL, "0", 0, HUGE_VAL, 0, 0, NULL,
-     "linear isotropic hardening modulus H, Pa (plastic models)", 0},
+     "linear isotropic hardening modulus H, Pa (plastic models)", 0, "Pa"},
     {"clamp.*.geometry", MPM_KEY_STRING, NULL, 0, 0, 0, 0, NULL,
-     "region whose nodes and particles are held fixed (a [geometry.NAME])", 0},
+     "region whose nodes and particles are held fixed (a [geometry.NAME])", 0, NULL},
     {"traction.*.geometry", MPM_KEY_STRING, NULL, 0, 0, 0, 0, NULL,
      "region (a [geometry.NAME]) covering the outermost particle layer of the loaded face; "
      "particles of deformable bodies inside it at seeding carry the traction",
-     0},
+     0, NULL},
     {"traction.*.value", MPM_KEY_REALS, NULL, -HUGE_VAL, HUGE_VAL, 0, 3, NULL,
-     "nominal traction, Pa (force per unit reference area; per unit depth in 2-D), dim values", 0},
+     "nominal traction, Pa (force per unit reference area; per unit depth in 2-D), dim values", 0,
+     "Pa"},
 };
 
 int solid_add_schema(mpm_config *cfg) {

@@ -23,18 +23,18 @@
 #include <unistd.h>
 
 static const mpm_key_spec g_keys[] = {
-    {"grid.dx", MPM_KEY_REAL, NULL, 0, HUGE_VAL, 1, 0, NULL, "grid spacing, m", 0},
-    {"grid.n", MPM_KEY_INT, "10", 1, 1000, 0, 0, NULL, "cells", 0},
-    {"grid.periodic", MPM_KEY_BOOL, "no", 0, 0, 0, 0, NULL, "periodic", 0},
-    {"grid.lo", MPM_KEY_REALS, "0 0 0", -HUGE_VAL, HUGE_VAL, 0, 3, NULL, "lower corner", 0},
-    {"run.name", MPM_KEY_STRING, "case", 0, 0, 0, 0, NULL, "name", 0},
-    {"run.level", MPM_KEY_ENUM, "info", 0, 0, 0, 0, "error|info|debug", "level", 0},
-    {"geometry.*.type", MPM_KEY_ENUM, NULL, 0, 0, 0, 0, "box|sphere", "shape", 0},
-    {"geometry.*.lo", MPM_KEY_REALS, "0 0", -1e3, 1e3, 0, 3, NULL, "corner", 0},
-    {"geometry.*.r", MPM_KEY_REAL, "1", 0, 10, 1, 0, NULL, "radius", 0},
-    {"geometry.*.of", MPM_KEY_NAMES, "none", 0, 0, 0, 0, NULL, "parts", 0},
-    {"solid.*.ppc", MPM_KEY_INT, NULL, 1, 8, 0, 0, NULL, "particles per cell", 0},
-    {"mesh.file", MPM_KEY_PATH, NULL, 0, 0, 0, 0, NULL, "mesh", 0},
+    {"grid.dx", MPM_KEY_REAL, NULL, 0, HUGE_VAL, 1, 0, NULL, "grid spacing, m", 0, NULL},
+    {"grid.n", MPM_KEY_INT, "10", 1, 1000, 0, 0, NULL, "cells", 0, NULL},
+    {"grid.periodic", MPM_KEY_BOOL, "no", 0, 0, 0, 0, NULL, "periodic", 0, NULL},
+    {"grid.lo", MPM_KEY_REALS, "0 0 0", -HUGE_VAL, HUGE_VAL, 0, 3, NULL, "lower corner", 0, NULL},
+    {"run.name", MPM_KEY_STRING, "case", 0, 0, 0, 0, NULL, "name", 0, NULL},
+    {"run.level", MPM_KEY_ENUM, "info", 0, 0, 0, 0, "error|info|debug", "level", 0, NULL},
+    {"geometry.*.type", MPM_KEY_ENUM, NULL, 0, 0, 0, 0, "box|sphere", "shape", 0, NULL},
+    {"geometry.*.lo", MPM_KEY_REALS, "0 0", -1e3, 1e3, 0, 3, NULL, "corner", 0, NULL},
+    {"geometry.*.r", MPM_KEY_REAL, "1", 0, 10, 1, 0, NULL, "radius", 0, NULL},
+    {"geometry.*.of", MPM_KEY_NAMES, "none", 0, 0, 0, 0, NULL, "parts", 0, NULL},
+    {"solid.*.ppc", MPM_KEY_INT, NULL, 1, 8, 0, 0, NULL, "particles per cell", 0, NULL},
+    {"mesh.file", MPM_KEY_PATH, NULL, 0, 0, 0, 0, NULL, "mesh", 0, NULL},
 };
 static const int g_nkeys = (int)(sizeof g_keys / sizeof g_keys[0]);
 

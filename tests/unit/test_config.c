@@ -23,20 +23,22 @@
 #include <cmocka.h>
 
 static const mpm_key_spec g_keys[] = {
-    {"grid.dx", MPM_KEY_REAL, NULL, 0, HUGE_VAL, 1, 0, NULL, "grid spacing, m", 0},
-    {"grid.n", MPM_KEY_INT, "10", 1, 1000, 0, 0, NULL, "cells per direction", 0},
-    {"grid.periodic", MPM_KEY_BOOL, "false", 0, 0, 0, 0, NULL, "periodic boundaries", 0},
-    {"grid.lo", MPM_KEY_REALS, "0 0 0", -HUGE_VAL, HUGE_VAL, 0, 3, NULL, "lower corner, m", 0},
-    {"run.name", MPM_KEY_STRING, "case", 0, 0, 0, 0, NULL, "run name", 0},
+    {"grid.dx", MPM_KEY_REAL, NULL, 0, HUGE_VAL, 1, 0, NULL, "grid spacing, m", 0, NULL},
+    {"grid.n", MPM_KEY_INT, "10", 1, 1000, 0, 0, NULL, "cells per direction", 0, NULL},
+    {"grid.periodic", MPM_KEY_BOOL, "false", 0, 0, 0, 0, NULL, "periodic boundaries", 0, NULL},
+    {"grid.lo", MPM_KEY_REALS, "0 0 0", -HUGE_VAL, HUGE_VAL, 0, 3, NULL, "lower corner, m", 0,
+     NULL},
+    {"run.name", MPM_KEY_STRING, "case", 0, 0, 0, 0, NULL, "run name", 0, NULL},
     {"run.log_level", MPM_KEY_ENUM, "info", 0, 0, 0, 0, "error|warn|info|debug|trace", "log level",
-     0},
-    {"time.t_end", MPM_KEY_REAL, "1", 0, HUGE_VAL, 1, 0, NULL, "end time, s", 0},
-    {"geometry.*.type", MPM_KEY_ENUM, NULL, 0, 0, 0, 0, "box|sphere", "region shape", 0},
-    {"geometry.*.lo", MPM_KEY_REALS, "0 0", -HUGE_VAL, HUGE_VAL, 0, 3, NULL, "lower corner, m", 0},
-    {"geometry.*.radius", MPM_KEY_REAL, "1", 0, HUGE_VAL, 1, 0, NULL, "radius, m", 0},
-    {"geometry.*.of", MPM_KEY_NAMES, "none", 0, 0, 0, 0, NULL, "regions to join", 0},
-    {"mesh.scale", MPM_KEY_REAL, "1", 0, HUGE_VAL, 1, 0, NULL, "mesh scale", 0},
-    {"mesh.file", MPM_KEY_PATH, NULL, 0, 0, 0, 0, NULL, "mesh file", 0},
+     0, NULL},
+    {"time.t_end", MPM_KEY_REAL, "1", 0, HUGE_VAL, 1, 0, NULL, "end time, s", 0, NULL},
+    {"geometry.*.type", MPM_KEY_ENUM, NULL, 0, 0, 0, 0, "box|sphere", "region shape", 0, NULL},
+    {"geometry.*.lo", MPM_KEY_REALS, "0 0", -HUGE_VAL, HUGE_VAL, 0, 3, NULL, "lower corner, m", 0,
+     NULL},
+    {"geometry.*.radius", MPM_KEY_REAL, "1", 0, HUGE_VAL, 1, 0, NULL, "radius, m", 0, NULL},
+    {"geometry.*.of", MPM_KEY_NAMES, "none", 0, 0, 0, 0, NULL, "regions to join", 0, NULL},
+    {"mesh.scale", MPM_KEY_REAL, "1", 0, HUGE_VAL, 1, 0, NULL, "mesh scale", 0, NULL},
+    {"mesh.file", MPM_KEY_PATH, NULL, 0, 0, 0, 0, NULL, "mesh file", 0, NULL},
 };
 static const int g_nkeys = (int)(sizeof g_keys / sizeof g_keys[0]);
 
@@ -742,11 +744,15 @@ static void test_getter_errors(void **state) {
 static void test_bad_schema(void **state) {
   (void)state;
   static const mpm_key_spec bad_default[] = {
-      {"a.x", MPM_KEY_REAL, "abc", 0, 1, 0, 0, NULL, "x", 0}};
-  static const mpm_key_spec no_section[] = {{"x", MPM_KEY_REAL, "1", 0, 1, 0, 0, NULL, "x", 0}};
-  static const mpm_key_spec star_last[] = {{"a.*", MPM_KEY_REAL, "1", 0, 1, 0, 0, NULL, "x", 0}};
-  static const mpm_key_spec no_choices[] = {{"a.e", MPM_KEY_ENUM, "x", 0, 0, 0, 0, NULL, "e", 0}};
-  static const mpm_key_spec out_of_range[] = {{"a.y", MPM_KEY_INT, "5", 0, 1, 0, 0, NULL, "y", 0}};
+      {"a.x", MPM_KEY_REAL, "abc", 0, 1, 0, 0, NULL, "x", 0, NULL}};
+  static const mpm_key_spec no_section[] = {
+      {"x", MPM_KEY_REAL, "1", 0, 1, 0, 0, NULL, "x", 0, NULL}};
+  static const mpm_key_spec star_last[] = {
+      {"a.*", MPM_KEY_REAL, "1", 0, 1, 0, 0, NULL, "x", 0, NULL}};
+  static const mpm_key_spec no_choices[] = {
+      {"a.e", MPM_KEY_ENUM, "x", 0, 0, 0, 0, NULL, "e", 0, NULL}};
+  static const mpm_key_spec out_of_range[] = {
+      {"a.y", MPM_KEY_INT, "5", 0, 1, 0, 0, NULL, "y", 0, NULL}};
   const mpm_key_spec *tables[] = {bad_default, no_section,   star_last,
                                   no_choices,  out_of_range, g_keys};
   for (int i = 0; i < 6; ++i) {
