@@ -1,4 +1,4 @@
-"""Coupling-scheme ablation: one case under every combination of spatial scheme x temporal
+r"""Coupling-scheme ablation: one case under every combination of spatial scheme x temporal
 scheme x time method, at several coupling steps, against a fine monolithic reference.
 
     /usr/bin/python3 bench/ablate.py CASE [options] [key=value ...]
@@ -23,13 +23,22 @@ time.adaptive = false); `contact` with the classic update only (its own restrict
 steps: time.cfl in --cfl. --skip leaves out runs by name (shell patterns), --skip-variants whole
 variants.
 
-Results go to --out (default bench/results/ablate_<case>; the runs' own output to --scratch,
-default out/ablate/<the results folder's name>/): runs.csv (one row per run, written as
-each run ends: an interrupted sweep resumes without redoing finished runs; delete a row to redo
-it; a reference run again, because the binary or the overrides changed, redoes its scheme's
-rows), ablation.md (the table and the findings' figures), and plots: error against wall time,
-and the interface energy against the coupling step. --ranks 2 runs every run on 2 ranks. The
-sweep prints progress and its own wall time.
+Results go to --out (default out/ablate/<case>/, never the tracked bench/results/; give
+--out bench/results/ablate_<case> to update a committed study), the runs' own output to
+--scratch (default <out>/runs/ without --out, out/ablate/<the results folder's name>/ with it):
+runs.csv (one row per run, written as each run ends: an interrupted sweep resumes without
+redoing finished runs; delete a row to redo it; a reference run again, because the binary or
+the overrides changed, redoes its scheme's rows), ablation.md (the table and the findings'
+figures), and ablation.png: the error against wall time, and the interface energy against the
+coupling step. --replot DIR redraws DIR/ablation.png from DIR/runs.csv alone (no run, no
+reference needed). --ranks 2 runs every run on 2 ranks. The sweep prints progress and its own
+wall time.
+
+Example (a small sweep: 1 reference and 12 runs, 34-62 s on the shared 2-core machine; results
+in out/ablate/fsi_piston/):
+    /usr/bin/python3 bench/ablate.py cases/fsi_piston.ini solid.slab.E=5200 time.t_end=1.5 \
+        --spatial velocity --temporal monolithic staggered multirate --methods usl \
+        --cfl 0.4 0.2 --skip-variants strong lag mristep
 
 Cost at equal error: for every run that is not monolithic, ablation.md gives the wall time
 monolithic (the same spatial scheme and time method) would need for the same error,
@@ -76,39 +85,84 @@ VARIANTS = [("monolithic", "", []),
             ("multirate", "mristep", ["time.adaptive=false"])]
 
 
-def parse():
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("case")
+SPATIAL = ["velocity", "contact", "traction"]
+TEMPORAL = ["monolithic", "staggered", "multirate"]
+METHODS = ["usl", "musl", "euler", "ralston21", "bs32", "zonneveld43", "dp54"]  # time.method
+
+
+class HelpFormatter(argparse.ArgumentDefaultsHelpFormatter, argparse.RawDescriptionHelpFormatter):
+    """Defaults shown after every option's help (but None and False, which the help says in
+    words); the description and epilog as written."""
+
+    def _get_help_string(self, action):
+        if action.default in (None, False):
+            return action.help
+        return super()._get_help_string(action)
+
+
+def parse(argv=None):
+    doc = __doc__.split("\n\n")
+    example = next(p for p in doc if p.startswith("Example"))
+    ap = argparse.ArgumentParser(
+        prog="ablate.py", formatter_class=HelpFormatter,
+        description=doc[0] + "\n\n" + doc[1] + "\n\nWhat every run records, the variants, "
+        "the cost at equal error and the noise: the docstring of bench/ablate.py.",
+        epilog=example + "\n\nRedraw a committed study's plot without running:\n"
+        "    /usr/bin/python3 bench/ablate.py --replot bench/results/ablate_fsi_piston")
+    ap.add_argument("case", nargs="?", help="the case file (not needed with --replot)")
     ap.add_argument("overrides", nargs="*", help="key=value for every run")
-    ap.add_argument("--spatial", nargs="+", default=["velocity", "contact", "traction"])
-    ap.add_argument("--temporal", nargs="+", default=["monolithic", "staggered", "multirate"])
-    ap.add_argument("--skip-variants", nargs="+", default=[],
-                    help="variants to leave out (solid_first, gas_first, parallel, strong, held, "
-                         "interpolated, lag, mristep)")
+    ap.add_argument("--spatial", nargs="+", default=SPATIAL, choices=SPATIAL, metavar="SCHEME",
+                    help=f"spatial coupling schemes (coupling.scheme): {', '.join(SPATIAL)}")
+    ap.add_argument("--temporal", nargs="+", default=TEMPORAL, choices=TEMPORAL,
+                    metavar="SCHEME",
+                    help=f"temporal coupling schemes (coupling.time): {', '.join(TEMPORAL)}")
+    variants = [v for _, v, _ in VARIANTS if v]
+    ap.add_argument("--skip-variants", nargs="+", default=[], choices=variants,
+                    metavar="VARIANT", help=f"variants to leave out: {', '.join(variants)}")
     ap.add_argument("--skip", nargs="+", default=[], metavar="PATTERN",
-                    help="run names to leave out, as shell patterns (e.g. '*-monolithic-bs32-*': "
+                    help="run names to leave out, as shell patterns (names are "
+                         "SPATIAL-TEMPORAL[-VARIANT]-METHOD-CFL, e.g. '*-monolithic-bs32-*': "
                          "monolithic bs32 at a stiff solid's step costs most of a sweep)")
-    ap.add_argument("--methods", nargs="+", default=["usl", "musl", "bs32"])
-    ap.add_argument("--cfl", nargs="+", type=float, default=[0.4, 0.2, 0.1])
-    ap.add_argument("--ref-cfl", type=float, default=0.05)
-    ap.add_argument("--quantity", default=None, help="probes.csv column (default: the first "
-                    "probe's x displacement)")
+    ap.add_argument("--methods", nargs="+", default=["usl", "musl", "bs32"], choices=METHODS,
+                    metavar="METHOD", help=f"time methods (time.method): {', '.join(METHODS)}; "
+                    "the partitioned schemes and contact take usl and musl only, mristep the "
+                    "ERK pairs only")
+    ap.add_argument("--cfl", nargs="+", type=float, default=[0.4, 0.2, 0.1],
+                    help="coupling steps, as time.cfl (fraction of the stable step, below 1)")
+    ap.add_argument("--ref-cfl", type=float, default=0.05,
+                    help="time.cfl of the monolithic usl reference runs")
+    ap.add_argument("--quantity", default=None, help="probes.csv column whose history is "
+                    "compared (default: the first probe's x displacement)")
     ap.add_argument("--energy-scale", type=float, default=None,
-                    help="J: report W_net relative to it")
-    ap.add_argument("--ranks", type=int, default=1)
+                    help="J (J/m in 2-D): also report W_net relative to it")
+    ap.add_argument("--ranks", type=int, default=1, help="MPI ranks of every run")
     ap.add_argument("--timeout", type=float, default=1800, help="s per run")
-    ap.add_argument("--out", default=None)
-    ap.add_argument("--scratch", default=None, help="the runs' own output (default "
-                    "out/ablate/<the results folder's name>)")
-    ap.add_argument("--binary", default=os.path.join(ROOT, "build", "app", "mpmfsi"))
+    ap.add_argument("--out", default=None, help="results folder: runs.csv, ablation.md, "
+                    "ablation.png (default: out/ablate/<case>)")
+    ap.add_argument("--scratch", default=None, help="the runs' own output (default: <out>/runs "
+                    "without --out, out/ablate/<the results folder's name> with it)")
+    ap.add_argument("--binary", default=os.path.join(ROOT, "build", "app", "mpmfsi"),
+                    help="the mpmfsi executable")
     ap.add_argument("--report-only", action="store_true",
-                    help="make no run: write the table and plot from runs.csv as it stands")
+                    help="make no run: write the table and plot from runs.csv as it stands "
+                         "(needs the reference runs in --scratch)")
+    ap.add_argument("--replot", metavar="DIR", default=None,
+                    help="make no run: redraw DIR/ablation.png from DIR/runs.csv alone (the "
+                         "rows ablation.md lists, if it exists), then stop")
     ap.add_argument("--sweep-s", type=float, default=None,
                     help="with every run already in runs.csv: the sweep's wall time to report")
     ap.add_argument("--repeat", type=int, default=1,
                     help="run every combination this many times, in rounds, and report the "
-                         "median wall time (default 1)")
-    return ap.parse_args()
+                         "median wall time")
+    args = ap.parse_args(argv)
+    if args.replot is None and args.case is None:
+        ap.error("give a case file (e.g. cases/fsi_piston.ini), or --replot DIR")
+    if args.case is not None and not os.path.isfile(args.case):
+        ap.error(f"no case file {args.case}")
+    if args.replot is None and not os.path.exists(args.binary) and not shutil.which(args.binary):
+        ap.error(f"no executable {args.binary}: build first (cmake --build build) or give "
+                 "--binary")
+    return args
 
 
 def run(args, out, extra):
@@ -335,12 +389,39 @@ def report(args, rows, outdir, col, sweep_s, nruns):
         lines += equal_error(ok)
     with open(os.path.join(outdir, "ablation.md"), "w") as f:
         f.write("\n".join(lines) + "\n")
-    plot(ok, outdir, col)
+    plot(ok, outdir, col, case_dim(args.case, args.overrides))
 
 
-def plot(rows, outdir, col):
+def case_dim(case, overrides=()):
+    """domain.dim of a case file (an override wins); None when it cannot be read."""
+    import configparser
+    for o in overrides:
+        if o.startswith("domain.dim="):
+            return int(o.split("=", 1)[1])
+    c = configparser.ConfigParser(inline_comment_prefixes=("#", ";"), strict=False)
+    try:
+        c.read(case)
+        return c.getint("domain", "dim")
+    except (configparser.Error, ValueError, TypeError):
+        return None
+
+
+# Units of a probes.csv column NAME_uq (displacement, m) and NAME_vq (velocity, m/s).
+def quantity_unit(col):
+    tail = col.rsplit("_", 1)[-1]
+    return {"u": "m", "v": "m/s"}.get(tail[:1], "") if len(tail) == 2 else ""
+
+
+def energy_unit(dim):
+    """The unit of an energy in a run of that many dimensions: per m of span in 2-D."""
+    return {1: "J/m^2", 2: "J/m", 3: "J"}.get(dim, "J, per unit span in 2-D")
+
+
+def plot(rows, outdir, col, dim=None):
     """Error against wall time and |W_net| against the coupling step: colour = temporal scheme
-    and variant, marker = spatial scheme, line = time method."""
+    and variant, marker = spatial scheme, line = time method; the legend lists only what the
+    rows hold. A zero (or missing) value has no place on a log axis: it is left out and
+    counted in the title."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -350,41 +431,124 @@ def plot(rows, outdir, col):
     marker = {"velocity": "o", "contact": "s", "traction": "^"}
     line = {"usl": "-", "musl": "--", "bs32": ":"}
     fig, ax = plt.subplots(1, 2, figsize=(13, 5.5))
-    groups = {}
+    groups, dropped = {}, [0, 0]
     for r in rows:
         groups.setdefault((r["spatial"], r["temporal"], r["variant"], r["method"]), []).append(r)
+
+    def positive(xs, ys, k):
+        keep = [(x, y) for x, y in zip(xs, ys) if y > 0 and math.isfinite(y)]
+        dropped[k] += len(xs) - len(keep)
+        return [x for x, _ in keep], [y for _, y in keep]
+
+    def num(v):
+        try:
+            return float(v)
+        except (TypeError, ValueError):
+            return float("nan")
     for (spatial, temporal, variant, method), rs in groups.items():
         rs.sort(key=lambda r: float(r["cfl"]))
+        # monolithic underneath, thicker: a partitioned scheme that matches it stays visible
+        mono = temporal == "monolithic"
         style = dict(color=colour[(temporal, variant)], marker=marker.get(spatial, "x"),
-                     ls=line.get(method, "-."), ms=5, lw=1)
-        ax[0].loglog([float(r["wall_s"]) for r in rs],
-                     [max(float(r["err_max"]), 1e-300) for r in rs], **style)
-        ax[1].loglog([float(r["cfl"]) for r in rs],
-                     [max(abs(float(r["W_net"])), 1e-300) for r in rs], **style)
+                     ls=line.get(method, "-."), ms=8 if mono else 5, lw=3 if mono else 1,
+                     zorder=1 if mono else 2)
+        ax[0].loglog(*positive([num(r["wall_s"]) for r in rs], [num(r["err_max"]) for r in rs],
+                               0), **style)
+        ax[1].loglog(*positive([num(r["cfl"]) for r in rs],
+                               [abs(num(r["W_net"])) for r in rs], 1), **style)
+    unit = quantity_unit(col)
     ax[0].set_xlabel("wall time (s)")
-    ax[0].set_ylabel(f"max |{col} - reference|")
-    ax[0].set_title("coupling error against cost (points: time.cfl)")
-    ax[1].set_xlabel("time.cfl (coupling step)")
-    ax[1].set_ylabel("|W_net|: energy the coupling created or destroyed (J)")
-    ax[1].set_title("interface energy")
+    ax[0].set_ylabel(f"coupling error: max |{col} - reference|" + (f" ({unit})" if unit else ""))
+    ax[0].set_title("coupling error against cost (points: time.cfl)"
+                    + (f"; {dropped[0]} run(s) with zero error not shown" if dropped[0] else ""),
+                    fontsize=10)
+    ax[1].set_xlabel("coupling step: time.cfl (fraction of the stable step, -)")
+    ax[1].set_ylabel(f"|W_net|: energy the coupling created or destroyed ({energy_unit(dim)})")
+    ax[1].set_title("interface energy"
+                    + (f"; {dropped[1]} run(s) with W_net = 0 not shown" if dropped[1] else ""),
+                    fontsize=10)
+    for a in ax:
+        a.grid(alpha=0.3, which="both")
+    from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
+    # Wall times in plain seconds at 1, 2, 5 x 10^k: a decade alone often holds one label.
+
+    def readable(axis, lo, hi):
+        """Labels at 1, 2, 5 x 10^k on a log axis spanning less than three decades (one decade
+        alone often holds a single label)."""
+        if lo > 0 and hi / lo < 1e3:
+            axis.set_major_locator(LogLocator(subs=(1, 2, 5)))
+            axis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+            axis.set_minor_formatter(NullFormatter())
+    for a in ax:
+        if a.get_xscale() == "log":  # (a table without a stable run has no log axis)
+            readable(a.xaxis, *a.get_xlim())
+            readable(a.yaxis, *a.get_ylim())
+    cfls = sorted({num(r["cfl"]) for r in rows if num(r["cfl"]) > 0})
+    if cfls and ax[1].get_xscale() == "log":  # ticks at the coupling steps swept, plain
+        ax[1].set_xticks(cfls, [f"{c:g}" for c in cfls])
+        ax[1].set_xticks([], minor=True)
+    methods = sorted({r["method"] for r in rows}, key=lambda m: list(line).index(m)
+                     if m in line else len(line))
+    spatials = sorted({r["spatial"] for r in rows}, key=lambda m: list(marker).index(m)
+                      if m in marker else len(marker))
     handles = [Line2D([], [], color=colour[v], lw=3, label=" ".join(x for x in v if x))
                for v in variants]
-    handles += [Line2D([], [], color="k", marker=m, ls="", label=k) for k, m in marker.items()]
-    handles += [Line2D([], [], color="k", ls=l, label=k) for k, l in line.items()]
-    ax[1].legend(handles=handles, fontsize=7, ncol=2)
+    handles += [Line2D([], [], color="k", marker=marker.get(k, "x"), ls="", label=k)
+                for k in spatials]
+    handles += [Line2D([], [], color="k", ls=line.get(k, "-."), label=k) for k in methods]
+    fig.legend(handles=handles, fontsize=8, loc="center left", bbox_to_anchor=(1.0, 0.5),
+               title="temporal scheme (colour),\nspatial (marker), method (line)",
+               title_fontsize=8)
     fig.tight_layout()
-    fig.savefig(os.path.join(outdir, "ablation.png"), dpi=110)
+    fig.savefig(os.path.join(outdir, "ablation.png"), dpi=110, bbox_inches="tight")
+    plt.close(fig)
+
+
+def replot(folder, quantity=None):
+    """Redraw folder/ablation.png from folder/runs.csv: the rows its ablation.md lists (all
+    of runs.csv's if there is none), the quantity's name from --quantity or ablation.md."""
+    table = os.path.join(folder, "runs.csv")
+    if not os.path.exists(table):
+        print(f"ablate.py: error: no {table}: --replot needs the runs.csv a sweep wrote (give "
+              "its --out folder)", file=sys.stderr)
+        sys.exit(2)
+    rows = list(load_rows(table).values())
+    md = os.path.join(folder, "ablation.md")
+    col, dim = quantity, None
+    if os.path.exists(md):
+        with open(md) as f:
+            text = f.read()
+        listed = {ln.split("|")[1].strip() for ln in text.splitlines() if ln.startswith("| ")}
+        rows = [r for r in rows if r["name"] in listed] or rows
+        if col is None and "Quantity: `" in text:
+            col = text.split("Quantity: `", 1)[1].split("`", 1)[0]
+        head = text.splitlines()[0] if text else ""
+        if head.startswith("# Coupling ablation: "):
+            case = os.path.join(ROOT, "cases", head.split(": ", 1)[1].strip())
+            overrides = text.split("overrides: ", 1)[1].split(". ")[0].split() if \
+                "overrides: " in text else []
+            dim = case_dim(case, overrides) if os.path.exists(case) else None
+    ok = [r for r in rows if r["status"] == "ok"]
+    plot(ok, folder, col or "quantity", dim)
+    print(f"wrote {os.path.join(folder, 'ablation.png')} from {len(ok)} stable run(s) of "
+          f"{table}")
 
 
 def main():
     args = parse()
+    if args.replot:
+        replot(args.replot, args.quantity)
+        return
     args.case = os.path.abspath(args.case)
     name = os.path.splitext(os.path.basename(args.case))[0]
-    outdir = os.path.abspath(args.out or os.path.join(HERE, "results", f"ablate_{name}"))
-    # The runs' own output, not committed: one folder per results folder, so that two sweeps of
-    # one case (another --out) never share runs or references.
-    scratch = os.path.abspath(args.scratch or os.path.join(ROOT, "out", "ablate",
-                                                           os.path.basename(outdir)))
+    # Without --out the results go to the untracked out/ (a trial sweep must not overwrite a
+    # committed study in bench/results/), and the runs beside them.
+    outdir = os.path.abspath(args.out or os.path.join(ROOT, "out", "ablate", name))
+    # With --out, the runs' own output, not committed: one folder per results folder, so that
+    # two sweeps of one case (another --out) never share runs or references.
+    scratch = os.path.abspath(args.scratch or (os.path.join(outdir, "runs") if args.out is None
+                                               else os.path.join(ROOT, "out", "ablate",
+                                                                 os.path.basename(outdir))))
     os.makedirs(scratch, exist_ok=True)
     os.makedirs(outdir, exist_ok=True)
     table = os.path.join(outdir, "runs.csv")

@@ -16,6 +16,9 @@ coupling.time = multirate, which the harness's reference inherited until 2026-11
    interpolated log-log to its error between the monolithic runs that bracket it (or
    extrapolated, marked, by at most 1.5x in error), and the ratio. Checked on made-up rows whose
    answers are known (--report-only: nothing runs).
+6. --replot redraws ablation.png from runs.csv alone (the made-up rows; nothing runs, no
+   reference needed), and a sweep given no --out writes under out/ablate/<case>/, never into
+   the tracked bench/results/.
 """
 import csv
 import math
@@ -124,4 +127,22 @@ check(not missing, "the cost at equal error of made-up multirate rows: monolithi
       "interpolated log-log to their errors (t ~ 1/error between the made-up monolithic rows: "
       "14.1 s at 1e-4/sqrt 2, 7.07x), extrapolated and marked at 1.2x beyond (4.17x), none at 10x"
       + (f"; missing: {missing}" if missing else ""))
+# 6: --replot, and where results go without --out (--report-only: nothing runs).
+png = os.path.join(made_up, "ablation.png")
+os.remove(png)
+p = subprocess.run([sys.executable, os.path.join(SOURCE, "bench", "ablate.py"), "--replot",
+                    made_up], capture_output=True, text=True, timeout=600)
+check(p.returncode == 0 and os.path.getsize(png) > 10000 and "from 6 stable run(s)" in p.stdout,
+      f"--replot redraws ablation.png from the 6 made-up rows ({p.stdout.strip()}{p.stderr})")
+default = os.path.join(SOURCE, "out", "ablate", "shock_panel")
+tracked = os.path.join(SOURCE, "bench", "results", "ablate_shock_panel", "ablation.md")
+before = os.path.getmtime(tracked) if os.path.exists(tracked) else None
+subprocess.run([sys.executable, os.path.join(SOURCE, "bench", "ablate.py"), CASE] + COMMON
+               + ["--spatial", "velocity", "--methods", "usl", "--temporal", "monolithic",
+                  "--report-only", "--binary",
+                  os.path.abspath(mt.BIN) if os.path.sep in mt.BIN else mt.BIN],
+               check=True, capture_output=True, timeout=600)
+after = os.path.getmtime(tracked) if os.path.exists(tracked) else None
+check(os.path.exists(os.path.join(default, "ablation.md")) and before == after,
+      f"without --out the results go to {default}, and bench/results/ is left alone")
 sys.exit(check.finish())
