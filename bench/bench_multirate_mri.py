@@ -20,7 +20,8 @@ each monolithic run's error, interpolated log-log between the MRIStep runs that 
 (--mri-cfl adds MRIStep runs at smaller steps for that).
 
 key=value pairs go to every run (coupling.scheme=traction, say). Writes
-bench/results/multirate_mri<tag>.md and .json.
+bench/results/multirate_mri<tag>.md and .json; the committed multirate_mri.md was made with
+--ranks 2, alone on the machine (without --tag a run replaces it).
 """
 import argparse
 import json

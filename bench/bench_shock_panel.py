@@ -25,6 +25,9 @@ its wall time; --cost-window 0 skips step 2; --tag names the result files.
 
 Writes bench/results/shock_panel_tip<tag>_<scheme>.csv (t, ux, uy in mm),
 shock_panel_tip<tag>.png (against the references) and shock_panel<tag>.md (the figures).
+bench/results/shock_panel.md is the committed current page (written by hand from tagged runs:
+_dx0.5mm_twin_rehome, _dx1mm_twin): a run without --tag replaces it, so give a --tag unless
+the run is meant to become the current page, and carry its notes over.
 
 --partial (with --reuse DIR): a run that stopped before its end (no summary.json): writes its tip
 history as shock_panel_tip_partial.csv and .png against the references, and nothing else.
