@@ -232,8 +232,10 @@ static int run(const char *cmd, const char *path, int argc, char **argv) {
   /* check builds everything a run needs (so every input error shows), then stops. */
   if (!rc && strcmp(cmd, "check") == 0)
     rc = print_resolved(cfg);
-  else if (!rc)
+  else if (!rc) {
+    mpm_sim_set_version(sim, cli_version());
     rc = mpm_sim_run(sim);
+  }
   mpm_sim_destroy(&sim);
   mpm_config_destroy(&cfg);
   return rc;

@@ -33,6 +33,7 @@
 enum { PROGRESS_OFF, PROGRESS_LOG, PROGRESS_LIVE };
 
 struct mpm_sim {
+  const char *version; /* the code's version and revision, for summary.json */
   MPI_Comm comm;
   int rank, size;
   mpm_config *cfg;
@@ -728,17 +729,18 @@ static int write_summary(mpm_sim *s, double wall) {
   FILE *f = fopen(path, "w");
   if (!f) MPM_FAIL(MPM_ERR_FILE, "cannot write '%s'", path);
   fprintf(f,
-          "{\"t\": %.17g, \"steps\": %ld, \"rhs_evals\": %ld, \"error_test_fails\": %ld, "
+          "{\"version\": \"%s\", \"t\": %.17g, \"steps\": %ld, \"rhs_evals\": %ld, "
+          "\"error_test_fails\": %ld, "
           "\"retries\": %ld, \"wall_s\": %.6f, \"ranks\": %d, \"particle_steps\": %.17g, "
           "\"particle_steps_per_s\": %.6g, \"coupling\": \"%s\", "
           "\"coupling_imbalance\": %.6g, \"coupling_work\": %.17g, "
           "\"coupling_crossed\": %.17g, \"coupling_work_of_crossed\": %.6g, "
           "\"solid_energy_peak\": %.17g, \"coupling_work_of_solid\": %.6g, "
           "\"coupling_work_of_total\": %.6g, \"steps_estimated\": %.17g}\n",
-          s->t, steps, rhs, fails, retries, wall, s->size, s->particle_steps,
-          s->particle_steps / wall, s->coupling ? s->coupling->type->name : "none",
-          s->coupling_imbalance, s->coupling_work, s->coupling_crossed, rel_crossed, s->solid_peak,
-          rel_solid, rel_total, s->estimate);
+          s->version ? s->version : "unknown", s->t, steps, rhs, fails, retries, wall, s->size,
+          s->particle_steps, s->particle_steps / wall,
+          s->coupling ? s->coupling->type->name : "none", s->coupling_imbalance, s->coupling_work,
+          s->coupling_crossed, rel_crossed, s->solid_peak, rel_solid, rel_total, s->estimate);
   fclose(f);
   return 0;
 }
@@ -829,4 +831,8 @@ int mpm_sim_run(mpm_sim *s) {
           "with `mpmfsi restart %s`",
           mpm_signal_name(sig), s->t, s->step, s->t_end, path, path);
   return MPM_ERR_INTERRUPTED;
+}
+
+void mpm_sim_set_version(mpm_sim *s, const char *version) {
+  s->version = version;
 }

@@ -22,6 +22,9 @@ int mpm_sim_create(mpm_sim **sim, mpm_config *cfg);
 /* Build a run from a checkpoint; cfg holds the checkpoint's configuration plus overrides. */
 int mpm_sim_restart(mpm_sim **sim, mpm_config *cfg, const char *checkpoint);
 int mpm_sim_run(mpm_sim *sim);
+/* Which code makes the results ("mpmfsi 0.1.0 (git 17dee4f)"), for summary.json; the text
+ * is not copied and must outlive the run. Unset, summary.json says "unknown". */
+void mpm_sim_set_version(mpm_sim *sim, const char *version);
 void mpm_sim_destroy(mpm_sim **sim);
 
 #endif
