@@ -88,7 +88,7 @@ static const char g_restart[] =
     "(output.dir=... chooses the folder; output.truncate=true cuts the old run back instead).\n"
     "\n" EXIT_CODES "\n"
     "Examples:\n"
-    "  mpmfsi restart out/ballistic2d/checkpoint_final.h5 time.t_end=1\n"
+    "  mpmfsi restart out/ballistic2d/checkpoint_final.h5 time.t_end=0.5\n"
     "  mpiexec -n 2 mpmfsi restart out/ballistic2d/checkpoint_000003.h5 output.dir=out/b2\n";
 
 static const char g_keys[] =

@@ -40,6 +40,8 @@ static const char *const g_ours[] = {"snap_[0-9]*.h5",
                                      "probes.csv",
                                      "timers.csv",
                                      "summary.json",
+                                     "obstacles.csv",
+                                     "surface_*.csv",
                                      RUNID_NAME,
                                      "run.log",
                                      "view.py"};

@@ -101,7 +101,7 @@ static const mpm_key_spec sim_keys[] = {
     {"grid.shape", MPM_KEY_ENUM, "quadratic", 0, 0, 0, 0, "linear|gimp|quadratic|cubic",
      "shape function", 0, NULL},
     {"grid.ranks", MPM_KEY_REALS, "0 0 0", 0, 65536, 0, 3, NULL,
-     "MPI ranks per direction (0: let MPI choose)", 0, "-"},
+     "MPI ranks per direction (0: mpmfsi chooses, the layout with the smallest halo)", 0, "-"},
     {"physics.gravity", MPM_KEY_REALS, "0 0 0", -HUGE_VAL, HUGE_VAL, 0, 3, NULL,
      "body acceleration, m/s^2", 0, "m/s^2"},
     {"transfer.velocity", MPM_KEY_ENUM, "flip", 0, 0, 0, 0, "flip|apic",

@@ -13,7 +13,7 @@
  * separates the run from monolithic at the same step is the held partner, the coupling lag
  * (and the step loop's work between steps, the gas's shifting for one, which every partitioned
  * scheme does once per coupling step); the rest of multirate's error is the slow module's own
- * step. On the shock panel at 1 mm the lag is the smaller part (README, Temporal coupling).
+ * step. On the shock panel at 1 mm the lag is the smaller part (docs/time.md).
  *
  * Which is fast depends on the scene: a steel panel in air is the fast module (its stable step
  * is about a tenth of the air's), a soft bar in a Mach 2.5 stream the slow one.

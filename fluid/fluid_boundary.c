@@ -642,7 +642,7 @@ void fluid_open_hold(const fluid_open *o, mpm_module *m) {
  * Why. The face itself sets only the one incoming characteristic of its boundary state; when
  * a noisy, mixed flow (the wake of a lifting aerofoil) crosses it, its virtual copies overlap the
  * gas's own particles and the gas next to the face drifts off the free stream, and with it the
- * whole tunnel (see README, Open faces). The layer imposes the same characteristic over a
+ * whole tunnel (see docs/gas.md, open faces). The layer imposes the same characteristic over a
  * depth instead of at a face, as a rate on each particle, with no reference to the copies.
  * It is a source of momentum and energy (that of the waves it absorbs): a run with a sponge
  * does not conserve them, as a run with open faces does not. Local. */

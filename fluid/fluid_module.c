@@ -121,8 +121,8 @@ static const mpm_key_spec fluid_keys[] = {
     {"fluid.stable_step", MPM_KEY_ENUM, "particle", 0, 0, 0, 0, "particle|neighbourhood",
      "how the gas's stable step is estimated: particle (the fastest single particle) or "
      "neighbourhood (mass-weighted over the 3^dim cells around each cell, so that light "
-     "refill particles in a wake do not set the step; see fluid/fluid_stable.c; it blew up "
-     "the main job at 2 mm, so particle stays the default)",
+     "refill particles in a wake do not set the step; see fluid/fluid_stable.c; the main job "
+     "uses it)",
      0, NULL},
     {"fluid.regularise_max", MPM_KEY_INT, NULL, 2, HUGE_VAL, 0, 0, NULL,
      "merge particles in a cell holding more than this (default 4 ppc^dim: only where the "

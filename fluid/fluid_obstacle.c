@@ -17,7 +17,7 @@
 const mpm_key_spec fluid_obstacle_keys[] = {
     {"fluid.obstacle_band", MPM_KEY_REAL, "0.5", -2, 2, 0, 0, NULL,
      "obstacle nodes: those with signed distance phi < band * grid.dx (0.5 puts the effective "
-     "wall on the surface; see README)",
+     "wall on the surface; see docs/gas.md)",
      0, "dx"},
     {"obstacle.*.shape", MPM_KEY_ENUM, NULL, 0, 0, 0, 0, "box|circle|sphere|polygon|wedge|airfoil",
      "box (lo, hi), circle (2-D) or sphere (3-D) (center, radius), polygon (vertices), wedge "
@@ -43,7 +43,7 @@ const mpm_key_spec fluid_obstacle_keys[] = {
     {"obstacle.*.length", MPM_KEY_REAL, NULL, 0, HUGE_VAL, 1, 0, NULL,
      "wedge: length of the ramp along +x, m", 1, "m"},
     {"obstacle.*.angle", MPM_KEY_REAL, NULL, 0, 90, 1, 0, NULL,
-     "wedge: ramp angle, degrees, in (0, 90)", 1, "deg"},
+     "wedge: ramp angle, degrees, in (0, 90]", 1, "deg"},
     {"obstacle.*.file", MPM_KEY_PATH, NULL, 0, 0, 0, 0, NULL,
      "airfoil: coordinate file (# comments, header x_over_c,y_over_c,surface, rows in order "
      "around the outline)",

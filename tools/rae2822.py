@@ -17,7 +17,7 @@ and returns (as JSON with --json) the figures the issue asks for:
 - steadiness: the Cl means of the last two such spans (a span = `--windows` windows each) and
   the RMS difference between the Cp of the last window and the mean of the span before it.
   The run is called steady when the two Cl means differ by less than 2 % and the Cp RMS by less
-  than 0.03 (the scatter of a single window on a steady run at these resolutions; see README).
+  than 0.03 (the scatter of a single window on a steady run at these resolutions; see docs/verification.md).
 - against the inviscid reference (bench/results/rae2822_euler_cp.csv, if there), the model's
   own answer on a body-fitted grid: the RMS difference at stations every 0.01 c on each surface
   (x/c 0.01-0.99), round the nose (0.01-0.1), on the upper surface ahead of the shock (0.1-0.5)

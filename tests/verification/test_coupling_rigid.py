@@ -11,7 +11,7 @@ differ by more (printed, not asserted: separation at the rear under contact, a n
 cell thick under velocity).
 
 Tolerance 2 dx / W (15.6 % at dx = W / 12.8): the obstacle's wall sits at phi = obstacle_band dx
-= dx / 2 from its surface (README), while a coupled interface lies where the gas's and the
+= dx / 2 from its surface (docs/gas.md), while a coupled interface lies where the gas's and the
 solid's stencils overlap, up to a cell outside the body on each side; the force on a bluff body
 scales with its frontal width. Measured at dx = 1/32 and 1/64: velocity +23 % / +11 % (its
 no-slip layer sits on the solid's outermost nodes: first order in dx), contact -13 % / -12 %,

@@ -13,7 +13,7 @@ id) of the velocity difference, relative to the largest velocity. Checks:
      (halfway between the lag's first order and the 2 the MPM right-hand side allows: bs32 is
      third order, but the kinks of the B-spline gradient where a particle crosses a cell face
      and the viscosity's compression switch cap it, as they cap the coupled cases at about 2;
-     README). Measured 2.01, 1.77, overall 1.89.
+     docs/verification.md). Measured 2.01, 1.77, overall 1.89.
   2. current is at least 4x more accurate than lagged at each time.cfl: measured 10.6x,
      19.7x, 28.7x (the bound leaves a factor 2.6 below the smallest).
   3. lagged is first order: overall order below 1.5 (measured 1.12, 1.22, overall 1.17). This

@@ -15,7 +15,7 @@ the bow shock stands in front of the bar) is opened in pvpython under xvfb-run:
        read back from the colours steps from the free stream (1.2) to post-shock (above 3.2;
        4.0 behind a normal shock at Mach 2.5) within a short distance (12 mm: 3 cells), at a
        stand-off from the bar's face in a sensible band (30-75 mm; 52 mm in the steady
-       reference solution, README "Main job").
+       reference solution, docs/main-job.md).
 If pvpython or xvfb-run is missing the test fails and names the Debian package.
 """
 import json

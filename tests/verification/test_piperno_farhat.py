@@ -41,8 +41,8 @@ Checks:
    sees the solid's end-of-step state), so strong coupling need not create less: measured +2.8e-6
    J against the weak scheme's -7.4e-7 J at this cfl.
    Why one in a thousand, not none: where the slab's support gains or loses a node, a node of
-   tiny solid mass makes the fixed-point map nearly discontinuous and Aitken can cycle (README,
-   Strong coupling); such a step keeps its best iterate, leaves the difference owed, and the
+   tiny solid mass makes the fixed-point map nearly discontinuous and Aitken can cycle (docs/time.md,
+   strong coupling); such a step keeps its best iterate, leaves the difference owed, and the
    momentum still balances (checked). Every step converged here until the gas's wall rule
    (fluid/fluid_transfer.c) moved the gas near the slip ends slightly: measured since, 1 of
    9606 steps (residual 3.9e-3 after 60 sub-iterations, at t = 3.95), 4.0 sub-iterations a step

@@ -27,7 +27,7 @@ strain rate, fluid.strain_rate = current), so that moves the solution by roundof
 measured 9.3e-13, tolerance 1e-10. (With the strain rate of the previous step, the default
 before, the particles differed by 6e-4: the step sequence changed the solution at first order.)
 `long` adds 400 and 800 cells for every method and checks the acceptance for bs32; for usl
-and musl it checks L1 at 400 and the shock position, and prints their orders (see README:
+and musl it checks L1 at 400 and the shock position, and prints their orders (see docs/verification.md:
 below 0.8, from particle noise that their exact-energy transfer turns into heat).
 """
 import os

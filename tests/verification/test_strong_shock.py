@@ -16,7 +16,7 @@ error of bs32 and musl must also fall from 200 to 800 cells (by at least 25 %, w
 the 50 % of first order, since the shock in L1 converges at first order at best). usl's L1
 stalls there (measured 3.03e-2 at 200 cells, 2.53e-2 at 400, 2.79e-2 at 800), as it does on
 Sod past 400 cells: particle velocity noise that its exact energy balance turns into heat,
-at a rate that grows as the cells shrink (README, gas section); it is printed, not checked.
+at a rate that grows as the cells shrink (docs/gas.md); it is printed, not checked.
 """
 import os
 import sys

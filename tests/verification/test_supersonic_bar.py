@@ -1,7 +1,7 @@
 """The main job's scene, coarse and short (cases/supersonic_bar.ini at dx = 4 mm, to 0.8 ms):
 Mach 2.5 air started impulsively over the clamped elastic bar, coupled by the `velocity`
 scheme. A smoke test of the whole chain, cheap enough for every CI run (the full
-run is the main job; its figures are in the README).
+run is the main job; its figures are in docs/main-job.md).
 
 1. The run completes (no blow-up, no fault; the gas behind the bar expands into near vacuum).
 2. Interface balance: the forces on the two phases cancel to 1e-12 of the interface force at
@@ -12,7 +12,7 @@ run is the main job; its figures are in the README).
    is between 10 and 90 mm: detached from the bar, and not at the inflow 100 mm upstream (an
    unstarted channel, a normal shock at the inflow, reads 100). This is a structural check;
    test_supersonic_bar_twin compares the stand-off with a finite-volume Euler reference, and
-   the README gives the main job's figures.
+   docs/main-job.md gives the main job's figures.
 4. The tip has moved downstream (probes.csv: tip_ux > 0.05 mm at the end) and the gas pushes
    the bar downstream (coupling.csv: Fx_solid > 0 over the last 0.1 ms).
 7. No empty cell inside the gas (a cell without gas whose four face neighbours hold gas,

@@ -35,7 +35,7 @@ Tolerances, with their reasons:
   and the stand-off of a bluff body grows in proportion to its height. Measured: velocity
   8.3 mm (its no-slip layer sits on the solid's outer nodes), contact 4.0 mm.
 - drag, slip obstacle against the reference: 10 %. The obstacle's wall sits half a cell off
-  the bar's faces (README, obstacles): a 30 mm bar 4 mm wider or taller by up to a cell.
+  the bar's faces (docs/gas.md, obstacles): a 30 mm bar 4 mm wider or taller by up to a cell.
 - drag, rigid bar against its obstacle: 2 dx / H = 27 % (H = 30 mm, the bar's height), the
   bound test_coupling_rigid states for a coupled interface, which lies where the two phases'
   stencils overlap, up to a cell outside the body on each side.

@@ -245,7 +245,7 @@ grid0 = entries[0][1][0][1]
 item = [a for a in grid0.findall("Attribute") if a.get("Name") == "F"][0].find("DataItem")
 check(F == [("F", "Matrix")] and item.get("Dimensions").split()[1:] == ["4"]
       and item.text.strip().endswith(":/solid/F"),
-      f"2-D tensors: F is a Matrix [N 4] of /solid/F (row-major, as the README gives) {F}")
+      f"2-D tensors: F is a Matrix [N 4] of /solid/F (row-major, as docs/output.md gives) {F}")
 listed = [os.path.basename(p) for _, p in mt.snapshots(out)]
 check(listed == [f"snap_{k:06d}.h5" for k in range(3)], f"mpmtest.snapshots(): {listed}")
 
