@@ -682,14 +682,14 @@ static void progress(mpm_sim *s, double dt, double wall0, int final) {
   const int log_due = now - s->progress_logged >= s->progress_interval && !final;
   if (log_due) {
     s->progress_logged = s->progress_last = now;
-    if (live)
-      mpm_log_record(MPM_LOG_INFO,
-                     "progress: step %ld, t = %.6g (%.1f%%), dt = %.3g, %.0f s wall, ETA %.0f s",
-                     s->step, s->t, 100 * frac, dt, wall, eta);
+    char line[256];
+    snprintf(line, sizeof line,
+             "progress: step %ld, t = %.6g (%.1f%%), dt = %.3g, %.0f s wall, ETA %.0f s", s->step,
+             s->t, 100 * frac, dt, wall, eta);
+    if (live) /* the console has the live line: the log line goes to run.log only */
+      mpm_log_record(MPM_LOG_INFO, "%s", line);
     else
-      mpm_log(MPM_LOG_INFO,
-              "progress: step %ld, t = %.6g (%.1f%%), dt = %.3g, %.0f s wall, ETA %.0f s", s->step,
-              s->t, 100 * frac, dt, wall, eta);
+      mpm_log(MPM_LOG_INFO, "%s", line);
   }
   if (!live || (!final && now - s->progress_last < 0.5 && !log_due)) return;
   s->progress_last = now;
