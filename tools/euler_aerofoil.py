@@ -20,6 +20,7 @@ first cell's); prints Cl, Cd (from each), the density residual.
       [--mach 0.729] [--alpha 2.31] [--ni 320] [--nj 96] [--out cp.csv] [--json out.json]
 """
 import argparse
+import ctypes
 import csv
 import json
 import math
@@ -33,6 +34,19 @@ from scipy.interpolate import CubicSpline
 GAMMA = 1.4
 K2, K4 = 0.5, 1.0 / 32.0
 STAGES = (0.25, 1.0 / 3.0, 0.5, 1.0)
+
+
+def keep_heap():
+    """Keep freed memory in the heap. Each numpy temporary here is a few hundred KiB, above
+    glibc's mmap and trim thresholds, so every operation would map fresh pages and unmap them
+    again: measured on the NACA 0012 check (192 x 64, 300 iterations), 17.9 s of CPU time, a
+    third of it in the kernel, against 4.8 s with the heap kept. No effect off glibc."""
+    try:
+        libc = ctypes.CDLL(None)
+        libc.mallopt(-1, 1 << 30)  # M_TRIM_THRESHOLD
+        libc.mallopt(-3, 1 << 30)  # M_MMAP_THRESHOLD
+    except (OSError, AttributeError):
+        pass
 
 
 def read_outline(path):
@@ -319,6 +333,7 @@ def solve(outline, mach, alpha, ni, nj, wall, radius, iters, tol, cfl, log=True)
     value at iteration 100 (checked every 100) or iters have run. Returns the solver, the mesh,
     Cl, Cd and the wall pressure (extrapolated), the history (iteration, residual drop, Cl, Cd)
     and the wall time."""
+    keep_heap()
     mesh = Mesh(make_grid(outline, ni, nj, wall, radius))
     s = Solver(mesh, mach, alpha, cfl)
     t0 = time.time()

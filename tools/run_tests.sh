@@ -34,7 +34,8 @@
 #   oversubscribed on 2 cores; test_halo_np*, test_migrate_np*, test_p2g_np*), test_restart_cases
 #   (every case's restart, 3 minutes there; test_restart, test_gas_output,
 #   test_coupling_ranks) and test_run_safety (output folders, locks, signals: test_restart,
-#   test_output).
+#   test_output);
+# - test_euler_reference: the inviscid aerofoil reference in numpy, which runs no mpmfsi at all.
 # The input refusal drivers (test_input_safety, test_bad_input, test_cases) run under the
 # sanitizers without the leak check at exit (NO_LEAK_CHECK in tests/CMakeLists.txt).
 # Idempotent.
@@ -45,7 +46,7 @@ PLAIN_ONLY+="|near_vacuum_order"
 PLAIN_ONLY+="|slanted_wall|bluff_bodies|sod|strong_shock|gas_time_order|gas_shear"
 PLAIN_ONLY+="|fsi_waves|piperno_farhat|timeschemes|timeschemes_mri|blowup_guard_coupled"
 PLAIN_ONLY+="|csm1|csm3_fast|axial_bar|cantilever3d|model_swap|ranks_solid|periodic|stability|disks"
-PLAIN_ONLY+="|decomposition|restart_cases|run_safety"
+PLAIN_ONLY+="|decomposition|restart_cases|run_safety|euler_reference"
 BOTH="checkpoint_integrity"
 
 # The tests also need clang-format (test_format) and ParaView under Xvfb (test_paraview), and
