@@ -28,7 +28,8 @@ Results go to --out (default out/ablate/<case>/, never the tracked bench/results
 --scratch (default <out>/runs/ without --out, out/ablate/<the results folder's name>/ with it):
 runs.csv (one row per run, written as each run ends: an interrupted sweep resumes without
 redoing finished runs; delete a row to redo it; a reference run again, because the binary or
-the overrides changed, redoes its scheme's rows), ablation.md (the table and the findings'
+the overrides changed, redoes its scheme's rows; the file is replaced whole, and a row cut or
+damaged, or unlike its run's summary.json, is run again, never tabulated), ablation.md (the table and the findings'
 figures), and ablation.png: the error against wall time, and the interface energy against the
 coupling step. --replot DIR redraws DIR/ablation.png from DIR/runs.csv alone (no run, no
 reference needed). --ranks 2 runs every run on 2 ranks. The sweep prints progress and its own
