@@ -28,7 +28,8 @@ Results go to --out (default out/ablate/<case>/, never the tracked bench/results
 --scratch (default <out>/runs/ without --out, out/ablate/<the results folder's name>/ with it):
 runs.csv (one row per run, written as each run ends: an interrupted sweep resumes without
 redoing finished runs; delete a row to redo it; a reference run again, because the binary or
-the overrides changed, redoes its scheme's rows), ablation.md (the table and the findings'
+the overrides changed, redoes its scheme's rows; the file is replaced whole, and a row cut or
+damaged, or unlike its run's summary.json, is run again, never tabulated), ablation.md (the table and the findings'
 figures), and ablation.png: the error against wall time, and the interface energy against the
 coupling step. --replot DIR redraws DIR/ablation.png from DIR/runs.csv alone (no run, no
 reference needed). --ranks 2 runs every run on 2 ranks. The sweep prints progress and its own
@@ -59,9 +60,11 @@ import fnmatch
 import json
 import math
 import os
+import re
 import shutil
 import subprocess
 import sys
+import tempfile
 import time
 
 import numpy as np
@@ -156,13 +159,100 @@ def parse(argv=None):
                          "median wall time")
     args = ap.parse_args(argv)
     if args.replot is None and args.case is None:
-        ap.error("give a case file (e.g. cases/fsi_piston.ini), or --replot DIR")
-    if args.case is not None and not os.path.isfile(args.case):
-        ap.error(f"no case file {args.case}")
-    if args.replot is None and not os.path.exists(args.binary) and not shutil.which(args.binary):
-        ap.error(f"no executable {args.binary}: build first (cmake --build build) or give "
-                 "--binary")
+        fail("give a case file (e.g. cases/fsi_piston.ini), or --replot DIR")
+    for opt, values in (("--cfl", args.cfl), ("--ref-cfl", [args.ref_cfl])):
+        bad = [v for v in values if not 0 < v <= 0.999]
+        if bad:
+            fail(f"{opt} {bad[0]:g}: a coupling step is time.cfl, a fraction of the stable step "
+                 "in (0, 0.999]")
+    for opt, value in (("--repeat", args.repeat), ("--ranks", args.ranks)):
+        if value < 1:
+            fail(f"{opt} {value}: give 1 or more")
+    if not args.timeout > 0:
+        fail(f"--timeout {args.timeout:g}: give the seconds allowed per run, above 0")
+    if args.replot is None:
+        if not os.path.exists(args.case):
+            fail(f"no case file {args.case}: give the path of a case file (e.g. "
+                 "cases/fsi_piston.ini)")
+        if os.path.isdir(args.case):
+            fail(f"{args.case} is a folder: give the path of a case file")
+        check_binary(args)
+        check_overrides(args)
     return args
+
+
+def fail(message, code=2):
+    """Stop with one line on stderr: code 2 for bad input (as mpmfsi), 1 for a failed run."""
+    print(f"ablate.py: error: {message}", file=sys.stderr)
+    sys.exit(code)
+
+
+def check_binary(args):
+    """The binary exists, is executable and runs (`--version`); else stop, saying which."""
+    path = args.binary if os.path.sep in args.binary else shutil.which(args.binary)
+    if not path or not os.path.exists(path):
+        fail(f"no executable {args.binary}: build first (cmake --build build) or give --binary")
+    if os.path.isdir(path) or not os.access(path, os.X_OK):
+        fail(f"--binary {args.binary} is not an executable file: give the mpmfsi built here "
+             "(build/app/mpmfsi)")
+    try:
+        p = subprocess.run([path, "--version"], env=ENV, capture_output=True, text=True,
+                           timeout=120)
+        why = "" if p.returncode == 0 and p.stdout.startswith("mpmfsi") else \
+            f"exit {p.returncode}, {first_line(p.stderr or p.stdout) or 'no output'}"
+    except (OSError, subprocess.SubprocessError) as e:
+        why = str(e)
+    if why:
+        fail(f"--binary {args.binary} does not run as mpmfsi (`{args.binary} --version`: {why}): "
+             "rebuild it (cmake --build build) or give another --binary")
+    if args.ranks > 1 and not shutil.which("mpiexec"):
+        fail(f"--ranks {args.ranks} needs mpiexec, which is not on PATH: install Open MPI or "
+             "give --ranks 1")
+
+
+def first_line(text):
+    return next((x.strip() for x in text.splitlines() if x.strip()), "")
+
+
+def check_overrides(args):
+    """No override sets a key the harness sets itself in some run (mpmfsi refuses a key given
+    twice, so every such run would fail)."""
+    own = {k.split("=", 1)[0] for k in ["output.dir=", "output.overwrite=", "output.interval="]
+           + REFERENCE + [f"time.cfl={args.ref_cfl}"]}
+    own |= {k.split("=", 1)[0] for c in combos(args) for k in c[-1]}
+    for o in args.overrides:
+        if "=" in o and o.split("=", 1)[0].strip() in own:
+            key = o.split("=", 1)[0].strip()
+            fail(f"override {o}: the harness sets {key} itself in its runs (the schemes and steps "
+                 "swept: --spatial, --temporal, --methods, --cfl, --skip-variants); leave it out")
+
+
+def check_case(args):
+    """Validate the case with `mpmfsi check` before any run and relay its first error (exit 2);
+    the case must hold a solid and a gas to couple, and a probe whose history is compared.
+    Returns the probe names."""
+    cmd = [args.binary, "check", args.case] + args.overrides
+    try:
+        p = subprocess.run(cmd, env=ENV, capture_output=True, text=True, timeout=600)
+    except (OSError, subprocess.SubprocessError) as e:
+        fail(f"`mpmfsi check {args.case}` did not finish: {e}", 1)
+    errors = [x.split("error: ", 1)[-1] for x in p.stderr.splitlines() if "error: " in x]
+    if p.returncode != 0:
+        more = (f" ({len(errors) - 1} more: run `mpmfsi check {args.case}` to see them)"
+                if len(errors) > 1 else "")
+        fail((errors[0] if errors else first_line(p.stderr) or f"exit {p.returncode}") + more,
+             2 if p.returncode == 2 else 1)
+    sections = re.findall(r"^\[([^\]\s]+)\]", p.stdout, re.M)
+    kinds = {k: [s.split(".", 1)[1] for s in sections if s.startswith(k + ".")]
+             for k in ("solid", "gas", "probe")}
+    if not kinds["solid"] or not kinds["gas"]:
+        has = "a solid" if kinds["solid"] else "a gas" if kinds["gas"] else "no body"
+        fail(f"{args.case}: the ablation couples a solid and a gas, and this case has only {has}: "
+             "give a case with both a [solid.NAME] and a [gas.NAME]")
+    if not kinds["probe"]:
+        fail(f"{args.case}: no [probe.NAME]: the ablation compares a probe's history "
+             "(probes.csv); add one, e.g. [probe.tip] with point = x y at the solid")
+    return kinds["probe"]
 
 
 def run(args, out, extra):
@@ -189,10 +279,11 @@ def history(out, quantity):
     with open(os.path.join(out, "probes.csv")) as f:
         rows = list(csv.DictReader(f))
     if not rows:
-        raise SystemExit(f"{out}/probes.csv is empty: the case needs a [probe.NAME]")
+        fail(f"{out}/probes.csv has no rows: the case needs a [probe.NAME]", 1)
     col = quantity or [k for k in rows[0] if k != "t"][0]
     if col not in rows[0]:
-        raise SystemExit(f"no column '{col}' in probes.csv; columns: {', '.join(rows[0])}")
+        fail(f"--quantity {col}: no such column in probes.csv; give one of "
+             f"{', '.join(k for k in rows[0] if k != 't')}")
     return col, np.array([float(r["t"]) for r in rows]), np.array([float(r[col]) for r in rows])
 
 
@@ -246,28 +337,136 @@ def combos(args):
                     yield name, spatial, temporal, variant, method, cfl, extra
 
 
-def load_rows(path):
+STATUSES = ("ok", "unstable", "not offered", "timeout")
+NUMBERS = ["wall_s", "steps", "rhs_evals", "err_max", "err_rms", "err_rel", "W_net", "imbalance"]
+
+
+def row_error(row):
+    """Why a row of runs.csv cannot be a finished run (a cut or edited line), or None: its
+    name is the one its columns make, its status is known, and an ok row's figures are finite
+    numbers whose wall_s is the median of its walls."""
+    try:
+        cfl = float(row["cfl"])
+        name = (f"{row['spatial']}-{row['temporal']}{'-' + row['variant'] if row['variant'] else ''}"
+                f"-{row['method']}-{cfl:g}")
+    except (TypeError, ValueError):
+        return f"cfl '{row.get('cfl')}' is not a number"
+    if row["name"] != name:
+        return f"its name is not {name}"
+    if row["status"] not in STATUSES:
+        return f"status '{row['status']}' is not one of {', '.join(STATUSES)}"
+    if row["status"] != "ok":
+        return None
+    try:
+        values = {k: float(row[k]) for k in NUMBERS}
+        walls = walls_of(row)
+        if row.get("W_rel"):
+            float(row["W_rel"])
+    except (TypeError, ValueError) as e:
+        return f"a figure is not a number ({e})"
+    if values["steps"] != int(values["steps"]) or values["rhs_evals"] != int(values["rhs_evals"]):
+        return "steps or rhs_evals is not a whole number"
+    # walls written with 6 digits before 2026-12 (a relative rounding of 5e-6 at most)
+    if not walls or abs(float(np.median(walls)) - values["wall_s"]) > 1e-5 * max(walls):
+        return f"wall_s {row['wall_s']} is not the median of walls {row.get('walls')}"
+    return None
+
+
+def run_error(row, out):
+    """Why an ok row does not match the output of its run in out (missing, or other figures),
+    or None: a row is kept on resume only if its run's summary.json says the same."""
+    try:
+        with open(os.path.join(out, "summary.json")) as f:
+            s = json.load(f)
+    except (OSError, ValueError):
+        return f"its run's output {os.path.join(out, 'summary.json')} is missing or unreadable"
+    try:
+        same = (int(float(row["steps"])) == int(s["steps"])
+                and int(float(row["rhs_evals"])) == int(s["rhs_evals"])
+                and equal(float(row["W_net"]), float(s["coupling_work"]))
+                and equal(float(row["imbalance"]), float(s["coupling_imbalance"])))
+    except (KeyError, TypeError, ValueError):
+        same = False
+    return None if same else f"its figures differ from its run's {out}/summary.json"
+
+
+def equal(a, b):
+    return a == b or (math.isnan(a) and math.isnan(b))
+
+
+def load_rows(path, scratch=None, verb="not tabulated"):
+    """The rows of runs.csv by name, each checked (row_error) and, given the runs' folder
+    scratch, matched to its run's output (run_error). A row that fails, or a last line without
+    its end of line (a cut file), is left out with one line saying why and what happens to it
+    (verb: run again, not tabulated). Returns the rows and the number left out."""
     if not os.path.exists(path):
-        return {}
-    with open(path) as f:
-        return {r["name"]: r for r in csv.DictReader(f)}
+        return {}, 0
+    with open(path, newline="") as f:
+        text = f.read()
+    lines = list(csv.reader(text.splitlines(keepends=True)))
+    if not lines:
+        return {}, 0
+    header, rows, dropped = lines[0], {}, 0
+    if header != FIELDS and header != FIELDS[:-1]:  # (files before 2026-11 have no walls)
+        fail(f"{path}: its header is not a runs.csv one ({','.join(FIELDS)}): give the results "
+             "folder of a sweep, or move the file away to start afresh")
+    for k, values in enumerate(lines[1:], 2):
+        row = dict(zip(header, values))
+        label = f"{path}:{k} ({values[0] if values else 'empty'})"
+        if len(values) != len(header):
+            why = f"{len(values)} fields, not {len(header)}"
+        elif k == len(lines) and not text.endswith(("\n", "\r")):
+            why = "the file ends inside it"
+        else:
+            why = row_error(row)
+            if why is None and scratch is not None and row["status"] == "ok":
+                why = run_error(row, os.path.join(scratch, row["name"]))
+        if why:
+            print(f"{label}: a partial or damaged row ({why}): {verb}", flush=True)
+            rows.pop(row.get("name"), None)
+            dropped += 1
+            continue
+        rows[row["name"]] = row
+    return rows, dropped
+
+
+def write_atomic(path, write, binary=False):
+    """Write path whole or not at all: write(f) fills a temporary beside it, which is synced
+    and renamed over path (an interrupted sweep leaves the old file or the new one, never a
+    cut one; a link named path is replaced, not written through)."""
+    folder = os.path.dirname(os.path.abspath(path))
+    fd, tmp = tempfile.mkstemp(prefix="." + os.path.basename(path) + ".", suffix=".tmp",
+                               dir=folder)
+    try:
+        mask = os.umask(0)
+        os.umask(mask)
+        os.fchmod(fd, 0o666 & ~mask)
+        with os.fdopen(fd, "wb" if binary else "w", **({} if binary else {"newline": ""})) as f:
+            write(f)
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except OSError:
+            pass
+        raise
+    dirfd = os.open(folder, os.O_RDONLY)
+    try:
+        os.fsync(dirfd)
+    finally:
+        os.close(dirfd)
 
 
 def rewrite_rows(path, rows):
-    with open(path, "w", newline="") as f:
+    """runs.csv with these rows, replaced whole (write_atomic)."""
+    def write(f):
         w = csv.DictWriter(f, fieldnames=FIELDS)
         w.writeheader()
         for r in rows:
-            w.writerow(r)
-
-
-def append_row(path, row):
-    new = not os.path.exists(path)
-    with open(path, "a", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=FIELDS)
-        if new:
-            w.writeheader()
-        w.writerow(row)
+            w.writerow({k: r.get(k, "") for k in FIELDS})
+    write_atomic(path, write)
 
 
 def walls_of(row):
@@ -292,11 +491,13 @@ def repeat_rounds(args, todo, done, table, scratch):
             made += 1
             shutil.rmtree(out, ignore_errors=True)
             if status != "ok" or int(s["steps"]) != int(row["steps"]):
-                raise SystemExit(f"{rname}, round {rnd}: {status} {msg} (steps "
-                                 f"{s['steps'] if s else '-'} against {row['steps']}): the runs "
-                                 "are not repeatable; check the machine and the binary")
+                fail(f"{rname}, round {rnd}: {status} {msg} (steps {s['steps'] if s else '-'} "
+                     f"against {row['steps']}): the runs are not repeatable; check the machine "
+                     "and the binary", 1)
             walls = walls_of(row) + [float(s["wall_s"])]
-            row["walls"] = ";".join(f"{w:.6g}" for w in walls)
+            # Every digit (repr reads back the same float): wall_s is the median of the walls
+            # runs.csv holds, whatever their size (6 digits lost some of a wall above 1 s).
+            row["walls"] = ";".join(repr(w) for w in walls)
             row["wall_s"] = float(np.median(walls))
             rewrite_rows(table, done.values())
             print(f"[round {rnd}, {k}/{len(due)}] {rname}: {s['wall_s']:.1f} s (median of "
@@ -353,7 +554,7 @@ def fmt(x, spec=".3g"):
     return "" if math.isnan(v) else format(v, spec)
 
 
-def report(args, rows, outdir, col, sweep_s, nruns):
+def report(args, rows, outdir, col, sweep_s, nruns, partial=""):
     ok = [r for r in rows if r["status"] == "ok"]
     nrep = max((len(walls_of(r)) for r in ok), default=1)
     lines = [f"# Coupling ablation: {os.path.basename(args.case)}", "",
@@ -387,8 +588,8 @@ def report(args, rows, outdir, col, sweep_s, nruns):
         lines += [f"- {k[0]}, cfl {k[1]}: {v['name']} ({fmt(v['err_max'])} in "
                   f"{fmt(v['wall_s'], '.2f')} s)" for k, v in sorted(best.items())]
         lines += equal_error(ok)
-    with open(os.path.join(outdir, "ablation.md"), "w") as f:
-        f.write("\n".join(lines) + "\n")
+    lines += [partial] if partial else []
+    write_atomic(os.path.join(outdir, "ablation.md"), lambda f: f.write("\n".join(lines) + "\n"))
     plot(ok, outdir, col, case_dim(args.case, args.overrides))
 
 
@@ -500,7 +701,8 @@ def plot(rows, outdir, col, dim=None):
                title="temporal scheme (colour),\nspatial (marker), method (line)",
                title_fontsize=8)
     fig.tight_layout()
-    fig.savefig(os.path.join(outdir, "ablation.png"), dpi=110, bbox_inches="tight")
+    write_atomic(os.path.join(outdir, "ablation.png"),
+                 lambda f: fig.savefig(f, format="png", dpi=110, bbox_inches="tight"), binary=True)
     plt.close(fig)
 
 
@@ -512,7 +714,7 @@ def replot(folder, quantity=None):
         print(f"ablate.py: error: no {table}: --replot needs the runs.csv a sweep wrote (give "
               "its --out folder)", file=sys.stderr)
         sys.exit(2)
-    rows = list(load_rows(table).values())
+    rows = list(load_rows(table)[0].values())
     md = os.path.join(folder, "ablation.md")
     col, dim = quantity, None
     if os.path.exists(md):
@@ -539,6 +741,8 @@ def main():
     if args.replot:
         replot(args.replot, args.quantity)
         return
+    if not args.report_only:  # (a report makes no run: it needs no valid case)
+        check_case(args)
     args.case = os.path.abspath(args.case)
     name = os.path.splitext(os.path.basename(args.case))[0]
     # Without --out the results go to the untracked out/ (a trial sweep must not overwrite a
@@ -552,8 +756,13 @@ def main():
     os.makedirs(scratch, exist_ok=True)
     os.makedirs(outdir, exist_ok=True)
     table = os.path.join(outdir, "runs.csv")
-    done = load_rows(table)
-    refs = {}
+    if args.report_only:
+        done, _ = load_rows(table)
+    else:  # a cut or damaged row, or one whose run's output says otherwise, is run again
+        done, dropped = load_rows(table, scratch, "run again")
+        if dropped:
+            rewrite_rows(table, done.values())
+    refs, failed = {}, []
     for spatial in args.spatial:
         out = os.path.join(scratch, f"reference-{spatial}")
         status, msg, _ = ("ok", "", None)
@@ -565,8 +774,8 @@ def main():
             status, msg, _ = run(args, out, REFERENCE + [f"coupling.scheme={spatial}",
                                                          f"time.cfl={args.ref_cfl}"])
             if status == "ok":
-                with open(os.path.join(out, "reference.json"), "w") as f:
-                    json.dump(reference_key(args), f)
+                write_atomic(os.path.join(out, "reference.json"),
+                             lambda f: json.dump(reference_key(args), f))
             stale = [n for n, r in done.items() if r["spatial"] == spatial]
             if stale:  # their errors were taken against the reference just replaced
                 print(f"  {len(stale)} {spatial} row(s) of runs.csv were measured against "
@@ -576,8 +785,12 @@ def main():
                 rewrite_rows(table, done.values())
         if status != "ok":
             print(f"  reference for {spatial} failed ({status}: {msg}); its runs are skipped")
+            failed.append(f"{spatial}: {status}: {msg}")
             continue
         refs[spatial] = history(out, args.quantity)
+    if failed and not refs:
+        fail(f"every reference run failed ({'; '.join(failed)}): nothing to measure against; "
+             "fix what the message says, then run again", 1)
     todo = [c for c in combos(args) if c[1] in refs]
     t0, made = time.time(), 0
     for k, (rname, spatial, temporal, variant, method, cfl, extra) in enumerate(todo, 1):
@@ -596,15 +809,15 @@ def main():
             _, t, u = history(out, col)
             diff = np.interp(tr, t, u) - ur
             scale = max(float(np.max(np.abs(ur))), 1e-300)
-            row.update(wall_s=s["wall_s"], walls=f"{s['wall_s']:.6g}", steps=s["steps"],
+            row.update(wall_s=float(s["wall_s"]), walls=repr(float(s["wall_s"])), steps=s["steps"],
                    rhs_evals=s["rhs_evals"],
                        err_max=float(np.max(np.abs(diff))),
                        err_rms=float(np.sqrt(np.mean(diff**2))),
                        err_rel=float(np.max(np.abs(diff))) / scale, W_net=s["coupling_work"],
                        W_rel=(s["coupling_work"] / args.energy_scale if args.energy_scale
                               else ""), imbalance=s["coupling_imbalance"])
-        append_row(table, row)
         done[rname] = row
+        rewrite_rows(table, done.values())
         elapsed = time.time() - t0
         eta = elapsed / made * sum(1 for c in todo[k:] if c[0] not in done)
         err = f", error {row['err_max']:.3g}" if s else ""
@@ -617,13 +830,11 @@ def main():
         print(f"{len(todo) - len(rows)} of {len(todo)} runs not made yet: the table is partial")
     col = refs[next(iter(refs))][0] if refs else "?"
     sweep = time.time() - t0 if made or args.sweep_s is None else args.sweep_s
+    missing = [c[0] for c in todo if c[0] not in done]
+    partial = (f"\n**Partial**: {len(missing)} of {len(todo)} runs not made yet ({missing[0]} ... "
+               f"{missing[-1]}); run the same command again to finish." if missing else "")
     report(args, rows, outdir, col, sweep if made or args.sweep_s is not None else 0.0,
-           made or len(rows))
-    if len(rows) < len(todo):
-        with open(os.path.join(outdir, "ablation.md"), "a") as f:
-            missing = [c[0] for c in todo if c[0] not in done]
-            f.write(f"\n**Partial**: {len(missing)} of {len(todo)} runs not made yet "
-                    f"({missing[0]} ... {missing[-1]}); run the same command again to finish.\n")
+           made or len(rows), partial)
     print(f"wrote {table}, {outdir}/ablation.md, {outdir}/ablation.png")
 
 

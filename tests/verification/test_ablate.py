@@ -11,7 +11,9 @@ coupling.time = multirate, which the harness's reference inherited until 2026-11
 3. The same sweep with one more override runs the reference again (the overrides changed) and
    redoes the row measured against the old one.
 4. --repeat 2 makes a second round: the finished row is run once more (the same steps), runs.csv
-   keeps both wall times and reports their median.
+   keeps both wall times and reports their median, to the last digit whatever the wall times (on
+   a busy machine, where the run took over 1 s, the 6 digits the harness kept of each wall lost
+   one, and this check failed; tests/conformance/test_ablate_input.py checks walls above 10 s).
 5. ablation.md gives each multirate run's cost at equal error: monolithic's wall time
    interpolated log-log to its error between the monolithic runs that bracket it (or
    extrapolated, marked, by at most 1.5x in error), and the ratio. Checked on made-up rows whose
@@ -86,7 +88,7 @@ twice = sweep(["fluid.regularise_every=0", "--repeat", "2"])
 r = rows()[NAME]
 walls = [float(w) for w in r["walls"].split(";")]
 check("[round 2, 1/1]" in twice and "[1/1]" not in twice and len(walls) == 2
-      and abs(float(r["wall_s"]) - statistics.median(walls)) <= 1e-9 * max(walls)
+      and float(r["wall_s"]) == statistics.median(walls)
       and r["steps"] == steps,
       f"--repeat 2: the finished row runs once more ({r['walls']} s, median {r['wall_s']} s; "
       f"{r['steps']} steps both times)")
@@ -114,8 +116,9 @@ subprocess.run([sys.executable, os.path.join(SOURCE, "bench", "ablate.py"), CASE
                + ["fluid.regularise_every=0", "--spatial", "velocity", "--methods", "usl",
                   "--ref-cfl", "0.2", "--out", made_up, "--scratch", scratch, "--report-only",
                   "--temporal", "monolithic", "multirate", "--skip-variants", "interpolated", "lag",
-                  "mristep", "--cfl", "0.4", "0.2", "0.1"], check=True, capture_output=True,
-               timeout=600)
+                  "mristep", "--cfl", "0.4", "0.2", "0.1", "--binary",
+                  os.path.abspath(mt.BIN) if os.path.sep in mt.BIN else mt.BIN], check=True,
+               capture_output=True, timeout=600)
 with open(os.path.join(made_up, "ablation.md")) as f:
     md = f.read()
 want = ["| velocity-multirate-held-usl-0.4 | 0.00012 | 2.00 | 8.3 (extrapolated) | 4.17 |",
