@@ -57,14 +57,15 @@ static int check_foreign_keys(const mpm_config *cfg, const mpm_coupling_type *ch
   return 0;
 }
 
-/* The first coupling key set away from its default, or NULL. */
+/* The first key under "coupling." given in the case (file or command line), at its default
+ * value or not, or NULL: every key of the schema in that section, so a key of a time scheme
+ * counts as one of a spatial scheme does. */
 static const char *first_coupling_key(const mpm_config *cfg) {
-  int n;
-  const mpm_coupling_type *const *types = mpm_coupling_types(&n);
-  if (mpm_config_set_off_default(cfg, &g_scheme_key[0])) return g_scheme_key[0].key;
-  for (int k = 0; k < n; ++k)
-    for (int j = 0; j < types[k]->nkeys; ++j)
-      if (mpm_config_set_off_default(cfg, &types[k]->keys[j])) return types[k]->keys[j].key;
+  static const char prefix[] = "coupling.";
+  const mpm_key_spec *sp;
+  for (size_t k = 0; (sp = mpm_config_spec(cfg, k)) != NULL; ++k)
+    if (strncmp(sp->key, prefix, sizeof prefix - 1) == 0 && mpm_config_has(cfg, sp->key))
+      return sp->key;
   return NULL;
 }
 
@@ -173,9 +174,9 @@ int mpm_coupling_new(mpm_coupling **cp, const mpm_config *cfg, mpm_grid *grid, m
     const char *key = first_coupling_key(cfg);
     if (key)
       return mpm_config_fail(cfg, key,
-                             "the scene has only %s, so there is nothing to couple; remove the "
-                             "[coupling] keys",
-                             nmod == 1 && mods[0]->role == MPM_ROLE_SOLID ? "solid bodies" : "gas");
+                             "%s has no effect: the scene has no %s, so there is nothing to "
+                             "couple; remove it",
+                             key, nmod == 1 && mods[0]->role == MPM_ROLE_SOLID ? "gas" : "solid");
     return 0;
   }
   MPM_CALL(check_foreign_keys(cfg, type));

@@ -14,6 +14,7 @@
 #include "mpm_output.h"
 #include "mpm_probe.h"
 #include "mpm_rundir.h"
+#include "mpm_scene.h"
 #include "mpm_signal.h"
 #include "mpm_timer.h"
 #include "fluid_module.h"
@@ -258,6 +259,7 @@ static int build_modules(mpm_sim *s, int seed) {
                            "the case defines neither bodies nor gas: add a [solid.NAME] or a "
                            "[gas.NAME] section");
   MPM_CALL(mpm_coupling_new(&s->coupling, s->cfg, s->grid, s->mod, s->nmod));
+  if (seed) MPM_CALL(mpm_scene_check_overlaps(s->cfg, s->grid, s->mod, s->nmod));
   /* The walls a coupling scheme offers are attached: a module that needs one and has none says
    * so now (mpm_module.h). */
   for (int k = 0; k < s->nmod; ++k) {
