@@ -507,16 +507,19 @@ int mpm_rundir_check_dir(const char *dir, int overwrite, char *why, size_t n) {
   char *real = why[0] ? NULL : mpm_path_resolve(dir);
   const char *top = real ? system_folder(real) : NULL;
   if (top) {
-    char where[64];
-    const int whole = strcmp(top, "/") == 0 || strcmp(real + 1, top) == 0;
-    snprintf(where, sizeof where, "%s%s",
-             strcmp(top, "/") == 0 ? "the root folder" : "the system folder /",
-             strcmp(top, "/") == 0 ? "" : top);
+    const int root = strcmp(top, "/") == 0, whole = root || strcmp(real + 1, top) == 0;
+    char how[64];
+    snprintf(how, sizeof how, "%s the %s%s", whole ? "" : " inside",
+             root ? "root folder" : "system folder /", root ? "" : top);
+    const int same = strcmp(real, dir) == 0;
     snprintf(why, n,
-             "%s%s%s %s %s: mpmfsi does not write there; choose a folder of your own (in your "
-             "home, /tmp or /var/tmp)",
-             strcmp(real, dir) ? "resolves to " : "names ", strcmp(real, dir) ? real : "",
-             strcmp(real, dir) ? "," : "", whole ? "which is" : "inside", where);
+             "%s%s%s%s: mpmfsi does not write there; choose a folder of your own (in your home, "
+             "/tmp or /var/tmp)",
+             same ? "is" : "resolves to ", same ? "" : real,
+             same    ? ""
+             : whole ? ", which is"
+                     : ",",
+             how);
   }
   free(real);
   char *name = why[0] || overwrite ? NULL : mpm_rundir_find_link(dir);

@@ -60,7 +60,7 @@ def plant(out, names, victims, replace=False):
     os.makedirs(out, exist_ok=True)
     os.makedirs(victims, exist_ok=True)
     for k, n in enumerate(names):
-        target, path = os.path.join(victims, n), os.path.join(out, n)
+        target, path = os.path.join(os.path.abspath(victims), n), os.path.join(out, n)
         if k % 2 == 0:
             with open(target, "wb") as f:
                 f.write(PRECIOUS)
@@ -100,9 +100,10 @@ for name, extra in CASES.items():
         # check and a fresh run without overwrite: refused, nothing touched
         out, vic = mt.outdir("fresh"), mt.outdir("victims")
         plant(out, names, vic)
-        p = mt.run(["check", ini, f"output.dir={out}"] + SHORT + extra, ranks=ranks, check=False)
-        check(link_refused(p), f"{tag}: check with links in the folder is refused: exit "
-              f"{p.returncode}: {(errors(p) or [p.stderr[-200:]])[0]}")
+        if ranks == 1:
+            p = mt.run(["check", ini, f"output.dir={out}"] + SHORT + extra, check=False)
+            check(link_refused(p), f"{tag}: check with links in the folder is refused: exit "
+                  f"{p.returncode}: {(errors(p) or [p.stderr[-200:]])[0]}")
         p = mt.run(["run", ini, f"output.dir={out}"] + SHORT + extra, ranks=ranks, check=False)
         ok, diff = untouched(vic, names)
         check(link_refused(p) and ok, f"{tag}: a fresh run into links is refused, no target "
@@ -142,24 +143,28 @@ def with_dir(d):
     return "\n".join(lines) + "\n"
 
 
-def check_dir(d, ranks=1, cmd="check"):
+def check_dir(d, ranks=1, cmd="check", extra=()):
     tmp = tempfile.mkdtemp(prefix="sysdir_", dir=".")
     path = os.path.join(tmp, "case.ini")
     with open(path, "w") as f:
         f.write(with_dir(d))
-    p = mt.run([cmd, path, "time.t_end=0.002", "output.interval=0.001"] + QUIET, ranks=ranks,
-               check=False)
+    p = mt.run([cmd, path, "time.t_end=0.002", "output.interval=0.001"] + QUIET + list(extra),
+               ranks=ranks, check=False)
     shutil.rmtree(tmp)
     return p
 
 
+# Both are given an error found only after output.dir is read, so that code without the check
+# (the old one) fails this test with that error instead of writing into the system folder.
+LATER_ERROR = ["solid.block.geometry=nosuch"]
 for d in ["/", "/usr/../", "//", "/etc", "/usr", "/var", "/lib", "/usr/share/mpmfsi-test",
           "/var/lib/mpmfsi-test", "/etc/../bin"]:
-    for cmd in ("check", "run"):
-        p = check_dir(d, cmd=cmd)
+    for cmd in ("check", "run") if d in ("/", "/usr/../", "/usr/share/mpmfsi-test") else ("check",):
+        p = check_dir(d, cmd=cmd, extra=LATER_ERROR)
         e = errors(p)
         ok = (p.returncode == 2 and len(e) == 1 and f"case.ini:{DIR_LINE}" in e[0]
-              and "output.dir" in e[0] and "system folder" in e[0])
+              and "output.dir" in e[0] and "does not write there" in e[0]
+              and ("system folder" in e[0] or "root folder" in e[0]))
         check(ok and not os.path.exists("/usr/share/mpmfsi-test")
               and not os.path.exists("/var/lib/mpmfsi-test"),
               f"{cmd} refuses output.dir = {d}: exit {p.returncode}: {(e or [p.stderr[-200:]])[0]}")
@@ -182,7 +187,7 @@ def long_dir(n):
     return d + "/" + "e" * (n - len(d) - 1)
 
 
-for n in (MAX_DIR - 1, MAX_DIR):
+for n in (MAX_DIR,):
     d = long_dir(n)
     p = check_dir(d)
     q = check_dir(d, ranks=2, cmd="run")
@@ -190,9 +195,9 @@ for n in (MAX_DIR - 1, MAX_DIR):
           and os.path.isfile(os.path.join(d, "checkpoint_final.h5")),
           f"output.dir of {n} characters: check exit {p.returncode}, run on 2 ranks exit "
           f"{q.returncode} {(errors(p) + errors(q) + [q.stderr[-300:]])[0]}")
-for n in (MAX_DIR + 1, 221, 230, 300):
+for n in (MAX_DIR + 1, 221, 300):
     d = long_dir(n)
-    for cmd in ("check", "run"):
+    for cmd in ("check", "run") if n < 300 else ("check",):
         p = check_dir(d, cmd=cmd)
         e = errors(p)
         ok = (p.returncode == 2 and len(e) == 1 and "output.dir" in e[0]
