@@ -85,18 +85,18 @@ static int write_failed(const mpm_h5 *h, int rc, const char *fmt, ...) {
 
 /* ---- files ----------------------------------------------------------------------------- */
 
-/* Before creating path: nothing of the names the create opens may be a link. Rank 0 removes
- * whatever has the name (a leftover of an interrupted write, or a link: unlink removes the link
- * itself); each rank removes PATH.locktestRANK, which Open MPI's OMPIO opens with O_CREAT and
- * without O_NOFOLLOW while it chooses its shared-file-pointer method. H5F_ACC_EXCL then
- * creates the file with O_EXCL, which never follows a link. 0, or 1 if a name could not be
- * freed. */
+/* Before creating path: no name the create opens may be a link. Rank 0 removes whatever has
+ * the name (a leftover of an interrupted write, or a link: unlink removes the link itself);
+ * each rank removes PATH.locktest.RANK, which Open MPI's OMPIO opens with O_CREAT and without
+ * O_NOFOLLOW while it chooses its shared-file-pointer method for a file opened for writing.
+ * H5F_ACC_EXCL then creates the file with O_EXCL, which never follows a link. 0, or 1 if a
+ * name could not be freed. */
 static int clear_names(MPI_Comm comm, const char *path) {
   int rank = 0;
   MPI_Comm_rank(comm, &rank);
   const size_t len = strlen(path) + 32;
   char *lock = malloc(len);
-  if (lock) snprintf(lock, len, "%s.locktest%d", path, rank);
+  if (lock) snprintf(lock, len, "%s.locktest.%d", path, rank);
   const int bad = !lock || mpm_file_remove(lock) != 0 || (rank == 0 && mpm_file_remove(path) != 0);
   free(lock);
   return bad;

@@ -48,18 +48,18 @@ static const char *const g_ours[] = {"snap_[0-9]*.h5",
                                      "view.py"};
 
 /* 1: a result; 2: a leftover of an interrupted write (a result's name + ".tmp", or the lock
- * test Open MPI's OMPIO makes beside a file it opens, NAME.tmp.locktestRANK); 0: not ours. */
+ * test Open MPI's OMPIO makes beside a file it opens, NAME.locktest.RANK); 0: not ours. */
 static int is_ours(const char *name) {
   char base[256];
   size_t n = strlen(name);
-  const char *test = strstr(name, ".locktest");
-  const int locktest = test && test[9] && !test[9 + strspn(test + 9, "0123456789")];
+  const char *test = strstr(name, ".locktest.");
+  const int locktest = test && test[10] && !test[10 + strspn(test + 10, "0123456789")];
   if (locktest) n = (size_t)(test - name);
   const int tmp = n > 4 && n < sizeof base && strncmp(name + n - 4, ".tmp", 4) == 0;
-  if (locktest && !tmp) return 0;
-  if (tmp) snprintf(base, sizeof base, "%.*s", (int)(n - 4), name);
+  if (n >= sizeof base) return 0;
+  snprintf(base, sizeof base, "%.*s", (int)(tmp ? n - 4 : n), name);
   for (size_t k = 0; k < sizeof g_ours / sizeof g_ours[0]; ++k)
-    if (fnmatch(g_ours[k], tmp ? base : name, 0) == 0) return tmp ? 2 : 1;
+    if (fnmatch(g_ours[k], base, 0) == 0) return tmp || locktest ? 2 : 1;
   return 0;
 }
 

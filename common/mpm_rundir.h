@@ -54,11 +54,11 @@ int mpm_rundir_latest(MPI_Comm comm, const char *dir, const char *checkpoint, do
                       double *latest);
 
 /* The longest file path mpmfsi can write: Open MPI's MPI-IO (OMPIO, sharedfp/lockedfile in
- * Open MPI 4) builds "FILE.locktestRANK" for every file it opens in a 256-byte buffer and
- * aborts beyond it; 239 characters leave room for ".locktest", a rank of 7 digits and the
- * terminating zero. The longest name in a folder is "checkpoint_NNNNNN.h5.tmp" (24), so
- * output.dir, as written, may have at most 239 - 25 characters. */
-#define MPM_RUNDIR_MAX_PATH 239
+ * Open MPI 4) writes "FILE.locktest.RANK" for every file it opens for writing into a 256-byte
+ * buffer, and aborts beyond it; 238 characters leave room for ".locktest.", a rank of 7 digits
+ * and the terminating zero. The longest name in a folder is "checkpoint_NNNNNN.h5.tmp" (24),
+ * so output.dir, as written, may have at most 238 - 25 characters. */
+#define MPM_RUNDIR_MAX_PATH 238
 #define MPM_RUNDIR_MAX_DIR  (MPM_RUNDIR_MAX_PATH - 25)
 
 /* Can dir be an output folder? Refused (MPM_ERR_INPUT, the reason in why, worded to follow

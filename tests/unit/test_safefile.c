@@ -77,8 +77,8 @@ static void test_checkpoint_links(void **state) {
   if (g_rank == 0) {
     plant("ck.h5", "final", 1);
     plant("ck.h5.tmp", "tmp", 1);
-    plant("ck.h5.tmp.locktest0", "locktest0", 0);
-    plant("ck.h5.tmp.locktest1", "locktest1", 0);
+    plant("ck.h5.tmp.locktest.0", "locktest0", 0);
+    plant("ck.h5.tmp.locktest.1", "locktest1", 0);
   }
   MPI_Barrier(MPI_COMM_WORLD);
   char path[4200];
