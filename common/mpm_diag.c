@@ -2,6 +2,7 @@
 #include "mpm_diag.h"
 
 #include "mpm_error.h"
+#include "mpm_safefile.h"
 
 #include <errno.h>
 #include <stdio.h>
@@ -52,12 +53,11 @@ int mpm_diag_open(mpm_diag **d, MPI_Comm comm, const char *path, int ncols,
   if (rank == 0) {
     char *kept = NULL;
     if (append && truncate_after(path, t_keep, &kept) != 0) kept = NULL;
-    (*d)->f = fopen(path, "w");
+    /* Written anew beside the old file and moved over it (mpm_safefile.h); the stream then
+     * goes on appending to the file in place. */
+    (*d)->f = mpm_file_begin(path, "w");
     if (!(*d)->f) {
-      mpm_log_all(MPM_LOG_ERROR,
-                  "cannot write diagnostics '%s': %s; check that the output folder is writable",
-                  path, strerror(errno));
-      status = MPM_ERR_FILE;
+      status = mpm_file_fail(path, errno, "diagnostics");
     } else if (kept && kept[0]) {
       fputs(kept, (*d)->f);
     } else {
@@ -65,7 +65,8 @@ int mpm_diag_open(mpm_diag **d, MPI_Comm comm, const char *path, int ncols,
       fputc('\n', (*d)->f);
     }
     free(kept);
-    if ((*d)->f) fflush((*d)->f);
+    const int e = !(*d)->f ? 0 : fflush((*d)->f) != 0 ? errno : mpm_file_publish(path);
+    if (e) status = mpm_file_fail(path, e, "diagnostics");
   }
   MPM_CALL_MPI(MPI_Bcast(&status, 1, MPI_INT, 0, comm));
   if (status) {

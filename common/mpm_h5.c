@@ -7,6 +7,7 @@
 #define _POSIX_C_SOURCE 200809L /* statvfs */
 #include "mpm_h5.h"
 #include "mpm_path.h"
+#include "mpm_safefile.h"
 
 #include <errno.h>
 #include <stdarg.h>
@@ -84,6 +85,23 @@ static int write_failed(const mpm_h5 *h, int rc, const char *fmt, ...) {
 
 /* ---- files ----------------------------------------------------------------------------- */
 
+/* Before creating path: no name the create opens may be a link. Rank 0 removes whatever has
+ * the name (a leftover of an interrupted write, or a link: unlink removes the link itself);
+ * each rank removes PATH.locktest.RANK, which Open MPI's OMPIO opens with O_CREAT and without
+ * O_NOFOLLOW while it chooses its shared-file-pointer method for a file opened for writing.
+ * H5F_ACC_EXCL then creates the file with O_EXCL, which never follows a link. 0, or 1 if a
+ * name could not be freed. */
+static int clear_names(MPI_Comm comm, const char *path) {
+  int rank = 0;
+  MPI_Comm_rank(comm, &rank);
+  const size_t len = strlen(path) + 32;
+  char *lock = malloc(len);
+  if (lock) snprintf(lock, len, "%s.locktest.%d", path, rank);
+  const int bad = !lock || mpm_file_remove(lock) != 0 || (rank == 0 && mpm_file_remove(path) != 0);
+  free(lock);
+  return bad;
+}
+
 /* Create or open path on every rank of comm. Collective metadata writes let HDF5 flush its
  * metadata cache in one collective write; they are harmless for a read-only file, which
  * has no metadata to write. HDF5's error stack is silenced: the caller says what went
@@ -92,8 +110,10 @@ static hid_t file_access(MPI_Comm comm, const char *path, int create, int checks
   const hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
   /* The 1.10 format checksums the superblock, every object header and the chunk indexes
    * (fixed arrays, single-chunk); the 1.8 one would still index chunks by v1 B-trees. */
+  const int cleared = !create || !clear_names(comm, path);
+  /* cleared joins last: H5Pset_fapl_mpio duplicates comm, a collective call every rank makes */
   const int ready =
-      fapl >= 0 && H5Pset_fapl_mpio(fapl, comm, MPI_INFO_NULL) >= 0 &&
+      fapl >= 0 && H5Pset_fapl_mpio(fapl, comm, MPI_INFO_NULL) >= 0 && cleared &&
       H5Pset_coll_metadata_write(fapl, 1) >= 0 &&
       (!checksums || H5Pset_libver_bounds(fapl, H5F_LIBVER_V110, H5F_LIBVER_V110) >= 0);
   hid_t file = -1;
@@ -102,7 +122,7 @@ static hid_t file_access(MPI_Comm comm, const char *path, int create, int checks
     void *data;
     H5Eget_auto2(H5E_DEFAULT, &func, &data);
     H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
-    file = create ? H5Fcreate(path, H5F_ACC_TRUNC, H5P_DEFAULT, fapl)
+    file = create ? H5Fcreate(path, H5F_ACC_EXCL, H5P_DEFAULT, fapl)
                   : H5Fopen(path, H5F_ACC_RDONLY, fapl);
     H5Eset_auto2(H5E_DEFAULT, func, data);
     /* The MPI-IO open underneath is collective and fails on every rank together; the

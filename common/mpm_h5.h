@@ -74,9 +74,10 @@ void mpm_h5_quiet_end(const mpm_h5_quiet *saved);
 /* Fills a freshly created file; returns an agreed code. */
 typedef int (*mpm_h5_fill)(const mpm_h5 *h, hid_t file, const void *arg);
 
-/* Create path (truncating it), fill it and close it. Returns once every rank has closed the
- * file, so the agreement doubles as a barrier: rank 0 may then rename it. A failure of the
- * helpers below (a full disk) is reported here, once, as one line. */
+/* Create path anew (whatever had the name is removed first, a link itself, and the file is
+ * created exclusively: see mpm_safefile.h), fill it and close it. Returns once every rank has
+ * closed the file, so the agreement doubles as a barrier: rank 0 may then rename it. A
+ * failure of the helpers below (a full disk) is reported here, once, as one line. */
 int mpm_h5_write_file(const mpm_h5 *h, const char *path, mpm_h5_fill fill, const void *arg);
 
 /* The same with checksums: the 1.10 file format (checksummed metadata) and every non-empty

@@ -4,6 +4,7 @@
  * The record must never stop a run: a failed open or write warns once and the run goes on. */
 #define _DEFAULT_SOURCE /* O_NOFOLLOW, O_CLOEXEC */
 #include "mpm_error.h"
+#include "mpm_safefile.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -115,13 +116,10 @@ void mpm_log_file_open(const char *path, int append, const char *separator) {
   if (g_rec.state == REC_FILE) close(g_rec.fd); /* a record still open: the lines held stay */
   snprintf(g_rec.path, sizeof g_rec.path, "%s", path);
   /* No link is followed (a link planted in the folder would redirect the write), a FIFO is not
-   * waited on (O_NONBLOCK), and only a regular file is written. */
-  const int fd = open(path,
-                      O_WRONLY | O_CREAT | O_APPEND | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC |
-                          (append ? 0 : O_TRUNC),
-                      0644);
+   * waited on, and only a regular file is written (mpm_safefile.h). */
+  const int fd = mpm_file_open_fd(path, O_WRONLY | O_CREAT | O_APPEND | (append ? 0 : O_TRUNC));
   struct stat st;
-  int err = fd < 0 ? errno : fstat(fd, &st) != 0 ? errno : !S_ISREG(st.st_mode) ? EINVAL : 0;
+  int err = fd < 0 ? errno : fstat(fd, &st) != 0 ? errno : 0;
   if (err) {
     if (fd >= 0) close(fd);
     /* A link, FIFO or folder of that name is left alone (as mpm_rundir does). */

@@ -32,6 +32,7 @@
 #include "mpm_error.h"
 #include "mpm_h5.h"
 #include "mpm_path.h"
+#include "mpm_safefile.h"
 #include "mpm_xdmf.h"
 
 #include <errno.h>
@@ -343,22 +344,19 @@ static int write_index(const char *dir, const mpm_xdmf *x, const char *name, int
 
 /* dir/view.py, through view.py.tmp so that it is never seen half written. */
 static int write_view_script(const char *dir) {
-  char *path = mpm_path_join(dir, VIEW_NAME), *tmp = mpm_path_join(dir, VIEW_NAME ".tmp");
-  FILE *f = path && tmp ? fopen(tmp, "wb") : NULL;
-  int bad = !f;
-  if (f) {
-    bad = fwrite(mpm_view_py, 1, sizeof mpm_view_py, f) != sizeof mpm_view_py;
-    bad |= fclose(f) != 0;
+  char *path = mpm_path_join(dir, VIEW_NAME);
+  if (!path) MPM_FAIL(MPM_ERR_MEMORY, "output: cannot build the path of " VIEW_NAME);
+  FILE *f = mpm_file_begin(path, "wb");
+  int e = f ? 0 : errno;
+  if (f && fwrite(mpm_view_py, 1, sizeof mpm_view_py, f) != sizeof mpm_view_py) {
+    e = errno ? errno : EIO;
+    mpm_file_abandon(f, path);
+  } else if (f) {
+    e = mpm_file_commit(f, path);
   }
-  bad = bad || rename(tmp, path) != 0;
-  const int e = errno;
-  if (bad && tmp) remove(tmp);
-  free(path), free(tmp);
-  if (bad)
-    MPM_FAIL(MPM_ERR_FILE,
-             "cannot write the ParaView script %s/" VIEW_NAME ": %s (is the disk full?)", dir,
-             strerror(e));
-  return 0;
+  const int rc = e ? mpm_file_fail(path, e, "ParaView script") : 0;
+  free(path);
+  return rc;
 }
 
 static int index_write(const mpm_output *out) {

@@ -1,5 +1,5 @@
 /* File-path helpers (see mpm_path.h). */
-#define _POSIX_C_SOURCE 200809L /* mkdir, stat, access */
+#define _DEFAULT_SOURCE /* mkdir, stat, access, realpath */
 #include "mpm_path.h"
 
 #include <errno.h>
@@ -46,4 +46,41 @@ int mpm_path_make_dir(const char *dir) {
   if (!err && !S_ISDIR(st.st_mode)) err = ENOTDIR;
   if (!err && access(dir, W_OK | X_OK) != 0) err = errno;
   return err;
+}
+
+/* res + "/" + name, with res absolute ("/" stays single). */
+static char *child(const char *res, const char *name, size_t n) {
+  const size_t len = strlen(res) + n + 2;
+  char *s = malloc(len);
+  if (s) snprintf(s, len, "%s%s%.*s", strcmp(res, "/") == 0 ? "" : res, "/", (int)n, name);
+  return s;
+}
+
+char *mpm_path_resolve(const char *dir) {
+  char *res = strdup("/"), cwd[4096];
+  int real = 1; /* res exists (and is resolved) */
+  if (dir[0] != '/') {
+    free(res);
+    res = getcwd(cwd, sizeof cwd) ? realpath(cwd, NULL) : NULL;
+  }
+  for (const char *p = dir; res && *p;) {
+    const size_t n = strcspn(p, "/");
+    char *next = NULL;
+    struct stat st;
+    if (n == 0 || (n == 1 && p[0] == '.')) {
+      next = strdup(res);
+    } else if (!real && n == 2 && p[0] == '.' && p[1] == '.') { /* back out of a new folder */
+      next = mpm_path_parent(res);
+      real = next && stat(next, &st) == 0;
+    } else {
+      next = child(res, p, n);
+      char *r = next && real && lstat(next, &st) == 0 ? realpath(next, NULL) : NULL;
+      if (r) free(next), next = r;
+      real = r != NULL;
+    }
+    free(res);
+    res = next;
+    p += n + (p[n] == '/');
+  }
+  return res;
 }

@@ -6,6 +6,7 @@
 #include "mpm_error.h"
 #include "mpm_h5.h"
 #include "mpm_path.h"
+#include "mpm_safefile.h"
 
 #include <dirent.h>
 #include <errno.h>
@@ -46,14 +47,19 @@ static const char *const g_ours[] = {"snap_[0-9]*.h5",
                                      "run.log",
                                      "view.py"};
 
-/* 1: a result; 2: a leftover of an interrupted write (a result's name + ".tmp"); 0: not ours. */
+/* 1: a result; 2: a leftover of an interrupted write (a result's name + ".tmp", or the lock
+ * test Open MPI's OMPIO makes beside a file it opens, NAME.locktest.RANK); 0: not ours. */
 static int is_ours(const char *name) {
   char base[256];
-  const size_t n = strlen(name);
-  const int tmp = n > 4 && n < sizeof base && strcmp(name + n - 4, ".tmp") == 0;
-  if (tmp) snprintf(base, sizeof base, "%.*s", (int)(n - 4), name);
+  size_t n = strlen(name);
+  const char *test = strstr(name, ".locktest.");
+  const int locktest = test && test[10] && !test[10 + strspn(test + 10, "0123456789")];
+  if (locktest) n = (size_t)(test - name);
+  const int tmp = n > 4 && n < sizeof base && strncmp(name + n - 4, ".tmp", 4) == 0;
+  if (n >= sizeof base) return 0;
+  snprintf(base, sizeof base, "%.*s", (int)(tmp ? n - 4 : n), name);
   for (size_t k = 0; k < sizeof g_ours / sizeof g_ours[0]; ++k)
-    if (fnmatch(g_ours[k], tmp ? base : name, 0) == 0) return tmp ? 2 : 1;
+    if (fnmatch(g_ours[k], base, 0) == 0) return tmp || locktest ? 2 : 1;
   return 0;
 }
 
@@ -62,11 +68,14 @@ static int is_ours(const char *name) {
 static int take_lock(const char *dir, int *fd_out) {
   char *path = mpm_path_join(dir, LOCK_NAME);
   if (!path) MPM_FAIL(MPM_ERR_MEMORY, "out of memory naming the lock of '%s'", dir);
-  const int fd = open(path, O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  const int fd = mpm_file_open_fd(path, O_RDWR | O_CREAT);
+  const int e = errno;
+  if (fd < 0 && e == ELOOP) mpm_log_all(MPM_LOG_ERROR, MPM_LINK_REFUSAL, path);
   free(path);
+  if (fd < 0 && e == ELOOP) return mpm_trace(__FILE__, __LINE__, __func__, MPM_ERR_INPUT);
   if (fd < 0)
     MPM_FAIL(MPM_ERR_INPUT, "cannot create the lock file %s/%s: %s; choose another output.dir", dir,
-             LOCK_NAME, strerror(errno));
+             LOCK_NAME, strerror(e));
   if (flock(fd, LOCK_EX | LOCK_NB) != 0 && errno != EWOULDBLOCK) {
     const int e = errno;
     close(fd);
@@ -257,17 +266,14 @@ static double folder_run_id(const char *dir) {
 }
 
 static int write_run_id(const char *dir, double id) {
-  char *path = mpm_path_join(dir, RUNID_NAME), *tmp = mpm_path_join(dir, RUNID_NAME ".tmp");
-  FILE *f = tmp ? fopen(tmp, "w") : NULL;
-  int ok = f && fprintf(f, "mpmfsi run %.0f\n", id) > 0;
-  if (f) ok = fclose(f) == 0 && ok;
-  ok = ok && rename(tmp, path) == 0;
-  const int e = errno;
-  free(path), free(tmp);
-  if (!ok)
-    MPM_FAIL(MPM_ERR_INPUT, "cannot write %s/%s: %s; check the output folder", dir, RUNID_NAME,
-             strerror(e));
-  return 0;
+  char *path = mpm_path_join(dir, RUNID_NAME);
+  FILE *f = path ? mpm_file_begin(path, "w") : NULL;
+  int e = f ? 0 : path ? errno : ENOMEM;
+  if (f) fprintf(f, "mpmfsi run %.0f\n", id);
+  if (f) e = mpm_file_commit(f, path);
+  if (e && path) mpm_file_fail(path, e, "run record");
+  free(path);
+  return e ? mpm_trace(__FILE__, __LINE__, __func__, MPM_ERR_INPUT) : 0;
 }
 
 /* A new record in dir: refused if an earlier run's results are there, unless overwrite.
@@ -365,6 +371,29 @@ static int continue_in_place(const mpm_rundir_request *req, const listing *l) {
   return 0;
 }
 
+/* Before anything is written: a link named as one of our files (a result, a temporary, the
+ * lock) is refused, or with overwrite removed (the link itself; its target is never
+ * touched). */
+static int clear_links(const char *dir, int overwrite) {
+  char *name = mpm_rundir_find_link(dir);
+  for (int removed = 0; name; name = mpm_rundir_find_link(dir)) {
+    char *path = mpm_path_join(dir, name);
+    const int err = !overwrite ? EEXIST : path ? mpm_file_remove(path) : ENOMEM;
+    if (err == EEXIST)
+      mpm_log_all(MPM_LOG_ERROR,
+                  MPM_LINK_REFUSAL " (or give output.overwrite=true to delete the link)",
+                  path ? path : name);
+    else if (err)
+      mpm_log_all(MPM_LOG_ERROR, "cannot delete the link %s: %s; remove it by hand",
+                  path ? path : name, strerror(err));
+    else if (++removed < 100)
+      mpm_log(MPM_LOG_INFO, "output.overwrite: deleted the link %s (not what it points to)", path);
+    free(path), free(name);
+    if (err) return mpm_trace(__FILE__, __LINE__, __func__, MPM_ERR_INPUT);
+  }
+  return 0;
+}
+
 static int claim(const mpm_rundir_request *req, int *fd, int *append, double *run_id,
                  long *next_checkpoint) {
   const char *dir = req->dir;
@@ -376,6 +405,7 @@ static int claim(const mpm_rundir_request *req, int *fd, int *append, double *ru
              "cannot use '%s' as the output folder: %s; choose another output.dir, or create "
              "this one with write permission",
              dir, strerror(err));
+  MPM_CALL(clear_links(dir, req->overwrite));
   MPM_CALL(take_lock(dir, fd));
   int rc = list_ours(dir, &l);
   int in_place = 0;
@@ -416,6 +446,90 @@ static int claim(const mpm_rundir_request *req, int *fd, int *append, double *ru
   listing_free(&l);
   if (!rc) rc = write_run_id(dir, *run_id);
   return rc;
+}
+
+char *mpm_rundir_find_link(const char *dir) {
+  DIR *d = opendir(dir);
+  char *found = NULL;
+  for (struct dirent *e; d && !found && (e = readdir(d));) {
+    if (!is_ours(e->d_name) && strcmp(e->d_name, LOCK_NAME) != 0) continue;
+    char *path = mpm_path_join(dir, e->d_name);
+    if (mpm_file_is_link(path)) found = strdup(e->d_name);
+    free(path);
+  }
+  if (d) closedir(d);
+  return found;
+}
+
+/* The top folders of the system: the root itself is refused too. */
+static const char *const g_system[] = {"bin",  "boot", "dev", "etc", "lib", "proc",
+                                       "sbin", "sys",  "usr", "var", "run"};
+
+/* The system folder the resolved path real lies in ("/" for the root; NULL: none). A folder
+ * inside one is the user's (allowed) when a folder on the way down to it, below the system
+ * folder, belongs to a user other than root or is a shared scratch folder (world-writable
+ * with the sticky bit, as /var/tmp and /dev/shm). */
+static const char *system_folder(const char *real) {
+  if (strcmp(real, "/") == 0) return "/";
+  const size_t n = strcspn(real + 1, "/");
+  const char *top = NULL;
+  for (size_t k = 0; k < sizeof g_system / sizeof g_system[0] && !top; ++k) {
+    const size_t m = strlen(g_system[k]);
+    const int lib = k == 4 && n >= m && strncmp(real + 1, "lib", 3) == 0; /* lib, lib64, ... */
+    if (lib || (n == m && strncmp(real + 1, g_system[k], m) == 0)) top = g_system[k];
+  }
+  if (!top) return NULL;
+  char *p = strdup(real);
+  int own = 0;
+  for (char *q = p ? p + 1 + n : NULL; q && *q && !own; ++q) { /* each folder below the top */
+    q += strcspn(q + 1, "/") + 1;
+    const char c = *q;
+    *q = 0;
+    struct stat st;
+    own = stat(p, &st) == 0 && S_ISDIR(st.st_mode) &&
+          (st.st_uid != 0 || ((st.st_mode & S_ISVTX) && (st.st_mode & S_IWOTH)));
+    *q = c;
+    if (!c) break;
+  }
+  free(p);
+  return own ? NULL : top;
+}
+
+int mpm_rundir_check_dir(const char *dir, int overwrite, char *why, size_t n) {
+  why[0] = 0;
+  const size_t len = strlen(dir);
+  if (len > MPM_RUNDIR_MAX_DIR)
+    snprintf(why, n,
+             "is %zu characters long; at most %d fit (the longest file path must stay within "
+             "%d characters, the limit of Open MPI's MPI-IO lock-test name): choose a shorter "
+             "path",
+             len, MPM_RUNDIR_MAX_DIR, MPM_RUNDIR_MAX_PATH);
+  char *real = why[0] ? NULL : mpm_path_resolve(dir);
+  const char *top = real ? system_folder(real) : NULL;
+  if (top) {
+    const int root = strcmp(top, "/") == 0, whole = root || strcmp(real + 1, top) == 0;
+    char how[64];
+    snprintf(how, sizeof how, "%s the %s%s", whole ? "" : " inside",
+             root ? "root folder" : "system folder /", root ? "" : top);
+    const int same = strcmp(real, dir) == 0;
+    snprintf(why, n,
+             "%s%s%s%s: mpmfsi does not write there; choose a folder of your own (in your home, "
+             "/tmp or /var/tmp)",
+             same ? "is" : "resolves to ", same ? "" : real,
+             same    ? ""
+             : whole ? ", which is"
+                     : ",",
+             how);
+  }
+  free(real);
+  char *name = why[0] || overwrite ? NULL : mpm_rundir_find_link(dir);
+  if (name) {
+    char *path = mpm_path_join(dir, name);
+    snprintf(why, n, MPM_LINK_REFUSAL " (or give output.overwrite=true to delete the link)",
+             path ? path : name);
+    free(path), free(name);
+  }
+  return why[0] ? MPM_ERR_INPUT : 0;
 }
 
 int mpm_rundir_latest(MPI_Comm comm, const char *dir, const char *checkpoint, double t,

@@ -16,12 +16,17 @@
  *   restart` without an output.dir sends such a restart to a new folder instead, see
  *   app/main.c, so the refusal is met only when that folder is named explicitly.)
  *
+ * Before the lock is taken, a symbolic link named as one of our files (a result, a temporary,
+ * the lock) is refused, or with `overwrite` deleted (the link, never its target): nothing is
+ * ever written through a link (the writers see to it too, mpm_safefile.h).
+ *
  * The folder records its run in DIR/run.id; checkpoints carry the same id, so a checkpoint
  * copied into another run's folder is not taken for that run's. */
 #ifndef MPM_RUNDIR_H
 #define MPM_RUNDIR_H
 
 #include <mpi.h>
+#include <stddef.h>
 
 typedef struct mpm_rundir mpm_rundir;
 
@@ -47,6 +52,26 @@ int mpm_rundir_claim(mpm_rundir **rd, MPI_Comm comm, const mpm_rundir_request *r
  * whether a restart can continue in dir. Collective; rank 0 reads. */
 int mpm_rundir_latest(MPI_Comm comm, const char *dir, const char *checkpoint, double t,
                       double *latest);
+
+/* The longest file path mpmfsi can write: Open MPI's MPI-IO (OMPIO, sharedfp/lockedfile in
+ * Open MPI 4) writes "FILE.locktest.RANK" for every file it opens for writing into a 256-byte
+ * buffer, and aborts beyond it; 238 characters leave room for ".locktest.", a rank of 7 digits
+ * and the terminating zero. The longest name in a folder is "checkpoint_NNNNNN.h5.tmp" (24),
+ * so output.dir, as written, may have at most 238 - 25 characters. */
+#define MPM_RUNDIR_MAX_PATH 238
+#define MPM_RUNDIR_MAX_DIR  (MPM_RUNDIR_MAX_PATH - 25)
+
+/* Can dir be an output folder? Refused (MPM_ERR_INPUT, the reason in why, worded to follow
+ * "output.dir ..."): a path longer than MPM_RUNDIR_MAX_DIR; the root folder or a system folder
+ * (/bin, /boot, /dev, /etc, /lib*, /proc, /sbin, /sys, /usr, /var, /run), links and ".."
+ * resolved, and any folder in one unless a folder on the way down belongs to a user other
+ * than root or is a shared scratch folder (sticky and world-writable: /var/tmp, /dev/shm);
+ * without overwrite, a link named as one of mpmfsi's files in it. Local: no MPI. */
+int mpm_rundir_check_dir(const char *dir, int overwrite, char *why, size_t n);
+
+/* The first entry of dir named as one of mpmfsi's files (a result, a temporary, the lock) that
+ * is a symbolic link: its name (malloc'ed), or NULL. */
+char *mpm_rundir_find_link(const char *dir);
 
 /* Release the lock (the folder and its files stay). */
 void mpm_rundir_release(mpm_rundir **rd);

@@ -2,6 +2,7 @@
 #include "mpm_timer.h"
 
 #include "mpm_error.h"
+#include "mpm_safefile.h"
 
 #include <errno.h>
 #include <stdio.h>
@@ -58,11 +59,12 @@ int mpm_timer_report(MPI_Comm comm, const char *path) {
   mpm_log(MPM_LOG_INFO, "%-11s %12s %12.4f %7.1f%%", "(other)", "", mean[MPM_T_TOTAL] - parts,
           100.0 * (mean[MPM_T_TOTAL] - parts) / total);
   if (!path) return 0;
-  FILE *f = fopen(path, "w");
-  if (!f) MPM_FAIL(MPM_ERR_FILE, "cannot write timers to '%s': %s", path, strerror(errno));
+  FILE *f = mpm_file_begin(path, "w");
+  if (!f) return mpm_file_fail(path, errno, "timers");
   fprintf(f, "phase,max_s,mean_s,fraction\n");
   for (int k = 0; k < MPM_T_COUNT; ++k)
     fprintf(f, "%s,%.6e,%.6e,%.4f\n", g_names[k], max[k], mean[k], max[k] / total);
-  if (fclose(f) != 0) MPM_FAIL(MPM_ERR_FILE, "cannot write timers to '%s'", path);
+  const int e = mpm_file_commit(f, path);
+  if (e) return mpm_file_fail(path, e, "timers");
   return 0;
 }

@@ -12,6 +12,7 @@
  * time is its first <Time> (the snapshot's; the grids inside repeat it). */
 #define _POSIX_C_SOURCE 200809L /* strcasecmp */
 #include "mpm_xdmf.h"
+#include "mpm_safefile.h"
 #include "mpm_error.h"
 #include "mpm_types.h"
 
@@ -356,26 +357,15 @@ static int write_all(const mpm_xdmf *x, FILE *f) {
 }
 
 int mpm_xdmf_write(const mpm_xdmf *x, const char *path) {
-  const size_t len = strlen(path) + 5;
-  char *tmp;
-  MPM_ALLOC(tmp, len);
-  snprintf(tmp, len, "%s.tmp", path);
-  FILE *f = fopen(tmp, "w");
-  if (!f) {
-    const int e = errno;
-    free(tmp);
-    MPM_FAIL(MPM_ERR_FILE, "cannot write the XDMF index %s.tmp: %s", path, strerror(e));
+  FILE *f = mpm_file_begin(path, "w");
+  if (!f) return mpm_file_fail(path, errno, "XDMF index");
+  if (write_all(x, f) != 0) {
+    const int e = errno ? errno : EIO;
+    mpm_file_abandon(f, path);
+    return mpm_file_fail(path, e, "XDMF index");
   }
-  int bad = write_all(x, f);
-  bad |= fclose(f) != 0;
-  if (bad || rename(tmp, path) != 0) {
-    const int e = errno;
-    remove(tmp);
-    free(tmp);
-    MPM_FAIL(MPM_ERR_FILE, "cannot write the XDMF index %s: %s (is the disk full?)", path,
-             strerror(e));
-  }
-  free(tmp);
+  const int e = mpm_file_commit(f, path);
+  if (e) return mpm_file_fail(path, e, "XDMF index");
   return 0;
 }
 

@@ -14,12 +14,14 @@
 #include "mpm_output.h"
 #include "mpm_probe.h"
 #include "mpm_rundir.h"
+#include "mpm_safefile.h"
 #include "mpm_scene.h"
 #include "mpm_signal.h"
 #include "mpm_timer.h"
 #include "fluid_module.h"
 #include "solid_module.h"
 
+#include <errno.h>
 #include <limits.h>
 #include <math.h>
 #include <stdio.h>
@@ -243,6 +245,11 @@ static int read_run_settings(mpm_sim *s) {
     return mpm_config_fail(s->cfg, "output.dir", "is empty; name the folder to write into");
   MPM_CALL(mpm_config_get_bool(s->cfg, "output.overwrite", &s->overwrite));
   MPM_CALL(mpm_config_get_bool(s->cfg, "output.truncate", &s->truncate));
+  /* Rank 0 looks at the folder (a file system need not look the same everywhere). */
+  char why[1024] = "";
+  int bad = s->rank == 0 ? mpm_rundir_check_dir(s->dir, s->overwrite, why, sizeof why) : 0;
+  MPM_CALL_MPI(MPI_Bcast(&bad, 1, MPI_INT, 0, s->comm));
+  if (bad) return mpm_config_fail(s->cfg, "output.dir", "%s", why);
   if (s->out_interval <= 0) s->out_interval = s->t_end / 10;
   if (s->ckpt_interval <= 0) s->ckpt_interval = HUGE_VAL;
   return 0;
@@ -728,8 +735,8 @@ static int write_summary(mpm_sim *s, double wall) {
         s->coupling_crossed, 100 * rel_solid, s->solid_peak, 100 * rel_total, s->energy);
   if (s->rank != 0) return 0;
   snprintf(path, sizeof path, "%s/summary.json", s->dir);
-  FILE *f = fopen(path, "w");
-  if (!f) MPM_FAIL(MPM_ERR_FILE, "cannot write '%s'", path);
+  FILE *f = mpm_file_begin(path, "w");
+  if (!f) return mpm_file_fail(path, errno, "summary");
   fprintf(f,
           "{\"version\": \"%s\", \"t\": %.17g, \"steps\": %ld, \"rhs_evals\": %ld, "
           "\"error_test_fails\": %ld, "
@@ -743,7 +750,8 @@ static int write_summary(mpm_sim *s, double wall) {
           s->particle_steps, s->particle_steps / wall,
           s->coupling ? s->coupling->type->name : "none", s->coupling_imbalance, s->coupling_work,
           s->coupling_crossed, rel_crossed, s->solid_peak, rel_solid, rel_total, s->estimate);
-  fclose(f);
+  const int e = mpm_file_commit(f, path);
+  if (e) return mpm_file_fail(path, e, "summary");
   return 0;
 }
 
