@@ -28,6 +28,9 @@ typedef struct mpm_fault {
   mpm_gidx id;
   double x[MPM_MAX_DIM];
   char cause[160];
+  /* What to change, when the cause knows better than the generic advice (which a retry with a
+   * smaller step would follow); "" for the generic advice. Bytes, as the ranks share faults. */
+  char advice[240];
 } mpm_fault;
 
 /* Local sums over a module's particles, reduced by the caller. */
