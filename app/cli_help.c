@@ -33,7 +33,7 @@ static const char g_usage[] =
   "  0  success\n"                                                                                 \
   "  1  the run failed (an unphysical state, or the blow-up guard stopped it)\n"                   \
   "  2  bad input: nothing ran and nothing was written; an error line names file:line and key\n"   \
-  "  3  stopped by SIGTERM or SIGINT; a final checkpoint was written (restart from it)\n"
+  "  3  stopped by SIGTERM, SIGINT or SIGHUP; a final checkpoint was written (restart from it)\n"
 
 static const char g_run[] =
     "usage: mpmfsi run CASE [key=value ...]\n"

@@ -13,7 +13,7 @@
  * cli_help.c, the key listing in cli_keys.c.
  *
  * Exit codes: 0 success, 1 a failure during the run, 2 bad input (nothing was run), 3 stopped
- * by SIGTERM or SIGINT (a final checkpoint was written; restart from it to go on). Input
+ * by SIGTERM, SIGINT or SIGHUP (a final checkpoint was written; restart from it to go on). Input
  * errors and unphysical states are found identically on every rank, so they end the run
  * cleanly; any other failure aborts all ranks so that none is left waiting in a collective
  * call. */

@@ -515,11 +515,42 @@ static void describe_fields(const mpm_particles *p, char *s, size_t size) {
                           p->field[f].ncomp);
 }
 
-/* The stored layout must be p's: same dimension, same fields in the same order. */
+/* How the stored components map onto p's: src[c] is the stored component that p's component c
+ * takes (-1: none, left zero), of nstored in all. The identity when the layouts are equal. */
+typedef struct layout_map {
+  int nstored;
+  int src[MPM_PARTICLES_MAX_COMPONENTS];
+} layout_map;
+
+/* Fill map from the stored fields names[0..nf) (ncomp each) by name: 1 if every field of p is
+ * stored with its size, or is one whose stored value no step reads (scratch: written before it
+ * is read; derived: recomputed before use), else 0. Stored fields p lacks are dropped: the
+ * stored case is this run's but for time.*, so the layouts differ only where time.method
+ * arranges its fields (the gas's lagged strain rate is state in usl and musl, the ERK pairs add
+ * their pending one), and the switch needs nothing more. */
+static int map_layout(const mpm_particles *p, char *const *names, const int *ncomp, int nf,
+                      layout_map *map) {
+  int start[MPM_PARTICLES_MAX_FIELDS];
+  map->nstored = 0;
+  for (int k = 0; k < nf; ++k) start[k] = map->nstored, map->nstored += ncomp[k];
+  for (int f = 0; f < p->nfields; ++f) {
+    int k = 0;
+    while (k < nf && strcmp(names[k], p->field[f].name) != 0) ++k;
+    if (k < nf && ncomp[k] != p->field[f].ncomp) return 0;
+    if (k == nf && !((p->scratch | p->derived) >> f & 1u)) return 0;
+    for (int c = 0; c < p->field[f].ncomp; ++c)
+      map->src[p->offset[f] + c] = k < nf ? start[k] + c : -1;
+  }
+  return 1;
+}
+
+/* The stored layout must supply p's: the same dimension, and every field p needs
+ * (map_layout). */
 static int check_layout(const mpm_checkpoint *ck, hid_t g, const char *phase,
-                        const mpm_particles *p) {
-  int dim = 0, ncomp[MPM_PARTICLES_MAX_FIELDS] = {0}, nstored = 0;
+                        const mpm_particles *p, layout_map *map) {
+  int dim = 0, ncomp[MPM_PARTICLES_MAX_FIELDS] = {0}, nstored = 0, nf = 0;
   char *names = NULL, want[512], have[512] = "", why[WHY_SIZE] = "";
+  char *field[MPM_PARTICLES_MAX_FIELDS];
   unsigned long long hash = 0;
   int st = attr_read_string(g, "field_names", &names);
   if (names) {
@@ -533,16 +564,21 @@ static int check_layout(const mpm_checkpoint *ck, hid_t g, const char *phase,
   if (st == -2) note(why, ck, "cannot read the layout of phase '%s' (%s)", phase, h5_cause());
   if (!st && ck->hashed && hash != text_hash(names, NULL))
     note(why, ck, "checksum mismatch in the field names of phase '%s' (text_hash)", phase);
+  for (int f = 0; !st && !why[0] && f < nstored; ++f) /* a size no field has: damaged */
+    if (ncomp[f] < 1 || ncomp[f] > 9) st = -1;
   if (!st && !why[0]) { /* "x,v,m" with ncomp {2,2,1} -> "x(2) v(2) m(1)" */
     size_t k = 0;
-    int f = 0;
     char *save = NULL;
-    for (char *tok = strtok_r(names, ",", &save); tok && k < sizeof have;
-         tok = strtok_r(NULL, ",", &save), ++f)
-      k += (size_t)snprintf(have + k, sizeof have - k, "%s%s(%d)", f ? " " : "", tok, ncomp[f]);
+    for (char *tok = strtok_r(names, ",", &save); tok && nf < nstored;
+         tok = strtok_r(NULL, ",", &save), ++nf) {
+      field[nf] = tok;
+      if (k < sizeof have)
+        k += (size_t)snprintf(have + k, sizeof have - k, "%s%s(%d)", nf ? " " : "", tok, ncomp[nf]);
+    }
   }
-  free(names);
   describe_fields(p, want, sizeof want);
+  const int fits = !st && !why[0] && nf == nstored && map_layout(p, field, ncomp, nf, map);
+  free(names);
   if (st == -1)
     snprintf(why, sizeof why,
              "the checkpoint '%s' does not describe the fields of phase '%s'; it was not "
@@ -550,7 +586,7 @@ static int check_layout(const mpm_checkpoint *ck, hid_t g, const char *phase,
              ck->path, phase);
   /* What one rank read decides for all: the ranks go on to collective reads together. */
   AGREE_WHY(ck, why);
-  if (dim != p->dim || strcmp(have, want) != 0)
+  if (dim != p->dim || !fits)
     MPM_FAIL_ON_ROOT(ck->rank, MPM_ERR_INPUT,
                      "the checkpoint '%s' holds phase '%s' as %d-D particles with fields %s, but "
                      "this run needs %d-D particles with fields %s. Restart with the case (model "
@@ -685,14 +721,34 @@ static int validate(const mpm_checkpoint *ck, const char *phase, const mpm_parti
   return 0;
 }
 
+/* The stored block (map->nstored components, stride n) in p's layout: a fresh block. */
+static double *remap(const layout_map *map, const mpm_particles *p, double *stored, size_t n) {
+  double *data = calloc((size_t)p->ncomp * n + 1, sizeof *data);
+  for (int c = 0; data && c < p->ncomp; ++c)
+    if (map->src[c] >= 0)
+      memcpy(data + (size_t)c * n, stored + (size_t)map->src[c] * n, n * sizeof *data);
+  free(stored);
+  return data;
+}
+
+static int identity(const layout_map *map, const mpm_particles *p) {
+  int same = map->nstored == p->ncomp;
+  for (int c = 0; same && c < p->ncomp; ++c) same = map->src[c] == c;
+  return same;
+}
+
 /* Read this rank's slice, check it, and make it p's whole contents. */
 static int read_slice(const mpm_checkpoint *ck, hid_t g, const char *phase, mpm_particles *p,
-                      int64_t total, int64_t offset, int64_t n) {
+                      const layout_map *map, int64_t total, int64_t offset, int64_t n) {
   mpm_gidx *id = malloc(((size_t)n + 1) * sizeof *id);
-  double *data = malloc(((size_t)p->ncomp * (size_t)n + 1) * sizeof *data);
+  double *data = malloc(((size_t)map->nstored * (size_t)n + 1) * sizeof *data);
   unsigned char *keep = calloc((size_t)p->n + 1, 1); /* all zero: drop what p held */
   int rc = mpm_h5_agree(ck->comm, id && data && keep ? 0 : MPM_ERR_MEMORY);
-  if (!rc) rc = read_datasets(ck, g, phase, p->ncomp, total, offset, n, id, data);
+  if (!rc) rc = read_datasets(ck, g, phase, map->nstored, total, offset, n, id, data);
+  if (!rc && !identity(map, p)) {
+    data = remap(map, p, data, (size_t)n);
+    rc = mpm_h5_agree(ck->comm, data ? 0 : MPM_ERR_MEMORY);
+  }
   if (!rc) rc = validate(ck, phase, p, n, id, data);
   /* Through mpm_particles_edit, which owns the block's allocation and its invariants. */
   if (!rc) rc = mpm_particles_edit(p, keep, (mpm_lidx)n, id, data);
@@ -705,7 +761,8 @@ static int read_slice(const mpm_checkpoint *ck, hid_t g, const char *phase, mpm_
 static int read_phase(mpm_checkpoint *ck, hid_t g, const char *phase, mpm_particles *p) {
   int64_t offset = 0, n = 0, total = 0, id_next = 0;
   char why[WHY_SIZE] = "";
-  MPM_CALL(check_layout(ck, g, phase, p));
+  layout_map map;
+  MPM_CALL(check_layout(ck, g, phase, p, &map));
   const int st = attr_read(g, "id_next", H5T_NATIVE_INT64, 1, &id_next);
   if (st || id_next < 0)
     note(why, ck, "cannot read a valid id_next for phase '%s' (%s)", phase,
@@ -715,7 +772,7 @@ static int read_phase(mpm_checkpoint *ck, hid_t g, const char *phase, mpm_partic
   AGREE_WHY(ck, why);
   MPM_CALL(choose_slice(ck, g, phase, &offset, &n, &total));
   p->id_next = id_next;
-  MPM_CALL(read_slice(ck, g, phase, p, total, offset, n));
+  MPM_CALL(read_slice(ck, g, phase, p, &map, total, offset, n));
   return 0;
 }
 

@@ -1203,6 +1203,130 @@ static void unknown_key(const mpm_config *cfg, const entry *e) {
   free(near), free(keys);
 }
 
+/* 1 if the section of key (all of it up to the last dot) is a section of the schema. */
+static int section_known(const mpm_config *cfg, const char *key) {
+  const size_t len = section_len(key);
+  for (size_t i = 0; len && i < cfg->nspecs; ++i) {
+    const char *sk = cfg->specs[i]->key;
+    if (section_in(key, sk, section_len(sk)) == len) return 1;
+  }
+  return 0;
+}
+
+/* The schema's section names ("run, domain, ..., solid.NAME"), each once, in order. */
+static char *section_names(const mpm_config *cfg) {
+  sbuf b = {0};
+  for (size_t i = 0; i < cfg->nspecs; ++i) {
+    const char *sk = cfg->specs[i]->key;
+    const size_t n = section_len(sk);
+    int seen = 0;
+    for (size_t j = 0; j < i && !seen; ++j)
+      seen = section_len(cfg->specs[j]->key) == n && memcmp(cfg->specs[j]->key, sk, n) == 0;
+    if (seen) continue;
+    if (b.len) sb_add(&b, ", ", 2);
+    for (size_t k = 0; k < n;) { /* component by component, "*" as NAME */
+      size_t c = strcspn(sk + k, ".");
+      if (c > n - k) c = n - k;
+      if (is_star(sk + k, c))
+        sb_str(&b, "NAME");
+      else
+        sb_add(&b, sk + k, c);
+      k += c;
+      if (k < n) sb_add(&b, ".", 1), ++k;
+    }
+  }
+  return sb_take(&b);
+}
+
+/* The schema section nearest to sec[0..len), with its instance names taken from sec, if it is
+ * near enough to be a likely typo; else NULL. */
+static char *nearest_section(const mpm_config *cfg, const char *sec, size_t len) {
+  size_t limit = len / 3 < 2 ? 2 : len / 3 > 8 ? 8 : len / 3, best_d = SIZE_MAX;
+  char *name = dup_n(sec, len), *best = NULL;
+  for (size_t i = 0; name && i < cfg->nspecs; ++i) {
+    char *pat = dup_n(cfg->specs[i]->key, section_len(cfg->specs[i]->key));
+    char *cand = pat ? instantiate(pat, name) : NULL;
+    const size_t d = cand && !strchr(cand, '*') ? edit_distance(name, cand, limit) : SIZE_MAX;
+    free(pat);
+    if (d <= limit && d < best_d)
+      free(best), best = cand, best_d = d;
+    else
+      free(cand);
+  }
+  free(name);
+  return best;
+}
+
+/* One line for a section the schema does not have, at its first key: the section named, and
+ * the nearest valid one or, when none is near, the sections there are. */
+static void unknown_section(const mpm_config *cfg, const entry *e) {
+  if (!error_room(cfg, e->where)) return;
+  const size_t len = section_len(e->key);
+  for (size_t i = 0; i < cfg->nspecs; ++i) { /* [solid] for [solid.NAME] */
+    const char *sk = cfg->specs[i]->key;
+    if (section_len(sk) == len + 2 && memcmp(sk, e->key, len) == 0 && sk[len] == '.' &&
+        sk[len + 1] == '*') {
+      mpm_log(MPM_LOG_ERROR, "%s: section '[%s]' needs a name: write '[%s.NAME]'", e->where,
+              show_n(e->key, len).s, show_n(e->key, len).s);
+      return;
+    }
+  }
+  char *near = nearest_section(cfg, e->key, len), *all = near ? NULL : section_names(cfg);
+  if (near)
+    mpm_log(MPM_LOG_ERROR, "%s: unknown section '[%s]'; did you mean '[%s]'?", e->where,
+            show_n(e->key, len).s, show(near).s);
+  else
+    mpm_log(MPM_LOG_ERROR, "%s: unknown section '[%s]'; the sections are %s", e->where,
+            show_n(e->key, len).s, all ? all : "listed by 'mpmfsi keys'");
+  free(near), free(all);
+}
+
+/* An entry whose key the schema lacks: one line per unknown section (at its first key, or the
+ * first after another section's), else one per key. */
+static void unknown_entry(const mpm_config *cfg, size_t i) {
+  const entry *e = &cfg->entries[i];
+  if (section_known(cfg, e->key)) {
+    unknown_key(cfg, e);
+    return;
+  }
+  const size_t len = section_len(e->key);
+  const char *prev = i > 0 ? cfg->entries[i - 1].key : NULL;
+  if (prev && section_len(prev) == len && memcmp(prev, e->key, len) == 0) return;
+  unknown_section(cfg, e);
+}
+
+/* The first instance name ("*" of the spec pattern) in key longer than MPM_CONFIG_NAME_MAX:
+ * its length, and its start in *name; 0 if there is none. */
+static size_t long_name(const char *pat, const char *key, const char **name) {
+  for (;;) {
+    const size_t pl = strcspn(pat, "."), kl = strcspn(key, ".");
+    if (is_star(pat, pl) && kl > MPM_CONFIG_NAME_MAX) {
+      *name = key;
+      return kl;
+    }
+    pat += pl, key += kl;
+    if (!*pat || !*key) return 0;
+    ++pat, ++key;
+  }
+}
+
+/* An instance name over the limit: one line per section (at its first key, or the first after
+ * another section's). Returns 1 if entry i has one. */
+static int name_too_long(const mpm_config *cfg, const mpm_key_spec *sp, size_t i) {
+  const entry *e = &cfg->entries[i];
+  const char *name = NULL;
+  const size_t n = long_name(sp->key, e->key, &name), len = section_len(e->key);
+  if (!n) return 0;
+  const char *prev = i > 0 ? cfg->entries[i - 1].key : NULL;
+  if (prev && section_len(prev) == len && memcmp(prev, e->key, len) == 0) return 1;
+  if (error_room(cfg, e->where))
+    mpm_log(MPM_LOG_ERROR,
+            "%s: the name in '[%.*s...]' is %zu characters long; a name may have at most %d: "
+            "choose a shorter one",
+            e->where, (int)(name - e->key) + 16, show_n(e->key, len).s, n, MPM_CONFIG_NAME_MAX);
+  return 1;
+}
+
 /* 1 if entry j is the first entry of the section (matching pat[0..plen)) that it lies in. */
 static int first_in_section(const mpm_config *cfg, size_t j, const char *pat, size_t plen) {
   const char *key = cfg->entries[j].key;
@@ -1258,7 +1382,9 @@ int mpm_config_validate(const mpm_config *cfg) {
     const mpm_key_spec *sp = find_spec(cfg, e->key);
     item it = entry_item(cfg, sp, e);
     if (!sp)
-      unknown_key(cfg, e), bad_any = 1;
+      unknown_entry(cfg, i), bad_any = 1;
+    else if (strchr(sp->key, '*') && name_too_long(cfg, sp, i))
+      bad_any = 1;
     else if (check_value(&it) != 0)
       bad_any = 1;
   }

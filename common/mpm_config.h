@@ -105,6 +105,11 @@ void mpm_config_enum_text(char *choices, size_t nchoices, char *help, size_t nhe
                           const char *intro, const char *const *name, const char *const *help_of,
                           int n);
 
+/* The longest instance name (the NAME of [solid.NAME]) a case may use: mpm_config_validate
+ * refuses a longer one, so that modules may keep a name in a char[64] and its keys in fixed
+ * buffers. */
+#define MPM_CONFIG_NAME_MAX 63
+
 /* Instance names used under a prefix, in order of first appearance: for "geometry" and
  * entries geometry.a.type, geometry.b.lo it gives {"a", "b"}. *names is owned by cfg. */
 int mpm_config_instances(const mpm_config *cfg, const char *prefix, const char *const **names,

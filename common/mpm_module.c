@@ -78,6 +78,38 @@ int mpm_fault_at(mpm_fault *fault, const mpm_particles *p, const double *y, mpm_
   va_start(ap, fmt);
   vsnprintf(fault->cause, sizeof fault->cause, fmt, ap);
   va_end(ap);
+  fault->advice[0] = '\0';
+  return 1;
+}
+
+/* Particle i lies beyond face (d, side): the cause and what to change. A solid particle there
+ * has been carried to the edge of the domain, which no body may leave, and a smaller step does
+ * not bring it back (at Mach 50 the flow tore the main job's bar from its clamp and swept it
+ * onto the outflow face). A gas particle beyond an open face by more than the cell it may cross
+ * moved too far in one step; beyond a wall it went through the wall. */
+static int fault_beyond(const mpm_module *m, const double *y, mpm_lidx i, int d, int side,
+                        mpm_fault *fault) {
+  const char face[] = {"xyz"[d], '_', side ? 'h' : 'l', side ? 'i' : 'o', '\0'};
+  if (m->role == MPM_ROLE_SOLID) {
+    mpm_fault_at(fault, m->particles, y, i,
+                 "the solid particle reached the domain's face boundary.%s, which no body may "
+                 "cross: the body moved, or the flow or the load tore or carried it, out of the "
+                 "domain",
+                 face);
+    snprintf(fault->advice, sizeof fault->advice,
+             "A smaller step does not help: make the body stiffer or hold it better (clamp.*), "
+             "ease the load or the flow, or extend the domain beyond boundary.%s",
+             face);
+  } else if (m->open[d][side]) {
+    mpm_fault_at(
+        fault, m->particles, y, i,
+        "the gas particle crossed the open face boundary.%s by more than a cell within one step",
+        face);
+    snprintf(fault->advice, sizeof fault->advice,
+             "The step is too long for the flow's speed there: lower time.cfl or time.dt_max");
+  } else {
+    mpm_fault_at(fault, m->particles, y, i, "the particle went through the wall boundary.%s", face);
+  }
   return 1;
 }
 
@@ -111,7 +143,7 @@ int mpm_module_check_positions(const mpm_module *m, const double *y, mpm_fault *
     for (mpm_lidx i = 0; i < n; ++i) bad |= !(x[i] >= lo_b && x[i] < hi_b);
     for (mpm_lidx i = 0; bad && i < n; ++i) {
       if (!g->periodic[d] && !(x[i] >= lo && x[i] < hi))
-        return mpm_fault_at(fault, p, y, i, "the particle left the domain");
+        return fault_beyond(m, y, i, d, !(x[i] < lo), fault);
       if (!(x[i] >= near_lo && x[i] < near_hi))
         return mpm_fault_at(fault, p, y, i,
                             "the particle moved more than one cell within one step");

@@ -27,7 +27,10 @@ typedef struct mpm_fault {
   int set;
   mpm_gidx id;
   double x[MPM_MAX_DIM];
-  char cause[160];
+  char cause[256];
+  /* What to change, when the cause knows better than the generic advice (which a retry with a
+   * smaller step would follow); "" for the generic advice. Bytes, as the ranks share faults. */
+  char advice[240];
 } mpm_fault;
 
 /* Local sums over a module's particles, reduced by the caller. */

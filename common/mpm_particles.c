@@ -151,6 +151,10 @@ void mpm_particles_set_derived(mpm_particles *p, int f) {
   if (f >= 0 && f < p->nfields) p->derived |= 1u << f;
 }
 
+void mpm_particles_set_scratch(mpm_particles *p, int f) {
+  if (f >= 0 && f < p->nfields) p->scratch |= 1u << f;
+}
+
 /* Copy the kept particles, in order, to the front of a block whose components are nnew
  * apart. Runs of kept particles go by memcpy: an edit or a migration keeps nearly all. */
 static void copy_kept(const mpm_particles *p, const unsigned char *keep, mpm_lidx nnew,

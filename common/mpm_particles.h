@@ -56,6 +56,7 @@ typedef struct mpm_particles {
   mpm_gidx id_next;                                /* next free global id; equal on every rank */
   mpm_field_range range[MPM_PARTICLES_MAX_FIELDS]; /* all reals unless the module narrows it */
   unsigned derived; /* bit f: field f is derived (mpm_particles_set_derived) */
+  unsigned scratch; /* bit f: field f is scratch (mpm_particles_set_scratch) */
   /* An edit recorded by mpm_particles_edit_deferred for the next migration (owned buffers;
    * set while one is pending). */
   struct {
@@ -118,6 +119,11 @@ void mpm_particles_set_range(mpm_particles *p, int f, double lo, double hi, int 
  * (an output field, filled just before a snapshot), so its values need not survive an edit, a
  * sort or a migration, and those leave them undefined instead of moving them. */
 void mpm_particles_set_derived(mpm_particles *p, int f);
+
+/* Mark field f as scratch: every step writes it before it reads it (the ERK pairs' pending
+ * strain rate), so a checkpoint need not hold it: a restart from one written without it (under
+ * another time.method) starts it at zero. */
+void mpm_particles_set_scratch(mpm_particles *p, int f);
 
 /* Check n particles given as ids and component-major data (stride n) in p's layout: every
  * id >= 0 (ids beyond id_next are legal: the gas's inflow hands out its own ranges) and

@@ -23,6 +23,10 @@ void mpm_signal_catch(void) {
   g_signal = 0;
   sigaction(SIGTERM, &sa, NULL);
   sigaction(SIGINT, &sa, NULL);
+  /* SIGHUP (the terminal or the ssh session went away) as SIGTERM, unless the run was started
+   * under nohup, which asks for it to be ignored: that wish is kept, as careful tools do. */
+  struct sigaction old;
+  if (sigaction(SIGHUP, NULL, &old) == 0 && old.sa_handler != SIG_IGN) sigaction(SIGHUP, &sa, NULL);
 }
 
 int mpm_signal_agreed(MPI_Comm comm, int *sig) {
@@ -32,5 +36,8 @@ int mpm_signal_agreed(MPI_Comm comm, int *sig) {
 }
 
 const char *mpm_signal_name(int sig) {
-  return sig == SIGTERM ? "SIGTERM" : sig == SIGINT ? "SIGINT" : "a signal";
+  return sig == SIGTERM  ? "SIGTERM"
+         : sig == SIGINT ? "SIGINT"
+         : sig == SIGHUP ? "SIGHUP"
+                         : "a signal";
 }

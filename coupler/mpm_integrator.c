@@ -679,10 +679,11 @@ static int report_fault(const mpm_integrator *it, double t, int tries) {
   else
     snprintf(where, sizeof where, "(%.6g, %.6g, %.6g)", f->x[0], f->x[1], f->x[2]);
   mpm_log(MPM_LOG_ERROR,
-          "the run stopped at t = %.6g after %d %s with smaller steps: particle %lld at %s: "
-          "%s. Reduce time.cfl or time.rtol, refine the grid, or check the material "
-          "parameters and boundary conditions near that point",
-          t, tries, tries == 1 ? "retry" : "retries", (long long)f->id, where, f->cause);
+          "the run stopped at t = %.6g after %d %s with smaller steps: particle %lld at %s: %s. %s",
+          t, tries, tries == 1 ? "retry" : "retries", (long long)f->id, where, f->cause,
+          f->advice[0] ? f->advice
+                       : "Reduce time.cfl or time.rtol, refine the grid, or check the material "
+                         "parameters and boundary conditions near that point");
   return MPM_ERR_UNPHYSICAL;
 }
 

@@ -9,6 +9,7 @@
 #include "mpm_error.h"
 #include "mpm_geometry.h"
 #include "mpm_guard.h"
+#include "mpm_h5.h"
 #include "mpm_integrator.h"
 #include "mpm_timescheme.h"
 #include "mpm_output.h"
@@ -77,6 +78,9 @@ struct mpm_sim {
   double estimate;                 /* the expected step count of the run from t (0: none yet) */
   double dt_first[ESTIMATE_AFTER]; /* the first steps' sizes, for the refined estimate */
   long step0;                      /* the step the run (or restart) started at */
+  /* RHS evaluations before this command (a restart: the checkpoint's), so that
+   * diagnostics.csv's rhs_evals continues the run's count; 0 for a new run. */
+  double rhs_before;
 };
 
 static const mpm_key_spec sim_keys[] = {
@@ -392,6 +396,21 @@ int mpm_sim_create(mpm_sim **sp, mpm_config *cfg) {
   return check_budget(s);
 }
 
+/* The run's RHS evaluations up to the checkpoint. A checkpoint from before they were kept
+ * continues from its step count: exact for usl and musl (one evaluation a step), a lower
+ * bound for the ERK pairs (at least one a step). */
+static int restore_rhs_count(mpm_sim *s, const mpm_checkpoint *ck, const char *path, double step) {
+  s->rhs_before = step;
+  if (!mpm_checkpoint_attr_optional(ck, "rhs_evals", &s->rhs_before)) return 0;
+  if (!(s->rhs_before >= step && s->rhs_before <= 0x1p53 && s->rhs_before == floor(s->rhs_before)))
+    MPM_FAIL_ON_ROOT(s->rank, MPM_ERR_INPUT,
+                     "the checkpoint '%s' is damaged: its RHS evaluation count rhs_evals is %.17g, "
+                     "not a whole number at least its step count %.17g. Restart from an earlier "
+                     "checkpoint",
+                     path, s->rhs_before, step);
+  return 0;
+}
+
 int mpm_sim_restart(mpm_sim **sp, mpm_config *cfg, const char *path) {
   MPM_CALL(sim_alloc(sp, cfg));
   mpm_sim *s = *sp;
@@ -408,6 +427,7 @@ int mpm_sim_restart(mpm_sim **sp, mpm_config *cfg, const char *path) {
   /* The summary's scale of the coupling work (0: a checkpoint from before it was kept). */
   if (!rc) mpm_checkpoint_attr_optional(ck, "coupling_crossed", &s->coupling_crossed);
   if (!rc) mpm_checkpoint_attr_optional(ck, "solid_peak", &s->solid_peak);
+  if (!rc) rc = restore_rhs_count(s, ck, path, step);
   if (!rc && !(s->checkpoint = strdup(path))) rc = MPM_ERR_MEMORY;
   for (int k = 0; !rc && k < s->nmod; ++k)
     rc = mpm_checkpoint_read_particles(ck, s->mod[k]->name, s->mod[k]->particles);
@@ -484,6 +504,13 @@ static int write_snapshot(mpm_sim *s) {
   return rc;
 }
 
+/* The run's RHS evaluations so far, restarts included. */
+static double rhs_evals(const mpm_sim *s) {
+  long steps, rhs, fails, retries;
+  mpm_timescheme_counts(s->it, &steps, &rhs, &fails, &retries);
+  return s->rhs_before + (double)rhs;
+}
+
 static int write_checkpoint(mpm_sim *s, const char *path) {
   const mpm_particles *p[SIM_MAX_MODULES + 1];
   MPM_CALL(prepare_output(s));
@@ -493,11 +520,12 @@ static int write_checkpoint(mpm_sim *s, const char *path) {
   mpm_particles *own = NULL;
   MPM_CALL(mpm_timescheme_save(s->it, &own, &names[s->nmod]));
   p[s->nmod] = own;
-  enum { NA = 7, MAXA = NA + MPM_PROBE_MAX * (1 + MPM_MAX_DIM) };
+  enum { NA = 8, MAXA = NA + MPM_PROBE_MAX * (1 + MPM_MAX_DIM) };
   const char *attr[MAXA] = {
-      "t", "step", "h_next", "coupling_work", "run_id", "coupling_crossed", "solid_peak"};
-  double val[MAXA] = {s->t,      (double)s->step,     s->h_next,    s->coupling_work,
-                      s->run_id, s->coupling_crossed, s->solid_peak};
+      "t",          "step",     "h_next", "coupling_work", "run_id", "coupling_crossed",
+      "solid_peak", "rhs_evals"};
+  double val[MAXA] = {s->t,      (double)s->step,     s->h_next,     s->coupling_work,
+                      s->run_id, s->coupling_crossed, s->solid_peak, rhs_evals(s)};
   const int na = NA + mpm_probes_attrs(&s->probes, attr + NA, val + NA, MAXA - NA);
   mpm_timer_start(MPM_T_IO);
   int rc = mpm_checkpoint_write(s->comm, path, s->config_text, attr, val, na, p, names,
@@ -557,10 +585,9 @@ static int diagnostics_row(mpm_sim *s, double dt) {
   MPM_CALL_MPI(MPI_Allreduce(local, sum, 10, MPI_DOUBLE, MPI_SUM, s->comm));
   s->energy = sum[5] + sum[6];
   if (s->coupling) MPM_CALL(coupling_row(s, dt, sum + 8));
-  long steps, rhs, fails, retries;
-  mpm_timescheme_counts(s->it, &steps, &rhs, &fails, &retries);
-  const double row[NDIAG] = {s->t,   (double)s->step, dt,     sum[0], sum[1],          sum[2],
-                             sum[3], sum[4],          sum[5], sum[6], sum[5] + sum[6], (double)rhs};
+  const double row[NDIAG] = {
+      s->t,   (double)s->step, dt,     sum[0], sum[1],          sum[2],
+      sum[3], sum[4],          sum[5], sum[6], sum[5] + sum[6], rhs_evals(s)};
   if (dt > 0) s->particle_steps += sum[0]; /* the row at t = 0 is not a step */
   if (s->probes.n > 0) {
     double prow[MPM_PROBE_MAX * 2 * MPM_MAX_DIM + 1];

@@ -748,6 +748,9 @@ static int particles_new(mpm_particles **p, int dim, fluid_layout *lay, int apic
   /* The output fields are filled just before a snapshot (fluid_output.c): edits, sorts and
    * migrations need not move them. */
   for (int k = lay->f_rho; k <= lay->f_s; ++k) mpm_particles_set_derived(*p, k);
+  /* Every RHS writes the pending strain rate before the step commits it: a restart from a
+   * checkpoint of usl or musl, which have none, needs none. */
+  if (lay->f_pending >= 0) mpm_particles_set_scratch(*p, lay->f_pending);
   return 0;
 }
 

@@ -219,9 +219,10 @@ static void test_comments_blanks_crlf_bom(void **state) {
 
 static void test_long_lines_and_names(void **state) {
   (void)state;
-  /* Far beyond inih's 200-byte line buffer and 50-byte section names. */
+  /* Far beyond inih's 200-byte line buffer and 50-byte section names (names stay within
+   * MPM_CONFIG_NAME_MAX). */
   size_t nval = 100000;
-  const char *inst = "a_very_long_instance_name_that_is_longer_than_fifty_bytes_for_sure";
+  const char *inst = "a_long_instance_name_that_is_longer_than_fifty_bytes_sure"; /* <= 63 */
   char *text = malloc(nval + 512);
   assert_non_null(text);
   int k = sprintf(text, "[run]\nname = ");
@@ -384,9 +385,30 @@ static void test_unknown_keys(void **state) {
                  NULL);
   expect_invalid("[grid]\ndx = 1\nzzzzzzzzzzzz = 2\n",
                  "case.ini:3: unknown key 'grid.zzzzzzzzzzzz'", "[grid] has: dx, n, periodic, lo");
-  expect_invalid("[nothing]\nzzzzzzzzzzzz = 2\n", "case.ini:2: unknown key 'nothing.zzzzzzzzzzzz'",
-                 "no section or key");
-  expect_invalid("[TIME]\nT_END = 2\n", "did you mean 'time.t_end'?", NULL);
+  /* An unknown section: one line for all its keys, with the nearest section or the list. */
+  expect_invalid("[nothing]\nzzzzzzzzzzzz = 2\nyy = 3\n",
+                 "case.ini:2: unknown section '[nothing]'; the sections are", NULL);
+  assert_int_equal(log_lines(), 1);
+  expect_invalid("[TIME]\nT_END = 2\n",
+                 "case.ini:2: unknown section '[TIME]'; did you mean '[time]'?", NULL);
+  expect_invalid("[geometri.block]\ntype = box\nlo = 0 0\n",
+                 "case.ini:2: unknown section '[geometri.block]'; did you mean '[geometry.block]'?",
+                 NULL);
+  /* An instance name over the limit: one line naming it and the limit. */
+  char text[200];
+  snprintf(text, sizeof text, "[geometry.%0*d]\ntype = box\nlo = 0 0\n", MPM_CONFIG_NAME_MAX + 1,
+           7);
+  expect_invalid(text,
+                 "case.ini:2: the name in '[geometry.0000000000000000...]' is 64 characters long; "
+                 "a name may have at most 63",
+                 NULL);
+  assert_int_equal(log_lines(), 1);
+  snprintf(text, sizeof text, "[geometry.%0*d]\ntype = box\n", MPM_CONFIG_NAME_MAX, 7);
+  mpm_config *ok = new_cfg();
+  assert_int_equal(read_validate(ok, text), 0);
+  mpm_config_destroy(&ok);
+  expect_invalid("[geometry]\ntype = box\n",
+                 "case.ini:2: section '[geometry]' needs a name: write '[geometry.NAME]'", NULL);
 }
 
 static void test_required_instance_key(void **state) {
