@@ -31,6 +31,7 @@
 #include "mpm_output.h"
 #include "mpm_error.h"
 #include "mpm_h5.h"
+#include "mpm_iowatch.h"
 #include "mpm_path.h"
 #include "mpm_xdmf.h"
 
@@ -353,12 +354,9 @@ static int write_view_script(const char *dir) {
   bad = bad || rename(tmp, path) != 0;
   const int e = errno;
   if (bad && tmp) remove(tmp);
+  if (bad) mpm_log_all(MPM_LOG_ERROR, "%s", mpm_iowatch_failed_write("ParaView script", path, e));
   free(path), free(tmp);
-  if (bad)
-    MPM_FAIL(MPM_ERR_FILE,
-             "cannot write the ParaView script %s/" VIEW_NAME ": %s (is the disk full?)", dir,
-             strerror(e));
-  return 0;
+  return bad ? mpm_trace(__FILE__, __LINE__, __func__, MPM_ERR_FILE) : 0;
 }
 
 static int index_write(const mpm_output *out) {
@@ -469,6 +467,8 @@ static int snapshot_write(mpm_output *out, snapshot *s) {
   if (out->rank == 0 && !rc) state[0] = publish(out, tmp, final, s, &state[1]);
   if (out->rank == 0 && rc && tmp) remove(tmp);
   if (MPI_Bcast(state, 2, MPI_INT, 0, out->comm) != MPI_SUCCESS) state[0] = MPM_ERR_MPI;
+  /* Rank 0's failure (the rename, the index), now known to every rank. */
+  if (state[0] && state[0] != MPM_ERR_MPI) state[0] = MPM_ERR_OUTPUT;
   if (state[1]) out->next++;
   free(tmp), free(final), free(s->buf);
   s->buf = NULL;
@@ -559,7 +559,7 @@ static int output_init(mpm_output *out, MPI_Comm comm, const char *dir, const ch
   int state[2] = {0, 0};
   if (out->rank == 0) state[0] = prepare_index(out, append, t_restart), state[1] = out->next;
   MPM_CALL_MPI(MPI_Bcast(state, 2, MPI_INT, 0, out->comm));
-  MPM_CALL(state[0]);
+  MPM_CALL(state[0] ? MPM_ERR_OUTPUT : 0); /* rank 0 explained it; every rank knows it */
   out->next = state[1];
   return 0;
 }

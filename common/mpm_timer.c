@@ -2,6 +2,7 @@
 #include "mpm_timer.h"
 
 #include "mpm_error.h"
+#include "mpm_iowatch.h"
 
 #include <errno.h>
 #include <stdio.h>
@@ -40,12 +41,22 @@ int mpm_timer_reduce(MPI_Comm comm, double *max, double *mean) {
   return 0;
 }
 
+static int report(const double *max, const double *mean, const char *path);
+
 int mpm_timer_report(MPI_Comm comm, const char *path) {
   double max[MPM_T_COUNT], mean[MPM_T_COUNT];
   int rank;
   MPM_CALL(mpm_timer_reduce(comm, max, mean));
   MPM_CALL_MPI(MPI_Comm_rank(comm, &rank));
-  if (rank != 0) return 0;
+  int status = rank == 0 ? report(max, mean, path) : 0;
+  /* Rank 0 wrote the file: every rank learns whether it could (MPM_ERR_OUTPUT, explained). */
+  MPM_CALL_MPI(MPI_Bcast(&status, 1, MPI_INT, 0, comm));
+  MPM_CALL(status ? MPM_ERR_OUTPUT : 0);
+  return 0;
+}
+
+/* Rank 0: the table in the log and, if path is not NULL, in path. */
+static int report(const double *max, const double *mean, const char *path) {
   const double total = max[MPM_T_TOTAL] > 0 ? max[MPM_T_TOTAL] : 1.0;
   mpm_log(MPM_LOG_INFO, "%-11s %12s %12s %8s", "phase", "max [s]", "mean [s]", "share");
   double parts = 0.0;
@@ -59,10 +70,14 @@ int mpm_timer_report(MPI_Comm comm, const char *path) {
           100.0 * (mean[MPM_T_TOTAL] - parts) / total);
   if (!path) return 0;
   FILE *f = fopen(path, "w");
-  if (!f) MPM_FAIL(MPM_ERR_FILE, "cannot write timers to '%s': %s", path, strerror(errno));
-  fprintf(f, "phase,max_s,mean_s,fraction\n");
-  for (int k = 0; k < MPM_T_COUNT; ++k)
-    fprintf(f, "%s,%.6e,%.6e,%.4f\n", g_names[k], max[k], mean[k], max[k] / total);
-  if (fclose(f) != 0) MPM_FAIL(MPM_ERR_FILE, "cannot write timers to '%s'", path);
+  int bad = !f;
+  if (f) {
+    fprintf(f, "phase,max_s,mean_s,fraction\n");
+    for (int k = 0; k < MPM_T_COUNT; ++k)
+      fprintf(f, "%s,%.6e,%.6e,%.4f\n", g_names[k], max[k], mean[k], max[k] / total);
+    bad = ferror(f);
+    bad |= fclose(f) != 0;
+  }
+  if (bad) MPM_FAIL(MPM_ERR_FILE, "%s", mpm_iowatch_failed_write("timers", path, errno));
   return 0;
 }

@@ -13,6 +13,7 @@
 #define _POSIX_C_SOURCE 200809L /* strcasecmp */
 #include "mpm_xdmf.h"
 #include "mpm_error.h"
+#include "mpm_iowatch.h"
 #include "mpm_types.h"
 
 #include <errno.h>
@@ -364,7 +365,7 @@ int mpm_xdmf_write(const mpm_xdmf *x, const char *path) {
   if (!f) {
     const int e = errno;
     free(tmp);
-    MPM_FAIL(MPM_ERR_FILE, "cannot write the XDMF index %s.tmp: %s", path, strerror(e));
+    MPM_FAIL(MPM_ERR_FILE, "%s", mpm_iowatch_failed_write("XDMF index", path, e));
   }
   int bad = write_all(x, f);
   bad |= fclose(f) != 0;
@@ -372,8 +373,7 @@ int mpm_xdmf_write(const mpm_xdmf *x, const char *path) {
     const int e = errno;
     remove(tmp);
     free(tmp);
-    MPM_FAIL(MPM_ERR_FILE, "cannot write the XDMF index %s: %s (is the disk full?)", path,
-             strerror(e));
+    MPM_FAIL(MPM_ERR_FILE, "%s", mpm_iowatch_failed_write("XDMF index", path, e));
   }
   free(tmp);
   return 0;

@@ -10,6 +10,7 @@
 #include "mpm_geometry.h"
 #include "mpm_guard.h"
 #include "mpm_integrator.h"
+#include "mpm_iowatch.h"
 #include "mpm_timescheme.h"
 #include "mpm_output.h"
 #include "mpm_probe.h"
@@ -19,6 +20,7 @@
 #include "fluid_module.h"
 #include "solid_module.h"
 
+#include <errno.h>
 #include <limits.h>
 #include <math.h>
 #include <stdio.h>
@@ -700,6 +702,8 @@ static void progress(mpm_sim *s, double dt, double wall0, int final) {
   if (final) mpm_log_status_end();
 }
 
+static int summary_json(const mpm_sim *s, double wall, char *path, size_t n);
+
 static int write_summary(mpm_sim *s, double wall) {
   long steps, rhs, fails, retries;
   mpm_timescheme_counts(s->it, &steps, &rhs, &fails, &retries);
@@ -724,10 +728,23 @@ static int write_summary(mpm_sim *s, double wall) {
         "J)",
         s->coupling->type->name, s->coupling_imbalance, s->coupling_work, 100 * rel_crossed,
         s->coupling_crossed, 100 * rel_solid, s->solid_peak, 100 * rel_total, s->energy);
-  if (s->rank != 0) return 0;
-  snprintf(path, sizeof path, "%s/summary.json", s->dir);
+  int status = s->rank == 0 ? summary_json(s, wall, path, sizeof path) : 0;
+  /* Rank 0 wrote it: every rank learns whether it could (MPM_ERR_OUTPUT, explained once). */
+  MPM_CALL_MPI(MPI_Bcast(&status, 1, MPI_INT, 0, s->comm));
+  MPM_CALL(status ? MPM_ERR_OUTPUT : 0);
+  return 0;
+}
+
+/* Rank 0: summary.json (path is a buffer of size n). */
+static int summary_json(const mpm_sim *s, double wall, char *path, size_t n) {
+  long steps, rhs, fails, retries;
+  mpm_timescheme_counts(s->it, &steps, &rhs, &fails, &retries);
+  const double rel_crossed = s->coupling_crossed > 0 ? s->coupling_work / s->coupling_crossed : 0;
+  const double rel_solid = s->solid_peak > 0 ? s->coupling_work / s->solid_peak : 0;
+  const double rel_total = s->energy > 0 ? s->coupling_work / s->energy : 0;
+  snprintf(path, n, "%s/summary.json", s->dir);
   FILE *f = fopen(path, "w");
-  if (!f) MPM_FAIL(MPM_ERR_FILE, "cannot write '%s'", path);
+  if (!f) MPM_FAIL(MPM_ERR_FILE, "%s", mpm_iowatch_failed_write("summary", path, errno));
   fprintf(f,
           "{\"version\": \"%s\", \"t\": %.17g, \"steps\": %ld, \"rhs_evals\": %ld, "
           "\"error_test_fails\": %ld, "
@@ -741,7 +758,8 @@ static int write_summary(mpm_sim *s, double wall) {
           s->particle_steps, s->particle_steps / wall,
           s->coupling ? s->coupling->type->name : "none", s->coupling_imbalance, s->coupling_work,
           s->coupling_crossed, rel_crossed, s->solid_peak, rel_solid, rel_total, s->estimate);
-  fclose(f);
+  const int bad = ferror(f) | (fclose(f) != 0);
+  if (bad) MPM_FAIL(MPM_ERR_FILE, "%s", mpm_iowatch_failed_write("summary", path, errno));
   return 0;
 }
 
