@@ -559,7 +559,9 @@ static int output_init(mpm_output *out, MPI_Comm comm, const char *dir, const ch
   int state[2] = {0, 0};
   if (out->rank == 0) state[0] = prepare_index(out, append, t_restart), state[1] = out->next;
   MPM_CALL_MPI(MPI_Bcast(state, 2, MPI_INT, 0, out->comm));
-  MPM_CALL(state[0] ? MPM_ERR_OUTPUT : 0); /* rank 0 explained it; every rank knows it */
+  /* Rank 0 explained it and every rank knows it: a folder or index that could not be written
+   * ends the run cleanly (an index it must refuse stays bad input). */
+  MPM_CALL(state[0] == MPM_ERR_FILE ? MPM_ERR_OUTPUT : state[0]);
   out->next = state[1];
   return 0;
 }

@@ -47,8 +47,8 @@ def env(extra=None):
     return e
 
 
-def command(ranks, out):
-    cmd = [mt.BIN, "run", mt.case("axial_bar.ini"), f"output.dir={out}"] + RUN
+def command(ranks, out, args=None):
+    cmd = [mt.BIN, "run", mt.case("axial_bar.ini"), f"output.dir={out}"] + (args or RUN)
     return ([mt.MPIEXEC, "-n", str(ranks)] + cmd) if ranks > 1 else cmd
 
 
@@ -61,14 +61,14 @@ def tmpfs_works(tmp):
     return p.returncode == 0, (p.stderr or p.stdout).strip()
 
 
-def run_tmpfs(ranks, work):
-    """The run on a tmpfs of SIZE; its output folder is copied to work/out afterwards (the
+def run_tmpfs(ranks, work, args=None, size=SIZE["tmpfs"]):
+    """The run on a tmpfs of size; its output folder is copied to work/out afterwards (the
     mount vanishes with its namespace). (exit status, seconds, output)."""
     mnt = os.path.join(work, "mnt")
     os.makedirs(mnt)
-    inner = shlex.join(command(ranks, os.path.join(mnt, "out")))
+    inner = shlex.join(command(ranks, os.path.join(mnt, "out"), args))
     m, w = shlex.quote(mnt), shlex.quote(work)
-    script = (f"mount -t tmpfs -o size={SIZE['tmpfs']} tmpfs {m} || exit 99; "
+    script = (f"mount -t tmpfs -o size={size} tmpfs {m} || exit 99; "
               f"timeout -s KILL {TIMEOUT} {inner}; rc=$?; cp -a {m}/out {w}/out; exit $rc")
     t0 = time.time()
     p = subprocess.run(["unshare", "-m", "sh", "-c", script], capture_output=True, text=True,
@@ -76,7 +76,7 @@ def run_tmpfs(ranks, work):
     return p.returncode, time.time() - t0, p.stdout + p.stderr
 
 
-def run_shim(ranks, work, shim):
+def run_shim(ranks, work, shim, args=None):
     """The run under the shim with a budget of SIZE bytes for work/out."""
     out = os.path.join(os.path.realpath(work), "out")
     os.makedirs(out)
@@ -87,15 +87,15 @@ def run_shim(ranks, work, shim):
              "ASAN_OPTIONS": os.environ.get("ASAN_OPTIONS", "") + ":verify_asan_link_order=0"}
     t0 = time.time()
     try:
-        p = subprocess.run(command(ranks, out), capture_output=True, text=True, env=env(extra),
-                           timeout=TIMEOUT)
+        p = subprocess.run(command(ranks, out, args), capture_output=True, text=True,
+                           env=env(extra), timeout=TIMEOUT)
         rc, text = p.returncode, p.stdout + p.stderr
     except subprocess.TimeoutExpired as e:
         rc, text = "timeout", str(e.stdout or "") + str(e.stderr or "")
     return rc, time.time() - t0, text
 
 
-def check_run(check, kind, ranks, rc, seconds, text, out):
+def check_run(check, kind, ranks, rc, seconds, text, out, what="snapshot"):
     errors = [l for l in text.splitlines() if l.startswith("error:")]
     line = errors[0] if errors else text[-500:]
     print(f"     {kind}, {ranks} rank(s): exit {rc} after {seconds:.1f} s: {line}")
@@ -103,9 +103,10 @@ def check_run(check, kind, ranks, rc, seconds, text, out):
           f"within {TIMEOUT} s (exit {rc}, {seconds:.1f} s)")
     named = line.split("earlier checkpoints are intact: ")[-1].strip() if errors else ""
     check(len(errors) == 1 and "no space left on device" in line and "watchdog" not in line
+          and f"cannot write the {what}" in line
           and named.endswith(".h5") and "HDF5-DIAG" not in text,
-          f"{kind}, {ranks} rank(s): one error line, naming the full disk and the last "
-          "checkpoint in the output folder (no watchdog, no HDF5 trace)")
+          f"{kind}, {ranks} rank(s): one error line, naming the {what}, the full disk and the "
+          "last checkpoint in the output folder (no watchdog, no HDF5 trace)")
     # (the line names it in the folder the run wrote to: a tmpfs is copied out afterwards)
     intact = os.path.join(out, os.path.basename(named)) if named else ""
     check(os.path.basename(intact).startswith("checkpoint_") and os.path.isfile(intact),
@@ -117,7 +118,8 @@ def check_run(check, kind, ranks, rc, seconds, text, out):
         missing = [p for p in listed if not os.path.isfile(p)]
     except Exception as e:  # noqa: BLE001 - any failure to read the index is the finding
         listed, missing = [], [str(e)]
-    check(listed and not missing, f"{kind}, {ranks} rank(s): series.xmf lists {len(listed)} "
+    check((listed or what != "snapshot") and not missing,
+          f"{kind}, {ranks} rank(s): series.xmf lists {len(listed)} "
           f"snapshot(s), all present ({missing})")
     return intact
 
@@ -142,6 +144,39 @@ def check_restart(check, kind, ranks, intact, work):
           f"{os.path.basename(ck)} (t = {t:g}) on a disk with room runs to t = {t + 0.5:g} "
           f"(exit {p.returncode})"
           + ("" if p.returncode == 0 else ": " + (p.stdout + p.stderr)[-300:]))
+
+
+def other_writers(check, kind, tmp, shim):
+    """2 ranks, the other collective writers: a checkpoint (no snapshots), and a CSV file
+    that rank 0 writes (no snapshots, no checkpoint until the end; tmpfs only: stdio's writes
+    go past an LD_PRELOAD shim)."""
+    work = os.path.join(tmp, f"{kind}_checkpoint_np2")
+    os.makedirs(work)
+    args = RUN + ["output.snapshots=false"]
+    rc, seconds, text = (run_tmpfs(2, work, args, "300k") if kind == "tmpfs"
+                         else run_shim(2, work, shim, args))
+    out = os.path.join(work, "out")
+    if os.path.isdir(out):
+        intact = check_run(check, kind + " (checkpoints only)", 2, rc, seconds, text, out,
+                           "checkpoint")
+        check_restart(check, kind + " (checkpoints only)", 2, intact, work)
+    else:
+        check(False, f"{kind} (checkpoints only): no output folder (exit {rc}): {text[-300:]}")
+    if kind != "tmpfs":
+        print("     skip the CSV writer under the shim: stdio's writes go past LD_PRELOAD")
+        return
+    work = os.path.join(tmp, "tmpfs_csv_np2")
+    os.makedirs(work)
+    args = ["output.snapshots=false", "output.checkpoint_interval=100", "time.t_end=60",
+            "run.progress=false"]
+    rc, seconds, text = run_tmpfs(2, work, args, "40k")
+    errors = [l for l in text.splitlines() if l.startswith("error:")]
+    print(f"     tmpfs, CSV, 2 ranks: exit {rc} after {seconds:.1f} s: "
+          f"{errors[0] if errors else text[-300:]}")
+    check(rc == 1 and len(errors) == 1 and "cannot write the diagnostics" in errors[0]
+          and "no space left on device" in errors[0] and "no checkpoint" in errors[0],
+          f"tmpfs, diagnostics.csv, 2 ranks: exit 1 with one line naming the file and the full "
+          f"disk ({seconds:.1f} s)")
 
 
 def watchdog(check, tmp, shim):
@@ -193,6 +228,7 @@ def main():
             continue
         intact = check_run(check, kind, ranks, rc, seconds, text, out)
         check_restart(check, kind, ranks, intact, work)
+    other_writers(check, kind, tmp, shim)
     watchdog(check, tmp, shim)
     return check.finish()
 
