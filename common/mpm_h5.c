@@ -370,8 +370,13 @@ int mpm_h5_write_block(const mpm_h5 *h, hid_t loc, const char *name, hid_t ftype
                        const void *buf) {
   const hid_t space = H5Screate_simple(rank, fdims, NULL);
   const hid_t dcpl = dataset_create_plist(rank, fdims);
-  unsigned long long bytes = H5Tget_size(ftype);
-  for (int d = 0; d < rank; ++d) bytes *= fdims[d];
+  /* The data; with checksums twice the data, and per chunk (at most CHUNK_MAX elements) its
+   * index entry: parallel HDF5 allocates each chunk early at its size unfiltered, then moves
+   * the filtered chunk (4 bytes longer) to new space, leaving the first unused. */
+  unsigned long long n = 1;
+  for (int d = 0; d < rank; ++d) n *= fdims[d];
+  const unsigned long long bytes =
+      n * H5Tget_size(ftype) * (g_write.checksums ? 2 : 1) + (n / CHUNK_MAX + 1) * 64;
   int rc = stage(h->comm, space < 0 || dcpl < 0 || reserve(bytes));
   const hid_t dset = rc ? -1 : H5Dcreate2(loc, name, ftype, space, H5P_DEFAULT, dcpl, H5P_DEFAULT);
   /* block_io's first stage takes in whether the create succeeded here. */
