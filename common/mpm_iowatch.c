@@ -18,7 +18,7 @@
 #include <time.h>
 
 static struct {
-  int installed;     /* the file error handler is on MPI_FILE_NULL */
+  int installed;     /* the timer and the rank are set up */
   int active;        /* between mpm_iowatch_begin and mpm_iowatch_end */
   int err;           /* errno of a failure this rank saw, for the watchdog's line */
   int armed, rank;   /* the timer runs; this rank in MPI_COMM_WORLD */
@@ -28,6 +28,18 @@ static struct {
   char path[4096];   /* the file being written */
   char intact[4096]; /* the newest complete checkpoint ("" if none yet) */
 } g_watch;
+
+/* The folder of path (a file), for statvfs. */
+static void folder_of(const char *path, char *dir, size_t size) {
+  snprintf(dir, size, "%s", path);
+  char *slash = strrchr(dir, '/');
+  if (!slash)
+    snprintf(dir, size, ".");
+  else if (slash == dir)
+    dir[1] = 0;
+  else
+    *slash = 0;
+}
 
 void mpm_iowatch_set_checkpoint(const char *path) {
   snprintf(g_watch.intact, sizeof g_watch.intact, "%s", path ? path : "");
@@ -64,32 +76,29 @@ void mpm_iowatch_cause(char *buf, size_t size, int err, const char *dir) {
              avail);
 }
 
-/* The timer thread: the write is stuck inside a collective call that another rank left. */
-static void expire(union sigval v) {
-  (void)v;
-  char cause[512], intact[4200], dir[4096];
-  snprintf(dir, sizeof dir, "%s", g_watch.path);
-  char *slash = strrchr(dir, '/');
-  if (slash) *slash = 0;
-  mpm_iowatch_cause(cause, sizeof cause, g_watch.err, slash && dir[0] ? dir : slash ? "/" : ".");
-  mpm_iowatch_intact(intact, sizeof intact);
-  mpm_log_all(MPM_LOG_ERROR,
-              "cannot write the %s %s: %s; the ranks did not finish the write together within "
-              "the watchdog's time, so the run is aborted. Any earlier file of the same name is "
-              "left as it was; %s",
-              g_watch.what, g_watch.path, cause, intact);
-  MPI_Abort(MPI_COMM_WORLD, 1);
-}
-
 static double watchdog_seconds(void) {
   const char *env = getenv("MPMFSI_IO_WATCHDOG");
   const double s = env ? atof(env) : 0;
   return s > 0 ? s : MPM_IOWATCH_SECONDS;
 }
 
-/* A rank fires 1 s after the rank below it (at most 10 s later), so
- * that one rank, the lowest that saw a failure, usually writes the line before MPI_Abort
- * ends the others. */
+/* The timer thread: the write is stuck inside a collective call that another rank left. */
+static void expire(union sigval v) {
+  (void)v;
+  char cause[512], intact[4200], dir[4096];
+  folder_of(g_watch.path, dir, sizeof dir);
+  mpm_iowatch_cause(cause, sizeof cause, g_watch.err, dir);
+  mpm_iowatch_intact(intact, sizeof intact);
+  mpm_log_all(MPM_LOG_ERROR,
+              "cannot write the %s %s: %s; the ranks did not finish the write together within "
+              "the watchdog's %g s, so the run is aborted. Any earlier file of the same name is "
+              "left as it was; %s",
+              g_watch.what, g_watch.path, cause, watchdog_seconds(), intact);
+  MPI_Abort(MPI_COMM_WORLD, 1);
+}
+
+/* Every rank arms its watchdog for the close; rank r fires r seconds later than rank 0 (at
+ * most 10 s later), so that one rank writes the line before MPI_Abort ends the others. */
 void mpm_iowatch_arm(int err) {
   g_watch.err = err;
   if (g_watch.armed || !g_watch.have_timer || !g_watch.active) return;
@@ -147,11 +156,9 @@ int mpm_iowatch_reserve(int fd, long long end, long long *reserved, int *unsuppo
 
 int mpm_iowatch_room(const char *path, long long bytes) {
   char dir[4096];
-  snprintf(dir, sizeof dir, "%s", path);
-  char *slash = strrchr(dir, '/');
-  if (slash) *slash = 0;
+  folder_of(path, dir, sizeof dir);
   struct statvfs fs;
-  if (statvfs(slash ? (dir[0] ? dir : "/") : ".", &fs) != 0) return 0; /* the create will say */
+  if (statvfs(dir, &fs) != 0) return 0; /* the create will say what is wrong */
   return (long long)fs.f_bavail * (long long)fs.f_frsize < bytes ? ENOSPC : 0;
 }
 
@@ -165,10 +172,8 @@ void mpm_iowatch_release(int fd, long long reserved) {
 const char *mpm_iowatch_failed_write(const char *what, const char *path, int err) {
   static char line[9000];
   char cause[512], intact[4200], dir[4096];
-  snprintf(dir, sizeof dir, "%s", path);
-  char *slash = strrchr(dir, '/');
-  if (slash) *slash = 0; /* the folder; "." for a bare name */
-  mpm_iowatch_cause(cause, sizeof cause, err, slash ? (dir[0] ? dir : "/") : ".");
+  folder_of(path, dir, sizeof dir);
+  mpm_iowatch_cause(cause, sizeof cause, err, dir);
   mpm_iowatch_intact(intact, sizeof intact);
   snprintf(line, sizeof line, "cannot write the %s %s: %s; %s", what, path, cause, intact);
   return line;
