@@ -14,9 +14,9 @@
  *
  * Exit codes: 0 success, 1 a failure during the run, 2 bad input (nothing was run), 3 stopped
  * by SIGTERM, SIGINT or SIGHUP (a final checkpoint was written; restart from it to go on). Input
- * errors and unphysical states are found identically on every rank, so they end the run
- * cleanly; any other failure aborts all ranks so that none is left waiting in a collective
- * call. */
+ * errors and unphysical states are found identically on every rank, and every rank agrees on
+ * a failed write of an output file (MPM_ERR_OUTPUT), so they end the run cleanly; any other
+ * failure aborts all ranks so that none is left waiting in a collective call. */
 #include "cli.h"
 #include "mpm_config.h"
 #include "mpm_error.h"
@@ -29,6 +29,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 #if defined(__SANITIZE_ADDRESS__)
 #include <sanitizer/lsan_interface.h>
 #endif
@@ -327,10 +328,18 @@ int main(int argc, char **argv) {
     rc = cli_keys(argc - 2, argv + 2);
   else
     rc = run(argv[1], argv[2], argc - 3, argv + 3);
-  /* Input errors and unphysical states are detected on every rank alike: end cleanly. */
-  if (rc != 0 && rc != MPM_ERR_INPUT && rc != MPM_ERR_UNPHYSICAL && rc != MPM_ERR_INTERRUPTED) {
+  /* Input errors and unphysical states are detected on every rank alike, and a failed write
+   * of an output file is agreed on by every rank: end cleanly. */
+  if (rc != 0 && rc != MPM_ERR_INPUT && rc != MPM_ERR_UNPHYSICAL && rc != MPM_ERR_INTERRUPTED &&
+      rc != MPM_ERR_OUTPUT) {
     mpm_log_all(MPM_LOG_DEBUG, "mpmfsi failed: %s", mpm_error_string(rc));
     MPI_Abort(MPI_COMM_WORLD, 1);
+  }
+  /* A file HDF5 could not close would crash HDF5's termination in MPI_Finalize (mpm_h5.h):
+   * every rank knows, and ends without it. */
+  if (rc == MPM_ERR_OUTPUT && mpm_h5_unclosed()) {
+    fflush(NULL);
+    _exit(exit_status(rc));
   }
 #if defined(__SANITIZE_ADDRESS__)
   /* Every allocation of ours is freed by now, and Open MPI's are still reachable from its

@@ -28,6 +28,7 @@
 #define _POSIX_C_SOURCE 200809L /* fsync, O_DIRECTORY */
 #include "mpm_error.h"
 #include "mpm_h5.h"
+#include "mpm_iowatch.h"
 #include "mpm_path.h"
 #include "mpm_output.h"
 
@@ -254,6 +255,9 @@ int mpm_checkpoint_write(MPI_Comm comm, const char *path, const char *config_tex
     if (rank == 0 && rc) remove(tmp);
     if (rank == 0 && !rc) rc = commit(tmp, path);
     if (MPI_Bcast(&rc, 1, MPI_INT, 0, comm) != MPI_SUCCESS) rc = MPM_ERR_MPI;
+    /* Rank 0's failure (the rename), now known to every rank. */
+    if (rc && rc != MPM_ERR_MPI) rc = MPM_ERR_OUTPUT;
+    if (!rc) mpm_iowatch_set_checkpoint(path);
   }
   free(tmp), free(counts);
   MPM_CALL(rc);
@@ -462,6 +466,7 @@ int mpm_checkpoint_open(mpm_checkpoint **ck, MPI_Comm comm, const char *path) {
   if (!rc) c->path = malloc(strlen(path) + 1);
   if (!rc) rc = mpm_h5_agree(c->comm, c->path ? 0 : MPM_ERR_MEMORY);
   if (!rc) strcpy(c->path, path), rc = open_file(c);
+  if (!rc) mpm_iowatch_set_checkpoint(path); /* a restart's source: complete and valid */
   if (rc) {
     mpm_checkpoint_close(&c);
     return mpm_trace(__FILE__, __LINE__, __func__, rc);

@@ -1,7 +1,10 @@
-/* Diagnostics CSV. Only rank 0 holds a FILE; other ranks hold a handle that does nothing. */
+/* Diagnostics CSV. Only rank 0 holds a FILE; every rank holds the communicator, so that a
+ * failed write (a full disk) is known to every rank before any acts on it: each row is
+ * collective and returns the same code everywhere (MPM_ERR_OUTPUT, explained once). */
 #include "mpm_diag.h"
 
 #include "mpm_error.h"
+#include "mpm_iowatch.h"
 #include "mpm_safefile.h"
 
 #include <errno.h>
@@ -12,7 +15,16 @@
 struct mpm_diag {
   FILE *f;
   int ncols;
+  MPI_Comm comm; /* the caller's: rows are written in the same order on every rank */
+  int rank;
+  char *path;
 };
+
+/* Every rank learns rank 0's status: MPM_ERR_OUTPUT on every rank if it failed. */
+static int agree(const mpm_diag *d, int status) {
+  if (MPI_Bcast(&status, 1, MPI_INT, 0, d->comm) != MPI_SUCCESS) return MPM_ERR_MPI;
+  return status ? MPM_ERR_OUTPUT : 0;
+}
 
 /* Keep the header and the rows with time <= t_keep of an existing file (none if there is no
  * file: a restart may write into a new folder). */
@@ -49,8 +61,13 @@ int mpm_diag_open(mpm_diag **d, MPI_Comm comm, const char *path, int ncols,
   int rank, status = 0;
   MPM_CALL_MPI(MPI_Comm_rank(comm, &rank));
   MPM_ALLOC(*d, 1);
-  (*d)->ncols = ncols;
-  if (rank == 0) {
+  (*d)->ncols = ncols, (*d)->comm = comm, (*d)->rank = rank;
+  (*d)->path = malloc(strlen(path) + 1);
+  if ((*d)->path) strcpy((*d)->path, path);
+  if (rank == 0 && !(*d)->path) {
+    mpm_log_all(MPM_LOG_ERROR, MPM_OOM_MESSAGE, (double)strlen(path) / 1e6);
+    status = MPM_ERR_MEMORY;
+  } else if (rank == 0) {
     char *kept = NULL;
     if (append && truncate_after(path, t_keep, &kept) != 0) kept = NULL;
     /* Written anew beside the old file and moved over it (mpm_safefile.h); the stream then
@@ -68,7 +85,7 @@ int mpm_diag_open(mpm_diag **d, MPI_Comm comm, const char *path, int ncols,
     const int e = !(*d)->f ? 0 : fflush((*d)->f) != 0 ? errno : mpm_file_publish(path);
     if (e) status = mpm_file_fail(path, e, "diagnostics");
   }
-  MPM_CALL_MPI(MPI_Bcast(&status, 1, MPI_INT, 0, comm));
+  status = agree(*d, status);
   if (status) {
     mpm_diag_close(d);
     return mpm_trace(__FILE__, __LINE__, __func__, status);
@@ -78,17 +95,22 @@ int mpm_diag_open(mpm_diag **d, MPI_Comm comm, const char *path, int ncols,
 
 /* Columns [0, ncols) of a row; the column `at` is the label (none if label is NULL). */
 static int write_row(mpm_diag *d, const char *label, int at, const double *values) {
-  if (!d->f) return 0;
-  for (int c = 0, k = 0; c < d->ncols; ++c) {
-    if (c) fputc(',', d->f);
-    if (label && c == at)
-      fputs(label, d->f);
-    else
-      fprintf(d->f, "%.17g", values[k++]);
+  int failed = 0;
+  if (d->f) {
+    for (int c = 0, k = 0; c < d->ncols; ++c) {
+      if (c) fputc(',', d->f);
+      if (label && c == at)
+        fputs(label, d->f);
+      else
+        fprintf(d->f, "%.17g", values[k++]);
+    }
+    fputc('\n', d->f);
+    errno = 0;
+    failed = fflush(d->f) != 0 || ferror(d->f);
+    if (failed)
+      mpm_log_all(MPM_LOG_ERROR, "%s", mpm_iowatch_failed_write("diagnostics", d->path, errno));
   }
-  fputc('\n', d->f);
-  if (fflush(d->f) != 0)
-    MPM_FAIL(MPM_ERR_FILE, "cannot write a diagnostics row: %s", strerror(errno));
+  MPM_CALL(agree(d, failed));
   return 0;
 }
 
@@ -103,6 +125,7 @@ int mpm_diag_row_label(mpm_diag *d, const char *label, const double *values) {
 void mpm_diag_close(mpm_diag **d) {
   if (!d || !*d) return;
   if ((*d)->f) fclose((*d)->f);
+  free((*d)->path);
   free(*d);
   *d = NULL;
 }

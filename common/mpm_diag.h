@@ -11,7 +11,8 @@ typedef struct mpm_diag mpm_diag;
  * column (time) exceeds t_keep are dropped and new rows follow; otherwise the file is new. */
 int mpm_diag_open(mpm_diag **d, MPI_Comm comm, const char *path, int ncols,
                   const char *const *names, int append, double t_keep);
-/* Write one row (rank 0 writes; the values must be the same on every rank). */
+/* Write one row (rank 0 writes; the values must be the same on every rank). Collective: a
+ * failed write is MPM_ERR_OUTPUT on every rank, explained once by rank 0. */
 int mpm_diag_row(mpm_diag *d, const double *values);
 /* Write one row whose second column is text: values[0], label, values[1 .. ncols - 2]
  * (several rows of one time, one per named object). */

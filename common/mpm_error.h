@@ -4,7 +4,10 @@
  * MPM_CALL(expr) propagates a failure and logs one traceback frame (file:line:function)
  * at debug level, so `run.log_level = debug` shows the whole chain while a user sees only
  * the one-line message written where the failure was detected (MPM_FAIL). MPI, HDF5 and
- * SUNDIALS return codes go through their own CALL variants. */
+ * SUNDIALS return codes go through their own CALL variants.
+ *
+ * MPM_ERR_OUTPUT is a failed write of one of the run's files that every rank has agreed on
+ * (and explained once): the run can end cleanly on every rank, as for bad input. */
 #ifndef MPM_ERROR_H
 #define MPM_ERROR_H
 
@@ -18,6 +21,7 @@
   X(MPM_ERR_SUNDIALS, "SUNDIALS call failed")                                                      \
   X(MPM_ERR_UNPHYSICAL, "unphysical state")                                                        \
   X(MPM_ERR_INTERRUPTED, "stopped by a signal")                                                    \
+  X(MPM_ERR_OUTPUT, "an output file could not be written")                                         \
   X(MPM_ERR_INTERNAL, "internal error")
 
 typedef enum {

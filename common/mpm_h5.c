@@ -4,28 +4,61 @@
  * MPI_Allreduce, and the stage's collective HDF5 call runs only where every rank is ready
  * for it, so a local failure never leaves the other ranks waiting inside HDF5. The last
  * stage is agreed on too, so every helper returns the same code on every rank. */
-#define _POSIX_C_SOURCE 200809L /* statvfs */
+#define _GNU_SOURCE /* O_NOFOLLOW, O_CLOEXEC */
 #include "mpm_h5.h"
+#include "mpm_iowatch.h"
 #include "mpm_path.h"
 #include "mpm_safefile.h"
 
 #include <errno.h>
+#include <fcntl.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
-#include <sys/statvfs.h>
 #include <unistd.h>
 
 /* While mpm_h5_write_file runs, the helpers record what failed here instead of logging, so
  * that the user reads one line that names the file and the cause. */
 static struct {
   int active;
-  char what[160]; /* the first object that failed, e.g. "dataset 'data'" */
-  int err;        /* errno just after the first failure on this rank */
-  int checksums;  /* the file being written gets checksums */
-} g_write;
+  char what[160];     /* the first object that failed, e.g. "dataset 'data'" */
+  int err;            /* errno just after the first failure on this rank */
+  int checksums;      /* the file being written gets checksums */
+  int fd;             /* rank 0: the file being written, to reserve its blocks (-1: cannot) */
+  long long declared; /* rank 0: the bytes the stages so far may have allocated */
+  long long reserved; /* rank 0: the file's blocks [0, reserved) are allocated */
+  int unsupported;    /* rank 0: the file system cannot reserve blocks */
+} g_write = {0, "", 0, 0, -1, 0, 0, 0};
+
+/* What a stage allocates beyond the bytes it declares (an object header, B-tree nodes, a
+ * block of HDF5's metadata aggregator: each well under this), and the margin for what HDF5
+ * allocates when the file is created and closed. The sum of the declared bytes and these
+ * bounds HDF5's end of allocation, which HDF5 1.10 does not tell for an MPI-IO file
+ * (H5Fget_eoa wants a SWMR driver, and H5Fget_filesize counts the reserved blocks). */
+#define STAGE_OVERHEAD (4 << 10)
+#define RESERVE_MARGIN (64 << 10)
+
+/* Before a stage that may write need bytes to the file being written (mpm_iowatch.h): rank 0
+ * makes sure that the blocks of everything the file may hold once the stage is done are
+ * allocated. Returns 1 (with errno in g_write.err) if they cannot be, for the stage's
+ * agreement; 0 on the other ranks and outside mpm_h5_write_file. */
+static int reserve(unsigned long long need) {
+  if (!g_write.active || g_write.fd < 0) return 0;
+  g_write.declared += (long long)need + STAGE_OVERHEAD;
+  const int err = mpm_iowatch_reserve(g_write.fd, g_write.declared + RESERVE_MARGIN,
+                                      &g_write.reserved, &g_write.unsupported);
+  if (err && !g_write.err) g_write.err = err;
+  return err != 0;
+}
+
+/* A file could not be closed (agreed on every rank): see write_file. */
+static int g_unclosed;
+
+int mpm_h5_unclosed(void) {
+  return g_unclosed;
+}
 
 int mpm_h5_agree(MPI_Comm comm, int rc) {
   int worst = rc;
@@ -137,36 +170,24 @@ hid_t mpm_h5_open(MPI_Comm comm, const char *path) {
   return file_access(comm, path, 0, 0);
 }
 
-/* Rank 0's one line for a failed write: the file, what failed, the likely cause. err is the
- * largest errno over the ranks (MPI-IO does not always leave a meaningful one). */
+/* Rank 0's one line for a failed write: the file, what failed, the cause and the checkpoint
+ * to restart from. err is the largest errno over the ranks (MPI-IO does not always leave a
+ * meaningful one). */
 static void explain_write_failure(const mpm_h5 *h, const char *path, const char *what, int err) {
-  char *dir = mpm_path_parent(path), cause[320];
-  struct statvfs fs;
+  char *dir = mpm_path_parent(path), cause[512], intact[4200];
   struct stat st;
-  const long long avail =
-      dir && statvfs(dir, &fs) == 0 ? (long long)fs.f_bavail * (long long)fs.f_frsize : -1;
-  if (err == ENOSPC || err == EDQUOT || (avail >= 0 && avail < (1LL << 20)))
-    snprintf(cause, sizeof cause,
-             "the file system is full (%lld bytes free%s); free some space or write the output "
-             "elsewhere (output.dir)",
-             avail, err == EDQUOT ? ", or the disk quota is exhausted" : "");
-  else if (!what[0] && stat(path, &st) == 0 && S_ISDIR(st.st_mode))
+  if (err != ENOSPC && err != EDQUOT && !what[0] && stat(path, &st) == 0 && S_ISDIR(st.st_mode))
     snprintf(cause, sizeof cause, "a directory of that name is in the way; move it");
-  else if (!what[0] && (!dir || access(dir, W_OK) != 0))
+  else if (err != ENOSPC && err != EDQUOT && !what[0] && (!dir || access(dir, W_OK) != 0))
     snprintf(cause, sizeof cause, "its directory %s is missing or not writable (%s)",
              dir ? dir : "", strerror(errno));
-  else if (err == EACCES || err == EROFS || err == EIO || err == EFBIG)
-    snprintf(cause, sizeof cause, "%s; check the disk and the permissions of its directory",
-             strerror(err));
   else
-    snprintf(cause, sizeof cause,
-             "HDF5 could not write it (%lld bytes free); check the disk and the permissions of "
-             "its directory",
-             avail);
+    mpm_iowatch_cause(cause, sizeof cause, err, dir);
+  mpm_iowatch_intact(intact, sizeof intact);
   mpm_log_all(MPM_LOG_ERROR,
               "cannot write the %s %s (%s): %s. Any earlier file of the same name is left as it "
-              "was",
-              h->what, path, what[0] ? what : "creating the file", cause);
+              "was; %s",
+              h->what, path, what[0] ? what : "creating the file", cause, intact);
   free(dir);
 }
 
@@ -174,16 +195,41 @@ static int write_file(const mpm_h5 *h, const char *path, mpm_h5_fill fill, const
                       int checksums) {
   mpm_h5_quiet quiet;
   mpm_h5_quiet_begin(&quiet);
+  mpm_iowatch_begin(h->what, path);
   g_write.active = 1, g_write.what[0] = 0, g_write.err = 0, g_write.checksums = checksums;
+  /* A file, once created, must be closed, which writes its superblock and root group: on a
+   * disk without room for those, no rank creates it. */
+  const int room = h->rank == 0 ? mpm_iowatch_room(path, STAGE_OVERHEAD + RESERVE_MARGIN) : 0;
+  g_write.err = room;
   errno = 0;
-  const hid_t file = file_access(h->comm, path, 1, checksums);
+  const hid_t file = mpm_h5_agree(h->comm, room ? MPM_ERR_FILE : 0)
+                         ? -1
+                         : file_access(h->comm, path, 1, checksums);
   int rc = file < 0 ? MPM_ERR_FILE : 0;
-  if (file < 0) g_write.err = errno;
+  if (file < 0 && !g_write.err) g_write.err = errno;
   if (file >= 0) {
-    rc = fill(h, file, arg);
+    /* Rank 0 reserves the file's blocks as it grows: a full disk then fails a reservation,
+     * which the ranks agree on, never a write inside HDF5, which they could not. */
+    g_write.declared = 0, g_write.reserved = 0, g_write.unsupported = 0;
+    g_write.fd = h->rank == 0 ? open(path, O_WRONLY | O_NOFOLLOW | O_CLOEXEC) : -1;
+    rc = stage(h->comm, reserve(0)); /* what the close will write */
+    if (rc) snprintf(g_write.what, sizeof g_write.what, "creating it");
+    if (!rc) rc = fill(h, file, arg);
     if (rc && !g_write.err) g_write.err = errno;
+    /* The close flushes HDF5's metadata: into blocks reserved here, agreed before. */
+    int closing = mpm_h5_agree(h->comm, reserve(0) ? MPM_ERR_FILE : 0);
+    if (closing && !rc) rc = closing, snprintf(g_write.what, sizeof g_write.what, "closing it");
     errno = 0;
+    mpm_iowatch_arm(g_write.err);
     const int closed = mpm_h5_agree(h->comm, H5Fclose(file) < 0 ? MPM_ERR_FILE : 0);
+    if (g_write.fd >= 0) {
+      mpm_iowatch_release(g_write.fd, g_write.reserved);
+      close(g_write.fd);
+    }
+    g_write.fd = -1;
+    /* HDF5 1.10 keeps a file it failed to close as an identifier that crashes its
+     * termination (in MPI_Finalize): main must then end without it (mpm_h5_unclosed). */
+    if (closed) g_unclosed = 1;
     if (closed && !rc) {
       rc = closed;
       if (!g_write.err) g_write.err = errno;
@@ -194,10 +240,14 @@ static int write_file(const mpm_h5 *h, const char *path, mpm_h5_fill fill, const
   g_write.active = 0, g_write.checksums = 0;
   mpm_h5_quiet_end(&quiet);
   /* errno is local; the largest one is as good a guess as any rank's. */
-  int err = g_write.err, any = recorded;
-  MPI_Allreduce(MPI_IN_PLACE, &err, 1, MPI_INT, MPI_MAX, h->comm);
-  MPI_Allreduce(MPI_IN_PLACE, &any, 1, MPI_INT, MPI_MAX, h->comm);
-  if (rc && any && h->rank == 0) explain_write_failure(h, path, g_write.what, err);
+  int err[2] = {g_write.err, recorded};
+  const int agreed = MPI_Allreduce(MPI_IN_PLACE, err, 2, MPI_INT, MPI_MAX, h->comm);
+  /* Every rank is past the file's last collective call: nothing can hang any more. */
+  mpm_iowatch_end();
+  if (agreed != MPI_SUCCESS) rc = MPM_ERR_MPI;
+  if (rc && err[1] && h->rank == 0) explain_write_failure(h, path, g_write.what, err[0]);
+  /* An agreed failure, explained once: the run may end cleanly on every rank. */
+  if (rc && rc != MPM_ERR_MPI) rc = MPM_ERR_OUTPUT;
   MPM_CALL(rc);
   return 0;
 }
@@ -227,7 +277,10 @@ int mpm_h5_attr(const mpm_h5 *h, hid_t loc, const char *name, hid_t type, int n,
                 const void *value) {
   const hsize_t dims = (hsize_t)n;
   const hid_t space = n == 1 ? H5Screate(H5S_SCALAR) : H5Screate_simple(1, &dims, NULL);
-  int rc = stage(h->comm, space < 0 || type < 0);
+  /* A variable-length string's bytes go to the global heap: its size is not the type's. */
+  size_t bytes = type >= 0 ? H5Tget_size(type) * (size_t)n : 0;
+  if (type >= 0 && H5Tis_variable_str(type) > 0) bytes = strlen(*(const char *const *)value) + 1;
+  int rc = stage(h->comm, space < 0 || type < 0 || reserve(bytes));
   const hid_t a = rc ? -1 : H5Acreate2(loc, name, type, space, H5P_DEFAULT, H5P_DEFAULT);
   if (!rc) rc = stage(h->comm, a < 0);
   if (!rc) rc = stage(h->comm, H5Awrite(a, type, value) < 0);
@@ -257,8 +310,10 @@ int mpm_h5_attr_fixed_string(const mpm_h5 *h, hid_t loc, const char *name, const
 }
 
 int mpm_h5_group(const mpm_h5 *h, hid_t loc, const char *name, hid_t *group) {
-  *group = H5Gcreate2(loc, name, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
-  const int rc = stage(h->comm, *group < 0);
+  *group = -1;
+  int rc = stage(h->comm, reserve(0));
+  if (!rc) *group = H5Gcreate2(loc, name, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+  if (!rc) rc = stage(h->comm, *group < 0);
   if (rc) {
     if (*group >= 0) H5Gclose(*group);
     *group = -1;
@@ -335,7 +390,14 @@ int mpm_h5_write_block(const mpm_h5 *h, hid_t loc, const char *name, hid_t ftype
                        const void *buf) {
   const hid_t space = H5Screate_simple(rank, fdims, NULL);
   const hid_t dcpl = dataset_create_plist(rank, fdims);
-  int rc = stage(h->comm, space < 0 || dcpl < 0);
+  /* The data; with checksums twice the data, and per chunk (at most CHUNK_MAX elements) its
+   * index entry: parallel HDF5 allocates each chunk early at its size unfiltered, then moves
+   * the filtered chunk (4 bytes longer) to new space, leaving the first unused. */
+  unsigned long long n = 1;
+  for (int d = 0; d < rank; ++d) n *= fdims[d];
+  const unsigned long long bytes =
+      n * H5Tget_size(ftype) * (g_write.checksums ? 2 : 1) + (n / CHUNK_MAX + 1) * 64;
+  int rc = stage(h->comm, space < 0 || dcpl < 0 || reserve(bytes));
   const hid_t dset = rc ? -1 : H5Dcreate2(loc, name, ftype, space, H5P_DEFAULT, dcpl, H5P_DEFAULT);
   /* block_io's first stage takes in whether the create succeeded here. */
   if (!rc) rc = block_io(h->comm, dset, 1, mtype, rank, start, count, (void *)buf, NULL);

@@ -85,6 +85,11 @@ int mpm_h5_write_file(const mpm_h5 *h, const char *path, mpm_h5_fill fill, const
 int mpm_h5_write_file_checksummed(const mpm_h5 *h, const char *path, mpm_h5_fill fill,
                                   const void *arg);
 
+/* 1 on every rank once a file written by mpm_h5_write_file could not be closed (a failed
+ * flush the disk space reservation could not prevent, mpm_iowatch.h): HDF5 1.10 then keeps an
+ * identifier that crashes its own termination, so the run must end without MPI_Finalize. */
+int mpm_h5_unclosed(void);
+
 /* Open path read-only; the same file on every rank, or -1 on every rank (without a
  * message: the caller says what went wrong). */
 hid_t mpm_h5_open(MPI_Comm comm, const char *path);

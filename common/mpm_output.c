@@ -31,6 +31,7 @@
 #include "mpm_output.h"
 #include "mpm_error.h"
 #include "mpm_h5.h"
+#include "mpm_iowatch.h"
 #include "mpm_path.h"
 #include "mpm_safefile.h"
 #include "mpm_xdmf.h"
@@ -467,6 +468,8 @@ static int snapshot_write(mpm_output *out, snapshot *s) {
   if (out->rank == 0 && !rc) state[0] = publish(out, tmp, final, s, &state[1]);
   if (out->rank == 0 && rc && tmp) remove(tmp);
   if (MPI_Bcast(state, 2, MPI_INT, 0, out->comm) != MPI_SUCCESS) state[0] = MPM_ERR_MPI;
+  /* Rank 0's failure (the rename, the index), now known to every rank. */
+  if (state[0] && state[0] != MPM_ERR_MPI) state[0] = MPM_ERR_OUTPUT;
   if (state[1]) out->next++;
   free(tmp), free(final), free(s->buf);
   s->buf = NULL;
@@ -557,7 +560,9 @@ static int output_init(mpm_output *out, MPI_Comm comm, const char *dir, const ch
   int state[2] = {0, 0};
   if (out->rank == 0) state[0] = prepare_index(out, append, t_restart), state[1] = out->next;
   MPM_CALL_MPI(MPI_Bcast(state, 2, MPI_INT, 0, out->comm));
-  MPM_CALL(state[0]);
+  /* Rank 0 explained it and every rank knows it: a folder or index that could not be written
+   * ends the run cleanly (an index it must refuse stays bad input). */
+  MPM_CALL(state[0] == MPM_ERR_FILE ? MPM_ERR_OUTPUT : state[0]);
   out->next = state[1];
   return 0;
 }

@@ -3,6 +3,7 @@
 #include "mpm_safefile.h"
 
 #include "mpm_error.h"
+#include "mpm_iowatch.h"
 #include "mpm_log.h"
 
 #include <errno.h>
@@ -97,8 +98,7 @@ int mpm_file_fail(const char *path, int err, const char *what) {
   if (link)
     mpm_log_all(MPM_LOG_ERROR, MPM_LINK_REFUSAL, mpm_file_is_link(tmp) ? tmp : path);
   else
-    mpm_log_all(MPM_LOG_ERROR, "cannot write the %s %s: %s; check the output folder%s", what, path,
-                strerror(err), err == ENOSPC || err == EDQUOT ? " (the disk is full)" : "");
+    mpm_log_all(MPM_LOG_ERROR, "%s", mpm_iowatch_failed_write(what, path, err));
   free(tmp);
   return mpm_trace(__FILE__, __LINE__, __func__, MPM_ERR_FILE);
 }

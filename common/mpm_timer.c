@@ -41,12 +41,22 @@ int mpm_timer_reduce(MPI_Comm comm, double *max, double *mean) {
   return 0;
 }
 
+static int report(const double *max, const double *mean, const char *path);
+
 int mpm_timer_report(MPI_Comm comm, const char *path) {
   double max[MPM_T_COUNT], mean[MPM_T_COUNT];
   int rank;
   MPM_CALL(mpm_timer_reduce(comm, max, mean));
   MPM_CALL_MPI(MPI_Comm_rank(comm, &rank));
-  if (rank != 0) return 0;
+  int status = rank == 0 ? report(max, mean, path) : 0;
+  /* Rank 0 wrote the file: every rank learns whether it could (MPM_ERR_OUTPUT, explained). */
+  MPM_CALL_MPI(MPI_Bcast(&status, 1, MPI_INT, 0, comm));
+  MPM_CALL(status ? MPM_ERR_OUTPUT : 0);
+  return 0;
+}
+
+/* Rank 0: the table in the log and, if path is not NULL, in path. */
+static int report(const double *max, const double *mean, const char *path) {
   const double total = max[MPM_T_TOTAL] > 0 ? max[MPM_T_TOTAL] : 1.0;
   mpm_log(MPM_LOG_INFO, "%-11s %12s %12s %8s", "phase", "max [s]", "mean [s]", "share");
   double parts = 0.0;

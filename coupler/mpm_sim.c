@@ -11,6 +11,7 @@
 #include "mpm_guard.h"
 #include "mpm_h5.h"
 #include "mpm_integrator.h"
+#include "mpm_iowatch.h"
 #include "mpm_timescheme.h"
 #include "mpm_output.h"
 #include "mpm_probe.h"
@@ -736,6 +737,8 @@ static void progress(mpm_sim *s, double dt, double wall0, int final) {
   if (final) mpm_log_status_end();
 }
 
+static int summary_json(const mpm_sim *s, double wall, char *path, size_t n);
+
 static int write_summary(mpm_sim *s, double wall) {
   long steps, rhs, fails, retries;
   mpm_timescheme_counts(s->it, &steps, &rhs, &fails, &retries);
@@ -760,8 +763,21 @@ static int write_summary(mpm_sim *s, double wall) {
         "J)",
         s->coupling->type->name, s->coupling_imbalance, s->coupling_work, 100 * rel_crossed,
         s->coupling_crossed, 100 * rel_solid, s->solid_peak, 100 * rel_total, s->energy);
-  if (s->rank != 0) return 0;
-  snprintf(path, sizeof path, "%s/summary.json", s->dir);
+  int status = s->rank == 0 ? summary_json(s, wall, path, sizeof path) : 0;
+  /* Rank 0 wrote it: every rank learns whether it could (MPM_ERR_OUTPUT, explained once). */
+  MPM_CALL_MPI(MPI_Bcast(&status, 1, MPI_INT, 0, s->comm));
+  MPM_CALL(status ? MPM_ERR_OUTPUT : 0);
+  return 0;
+}
+
+/* Rank 0: summary.json (path is a buffer of size n). */
+static int summary_json(const mpm_sim *s, double wall, char *path, size_t n) {
+  long steps, rhs, fails, retries;
+  mpm_timescheme_counts(s->it, &steps, &rhs, &fails, &retries);
+  const double rel_crossed = s->coupling_crossed > 0 ? s->coupling_work / s->coupling_crossed : 0;
+  const double rel_solid = s->solid_peak > 0 ? s->coupling_work / s->solid_peak : 0;
+  const double rel_total = s->energy > 0 ? s->coupling_work / s->energy : 0;
+  snprintf(path, n, "%s/summary.json", s->dir);
   FILE *f = mpm_file_begin(path, "w");
   if (!f) return mpm_file_fail(path, errno, "summary");
   fprintf(f,

@@ -842,8 +842,8 @@ int fluid_obstacles_report(fluid_obstacles *o, const mpm_grid *grid, double t, d
   const double *use = o->f[mpm_rhs_records_pick(&o->rec, t)];
   double *f;
   MPM_ALLOC(f, (size_t)dim * o->count);
-  int rc = MPI_Allreduce(use, f, dim * o->count, MPI_DOUBLE, MPI_SUM, grid->comm);
-  for (int k = 0; rc == MPI_SUCCESS && k < o->count; ++k) {
+  int rc = MPI_Allreduce(use, f, dim * o->count, MPI_DOUBLE, MPI_SUM, grid->comm), failed = 0;
+  for (int k = 0; rc == MPI_SUCCESS && !failed && k < o->count; ++k) {
     const fluid_obstacle *ob = &o->ob[k];
     double row[6], drag = 0.0, lift = 0.0;
     int c = 0;
@@ -854,10 +854,11 @@ int fluid_obstacles_report(fluid_obstacles *o, const mpm_grid *grid, double t, d
     }
     row[c++] = ob->has_ref ? drag / ob->q_ref_area : NAN;
     row[c++] = ob->has_ref ? lift / ob->q_ref_area : NAN;
-    rc = mpm_diag_row_label(o->csv, ob->name, row) ? -1 : MPI_SUCCESS;
+    failed = mpm_diag_row_label(o->csv, ob->name, row); /* explained, agreed on every rank */
   }
   free(f);
-  if (rc != MPI_SUCCESS) MPM_FAIL(MPM_ERR_FILE, "cannot report the obstacle forces");
+  MPM_CALL(failed);
+  if (rc != MPI_SUCCESS) MPM_FAIL(MPM_ERR_MPI, "cannot report the obstacle forces");
   for (int k = 0; k < o->count; ++k) MPM_CALL(fluid_surface_step(&o->ob[k].surf, grid, t, h));
   return 0;
 }

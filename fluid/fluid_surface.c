@@ -76,8 +76,7 @@ static int write_window(fluid_surface *s, double t) {
     const double p = s->acc[2 * i + 1] > 0.0 ? s->acc[2 * i] / s->acc[2 * i + 1] : NAN;
     const double cp = s->q_ref > 0.0 ? (p - s->p_ref) / s->q_ref : NAN;
     const double row[] = {t, i, s->x[2 * i], s->x[2 * i + 1], s->coord[i], p, cp};
-    if (mpm_diag_row_label(s->csv, label[s->side[i]], row))
-      MPM_FAIL(MPM_ERR_FILE, "cannot write %s", s->path);
+    MPM_CALL(mpm_diag_row_label(s->csv, label[s->side[i]], row)); /* explained, agreed */
   }
   memset(s->acc, 0, sizeof *s->acc * 2 * (size_t)s->n);
   return 0;

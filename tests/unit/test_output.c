@@ -560,9 +560,9 @@ static void test_output_dir_errors(void **state) {
   MPI_Barrier(MPI_COMM_WORLD);
   path_of(dir, sizeof dir, file, "sub");
   mpm_output *out = (mpm_output *)&out; /* not NULL: a failure must reset it */
-  assert_int_equal(mpm_output_new(&out, MPI_COMM_WORLD, dir, "", 2, 0, 0.0), MPM_ERR_FILE);
+  assert_int_equal(mpm_output_new(&out, MPI_COMM_WORLD, dir, "", 2, 0, 0.0), MPM_ERR_OUTPUT);
   assert_null(out);
-  assert_int_equal(mpm_output_new(&out, MPI_COMM_WORLD, file, "", 2, 0, 0.0), MPM_ERR_FILE);
+  assert_int_equal(mpm_output_new(&out, MPI_COMM_WORLD, file, "", 2, 0, 0.0), MPM_ERR_OUTPUT);
   assert_int_equal(mpm_output_new(&out, MPI_COMM_WORLD, dir, "", 1, 0, 0.0), MPM_ERR_INPUT);
   /* An index this module did not write is refused on a restart, not silently dropped. */
   snap_dir(dir, sizeof dir, "foreign_index");
@@ -769,7 +769,7 @@ static void test_checkpoint_failed_write(void **state) {
   /* A directory in the way of PATH.tmp makes the next write fail at the start. */
   if (g_rank == 0) assert_int_equal(mkdir(tmp, 0777), 0);
   MPI_Barrier(MPI_COMM_WORLD);
-  assert_int_equal(write_ck(MPI_COMM_WORLD, path, g_rank, 2.0), MPM_ERR_FILE);
+  assert_int_equal(write_ck(MPI_COMM_WORLD, path, g_rank, 2.0), MPM_ERR_OUTPUT);
   mpm_checkpoint *ck;
   double t = 0;
   assert_int_equal(mpm_checkpoint_open(&ck, MPI_COMM_WORLD, path), 0);
@@ -784,7 +784,7 @@ static void test_checkpoint_failed_write(void **state) {
   if (g_rank == 0) rmdir(tmp);
   /* A directory that does not exist: an error, and nothing at the path. */
   ck_path(missing, sizeof missing, "no/such/dir/ck.h5");
-  assert_int_equal(write_ck(MPI_COMM_WORLD, missing, g_rank, 1.0), MPM_ERR_FILE);
+  assert_int_equal(write_ck(MPI_COMM_WORLD, missing, g_rank, 1.0), MPM_ERR_OUTPUT);
   assert_int_not_equal(access(missing, F_OK), 0);
 }
 
