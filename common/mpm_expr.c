@@ -180,8 +180,8 @@ int mpm_expr_check_finite(const mpm_expr *e, const mpm_config *cfg, const char *
   if (isfinite(info[0]))
     return mpm_config_fail(cfg, key,
                            "gives %s%s at %s, a subnormal number (smaller in magnitude than "
-                           "2.2e-308, too small to compute with); the field must be 0 or larger "
-                           "wherever it is used: check for an underflow",
+                           "2.2e-308, too small to compute with); the field must be 0 or at least "
+                           "that large wherever it is used: check for an underflow",
                            mpm_expr_value_text(info[0], vbuf), which, at);
   return mpm_config_fail(cfg, key,
                          "gives %s%s at %s; the field must be finite wherever it is used: "
