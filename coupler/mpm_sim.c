@@ -363,8 +363,13 @@ static int output_bytes(const mpm_sim *s, double *bytes) {
 
 /* Refuse an absurd run before it starts (mpm_budget.h). */
 static int check_budget(mpm_sim *s) {
-  mpm_budget b = {s->t, s->t_end, 0, s->out_interval, s->ckpt_interval, s->snapshots, 0};
+  mpm_budget b = {.t = s->t,
+                  .t_end = s->t_end,
+                  .out_interval = s->out_interval,
+                  .ckpt_interval = s->ckpt_interval,
+                  .snapshots = s->snapshots};
   MPM_CALL(mpm_timescheme_cfl_step(s->it, &b.h0));
+  MPM_CALL(mpm_timescheme_work(s->it, &b.work, &b.work_key));
   MPM_CALL(output_bytes(s, &b.bytes));
   return mpm_budget_check(s->cfg, &b, &s->estimate);
 }
