@@ -24,7 +24,7 @@ const int mpm_budget_nkeys = (int)(sizeof mpm_budget_keys / sizeof mpm_budget_ke
 
 /* What b->work counts, as a message says it. */
 static const char *work_noun(const mpm_budget *b) {
-  if (!b->work_key) return "substeps of the fast module (its stable step over the slow one's)";
+  if (!b->work_key) return "substeps of the fast module, as many as its stable step needs";
   if (strcmp(b->work_key, "coupling.iterations") == 0) return "sub-iterations at most";
   if (strcmp(b->work_key, "coupling.slow_substeps") == 0) return "substeps of the slow module";
   return "substeps of the fast module";

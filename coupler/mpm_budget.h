@@ -18,7 +18,8 @@
  * the first step, and an adaptive pair's error control may hold it lower (measured: Sod 0.27,
  * the main job 0.5 of it). The run refines its estimate after its first steps
  * (mpm_sim.c, refine_estimate); the budget keeps this one, which counts fewer steps than the
- * run takes, so it never refuses a run that would fit. */
+ * run takes, so it never refuses a run that would fit, except by counting every sub-iteration
+ * strong coupling may take (a step that never converges takes them all). */
 #ifndef MPM_BUDGET_H
 #define MPM_BUDGET_H
 

@@ -384,8 +384,8 @@ static int check_advance(mpm_sim *s, const char *path) {
   if (!(h0 > 0) || s->t + h0 > s->t) return 0;
   mpm_log(MPM_LOG_ERROR,
           "the checkpoint '%s' cannot be continued: at its time t = %.17g a step of %.3g s (the "
-          "stable step of its state) does not change the time (a double resolves %.3g s "
-          "there). Restart from an earlier checkpoint",
+          "step its state allows) does not change the time (a double resolves %.3g s there). "
+          "Restart from an earlier checkpoint",
           path, s->t, h0, nextafter(s->t, HUGE_VAL) - s->t);
   return MPM_ERR_INPUT;
 }
