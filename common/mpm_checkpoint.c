@@ -9,7 +9,7 @@
  *   dataset has the Fletcher32 filter, and "text_hash" attributes (on the root and on each
  *   phase group) hash the strings, which HDF5 keeps in its unchecksummed global heap. A
  *   reader refuses a file whose bytes changed, and then validates what it holds: finite
- *   values, the stored step and time step, ids non-negative and unique over all ranks,
+ *   values, the stored time, step and time step, ids non-negative and unique over all ranks,
  *   each field within the range its module declares (mpm_particles_set_range). Files of
  *   format 1 (no checksums) are still read, with the same validation.
  * - A damaged checkpoint is bad input (MPM_ERR_INPUT): one line names the file and what is
@@ -336,8 +336,10 @@ static int probe(const char *path) {
   return 0;
 }
 
-/* What the writer (coupler/mpm_sim.c) stores at the root, beyond "finite": the step count
- * is a whole number >= 0 and the next step size is >= 0 (0: no hint). */
+/* What the writer (coupler/mpm_sim.c) stores at the root, beyond "finite": the time is >= 0
+ * (a run starts at 0; from a negative time it took steps of zero length and, without the
+ * blow-up guard, never ended), the step count is a whole number >= 0 and the next step size
+ * is >= 0 (0: no hint). */
 typedef struct root_check {
   const mpm_checkpoint *ck;
   char *why;
@@ -361,6 +363,8 @@ static herr_t check_root_value(hid_t loc, const char *name, const H5A_info_t *in
   if (!real || npoints != 1) return 0;
   if (!isfinite(v))
     note(rc->why, rc->ck, "its value '%s' is %g, not a finite number", name, v);
+  else if (strcmp(name, "t") == 0 && v < 0)
+    note(rc->why, rc->ck, "its time t is %.17g, below zero (a run starts at t = 0)", v);
   else if (strcmp(name, "step") == 0 && (v < 0 || v != floor(v) || v > 0x1p53))
     note(rc->why, rc->ck, "its step count is %.17g, not a whole number >= 0", v);
   else if (strcmp(name, "h_next") == 0 && v < 0)

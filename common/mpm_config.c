@@ -413,15 +413,34 @@ __attribute__((format(printf, 2, 3))) static int bad(const item *it, const char 
   return MPM_ERR_INPUT;
 }
 
-/* Strict number parsing: the whole text must be the number. */
+/* Why a text is not a usable real number (parse_real). */
+enum { REAL_SYNTAX = -1, REAL_NONFINITE = -2, REAL_TINY = -3 };
+
+/* Strict number parsing: the whole text must be the number, and a normal double or zero. NaN,
+ * the infinities and overflows (REAL_NONFINITE) are refused, and so are values too small to
+ * hold at full precision (REAL_TINY): subnormal ones (1e-320), and non-zero texts that round
+ * to zero (1e-400). No physical input is that small, and arithmetic on them loses its
+ * precision and runs slowly, so 1e-320 kg/m^3 is a typo, not a density. */
 static int parse_real(const char *s, size_t n, double *v) {
   char *end;
-  if (n == 0 || is_blank((unsigned char)*s)) return -1;
+  if (n == 0 || is_blank((unsigned char)*s)) return REAL_SYNTAX;
   errno = 0;
   double x = strtod(s, &end);
-  if (end != s + n || !isfinite(x) || (errno == ERANGE && fabs(x) == HUGE_VAL)) return -1;
+  if (end != s + n) return REAL_SYNTAX;
+  if (!isfinite(x) || (errno == ERANGE && fabs(x) == HUGE_VAL)) return REAL_NONFINITE;
+  if (fpclassify(x) == FP_SUBNORMAL || (errno == ERANGE && x == 0)) return REAL_TINY;
   *v = x;
   return 0;
+}
+
+/* What to say about a text parse_real refused with code why. */
+static const char *real_problem(int why) {
+  if (why == REAL_NONFINITE)
+    return "is not finite (NaN, an infinity, or beyond 1.8e308); give a finite real number";
+  if (why == REAL_TINY)
+    return "is smaller in magnitude than 2.2e-308 (subnormal, or it rounds to 0), too small "
+           "to compute with; check its exponent";
+  return "is not a real number";
 }
 
 /* 0, -1 if not an integer, -2 if out of the range of int. */
@@ -486,8 +505,9 @@ static shown range_text(const mpm_key_spec *sp) {
 
 static int check_real(const item *it) {
   double x;
-  if (parse_real(it->value, strlen(it->value), &x) != 0)
-    return bad(it, "expected a finite real number");
+  const int why = parse_real(it->value, strlen(it->value), &x);
+  if (why == REAL_SYNTAX) return bad(it, "expected a finite real number");
+  if (why) return bad(it, "%s", real_problem(why));
   if (!in_range(it->sp, x)) return bad(it, "must be %s", range_text(it->sp).s);
   return 0;
 }
@@ -532,8 +552,10 @@ static int check_reals(const item *it) {
   double x;
   while (next_item(it->value, &pos, &s, &n)) {
     ++count;
-    if (parse_real(s, n, &x) != 0)
+    const int why = parse_real(s, n, &x);
+    if (why == REAL_SYNTAX)
       return bad(it, "value %d ('%s') is not a finite real number", count, show_n(s, n).s);
+    if (why) return bad(it, "value %d ('%s') %s", count, show_n(s, n).s, real_problem(why));
     if (!in_range(sp, x)) return bad(it, "value %d (%g) must be %s", count, x, range_text(sp).s);
   }
   if (count == 0) return bad(it, "expected one or more real numbers");
@@ -1157,12 +1179,16 @@ static char *instantiate(const char *pat, const char *key) {
   return sb_take(&b);
 }
 
-/* The valid key nearest to key, if it is near enough to be a likely typo; else NULL. */
+/* The valid key nearest to key, if it is near enough to be a likely typo; else NULL. A key
+ * longer than SUGGEST_MAX is no typo of one, and comparing it with every spec would cost its
+ * length times the specs (a 15 MB key took 39 s). */
+enum { SUGGEST_MAX = 512 };
 static char *nearest_key(const mpm_config *cfg, const char *key) {
   /* A third of the key, at least 2 and at most 8: beyond that it is no typo. */
   size_t len = strlen(key), limit = len / 3 < 2 ? 2 : len / 3 > 8 ? 8 : len / 3;
   size_t best_d = SIZE_MAX;
   char *best = NULL;
+  if (len > SUGGEST_MAX) return NULL;
   for (size_t i = 0; i < cfg->nspecs; ++i) {
     char *cand = instantiate(cfg->specs[i]->key, key);
     size_t d = cand ? edit_distance(key, cand, limit) : SIZE_MAX;

@@ -42,6 +42,14 @@ void mpm_guard_free(mpm_guard *g) {
 #define GUARD_MIN_STEPS 20
 
 int mpm_guard_check(mpm_guard *g, double t, long step, double h, int cut_short, double energy) {
+  /* Whatever the thresholds: a step of zero length repeats forever. */
+  if (!(h > 0))
+    MPM_FAIL(MPM_ERR_UNPHYSICAL,
+             "the run stopped at t = %.17g (step %ld): its step (%.3g s) no longer advances the "
+             "time, which a double resolves to %.3g s there, so the run could never end; the "
+             "step has collapsed (lower time.cfl, refine grid.dx) or the time is too large "
+             "for it",
+             t, step, h, nextafter(t, HUGE_VAL) - t);
   if (!isfinite(energy))
     MPM_FAIL(MPM_ERR_UNPHYSICAL,
              "the run blew up at t = %.6g (step %ld): the total energy is %g; lower time.cfl, "

@@ -12,7 +12,9 @@
  *   - for time.collapse_steps accepted steps in a row, the step was below time.collapse_ratio
  *     times the CFL step of the state the run started from (steps cut short to land on an
  *     output or checkpoint time do not count, and do not break a streak).
- * Both are checked after every accepted step, from the totals the diagnostics already sum. */
+ * Both are checked after every accepted step, from the totals the diagnostics already sum. A
+ * step of zero length (the time too large for the step: t + h == t) stops the run whatever
+ * the thresholds, since it would repeat forever. */
 #ifndef MPM_GUARD_H
 #define MPM_GUARD_H
 

@@ -650,6 +650,10 @@ int mpm_integrator_resize(mpm_integrator *it, double t) {
   return 0;
 }
 
+int mpm_integrator_substeps(const mpm_integrator *it) {
+  return it->mri ? it->substeps : 0;
+}
+
 int mpm_integrator_cfl_step(mpm_integrator *it, double *h) {
   double hs, *yk[MPM_MAX_MODULES];
   particle_blocks(it, yk);

@@ -70,6 +70,10 @@ int mpm_integrator_step(mpm_integrator *it, double tstop, double *t, double *h);
 /* The particle sets changed (count, order or storage): re-wrap the state. Collective. */
 int mpm_integrator_resize(mpm_integrator *it, double t);
 
+/* The fast module's substeps in one step of a multirate integrator as coupling.substeps sets
+ * them; 0 when they follow the stable steps, or for any other integrator. */
+int mpm_integrator_substeps(const mpm_integrator *it);
+
 /* The CFL step of the current state: time.cfl times the modules' stability limit, 0 if
  * nothing limits it. Collective. */
 int mpm_integrator_cfl_step(mpm_integrator *it, double *h);

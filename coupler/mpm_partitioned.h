@@ -31,6 +31,7 @@ typedef struct mpm_partitioned {
   int slow_substeps;         /* multirate: of the slow module (0: as many as the fast module) */
   int interpolate;           /* multirate: the solid's substeps see a linear trend of the load */
   struct mpm_strong *strong; /* staggered: sub-iterations (NULL: none) */
+  int iterations;            /* staggered: the most sub-iterations in a coupling step */
   long steps;
   mpm_coupling_record sum; /* the coupling step under way: sums of h times the rates */
   mpm_coupling_record rec; /* the last coupling step's record */

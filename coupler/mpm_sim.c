@@ -377,13 +377,32 @@ static int output_bytes(const mpm_sim *s, double *bytes) {
 
 /* Refuse an absurd run before it starts (mpm_budget.h). */
 static int check_budget(mpm_sim *s) {
-  mpm_budget b = {s->t, s->t_end, 0, s->out_interval, s->ckpt_interval, s->snapshots, 0};
+  mpm_budget b = {.t = s->t,
+                  .t_end = s->t_end,
+                  .out_interval = s->out_interval,
+                  .ckpt_interval = s->ckpt_interval,
+                  .snapshots = s->snapshots};
   MPM_CALL(mpm_timescheme_cfl_step(s->it, &b.h0));
+  MPM_CALL(mpm_timescheme_work(s->it, &b.work, &b.work_key));
   MPM_CALL(output_bytes(s, &b.bytes));
   return mpm_budget_check(s->cfg, &b, &s->estimate);
 }
 
 static int between_substeps(void *ctx, mpm_module *m, double t, double h, int *changed);
+
+/* A checkpoint whose time is so large that a step of its state would not change it (an
+ * edited time) could only take steps of zero length: refused like a damaged one. */
+static int check_advance(mpm_sim *s, const char *path) {
+  double h0;
+  MPM_CALL(mpm_timescheme_cfl_step(s->it, &h0));
+  if (!(h0 > 0) || s->t + h0 > s->t) return 0;
+  mpm_log(MPM_LOG_ERROR,
+          "the checkpoint '%s' cannot be continued: at its time t = %.17g a step of %.3g s (the "
+          "step its state allows) does not change the time (a double resolves %.3g s there). "
+          "Restart from an earlier checkpoint",
+          path, s->t, h0, nextafter(s->t, HUGE_VAL) - s->t);
+  return MPM_ERR_INPUT;
+}
 
 int mpm_sim_create(mpm_sim **sp, mpm_config *cfg) {
   MPM_CALL(sim_alloc(sp, cfg));
@@ -459,6 +478,7 @@ int mpm_sim_restart(mpm_sim **sp, mpm_config *cfg, const char *path) {
   mpm_checkpoint_close(&ck);
   MPM_CALL(rc);
   s->it->between = between_substeps, s->it->between_ctx = s;
+  MPM_CALL(check_advance(s, path));
   MPM_CALL(check_budget(s));
   mpm_log(MPM_LOG_INFO, "restarted from %s at t = %.6g, step %ld", path, s->t, s->step);
   return 0;

@@ -57,7 +57,8 @@ int mpm_timescheme_new(mpm_timescheme **tsp, const mpm_config *cfg, mpm_grid *gr
   *tsp = ts;
   *ts = (mpm_timescheme){
       .type = type, .grid = grid, .mod = modules, .nmod = nmodules, .coupling = coupling};
-  const int rc = type->ops->create(ts, cfg);
+  int rc = mpm_config_get_real(cfg, "time.dt_max", &ts->dt_max);
+  if (!rc) rc = type->ops->create(ts, cfg);
   if (rc) {
     mpm_timescheme_destroy(tsp);
     return mpm_trace(__FILE__, __LINE__, __func__, rc);
@@ -84,8 +85,17 @@ int mpm_timescheme_resize(mpm_timescheme *ts, double t) {
   return ts->type->ops->resize(ts, t);
 }
 
+/* Every scheme caps its steps by time.dt_max; a CFL step that did not would make a small
+ * dt_max look like a collapse to the blow-up guard and hide it from the budget. */
 int mpm_timescheme_cfl_step(mpm_timescheme *ts, double *h) {
-  return ts->type->ops->cfl_step(ts, h);
+  MPM_CALL(ts->type->ops->cfl_step(ts, h));
+  if (ts->dt_max > 0 && !(*h > 0 && *h <= ts->dt_max)) *h = ts->dt_max;
+  return 0;
+}
+
+int mpm_timescheme_work(mpm_timescheme *ts, double *advances, const char **key) {
+  *advances = 1, *key = NULL;
+  return ts->type->ops->work ? ts->type->ops->work(ts, advances, key) : 0;
 }
 
 double mpm_timescheme_next_step(const mpm_timescheme *ts) {

@@ -35,6 +35,11 @@ typedef struct mpm_timescheme_ops {
   int (*resize)(mpm_timescheme *ts, double t);
   /* time.cfl times the stability limit of the current state (0: no limit). Collective. */
   int (*cfl_step)(mpm_timescheme *ts, double *h);
+  /* The advances the busiest module makes in one coupling step from the current state: its
+   * substeps, or the most sub-iterations a step may take (the run's budget counts them), and
+   * the key that sets that number (NULL: the scene's own stable steps do). Optional: 1, NULL.
+   * Collective. */
+  int (*work)(mpm_timescheme *ts, double *advances, const char **key);
   double (*next_step)(const mpm_timescheme *ts);
   void (*counts)(const mpm_timescheme *ts, long *steps, long *rhs, long *fails, long *retries);
   /* The interface record of the step that reached t, reduced over the ranks. Optional: the
@@ -70,6 +75,7 @@ struct mpm_timescheme {
   mpm_coupling *coupling;         /* NULL: one phase, or the modules do not interact */
   mpm_timescheme_between between; /* set by the step loop (may be NULL) */
   void *between_ctx;
+  double dt_max; /* time.dt_max (0: none), which caps the CFL step */
 };
 
 /* The ops of a scheme that is one integrator (mpm_integrator.h) in ts->content
@@ -92,7 +98,11 @@ void mpm_timescheme_destroy(mpm_timescheme **ts);
 int mpm_timescheme_start(mpm_timescheme *ts, double t, double h0);
 int mpm_timescheme_step(mpm_timescheme *ts, double tstop, double *t, double *h);
 int mpm_timescheme_resize(mpm_timescheme *ts, double t);
+/* The scheme's CFL step capped by time.dt_max: the step it plans from the current state (the
+ * run's budget and the blow-up guard measure against it). 0: nothing limits it. */
 int mpm_timescheme_cfl_step(mpm_timescheme *ts, double *h);
+/* See mpm_timescheme_ops.work. */
+int mpm_timescheme_work(mpm_timescheme *ts, double *advances, const char **key);
 double mpm_timescheme_next_step(const mpm_timescheme *ts);
 void mpm_timescheme_counts(const mpm_timescheme *ts, long *steps, long *rhs, long *fails,
                            long *retries);

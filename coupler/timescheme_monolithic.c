@@ -35,6 +35,14 @@ static int mono_cfl_step(mpm_timescheme *ts, double *h) {
   return mpm_integrator_cfl_step(ts->content, h);
 }
 
+/* MRIStep's fast substeps, when coupling.substeps sets them (otherwise counted as 1: the
+ * budget's estimate is a lower bound). */
+static int mono_work(mpm_timescheme *ts, double *advances, const char **key) {
+  const int m = mpm_integrator_substeps(ts->content);
+  *advances = m > 0 ? m : 1, *key = m > 0 ? "coupling.substeps" : NULL;
+  return 0;
+}
+
 static double mono_next_step(const mpm_timescheme *ts) {
   return mpm_integrator_next_step(ts->content);
 }
@@ -51,6 +59,7 @@ const mpm_timescheme_ops timescheme_monolithic_ops = {
     .step = mono_step,
     .resize = mono_resize,
     .cfl_step = mono_cfl_step,
+    .work = mono_work,
     .next_step = mono_next_step,
     .counts = mono_counts,
 };

@@ -34,12 +34,16 @@
 #include <string.h>
 
 enum { KEY_SUBSTEPS, KEY_SLOW_SUBSTEPS, KEY_LOAD, KEY_MRI_TABLE }; /* multirate_keys, in order */
+/* The substep keys go up to MULTIRATE_MAX_SUBSTEPS, the most the scheme takes on its own before
+ * it calls the fast module's step collapsed (below): 10-100 is what two stable modules need.
+ * Up to 1e6 was allowed: at that setting a coupling step took 84 s (issue 54), while the run's
+ * budget counted coupling steps only (it now counts the substeps too). */
 static const mpm_key_spec multirate_keys[] = {
-    {"coupling.substeps", MPM_KEY_INT, NULL, 1, 1e6, 0, 0, NULL,
+    {"coupling.substeps", MPM_KEY_INT, NULL, 1, 1e4, 0, 0, NULL,
      "multirate: substeps of the fast module in each coupling step, >= 1 (unset: the fewest its "
      "own stable step allows; 1: the monolithic step)",
      1, "-"},
-    {"coupling.slow_substeps", MPM_KEY_INT, "1", 0, 1e6, 0, 0, NULL,
+    {"coupling.slow_substeps", MPM_KEY_INT, "1", 0, 1e4, 0, 0, NULL,
      "multirate, classic update: substeps of the slow module in each coupling step, against the "
      "fast one held (1: one step, multirate itself; 0: as many as the fast module, an ablation: "
      "the coupling lag without the slow module's own step error)",
@@ -162,6 +166,23 @@ static int multirate_cfl_step(mpm_timescheme *ts, double *h) {
   return 0;
 }
 
+/* The substeps of the fast and slow modules in a coupling step from the current state, as
+ * multirate_step takes them (m = 0 where the fast module's step collapsed: it refuses). */
+static int multirate_work(mpm_timescheme *ts, double *advances, const char **key) {
+  const mpm_partitioned *pp = ts->content;
+  double hs, hg;
+  MPM_CALL(mpm_partitioned_cfl_steps(ts, &hs, &hg));
+  hs = limit(hs), hg = limit(hg);
+  const double h_fast = fmin(hs, hg), H = coupling_step(pp, h_fast, fmax(hs, hg));
+  double m = pp->substeps;
+  if (m == 0 && isfinite(h_fast) && isfinite(H)) m = ceil(H / h_fast * (1 - 1e-12));
+  m = fmax(m, 1.0);
+  const double n = pp->slow_substeps > 0 ? pp->slow_substeps : m;
+  *advances = fmax(m, n);
+  *key = n > m ? "coupling.slow_substeps" : pp->substeps > 0 ? "coupling.substeps" : NULL;
+  return 0;
+}
+
 static int multirate_step(mpm_timescheme *ts, double tstop, double *t, double *h) {
   const mpm_partitioned *pp = ts->content;
   double hs, hg;
@@ -200,6 +221,7 @@ static const mpm_timescheme_ops multirate_ops = {
     .step = multirate_step,
     .resize = mpm_partitioned_resize,
     .cfl_step = multirate_cfl_step,
+    .work = multirate_work,
     .next_step = mpm_partitioned_next_step,
     .counts = mpm_partitioned_counts,
     .record = mpm_partitioned_record,

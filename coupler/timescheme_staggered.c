@@ -83,6 +83,7 @@ static int stag_create(mpm_timescheme *ts, const mpm_config *cfg) {
                            "relative interface residual to reach (e.g. 1e-6)",
                            iterations);
   MPM_CALL(mpm_config_get_real(cfg, "coupling.tolerance", &tolerance));
+  pp->iterations = iterations;
   return mpm_strong_new(&pp->strong, pp, iterations, tolerance, relaxation);
 }
 
@@ -90,6 +91,14 @@ static void stag_destroy(mpm_timescheme *ts) {
   mpm_partitioned *pp = ts->content;
   if (pp) mpm_strong_destroy(&pp->strong);
   mpm_partitioned_destroy(ts);
+}
+
+/* A step that never converges takes every sub-iteration (and is accepted with a warning): the
+ * budget counts them all. */
+static int stag_work(mpm_timescheme *ts, double *advances, const char **key) {
+  const mpm_partitioned *pp = ts->content;
+  *advances = pp->strong ? pp->iterations : 1, *key = pp->strong ? "coupling.iterations" : NULL;
+  return 0;
 }
 
 static int stag_step(mpm_timescheme *ts, double tstop, double *t, double *h) {
@@ -132,6 +141,7 @@ static const mpm_timescheme_ops stag_ops = {
     .step = stag_step,
     .resize = mpm_partitioned_resize,
     .cfl_step = mpm_partitioned_cfl_step,
+    .work = stag_work,
     .next_step = mpm_partitioned_next_step,
     .counts = mpm_partitioned_counts,
     .record = mpm_partitioned_record,

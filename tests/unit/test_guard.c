@@ -101,6 +101,21 @@ static void test_off_and_energy(void **state) {
   mpm_config_destroy(&cfg);
 }
 
+/* A step of zero length (t + h == t: an edited checkpoint time of 1e17) repeats forever: it is
+ * stopped at once, even with both criteria off, and as the first step of a run. */
+static void test_zero_step_stops(void **state) {
+  (void)state;
+  mpm_guard g = {0};
+  mpm_config *cfg = NULL;
+  const char *const off[] = {"time.collapse_ratio=0", "time.energy_growth=0", NULL};
+  guard_with(&g, &cfg, off);
+  assert_int_equal(mpm_guard_check(&g, 1e17, 1, 0.0, 0, E0), MPM_ERR_UNPHYSICAL);
+  assert_int_equal(mpm_guard_check(&g, 1e17, 2, 0.0, 1, E0), MPM_ERR_UNPHYSICAL);
+  assert_int_equal(mpm_guard_check(&g, 1.0, 3, H0, 0, E0), 0);
+  mpm_guard_free(&g);
+  mpm_config_destroy(&cfg);
+}
+
 int main(int argc, char **argv) {
   MPI_Init(&argc, &argv);
   mpm_log_init(MPI_COMM_WORLD, MPM_LOG_INFO, 0);
@@ -109,6 +124,7 @@ int main(int argc, char **argv) {
       cmocka_unit_test(test_default_lets_small_steps_run),
       cmocka_unit_test(test_cut_short_steps_neither_count_nor_break),
       cmocka_unit_test(test_off_and_energy),
+      cmocka_unit_test(test_zero_step_stops),
   };
   const int failed = cmocka_run_group_tests(tests, NULL, NULL);
   MPI_Finalize();
