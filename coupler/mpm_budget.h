@@ -32,6 +32,7 @@ typedef struct mpm_budget {
   double t, t_end;      /* the time to run */
   double h0;            /* planned step of the starting state (0 or inf: nothing limits it) */
   double work;          /* advances of the busiest module per step (>= 1; mpm_timescheme_work) */
+  double need;          /* of those, the advances stability needs (<= work) */
   const char *work_key; /* the key that sets work, or NULL */
   double out_interval;  /* time between snapshots (> 0) */
   double ckpt_interval; /* time between checkpoints (inf: only the final one) */

@@ -383,7 +383,7 @@ static int check_budget(mpm_sim *s) {
                   .ckpt_interval = s->ckpt_interval,
                   .snapshots = s->snapshots};
   MPM_CALL(mpm_timescheme_cfl_step(s->it, &b.h0));
-  MPM_CALL(mpm_timescheme_work(s->it, &b.work, &b.work_key));
+  MPM_CALL(mpm_timescheme_work(s->it, &b.work, &b.need, &b.work_key));
   MPM_CALL(output_bytes(s, &b.bytes));
   return mpm_budget_check(s->cfg, &b, &s->estimate);
 }

@@ -93,9 +93,11 @@ int mpm_timescheme_cfl_step(mpm_timescheme *ts, double *h) {
   return 0;
 }
 
-int mpm_timescheme_work(mpm_timescheme *ts, double *advances, const char **key) {
+int mpm_timescheme_work(mpm_timescheme *ts, double *advances, double *need, const char **key) {
   *advances = 1, *key = NULL;
-  return ts->type->ops->work ? ts->type->ops->work(ts, advances, key) : 0;
+  MPM_CALL(ts->type->ops->work ? ts->type->ops->work(ts, advances, need, key) : 0);
+  if (!ts->type->ops->work) *need = 1;
+  return 0;
 }
 
 double mpm_timescheme_next_step(const mpm_timescheme *ts) {

@@ -37,9 +37,10 @@ typedef struct mpm_timescheme_ops {
   int (*cfl_step)(mpm_timescheme *ts, double *h);
   /* The advances the busiest module makes in one coupling step from the current state: its
    * substeps, or the most sub-iterations a step may take (the run's budget counts them), and
-   * the key that sets that number (NULL: the scene's own stable steps do). Optional: 1, NULL.
-   * Collective. */
-  int (*work)(mpm_timescheme *ts, double *advances, const char **key);
+   * the key that sets that number (NULL: the scene's own stable steps do); and how many of
+   * those advances stability needs (*need, as many as *advances unless a key asks for more).
+   * Optional: 1, 1, NULL. Collective. */
+  int (*work)(mpm_timescheme *ts, double *advances, double *need, const char **key);
   double (*next_step)(const mpm_timescheme *ts);
   void (*counts)(const mpm_timescheme *ts, long *steps, long *rhs, long *fails, long *retries);
   /* The interface record of the step that reached t, reduced over the ranks. Optional: the
@@ -102,7 +103,7 @@ int mpm_timescheme_resize(mpm_timescheme *ts, double t);
  * run's budget and the blow-up guard measure against it). 0: nothing limits it. */
 int mpm_timescheme_cfl_step(mpm_timescheme *ts, double *h);
 /* See mpm_timescheme_ops.work. */
-int mpm_timescheme_work(mpm_timescheme *ts, double *advances, const char **key);
+int mpm_timescheme_work(mpm_timescheme *ts, double *advances, double *need, const char **key);
 double mpm_timescheme_next_step(const mpm_timescheme *ts);
 void mpm_timescheme_counts(const mpm_timescheme *ts, long *steps, long *rhs, long *fails,
                            long *retries);

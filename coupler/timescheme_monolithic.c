@@ -37,9 +37,10 @@ static int mono_cfl_step(mpm_timescheme *ts, double *h) {
 
 /* MRIStep's fast substeps, when coupling.substeps sets them (otherwise counted as 1: the
  * budget's estimate is a lower bound). */
-static int mono_work(mpm_timescheme *ts, double *advances, const char **key) {
+static int mono_work(mpm_timescheme *ts, double *advances, double *need, const char **key) {
   const int m = mpm_integrator_substeps(ts->content);
   *advances = m > 0 ? m : 1, *key = m > 0 ? "coupling.substeps" : NULL;
+  *need = *advances; /* MRIStep's fast step is not planned here: no claim */
   return 0;
 }
 

@@ -168,17 +168,20 @@ static int multirate_cfl_step(mpm_timescheme *ts, double *h) {
 
 /* The substeps of the fast and slow modules in a coupling step from the current state, as
  * multirate_step takes them (m = 0 where the fast module's step collapsed: it refuses). */
-static int multirate_work(mpm_timescheme *ts, double *advances, const char **key) {
+static int multirate_work(mpm_timescheme *ts, double *advances, double *need, const char **key) {
   const mpm_partitioned *pp = ts->content;
   double hs, hg;
   MPM_CALL(mpm_partitioned_cfl_steps(ts, &hs, &hg));
   hs = limit(hs), hg = limit(hg);
   const double h_fast = fmin(hs, hg), H = coupling_step(pp, h_fast, fmax(hs, hg));
-  double m = pp->substeps;
-  if (m == 0 && isfinite(h_fast) && isfinite(H)) m = ceil(H / h_fast * (1 - 1e-12));
-  m = fmax(m, 1.0);
+  const double stable =
+      isfinite(h_fast) && isfinite(H) ? fmax(ceil(H / h_fast * (1 - 1e-12)), 1.0) : 1.0;
+  const double m = pp->substeps > 0 ? pp->substeps : stable;
   const double n = pp->slow_substeps > 0 ? pp->slow_substeps : m;
   *advances = fmax(m, n);
+  /* the fast module needs what its stable step asks; the slow one, at most as many (its
+   * substeps are an ablation of the coupling lag) */
+  *need = n > m ? m : stable;
   *key = n > m ? "coupling.slow_substeps" : pp->substeps > 0 ? "coupling.substeps" : NULL;
   return 0;
 }

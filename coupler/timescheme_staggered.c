@@ -95,9 +95,10 @@ static void stag_destroy(mpm_timescheme *ts) {
 
 /* A step that never converges takes every sub-iteration (and is accepted with a warning): the
  * budget counts them all. */
-static int stag_work(mpm_timescheme *ts, double *advances, const char **key) {
+static int stag_work(mpm_timescheme *ts, double *advances, double *need, const char **key) {
   const mpm_partitioned *pp = ts->content;
   *advances = pp->strong ? pp->iterations : 1, *key = pp->strong ? "coupling.iterations" : NULL;
+  *need = *advances; /* a step may need every sub-iteration it allows */
   return 0;
 }
 

@@ -147,11 +147,22 @@ def reals():
 def runaway():
     both("multirate, coupling.substeps = 1e6 (the old maximum)", PANEL,
          ["coupling.substeps=1000000"], "command line: coupling.substeps", "[1, 10000]")
-    both("multirate, coupling.substeps = 1e4 over run.max_steps", PANEL,
-         ["coupling.substeps=10000", "run.max_steps=1e7"], "command line: coupling.substeps",
+    both("multirate, coupling.substeps = 1e4 (the maximum), about 700 times what it needs",
+         PANEL, ["coupling.substeps=10000"], "command line: coupling.substeps",
+         "that the fast module's stable step needs", "at most")
+    p = mpmfsi(["check", PANEL, "coupling.substeps=10000"])
+    most = re.search(r"give at most (\d+)", p.stderr if p else "")
+    p = mpmfsi(["check", PANEL, f"coupling.substeps={most.group(1)}"]) if most else None
+    check(p is not None and p.returncode == 0,
+          f"multirate, coupling.substeps = {most.group(1) if most else '?'} (the most the "
+          "refusal offers, 100 times what stability needs) is accepted")
+    both("multirate, coupling.substeps = 1000 over run.max_steps", PANEL,
+         ["coupling.substeps=1000", "run.max_steps=1e6"], "command line: coupling.substeps",
          "substeps of the fast module", "lower coupling.substeps")
-    both("multirate, coupling.slow_substeps = 1e4 over run.max_steps", PANEL,
-         ["coupling.slow_substeps=10000", "run.max_steps=1e7"],
+    both("multirate, coupling.slow_substeps = 1e4, far more than the fast module takes", PANEL,
+         ["coupling.slow_substeps=10000"], "command line: coupling.slow_substeps", "at most")
+    both("multirate, coupling.slow_substeps = 1000 over run.max_steps", PANEL,
+         ["coupling.slow_substeps=1000", "run.max_steps=1e6"],
          "command line: coupling.slow_substeps", "substeps of the slow module")
     both("strong coupling, coupling.iterations = 1000 over run.max_steps", BAR,
          ["coupling.time=staggered", "coupling.iterations=1000", "coupling.tolerance=1e-6",
