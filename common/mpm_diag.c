@@ -69,11 +69,13 @@ int mpm_diag_open(mpm_diag **d, MPI_Comm comm, const char *path, int ncols,
     status = MPM_ERR_MEMORY;
   } else if (rank == 0) {
     char *kept = NULL;
-    if (append && truncate_after(path, t_keep, &kept) != 0) kept = NULL;
-    /* Written anew beside the old file and moved over it (mpm_safefile.h); the stream then
-     * goes on appending to the file in place. */
-    (*d)->f = mpm_file_begin(path, "w");
-    if (!(*d)->f) {
+    /* The rows up to the checkpoint's time must be read before the file is replaced: if they
+     * cannot be, the run stops rather than replace the history with a bare header. The file is
+     * written anew beside the old one and moved over it (mpm_safefile.h); the stream then goes
+     * on appending to the file in place. */
+    if (append && (status = truncate_after(path, t_keep, &kept)) != 0) {
+      (*d)->f = NULL;
+    } else if (!((*d)->f = mpm_file_begin(path, "w"))) {
       status = mpm_file_fail(path, errno, "diagnostics");
     } else if (kept && kept[0]) {
       fputs(kept, (*d)->f);
@@ -82,7 +84,14 @@ int mpm_diag_open(mpm_diag **d, MPI_Comm comm, const char *path, int ncols,
       fputc('\n', (*d)->f);
     }
     free(kept);
-    const int e = !(*d)->f ? 0 : fflush((*d)->f) != 0 ? errno : mpm_file_publish(path);
+    int e = 0;
+    if ((*d)->f && (fflush((*d)->f) != 0 || ferror((*d)->f))) {
+      e = errno ? errno : EIO;
+      mpm_file_abandon((*d)->f, path); /* the old file stays as it was */
+      (*d)->f = NULL;
+    } else if ((*d)->f) {
+      e = mpm_file_publish(path);
+    }
     if (e) status = mpm_file_fail(path, e, "diagnostics");
   }
   status = agree(*d, status);

@@ -185,7 +185,7 @@ static void explain_write_failure(const mpm_h5 *h, const char *path, const char 
     mpm_iowatch_cause(cause, sizeof cause, err, dir);
   mpm_iowatch_intact(intact, sizeof intact);
   mpm_log_all(MPM_LOG_ERROR,
-              "cannot write the %s %s (%s): %s. Any earlier file of the same name is left as it "
+              "cannot write the %s %s (%s): %s. The file it was to replace, if any, is left as it "
               "was; %s",
               h->what, path, what[0] ? what : "creating the file", cause, intact);
   free(dir);
@@ -212,7 +212,11 @@ static int write_file(const mpm_h5 *h, const char *path, mpm_h5_fill fill, const
      * which the ranks agree on, never a write inside HDF5, which they could not. */
     g_write.declared = 0, g_write.reserved = 0, g_write.unsupported = 0;
     g_write.fd = h->rank == 0 ? open(path, O_WRONLY | O_NOFOLLOW | O_CLOEXEC) : -1;
-    rc = stage(h->comm, reserve(0)); /* what the close will write */
+    /* without that handle nothing could be reserved (and a link swapped in since the create
+     * fails O_NOFOLLOW): the stage fails, agreed, rather than writing unguarded */
+    const int no_fd = h->rank == 0 && g_write.fd < 0;
+    if (no_fd && !g_write.err) g_write.err = errno;
+    rc = stage(h->comm, no_fd || reserve(0)); /* what the close will write */
     if (rc) snprintf(g_write.what, sizeof g_write.what, "creating it");
     if (!rc) rc = fill(h, file, arg);
     if (rc && !g_write.err) g_write.err = errno;

@@ -91,7 +91,7 @@ static void expire(union sigval v) {
   mpm_iowatch_intact(intact, sizeof intact);
   mpm_log_all(MPM_LOG_ERROR,
               "cannot write the %s %s: %s; the ranks did not finish the write together within "
-              "the watchdog's %g s, so the run is aborted. Any earlier file of the same name is "
+              "the watchdog's %g s, so the run is aborted. The file it was to replace, if any, is "
               "left as it was; %s",
               g_watch.what, g_watch.path, cause, watchdog_seconds(), intact);
   MPI_Abort(MPI_COMM_WORLD, 1);

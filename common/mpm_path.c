@@ -57,11 +57,11 @@ static char *child(const char *res, const char *name, size_t n) {
 }
 
 char *mpm_path_resolve(const char *dir) {
-  char *res = strdup("/"), cwd[4096];
+  char *res = strdup("/");
   int real = 1; /* res exists (and is resolved) */
   if (dir[0] != '/') {
     free(res);
-    res = getcwd(cwd, sizeof cwd) ? realpath(cwd, NULL) : NULL;
+    res = realpath(".", NULL); /* no length limit, unlike getcwd into a buffer */
   }
   for (const char *p = dir; res && *p;) {
     const size_t n = strcspn(p, "/");

@@ -462,8 +462,8 @@ char *mpm_rundir_find_link(const char *dir) {
 }
 
 /* The top folders of the system: the root itself is refused too. */
-static const char *const g_system[] = {"bin",  "boot", "dev", "etc", "lib", "proc",
-                                       "sbin", "sys",  "usr", "var", "run"};
+static const char *const g_system[] = {"bin",    "boot", "dev",  "etc", "lib", "lib32", "lib64",
+                                       "libx32", "proc", "sbin", "sys", "usr", "var",   "run"};
 
 /* The system folder the resolved path real lies in ("/" for the root; NULL: none). A folder
  * inside one is the user's (allowed) when a folder on the way down to it, below the system
@@ -475,8 +475,7 @@ static const char *system_folder(const char *real) {
   const char *top = NULL;
   for (size_t k = 0; k < sizeof g_system / sizeof g_system[0] && !top; ++k) {
     const size_t m = strlen(g_system[k]);
-    const int lib = k == 4 && n >= m && strncmp(real + 1, "lib", 3) == 0; /* lib, lib64, ... */
-    if (lib || (n == m && strncmp(real + 1, g_system[k], m) == 0)) top = g_system[k];
+    if (n == m && strncmp(real + 1, g_system[k], m) == 0) top = g_system[k];
   }
   if (!top) return NULL;
   char *p = strdup(real);
@@ -505,6 +504,11 @@ int mpm_rundir_check_dir(const char *dir, int overwrite, char *why, size_t n) {
              "path",
              len, MPM_RUNDIR_MAX_DIR, MPM_RUNDIR_MAX_PATH);
   char *real = why[0] ? NULL : mpm_path_resolve(dir);
+  if (!why[0] && !real) /* never accepted unchecked */
+    snprintf(why, n,
+             "cannot be resolved (%s): mpmfsi checks where it writes before it does; give a "
+             "path whose folders exist and can be searched",
+             strerror(errno));
   const char *top = real ? system_folder(real) : NULL;
   if (top) {
     const int root = strcmp(top, "/") == 0, whole = root || strcmp(real + 1, top) == 0;

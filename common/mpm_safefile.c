@@ -74,16 +74,20 @@ void mpm_file_abandon(FILE *f, const char *path) {
 }
 
 int mpm_file_open_fd(const char *path, int flags) {
-  const int fd = open(path, flags | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC, 0644);
+  /* O_TRUNC only once the file is known to be ours: a hard link planted under the name (whose
+   * other name may be anywhere) is refused before anything of it is cut. */
+  const int fd = open(path, (flags & ~O_TRUNC) | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC, 0644);
   if (fd < 0) return -1;
   struct stat st;
-  const int err =
-      fstat(fd, &st) != 0    ? errno
-      : S_ISDIR(st.st_mode)  ? EISDIR
-      : !S_ISREG(st.st_mode) ? EINVAL
-      : (flags & O_NONBLOCK) == 0 && fcntl(fd, F_SETFL, fcntl(fd, F_GETFL) & ~O_NONBLOCK) != 0
-          ? errno
-          : 0;
+  const int fl = fcntl(fd, F_GETFL);
+  const int err = fstat(fd, &st) != 0                                                      ? errno
+                  : S_ISDIR(st.st_mode)                                                    ? EISDIR
+                  : !S_ISREG(st.st_mode)                                                   ? EINVAL
+                  : st.st_nlink > 1                                                        ? EMLINK
+                  : fl < 0                                                                 ? errno
+                  : (flags & O_NONBLOCK) == 0 && fcntl(fd, F_SETFL, fl & ~O_NONBLOCK) != 0 ? errno
+                  : (flags & O_TRUNC) && ftruncate(fd, 0) != 0                             ? errno
+                                                                                           : 0;
   if (err) {
     close(fd);
     errno = err;

@@ -40,8 +40,9 @@ void mpm_file_abandon(FILE *f, const char *path);
 
 /* open(2) for writing an existing or new regular file in place, never through a link: flags
  * as for open (O_NOFOLLOW, O_NONBLOCK and O_CLOEXEC are added; O_NONBLOCK is cleared again
- * once the file is known to be regular). -1 with errno set on failure: ELOOP for a link,
- * EISDIR for a folder, ENXIO or EINVAL for anything else that is not a regular file. */
+ * once the file is known to be regular; O_TRUNC is applied only then). -1 with errno set on
+ * failure: ELOOP for a link, EMLINK for a file with another (hard) link, EISDIR for a folder,
+ * ENXIO or EINVAL for anything else that is not a regular file. */
 int mpm_file_open_fd(const char *path, int flags);
 
 /* Remove path, a link itself if it is one: 0 or an errno value (ENOENT counts as success). */

@@ -38,10 +38,12 @@ static const char *work_noun(const mpm_budget *b) {
  * 20 s on a busy machine, the run about 46 hours. */
 #define MPM_BUDGET_OVERSTEP 100.0
 
-/* Refuse substeps that do nothing but cost (see MPM_BUDGET_OVERSTEP). */
+/* Refuse substeps that do nothing but cost (see MPM_BUDGET_OVERSTEP). Only before a new run: a
+ * restart cannot change coupling.*, and the stable ratio moves as the flow develops, so a run
+ * accepted at its start is never refused halfway. */
 static int check_overstep(const mpm_config *cfg, const mpm_budget *b) {
   const double need = fmax(b->need, 1.0), most = MPM_BUDGET_OVERSTEP * need;
-  if (!b->work_key || b->work <= most || b->work <= MPM_BUDGET_OVERSTEP) return 0;
+  if (b->restart || !b->work_key || b->work <= most || b->work <= MPM_BUDGET_OVERSTEP) return 0;
   return mpm_config_fail(cfg, b->work_key,
                          "%.6g substeps are %.3g times the %.3g that the fast module's stable "
                          "step needs; more than %.3g times only shrink a step below what "

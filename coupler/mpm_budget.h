@@ -29,6 +29,7 @@ extern const mpm_key_spec mpm_budget_keys[];
 extern const int mpm_budget_nkeys;
 
 typedef struct mpm_budget {
+  int restart;          /* from a checkpoint: keys outside time.*, run.*, output.* are fixed */
   double t, t_end;      /* the time to run */
   double h0;            /* planned step of the starting state (0 or inf: nothing limits it) */
   double work;          /* advances of the busiest module per step (>= 1; mpm_timescheme_work) */

@@ -165,6 +165,10 @@ int mpm_scene_check_overlaps(const mpm_config *cfg, const mpm_grid *grid, mpm_mo
                              int nmod) {
   scene s = {0};
   int rc = scene_read(&s, cfg, grid), found = 0;
+  /* a rank that could not read the scene must not leave the others in find_offence's
+   * reductions */
+  if (MPI_Allreduce(MPI_IN_PLACE, &rc, 1, MPI_INT, MPI_MAX, grid->comm) != MPI_SUCCESS)
+    rc = rc ? rc : MPM_ERR_MPI;
   offence o = {0, 0, {0, 0, 0}};
   if (s.nsolid + s.ngas < 2 || s.nsolid == 0) { /* gas regions alone never overlap */
     scene_free(&s);

@@ -376,8 +376,9 @@ static int output_bytes(const mpm_sim *s, double *bytes) {
 }
 
 /* Refuse an absurd run before it starts (mpm_budget.h). */
-static int check_budget(mpm_sim *s) {
-  mpm_budget b = {.t = s->t,
+static int check_budget(mpm_sim *s, int restart) {
+  mpm_budget b = {.restart = restart,
+                  .t = s->t,
                   .t_end = s->t_end,
                   .out_interval = s->out_interval,
                   .ckpt_interval = s->ckpt_interval,
@@ -413,7 +414,7 @@ int mpm_sim_create(mpm_sim **sp, mpm_config *cfg) {
   s->ckpt_next = 1;
   MPM_CALL(mpm_timescheme_new(&s->it, cfg, s->grid, s->mod, s->nmod, s->coupling));
   s->it->between = between_substeps, s->it->between_ctx = s;
-  return check_budget(s);
+  return check_budget(s, 0);
 }
 
 /* The run's RHS evaluations up to the checkpoint. A checkpoint from before they were kept
@@ -479,7 +480,7 @@ int mpm_sim_restart(mpm_sim **sp, mpm_config *cfg, const char *path) {
   MPM_CALL(rc);
   s->it->between = between_substeps, s->it->between_ctx = s;
   MPM_CALL(check_advance(s, path));
-  MPM_CALL(check_budget(s));
+  MPM_CALL(check_budget(s, 1));
   mpm_log(MPM_LOG_INFO, "restarted from %s at t = %.6g, step %ld", path, s->t, s->step);
   return 0;
 }

@@ -145,6 +145,38 @@ static void test_in_place_and_check(void **state) {
   assert_int_equal(mpm_rundir_check_dir(g_dir, 1, why, sizeof why), 0);
 }
 
+/* A hard link planted at a file written in place (run.log, .lock) is refused before anything of
+ * it is cut: the other name may be anywhere on the same file system. Our own file, with one
+ * name, is truncated as asked. */
+static void test_hard_link(void **state) {
+  (void)state;
+  if (g_rank != 0) return;
+  char path[4200], to[4200];
+  join(path, sizeof path, g_dir, "run.log");
+  join(to, sizeof to, g_victims, "hard");
+  FILE *f = fopen(to, "w");
+  assert_non_null(f);
+  fputs(g_precious, f);
+  fclose(f);
+  unlink(path);
+  assert_int_equal(link(to, path), 0);
+  errno = 0;
+  assert_int_equal(mpm_file_open_fd(path, O_WRONLY | O_CREAT | O_TRUNC), -1);
+  assert_int_equal(errno, EMLINK);
+  assert_untouched("hard", 1);
+  assert_int_equal(unlink(path), 0);
+  const int fd = mpm_file_open_fd(path, O_WRONLY | O_CREAT | O_TRUNC);
+  assert_true(fd >= 0);
+  assert_int_equal(write(fd, "x", 1), 1);
+  close(fd);
+  const int again = mpm_file_open_fd(path, O_WRONLY | O_CREAT | O_TRUNC);
+  struct stat st;
+  assert_true(again >= 0);
+  assert_int_equal(fstat(again, &st), 0);
+  assert_int_equal((int)st.st_size, 0);
+  close(again);
+}
+
 int main(int argc, char **argv) {
   MPI_Init(&argc, &argv);
   MPI_Comm_rank(MPI_COMM_WORLD, &g_rank);
@@ -165,6 +197,7 @@ int main(int argc, char **argv) {
       cmocka_unit_test(test_checkpoint_links),
       cmocka_unit_test(test_csv_links),
       cmocka_unit_test(test_in_place_and_check),
+      cmocka_unit_test(test_hard_link),
   };
   const int failed = cmocka_run_group_tests(tests, NULL, NULL);
   int any = failed;
