@@ -8,6 +8,7 @@
 
 #include <errno.h>
 #include <fcntl.h>
+#include <math.h>
 #include <mpi.h>
 #include <signal.h>
 #include <stdio.h>
@@ -16,6 +17,7 @@
 #include <sys/stat.h>
 #include <sys/statvfs.h>
 #include <time.h>
+#include <unistd.h>
 
 static struct {
   int installed;     /* the timer and the rank are set up */
@@ -79,7 +81,7 @@ void mpm_iowatch_cause(char *buf, size_t size, int err, const char *dir) {
 static double watchdog_seconds(void) {
   const char *env = getenv("MPMFSI_IO_WATCHDOG");
   const double s = env ? atof(env) : 0;
-  return s > 0 ? s : MPM_IOWATCH_SECONDS;
+  return s > 0 ? fmin(s, 1e6) : MPM_IOWATCH_SECONDS; /* a timer's seconds must fit */
 }
 
 /* The timer thread: the write is stuck inside a collective call that another rank left. */
@@ -94,11 +96,14 @@ static void expire(union sigval v) {
               "the watchdog's %g s, so the run is aborted. The file it was to replace, if any, is "
               "left as it was; %s",
               g_watch.what, g_watch.path, cause, watchdog_seconds(), intact);
-  MPI_Abort(MPI_COMM_WORLD, 1);
+  /* Not MPI_Abort: MPI was initialised without thread support and this is the timer's
+   * thread. A rank that exits with a non-zero status makes mpiexec end the others. */
+  fflush(stderr);
+  _exit(1);
 }
 
 /* Every rank arms its watchdog for the close; rank r fires r seconds later than rank 0 (at
- * most 10 s later), so that one rank writes the line before MPI_Abort ends the others. */
+ * most 10 s later), so that one rank writes the line before its exit ends the others. */
 void mpm_iowatch_arm(int err) {
   g_watch.err = err;
   if (g_watch.armed || !g_watch.have_timer || !g_watch.active) return;

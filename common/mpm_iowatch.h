@@ -17,8 +17,9 @@
  * - Where blocks cannot be reserved (a file system without fallocate), the free space is
  *   checked instead, which a race or a quota can beat. The last resort is a watchdog armed
  *   around the file's close: if the ranks have not all closed the file within
- *   MPM_IOWATCH_SECONDS ($MPMFSI_IO_WATCHDOG seconds, if set), it logs the one line and calls
- *   MPI_Abort (exit 1). It never fires on a close that ends, failed or not. */
+ *   MPM_IOWATCH_SECONDS ($MPMFSI_IO_WATCHDOG seconds, if set), it logs the one line and
+ *   exits (status 1; mpiexec then ends the other ranks). It never fires on a close that ends,
+ *   failed or not. */
 #ifndef MPM_IOWATCH_H
 #define MPM_IOWATCH_H
 
