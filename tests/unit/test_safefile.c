@@ -33,17 +33,20 @@ static void join(char *buf, size_t n, const char *dir, const char *name) {
   snprintf(buf, n, "%s/%s", dir, name);
 }
 
+/* A file at path holding g_precious, which mpmfsi must never write. */
+static void make_victim(const char *path) {
+  FILE *f = fopen(path, "w");
+  assert_non_null(f);
+  fputs(g_precious, f);
+  fclose(f);
+}
+
 /* dir/name -> victims/target; the target is made (holding g_precious) if exists. Rank 0. */
 static void plant(const char *name, const char *target, int exists) {
   char link[4200], to[4200];
   join(link, sizeof link, g_dir, name);
   join(to, sizeof to, g_victims, target);
-  if (exists) {
-    FILE *f = fopen(to, "w");
-    assert_non_null(f);
-    fputs(g_precious, f);
-    fclose(f);
-  }
+  if (exists) make_victim(to);
   unlink(link);
   assert_int_equal(symlink(to, link), 0);
 }
@@ -154,10 +157,7 @@ static void test_hard_link(void **state) {
   char path[4200], to[4200];
   join(path, sizeof path, g_dir, "run.log");
   join(to, sizeof to, g_victims, "hard");
-  FILE *f = fopen(to, "w");
-  assert_non_null(f);
-  fputs(g_precious, f);
-  fclose(f);
+  make_victim(to);
   unlink(path);
   assert_int_equal(link(to, path), 0);
   errno = 0;
