@@ -21,8 +21,8 @@
 #include <math.h>
 
 /* The riemann form's default coefficients c_lin and c_quad (fluid.av_form). */
-#define FLUID_RIEMANN_LIN  0.5
-#define FLUID_RIEMANN_QUAD 1.0
+#define FLUID_RIEMANN_LIN  1.0
+#define FLUID_RIEMANN_QUAD 4.0
 
 typedef struct fluid_gas {
   double gamma;           /* ratio of specific heats */
