@@ -65,7 +65,9 @@ static inline double fluid_av_pressure(const fluid_gas *g, double rho, double c,
 static inline double fluid_viscous_speed(const fluid_gas *g, double rho, double c, double divv,
                                          double psi, double dx) {
   double nu = g->mu > 0.0 ? 4.0 / 3.0 * g->mu / rho : 0.0; /* (rho is only read if mu > 0) */
-  if (divv < 0.0) nu += g->l * fluid_av_speed(g, c, -g->l * divv, psi);
+  if (divv < 0.0) /* (vnr in its own order of operations: its step sizes bit for bit) */
+    nu += g->l * (g->av_riemann ? fluid_av_speed(g, c, -g->l * divv, psi)
+                                : g->av_lin * c - g->av_quad * g->l * divv);
   return 2.0 * nu / dx;
 }
 
