@@ -18,6 +18,7 @@ enum { FLUID_X, FLUID_V, FLUID_J, FLUID_E };
 
 typedef struct fluid_layout {
   int f_C, f_m, f_V0, f_divv, f_D;  /* field indices; -1 if absent */
+  int f_psi;                        /* riemann viscosity: its limiter (after divv, D) */
   int f_pending;                    /* method of lines: this RHS's tr D (and D) */
   int f_rho, f_p, f_mach, f_T, f_s; /* output fields */
 } fluid_layout;
@@ -56,6 +57,8 @@ typedef struct fluid_content {
   double *Cnew;              /* MUSL with APIC: their new affine velocities (dim^2 cap) */
   double *power;             /* de/dt of each particle (cap) */
   double *tscratch;   /* the classic transfer's a_p, scalars and APIC terms (see ensure_scratch) */
+  double *lim;        /* the limiter's neighbour points (fluid_limiter.c) */
+  mpm_lidx lim_cap;   /* their capacity */
   double *node;       /* nodal scratch: time-centred velocity and scalars ((dim + 3) nnodes) */
   mpm_module_ops ops; /* the module's ops: p2g_rate only with the current strain rate */
 } fluid_content;
@@ -75,6 +78,12 @@ void fluid_classic_transfer(mpm_module *m, const double *y, double h, const flui
  * relaxes the particles' velocity into a wall face at (1 - keep) 2 c / dx, subtracting from
  * vdot, and adds the kinetic energy removed to power (de/dt). */
 void fluid_wall_rate_mol(const mpm_module *m, const double *y, double *const *vdot, double *power);
+
+/* The riemann viscosity's limiter psi (fluid_stress.h) of every particle of state y, from
+ * the nodal velocity v_i whose gradient at the particles is L (dim^2 components of n)
+ * (fluid_limiter.c). */
+int fluid_limiter(mpm_module *m, const double *y, const double *const *v_i, const double *L,
+                  double *psi);
 
 /* Seed every [gas.NAME] region into the (empty) particle set (fluid_seed.c). */
 int fluid_seed(mpm_module *m, const mpm_config *cfg);

@@ -46,12 +46,21 @@ static const mpm_key_spec fluid_keys[] = {
      "J/(kg K)"},
     {"fluid.viscosity", MPM_KEY_REAL, "0", 0, HUGE_VAL, 0, 0, NULL,
      "dynamic viscosity mu, Pa s (0: inviscid; air: 1.8e-5)", 0, "Pa s"},
-    {"fluid.av_linear", MPM_KEY_REAL, "0.5", 0, HUGE_VAL, 0, 0, NULL,
-     "linear artificial viscosity coefficient c_lin: q = rho l |tr D| (c_lin c + c_quad l "
-     "|tr D|) in compression, l = grid.dx",
-     0, "-"},
-    {"fluid.av_quadratic", MPM_KEY_REAL, "2", 0, HUGE_VAL, 0, 0, NULL,
-     "quadratic artificial viscosity coefficient c_quad (see av_linear)", 0, "-"},
+    {"fluid.av_form", MPM_KEY_ENUM, "vnr", 0, 0, 0, 0, "vnr|riemann",
+     "form of the artificial viscosity q, in compression only, with du = l |tr D|, l = grid.dx: "
+     "vnr (von Neumann-Richtmyer + Landshoff: q = rho du (c_lin c + c_quad du)) or riemann "
+     "(Kuropatenko's two-shock form q = rho du (1 - psi) (c_quad a du + sqrt(c_quad^2 a^2 du^2 "
+     "+ c_lin^2 c^2)), a = (gamma + 1) / 4, with a Christensen limiter psi that switches it off "
+     "in smooth compression; see docs/gas.md)",
+     0, NULL},
+    {"fluid.av_linear", MPM_KEY_REAL, NULL, 0, HUGE_VAL, 0, 0, NULL,
+     "linear artificial viscosity coefficient c_lin (see av_form; default 0.5 with vnr, "
+     "1 with riemann)",
+     1, "-"},
+    {"fluid.av_quadratic", MPM_KEY_REAL, NULL, 0, HUGE_VAL, 0, 0, NULL,
+     "quadratic artificial viscosity coefficient c_quad (see av_form; default 2 with vnr, "
+     "4 with riemann)",
+     1, "-"},
     {"fluid.pic_fraction", MPM_KEY_REAL, NULL, 0, 1, 0, 0, NULL,
      "the gas's own PIC share of the particle velocity update, in place of "
      "transfer.pic_fraction (default: that), for a step at the gas's own stable step at "
@@ -298,6 +307,7 @@ static fluid_batch batch_of(const mpm_module *m, const double *y) {
                        .e = state(p, y, FLUID_E),
                        .divv = field(p, y, fc->lay.f_divv),
                        .D = fc->lay.f_D >= 0 ? field(p, y, fc->lay.f_D) : NULL,
+                       .psi = fc->lay.f_psi >= 0 ? field(p, y, fc->lay.f_psi) : NULL,
                        .vsig = fc->vsig};
 }
 
@@ -325,6 +335,12 @@ static int fluid_p2g(mpm_module *m, double t, const double *y) {
   return 0;
 }
 
+/* The limiter's slot in the field pending: after tr and D. */
+static double *pending_psi(const fluid_content *fc, const mpm_particles *p) {
+  return mpm_particles_comp(p, fc->lay.f_pending, 0) +
+         (size_t)p->n * (1 + (fc->lay.f_D >= 0 ? p->dim * p->dim : 0));
+}
+
 /* The current rate from the previewed nodal velocity (above), and the viscous deposit. */
 static int fluid_p2g_rate(mpm_module *m, double t, const double *y) {
   (void)t;
@@ -339,6 +355,13 @@ static int fluid_p2g_rate(mpm_module *m, double t, const double *y) {
     vout[d] = fc->scratch + (size_t)d * n, aout[d] = fc->scratch + (size_t)(dim + d) * n;
   mpm_transfer_g2p(m->grid, m->phase, p, y, fc->lp, vout, aout, L, NULL);
   mpm_timer_stop(MPM_T_G2P);
+  if (fc->lay.f_psi >= 0) { /* this RHS's limiter, into pending (g2p keeps it) */
+    const double *v_i[MPM_MAX_DIM];
+    for (int d = 0; d < dim; ++d) v_i[d] = m->grid->phase[m->phase].v_i[d];
+    double *psi = pending_psi(fc, p);
+    MPM_CALL(fluid_limiter(m, y, v_i, L, psi));
+    b.psi = psi;
+  }
   double *D = b.D ? L : NULL; /* sym L in place */
   rate_parts(dim, n, L, fc->power, D);
   b.divv = fc->power, b.D = D;
@@ -443,7 +466,8 @@ static void as_rate(double *out, const double *src, const double *y, size_t coun
  * in the classic update as the state's rate (new - old) / h; in the method-of-lines RHS in the
  * field `pending`, which fluid_post_step commits after an accepted step (the RHS must not
  * change what it reads: ARKODE also probes it at trial states). */
-static void volume_rate(mpm_module *m, const double *y, double *ydot, const double *L, double h) {
+static int volume_rate(mpm_module *m, const double *y, double *ydot, const double *L,
+                       const double *const *v_i, double h) {
   const fluid_content *fc = m->content;
   const mpm_particles *p = m->particles;
   const int dim = p->dim;
@@ -457,9 +481,15 @@ static void volume_rate(mpm_module *m, const double *y, double *ydot, const doub
                               : tr + n;
   rate_parts(dim, n, L, tr, D);
   for (mpm_lidx i = 0; i < n; ++i) Jdot[i] = J[i] * tr[i];
-  if (!in_state) return;
+  /* The limiter (riemann viscosity): with the current rate p2g_rate has set this RHS's. */
+  double *psi = fc->lay.f_psi < 0 ? NULL : in_state ? fc->scratch + n : pending_psi(fc, p);
+  if (psi && !fc->current_rate) MPM_CALL(fluid_limiter(m, y, v_i, L, psi));
+  if (!in_state) return 0;
   as_rate(ydot + (size_t)p->offset[fc->lay.f_divv] * n, tr, field(p, y, fc->lay.f_divv), n, h);
   if (D) as_rate(D, NULL, field(p, y, fc->lay.f_D), (size_t)dim * dim * n, h);
+  if (psi)
+    as_rate(ydot + (size_t)p->offset[fc->lay.f_psi] * n, psi, field(p, y, fc->lay.f_psi), n, h);
+  return 0;
 }
 
 /* Three forms of G2P: the method-of-lines RHS (h = 0): dx/dt = sum S v_i, dv/dt = sum S a_i;
@@ -497,7 +527,12 @@ static int fluid_g2p(mpm_module *m, double t, const double *y, double *ydot, dou
     as_rate(vdot[0], fc->vnew, v, nv, h);
     if (Cdot) as_rate(Cdot, fc->Cnew, C, nC, h);
   }
-  volume_rate(m, y, ydot, L, h);
+  /* The nodal velocity L is the gradient of: usl's time-centred one (fluid_transfer.c). */
+  const double *v_i[MPM_MAX_DIM];
+  for (int d = 0; d < dim; ++d)
+    v_i[d] = h > 0 && !fc->tr.musl ? fc->node + (size_t)d * m->grid->nnodes
+                                   : m->grid->phase[m->phase].v_i[d];
+  MPM_CALL(volume_rate(m, y, ydot, L, v_i, h));
   const double *pos[MPM_MAX_DIM] = {NULL};
   for (int d = 0; d < dim; ++d) pos[d] = state(p, y, FLUID_X) + (size_t)d * n;
   fluid_obstacles_heat(&fc->obs, m->grid, n, pos, state(p, y, FLUID_E), h, fc->power);
@@ -514,7 +549,8 @@ static int fluid_post_step(mpm_module *m, double t, double h, int *changed) {
   fluid_content *fc = m->content;
   const mpm_particles *p = m->particles;
   if (fc->lay.f_pending >= 0) { /* divv and D follow pending in the particle data */
-    const size_t count = (size_t)p->n * (1 + (fc->lay.f_D >= 0 ? p->dim * p->dim : 0));
+    const size_t count = (size_t)p->n * (1 + (fc->lay.f_D >= 0 ? p->dim * p->dim : 0) +
+                                         (fc->lay.f_psi >= 0 ? 1 : 0));
     memcpy(mpm_particles_comp(p, fc->lay.f_divv, 0), mpm_particles_comp(p, fc->lay.f_pending, 0),
            sizeof(double) * count);
   }
@@ -559,6 +595,7 @@ static double fluid_stable_dt(const mpm_module *m, const double *y) {
   const double *mass = mpm_particles_comp(p, fc->lay.f_m, 0);
   const double *V0 = mpm_particles_comp(p, fc->lay.f_V0, 0);
   const double *divv = field(p, y, fc->lay.f_divv);
+  const double *psi = fc->lay.f_psi >= 0 ? field(p, y, fc->lay.f_psi) : NULL;
   const double *J = state(p, y, FLUID_J), *e = state(p, y, FLUID_E);
   const int viscous = fc->gas.mu > 0.0;
   double smax = 0.0; /* the fastest signal: dt = dx / smax */
@@ -570,7 +607,8 @@ static double fluid_stable_dt(const mpm_module *m, const double *y) {
     }
     const double rho = viscous ? mass[i] / (V0[i] * J[i]) : 1.0; /* only viscosity needs it */
     const double c = sqrt(gamma * (gamma - 1.0) * fabs(e[i]));   /* sqrt(gamma p / rho) */
-    const double s = c + sqrt(v2) + fluid_viscous_speed(&fc->gas, rho, c, divv[i], dx);
+    const double s =
+        c + sqrt(v2) + fluid_viscous_speed(&fc->gas, rho, c, divv[i], psi ? psi[i] : 0.0, dx);
     if (s > smax) smax = s; /* (fmax is a call: its NaN rules block inlining) */
   }
   return smax > 0.0 ? dx / smax : HUGE_VAL;
@@ -622,7 +660,7 @@ static void fluid_destroy(mpm_module *m) {
     fluid_virtual_free(&fc->virt);
     free(fc->vsig), free(fc->scratch), free(fc->vnew), free(fc->Cnew), free(fc->power);
     free(fc->sub), free(fc->zero);
-    free(fc->tscratch), free(fc->node), free(fc->cellsum);
+    free(fc->tscratch), free(fc->node), free(fc->cellsum), free(fc->lim);
     free(fc);
   }
   mpm_particles_destroy(&m->particles);
@@ -680,13 +718,26 @@ static int read_regularise(fluid_content *fc, const mpm_config *cfg, int dim) {
                          fc->reg_min, fc->reg_max);
 }
 
+/* fluid.av_form and its coefficients, whose defaults depend on the form. */
+static int read_av(fluid_gas *gas, const mpm_config *cfg) {
+  const char *form;
+  MPM_CALL(mpm_config_get_string(cfg, "fluid.av_form", &form));
+  gas->av_riemann = strcmp(form, "riemann") == 0;
+  gas->av_lin = gas->av_riemann ? FLUID_RIEMANN_LIN : 0.5;
+  gas->av_quad = gas->av_riemann ? FLUID_RIEMANN_QUAD : 2.0;
+  if (mpm_config_has(cfg, "fluid.av_linear"))
+    MPM_CALL(mpm_config_get_real(cfg, "fluid.av_linear", &gas->av_lin));
+  if (mpm_config_has(cfg, "fluid.av_quadratic"))
+    MPM_CALL(mpm_config_get_real(cfg, "fluid.av_quadratic", &gas->av_quad));
+  return 0;
+}
+
 static int read_settings(fluid_content *fc, const mpm_config *cfg, const mpm_grid *g) {
   int nv;
   double grav[3] = {0, 0, 0};
   MPM_CALL(mpm_config_get_real(cfg, "fluid.gamma", &fc->gas.gamma));
   MPM_CALL(mpm_config_get_real(cfg, "fluid.viscosity", &fc->gas.mu));
-  MPM_CALL(mpm_config_get_real(cfg, "fluid.av_linear", &fc->gas.av_lin));
-  MPM_CALL(mpm_config_get_real(cfg, "fluid.av_quadratic", &fc->gas.av_quad));
+  MPM_CALL(read_av(&fc->gas, cfg));
   const char *stable;
   MPM_CALL(mpm_config_get_string(cfg, "fluid.stable_step", &stable));
   fc->stable_local = strcmp(stable, "neighbourhood") == 0, fc->s_local = -1.0;
@@ -718,26 +769,30 @@ static int read_settings(fluid_content *fc, const mpm_config *cfg, const mpm_gri
  * y_{n+1}. The step size the driver sets and the one the RHS computed for the same state are
  * then the same, which the exact energy balance needs; a restart also gets it bit for bit. In
  * the method-of-lines RHS it is an ordinary field the RHS overwrites (the previous stage's). */
-static void lag_fields(mpm_field_desc *f, int *nf, fluid_layout *lay, int dim, int viscous) {
+static void lag_fields(mpm_field_desc *f, int *nf, fluid_layout *lay, int dim, int viscous,
+                       int limiter) {
   lay->f_divv = *nf, f[(*nf)++] = (mpm_field_desc){"divv", 1};
   lay->f_D = viscous ? *nf : -1;
   if (viscous) f[(*nf)++] = (mpm_field_desc){"D", dim * dim};
+  lay->f_psi = limiter ? *nf : -1;
+  if (limiter) f[(*nf)++] = (mpm_field_desc){"psi", 1};
 }
 
 static int particles_new(mpm_particles **p, int dim, fluid_layout *lay, int apic, int viscous,
-                         int lag_in_state) {
+                         int limiter, int lag_in_state) {
   mpm_field_desc f[MPM_PARTICLES_MAX_FIELDS] = {{"x", dim}, {"v", dim}, {"J", 1}, {"e", 1}};
   int nf = 4;
   lay->f_C = apic ? nf : -1;
   if (apic) f[nf++] = (mpm_field_desc){"C", dim * dim};
-  if (lag_in_state) lag_fields(f, &nf, lay, dim, viscous);
+  if (lag_in_state) lag_fields(f, &nf, lay, dim, viscous, limiter);
   const int nstate = nf;
   lay->f_m = nf, f[nf++] = (mpm_field_desc){"m", 1};
   lay->f_V0 = nf, f[nf++] = (mpm_field_desc){"V0", 1};
   lay->f_pending = -1;
-  if (!lag_in_state) { /* pending directly before divv and D: post_step copies one block */
-    lay->f_pending = nf, f[nf++] = (mpm_field_desc){"pending", 1 + (viscous ? dim * dim : 0)};
-    lag_fields(f, &nf, lay, dim, viscous);
+  if (!lag_in_state) { /* pending directly before divv, D, psi: post_step copies one block */
+    lay->f_pending = nf,
+    f[nf++] = (mpm_field_desc){"pending", 1 + (viscous ? dim * dim : 0) + (limiter ? 1 : 0)};
+    lag_fields(f, &nf, lay, dim, viscous, limiter);
   }
   lay->f_rho = nf, f[nf++] = (mpm_field_desc){"rho", 1};
   lay->f_p = nf, f[nf++] = (mpm_field_desc){"p", 1};
@@ -771,8 +826,8 @@ static int build(mpm_module *m, const mpm_config *cfg, int seed) {
   fc->virt.phase = -1;
   if (fluid_open_uses_virtual(fc->open)) MPM_CALL(fluid_virtual_init(&fc->virt, g));
   MPM_ALLOC(fc->node, (size_t)(g->dim + 3) * g->nnodes);
-  MPM_CALL(
-      particles_new(&m->particles, g->dim, &fc->lay, fc->tr.apic, fc->gas.mu > 0, fc->tr.classic));
+  MPM_CALL(particles_new(&m->particles, g->dim, &fc->lay, fc->tr.apic, fc->gas.mu > 0,
+                         fc->gas.av_riemann, fc->tr.classic));
   /* What a checkpoint may hold: positive mass, volume, volume ratio and internal energy (the
    * module's check faults on any other). */
   mpm_particles_set_range(m->particles, fc->lay.f_m, 0.0, HUGE_VAL, MPM_FIELD_LO_OPEN);

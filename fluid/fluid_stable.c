@@ -40,6 +40,7 @@ static void deposit(const mpm_module *m, double *const *sum) {
   const double *mass = mpm_particles_comp(p, fc->lay.f_m, 0);
   const double *V0 = mpm_particles_comp(p, fc->lay.f_V0, 0);
   const double *divv = mpm_particles_comp(p, fc->lay.f_divv, 0);
+  const double *psi = fc->lay.f_psi >= 0 ? mpm_particles_comp(p, fc->lay.f_psi, 0) : NULL;
   const double *J = mpm_particles_comp(p, FLUID_J, 0), *e = mpm_particles_comp(p, FLUID_E, 0);
   const double *x[MPM_MAX_DIM], *vel[MPM_MAX_DIM]; /* (read once: sum may alias the block) */
   for (int d = 0; d < g->dim; ++d)
@@ -53,7 +54,7 @@ static void deposit(const mpm_module *m, double *const *sum) {
     }
     const double rho = fc->gas.mu > 0.0 ? mass[i] / (V0[i] * J[i]) : 1.0; /* only mu needs it */
     const double cs = sqrt(gamma * (gamma - 1.0) * fabs(e[i]));
-    const double s = cs + fluid_viscous_speed(&fc->gas, rho, cs, divv[i], dx);
+    const double s = cs + fluid_viscous_speed(&fc->gas, rho, cs, divv[i], psi ? psi[i] : 0.0, dx);
     const mpm_lidx l = mpm_grid_local_index(g, c);
     sum[0][l] += mass[i], sum[1][l] += mass[i] * s * s, sum[2][l] += mass[i] * sqrt(v2);
   }

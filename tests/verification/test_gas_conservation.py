@@ -19,7 +19,9 @@ enters or leaves, no body force acts, so the totals in diagnostics.csv must stay
     of state: tolerance time.rtol = 1e-6 relative (measured about 1e-7).
 The same with slip walls on all four faces instead of periodic ones (usl, musl: 1e-12): a wall
 node has no normal velocity, so the wall does no work, and the mirrored pad nodes fold back
-symmetrically. And a 3-D periodic box (8^3 cells, usl: 1e-12) for the 3-D kernels.
+symmetrically. And a 3-D periodic box (8^3 cells, usl: 1e-12) for the 3-D kernels. The same
+with the riemann viscosity (fluid.av_form = riemann): usl, musl (1e-12), bs32 (1e-6), usl with
+slip walls and in 3-D (1e-12), and 2 ranks against 1 by id (1e-12).
 Particle shifting (fluid.shift, fluid/fluid_shift.c) moves positions only, so with it on every
 step the same tolerances hold (usl, periodic and slip walls, 2-D and 3-D). Gas at rest at a
 uniform pressure, in the box with slip walls and shifting on, stays exactly at rest: the volume
@@ -83,6 +85,14 @@ SHIFT = ["time.method=usl", "fluid.shift=0.375"]
 totals("usl shift", SHIFT, 1e-12)
 totals("usl shift slip walls", SHIFT + WALLS, 1e-12)
 totals("usl shift 3-D", SHIFT + BOX3, 1e-12)
+# The riemann viscosity (fluid.av_form; its limiter reads the nodal velocity one cell either
+# side) only scales a compression-only stress: the same balances, the same tolerances.
+RIEMANN = ["fluid.av_form=riemann"]
+for method in ("usl", "musl"):
+    totals(f"{method} riemann", [f"time.method={method}"] + RIEMANN, 1e-12)
+totals("bs32 riemann", ["time.method=bs32"] + RIEMANN, 1e-6)
+totals("usl riemann slip walls", ["time.method=usl"] + RIEMANN + WALLS, 1e-12)
+totals("usl riemann 3-D", ["time.method=usl"] + RIEMANN + BOX3, 1e-12)
 
 
 def at_rest():
@@ -103,23 +113,25 @@ def at_rest():
 at_rest()
 
 
-def ranks():
-    """The pulse with slip walls and shifting on 2 ranks (split along x: each rank folds its own
-    wall, and the halo carries the volume fraction across the split) against 1, by id."""
+def ranks(label, extra):
+    """The pulse with slip walls on 2 ranks (split along x: each rank folds its own wall, and
+    the halo carries the volume fraction and the nodal velocity the riemann limiter reads across
+    the split) against 1, by id."""
     res = []
     for r in (1, 2):
-        out = mt.outdir(f"gas_box_shift_np{r}")
+        out = mt.outdir(f"gas_box_{label.replace(' ', '_')}_np{r}")
         mt.run(["run", CASE, f"output.dir={out}", "run.progress=false", "time.t_end=0.2",
-                "output.interval=0.2"] + SHIFT + WALLS + (["grid.ranks=2 1"] if r == 2 else []),
+                "output.interval=0.2"] + extra + WALLS + (["grid.ranks=2 1"] if r == 2 else []),
                ranks=r)
         res.append(mt.particles(mt.snapshots(out)[-1][1], "fluid"))
     same = np.array_equal(res[0]["id"], res[1]["id"])
     diff = mt.worst_difference(res[0], res[1])[0] if same else np.inf
-    check(same and diff <= 1e-12, f"shift, slip walls, 2 ranks vs 1 by id: largest relative "
+    check(same and diff <= 1e-12, f"{label}, slip walls, 2 ranks vs 1 by id: largest relative "
           f"difference {diff:.1e} over every field (<= 1e-12: sums in another order)")
 
 
-ranks()
+ranks("shift", SHIFT)
+ranks("usl riemann", ["time.method=usl"] + RIEMANN)
 
 
 def into_the_floor(method, v_tol, e_tol):
