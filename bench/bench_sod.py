@@ -39,7 +39,7 @@ EXACT = Riemann(LEFT, RIGHT, gamma=1.4, x0=0.5)
 FV_L1, FV_N = 1.3e-3, 400  # second-order finite-volume Godunov at 400 cells (issue 4)
 CELLS = [100, 200, 400, 800, 1600]
 NOTES = "<!-- notes: written by hand, kept when bench_sod.py rewrites the tables above -->"
-METHODS = ["usl", "musl", "bs32", "zonneveld43", "dp54"]
+METHODS = ["usl", "musl", "bs32", "zonneveld43", "dp54", "ssprk2"]
 
 
 def arg(name, default, conv=str):

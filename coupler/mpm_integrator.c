@@ -26,8 +26,8 @@ struct mpm_integrator {
   int nmod;
   mpm_cycle cycle; /* the RHS over mod[] */
   mpm_method method;
-  int fixed;  /* fixed CFL steps without error control (classic, euler, time.adaptive = false) */
-  int direct; /* one stage, fixed step (classic, euler): taken here, without ERKStep */
+  int fixed;  /* fixed CFL steps without error control (direct, time.adaptive = false) */
+  int direct; /* fixed step (classic, euler, ssprk2): taken here, without ERKStep */
   double rtol, atol, cfl, dt_max;
   int max_retries;
   double h_limit;   /* fixed steps: the stability-limited step of the current state (0: none) */
@@ -36,7 +36,7 @@ struct mpm_integrator {
   double tstop;     /* stop time of the current step */
   double scale;     /* step reduction of the current retry (1 when not retrying) */
   double checked_t; /* direct steps: time of the last step end whose state was checked */
-  double *work;     /* direct steps: f and the new state, each module's block in turn */
+  double *work;     /* direct steps: f and the stage state, each module's block in turn */
   size_t work_cap;  /* doubles allocated in work */
   mpm_fault fault;  /* last unphysical state seen by the RHS (same on every rank) */
   int rhs_error;    /* a non-recoverable failure inside the RHS */
@@ -60,9 +60,10 @@ struct mpm_integrator {
 const mpm_key_spec mpm_integrator_keys[] = {
     {"time.t_end", MPM_KEY_REAL, NULL, 0, HUGE_VAL, 1, 0, NULL, "end time of the run, s", 0, "s"},
     {"time.method", MPM_KEY_ENUM, "bs32", 0, 0, 0, 0,
-     "usl|musl|euler|ralston21|bs32|zonneveld43|dp54",
-     "time method: usl or musl (classic MPM, fixed CFL step) or an adaptive embedded ERK pair", 0,
-     NULL},
+     "usl|musl|euler|ralston21|bs32|zonneveld43|dp54|ssprk2",
+     "time method: usl or musl (classic MPM, fixed CFL step), an adaptive embedded ERK pair, or "
+     "ssprk2 (two-stage second-order SSP Runge-Kutta, fixed CFL step)",
+     0, NULL},
     {"time.rtol", MPM_KEY_REAL, "1e-6", 0, 1, 1, 0, NULL, "relative tolerance (adaptive)", 0, "-"},
     {"time.atol", MPM_KEY_REAL, "1e-9", 0, HUGE_VAL, 1, 0, NULL,
      "absolute tolerance (adaptive), in state units (m, m/s, 1)", 0, "m, m/s, -"},
@@ -72,7 +73,7 @@ const mpm_key_spec mpm_integrator_keys[] = {
      "s"},
     {"time.adaptive", MPM_KEY_BOOL, "true", 0, 0, 0, 0, NULL,
      "false: the ERK pairs take a fixed step, time.cfl of the stability limit, without error "
-     "control (for stability studies; usl, musl and euler always do)",
+     "control (for stability studies; usl, musl, euler and ssprk2 always do)",
      0, NULL},
     {"time.max_retries", MPM_KEY_INT, "8", 0, 100, 0, 0, NULL,
      "restarts with a 4x smaller step after an unphysical stage before the run stops", 0, "-"},
@@ -80,7 +81,7 @@ const mpm_key_spec mpm_integrator_keys[] = {
 const int mpm_integrator_nkeys = (int)(sizeof mpm_integrator_keys / sizeof mpm_integrator_keys[0]);
 
 static const char *const g_method_names[MPM_METHOD_COUNT] = {
-    "usl", "musl", "euler", "ralston21", "bs32", "zonneveld43", "dp54"};
+    "usl", "musl", "euler", "ralston21", "bs32", "zonneveld43", "dp54", "ssprk2"};
 const char *mpm_method_name(mpm_method m) {
   return g_method_names[m];
 }
@@ -218,7 +219,7 @@ static int estab(N_Vector y, mpm_sunreal t, mpm_sunreal *hstab, void *user) {
   return 0;
 }
 
-/* The stability-limited fixed step (usl, musl, euler, non-adaptive pairs) at y: the CFL
+/* The stability-limited fixed step (direct methods, non-adaptive pairs) at y: the CFL
  * fraction of the limit, capped by dt_max; 0 when nothing limits it. */
 static int fixed_limit(mpm_integrator *it, double *const *yk, double *h) {
   double hs;
@@ -308,7 +309,7 @@ static int wrap_state(mpm_integrator *it) {
   return 0;
 }
 
-/* ---- one stage, fixed step: taken here ---------------------------------------------------- */
+/* ---- fixed steps taken here: one stage, and SSP-RK2 ---------------------------------------- */
 
 /* The classic update (usl, musl) and forward Euler are one stage with a fixed step,
  * y_{n+1} = y_n + h f(t_n, y_n), where the classic update's f also depends on h (the grid
@@ -316,11 +317,19 @@ static int wrap_state(mpm_integrator *it) {
  * changes the particles between nearly all steps, and f depends on the step), an interpolant,
  * an end-of-step RHS and some seven copies of the state, and every vector was reallocated
  * whenever a particle entered, left, or changed rank. Here a step is one RHS, one combination
- * h f + y (ERKStep's arithmetic, so results are bit for bit the same) and one copy. */
+ * h f + y (ERKStep's arithmetic, so results are bit for bit the same) and one copy.
+ *
+ * SSP-RK2 (Shu and Osher 1988; Heun's method, c = (0, 1), b = (1/2, 1/2)) is two forward
+ * Euler stages of the method-of-lines RHS, y1 = y + h f(t, y), then
+ * y_{n+1} = (y + y1 + h f(t + h, y1)) / 2: second order, and it keeps any convex bound
+ * (positive density and J, no new extrema) that a forward Euler step of h keeps. Taken
+ * here rather than through ERKStep: ARKODE before 6.7 treats a table whose last node is c = 1
+ * as first-same-as-last and reuses the second stage's RHS as the next step's first
+ * (llnl/sundials#311), and every stage is checked as a one-stage step's end is. */
 
 #define MPM_RETRY (-1)
 
-/* Room for f and the new state of every module's block; grows by a quarter beyond the need. */
+/* Room for f and the stage state of every module's block; grows by a quarter beyond the need. */
 static int ensure_work(mpm_integrator *it) {
   size_t need = 0;
   for (int k = 0; k < it->nmod; ++k) need += 2 * block_length(it, k);
@@ -355,6 +364,17 @@ static int direct_step(mpm_integrator *it, double h, double *t, double *h_taken)
     for (size_t i = 0; i < len[k]; ++i) zk[i] = h * fk[i] + yk[i];
   }
   if (check_state(it, y1)) return MPM_RETRY;
+  if (it->method == MPM_METHOD_SSPRK2) {
+    /* The second stage: f(t + h, y1) into f, then the average in place of y1. */
+    it->rhs_evals++;
+    MPM_CALL(mpm_cycle_rhs(&it->cycle, it->t_last + h, y1, f, 0));
+    for (int k = 0; k < it->nmod; ++k) {
+      const double *fk = f[k], *yk = y[k];
+      double *zk = y1[k];
+      for (size_t i = 0; i < len[k]; ++i) zk[i] = 0.5 * (yk[i] + (h * fk[i] + zk[i]));
+    }
+    if (check_state(it, y1)) return MPM_RETRY;
+  }
   for (int k = 0; k < it->nmod; ++k)
     if (len[k] > 0) memcpy(y[k], y1[k], len[k] * sizeof(double));
   it->t_last = it->checked_t = it->t_last + h;
@@ -377,7 +397,7 @@ static int read_settings(mpm_integrator *it, const mpm_config *cfg) {
   MPM_CALL(mpm_config_get_int(cfg, "time.max_retries", &it->max_retries));
   int adaptive;
   MPM_CALL(mpm_config_get_bool(cfg, "time.adaptive", &adaptive));
-  it->direct = mpm_method_is_classic(it->method) || it->method == MPM_METHOD_EULER;
+  it->direct = mpm_method_is_direct(it->method);
   it->fixed = !adaptive || it->direct;
   if (it->dt_max <= 0) it->dt_max = HUGE_VAL;
   return 0;

@@ -1,6 +1,6 @@
 /* Time integration of the coupled modules: the ERK pairs with ARKODE's ERKStep (or, multirate,
- * MRIStep with a fast partition of its own, mpm_integrator_new_multirate), the one-stage
- * methods directly.
+ * MRIStep with a fast partition of its own, mpm_integrator_new_multirate), the fixed-step
+ * methods (one stage, and SSP-RK2) directly.
  *
  * The ODE state is every module's state block of its particle set. For ERKStep it is an
  * MPIManyVector with one serial subvector per module, each wrapping that block (no copy). The
@@ -9,14 +9,15 @@
  *
  * Methods: the classic MPM update (USL, and MUSL with its second transfer) and forward Euler
  * are one stage, y += h f, with a fixed step set before every step from the stability limit;
- * the classic update's grid velocity is advanced by that step before G2P. The integrator takes
- * them itself, with ERKStep's arithmetic. The adaptive methods are embedded ERK pairs with
+ * the classic update's grid velocity is advanced by that step before G2P. SSP-RK2 is two such
+ * stages of the method-of-lines RHS averaged with the start (Shu-Osher form) at the same fixed
+ * step. The integrator takes these itself. The adaptive methods are embedded ERK pairs with
  * error control and the same stability limit.
  *
  * Failures: an unphysical stage (NaN, J <= 0, a particle outside the domain or too far out
- * of its box), or such a state at the end of a one-stage step, is seen on every rank. ERKStep
- * 6.4 cannot retry after a recoverable explicit RHS failure, so the integrator restarts
- * itself (and retries a one-stage step) from the last accepted state with a quarter of the step, up
+ * of its box), or such a state at the end of a direct step or its stage, is seen on every rank.
+ * ERKStep 6.4 cannot retry after a recoverable explicit RHS failure, so the integrator restarts
+ * itself (and retries a direct step) from the last accepted state with a quarter of the step, up
  * to max_retries times for one step or until the step falls below 1e-6 of the CFL step (a barrier
  * no step size removes), and then fails with a message that names the particle, its position and
  * the cause. */
@@ -36,6 +37,7 @@ typedef enum {
   MPM_METHOD_BS32,        /* Bogacki-Shampine 3(2) */
   MPM_METHOD_ZONNEVELD43, /* Zonneveld 4(3) */
   MPM_METHOD_DP54,        /* Dormand-Prince 5(4) */
+  MPM_METHOD_SSPRK2,      /* Shu-Osher SSP-RK2 (Heun), two stages, fixed CFL step */
   MPM_METHOD_COUNT
 } mpm_method;
 
@@ -59,7 +61,7 @@ int mpm_integrator_new_multirate(mpm_integrator **it, const mpm_config *cfg, con
 void mpm_integrator_destroy(mpm_integrator **it);
 
 /* (Re)start the integration at (t, current particle state) with first step h0 (0: let
- * ARKODE choose; the one-stage methods take their CFL step). A fresh ERKStep instance each
+ * ARKODE choose; the direct methods take their CFL step). A fresh ERKStep instance each
  * time, so a run that passes through a checkpoint and a run restarted from it take the same
  * steps. */
 int mpm_integrator_start(mpm_integrator *it, double t, double h0);
@@ -78,7 +80,7 @@ int mpm_integrator_substeps(const mpm_integrator *it);
  * nothing limits it. Collective. */
 int mpm_integrator_cfl_step(mpm_integrator *it, double *h);
 
-/* Step ARKODE would try next, or the one-stage methods' last step (for checkpoints). */
+/* Step ARKODE would try next, or the direct methods' last step (for checkpoints). */
 double mpm_integrator_next_step(const mpm_integrator *it);
 
 /* Counters since creation: steps, RHS evaluations, failed (error-test) steps, retries. */
@@ -90,6 +92,11 @@ const char *mpm_method_name(mpm_method m);
 /* Is m a classic MPM update (fixed CFL step known to the RHS)? */
 static inline int mpm_method_is_classic(mpm_method m) {
   return m == MPM_METHOD_USL || m == MPM_METHOD_MUSL;
+}
+
+/* Does the integrator take m's steps itself (fixed CFL steps, no ERKStep)? */
+static inline int mpm_method_is_direct(mpm_method m) {
+  return mpm_method_is_classic(m) || m == MPM_METHOD_EULER || m == MPM_METHOD_SSPRK2;
 }
 
 #endif

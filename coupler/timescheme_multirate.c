@@ -123,6 +123,15 @@ static int multirate_mri_create(mpm_timescheme *ts, const mpm_config *cfg, const
 static int multirate_create(mpm_timescheme *ts, const mpm_config *cfg) {
   const char *method;
   MPM_CALL(mpm_config_get_string(cfg, "time.method", &method));
+  /* MRIStep steps the gas (the slow partition) with its coupling table, never the method's:
+   * ssprk2 would change the solid's substeps only, and name a gas step it is not. */
+  if (strcmp(method, "ssprk2") == 0)
+    return mpm_config_fail(
+        cfg, "time.method",
+        "ssprk2 steps the whole scene at one step, and coupling.time = "
+        "multirate steps the gas with the classic update (usl, musl) or MRIStep's "
+        "own coupling table (bs32 with time.adaptive = false); choose one of "
+        "those, or coupling.time = monolithic");
   if (strcmp(method, "usl") != 0 && strcmp(method, "musl") != 0 && strcmp(method, "euler") != 0)
     return multirate_mri_create(ts, cfg, method);
   MPM_CALL(foreign_key(cfg, KEY_MRI_TABLE,

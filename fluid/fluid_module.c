@@ -759,6 +759,12 @@ static int read_settings(fluid_content *fc, const mpm_config *cfg, const mpm_gri
                            "updates the stress last, with the rate of the step before; remove "
                            "the key or choose time.method = bs32");
   fc->current_rate = !fc->tr.classic && strcmp(rate, "current") == 0;
+  const char *method;
+  MPM_CALL(mpm_config_get_string(cfg, "time.method", &method));
+  if (!fc->current_rate && strcmp(method, "ssprk2") == 0)
+    return mpm_config_fail(cfg, "fluid.strain_rate",
+                           "lagged makes every stage of ssprk2 read the rate of the step before "
+                           "(first order in time); remove the key, current is the default");
   fc->gas.l = g->dx;
   fc->lp = 0.5 / fc->ppc;
   return 0;
