@@ -27,7 +27,7 @@ mean of the strip's 3 rows, which agree to roundoff). Shock position: riemann.sh
 in test_sod. Star plateau: the mean density over the middle half of the exact post-shock
 plateau (between contact and shock) against the exact rho*_R, as a relative error.
 
-Wall time: the solver's step loop only (numpy, one core, freed memory kept in the heap as
+Wall and CPU time (process_time): the solver's step loop only (numpy, one core, freed memory kept in the heap as
 tools/euler_aerofoil.py does), not the set-up nor the measure.
 
 Usage: /usr/bin/python3 bench/fv_strip.py [--problem sod|toro3|toro3_moving|all]
@@ -124,14 +124,15 @@ def solve(name, N, cfl=0.8, limiter="vanleer"):
                   zip((pr.left[0], pr.left[1], 0.0, pr.left[2]),
                       (pr.right[0], pr.right[1], 0.0, pr.right[2]))])
     s.set_interior(W[:, :, None] * np.ones((1, 1, NY)))
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     while s.t < pr.t * (1 - 1e-12):
         s.step(min(s.max_dt(), pr.t - s.t))
-    wall = time.perf_counter() - t0
+    wall, cpu = time.perf_counter() - t0, time.process_time() - c0
     rho = s.primitive()[0, 1:-1, 1:-1]
     l1, off, plat = measure(pr, xc, rho.mean(axis=1), N)
     return {"cells": N, "method": "fv", "particles": N * NY, "l1": l1,
-            "shock_offset_cells": off, "plateau_err": plat, "wall_s": wall, "steps": s.steps,
+            "shock_offset_cells": off, "plateau_err": plat, "wall_s": wall, "cpu_s": cpu,
+            "steps": s.steps,
             "rhs_evals": s.steps, "particle_steps": s.steps * N * NY,
             "first_order_steps": s.first_order_steps,
             "transverse_spread": float(np.ptp(rho, axis=1).max())}
