@@ -24,8 +24,9 @@ Metric: the one test_sod applies to mpmfsi (tests/tools/shocktube.py): L1 = sum 
 (riemann.Riemann.cell_averages), rho_cell the method's cell average: for mpmfsi the particle
 densities joined linearly and averaged over the cell, here the finite-volume cell value (the
 mean of the strip's 3 rows, which agree to roundoff). Shock position: riemann.shock_front, as
-in test_sod. Star plateau: the mean density over the middle half of the exact post-shock
-plateau (between contact and shock) against the exact rho*_R, as a relative error.
+in test_sod. Star plateaux: the mean density over the middle half of the exact post-shock
+plateau (between contact and shock) against the exact rho*_R, and over the middle half of the
+left one (between the fan's tail and the contact) against rho*_L, as relative errors.
 
 Wall and CPU time (process_time): the solver's step loop only (numpy, one core, freed memory kept in the heap as
 tools/euler_aerofoil.py does), not the set-up nor the measure.
@@ -81,23 +82,32 @@ PROBLEMS = {
 
 
 def measure(problem, xc, prof, N):
-    """(L1, shock offset in cells, star-plateau relative error) of a cell profile."""
+    """(L1, shock offset in cells, star-plateau relative errors (right, left)) of a cell
+    profile."""
     ex, t = problem.exact, problem.t
     edges = np.linspace(0.0, 1.0, N + 1)
     l1 = float(np.sum(np.abs(prof - ex.cell_averages(edges, t)[0])) / N)
     xs = shock_front(xc, prof, ex.rr, ex.r_star_r, ex.contact_position(t) + 0.02)
-    return l1, (xs - ex.shock_position(t)) * N, plateau_error(problem, xc, prof)
+    return l1, (xs - ex.shock_position(t)) * N, (plateau_error(problem, xc, prof),
+                                                 plateau_error(problem, xc, prof, "left"))
 
 
-def plateau_error(problem, xc, prof):
-    """Mean density over the cells whose centres lie in the middle half of the exact
-    contact-shock plateau, relative to rho*_R (NaN if no cell centre lies there)."""
+def plateau_error(problem, xc, prof, side="right"):
+    """Mean density over the cells whose centres lie in the middle half of an exact star
+    plateau, relative to its density (NaN if no cell centre lies there): side 'right', the
+    contact-shock plateau (rho*_R); 'left', between the left fan's tail and the contact
+    (rho*_L; the problems here have a left rarefaction)."""
     ex, t = problem.exact, problem.t
-    a, b = ex.contact_position(t), ex.shock_position(t)
+    if side == "right":
+        a, b, ref = ex.contact_position(t), ex.shock_position(t), ex.r_star_r
+    else:
+        c_star = ex.cl * (ex.p_star / ex.pl) ** ((ex.g - 1) / (2 * ex.g))
+        a = ex.x0 + (ex.u_star - c_star) * t
+        b, ref = ex.contact_position(t), ex.r_star_l
     sel = (xc >= a + 0.25 * (b - a)) & (xc <= b - 0.25 * (b - a))
     if not sel.any():
         return float("nan")
-    return float(prof[sel].mean() / ex.r_star_r - 1.0)
+    return float(prof[sel].mean() / ref - 1.0)
 
 
 def mpm_measure(problem, P, N):
@@ -131,7 +141,8 @@ def solve(name, N, cfl=0.8, limiter="vanleer"):
     rho = s.primitive()[0, 1:-1, 1:-1]
     l1, off, plat = measure(pr, xc, rho.mean(axis=1), N)
     return {"cells": N, "method": "fv", "particles": N * NY, "l1": l1,
-            "shock_offset_cells": off, "plateau_err": plat, "wall_s": wall, "cpu_s": cpu,
+            "shock_offset_cells": off, "plateau_err": plat[0], "plateau_l_err": plat[1],
+            "wall_s": wall, "cpu_s": cpu,
             "steps": s.steps,
             "rhs_evals": s.steps, "particle_steps": s.steps * N * NY,
             "first_order_steps": s.first_order_steps,
@@ -147,7 +158,8 @@ def main():
         for N in (int(v) for v in a.cells.split(",")):
             r = solve(name, N)
             print(f"{name:<13} N {N:5d}  L1 {r['l1']:.3e}  shock {r['shock_offset_cells']:+.2f}"
-                  f" cells  plateau {100 * r['plateau_err']:+.2f} %  steps {r['steps']:5d}"
+                  f" cells  plateaux {100 * r['plateau_l_err']:+.2f} % | "
+                  f"{100 * r['plateau_err']:+.2f} %  steps {r['steps']:5d}"
                   f"  wall {r['wall_s']:.3f} s  (first-order steps {r['first_order_steps']},"
                   f" transverse spread {r['transverse_spread']:.1e})", flush=True)
 
