@@ -17,12 +17,14 @@ import mpmtest as mt
 from riemann import cell_profile, shock_front
 
 
-def run(case, N, method, t_end, ranks=1, extra=()):
-    """Run `case` with N cells along x (3 across) to t_end; returns the output folder."""
+def run(case, N, method, t_end, ranks=1, extra=(), x0=0.5):
+    """Run `case` with N cells along x (3 across) to t_end, the diaphragm between its left
+    and right regions at x0; returns the output folder."""
     h = 3.0 / N
     out = mt.outdir(f"{case.split('.')[0]}_{method}_N{N}_np{ranks}")
     mt.run(["run", mt.case(case), f"output.dir={out}", f"grid.dx={1.0 / N}", f"domain.hi=1 {h}",
-            f"geometry.left.hi=0.5 {h}", f"geometry.right.hi=1 {h}", f"time.method={method}",
+            f"geometry.left.hi={x0} {h}", f"geometry.right.lo={x0} 0",
+            f"geometry.right.hi=1 {h}", f"time.method={method}",
             f"time.t_end={t_end}", "run.progress=false"] + list(extra), ranks)
     return out
 
