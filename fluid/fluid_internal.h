@@ -17,10 +17,10 @@
 enum { FLUID_X, FLUID_V, FLUID_J, FLUID_E };
 
 typedef struct fluid_layout {
-  int f_C, f_m, f_V0, f_divv, f_D;  /* field indices; -1 if absent */
-  int f_psi;                        /* riemann viscosity: its limiter (after divv, D) */
-  int f_pending;                    /* method of lines: this RHS's tr D (and D) */
-  int f_rho, f_p, f_mach, f_T, f_s; /* output fields */
+  int f_C, f_m, f_V0, f_divv, f_D;              /* field indices; -1 if absent */
+  int f_psi;                                    /* riemann viscosity: its limiter (after divv, D) */
+  int f_pending;                                /* method of lines: this RHS's tr D (and D) */
+  int f_rho, f_p, f_mach, f_T, f_s, f_rho_grid; /* output fields */
 } fluid_layout;
 
 typedef struct fluid_content {
@@ -105,6 +105,6 @@ int fluid_regularise(mpm_module *m, long step, int *changed);
 int fluid_shift(mpm_module *m, long step, double h, int *changed);
 
 /* Refresh the output fields rho, p, mach, T, s from the particle data (before output). */
-void fluid_output_fields(mpm_module *m);
+int fluid_output_fields(mpm_module *m);
 
 #endif

@@ -579,7 +579,7 @@ static const char *fluid_reserved(const mpm_module *m, const double *x) {
 }
 
 static int fluid_output(mpm_module *m) {
-  fluid_output_fields(m);
+  MPM_CALL(fluid_output_fields(m));
   return 0;
 }
 
@@ -805,10 +805,11 @@ static int particles_new(mpm_particles **p, int dim, fluid_layout *lay, int apic
   lay->f_mach = nf, f[nf++] = (mpm_field_desc){"mach", 1};
   lay->f_T = nf, f[nf++] = (mpm_field_desc){"T", 1};
   lay->f_s = nf, f[nf++] = (mpm_field_desc){"s", 1};
+  lay->f_rho_grid = nf, f[nf++] = (mpm_field_desc){"rho_grid", 1};
   MPM_CALL(mpm_particles_new(p, dim, f, nf, nstate));
   /* The output fields are filled just before a snapshot (fluid_output.c): edits, sorts and
    * migrations need not move them. */
-  for (int k = lay->f_rho; k <= lay->f_s; ++k) mpm_particles_set_derived(*p, k);
+  for (int k = lay->f_rho; k <= lay->f_rho_grid; ++k) mpm_particles_set_derived(*p, k);
   /* Every RHS writes the pending strain rate before the step commits it: a restart from a
    * checkpoint of usl or musl, which have none, needs none. */
   if (lay->f_pending >= 0) mpm_particles_set_scratch(*p, lay->f_pending);

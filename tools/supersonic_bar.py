@@ -7,7 +7,9 @@ grid of density panels, and the histories a user of the main job looks at. Run w
 
 writes into the run folder (the domain, cell size and bar are read from the case stored in
 the snapshots, so refined runs and the gas-only twin with an `[obstacle.bar]` work too)
-  density_strip.png  gas density (the particles' own density, mass-weighted over each cell;
+  density_strip.png  gas density (the snapshot's rho_grid, the grid's density mapped back to
+                     the particles, mass-weighted over each cell; --density particle: the
+                     particles' own rho, which shows the particle noise cell by cell;
                      white: a cell without gas) at every snapshot after t = 0, one panel each
                      (3 across), axes in mm, one colour bar from 0 to 1.5 x the density behind
                      a normal shock at the free stream's Mach number, so that neither the
@@ -119,16 +121,16 @@ def density(P, lo, hi, dx):
     return H / (dx * dx)
 
 
-def density_field(P, lo, hi, dx):
-    """The gas's own density (the particles' rho, mass-weighted over each cell; 0 in a cell
-    without gas), for the picture: it does not flicker with the number of particles a cell
-    happens to hold, as the mass per cell (density) does."""
+def density_field(P, lo, hi, dx, key="rho"):
+    """The gas's own density (the particles' `key`, rho or rho_grid, mass-weighted over each
+    cell; 0 in a cell without gas), for the picture: it does not flicker with the number of
+    particles a cell happens to hold, as the mass per cell (density) does."""
     nx, ny = int(round((hi[0] - lo[0]) / dx)), int(round((hi[1] - lo[1]) / dx))
     rng = ((lo[0], hi[0]), (lo[1], hi[1]))
     m = P["m"][:, 0]
     M = np.histogram2d(P["x"][:, 0], P["x"][:, 1], bins=(nx, ny), range=rng, weights=m)[0]
     R = np.histogram2d(P["x"][:, 0], P["x"][:, 1], bins=(nx, ny), range=rng,
-                       weights=m * P["rho"][:, 0])[0]
+                       weights=m * P[key][:, 0])[0]
     return np.divide(R, M, out=np.zeros_like(R), where=M > 0)
 
 
@@ -239,8 +241,10 @@ def draw_bar(ax, S, sc, spacing, scale):
     ax.contour(xc, yc, m.T, levels=[0.5], colors="k", linewidths=0.8)
 
 
-def density_figure(out, shown, sc, path):
-    """density_strip.png: one panel per snapshot in `shown`; returns the standoff.csv rows."""
+def density_figure(out, shown, sc, path, which="grid"):
+    """density_strip.png: one panel per snapshot in `shown`, the particles' rho_grid (which =
+    grid; their rho where a snapshot has none) or rho (particle); returns the standoff.csv
+    rows."""
     import matplotlib.pyplot as plt
     lo, hi, dx = sc["lo"], sc["hi"], sc["dx"]
     mm = 1e3
@@ -267,7 +271,8 @@ def density_figure(out, shown, sc, path):
         rho = density(G, lo, hi, dx)
         so, ne = standoff(rho, sc), empty_inside(rho, bar_cells(S, sc, rho.shape))
         rows.append((t, so, ne))
-        shown_rho = density_field(G, lo, hi, dx) if "rho" in G else rho
+        key = "rho_grid" if which == "grid" and "rho_grid" in G else "rho"
+        shown_rho = density_field(G, lo, hi, dx, key) if key in G else rho
         im = ax.imshow(np.ma.masked_equal(shown_rho.T, 0), origin="lower", extent=ext, cmap=cmap,
                        vmin=0, vmax=vmax, interpolation="nearest")
         draw_bar(ax, S, sc, spacing, mm)
@@ -282,7 +287,8 @@ def density_figure(out, shown, sc, path):
     rigid = sc["rigid"] or sc["bar"].get("solid.bar.material") == "rigid"
     kind = "gas only" if sc["rigid"] else f"{sc['scheme']} coupling, {sc['method']}"
     fig.suptitle(f"Mach {sc['u_inf'] / np.sqrt(sc['gamma'] * sc['p_inf'] / sc['rho_inf']):.1f} "
-                 f"air over a {'rigid' if rigid else 'clamped elastic'} bar: gas density ({kind}, "
+                 f"air over a {'rigid' if rigid else 'clamped elastic'} bar: gas "
+                 f"{'particle ' if which == 'particle' else ''}density ({kind}, "
                  f"dx = {mm * dx:g} mm, CFL {sc['cfl']:g})", fontsize=11)
     fig.colorbar(im, ax=axes.ravel().tolist(), label="density (kg/m^3)", shrink=0.8,
                  extend="max")
@@ -421,7 +427,7 @@ def force_figure(t, Fx, Fy, sc, euler_path, path):
     plt.close(fig)
 
 
-def main(out, runs=RUNS, euler=EULER):
+def main(out, runs=RUNS, euler=EULER, which="grid"):
     """Draw the figures and write the tables of run folder `out`; raises RunError for a folder
     that is not a run of the case."""
     import matplotlib
@@ -439,7 +445,7 @@ def main(out, runs=RUNS, euler=EULER):
         raise RunError(f"{out} holds no snapshot after t = 0: the run stopped before its first "
                        "output.interval")
     sc = scene(snaps[0][1])
-    rows = density_figure(out, shown, sc, os.path.join(out, "density_strip.png"))
+    rows = density_figure(out, shown, sc, os.path.join(out, "density_strip.png"), which)
     with open(os.path.join(out, "standoff.csv"), "w", newline="") as f:
         w = csv.writer(f)
         w.writerow(["t", "standoff_m", "empty_cells_inside_gas"])
@@ -480,9 +486,13 @@ def cli(argv=None):
     ap.add_argument("--euler", default=EULER,
                     help="the rigid bar's finite-volume Euler reference force.png compares "
                          "with (bench/euler_reference.py's csv; 'none' for none)")
+    ap.add_argument("--density", choices=("grid", "particle"), default="grid",
+                    help="the strip's density: the snapshots' rho_grid (the grid's density "
+                         "mapped back to the particles) or the particles' own rho")
     a = ap.parse_args(argv)
     try:
-        main(a.out, None if a.runs == "none" else a.runs, None if a.euler == "none" else a.euler)
+        main(a.out, None if a.runs == "none" else a.runs, None if a.euler == "none" else a.euler,
+             a.density)
     except RunError as e:
         print(f"supersonic_bar.py: error: {e}", file=sys.stderr)
         return 2
