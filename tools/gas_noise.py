@@ -33,10 +33,12 @@ import glob
 import json
 import math
 import os
-import re
 import sys
 
 import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from plot_fields import config_value  # noqa: E402
 
 BETA, THETA, FOOT = 36.94, 15.0, 0.2
 RHO1_WEDGE, RHO_RATIO_WEDGE = 1.4, 1.8663  # theta-beta-M, gamma = 1.4, M = 2.5, 15 deg
@@ -67,20 +69,6 @@ def load(path):
     P["config"] = cfg.decode() if isinstance(cfg, bytes) else str(cfg)
     P["path"] = path
     return P
-
-
-def config_value(text, section, key, default=None):
-    current = None
-    for line in text.splitlines():
-        line = line.split("#", 1)[0].strip()
-        m = re.fullmatch(r"\[(.+)\]", line)
-        if m:
-            current = m.group(1).strip()
-        elif current == section and "=" in line:
-            k, v = (s.strip() for s in line.split("=", 1))
-            if k == key:
-                return v
-    return default
 
 
 def region_mask(kind, x, y, dx, margin):

@@ -40,9 +40,13 @@ LABELS = {"rho": "density ρ [kg/m³]", "p": "pressure p [Pa]", "mach": "Mach nu
           "sigma": "von Mises stress [Pa]", "J": "volume ratio J"}
 
 
-def config_value(text, section, key):
+_REQUIRED = object()
+
+
+def config_value(text, section, key, default=_REQUIRED):
     """Value of `key` in `[section]` of the resolved case text a snapshot carries (the
-    `config` attribute: one `key = value   # origin` line per key)."""
+    `config` attribute: one `key = value   # origin` line per key); `default` if it has none
+    (KeyError without one)."""
     current = None
     for line in text.splitlines():
         line = line.split("#", 1)[0].strip()
@@ -53,6 +57,8 @@ def config_value(text, section, key):
             k, v = (s.strip() for s in line.split("=", 1))
             if k == key:
                 return v
+    if default is not _REQUIRED:
+        return default
     raise KeyError(f"no {section}.{key} in the snapshot's configuration")
 
 

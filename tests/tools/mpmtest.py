@@ -182,3 +182,31 @@ def restart_difference(case_path, args, T, name, phase="solid"):
     if not np.array_equal(a["id"], b["id"]):
         return False, float("inf"), []
     return (True,) + worst_difference(a, b)
+
+
+def time_errors(label, run_at, cfls, ref_cfl, norm):
+    """The time error of a gas run at each of `cfls` against the same run at `ref_cfl` (same
+    grid, same particles): `run_at(cfl)` runs it and returns its output folder; the error is
+    `norm` of the final particle velocity difference (matched by id) over the largest reference
+    velocity. Prints each run's cost; returns the errors."""
+    def final(cfl):
+        out = run_at(cfl)
+        p = particles(snapshots(out)[-1][1], "fluid")
+        return p["id"], p["v"], cost(out)
+
+    ids, v_ref, c = final(ref_cfl)
+    print(f"{label}: reference at time.cfl = {ref_cfl}: {c}")
+    scale = float(np.max(np.abs(v_ref)))
+    e = []
+    for cfl in cfls:
+        i, v, c = final(cfl)
+        if not np.array_equal(i, ids):
+            raise SystemExit(f"{label}, time.cfl = {cfl}: particle ids differ from the reference")
+        e.append(norm(v - v_ref) / scale)
+        print(f"{label}, time.cfl = {cfl}: velocity error {e[-1]:.3e}; {c}")
+    return e
+
+
+def orders(e):
+    """Observed orders of errors at halved steps: per halving, and first to last."""
+    return [np.log2(a / b) for a, b in zip(e, e[1:])], np.log2(e[0] / e[-1]) / (len(e) - 1)

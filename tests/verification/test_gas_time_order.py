@@ -38,35 +38,16 @@ CFLS = (0.4, 0.2, 0.1)
 REF_CFL = 0.025
 
 
-def final_velocity(rate, cfl):
-    out = shocktube.run("sod.ini", N, "bs32", T, extra=[
-        f"fluid.strain_rate={rate}", f"time.cfl={cfl}", "time.adaptive=false",
-        f"output.interval={T}"])
-    p = mt.particles(mt.snapshots(out)[-1][1], "fluid")
-    order = np.argsort(p["id"])
-    return p["id"][order], p["v"][order], mt.cost(out)
-
-
 def errors(rate):
-    ids, v_ref, cost = final_velocity(rate, REF_CFL)
-    print(f"{rate}: reference at time.cfl = {REF_CFL}: {cost}")
-    scale = float(np.max(np.abs(v_ref)))
-    e = []
-    for cfl in CFLS:
-        i, v, cost = final_velocity(rate, cfl)
-        if not np.array_equal(i, ids):
-            raise SystemExit(f"{rate}, time.cfl = {cfl}: particle ids differ from the reference")
-        e.append(float(np.mean(np.abs(v - v_ref))) / scale)
-        print(f"{rate}, time.cfl = {cfl}: velocity error {e[-1]:.3e}; {cost}")
-    return e
-
-
-def orders(e):
-    return [np.log2(a / b) for a, b in zip(e, e[1:])], np.log2(e[0] / e[-1]) / (len(e) - 1)
+    def run_at(cfl):
+        return shocktube.run("sod.ini", N, "bs32", T, extra=[
+            f"fluid.strain_rate={rate}", f"time.cfl={cfl}", "time.adaptive=false",
+            f"output.interval={T}"])
+    return mt.time_errors(rate, run_at, CFLS, REF_CFL, lambda d: float(np.mean(np.abs(d))))
 
 
 cur, lag = errors("current"), errors("lagged")
-steps, overall = orders(cur)
+steps, overall = mt.orders(cur)
 check(all(a > b for a, b in zip(cur, cur[1:])) and overall >= 1.5,
       f"current: velocity error {', '.join(f'{x:.2e}' for x in cur)} at time.cfl "
       f"{', '.join(map(str, CFLS))}: orders {', '.join(f'{o:.2f}' for o in steps)}, overall "
@@ -74,7 +55,7 @@ check(all(a > b for a, b in zip(cur, cur[1:])) and overall >= 1.5,
 ratios = [b / a for a, b in zip(cur, lag)]
 check(min(ratios) >= 4, f"current against lagged: {', '.join(f'{r:.1f}x' for r in ratios)} "
       f"more accurate (at least 4x)")
-steps, overall = orders(lag)
+steps, overall = mt.orders(lag)
 check(overall < 1.5, f"lagged: velocity error {', '.join(f'{x:.2e}' for x in lag)}: orders "
       f"{', '.join(f'{o:.2f}' for o in steps)}, overall {overall:.2f} (first order: below 1.5)")
 sys.exit(check.finish())

@@ -28,31 +28,14 @@ CFLS = (0.4, 0.2, 0.1)
 REF_CFL = 0.025
 
 
-def final_velocity(method, cfl):
-    out = mt.outdir(f"time_order_{method}_{cfl}")
-    mt.run(["run", mt.case("acoustic_pulse.ini"), f"output.dir={out}", f"time.method={method}",
-            f"time.cfl={cfl}", f"time.t_end={T}", f"output.interval={T}", "run.progress=false"])
-    p = mt.particles(mt.snapshots(out)[-1][1], "fluid")
-    order = np.argsort(p["id"])
-    return p["id"][order], p["v"][order], mt.cost(out)
-
-
 def errors(method):
-    ids, v_ref, cost = final_velocity(method, REF_CFL)
-    print(f"{method}: reference at time.cfl = {REF_CFL}: {cost}")
-    scale = float(np.max(np.abs(v_ref)))
-    e = []
-    for cfl in CFLS:
-        i, v, cost = final_velocity(method, cfl)
-        if not np.array_equal(i, ids):
-            raise SystemExit(f"{method}, time.cfl = {cfl}: particle ids differ from the reference")
-        e.append(float(np.sqrt(np.mean((v - v_ref) ** 2))) / scale)
-        print(f"{method}, time.cfl = {cfl}: velocity error {e[-1]:.3e}; {cost}")
-    return e
-
-
-def orders(e):
-    return [np.log2(a / b) for a, b in zip(e, e[1:])], np.log2(e[0] / e[-1]) / (len(e) - 1)
+    def run_at(cfl):
+        out = mt.outdir(f"time_order_{method}_{cfl}")
+        mt.run(["run", mt.case("acoustic_pulse.ini"), f"output.dir={out}",
+                f"time.method={method}", f"time.cfl={cfl}", f"time.t_end={T}",
+                f"output.interval={T}", "run.progress=false"])
+        return out
+    return mt.time_errors(method, run_at, CFLS, REF_CFL, lambda d: float(np.sqrt(np.mean(d**2))))
 
 
 def fmt(e, steps, overall):
@@ -62,10 +45,10 @@ def fmt(e, steps, overall):
 
 
 rk2, usl = errors("ssprk2"), errors("usl")
-steps, overall = orders(rk2)
+steps, overall = mt.orders(rk2)
 check(all(a > b for a, b in zip(rk2, rk2[1:])) and overall >= 1.8,
       f"ssprk2: {fmt(rk2, steps, overall)} (falls at every halving; overall at least 1.8)")
-steps, overall = orders(usl)
+steps, overall = mt.orders(usl)
 check(overall < 1.5, f"usl: {fmt(usl, steps, overall)} (first order: below 1.5)")
 check(usl[2] >= 2 * rk2[1], f"at equal RHS evaluations, ssprk2 at time.cfl = {CFLS[1]} "
       f"({rk2[1]:.2e}) against usl at {CFLS[2]} ({usl[2]:.2e}): {usl[2] / rk2[1]:.1f}x more "
