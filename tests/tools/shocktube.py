@@ -17,9 +17,16 @@ import mpmtest as mt
 from riemann import cell_profile, shock_front
 
 
+# The shock-tube cases set time.cfl for bs32's fixed step (0.8); usl, musl and ssprk2 run at
+# their documented 0.4 unless a caller gives time.cfl.
+CLASSIC_CFL = {"usl": 0.4, "musl": 0.4, "ssprk2": 0.4}
+
+
 def run(case, N, method, t_end, ranks=1, extra=()):
     """Run `case` with N cells along x (3 across) to t_end; returns the output folder."""
     h = 3.0 / N
+    if method in CLASSIC_CFL and not any(e.startswith("time.cfl=") for e in extra):
+        extra = list(extra) + [f"time.cfl={CLASSIC_CFL[method]}"]
     out = mt.outdir(f"{case.split('.')[0]}_{method}_N{N}_np{ranks}")
     mt.run(["run", mt.case(case), f"output.dir={out}", f"grid.dx={1.0 / N}", f"domain.hi=1 {h}",
             f"geometry.left.hi=0.5 {h}", f"geometry.right.hi=1 {h}", f"time.method={method}",
