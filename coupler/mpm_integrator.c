@@ -73,7 +73,7 @@ const mpm_key_spec mpm_integrator_keys[] = {
      "s"},
     {"time.adaptive", MPM_KEY_BOOL, "true", 0, 0, 0, 0, NULL,
      "false: the ERK pairs take a fixed step, time.cfl of the stability limit, without error "
-     "control (for stability studies; usl, musl, euler and ssprk2 always do)",
+     "control (the shock tubes: bs32 at time.cfl = 0.8; usl, musl, euler and ssprk2 always do)",
      0, NULL},
     {"time.max_retries", MPM_KEY_INT, "8", 0, 100, 0, 0, NULL,
      "restarts with a 4x smaller step after an unphysical stage before the run stops", 0, "-"},

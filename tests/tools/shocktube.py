@@ -17,10 +17,17 @@ import mpmtest as mt
 from riemann import cell_profile, shock_front
 
 
+# The shock-tube cases set time.cfl for bs32's fixed step (0.8); usl, musl and ssprk2 run at
+# their documented 0.4 unless a caller gives time.cfl.
+CLASSIC_CFL = {"usl": 0.4, "musl": 0.4, "ssprk2": 0.4}
+
+
 def run(case, N, method, t_end, ranks=1, extra=(), x0=0.5):
     """Run `case` with N cells along x (3 across) to t_end, the diaphragm between its left
     and right regions at x0; returns the output folder."""
     h = 3.0 / N
+    if method in CLASSIC_CFL and not any(e.startswith("time.cfl=") for e in extra):
+        extra = list(extra) + [f"time.cfl={CLASSIC_CFL[method]}"]
     out = mt.outdir(f"{case.split('.')[0]}_{method}_N{N}_np{ranks}")
     mt.run(["run", mt.case(case), f"output.dir={out}", f"grid.dx={1.0 / N}", f"domain.hi=1 {h}",
             f"geometry.left.hi={x0} {h}", f"geometry.right.lo={x0} 0",
