@@ -1,8 +1,9 @@
 #!/usr/bin/python3
 """Work-precision of the gas time methods on the shock tubes: the L1 density error against
-wall time and particle-steps over 100 ... 1600 cells and the time methods usl, musl (classic
-updates at the case's CFL) and the adaptive pairs bs32, zonneveld43, dp54 (at the case's
-atol), with, measured in the same run, the reference finite-volume solver (MUSCL-Hancock +
+wall time and particle-steps over 100 ... 1600 cells and the time methods usl, musl, ssprk2
+(at time.cfl 0.4, tests/tools/shocktube.py) and the pairs bs32, zonneveld43, dp54 at the
+case's time settings (the shock-tube cases: a fixed step at time.cfl 0.8; `--set
+time.adaptive=true,time.cfl=0.4,time.atol=1e-4` for the adaptive pairs), with, measured in the same run, the reference finite-volume solver (MUSCL-Hancock +
 HLLC, bench/fv_strip.py) on the same problem in the same strip at 400, 800 and 1600 cells,
 and each method's cost at equal error as a ratio to it.
 
