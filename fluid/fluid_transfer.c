@@ -312,7 +312,7 @@ void fluid_wall_rate_mol(const mpm_module *m, const double *y, double *const *vd
  * P is self-adjoint in the mass-weighted product the kinetic energy removed is sum m k |q|^2,
  * which each particle takes as heat k |q|^2 >= 0. A resolved wave of wavenumber kx has
  * 1 - P ~ (kx dx)^2 / 4 per axis, squared here: the pulse's peak lost 0.07 % in four crossings
- * (2 % with one filter at half the rate). */
+ * (1.4 % with one filter at half the rate). */
 
 /* The filtered velocity P s of particle velocities s: deposit m s into the filter's phase, sum
  * the ranks' halos, divide by the nodal mass and interpolate back. sum_p m_p (P s)_p =
