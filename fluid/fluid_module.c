@@ -227,6 +227,13 @@ static int deposit(mpm_module *m, const double *y, const double *vsig, const flu
     a.gravity[d] = vsig ? fc->gravity[d] : 0.0;
   }
   mpm_kernels_get(dim)->p2g(m->grid, m->phase, &a);
+  if (fc->filter_phase >= 0) { /* the particles' own m and m v, for fluid_mol_damping */
+    const mpm_grid_phase *ph = &m->grid->phase[m->phase];
+    mpm_grid_phase *fp = &m->grid->phase[fc->filter_phase];
+    const size_t bytes = sizeof(double) * (size_t)m->grid->nnodes;
+    memcpy(fp->m_i, ph->m_i, bytes);
+    for (int d = 0; d < dim; ++d) memcpy(fp->mv_i[d], ph->mv_i[d], bytes);
+  }
   fluid_virtual_clear(&fc->virt);
   MPM_CALL(fluid_open_p2g(fc->open, m, y, &fc->virt));
   MPM_CALL(fluid_virtual_deposit(&fc->virt, m->grid, fc->lp));

@@ -319,17 +319,19 @@ void fluid_wall_rate_mol(const mpm_module *m, const double *y, double *const *vd
  * sum_i (m s)_i = sum_p m_p s_p exactly, whatever the walls and other phases do, because the
  * phase holds these particles alone. */
 static int filter(mpm_module *m, const double *y, double *const *s, double *const *out,
-                  double *dummy) {
+                  double *dummy, int deposited) {
   fluid_content *fc = m->content;
   const mpm_particles *p = m->particles;
   mpm_grid *g = m->grid;
   const int dim = p->dim;
   const mpm_lidx n = p->n;
   mpm_grid_phase *ph = &g->phase[fc->filter_phase];
-  mpm_grid_phase_zero(g, fc->filter_phase);
   mpm_p2g_args a = {.n = n, .m = mpm_particles_comp(p, fc->lay.f_m, 0), .lp = fc->lp};
   for (int d = 0; d < dim; ++d) a.x[d] = y + (size_t)(p->offset[FLUID_X] + d) * n, a.v[d] = s[d];
-  mpm_kernels_get(dim)->p2g(g, fc->filter_phase, &a);
+  if (!deposited) { /* (the velocities' own deposit was copied here by fluid_p2g) */
+    mpm_grid_phase_zero(g, fc->filter_phase);
+    mpm_kernels_get(dim)->p2g(g, fc->filter_phase, &a);
+  }
   double *f[1 + MPM_MAX_DIM];
   f[0] = ph->m_i;
   for (int d = 0; d < dim; ++d) f[1 + d] = ph->mv_i[d];
@@ -367,7 +369,7 @@ int fluid_mol_damping(mpm_module *m, const double *y, double *const *vdot, doubl
     q[d] = work + (size_t)d * n, s[d] = work + (size_t)(dim + d) * n;
     ps[d] = work + (size_t)(2 * dim + d) * n;
   }
-  MPM_CALL(filter(m, y, vp, q, dummy)); /* q = (1 - P) v, the velocity the grid does not see */
+  MPM_CALL(filter(m, y, vp, q, dummy, 1)); /* q = (1 - P) v, the velocity the grid does not see */
   for (mpm_lidx i = 0; i < n; ++i) {
     const double k = beta * sqrt(gamma * (gamma - 1.0) * fabs(e[i])); /* beta c / dx */
     for (int d = 0; d < dim; ++d) {
@@ -376,7 +378,7 @@ int fluid_mol_damping(mpm_module *m, const double *y, double *const *vdot, doubl
       power[i] += k * q[d][i] * q[d][i];
     }
   }
-  MPM_CALL(filter(m, y, s, ps, dummy));
+  MPM_CALL(filter(m, y, s, ps, dummy, 0));
   for (int d = 0; d < dim; ++d)
     for (mpm_lidx i = 0; i < n; ++i) vdot[d][i] -= s[d][i] - ps[d][i];
   return 0;
