@@ -46,6 +46,9 @@ typedef struct fluid_content {
   int shift_every;           /* shift every shift_every steps */
   double shift_J;            /* only particles with J >= shift_J move */
   int current_rate;          /* fluid.strain_rate = current (fluid_module.c) */
+  double mol_damping;        /* fluid.mol_damping (fluid_transfer.c); 0: off */
+  int filter_phase;          /* its scratch grid phase (-1: none) */
+  double *work;              /* its particle scratch (4 dim cap) */
   double *sub, *zero;        /* its viscous deposit: positions and stresses, zeros (cap each) */
   int stable_local;          /* fluid.stable_step = neighbourhood (fluid_stable.c) */
   double s_local;            /* its fastest signal for this step, m/s; < 0: not yet known */
@@ -78,6 +81,11 @@ void fluid_classic_transfer(mpm_module *m, const double *y, double h, const flui
  * relaxes the particles' velocity into a wall face at (1 - keep) 2 c / dx, subtracting from
  * vdot, and adds the kinetic energy removed to power (de/dt). */
 void fluid_wall_rate_mol(const mpm_module *m, const double *y, double *const *vdot, double *power);
+/* The method of lines' damping of the particle velocity the grid does not see (fluid_transfer.c,
+ * fluid.mol_damping): subtracts it from vdot and adds the kinetic energy it removes to power.
+ * work: 4 dim n doubles of particle scratch. */
+int fluid_mol_damping(mpm_module *m, const double *y, double *const *vdot, double *power,
+                      double *work);
 
 /* The riemann viscosity's limiter psi (fluid_stress.h) of every particle of state y, from
  * the nodal velocity v_i whose gradient at the particles is L (dim^2 components of n)

@@ -74,6 +74,13 @@ static const mpm_key_spec fluid_keys[] = {
      "(of the previous step: cheaper, but it holds every ERK pair to first order in time "
      "wherever the artificial viscosity acts); the classic update always lags",
      0, NULL},
+    {"fluid.mol_damping", MPM_KEY_REAL, "0.1", 0, 1, 0, 0, NULL,
+     "ERK pairs: the rate, in units of c / dx, at which the particle velocity the grid does not "
+     "see (v_p - sum S v_i, filtered once more through the grid so that smooth flow keeps it) "
+     "relaxes, its kinetic energy becoming the particle's heat (0: off). Stops a transverse "
+     "grid-scale mode that the method of lines grows from roundoff where particles sit off "
+     "their lattice (docs/gas.md); mass, momentum and total energy stay exact",
+     0, "-"},
     {"fluid.ppc", MPM_KEY_INT, "2", 1, 8, 0, 0, NULL,
      "gas particles per cell per direction at seeding", 0, "-"},
     {"fluid.regularise_every", MPM_KEY_INT, "0", 0, HUGE_VAL, 0, 0, NULL,
@@ -186,11 +193,12 @@ static int ensure_scratch(mpm_module *m) {
   const int dim = m->grid->dim;
   if (n <= fc->cap && fc->vsig) return 0;
   free(fc->vsig), free(fc->scratch), free(fc->vnew), free(fc->Cnew), free(fc->power);
-  free(fc->tscratch), free(fc->sub), free(fc->zero);
-  fc->vnew = fc->Cnew = fc->tscratch = fc->sub = fc->zero = NULL;
+  free(fc->tscratch), free(fc->sub), free(fc->zero), free(fc->work);
+  fc->vnew = fc->Cnew = fc->tscratch = fc->sub = fc->zero = fc->work = NULL;
   fc->cap = n + n / 4 + 16;
   MPM_ALLOC(fc->vsig, (size_t)dim * dim * fc->cap);
   MPM_ALLOC(fc->scratch, (size_t)(2 * dim + dim * dim) * fc->cap);
+  if (fc->mol_damping > 0) MPM_ALLOC(fc->work, (size_t)4 * dim * fc->cap);
   MPM_ALLOC(fc->power, fc->cap);
   if (fc->tr.classic)
     MPM_ALLOC(fc->tscratch, (size_t)(dim + 3 + (fc->tr.apic ? dim * dim + 2 * dim : 0)) * fc->cap);
@@ -219,6 +227,13 @@ static int deposit(mpm_module *m, const double *y, const double *vsig, const flu
     a.gravity[d] = vsig ? fc->gravity[d] : 0.0;
   }
   mpm_kernels_get(dim)->p2g(m->grid, m->phase, &a);
+  if (fc->filter_phase >= 0) { /* the particles' own m and m v, for fluid_mol_damping */
+    const mpm_grid_phase *ph = &m->grid->phase[m->phase];
+    mpm_grid_phase *fp = &m->grid->phase[fc->filter_phase];
+    const size_t bytes = sizeof(double) * (size_t)m->grid->nnodes;
+    memcpy(fp->m_i, ph->m_i, bytes);
+    for (int d = 0; d < dim; ++d) memcpy(fp->mv_i[d], ph->mv_i[d], bytes);
+  }
   fluid_virtual_clear(&fc->virt);
   MPM_CALL(fluid_open_p2g(fc->open, m, y, &fc->virt));
   MPM_CALL(fluid_virtual_deposit(&fc->virt, m->grid, fc->lp));
@@ -516,6 +531,7 @@ static int fluid_g2p(mpm_module *m, double t, const double *y, double *ydot, dou
     mpm_transfer_g2p(m->grid, m->phase, p, y, fc->lp, xdot, vdot, L, NULL);
     energy_rate(m, L, NULL, h);
     if (!fc->tr.apic) fluid_wall_rate_mol(m, y, vdot, fc->power);
+    MPM_CALL(fluid_mol_damping(m, y, vdot, fc->power, fc->work));
   } else if (!fc->tr.musl) {
     fluid_step_out o = {.C = Cdot};
     for (int d = 0; d < dim; ++d) o.vhat[d] = xdot[d], o.vnew[d] = vdot[d];
@@ -659,7 +675,7 @@ static void fluid_destroy(mpm_module *m) {
     fluid_wall_ls_free(&fc->wall);
     fluid_virtual_free(&fc->virt);
     free(fc->vsig), free(fc->scratch), free(fc->vnew), free(fc->Cnew), free(fc->power);
-    free(fc->sub), free(fc->zero);
+    free(fc->sub), free(fc->zero), free(fc->work);
     free(fc->tscratch), free(fc->node), free(fc->cellsum), free(fc->lim);
     free(fc);
   }
@@ -759,6 +775,12 @@ static int read_settings(fluid_content *fc, const mpm_config *cfg, const mpm_gri
                            "updates the stress last, with the rate of the step before; remove "
                            "the key or choose time.method = bs32");
   fc->current_rate = !fc->tr.classic && strcmp(rate, "current") == 0;
+  MPM_CALL(mpm_config_get_real(cfg, "fluid.mol_damping", &fc->mol_damping));
+  if (fc->tr.classic && mpm_config_has(cfg, "fluid.mol_damping"))
+    return mpm_config_fail(cfg, "fluid.mol_damping",
+                           "is read with the ERK pairs only: the classic update (usl, musl) "
+                           "damps through fluid.pic_fraction; remove the key");
+  if (fc->tr.classic || fc->tr.apic) fc->mol_damping = 0.0;
   const char *method;
   MPM_CALL(mpm_config_get_string(cfg, "time.method", &method));
   if (!fc->current_rate && strcmp(method, "ssprk2") == 0)
@@ -822,8 +844,10 @@ static int build(mpm_module *m, const mpm_config *cfg, int seed) {
   mpm_walls walls;
   MPM_CALL(mpm_grid_add_phase(g, "fluid", &m->phase));
   MPM_CALL(mpm_config_get_real(cfg, "fluid.empty_node_mass", &g->phase[m->phase].empty_fraction));
+  fc->filter_phase = -1;
   MPM_CALL(mpm_config_get_real(cfg, "fluid.light_node_mass", &g->phase[m->phase].light_fraction));
   MPM_CALL(read_settings(fc, cfg, g));
+  if (fc->mol_damping > 0.0) MPM_CALL(mpm_grid_add_phase(g, "fluid_filter", &fc->filter_phase));
   MPM_CALL(mpm_walls_from_config(&walls, cfg, g->dim));
   MPM_CALL(mpm_constraints_add_walls(&fc->cons, &walls, g));
   fc->walls = walls;
