@@ -218,8 +218,10 @@ def page(rows):
     name = PAGES[PROBLEM][0]
     L = [f"# {PAGES[PROBLEM][1]} (bench/bench_sod.py --problem {PROBLEM})", "",
          f"{PAGES[PROBLEM][2]}, quadratic B-splines, 2 particles per cell "
-         "per direction. usl and musl at the case's CFL 0.4 with FLIP; bs32, zonneveld43 and dp54 "
-         "adaptive at the case's atol 1e-4 (default rtol). Error: L1 of the cell-averaged density "
+         "per direction. usl, musl (FLIP) and ssprk2 at time.cfl 0.4; bs32, zonneveld43 and dp54 "
+         "at the case's time settings when the row was measured (each row's invocation and "
+         "commit are in the JSON; since 2026-12-02 the shock-tube cases take a fixed step at "
+         "time.cfl 0.8, before that adaptive at atol 1e-4). Error: L1 of the cell-averaged density "
          "against the exact solution, as `test_sod` measures it (`tests/tools/shocktube.py`, "
          "`tests/tools/riemann.py`). One rank. Raw rows: "
          f"[csv]({name}.csv), [json]({name}.json).", "",
