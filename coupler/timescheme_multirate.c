@@ -5,7 +5,13 @@
  * first, against the solid held at the start of the step, then the solid under exactly the
  * momentum the gas gave up, spread over H either evenly (coupling.load = held) or with the
  * load's linear trend since the last coupling step (interpolated; the same momentum). With
- * m = 1 this is the monolithic classic step (see timescheme_staggered.c, gas_first).
+ * m = 1 this is the monolithic classic step (see timescheme_staggered.c, gas_first). With
+ * coupling.predictor = linear the gas meets the held solid's interface velocity extrapolated
+ * from its last two coupling steps instead (mpm_interface.h); the exchange stays exact.
+ *
+ * H is the slow module's stable step. On the shock panel that is the gas's, and in it the
+ * artificial viscosity's diffusion limit (fluid.viscous_step, fluid_stress.h): a trace-level log
+ * line gives both modules' stable steps and the substeps of every coupling step.
  *
  * An ablation of multirate's own error: with coupling.slow_substeps = n the slow module, too,
  * takes n substeps of H / n against the fast one held at the start of the coupling step (0: as
