@@ -52,7 +52,7 @@ static int grid_pass(const mpm_cycle *c, double t, double h, mpm_pass pass) {
   MPM_CALL(halo(c, 1));
   mpm_timer_start(MPM_T_GRID);
   for (int k = 0; k < c->nmod; ++k) MPM_CALL(c->mod[k]->ops->forces(c->mod[k], t, h, pass));
-  if (hm) mpm_interface_restore(c->iface);
+  if (hm) mpm_interface_restore(c->iface), mpm_interface_predict(c->iface, t);
   /* Held and loaded first passes capture what the solid is given (mpm_interface.h). */
   mpm_interface *cap = c->mode != MPM_CYCLE_JOINT && pass == MPM_PASS_FIRST ? c->iface : NULL;
   if (cap) mpm_interface_capture_begin(cap);

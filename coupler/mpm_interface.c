@@ -35,7 +35,9 @@ void mpm_interface_destroy(mpm_interface **ifcp) {
     free(ifc->mv[d]), free(ifc->f[d]), free(ifc->normal[d]);
     free(ifc->capture[d]), free(ifc->impulse[d]), free(ifc->load[d]);
     free(ifc->trend[d]), free(ifc->prev[d]), free(ifc->now[d]), free(ifc->moved[d]);
+    free(ifc->vprev[d]), free(ifc->accel[d]);
   }
+  free(ifc->mprev);
   free(ifc);
   *ifcp = NULL;
 }
@@ -60,6 +62,48 @@ void mpm_interface_hold(mpm_interface *ifc) {
 
 void mpm_interface_restore(const mpm_interface *ifc) {
   copy_fields(ifc, 0);
+}
+
+int mpm_interface_want_predictor(mpm_interface *ifc) {
+  const size_t nn = (size_t)ifc->grid->nnodes;
+  MPM_ALLOC(ifc->mprev, nn);
+  for (int d = 0; d < ifc->grid->dim; ++d) {
+    MPM_ALLOC(ifc->vprev[d], nn);
+    MPM_ALLOC(ifc->accel[d], nn);
+  }
+  ifc->t_prev = -1.0;
+  return 0;
+}
+
+void mpm_interface_predict_hold(mpm_interface *ifc, double t) {
+  if (!ifc->mprev) return;
+  const int dim = ifc->grid->dim;
+  const double span = t - ifc->t_prev, inv = ifc->t_prev >= 0.0 && span > 0.0 ? 1.0 / span : 0.0;
+  for (mpm_lidx l = 0; l < ifc->grid->nnodes; ++l) {
+    const double m = ifc->m[l];
+    const int known = inv > 0.0 && m > 0.0 && ifc->mprev[l] > 0.0;
+    for (int d = 0; d < dim; ++d) {
+      const double v = m > 0.0 ? ifc->mv[d][l] / m : 0.0;
+      /* (no history: the held force, as without the predictor) */
+      ifc->accel[d][l] = known     ? (v - ifc->vprev[d][l]) * inv - ifc->load[d][l] / m
+                         : m > 0.0 ? ifc->f[d][l] / m
+                                   : 0.0;
+      ifc->vprev[d][l] = v;
+    }
+    ifc->mprev[l] = m;
+  }
+  ifc->t_prev = ifc->t_hold = t;
+}
+
+void mpm_interface_predict(const mpm_interface *ifc, double t) {
+  if (!ifc->mprev) return;
+  mpm_grid_phase *ph = &ifc->grid->phase[ifc->phase];
+  const double s = t - ifc->t_hold;
+  for (int d = 0; d < ifc->grid->dim; ++d)
+    for (mpm_lidx l = 0; l < ifc->grid->nnodes; ++l) {
+      const double ma = ph->m_i[l] * ifc->accel[d][l];
+      ph->mv_i[d][l] += s * ma, ph->f_i[d][l] = ma;
+    }
 }
 
 void mpm_interface_capture_begin(mpm_interface *ifc) {
@@ -172,11 +216,12 @@ void mpm_interface_owed(const mpm_interface *ifc, const unsigned char *owned, do
 
 /* ---- checkpoints ---------------------------------------------------------------------------- */
 
-enum { IFC_X, IFC_J, IFC_L, IFC_SPAN, IFC_NFIELDS };
+enum { IFC_X, IFC_J, IFC_L, IFC_SPAN, IFC_P, IFC_PM, IFC_TP, IFC_Q, IFC_NFIELDS };
 
-int mpm_interface_particles_new(mpm_particles **p, int dim) {
-  const mpm_field_desc fields[IFC_NFIELDS] = {{"x", dim}, {"v", dim}, {"L", dim}, {"span", 1}};
-  return mpm_particles_new(p, dim, fields, IFC_NFIELDS, 2);
+int mpm_interface_particles_new(mpm_particles **p, int dim, int predictor) {
+  const mpm_field_desc fields[IFC_NFIELDS] = {{"x", dim}, {"v", dim}, {"L", dim}, {"span", 1},
+                                              {"P", dim}, {"Pm", 1},  {"tp", 1},  {"Q", dim}};
+  return mpm_particles_new(p, dim, fields, predictor ? IFC_NFIELDS : IFC_P, 2);
 }
 
 /* Does node l carry state? */
@@ -184,7 +229,7 @@ static int carries(const mpm_interface *ifc, mpm_lidx l) {
   int any = 0;
   for (int d = 0; d < ifc->grid->dim; ++d)
     any |= ifc->impulse[d][l] != 0.0 || (ifc->prev[d] && ifc->prev[d][l] != 0.0);
-  return any;
+  return any || (ifc->mprev && ifc->mprev[l] > 0.0);
 }
 
 int mpm_interface_pack(const mpm_interface *ifc, const unsigned char *owned, mpm_particles *p) {
@@ -210,7 +255,14 @@ int mpm_interface_pack(const mpm_interface *ifc, const unsigned char *owned, mpm
       add[(size_t)(dim + d) * n + k] = ifc->impulse[d][l];
       add[(size_t)(2 * dim + d) * n + k] = ifc->prev[d] ? ifc->prev[d][l] : 0.0;
     }
-    add[(size_t)(3 * dim) * n + k++] = ifc->span_prev;
+    add[(size_t)(3 * dim) * n + k] = ifc->span_prev;
+    if (ifc->mprev) {
+      for (int d = 0; d < dim; ++d) add[(size_t)(3 * dim + 1 + d) * n + k] = ifc->vprev[d][l];
+      add[(size_t)(4 * dim + 1) * n + k] = ifc->mprev[l];
+      add[(size_t)(4 * dim + 2) * n + k] = ifc->t_prev;
+      for (int d = 0; d < dim; ++d) add[(size_t)(4 * dim + 3 + d) * n + k] = ifc->load[d][l];
+    }
+    ++k;
   }
   const int rc = mpm_particles_inject(p, g->comm, n, add);
   free(add);
@@ -229,5 +281,10 @@ void mpm_interface_unpack(mpm_interface *ifc, const mpm_particles *p) {
       if (ifc->prev[d]) ifc->prev[d][l] = mpm_particles_comp(p, IFC_L, d)[i];
     }
     ifc->span_prev = ifc->trend[0] ? mpm_particles_comp(p, IFC_SPAN, 0)[i] : 0.0;
+    if (!ifc->mprev) continue;
+    for (int d = 0; d < g->dim; ++d) ifc->vprev[d][l] = mpm_particles_comp(p, IFC_P, d)[i];
+    ifc->mprev[l] = mpm_particles_comp(p, IFC_PM, 0)[i];
+    ifc->t_prev = mpm_particles_comp(p, IFC_TP, 0)[i];
+    for (int d = 0; d < g->dim; ++d) ifc->load[d][l] = mpm_particles_comp(p, IFC_Q, d)[i];
   }
 }

@@ -63,6 +63,11 @@ typedef struct mpm_interface {
   double *m_start;            /* the solid's nodal mass at the first RHS of its current advance */
   double *moved[MPM_MAX_DIM]; /* scratch of mpm_interface_rehome (allocated at its first call) */
   int start_due;              /* m_start is taken at the next loaded RHS */
+  /* The predictor (mpm_interface_want_predictor; else NULL): the held solid's nodal velocity
+   * and mass at the hold before (vprev, mprev, at time t_prev, < 0: none yet) and the
+   * acceleration predicted from them at the current hold (at t_hold), m/s^2 per node. */
+  double *vprev[MPM_MAX_DIM], *mprev, *accel[MPM_MAX_DIM];
+  double t_prev, t_hold;
 } mpm_interface;
 
 int mpm_interface_new(mpm_interface **ifc, mpm_grid *grid, int phase);
@@ -72,6 +77,28 @@ void mpm_interface_destroy(mpm_interface **ifc);
 void mpm_interface_hold(mpm_interface *ifc);
 /* Put them back into the held phase. */
 void mpm_interface_restore(const mpm_interface *ifc);
+
+/* The predictor (coupling.predictor = linear). A held solid is otherwise met as it was at the
+ * hold, advanced over each gas step by its own nodal force at the hold (its internal force: on
+ * a stiff, fast solid a quantity of its own fast time scale, which one gas step of many fast
+ * ones turns into a face velocity that need not be the solid's). With the predictor the gas
+ * meets the solid's nodal velocity extrapolated linearly from its last two holds: at each gas
+ * RHS at t with step h the held node has momentum m (v + a (t - t_hold)) and force m a, with
+ * a = (v - v_prev) / (t_hold - t_prev) - load / m, the solid's mean acceleration over its last
+ * advance less what the gas's load gave it then (the spatial scheme adds the gas's exchange
+ * of this step itself: left in, the load counted twice and the predictor's error on the
+ * stiff piston was 5-9 times the held solid's), so that the solve gives v + a (t + h - t_hold).
+ * Where the node had no solid mass at the hold before (or at the first hold) the held force stays.
+ * It changes only what the gas sees: what it gives up is still captured and owed, so the
+ * interface balances exactly as before. The previous hold's velocity, mass and time are state
+ * (checkpointed with the rest). */
+int mpm_interface_want_predictor(mpm_interface *ifc);
+/* At a hold at time t (after mpm_interface_hold): the acceleration from this hold and the last,
+ * and this hold becomes the last. */
+void mpm_interface_predict_hold(mpm_interface *ifc, double t);
+/* After mpm_interface_restore in a held RHS at t: the held phase's momentum and force as the
+ * predictor has them (nothing without a predictor). */
+void mpm_interface_predict(const mpm_interface *ifc, double t);
 
 /* A gas or solid RHS begins: nothing captured yet. */
 void mpm_interface_capture_begin(mpm_interface *ifc);
@@ -110,12 +137,15 @@ void mpm_interface_owed(const mpm_interface *ifc, const unsigned char *owned, do
  * What an interface carries from one coupling step to the next is state: the momentum owed to
  * the solid and, with interpolated loads, the last load and its span. A checkpoint stores it as
  * a particle set, one particle per owned node that carries any (x: the node, v: the owed
- * impulse, L: the last load, span), so that a restart on any number of ranks finds it by
- * position, after migration, on the node it came from. */
+ * impulse, L: the last load, span; with the predictor, the last hold's velocity and mass), so that
+ * a restart on any number of ranks finds it by position, after migration, on the node it came from.
+ */
 
-/* An empty set with that layout, and its name in a checkpoint. */
+/* An empty set with that layout, and its name in a checkpoint. With the predictor
+ * (predictor = 1) each particle also carries the node's velocity and mass at the last hold,
+ * that hold's time and the load of the last advance (P, Pm, tp, Q). */
 #define MPM_INTERFACE_PHASE "interface"
-int mpm_interface_particles_new(mpm_particles **p, int dim);
+int mpm_interface_particles_new(mpm_particles **p, int dim, int predictor);
 /* Fill p (from mpm_interface_particles_new) with this rank's owned nodes that carry state. */
 int mpm_interface_pack(const mpm_interface *ifc, const unsigned char *owned, mpm_particles *p);
 /* Put the state of p (migrated to the owners of its nodes) back on the nodes. */

@@ -80,6 +80,7 @@ int mpm_partitioned_hold(mpm_timescheme *ts, double t) {
   double *y = pp->solid->particles->data;
   MPM_CALL(mpm_cycle_deposit(&pp->deposit, t, &y));
   mpm_interface_hold(pp->ifc);
+  mpm_interface_predict_hold(pp->ifc, t);
   return 0;
 }
 
@@ -194,7 +195,7 @@ int mpm_partitioned_record(mpm_timescheme *ts, double t, mpm_coupling_record *ou
 
 int mpm_partitioned_save(mpm_timescheme *ts, mpm_particles **p, const char **name) {
   mpm_partitioned *pp = ts->content;
-  MPM_CALL(mpm_interface_particles_new(p, ts->grid->dim));
+  MPM_CALL(mpm_interface_particles_new(p, ts->grid->dim, pp->ifc->mprev != NULL));
   *name = MPM_INTERFACE_PHASE;
   return mpm_interface_pack(pp->ifc, ts->coupling->owned, *p);
 }
@@ -202,7 +203,7 @@ int mpm_partitioned_save(mpm_timescheme *ts, mpm_particles **p, const char **nam
 int mpm_partitioned_restore(mpm_timescheme *ts, mpm_checkpoint *ck) {
   mpm_partitioned *pp = ts->content;
   mpm_particles *p = NULL;
-  int rc = mpm_interface_particles_new(&p, ts->grid->dim);
+  int rc = mpm_interface_particles_new(&p, ts->grid->dim, pp->ifc->mprev != NULL);
   if (!rc) rc = mpm_checkpoint_read_particles(ck, MPM_INTERFACE_PHASE, p);
   if (!rc) rc = mpm_particles_migrate(p, ts->grid, NULL);
   if (!rc) mpm_interface_unpack(pp->ifc, p);

@@ -5,7 +5,13 @@
  * first, against the solid held at the start of the step, then the solid under exactly the
  * momentum the gas gave up, spread over H either evenly (coupling.load = held) or with the
  * load's linear trend since the last coupling step (interpolated; the same momentum). With
- * m = 1 this is the monolithic classic step (see timescheme_staggered.c, gas_first).
+ * m = 1 this is the monolithic classic step (see timescheme_staggered.c, gas_first). With
+ * coupling.predictor = linear the gas meets the held solid's interface velocity extrapolated
+ * from its last two coupling steps instead (mpm_interface.h); the exchange stays exact.
+ *
+ * H is the slow module's stable step. On the shock panel that is the gas's, and in it the
+ * artificial viscosity's diffusion limit (fluid.viscous_step, fluid_stress.h): a trace-level log
+ * line gives both modules' stable steps and the substeps of every coupling step.
  *
  * An ablation of multirate's own error: with coupling.slow_substeps = n the slow module, too,
  * takes n substeps of H / n against the fast one held at the start of the coupling step (0: as
@@ -27,13 +33,14 @@
  * the slow partition: its particles enter, leave and change rank between steps only. */
 #include "mpm_error.h"
 #include "mpm_integrator.h"
+#include "mpm_log.h"
 #include "mpm_partitioned.h"
 
 #include <arkode/arkode_mristep.h>
 #include <math.h>
 #include <string.h>
 
-enum { KEY_SUBSTEPS, KEY_SLOW_SUBSTEPS, KEY_LOAD, KEY_MRI_TABLE }; /* multirate_keys, in order */
+enum { KEY_SUBSTEPS, KEY_SLOW_SUBSTEPS, KEY_LOAD, KEY_MRI_TABLE, KEY_PREDICTOR }; /* in order */
 /* The substep keys go up to MULTIRATE_MAX_SUBSTEPS, the most the scheme takes on its own before
  * it calls the fast module's step collapsed (below): 10-100 is what two stable modules need.
  * Up to 1e6 was allowed: at that setting a coupling step took 84 s (issue 54), while the run's
@@ -57,6 +64,12 @@ static const mpm_key_spec multirate_keys[] = {
      "mri_gark_erk33a|mis_kw3|mri_gark_erk45a",
      "multirate with an ERK pair (MRIStep): the MRI coupling table, MRI-GARK-ERK33a (order 3), "
      "MIS-KW3 (order 3) or MRI-GARK-ERK45a (order 4)",
+     0, NULL},
+    {"coupling.predictor", MPM_KEY_ENUM, "none", 0, 0, 0, 0, "none|linear",
+     "multirate, classic update: the solid's interface velocity the gas meets over a coupling "
+     "step: none (the solid at the step's start, advanced by its own nodal force then) or "
+     "linear (extrapolated from its last two coupling steps); the momentum exchanged stays "
+     "exact either way",
      0, NULL},
 };
 
@@ -90,6 +103,9 @@ static int multirate_mri_create(mpm_timescheme *ts, const mpm_config *cfg, const
   MPM_CALL(foreign_key(cfg, KEY_LOAD,
                        "is read with the classic update only: MRIStep (an ERK pair) passes the "
                        "gas's stages to the solid itself; remove it or use time.method = usl"));
+  MPM_CALL(foreign_key(cfg, KEY_PREDICTOR,
+                       "is read with the classic update only: MRIStep (an ERK pair) passes the "
+                       "solid's stages to the gas itself; remove it or use time.method = usl"));
   MPM_CALL(foreign_key(cfg, KEY_SLOW_SUBSTEPS,
                        "is read with the classic update only: MRIStep (an ERK pair) takes one "
                        "slow step per coupling step; remove it or use time.method = usl"));
@@ -146,6 +162,9 @@ static int multirate_create(mpm_timescheme *ts, const mpm_config *cfg) {
   MPM_CALL(mpm_config_get_string(cfg, "coupling.load", &load));
   pp->interpolate = strcmp(load, "interpolated") == 0;
   if (pp->interpolate) MPM_CALL(mpm_interface_want_trend(pp->ifc));
+  const char *predictor;
+  MPM_CALL(mpm_config_get_string(cfg, "coupling.predictor", &predictor));
+  if (strcmp(predictor, "linear") == 0) MPM_CALL(mpm_interface_want_predictor(pp->ifc));
   return 0;
 }
 
@@ -217,6 +236,10 @@ static int multirate_step(mpm_timescheme *ts, double tstop, double *t, double *h
     m = (int)need;
   }
   const int n = pp->slow_substeps > 0 ? pp->slow_substeps : m;
+  mpm_log(
+      MPM_LOG_TRACE,
+      "multirate at t = %.9g: stable steps solid %.4g s, gas %.4g s; H %.4g s, %d + %d substeps",
+      t0, hs, hg, H, solid_fast ? n : m, solid_fast ? m : n);
   const double t1 = H < rest ? t0 + H : tstop;
   MPM_CALL(mpm_partitioned_hold(ts, t0));
   MPM_CALL(mpm_partitioned_advance_gas(ts, t0, t1, solid_fast ? n : m));

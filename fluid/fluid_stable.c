@@ -14,12 +14,13 @@
  * quadratic B-spline):
  *   s_c = sqrt(sum m s_p^2 / sum m) + sum m |v_p| / sum m,
  * with s_p = c_p + 2 nu_p / dx the particle's acoustic and viscous (artificial and physical)
- * speed, and the step is dx over the largest s_c. The sums are taken per cell after
- * migration, when every particle sits on the rank owning its cell, and the forward halo gives
- * each rank its neighbours' cells: the result does not depend on the decomposition (up to the
- * order of the sums). It is computed once per step, at the first estimate after the step
- * began (every rank asks at the same points: the estimate is collective), from the state the
- * step starts from; the adaptive pairs' stage and end-of-step estimates reuse it. */
+ * speed (fluid.viscous_step = damped: fluid_signal_speed's damped form), and the step is dx over
+ * the largest s_c. The sums are taken per cell after migration, when every particle sits on the
+ * rank owning its cell, and the forward halo gives each rank its neighbours' cells: the result does
+ * not depend on the decomposition (up to the order of the sums). It is computed once per step, at
+ * the first estimate after the step began (every rank asks at the same points: the estimate is
+ * collective), from the state the step starts from; the adaptive pairs' stage and end-of-step
+ * estimates reuse it. */
 #include "fluid_internal.h"
 
 #include "fluid_stress.h"
@@ -54,7 +55,10 @@ static void deposit(const mpm_module *m, double *const *sum) {
     }
     const double rho = fc->gas.mu > 0.0 ? mass[i] / (V0[i] * J[i]) : 1.0; /* only mu needs it */
     const double cs = sqrt(gamma * (gamma - 1.0) * fabs(e[i]));
-    const double s = cs + fluid_viscous_speed(&fc->gas, rho, cs, divv[i], psi ? psi[i] : 0.0, dx);
+    const double s =
+        fc->gas.damped_step
+            ? fluid_signal_speed(&fc->gas, rho, cs, divv[i], psi ? psi[i] : 0.0, dx)
+            : cs + fluid_viscous_speed(&fc->gas, rho, cs, divv[i], psi ? psi[i] : 0.0, dx);
     const mpm_lidx l = mpm_grid_local_index(g, c);
     sum[0][l] += mass[i], sum[1][l] += mass[i] * s * s, sum[2][l] += mass[i] * sqrt(v2);
   }

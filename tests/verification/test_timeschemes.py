@@ -25,12 +25,13 @@ probe at its middle (probes.csv, every step).
    (summary.json; the owed momentum included).
 4. Restart is bitwise for every temporal scheme: staggered (solid_first, gas_first, parallel,
    and solid_first strongly coupled: sub-iterations with Aitken relaxation, whose predictor is
-   checkpointed interface state), multirate (held and interpolated) and monolithic, run to 0.6 with a checkpoint at 0.3 and
+   checkpointed interface state), multirate (held, interpolated, and with the predictor,
+   coupling.predictor = linear, whose last hold is checkpointed) and monolithic, run to 0.6 with a checkpoint at 0.3 and
    restarted from it on 1 rank: the last snapshots equal to the bit, and the restarted run's
    momentum balance still closes (the owed momentum is in the checkpoint).
 `quick` (the argument; for the sanitizer pass): check 4 alone, to t = 0.06 with the checkpoint at
 0.03, and on 2 ranks the restarts of staggered solid_first, strong staggered and multirate
-(classic and MRIStep).
+(classic, classic with the predictor, and MRIStep).
 
 `mri` (the argument): multirate with an ERK pair, ARKODE MRIStep (bs32 fixed steps,
 MRI-GARK-ERK33a; coupler/timescheme_multirate.c), on the same stiff piston:
@@ -206,7 +207,9 @@ SCHEMES = [("monolithic", ["coupling.time=monolithic"]),
            ("multirate interpolated", ["coupling.time=multirate", "coupling.load=interpolated",
                                        "solid.slab.E=5200"]),
            ("multirate mristep", ["coupling.time=multirate", "solid.slab.E=5200",
-                                  "time.method=bs32", "time.adaptive=false"])]
+                                  "time.method=bs32", "time.adaptive=false"]),
+           ("multirate predictor", ["coupling.time=multirate", "coupling.predictor=linear",
+                                    "fluid.viscous_step=damped", "solid.slab.E=5200"])]
 ERK = ["time.method=bs32", "time.adaptive=false"]
 
 
@@ -276,7 +279,7 @@ def light_nodes():
 
 if QUICK:
     restarts(0.03, 1, SCHEMES)
-    restarts(0.03, 2, [SCHEMES[1], SCHEMES[4], SCHEMES[6], SCHEMES[7]])
+    restarts(0.03, 2, [SCHEMES[1], SCHEMES[4], SCHEMES[6], SCHEMES[7], SCHEMES[8]])
     sys.exit(check.finish())
 if MRI:
     mri_convergence()
