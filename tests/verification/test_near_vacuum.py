@@ -45,6 +45,7 @@ import numpy as np
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "tools"))
 import mpmtest as mt  # noqa: E402
 from riemann import Riemann  # noqa: E402
+import shocktube  # noqa: E402
 
 check = mt.Checks("test_near_vacuum")
 EXACT = Riemann((1.0, -2.0, 0.4), (1.0, 2.0, 0.4))
@@ -80,30 +81,9 @@ def conservation(ev):
     return dM, dP, dE
 
 
-def bspline2(r):
-    a = np.abs(r)
-    return np.where(a < 0.5, 0.75 - a * a, np.where(a < 1.5, 0.5 * (1.5 - a) ** 2, 0.0))
-
-
 def measure(out, N):
     """(L1 density error, empty nodes between the outermost particles) at the last snapshot."""
-    t, path = mt.snapshots(out)[-1]
-    P = mt.particles(path, "fluid")
-    x, m = P["x"][:, 0], P["m"][:, 0]
-    h = 1.0 / N
-    nodes = np.arange(2, N - 1)  # interior nodes: their stencils stay inside the domain
-    rho = np.zeros(len(nodes))
-    base = np.floor(x / h + 0.5).astype(int)
-    for off in (-1, 0, 1):
-        j = base + off
-        ok = (j >= nodes[0]) & (j <= nodes[-1])
-        np.add.at(rho, j[ok] - nodes[0], (bspline2(x / h - j) * m)[ok])
-    rho /= h * 3 * h
-    xi = nodes * h
-    edges = np.concatenate([xi - h / 2, [xi[-1] + h / 2]])
-    ref = EXACT.cell_averages(edges, t)[0]
-    inside = (xi > x.min()) & (xi < x.max())
-    return float(np.sum(np.abs(rho - ref)) * h), int(np.sum((rho == 0) & inside))
+    return shocktube.nodal_density(out, N, EXACT)
 
 
 mode = sys.argv[1] if len(sys.argv) > 1 else "refill"
