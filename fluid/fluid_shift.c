@@ -174,11 +174,15 @@ static void fold_faces(const mpm_grid *g, double *phi) {
   }
 }
 
-/* Does the particle's stencil reach a node where another phase holds mass? */
+/* Does the particle's stencil reach a node where another phase holds mass? (The gas's own
+ * scratch phase for fluid.mol_damping holds the gas's mass: not another phase.) */
 static int near_other_phase(const mpm_module *m, const shift_stencil *s) {
   const mpm_grid *g = m->grid;
+  const fluid_content *fc = m->content;
   for (int k = 0; k < g->nphases; ++k)
-    if (k != m->phase && g->phase[k].m_i && stencil_touches(s, g->phase[k].m_i)) return 1;
+    if (k != m->phase && k != fc->filter_phase && g->phase[k].m_i &&
+        stencil_touches(s, g->phase[k].m_i))
+      return 1;
   return 0;
 }
 
