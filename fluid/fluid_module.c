@@ -74,12 +74,12 @@ static const mpm_key_spec fluid_keys[] = {
      "(of the previous step: cheaper, but it holds every ERK pair to first order in time "
      "wherever the artificial viscosity acts); the classic update always lags",
      0, NULL},
-    {"fluid.mol_damping", MPM_KEY_REAL, "0.1", 0, 1, 0, 0, NULL,
+    {"fluid.mol_damping", MPM_KEY_REAL, "0", 0, 1, 0, 0, NULL,
      "ERK pairs: the rate, in units of c / dx, at which the particle velocity the grid does not "
      "see (v_p - sum S v_i, filtered once more through the grid so that smooth flow keeps it) "
      "relaxes, its kinetic energy becoming the particle's heat (0: off). Stops a transverse "
      "grid-scale mode that the method of lines grows from roundoff where particles sit off "
-     "their lattice (docs/gas.md); mass, momentum and total energy stay exact",
+     "their lattice (docs/gas.md; 0.1 cures it); mass, momentum and total energy stay exact",
      0, "-"},
     {"fluid.ppc", MPM_KEY_INT, "2", 1, 8, 0, 0, NULL,
      "gas particles per cell per direction at seeding", 0, "-"},
