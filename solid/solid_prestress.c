@@ -231,14 +231,14 @@ int solid_prestress_solve(solid_prestress *ps, const solid_material *mat, int di
   memset(ps, 0, sizeof *ps);
   for (int d = 0; d < dim; ++d) ps->F0[d * dim + d] = 1.0;
   ps->J0 = 1.0;
+  double scale = 0.0;
+  for (int k = 0; k < dim * dim; ++k) scale = fmax(scale, fabs(sigma0[k]));
+  if (scale == 0.0) return 0; /* stress-free: every model, rigid too, starts at F = I */
   if (mat->ops->rigid) return snprintf(why, nwhy, "a rigid body carries no stress"), MPM_ERR_INPUT;
   if (mat->ops->rate) { /* the stress is state: it starts where it is given */
     memcpy(ps->sigma0, sigma0, sizeof(double) * (size_t)(dim * dim));
     return 0;
   }
-  double scale = 0.0;
-  for (int k = 0; k < dim * dim; ++k) scale = fmax(scale, fabs(sigma0[k]));
-  if (scale == 0.0) return 0;
   return ps_solve_stretch(ps, mat, dim, sigma0, scale, why, nwhy);
 }
 
