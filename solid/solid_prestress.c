@@ -76,13 +76,14 @@ static int ps_residual(const ps_ctx *c, const double *u, double *r, double *rmax
   const solid_batch b = ps_batch(c, U, out);
   c->mat->ops->stress(c->mat, &b);
   const double J = solid_det(c->dim, U, 1, 0);
-  *rmax = 0.0;
+  double m = 0.0;
   for (int k = 0; k < c->ns; ++k) {
     const int rc = c->sym[k][0] * c->dim + c->sym[k][1];
     r[k] = (out[rc] / J - c->sigma0[rc]) / c->scale;
     if (!isfinite(r[k])) return 1;
-    *rmax = fmax(*rmax, fabs(r[k]));
+    m = fmax(m, fabs(r[k]));
   }
+  *rmax = m;
   return 0;
 }
 
@@ -143,9 +144,9 @@ static int ps_linear_solve(int n, double A[6][6], double *b, double *x) {
 /* Newton from U = I; u ends at the smallest residual found, *rmax is it and *tol the residual
  * accepted as converged. */
 static void ps_newton(const ps_ctx *c, double *u, double *rmax, double *tol) {
-  double r[6], Jm[6][6], du[6], ut[6], rt[6], rtmax, kmax;
+  double r[6], Jm[6][6], du[6], ut[6] = {0}, rt[6], rtmax, kmax;
   memset(u, 0, sizeof(double) * 6);
-  *tol = HUGE_VAL;
+  *tol = 0.0; /* nothing is accepted before the first Jacobian sets it */
   if (ps_residual(c, u, r, rmax)) return;
   for (int it = 0; it < PS_MAXIT; ++it) {
     if (ps_jacobian(c, u, r, Jm, &kmax)) return;
