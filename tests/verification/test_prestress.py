@@ -11,18 +11,18 @@ Measured per run:
   KE from diagnostics.csv (each step) and m_min the lightest particle; over c_g. Bound 1e-10:
   the forces cancel node by node up to the roundoff of sums of O(10) terms of size p V (1e-16
   relative), which moves the particles at ~1e-16 p / Z per step, a random walk over 1,000 steps
-  near 1e-12 c_g (measured: the bound 5e-13 - 1.1e-12, the largest speed in the snapshots
+  near 1e-12 c_g (measured: the bound 5e-13 - 1.6e-12, the largest speed in the snapshots
   3e-14 - 9e-14); the same scene without the initial stress moves at O(p / (Z_s + Z_g)) =
   0.24 c_g (its rms speed sqrt(2 KE / M), a lower bound of the largest, must exceed a tenth of
   that; measured 0.056 c_g), about nine orders above the bound.
 - stress: the slab's Cauchy stress from its F (neo_hookean: (mu (b - I) + lambda ln J I) / J)
   at every snapshot, max |sigma + p I| / p <= 1e-10 (the Newton solve of F0 ends at the roundoff
-  of the model's stress, eps E / p ~ 1e-14; measured 2e-14 - 3e-13); and the gas pressure
+  of the model's stress, eps E / p ~ 1e-14; measured 2e-14 - 3.1e-13); and the gas pressure
   max |p_gas - p| / p <= 1e-10 (measured 2e-13).
 Runs: coupling.scheme velocity, contact, traction under time.method usl and the default bs32
 (contact refuses bs32: its on/off switch is non-smooth for an adaptive pair; it runs usl and
 musl); traction with the least-squares wall (fluid.wall_treatment); coupling.time multirate and
-staggered gas_first; the other models (linear_elastic, stvk, hypoelastic, j2) under velocity usl
+staggered gas_first; velocity usl on 2 ranks and in 3-D (the strip 3 cells deep, periodic in z); the other models (linear_elastic, stvk, hypoelastic, j2) under velocity usl
 (speed only: their stress is not in the output).
 Also: the initial total energy holds the slab's stored energy W(F0) V0 (1e-10 relative: the
 same sum in C and here, roundoff only; measured 2e-13) and the coupling creates none
@@ -54,10 +54,18 @@ MU, LAM = E / (2 * (1 + NU)), E * NU / ((1 + NU) * (1 - 2 * NU))
 TOL = 1e-10
 
 
-def run(name, *extra, case=CASE):
+def run(name, *extra, ranks=1):
     out = mt.outdir(name)
-    mt.run(["run", case, f"output.dir={out}", "run.progress=false"] + list(extra))
+    mt.run(["run", CASE, f"output.dir={out}", "run.progress=false"] + list(extra), ranks)
     return out
+
+
+# The same scene in 3-D: the strip 3 cells deep too, periodic in z.
+THREE_D = ["domain.dim=3", "domain.lo=0 0 0", "domain.hi=0.8 0.03 0.03", "boundary.z_lo=periodic",
+           "boundary.z_hi=periodic",
+           "geometry.left.lo=0 0 0", "geometry.left.hi=0.3 0.03 0.03",
+           "geometry.slab.lo=0.3 0 0", "geometry.slab.hi=0.5 0.03 0.03",
+           "geometry.right.lo=0.5 0 0", "geometry.right.hi=0.8 0.03 0.03"]
 
 
 def diagnostics(out):
@@ -65,15 +73,15 @@ def diagnostics(out):
 
 
 def nh_stress(F):
-    J = np.linalg.det(F)
+    J, eye = np.linalg.det(F), np.eye(F.shape[1])
     b = F @ F.transpose(0, 2, 1)
-    return (MU * (b - np.eye(2)) + LAM * np.log(J)[:, None, None] * np.eye(2)) / J[:, None, None]
+    return (MU * (b - eye) + LAM * np.log(J)[:, None, None] * eye) / J[:, None, None]
 
 
 def nh_energy(F):
     J = np.linalg.det(F)
     trb = np.einsum("nij,nij->n", F, F)
-    return 0.5 * MU * (trb - 2) - MU * np.log(J) + 0.5 * LAM * np.log(J) ** 2
+    return 0.5 * MU * (trb - F.shape[1]) - MU * np.log(J) + 0.5 * LAM * np.log(J) ** 2
 
 
 def measure(out):
@@ -88,8 +96,9 @@ def measure(out):
     stress = pgas = 0.0
     for _, path in snaps:
         s, g = mt.particles(path), mt.particles(path, "fluid")
-        sig = nh_stress(s["F"].reshape(-1, 2, 2))
-        stress = max(stress, float(np.abs(sig + P * np.eye(2)).max()))
+        dim = s["x"].shape[1]
+        sig = nh_stress(s["F"].reshape(-1, dim, dim))
+        stress = max(stress, float(np.abs(sig + P * np.eye(dim)).max()))
         pgas = max(pgas, float(np.abs(g["p"] - P).max()))
     return speed, stress / P, pgas / P, int(d["step"][-1])
 
@@ -116,6 +125,8 @@ for scheme, method in (("velocity", "usl"), ("velocity", "bs32"), ("contact", "u
 at_rest("traction usl, least-squares wall",
         run("prestress_ls", "coupling.scheme=traction", "fluid.wall_treatment=least_squares"))
 at_rest("velocity usl, multirate", run("prestress_multirate", "coupling.time=multirate"))
+at_rest("velocity usl, 2 ranks", run("prestress_np2", ranks=2))
+at_rest("velocity usl, 3-D", run("prestress_3d", *THREE_D))
 at_rest("velocity usl, staggered gas_first",
         run("prestress_gas_first", "coupling.time=staggered", "coupling.order=gas_first"))
 for mat, extra in (("linear_elastic", ()), ("stvk", ()), ("hypoelastic", ()),
