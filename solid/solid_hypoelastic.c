@@ -1,10 +1,10 @@
 /* Hypoelasticity with the Jaumann rate (the solid of the seed paper, Hu et al. 2010):
  *   d sigma/dt = lambda tr(D) I + 2 mu D + W sigma - sigma W,  D = sym(L), W = skew(L).
- * A rate-form model: the Cauchy stress is the "sigma" state field (zero at the start), so it
- * is objective (the Jaumann rate co-rotates with the material) but path dependent: it
- * derives from no stored-energy function, and a closed strain cycle can leave a residual
- * stress. In 2-D plane strain sigma, D and W are the in-plane 2 x 2 blocks (sigma_zz is not
- * needed by the in-plane equations). Parameters: E > 0, 0 <= nu < 0.5 (solid_elastic). */
+ * A rate-form model: the Cauchy stress is the "sigma" state field (zero at the start, or the
+ * initial stress), so it is objective (the Jaumann rate co-rotates with the material) but path
+ * dependent: it derives from no stored-energy function, and a closed strain cycle can leave a
+ * residual stress. In 2-D plane strain sigma, D and W are the in-plane 2 x 2 blocks (sigma_zz
+ * is not needed by the in-plane equations). Parameters: E > 0, 0 <= nu < 0.5 (solid_elastic). */
 #include "solid_tensor.h"
 #include "solid_elastic.h"
 

@@ -57,7 +57,8 @@ typedef struct solid_material_ops {
   /* Optional: after an accepted step, store the returned state in b->hist. */
   void (*commit)(const solid_material *mat, const solid_batch *b);
   /* Optional, rate-form models only: d sigma/dt from b->sigma and b->L into b->out. Such a
-   * model keeps its stress in the "sigma" state field, which starts at zero. */
+   * model keeps its stress in the "sigma" state field, which starts at zero (or at the body's
+   * initial stress, solid_prestress.h). */
   void (*rate)(const solid_material *mat, const solid_batch *b);
   /* 1 if the model is only valid for small strains and rotations (it is then checked for
    * objectivity to first order only). */
