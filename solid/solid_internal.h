@@ -10,6 +10,7 @@
 #include "mpm_module.h"
 #include "mpm_transfer.h"
 #include "solid_material.h"
+#include "solid_prestress.h"
 
 #include <stdio.h>
 
@@ -21,9 +22,10 @@ typedef struct {
   char section[96];
   solid_material *mat;
   double rho;
-  double c;           /* elastic wave speed of the model at rho (for the stable step) */
-  double v[3];        /* rigid bodies: the prescribed velocity */
-  mpm_region *region; /* rigid bodies: the seeded region (the nodes it holds); else NULL */
+  double c;            /* elastic wave speed of the model at rho (for the stable step) */
+  double v[3];         /* rigid bodies: the prescribed velocity */
+  mpm_region *region;  /* rigid bodies: the seeded region (the nodes it holds); else NULL */
+  solid_prestress pre; /* the seeded state that carries the initial stress */
 } solid_body;
 
 typedef struct {

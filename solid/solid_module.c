@@ -7,7 +7,9 @@
  * The per-body index lists used for batched stress evaluation are rebuilt at each P2G, so they
  * never go stale after migration, sorting or injection. A rigid body's particles keep F = I,
  * C = 0 and their seeded velocity, and its region moves rigidly with that velocity: at time t
- * it is the seeded region translated by v t (wrapped through periodic faces). */
+ * it is the seeded region translated by v t (wrapped through periodic faces). A body with an
+ * initial stress is seeded at its state of solid_prestress.h: F = F0 (and sigma = sigma0 for a
+ * rate-form model), V0 = seeded volume / det F0. */
 #include "solid_internal.h"
 #include "solid_module.h"
 #include "solid_tensor.h"
@@ -48,6 +50,15 @@ static mpm_key_spec solid_keys[] = {
      "initial yield stress, Pa (plastic models)", 1, "Pa"},
     {"solid.*.hardening", MPM_KEY_REAL, "0", 0, HUGE_VAL, 0, 0, NULL,
      "linear isotropic hardening modulus H, Pa (plastic models)", 0, "Pa"},
+    {"solid.*.initial_stress", MPM_KEY_REALS, NULL, -HUGE_VAL, HUGE_VAL, 0, 9, NULL,
+     "Cauchy stress of the body as seeded, Pa: dim x dim values row by row (xx xy yx yy in "
+     "2-D), symmetric; realised in the model's terms (an elastic stretch, or the rate form's "
+     "stress state), so a gas at the same pressure beside the body starts in equilibrium",
+     1, "Pa"},
+    {"solid.*.initial_pressure", MPM_KEY_REAL, NULL, -HUGE_VAL, HUGE_VAL, 0, 0, NULL,
+     "uniform pressure of the body as seeded, Pa: the initial stress -p I (instead of "
+     "initial_stress)",
+     1, "Pa"},
     {"clamp.*.geometry", MPM_KEY_STRING, NULL, 0, 0, 0, 0, NULL,
      "region whose nodes and particles are held fixed (a [geometry.NAME])", 0, NULL},
     {"traction.*.geometry", MPM_KEY_STRING, NULL, 0, 0, 0, 0, NULL,
@@ -192,16 +203,22 @@ static int seed_body(mpm_module *m, const mpm_config *cfg, int b, double *lp) {
   double *data;
   MPM_ALLOC(data, (size_t)p->ncomp * (size_t)(n ? n : 1));
   const double vol = pow(g->dx / ppc, dim);
+  const solid_prestress *pre = &sc->body[b].pre;
   for (mpm_lidx i = 0; i < n; ++i) {
     double xp[3] = {0, 0, 0};
     for (int d = 0; d < dim; ++d) xp[d] = x[(size_t)d * n + i];
     for (int d = 0; d < dim; ++d) {
       data[(size_t)(p->offset[F_X] + d) * n + i] = xp[d];
       data[(size_t)(p->offset[F_V] + d) * n + i] = vfield ? mpm_expr_eval(vfield, d, xp) : v0[d];
-      data[(size_t)(p->offset[F_F] + d * dim + d) * n + i] = 1.0;
     }
+    for (int rc = 0; rc < dim * dim; ++rc) {
+      data[(size_t)(p->offset[F_F] + rc) * n + i] = pre->F0[rc];
+      if (sc->lay.f_sigma >= 0)
+        data[(size_t)(p->offset[sc->lay.f_sigma] + rc) * n + i] = pre->sigma0[rc];
+    }
+    /* Seeded where it is: the current volume V0 det F0 is the seeding volume. */
     data[(size_t)p->offset[sc->lay.f_m] * n + i] = sc->body[b].rho * vol;
-    data[(size_t)p->offset[sc->lay.f_V0] * n + i] = vol;
+    data[(size_t)p->offset[sc->lay.f_V0] * n + i] = vol / pre->J0;
     data[(size_t)p->offset[sc->lay.f_body] * n + i] = b;
     if (sc->lay.f_fixed >= 0)
       data[(size_t)p->offset[sc->lay.f_fixed] * n + i] = solid_in_clamp(sc, xp);
@@ -605,6 +622,8 @@ static int read_bodies(mpm_module *m, const mpm_config *cfg) {
     MPM_CALL(solid_material_create(&sc->body[b].mat, type, cfg, sc->body[b].section, m->grid->dim));
     /* Constant per body: evaluated once, not per particle in every stable-step scan. */
     sc->body[b].c = sc->body[b].mat->ops->wave_speed(sc->body[b].mat, sc->body[b].rho);
+    MPM_CALL(solid_prestress_read(&sc->body[b].pre, cfg, sc->body[b].section, sc->body[b].mat,
+                                  m->grid->dim));
     if (sc->body[b].mat->ops->rigid) MPM_CALL(solid_read_rigid(m, cfg, &sc->body[b]));
   }
   double g[3] = {0, 0, 0};

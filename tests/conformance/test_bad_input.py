@@ -79,6 +79,32 @@ for name, old, new, key, words in CASES:
         line = line_of(text, "geometry = block")
     expect_error(name, text, key, words, line)
 
+# A body's initial stress (solid.NAME.initial_stress / initial_pressure), on the same case: the
+# key and its line named, exit 2. The block is linear_elastic with E = 1e6 in 2-D.
+ELASTIC = "nu = 0.3\n"
+RIGID = BASE.replace("material = linear_elastic", "material = rigid").replace(
+    "E = 1e6\n", "").replace(ELASTIC, "")
+PRESTRESS_CASES = [
+    ("initial_stress of the wrong size", BASE, "initial_stress = -1 0 -1", "initial_stress",
+     "needs 4 values in a 2-D case"),
+    ("initial_stress not symmetric", BASE, "initial_stress = -1 2 3 -1", "initial_stress",
+     "must be symmetric"),
+    ("initial_stress and initial_pressure", BASE,
+     "initial_stress = -1 0 0 -1\ninitial_pressure = 1", "initial_pressure", "not both"),
+    ("initial_pressure on a rigid body", RIGID, "initial_pressure = 5", "initial_pressure",
+     "carries no stress"),
+    ("initial_stress beyond j2's yield surface",
+     BASE.replace("material = linear_elastic", "material = j2\nsigma_y = 1e3"),
+     "initial_stress = 1e4 0 0 -1e4", "initial_stress", "yield surface"),
+    ("a tension neo_hookean cannot reach (its stress saturates near 5e5 Pa)",
+     BASE.replace("material = linear_elastic", "material = neo_hookean"),
+     "initial_pressure = -1e7", "initial_pressure", "no elastic stretch gives it"),
+]
+for name, base, body, key, words in PRESTRESS_CASES:
+    assert ELASTIC in base or base is RIGID
+    text = base.replace("velocity = 3 2", "velocity = 3 2\n" + body, 1)
+    expect_error(name, text, "solid.block." + key, words, line_of(text, body.splitlines()[-1]))
+
 # Gas keys, on the valid cases/sod.ini (same form: one error with file:line and key, exit 2).
 GAS = open(mt.case("sod.ini")).read()
 GAS_CASES = [

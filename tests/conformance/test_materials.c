@@ -21,6 +21,12 @@
  *  h      history models: the yield surface (perfect plasticity, H = 0), the hardening
  *         law (H > 0) along isochoric pure shear with a commit per increment, consistency
  *         of commit, and init_history resetting the state.
+ *  p      initial stress (solid_prestress.h): the seeded state that solid_prestress_solve gives
+ *         for a pressure, a tension and a full symmetric tensor with shear (and, for models
+ *         without history, the same ten times larger, strains of a few per cent) reproduces the
+ *         Cauchy stress through stress() to 1e-10 relative, with F0 a symmetric positive
+ *         definite stretch (the solve stops at the roundoff of the stress, about eps E / |sigma0|
+ *         ~ 1e-13 here); a model with history refuses a stress beyond its yield surface.
  *  r      rigid models (ops->rigid): zero stress and energy at any F, a wave speed of exactly
  *         0 (only the body's velocity may limit the step), no history and no rate. Checks
  *         b-f concern an elastic response and are skipped for them, each with its reason;
@@ -35,6 +41,7 @@
 #include "mpm_error.h"
 #include "solid_material.h"
 #include "solid_module.h"
+#include "solid_prestress.h"
 
 #include "mpm_testing.h"
 
@@ -925,6 +932,56 @@ static void check_hardening(const model *m) {
   report(m, "h: |sigma(I)| / E after init_history", m_maxabs(dim, sig) / g_E, 1e-12);
 }
 
+/* p: the initial state for sigma0 (scaled by k) and the relative error of the stress it gives. */
+static double prestress_error(const model *m, const double sig0[3][3], double k, char *why,
+                              size_t nwhy, int *refused) {
+  const int dim = m->dim;
+  double s0[9] = {0}, F0[3][3], s[3][3], sig[3][3], target[3][3], hist[MAXH];
+  solid_prestress ps;
+  for (int r = 0; r < dim; ++r)
+    for (int c = 0; c < dim; ++c) s0[r * dim + c] = target[r][c] = k * sig0[r][c];
+  *refused = solid_prestress_solve(&ps, m->mat, dim, s0, why, nwhy) != 0;
+  if (*refused) return HUGE_VAL;
+  m_zero(F0);
+  m_zero(s);
+  for (int r = 0; r < dim; ++r)
+    for (int c = 0; c < dim; ++c) F0[r][c] = ps.F0[r * dim + c], s[r][c] = ps.sigma0[r * dim + c];
+  double asym = 0.0;
+  for (int r = 0; r < dim; ++r)
+    for (int c = 0; c < dim; ++c) asym = fmax(asym, fabs(F0[r][c] - F0[c][r]));
+  const double J = m_det(dim, F0);
+  if (asym != 0.0 || !(J > 0.0) || fabs(J - ps.J0) > 1e-15 * J) return HUGE_VAL;
+  fresh_history(m, hist);
+  stress_at(m, F0, s, hist, sig); /* out / (V0 det F0): the Cauchy stress the grid sees */
+  return m_maxdiff(dim, sig, target) / m_maxabs(dim, target);
+}
+
+static void check_prestress(const model *m) {
+  const int dim = m->dim;
+  const double p = 0.3 * g_sy;
+  /* shear and normal parts of a few 1e4 Pa: inside the j2 yield surface (sigma_y = 1e5) */
+  const double shear[3][3] = {{-3e4, 1.2e4, -0.5e4}, {1.2e4, -1e4, 0.8e4}, {-0.5e4, 0.8e4, 2e4}};
+  const double press[3][3] = {{-p, 0, 0}, {0, -p, 0}, {0, 0, -p}};
+  const char *name[] = {"pressure", "tension", "tensor with shear"};
+  const double *const cases[] = {&press[0][0], &press[0][0], &shear[0][0]};
+  const double scale[] = {1.0, -0.5, 1.0};
+  char why[256], label[96];
+  for (int big = 0; big <= (m->nh ? 0 : 1); ++big)
+    for (int k = 0; k < 3; ++k) {
+      int refused;
+      const double f = big ? 10.0 : 1.0;
+      const double err =
+          prestress_error(m, (const double(*)[3])cases[k], f * scale[k], why, sizeof why, &refused);
+      snprintf(label, sizeof label, "p: %s%s, |sigma(F0) - sigma0|", big ? "10 x " : "", name[k]);
+      if (refused && g_rank == 0) printf("  %-12s %dD  p: refused: %s\n", m->ops->name, dim, why);
+      report(m, label, err, 1e-10);
+    }
+  if (!m->nh) return;
+  int refused;
+  (void)prestress_error(m, shear, 5.0, why, sizeof why, &refused); /* q ~ 2.6 sigma_y */
+  report(m, "p: beyond yield refused (0: yes)", !(refused && strstr(why, "yield")), 0.0);
+}
+
 /* ---- driver ------------------------------------------------------------------------------ */
 
 static int create_model(model *m, const solid_material_ops *ops, int dim, double hardening) {
@@ -996,6 +1053,7 @@ int main(int argc, char **argv) {
       check_wave_speed(&m);
       check_energy(&m);
       check_spin(&m);
+      check_prestress(&m);
       if (m.nh) {
         check_yield_surface(&m);
         check_hardening(&m);

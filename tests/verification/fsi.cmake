@@ -40,3 +40,10 @@ mpm_add_script_test(test_fsi_reflection SCRIPT verification/test_fsi_reflection.
                     LABELS verification TIMEOUT 600)
 mpm_add_script_test(test_fsi_reflection_long SCRIPT verification/test_fsi_reflection.py ARGS long
                     LABELS "verification;long" TIMEOUT 2400)
+# Initial stress (solid.NAME.initial_pressure): a pre-stressed slab between gas columns at the
+# same pressure stays at rest to roundoff for 1,000 steps under velocity, contact and traction,
+# usl and bs32 (contact: usl, musl), the least-squares wall, multirate, staggered gas_first and
+# every deformable model; the stress-free control moves; energy bookkeeping; bitwise restart
+# (~25 s).
+mpm_add_script_test(test_prestress SCRIPT verification/test_prestress.py
+                    LABELS verification TIMEOUT 300)
