@@ -33,10 +33,10 @@ Measured at t_end (the last snapshot):
                 p* (the gas pressure on the face);
   transmitted   the median of P = M (F - 1) / F over the slab from 5 cells behind its face to
                 DELAY (in slab travel) behind its transmitted front and 0.5 ahead of that
-                front's reflection from the wall: the jump -median - p0 against p* - p0; its ringing: the
-                cell averages of P (columns of 12 particles) about the median, their RMS and
-                largest deviation, over p* - p0 (the particles' scatter about their cell's mean
-                is printed: FLIP noise, not a wave).
+                front's reflection from the wall: the jump -median - p0 against p* - p0; its
+                ringing: the cell averages of P (columns of 12 particles) about the median,
+                their RMS and largest deviation, over p* - p0 (the particles' scatter about
+                their cell's mean is printed: FLIP noise, not a wave).
 
 Tolerances and why:
   first layer   3 % in p and rho (issue 55's acceptance).
@@ -86,7 +86,8 @@ import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "tools"))
 import mpmtest as mt  # noqa: E402
-from gaswaves import bisect, shock_density, shock_pressure, shock_state, sound, wave_du  # noqa: E402
+from gaswaves import (bisect, shock_density, shock_pressure, shock_state,  # noqa: E402
+                      sound, wave_du)
 
 check = mt.Checks("test_fsi_reflection")
 ARGS = sys.argv[1:]
@@ -217,7 +218,8 @@ def measure(name, sl, ex, scheme, method, ls):
     rms = float(np.sqrt(np.mean((cells - med) ** 2))) / jump
     dev = float(np.max(np.abs(cells - med))) / jump
     scat = float(np.sqrt(np.mean((P[reg] - cells[np.searchsorted(np.unique(k), k)]) ** 2))) / jump
-    print(f"info {tag}: face at {face:.4f} (exact {sl['x_i'] + ex['us'] * (tf - ex['t_hit']):.4f}); "
+    face_ex = sl["x_i"] + ex["us"] * (tf - ex["t_hit"])
+    print(f"info {tag}: face at {face:.4f} (exact {face_ex:.4f}); "
           f"columns at {lay[0][2]:.4f}, {lay[1][2]:.4f} from it: p {lay[0][0]:.4f}, "
           f"{lay[1][0]:.4f}, rho {lay[0][1]:.4f}, {lay[1][1]:.4f}; entropy p/rho^g first layer "
           f"{ent:.4f}, plateau {ent_pl:.4f} (exact {ex['ps'] / ex['rs'] ** 1.4:.4f}, ambient 1)")
@@ -234,7 +236,8 @@ def measure(name, sl, ex, scheme, method, ls):
     e_pp, e_rp = p_pl / ex["ps"] - 1, r_pl / ex["rs"] - 1
     check(abs(e_pp) <= TOL_PLATEAU and abs(e_rp) <= TOL_PLATEAU,
           f"{tag}: reflected plateau [{x_refl + 5 * DX:.3f}, {face - 4 * DX:.3f}] p {p_pl:.4f} "
-          f"({100 * e_pp:+.2f} %), rho {r_pl:.4f} ({100 * e_rp:+.2f} %) (<= {100 * TOL_PLATEAU:g} %)")
+          f"({100 * e_pp:+.2f} %), rho {r_pl:.4f} ({100 * e_rp:+.2f} %) "
+          f"(<= {100 * TOL_PLATEAU:g} %)")
     e_f = p_if / ex["ps"] - 1
     check(abs(e_f) <= TOL_FORCE, f"{tag}: interface force / H {p_if:.5f} against p* "
           f"{ex['ps']:.5f}: {100 * e_f:+.3f} % (<= {100 * TOL_FORCE:g} %)")
@@ -269,7 +272,8 @@ def variants():
 for name, sl in SLABS.items():
     ex = exact(sl)
     print(f"info {name}: p1 {ex['p1']:.5f}, rho1 {ex['rho1']:.5f}, u1 {ex['u1']:.5f}; exact p* "
-          f"{ex['ps']:.6f}, rho* {ex['rs']:.6f}, u* {ex['us']:.6g}; reflected shock {ex['W']:+.4f}; "
+          f"{ex['ps']:.6f}, rho* {ex['rs']:.6f}, u* {ex['us']:.6g}; reflected shock "
+          f"{ex['W']:+.4f}; "
           f"transmitted U {ex['U']:.4f}, strain {1 - ex['Fs'] / ex['F0']:.4f}; impact at "
           f"{ex['t_hit']:.4f}; Z_s / Z_g {math.sqrt(sl['rho_s'] * sl['E']) / sound(RHO0, P0):.4g}")
 for name, scheme, method, ls in variants():
