@@ -82,8 +82,9 @@ Arguments: [long] [slab:scheme:method[:ls] ...]. Default (~80 s): the rigid slab
 velocity:usl, contact:usl, traction:usl, traction:usl:ls (fluid.wall_treatment =
 least_squares) and velocity:bs32 (the default time method); the soft slab under velocity:usl
 and traction:usl:ls. `long` runs the rest: rigid traction:bs32, velocity:musl,
-traction:musl; soft contact:usl, traction:usl, velocity:bs32 (about 6 minutes alone),
-traction:bs32, velocity:musl.
+traction:musl; soft contact:usl, traction:usl, velocity:bs32 (3-4 minutes alone),
+traction:bs32, velocity:musl (about 8 minutes in all; measured 467 s with another run
+sharing the core). Rigid under musl: ringing RMS 1.4 %, largest 6.0 %.
 """
 import math
 import os
@@ -252,7 +253,7 @@ def measure(name, sl, ex, scheme, method, ls):
     check(abs(T - 1) <= TOL_T, f"{tag}: transmitted stress jump (median) {-med - P0:.5f} against "
           f"p* - p0 = {jump:.5f}: {100 * (T - 1):+.2f} % (<= {100 * TOL_T:g} %)")
     verdict(rms <= TOL_RMS and dev <= TOL_MAX,
-            None if name == "rigid" and method == "usl" else RING_REASON,
+            None if name == "rigid" and method in ("usl", "musl") else RING_REASON,
             f"{tag}: ringing of the transmitted stress (cell averages): RMS {100 * rms:.2f} %, "
             f"largest {100 * dev:.2f} % of the jump (<= {100 * TOL_RMS:g} %, {100 * TOL_MAX:g} %)")
 
