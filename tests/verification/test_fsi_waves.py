@@ -46,6 +46,7 @@ import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "tools"))
 import mpmtest as mt  # noqa: E402
+from gaswaves import bisect, plane_strain_M, shock_state, sound, wave_du  # noqa: E402
 
 check = mt.Checks("test_fsi_waves")
 ARGS = sys.argv[1:]
@@ -57,47 +58,6 @@ PAIRS = [a.split(":") for a in ARGS] or [("velocity", "usl"), ("velocity", "musl
                                          ("traction", "usl"), ("traction", "musl")]
 DX = 0.005 if LONG else 0.01
 H = 3 * DX  # strip height: 3 cells, the fewest a periodic axis allows with quadratic splines
-GAMMA = 1.4
-
-
-# ---- ideal gas: exact shock and rarefaction relations (Toro, ch. 4) ---------------------------
-def sound(rho, p):
-    return math.sqrt(GAMMA * p / rho)
-
-
-def wave_du(p, rho, pk):
-    """Velocity change across a wave from the state (rho, pk) to pressure p (f_K of Toro):
-    positive for a shock (p > pk), negative for a rarefaction."""
-    g = GAMMA
-    if p > pk:
-        a, b = 2 / ((g + 1) * rho), (g - 1) / (g + 1) * pk
-        return (p - pk) * math.sqrt(a / (p + b))
-    return 2 * sound(rho, pk) / (g - 1) * ((p / pk) ** ((g - 1) / (2 * g)) - 1)
-
-
-def shock_state(rho0, p0, p1):
-    """(rho1, u1, speed) behind a right-going shock of pressure p1 into (rho0, 0, p0)."""
-    g, q = GAMMA, p1 / p0
-    b = (g - 1) / (g + 1)
-    rho1 = rho0 * (q + b) / (b * q + 1)
-    s = sound(rho0, p0) * math.sqrt((g + 1) / (2 * g) * q + (g - 1) / (2 * g))
-    return rho1, s * (1 - rho0 / rho1), s
-
-
-def bisect(f, lo, hi):
-    flo = f(lo)
-    for _ in range(200):
-        mid = 0.5 * (lo + hi)
-        fm = f(mid)
-        if (fm > 0) == (flo > 0):
-            lo, flo = mid, fm
-        else:
-            hi = mid
-    return 0.5 * (lo + hi)
-
-
-def plane_strain_M(E, nu):
-    return E * (1 - nu) / ((1 + nu) * (1 - 2 * nu))
 
 
 def mean_in(x, q, a, b):
