@@ -12,14 +12,21 @@
  *   - from the 20th step on, the kinetic energy exceeds time.kinetic_growth times the larger
  *     of the largest kinetic energy of the first half of the steps taken so far and
  *     MPM_GUARD_KINETIC_FLOOR times the largest total energy so far: the same test on the
- *     energy that blows up first. A particle-scale velocity mode can grow from the internal
- *     energy of a gas, which dominates the total, and leave the total flat (issue 55: a gas
- *     column beside a slab, the kinetic energy x1e6 from 1e-7 of the total); the floor keeps
- *     roundoff-level motion of a scene at rest (1e-30 of the total) from counting as growth;
+ *     energy that blows up first. A velocity mode can grow from the internal energy of a gas,
+ *     which dominates the total, and leave the total flat (issue 55: a gas column beside a
+ *     slab, the kinetic energy x1e6 from an acoustic 1e-7 of the total, exit 0). The default
+ *     1000 is energy_growth's, by the same argument: motion a load starts from rest grows like
+ *     t^p (2^p over half the run; the adaptive pairs' first, growing steps gave up to 11 on the
+ *     scenes of the tests), while a mode that rises from below the acoustic level stops at
+ *     1000 times it, 1e-4 of the total. The floor 1e-9 keeps roundoff-level motion of a scene
+ *     at rest (1e-30 of the total, and what roundoff grows to) from counting as growth: a mode
+ *     from roundoff stops at 1e-6 of the total energy, long before it holds an O(1) share;
  *   - for time.collapse_steps accepted steps in a row, the step was below time.collapse_ratio
  *     times the CFL step of the state the run started from (steps cut short to land on an
  *     output or checkpoint time do not count, and do not break a streak).
- * All are checked after every accepted step, from the totals the diagnostics already sum. A
+ * All are checked after every accepted step, from the totals the diagnostics already sum (the
+ * kinetic energy is their `kinetic` column), and under a partitioned time scheme after every
+ * coupling step. A restart starts the history afresh from the checkpoint's state. A
  * step of zero length (the time too large for the step: t + h == t) stops the run whatever
  * the thresholds, since it would repeat forever. */
 #ifndef MPM_GUARD_H
