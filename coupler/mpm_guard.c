@@ -18,10 +18,10 @@ const mpm_key_spec mpm_guard_keys[] = {
      "energy of the first half of the steps taken (0: never; a non-finite energy always stops "
      "the run)",
      0, "-"},
-    /* 1e-9: MPM_GUARD_KINETIC_FLOOR */
-    {"time.kinetic_growth", MPM_KEY_REAL, "1000", 0, HUGE_VAL, 0, 0, NULL,
+    /* 1e-5: MPM_GUARD_KINETIC_FLOOR */
+    {"time.kinetic_growth", MPM_KEY_REAL, "100", 0, HUGE_VAL, 0, 0, NULL,
      "blow-up guard: stop when the kinetic energy exceeds this multiple of the largest kinetic "
-     "energy of the first half of the steps taken, or of 1e-9 of the largest total energy if "
+     "energy of the first half of the steps taken, or of 1e-5 of the largest total energy if "
      "that is larger (a velocity mode that grows while the total energy stays flat; 0: never)",
      0, "-"},
 };

@@ -12,6 +12,9 @@ elastic waves, energy 6.25e-8 J, no energy enters), 20 time units.
    run on. The state where it stopped is the last snapshot of series.xmf (at the stop time),
    and an error line names it.
 2. forward Euler at 0.9 (an explicit method without error control, ERK fixed step): the same.
+   Both with time.kinetic_growth = 0, so that they test the total-energy criterion: with the
+   default the kinetic criterion (section 6) sees the same blow-up and stops the forward Euler
+   run first (step 57, the energy x110).
 3. The adaptive pair bs32 (error-controlled): it does not blow up on this bar, so the step
    collapse criterion is exercised with the error control itself: at rtol = 1e-12 its steps
    are about 0.06 of the CFL step. With time.collapse_ratio = 0.2 the guard stops the run
@@ -38,13 +41,14 @@ elastic waves, energy 6.25e-8 J, no energy enters), 20 time units.
    ended with exit 0 before the kinetic criterion (measured on the commit before it: status 0,
    t = 4). Checks, with the defaults:
    - status 1 and one error line saying "blew up" and naming the kinetic energy and
-     time.kinetic_growth, before t_end (at t = 1.62, step 287, measured);
-   - it stopped at the limit: the last row's kinetic energy exceeds 1000 x max(largest kinetic
-     energy of the first half of the rows, 1e-9 x the largest total energy) and the row before
-     did not (the criterion as documented, recomputed from diagnostics.csv; exact, no
-     tolerance beyond a relative 1e-12 for the printed digits);
-   - the total energy at the stop is within 1e-4 of the start (measured 1.9e-6): the total-energy
-     criterion could not have seen it.
+     time.kinetic_growth, before t_end (measured: t = 2.39, step 437, the kinetic energy
+     1.4e-4 J, 1.1e-3 of the total);
+   - it stopped at the limit: the last row's kinetic energy exceeds 100 x max(largest kinetic
+     energy of the first half of the rows, 1e-5 x the largest total energy) and the row before
+     did not (the criterion as documented, recomputed from diagnostics.csv; exact but for a
+     relative 1e-12 for the printed digits);
+   - the total energy at the stop is within 1 % of the start (measured 0.32 %): the
+     total-energy criterion (x1000) could not have seen it.
    The control, time.kinetic_growth = 0 (the old behaviour): the run reaches t_end with status
    0 and its kinetic energy ends at least 1e6 x its largest value over the first 100 steps
    (measured 2.6e7), so the scene does blow up and the first check can fail.
@@ -90,7 +94,7 @@ def bar_sections():
     for label, extra in (("usl", ["time.method=usl", "time.cfl=0.95", "output.snapshots=true",
                                   "output.interval=5"]),
                          ("euler", ["time.method=euler", "time.cfl=0.9"])):
-        p, d, out = run(label, extra)
+        p, d, out = run(label, extra + ["time.kinetic_growth=0"])
         msg = [l for l in p.stderr.splitlines() if l.startswith("error:")]
         check(p.returncode != 0 and msg and "blew up" in msg[0] and "time.energy_growth" in msg[0],
               f"{label}: stopped with status {p.returncode}: {msg[0].strip()[:160] if msg else ''}")
@@ -167,9 +171,9 @@ def pulse(label, extra):
 
 def limit(d, n):
     """The kinetic criterion's threshold at row n (row 0 is the start): time.kinetic_growth =
-    1000 times the larger of the largest kinetic energy of rows 0 .. n // 2 and 1e-9 of the
+    100 times the larger of the largest kinetic energy of rows 0 .. n // 2 and 1e-5 of the
     largest |total energy| of rows 0 .. n."""
-    return 1000 * max(d["kinetic"][:n // 2 + 1].max(), 1e-9 * np.abs(d["total"][:n + 1]).max())
+    return 100 * max(d["kinetic"][:n // 2 + 1].max(), 1e-5 * np.abs(d["total"][:n + 1]).max())
 
 
 def kinetic_section():
@@ -188,8 +192,8 @@ def kinetic_section():
           f"{limit(d, n - 1):.4g} J at the row before, {k[n]:.4g} J > {limit(d, n):.4g} J at the "
           "last")
     drift = abs(d["total"][-1] / d["total"][0] - 1)
-    check(drift < 1e-4, f"euler pulse: total energy at the stop within {drift:.2g} of the start "
-          "(< 1e-4: the total-energy criterion could not see it)")
+    check(drift < 1e-2, f"euler pulse: total energy at the stop within {drift:.2g} of the start "
+          "(< 1 %: the total-energy criterion could not see it)")
     p, d = pulse("off", ["time.kinetic_growth=0"])
     grew = d["kinetic"][-1] / d["kinetic"][:101].max()
     check(p.returncode == 0 and abs(d["t"][-1] - 4) < 1e-9 and grew >= 1e6,
