@@ -50,6 +50,7 @@ struct mpm_sim {
   mpm_timescheme *it;     /* the temporal coupling scheme */
   mpm_guard guard;
   double energy;      /* total energy at the last diagnostics row */
+  double kinetic;     /* kinetic energy at the last diagnostics row */
   mpm_rundir *rundir; /* the claim on the output folder, while the run writes */
   double run_id;      /* the run's id, in its folder's run.id and its checkpoints */
   char *checkpoint;   /* restart: the checkpoint it started from */
@@ -605,7 +606,7 @@ static int diagnostics_row(mpm_sim *s, double dt) {
     local[8 + s->mod[k]->role] += m.kinetic + m.internal;
   }
   MPM_CALL_MPI(MPI_Allreduce(local, sum, 10, MPI_DOUBLE, MPI_SUM, s->comm));
-  s->energy = sum[5] + sum[6];
+  s->energy = sum[5] + sum[6], s->kinetic = sum[5];
   if (s->coupling) MPM_CALL(coupling_row(s, dt, sum + 8));
   const double row[NDIAG] = {
       s->t,   (double)s->step, dt,     sum[0], sum[1],          sum[2],
@@ -619,15 +620,16 @@ static int diagnostics_row(mpm_sim *s, double dt) {
   return mpm_diag_row(s->diag, row);
 }
 
-/* Total energy of every module, summed over the ranks. */
-static int total_energy(mpm_sim *s, double *energy) {
-  double local = 0.0;
+/* Total and kinetic energy of every module, summed over the ranks (as diagnostics_row does). */
+static int energies(mpm_sim *s) {
+  double local[2] = {0.0, 0.0}, sum[2];
   for (int k = 0; k < s->nmod; ++k) {
     mpm_module_sums m;
     s->mod[k]->ops->sums(s->mod[k], &m);
-    local += m.kinetic + m.internal;
+    local[0] += m.kinetic, local[1] += m.internal;
   }
-  MPM_CALL_MPI(MPI_Allreduce(&local, energy, 1, MPI_DOUBLE, MPI_SUM, s->comm));
+  MPM_CALL_MPI(MPI_Allreduce(local, sum, 2, MPI_DOUBLE, MPI_SUM, s->comm));
+  s->energy = sum[0] + sum[1], s->kinetic = sum[0];
   return 0;
 }
 
@@ -835,8 +837,8 @@ static int stopped(mpm_sim *s, int rc) {
 
 /* The blow-up guard after an accepted step. */
 static int guard(mpm_sim *s, double dt, double tstop) {
-  const int rc =
-      mpm_guard_check(&s->guard, s->t, s->step, dt, s->t >= tstop * (1 - 1e-14), s->energy);
+  const int rc = mpm_guard_check(&s->guard, s->t, s->step, dt, s->t >= tstop * (1 - 1e-14),
+                                 s->energy, s->kinetic);
   return rc ? stopped(s, rc) : 0;
 }
 
@@ -853,7 +855,7 @@ int mpm_sim_run(mpm_sim *s) {
     if (s->snapshots) MPM_CALL(write_snapshot(s));
     s->out_next = 1;
   } else {
-    MPM_CALL(total_energy(s, &s->energy));
+    MPM_CALL(energies(s));
   }
   if (s->coupling) { /* the interface momentum owed at the start (a restarted staggered run) */
     mpm_coupling_record r;
@@ -862,7 +864,7 @@ int mpm_sim_run(mpm_sim *s) {
   }
   double h0;
   MPM_CALL(mpm_timescheme_cfl_step(s->it, &h0));
-  MPM_CALL(mpm_guard_init(&s->guard, s->cfg, h0, s->energy));
+  MPM_CALL(mpm_guard_init(&s->guard, s->cfg, h0, s->energy, s->kinetic));
   const double t_stop = s->t_end * (1 - 1e-14);
   double dt = 0.0;
   int sig = 0;

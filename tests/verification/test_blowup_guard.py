@@ -12,6 +12,9 @@ elastic waves, energy 6.25e-8 J, no energy enters), 20 time units.
    run on. The state where it stopped is the last snapshot of series.xmf (at the stop time),
    and an error line names it.
 2. forward Euler at 0.9 (an explicit method without error control, ERK fixed step): the same.
+   Both with time.kinetic_growth = 0, so that they test the total-energy criterion: with the
+   default the kinetic criterion (section 6) sees the same blow-up and stops the forward Euler
+   run first (step 57, the energy x110).
 3. The adaptive pair bs32 (error-controlled): it does not blow up on this bar, so the step
    collapse criterion is exercised with the error control itself: at rtol = 1e-12 its steps
    are about 0.06 of the CFL step. With time.collapse_ratio = 0.2 the guard stops the run
@@ -29,7 +32,28 @@ elastic waves, energy 6.25e-8 J, no energy enters), 20 time units.
    1e-20 s, a step that small no longer moved the time, and the end of that step was transferred
    unchecked.
 
-Sections 1-4 run by default; `coupled` runs section 5 alone (test_blowup_guard_coupled: three
+6. A velocity mode that the total energy does not show (time.kinetic_growth): the acoustic pulse
+   (cases/acoustic_pulse.ini: gas at rest between slip faces, 160 x 3 cells, a pulse of
+   amplitude 1e-4, kinetic energy 1.3e-11 J against a total of 0.134 J, the gas's internal
+   energy) under forward Euler at time.cfl = 0.9, which amplifies every undamped wave. The
+   kinetic energy grows from 1e-11 to 4.6e-4 J by t = 4 (x3e7; velocities near Mach 0.1 from a
+   pulse of 1e-4) while the total grows by 6.5 %: far inside time.energy_growth, so the run
+   ended with exit 0 before the kinetic criterion (measured on the commit before it: status 0,
+   t = 4). Checks, with the defaults:
+   - status 1 and one error line saying "blew up" and naming the kinetic energy and
+     time.kinetic_growth, before t_end (measured: t = 2.39, step 437, the kinetic energy
+     1.4e-4 J, 1.1e-3 of the total);
+   - it stopped at the limit: the last row's kinetic energy exceeds 100 x max(largest kinetic
+     energy of the first half of the rows, 1e-5 x the largest total energy) and the row before
+     did not (the criterion as documented, recomputed from diagnostics.csv; exact but for a
+     relative 1e-12 for the printed digits);
+   - the total energy at the stop is within 1 % of the start (measured 0.32 %): the
+     total-energy criterion (x1000) could not have seen it.
+   The control, time.kinetic_growth = 0 (the old behaviour): the run reaches t_end with status
+   0 and its kinetic energy ends at least 1e6 x its largest value over the first 100 steps
+   (measured 2.6e7), so the scene does blow up and the first check can fail.
+
+Sections 1-4 and 6 run by default; `coupled` runs section 5 alone (test_blowup_guard_coupled: three
 runs of the main job's scene, over 3 minutes under the sanitizers, so that pass leaves it to the
 plain one, where the fault it guards against showed as a signal, not a message).
 """
@@ -70,7 +94,7 @@ def bar_sections():
     for label, extra in (("usl", ["time.method=usl", "time.cfl=0.95", "output.snapshots=true",
                                   "output.interval=5"]),
                          ("euler", ["time.method=euler", "time.cfl=0.9"])):
-        p, d, out = run(label, extra)
+        p, d, out = run(label, extra + ["time.kinetic_growth=0"])
         msg = [l for l in p.stderr.splitlines() if l.startswith("error:")]
         check(p.returncode != 0 and msg and "blew up" in msg[0] and "time.energy_growth" in msg[0],
               f"{label}: stopped with status {p.returncode}: {msg[0].strip()[:160] if msg else ''}")
@@ -131,9 +155,56 @@ def coupled_sections():
               f"{msg.strip()[:160]}")
 
 
+PULSE = ["boundary.x_lo=slip", "boundary.x_hi=slip", "time.method=euler", "time.cfl=0.9",
+         "time.t_end=4", "output.snapshots=false", "run.progress=false",
+         "gas.air.density_field=1 + 1e-4*exp(-(x-1)^2/0.01)",
+         "gas.air.pressure_field=0.714285714285714*(1 + 1.4e-4*exp(-(x-1)^2/0.01))"]
+
+
+def pulse(label, extra):
+    out = mt.outdir("blowup_kinetic_" + label)
+    p = mt.run(["run", mt.case("acoustic_pulse.ini"), f"output.dir={out}"] + PULSE + extra,
+               check=False)
+    d = np.genfromtxt(os.path.join(out, "diagnostics.csv"), delimiter=",", names=True)
+    return p, d
+
+
+def limit(d, n):
+    """The kinetic criterion's threshold at row n (row 0 is the start): time.kinetic_growth =
+    100 times the larger of the largest kinetic energy of rows 0 .. n // 2 and 1e-5 of the
+    largest |total energy| of rows 0 .. n."""
+    return 100 * max(d["kinetic"][:n // 2 + 1].max(), 1e-5 * np.abs(d["total"][:n + 1]).max())
+
+
+def kinetic_section():
+    """Section 6: a kinetic blow-up at a flat total energy."""
+    p, d = pulse("default", [])
+    msg = error_line(p.stderr)
+    check(p.returncode == 1 and "blew up" in msg and "kinetic energy" in msg
+          and "time.kinetic_growth" in msg,
+          f"euler pulse: stopped with status {p.returncode} at t = {d['t'][-1]:.4g} (step "
+          f"{len(d) - 1}): {msg.strip()[:200]}")
+    n = len(d) - 1
+    k = d["kinetic"]
+    check(n > 20 and d["t"][-1] < 4 and k[n] > limit(d, n) * (1 - 1e-12)
+          and k[n - 1] <= limit(d, n - 1) * (1 + 1e-12),
+          f"euler pulse: stopped at the limit: kinetic energy {k[n - 1]:.4g} J <= "
+          f"{limit(d, n - 1):.4g} J at the row before, {k[n]:.4g} J > {limit(d, n):.4g} J at the "
+          "last")
+    drift = abs(d["total"][-1] / d["total"][0] - 1)
+    check(drift < 1e-2, f"euler pulse: total energy at the stop within {drift:.2g} of the start "
+          "(< 1 %: the total-energy criterion could not see it)")
+    p, d = pulse("off", ["time.kinetic_growth=0"])
+    grew = d["kinetic"][-1] / d["kinetic"][:101].max()
+    check(p.returncode == 0 and abs(d["t"][-1] - 4) < 1e-9 and grew >= 1e6,
+          f"euler pulse, time.kinetic_growth = 0: status {p.returncode} at t = {d['t'][-1]:.4g}, "
+          f"kinetic energy x{grew:.3g} over its first 100 steps (>= 1e6: it blows up)")
+
+
 if COUPLED:
     coupled_sections()
 else:
     bar_sections()
+    kinetic_section()
 sys.exit(check.finish())
 
