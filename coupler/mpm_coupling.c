@@ -365,6 +365,48 @@ int mpm_coupling_apply_load(mpm_coupling *c, double t, double h, const double *c
   return 0;
 }
 
+void mpm_coupling_apply_shared(mpm_coupling *c, double h, const double *m_gas,
+                               const double *const *f_gas, const double *const *v_gas,
+                               double *const *v_out, unsigned char *touched) {
+  mpm_timer_start(MPM_T_COUPLING);
+  c->recording = 1;
+  const mpm_grid_phase *s = mpm_coupling_phase(c, MPM_ROLE_SOLID);
+  const int dim = c->grid->dim;
+  for (mpm_lidx l = 0; l < c->grid->nnodes; ++l) {
+    const double mg = m_gas[l];
+    touched[l] = 0;
+    if (!(mg > 0.0)) continue;
+    const int solid = mpm_coupling_has_mass(c, MPM_ROLE_SOLID, l);
+    const double ms = solid ? s->m_i[l] : 0.0, inv = 1.0 / (ms + mg);
+    double v[MPM_MAX_DIM];
+    for (int d = 0; d < dim; ++d)
+      v_out[d][l] = v[d] =
+          ((solid ? ms * s->v_i[d][l] : 0.0) + mg * v_gas[d][l] + h * f_gas[d][l]) * inv;
+    if (!solid) continue;
+    touched[l] = 1;
+    mpm_coupling_exchange(c, MPM_ROLE_SOLID, l, v, NULL, h);
+  }
+  c->recording = 0;
+  mpm_timer_stop(MPM_T_COUPLING);
+}
+
+void mpm_coupling_follow_shared(mpm_coupling *c, double t, double h, const double *const *v,
+                                const unsigned char *touched) {
+  mpm_timer_start(MPM_T_COUPLING);
+  begin_record(c, t, h);
+  c->recording = 1;
+  const int dim = c->grid->dim;
+  for (mpm_lidx l = 0; l < c->grid->nnodes; ++l) {
+    if (!touched[l] || !mpm_coupling_has_mass(c, MPM_ROLE_FLUID, l)) continue;
+    double vl[MPM_MAX_DIM], f[MPM_MAX_DIM];
+    for (int d = 0; d < dim; ++d) vl[d] = v[d][l];
+    mpm_coupling_exchange_force(c, MPM_ROLE_FLUID, l, vl, NULL, h, f);
+    for (int d = 0; c->capture && d < dim; ++d) c->capture->capture[d][l] -= f[d];
+  }
+  c->recording = 0;
+  mpm_timer_stop(MPM_T_COUPLING);
+}
+
 int mpm_coupling_body_loads(mpm_coupling *c, const double *y_solid) {
   if (!c || !c->nbodies) return 0;
   mpm_timer_start(MPM_T_COUPLING);

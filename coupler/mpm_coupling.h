@@ -160,6 +160,21 @@ void mpm_coupling_exchange_force(mpm_coupling *c, mpm_role role, mpm_lidx l, con
 #define MPM_ALL_AXES ((1u << MPM_MAX_DIM) - 1)
 void mpm_coupling_follow_solid(mpm_coupling *c, mpm_lidx l, double h, unsigned axes);
 
+/* coupling.exchange = shared (mpm_interface.h, the shared nodes), in a loaded RHS after
+ * mpm_coupling_apply_load: every node where the gas had mass at the coupling step's start (m_gas,
+ * f_gas, its nodal mass and force then; v_gas, the node's velocity as the last accepted substep
+ * left it) advances as a shared node, v = (m_s v_s + m_gas v_gas + h f_gas) / (m_s + m_gas),
+ * the solid's part as an exchange (recorded, captured as delivered), written to v_out; where the
+ * solid has no mass, v_out = v_gas + h f_gas / m_gas. touched[l] = 1 where the solid had mass. */
+void mpm_coupling_apply_shared(mpm_coupling *c, double h, const double *m_gas,
+                               const double *const *f_gas, const double *const *v_gas,
+                               double *const *v_out, unsigned char *touched);
+/* The gas's half of the same, in its step over the coupling step t -> t + h (a follow RHS): the
+ * gas takes velocity v at every node marked in touched where it has mass, as an exchange, and
+ * what it gives up there is captured for the solid. Starts this RHS's record. */
+void mpm_coupling_follow_shared(mpm_coupling *c, double t, double h, const double *const *v,
+                                const unsigned char *touched);
+
 /* Record, without changing any field, that phase role received force f (dim values) at node l
  * and moves there with velocity v: the reaction a constraint takes for a phase (a clamped or
  * rigid solid holding the gas) counts as interface force. */

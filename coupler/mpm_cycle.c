@@ -38,17 +38,27 @@ static mpm_module *held(const mpm_cycle *c) {
 /* The coupling between the solve and the constraints: the spatial scheme (joint, held: its
  * exchanges into the held solid are captured) or the load (loaded, first pass only). */
 static int interact(const mpm_cycle *c, double t, double hs, mpm_pass pass) {
-  if (c->mode != MPM_CYCLE_LOADED) return mpm_coupling_after_solve(c->coupling, t, hs, pass);
+  if (c->mode == MPM_CYCLE_JOINT || c->mode == MPM_CYCLE_HELD)
+    return mpm_coupling_after_solve(c->coupling, t, hs, pass);
   if (pass != MPM_PASS_FIRST) return 0;
-  return mpm_coupling_apply_load(c->coupling, t, hs, mpm_interface_load_at(c->iface, t, hs),
-                                 mpm_interface_mass_start(c->iface));
+  mpm_interface *ifc = c->iface;
+  if (c->mode == MPM_CYCLE_FOLLOW) {
+    mpm_coupling_follow_shared(c->coupling, t, hs, (const double *const *)ifc->v_gas, ifc->touched);
+    return 0;
+  }
+  MPM_CALL(mpm_coupling_apply_load(c->coupling, t, hs, mpm_interface_load_at(ifc, t, hs),
+                                   mpm_interface_mass_start(ifc)));
+  if (ifc->m_gas)
+    mpm_coupling_apply_shared(c->coupling, hs, ifc->m_gas, (const double *const *)ifc->f_gas,
+                              (const double *const *)ifc->v_gas, ifc->v_now, ifc->touched_now);
+  return 0;
 }
 
 /* The grid work between the transfers. The solve takes the step only in the first pass. */
 static int grid_pass(const mpm_cycle *c, double t, double h, mpm_pass pass) {
   const double hs = pass == MPM_PASS_FIRST ? h : 0.0;
   mpm_module *hm = held(c);
-  const int hooks = c->mode != MPM_CYCLE_LOADED;
+  const int hooks = c->mode == MPM_CYCLE_JOINT || c->mode == MPM_CYCLE_HELD;
   MPM_CALL(halo(c, 1));
   mpm_timer_start(MPM_T_GRID);
   for (int k = 0; k < c->nmod; ++k) MPM_CALL(c->mod[k]->ops->forces(c->mod[k], t, h, pass));

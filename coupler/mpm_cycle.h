@@ -21,7 +21,10 @@
  *           with them, the spatial scheme acts as in a joint cycle, and what it gives the held
  *           partner is captured instead of applied (the partner takes no G2P);
  *   loaded  the modules advance alone, under the interface load captured from the partner's
- *           last advance (no spatial scheme hook runs). */
+ *           last advance (no spatial scheme hook runs); with shared nodes (mpm_interface.h)
+ *           the nodes where the gas has mass also advance as shared nodes;
+ *   follow  the gas advances alone and takes the velocity the solid's substeps left on the
+ *           shared nodes (coupling.exchange = shared; no spatial scheme hook runs). */
 #ifndef MPM_CYCLE_H
 #define MPM_CYCLE_H
 
@@ -32,7 +35,7 @@
 /* Modules one cycle (and one integrator) advances at most. */
 #define MPM_MAX_MODULES 4
 
-typedef enum { MPM_CYCLE_JOINT, MPM_CYCLE_HELD, MPM_CYCLE_LOADED } mpm_cycle_mode;
+typedef enum { MPM_CYCLE_JOINT, MPM_CYCLE_HELD, MPM_CYCLE_LOADED, MPM_CYCLE_FOLLOW } mpm_cycle_mode;
 
 typedef struct mpm_cycle {
   mpm_grid *grid;

@@ -36,8 +36,9 @@ void mpm_interface_destroy(mpm_interface **ifcp) {
     free(ifc->capture[d]), free(ifc->impulse[d]), free(ifc->load[d]);
     free(ifc->trend[d]), free(ifc->prev[d]), free(ifc->now[d]), free(ifc->moved[d]);
     free(ifc->vprev[d]), free(ifc->accel[d]);
+    free(ifc->f_gas[d]), free(ifc->v_gas[d]), free(ifc->v_now[d]);
   }
-  free(ifc->mprev);
+  free(ifc->mprev), free(ifc->m_gas), free(ifc->touched), free(ifc->touched_now);
   free(ifc);
   *ifcp = NULL;
 }
@@ -106,6 +107,32 @@ void mpm_interface_predict(const mpm_interface *ifc, double t) {
     }
 }
 
+int mpm_interface_want_shared(mpm_interface *ifc) {
+  const size_t nn = (size_t)ifc->grid->nnodes;
+  MPM_ALLOC(ifc->m_gas, nn);
+  MPM_ALLOC(ifc->touched, nn);
+  MPM_ALLOC(ifc->touched_now, nn);
+  for (int d = 0; d < ifc->grid->dim; ++d) {
+    MPM_ALLOC(ifc->f_gas[d], nn);
+    MPM_ALLOC(ifc->v_gas[d], nn);
+    MPM_ALLOC(ifc->v_now[d], nn);
+  }
+  return 0;
+}
+
+void mpm_interface_share(mpm_interface *ifc, int gas_phase) {
+  const mpm_grid_phase *ph = &ifc->grid->phase[gas_phase];
+  const size_t nn = (size_t)ifc->grid->nnodes;
+  for (mpm_lidx l = 0; l < ifc->grid->nnodes; ++l)
+    ifc->m_gas[l] = ph->m_i[l] > ph->m_empty ? ph->m_i[l] : 0.0;
+  memset(ifc->touched, 0, nn);
+  for (int d = 0; d < ifc->grid->dim; ++d) {
+    memcpy(ifc->f_gas[d], ph->f_i[d], sizeof(double) * nn);
+    for (mpm_lidx l = 0; l < ifc->grid->nnodes; ++l)
+      ifc->v_gas[d][l] = ifc->m_gas[l] > 0.0 ? ph->mv_i[d][l] / ifc->m_gas[l] : 0.0;
+  }
+}
+
 void mpm_interface_capture_begin(mpm_interface *ifc) {
   for (int d = 0; d < ifc->grid->dim; ++d)
     memset(ifc->capture[d], 0, sizeof(double) * (size_t)ifc->grid->nnodes);
@@ -113,6 +140,11 @@ void mpm_interface_capture_begin(mpm_interface *ifc) {
 
 void mpm_interface_capture_accept(mpm_interface *ifc, double h, int sign) {
   const double w = sign * h;
+  if (sign < 0 && ifc->m_gas) { /* a solid substep: the shared nodes move on */
+    for (int d = 0; d < ifc->grid->dim; ++d)
+      memcpy(ifc->v_gas[d], ifc->v_now[d], sizeof(double) * (size_t)ifc->grid->nnodes);
+    for (mpm_lidx l = 0; l < ifc->grid->nnodes; ++l) ifc->touched[l] |= ifc->touched_now[l];
+  }
   for (int d = 0; d < ifc->grid->dim; ++d)
     for (mpm_lidx l = 0; l < ifc->grid->nnodes; ++l) ifc->impulse[d][l] += w * ifc->capture[d][l];
 }

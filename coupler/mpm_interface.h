@@ -68,6 +68,11 @@ typedef struct mpm_interface {
    * acceleration predicted from them at the current hold (at t_hold), m/s^2 per node. */
   double *vprev[MPM_MAX_DIM], *mprev, *accel[MPM_MAX_DIM];
   double t_prev, t_hold;
+  /* The shared nodes (mpm_interface_want_shared; else NULL): the gas's nodal mass and force at
+   * the coupling step's start, the nodes' velocity as the solid's last accepted substep left
+   * them (and this RHS's), and which nodes the solid reached (accepted, this RHS's). */
+  double *m_gas, *f_gas[MPM_MAX_DIM], *v_gas[MPM_MAX_DIM], *v_now[MPM_MAX_DIM];
+  unsigned char *touched, *touched_now;
 } mpm_interface;
 
 int mpm_interface_new(mpm_interface **ifc, mpm_grid *grid, int phase);
@@ -99,6 +104,23 @@ void mpm_interface_predict_hold(mpm_interface *ifc, double t);
 /* After mpm_interface_restore in a held RHS at t: the held phase's momentum and force as the
  * predictor has them (nothing without a predictor). */
 void mpm_interface_predict(const mpm_interface *ifc, double t);
+
+/* The shared nodes (coupling.exchange = shared). The default exchange holds the solid for the
+ * gas's step and gives the solid the gas's impulse as a load spread over its substeps. Where the
+ * solid is light beside the gas (a soft slab under a shock: its face nodes carry a few per cent
+ * of the gas's nodal mass there), a face node alone under that load rings at the solid's own
+ * frequency around the velocity the gas met, and the velocity scheme's inelastic merge at the
+ * next step takes the ringing's energy out (tests/verification/test_multirate_face.py). With
+ * shared nodes the solid goes first, and on every node where the gas has mass its substeps
+ * advance the node as the joint solve would, with the gas's nodal mass beside the solid's and
+ * the gas's nodal force of the step's start: the fast partition carries the interface's inertia
+ * and the slow one's force, as in a multirate (MRI) method. The gas's step then takes, on the
+ * nodes the solid reached, the velocity the substeps left there. What the solid received and the
+ * gas gave up are captured on both sides, so the owed momentum keeps the balance exact. */
+int mpm_interface_want_shared(mpm_interface *ifc);
+/* At the coupling step's start, after the gas's deposit (mpm_cycle_deposit): take the gas's
+ * nodal mass, force and velocity from its phase. */
+void mpm_interface_share(mpm_interface *ifc, int gas_phase);
 
 /* A gas or solid RHS begins: nothing captured yet. */
 void mpm_interface_capture_begin(mpm_interface *ifc);

@@ -36,6 +36,7 @@ int mpm_partitioned_new(mpm_timescheme *ts, const mpm_config *cfg, const char *s
   solid.mod = &pp->solid, solid.mode = MPM_CYCLE_LOADED;
   gas.mod = &pp->gas, gas.mode = MPM_CYCLE_HELD;
   pp->deposit = solid, pp->deposit.mode = MPM_CYCLE_JOINT;
+  pp->gas_deposit = gas, pp->gas_deposit.mode = MPM_CYCLE_JOINT;
   MPM_CALL(mpm_integrator_new(&pp->it_solid, cfg, &solid));
   MPM_CALL(mpm_integrator_new(&pp->it_gas, cfg, &gas));
   return 0;
@@ -72,6 +73,25 @@ int mpm_partitioned_cfl_step(mpm_timescheme *ts, double *h) {
   double hs, hg;
   MPM_CALL(mpm_partitioned_cfl_steps(ts, &hs, &hg));
   *h = hs > 0 && hg > 0 ? fmin(hs, hg) : fmax(hs, hg);
+  return 0;
+}
+
+int mpm_partitioned_want_shared(mpm_timescheme *ts, const mpm_config *cfg) {
+  mpm_partitioned *pp = ts->content;
+  MPM_CALL(mpm_interface_want_shared(pp->ifc));
+  mpm_cycle gas = pp->gas_deposit;
+  gas.mode = MPM_CYCLE_FOLLOW;
+  mpm_integrator_destroy(&pp->it_gas);
+  MPM_CALL(mpm_integrator_new(&pp->it_gas, cfg, &gas));
+  pp->shared = 1;
+  return 0;
+}
+
+int mpm_partitioned_share(mpm_timescheme *ts, double t) {
+  mpm_partitioned *pp = ts->content;
+  double *y = pp->gas->particles->data;
+  MPM_CALL(mpm_cycle_deposit(&pp->gas_deposit, t, &y));
+  mpm_interface_share(pp->ifc, pp->gas->phase);
   return 0;
 }
 
@@ -149,7 +169,7 @@ int mpm_partitioned_advance_solid_under(mpm_timescheme *ts, double t0, double t1
   for (int d = 0; q && d < ts->grid->dim; ++d)
     for (mpm_lidx l = 0; l < ts->grid->nnodes; ++l) pp->ifc->load[d][l] += q[d][l];
   MPM_CALL(advance(ts, pp->it_solid, MPM_ROLE_SOLID, t0, t1, n));
-  return mpm_interface_rehome(pp->ifc, ts->coupling->owned);
+  return pp->shared ? 0 : mpm_interface_rehome(pp->ifc, ts->coupling->owned);
 }
 
 int mpm_partitioned_end(mpm_timescheme *ts, double t0, double t1) {

@@ -22,9 +22,11 @@ typedef struct mpm_partitioned {
   mpm_module *solid, *gas;
   mpm_integrator *it_solid, *it_gas;
   mpm_interface *ifc;
-  mpm_cycle deposit; /* the solid alone, for its deposit before the gas advances */
-  double dt_max;     /* time.dt_max (HUGE_VAL: none) */
-  double h_last;     /* the last coupling step */
+  mpm_cycle deposit;     /* the solid alone, for its deposit before the gas advances */
+  mpm_cycle gas_deposit; /* the gas alone, for its deposit before shared nodes advance */
+  int shared;            /* multirate: coupling.exchange = shared (mpm_interface.h) */
+  double dt_max;         /* time.dt_max (HUGE_VAL: none) */
+  double h_last;         /* the last coupling step */
   /* The scheme's own settings, read by its create. */
   int order;    /* staggered: the order of the advances */
   int substeps; /* multirate: substeps of the fast module per coupling step (0: from the ratio) */
@@ -41,6 +43,12 @@ typedef struct mpm_partitioned {
  * else an input error naming the key (scheme: the coupling.time name, for the message). */
 int mpm_partitioned_new(mpm_timescheme *ts, const mpm_config *cfg, const char *scheme);
 
+/* Use shared nodes (coupling.exchange = shared, mpm_interface.h): the gas then advances in
+ * follow cycles. */
+int mpm_partitioned_want_shared(mpm_timescheme *ts, const mpm_config *cfg);
+/* Deposit the gas as it is now, at t, for the shared nodes. Collective. */
+int mpm_partitioned_share(mpm_timescheme *ts, double t);
+
 /* The CFL steps of the solid and of the gas (0: no limit). Collective. */
 int mpm_partitioned_cfl_steps(mpm_timescheme *ts, double *h_solid, double *h_gas);
 
@@ -50,7 +58,9 @@ int mpm_partitioned_hold(mpm_timescheme *ts, double t);
  * the solid to the owed momentum. Collective. */
 int mpm_partitioned_advance_gas(mpm_timescheme *ts, double t0, double t1, int n);
 /* Advance the solid from t0 to t1 in n equal substeps under the owed momentum (spread evenly
- * over t1 - t0, or with the trend since the last load when interpolating). Collective. */
+ * over t1 - t0, or with the trend since the last load when interpolating), then move what stays
+ * owed where the solid left (mpm_interface_rehome; with shared nodes the scheme does that after
+ * the gas's step, which pays what the solid received). Collective. */
 int mpm_partitioned_advance_solid(mpm_timescheme *ts, double t0, double t1, int n);
 /* The same with the load rate q (N per node, dim arrays over the box nodes) added to that of the
  * owed momentum: the solid receives H q more than it is owed, which the gas's advance is then

@@ -40,7 +40,14 @@
 #include <math.h>
 #include <string.h>
 
-enum { KEY_SUBSTEPS, KEY_SLOW_SUBSTEPS, KEY_LOAD, KEY_MRI_TABLE, KEY_PREDICTOR }; /* in order */
+enum {
+  KEY_SUBSTEPS,
+  KEY_SLOW_SUBSTEPS,
+  KEY_LOAD,
+  KEY_MRI_TABLE,
+  KEY_PREDICTOR,
+  KEY_EXCHANGE
+}; /* in order */
 /* The substep keys go up to MULTIRATE_MAX_SUBSTEPS, the most the scheme takes on its own before
  * it calls the fast module's step collapsed (below): 10-100 is what two stable modules need.
  * Up to 1e6 was allowed: at that setting a coupling step took 84 s (issue 54), while the run's
@@ -70,6 +77,12 @@ static const mpm_key_spec multirate_keys[] = {
      "step: none (the solid at the step's start, advanced by its own nodal force then) or "
      "linear (extrapolated from its last two coupling steps); the momentum exchanged stays "
      "exact either way",
+     0, NULL},
+    {"coupling.exchange", MPM_KEY_ENUM, "held", 0, 0, 0, 0, "held|shared",
+     "multirate, classic update, velocity scheme: held (the gas first, against the solid held "
+     "at the step's start; the solid then under the gas's impulse as a load) or shared (the "
+     "solid first, its substeps advancing the nodes it shares with the gas with the gas's "
+     "nodal mass and force beside its own; the gas then takes the velocity they left there)",
      0, NULL},
 };
 
@@ -109,6 +122,9 @@ static int multirate_mri_create(mpm_timescheme *ts, const mpm_config *cfg, const
   MPM_CALL(foreign_key(cfg, KEY_SLOW_SUBSTEPS,
                        "is read with the classic update only: MRIStep (an ERK pair) takes one "
                        "slow step per coupling step; remove it or use time.method = usl"));
+  MPM_CALL(foreign_key(cfg, KEY_EXCHANGE,
+                       "is read with the classic update only: MRIStep (an ERK pair) advances "
+                       "the shared nodes with the gas; remove it or use time.method = usl"));
   int adaptive;
   MPM_CALL(mpm_config_get_bool(cfg, "time.adaptive", &adaptive));
   if (adaptive)
@@ -134,6 +150,32 @@ static int multirate_mri_create(mpm_timescheme *ts, const mpm_config *cfg, const
   const int rc = mpm_integrator_new_multirate(&it, cfg, &cycle, fast, substeps, mri_tables[t].id);
   ts->content = it;
   return rc;
+}
+
+/* coupling.exchange = shared: what it needs, and the gas's follow cycles. */
+static int want_shared(mpm_timescheme *ts, const mpm_config *cfg, const char *method,
+                       const char *predictor) {
+  const mpm_partitioned *pp = ts->content;
+  if (strcmp(ts->coupling->type->name, "velocity") != 0)
+    return mpm_config_fail(cfg, "coupling.exchange",
+                           "shared advances the nodes both phases share as one velocity, which "
+                           "is coupling.scheme = velocity; this scene uses %s: use held, or "
+                           "coupling.scheme = velocity",
+                           ts->coupling->type->name);
+  if (strcmp(method, "usl") != 0)
+    return mpm_config_fail(cfg, "coupling.exchange",
+                           "shared takes the gas's nodal force of the step's first transfer, and "
+                           "%s transfers twice: use held, or time.method = usl",
+                           method);
+  if (strcmp(predictor, "none") != 0)
+    return mpm_config_fail(cfg, "coupling.predictor",
+                           "predicts the held solid for the gas, and coupling.exchange = shared "
+                           "holds no solid (the solid goes first): remove one of the two keys");
+  if (pp->slow_substeps != 1)
+    return mpm_config_fail(cfg, "coupling.slow_substeps",
+                           "coupling.exchange = shared takes the gas in one step per coupling "
+                           "step: remove the key or use coupling.exchange = held");
+  return mpm_partitioned_want_shared(ts, cfg);
 }
 
 static int multirate_create(mpm_timescheme *ts, const mpm_config *cfg) {
@@ -165,6 +207,9 @@ static int multirate_create(mpm_timescheme *ts, const mpm_config *cfg) {
   const char *predictor;
   MPM_CALL(mpm_config_get_string(cfg, "coupling.predictor", &predictor));
   if (strcmp(predictor, "linear") == 0) MPM_CALL(mpm_interface_want_predictor(pp->ifc));
+  const char *exchange;
+  MPM_CALL(mpm_config_get_string(cfg, "coupling.exchange", &exchange));
+  if (strcmp(exchange, "shared") == 0) MPM_CALL(want_shared(ts, cfg, method, predictor));
   return 0;
 }
 
@@ -178,9 +223,12 @@ static double limit(double h) {
 }
 
 /* The coupling step from the two modules' CFL steps (before the stop time): the slow one's,
- * or m times the fast one's when coupling.substeps = m is smaller. */
-static double coupling_step(const mpm_partitioned *pp, double h_fast, double h_slow) {
-  const double H = pp->substeps > 0 ? fmin(h_slow, pp->substeps * h_fast) : h_slow;
+ * or m times the fast one's when coupling.substeps = m is smaller; with shared nodes at most
+ * the gas's (it takes one step per coupling step). */
+static double coupling_step(const mpm_partitioned *pp, double h_solid, double h_gas) {
+  const double h_fast = fmin(h_solid, h_gas), h_slow = fmax(h_solid, h_gas);
+  double H = pp->substeps > 0 ? fmin(h_slow, pp->substeps * h_fast) : h_slow;
+  if (pp->shared) H = fmin(H, h_gas);
   return fmin(H, pp->dt_max);
 }
 
@@ -189,7 +237,7 @@ static int multirate_cfl_step(mpm_timescheme *ts, double *h) {
   double hs, hg;
   MPM_CALL(mpm_partitioned_cfl_steps(ts, &hs, &hg));
   hs = limit(hs), hg = limit(hg);
-  const double H = coupling_step(ts->content, fmin(hs, hg), fmax(hs, hg));
+  const double H = coupling_step(ts->content, hs, hg);
   *h = isfinite(H) ? H : 0.0;
   return 0;
 }
@@ -201,7 +249,7 @@ static int multirate_work(mpm_timescheme *ts, double *advances, double *need, co
   double hs, hg;
   MPM_CALL(mpm_partitioned_cfl_steps(ts, &hs, &hg));
   hs = limit(hs), hg = limit(hg);
-  const double h_fast = fmin(hs, hg), H = coupling_step(pp, h_fast, fmax(hs, hg));
+  const double h_fast = fmin(hs, hg), H = coupling_step(pp, hs, hg);
   const double stable =
       isfinite(h_fast) && isfinite(H) ? fmax(ceil(H / h_fast * (1 - 1e-12)), 1.0) : 1.0;
   const double m = pp->substeps > 0 ? pp->substeps : stable;
@@ -222,7 +270,7 @@ static int multirate_step(mpm_timescheme *ts, double tstop, double *t, double *h
   const int solid_fast = hs < hg;
   const double h_fast = fmin(hs, hg);
   const double t0 = *t, rest = tstop - t0;
-  const double H = fmin(coupling_step(pp, h_fast, fmax(hs, hg)), rest);
+  const double H = fmin(coupling_step(pp, hs, hg), rest);
   int m = pp->substeps;
   if (m == 0) {
     const double need = isfinite(h_fast) ? fmax(1.0, ceil(H / h_fast * (1 - 1e-12))) : 1.0;
@@ -241,9 +289,16 @@ static int multirate_step(mpm_timescheme *ts, double tstop, double *t, double *h
       "multirate at t = %.9g: stable steps solid %.4g s, gas %.4g s; H %.4g s, %d + %d substeps",
       t0, hs, hg, H, solid_fast ? n : m, solid_fast ? m : n);
   const double t1 = H < rest ? t0 + H : tstop;
-  MPM_CALL(mpm_partitioned_hold(ts, t0));
-  MPM_CALL(mpm_partitioned_advance_gas(ts, t0, t1, solid_fast ? n : m));
-  MPM_CALL(mpm_partitioned_advance_solid(ts, t0, t1, solid_fast ? m : n));
+  if (pp->shared) { /* the solid first, then the gas pays what it received */
+    MPM_CALL(mpm_partitioned_share(ts, t0));
+    MPM_CALL(mpm_partitioned_advance_solid(ts, t0, t1, solid_fast ? m : n));
+    MPM_CALL(mpm_partitioned_advance_gas(ts, t0, t1, 1));
+    MPM_CALL(mpm_interface_rehome(pp->ifc, ts->coupling->owned));
+  } else {
+    MPM_CALL(mpm_partitioned_hold(ts, t0));
+    MPM_CALL(mpm_partitioned_advance_gas(ts, t0, t1, solid_fast ? n : m));
+    MPM_CALL(mpm_partitioned_advance_solid(ts, t0, t1, solid_fast ? m : n));
+  }
   MPM_CALL(mpm_partitioned_end(ts, t0, t1));
   *t = t1, *h = t1 - t0;
   return 0;
