@@ -2,12 +2,13 @@
  * timescheme_multirate.c): one ARKODE integrator per module, the interface data between them
  * (mpm_interface.h), and the advances a coupling step is made of.
  *
- * The gas always advances against the solid held at its last deposit (a held cycle); the solid
- * always advances under the momentum the gas gave up (a loaded cycle), so the interface balances
- * over every exchange to roundoff. A scheme decides the order, the coupling step and the
- * substeps; these functions do the rest. The classic update only (usl, musl): the captured load
- * is the interface force of each step's one RHS, where an adaptive pair's stages would each
- * give another.
+ * The gas advances against the solid held at its last deposit (a held cycle), or with shared
+ * nodes (mpm_interface.h) after the solid, taking the velocity its substeps left on them (a
+ * follow cycle); the solid advances under the momentum the gas gave up (a loaded cycle), so the
+ * interface balances over every exchange to roundoff. A scheme decides the order, the coupling
+ * step and the substeps; these functions do the rest. The classic update only (usl, musl): the
+ * captured load is the interface force of each step's one RHS, where an adaptive pair's stages
+ * would each give another.
  *
  * A coupling step: partitioned_begin, then hold / advance_gas / advance_solid in the scheme's
  * order, then partitioned_end, which forms the step's interface record: the rates of each side

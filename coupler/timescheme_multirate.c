@@ -8,6 +8,10 @@
  * m = 1 this is the monolithic classic step (see timescheme_staggered.c, gas_first). With
  * coupling.predictor = linear the gas meets the held solid's interface velocity extrapolated
  * from its last two coupling steps instead (mpm_interface.h); the exchange stays exact.
+ * With coupling.exchange = shared (velocity scheme, usl) the solid goes first and its substeps
+ * advance the nodes it shares with the gas with the gas's nodal mass and force beside its own;
+ * the gas, in one step, then takes the velocity they left there (mpm_interface.h, the shared
+ * nodes): where the solid is light beside the gas, the held exchange makes its face ring.
  *
  * H is the slow module's stable step. On the shock panel that is the gas's, and in it the
  * artificial viscosity's diffusion limit (fluid.viscous_step, fluid_stress.h): a trace-level log
