@@ -141,8 +141,11 @@ void mpm_interface_capture_begin(mpm_interface *ifc) {
 void mpm_interface_capture_accept(mpm_interface *ifc, double h, int sign) {
   const double w = sign * h;
   if (sign < 0 && ifc->m_gas) { /* a solid substep: the shared nodes move on */
+    /* where the solid has mass, as its constraints and the forward halo left them */
+    const mpm_grid_phase *ph = &ifc->grid->phase[ifc->phase];
     for (int d = 0; d < ifc->grid->dim; ++d)
-      memcpy(ifc->v_gas[d], ifc->v_now[d], sizeof(double) * (size_t)ifc->grid->nnodes);
+      for (mpm_lidx l = 0; l < ifc->grid->nnodes; ++l)
+        ifc->v_gas[d][l] = ifc->touched_now[l] ? ph->v_i[d][l] : ifc->v_now[d][l];
     for (mpm_lidx l = 0; l < ifc->grid->nnodes; ++l) ifc->touched[l] |= ifc->touched_now[l];
   }
   for (int d = 0; d < ifc->grid->dim; ++d)
