@@ -15,7 +15,7 @@ of mode 1), fitted by least squares with two damped sinusoids and a constant (va
 projection, started from a Hann-windowed FFT's parabolic peaks).
 
 Arguments: [long] [standin] [scheme:method:time ...]; default velocity:usl:monolithic and
-velocity:usl:multirate at 50, 100, 200 cells per metre (about 45 s on an idle core; in this 1-D
+velocity:usl:multirate at 50, 100, 200 cells per metre (40 s of CPU, measured; in this 1-D
 strip the interface normal is the whole velocity, and velocity, contact and traction give the
 same figures to the printed digits). `long`:
 velocity, contact and traction under usl; velocity under bs32 (adaptive, the default) and under
