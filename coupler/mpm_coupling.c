@@ -271,7 +271,11 @@ int mpm_coupling_after_constrain(mpm_coupling *c, double t, double h, mpm_pass p
   if (!c) return 0;
   if (c->type->needs & MPM_COUPLING_HOLDS) MPM_CALL(run_hook(c, follow_held, t, h, pass));
   MPM_CALL(run_hook(c, c->type->ops->after_constrain, t, h, pass));
-  if (pass != MPM_PASS_FIRST) return 0;
+  if (pass == MPM_PASS_FIRST) mpm_coupling_record_inside(c);
+  return 0;
+}
+
+void mpm_coupling_record_inside(mpm_coupling *c) {
   /* Interpenetration: gas mass on the owned nodes inside the solid, those with at least 90 %
    * of the largest solid nodal mass of the grid (full support: the stencil is covered). */
   mpm_timer_start(MPM_T_COUPLING);
@@ -284,7 +288,6 @@ int mpm_coupling_after_constrain(mpm_coupling *c, double t, double h, mpm_pass p
     if (c->owned[l] && ms[l] >= 0.9 * mmax && mmax > 0) inside += mf[l];
   c->rec[c->which.latest].gas_inside = inside;
   mpm_timer_stop(MPM_T_COUPLING);
-  return 0;
 }
 
 /* ---- for the schemes ---------------------------------------------------------------------- */

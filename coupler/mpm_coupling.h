@@ -118,6 +118,9 @@ void mpm_coupling_destroy(mpm_coupling **c);
 int mpm_coupling_before_solve(mpm_coupling *c, double t, double h, mpm_pass pass);
 int mpm_coupling_after_solve(mpm_coupling *c, double t, double h, mpm_pass pass);
 int mpm_coupling_after_constrain(mpm_coupling *c, double t, double h, mpm_pass pass);
+/* The latest record's gas_inside, from the phases' nodal masses as they stand (the
+ * after_constrain hook's first pass does it; a follow cycle, which runs no hooks, calls it). */
+void mpm_coupling_record_inside(mpm_coupling *c);
 
 /* A staggered scheme's load (mpm_interface.h): after the solid's solve, accelerate the solid
  * wherever it has mass by load (N per box node, dim arrays) over the larger of its nodal mass

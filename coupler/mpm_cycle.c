@@ -74,6 +74,8 @@ static int grid_pass(const mpm_cycle *c, double t, double h, mpm_pass pass) {
   for (int k = 0; k < c->nmod; ++k) MPM_CALL(c->mod[k]->ops->constrain(c->mod[k], t, h, pass));
   if (hm) MPM_CALL(hm->ops->constrain(hm, t, h, pass));
   if (hooks) MPM_CALL(mpm_coupling_after_constrain(c->coupling, t, hs, pass));
+  if (c->mode == MPM_CYCLE_FOLLOW && pass == MPM_PASS_FIRST)
+    mpm_coupling_record_inside(c->coupling);
   mpm_coupling_capture(c->coupling, NULL);
   mpm_timer_stop(MPM_T_GRID);
   return halo(c, 0);
