@@ -1,6 +1,8 @@
 /* The interface data of a partitioned time scheme (staggered, multirate): what the gas knows of the
- * solid, and the solid of the gas, between their exchanges. The gas always advances against a held
- * solid; the solid always advances under the load the gas left it.
+ * solid, and the solid of the gas, between their exchanges. The gas advances against a held
+ * solid and the solid under the load the gas left it; under multirate's `coupling.exchange =
+ * shared` the solid goes first, advancing the shared nodes with the gas's mass and force beside
+ * its own, and the gas then takes the velocity left there (mpm_interface_share below).
  *
  * Held fields. Before the gas advances, the solid is deposited (P2G, reverse halo, forces:
  * mpm_cycle_deposit) and its nodal mass, momentum, force and mass gradient are saved here.

@@ -620,10 +620,14 @@ static int read_bodies(mpm_module *m, const mpm_config *cfg) {
     solid_key(key, sizeof key, sc->body[b].section, "material");
     MPM_CALL(mpm_config_get_string(cfg, key, &type));
     MPM_CALL(solid_material_create(&sc->body[b].mat, type, cfg, sc->body[b].section, m->grid->dim));
-    /* Constant per body: evaluated once, not per particle in every stable-step scan. */
-    sc->body[b].c = sc->body[b].mat->ops->wave_speed(sc->body[b].mat, sc->body[b].rho);
     MPM_CALL(solid_prestress_read(&sc->body[b].pre, cfg, sc->body[b].section, sc->body[b].mat,
                                   m->grid->dim));
+    /* Constant per body: evaluated once, not per particle in every stable-step scan. At the
+     * reference density: a body pre-compressed to J0 < 1 is denser than its unstressed state
+     * (rho J0 is the reference density), so the step shrinks with it; the stiffening of the
+     * tangent at F0 is not included. */
+    sc->body[b].c =
+        sc->body[b].mat->ops->wave_speed(sc->body[b].mat, sc->body[b].rho * sc->body[b].pre.J0);
     if (sc->body[b].mat->ops->rigid) MPM_CALL(solid_read_rigid(m, cfg, &sc->body[b]));
   }
   double g[3] = {0, 0, 0};

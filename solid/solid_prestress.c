@@ -213,7 +213,10 @@ static int ps_solve_stretch(solid_prestress *ps, const solid_material *mat, int 
   if (yields) {
     snprintf(why, nwhy,
              "it lies beyond the model's initial yield surface (the body would yield "
-             "at once); lower its deviatoric part");
+             "at once); lower its deviatoric part%s",
+             dim == 2 ? " (in 2-D the plane-strain out-of-plane stress adds one, even to a "
+                        "pure pressure, of about (mu / K) p)"
+                      : "");
     return MPM_ERR_INPUT;
   }
   if (!(rmax <= tol)) {
