@@ -22,7 +22,8 @@ mpm_add_script_test(test_timeschemes SCRIPT verification/test_timeschemes.py
 # checkpoints and restarts on 1 and 2 ranks in every CI run.
 mpm_add_script_test(test_timeschemes_mri SCRIPT verification/test_timeschemes.py ARGS mri
                     LABELS "verification;mpi;long" TIMEOUT 900)
-# Its restart checks alone, short (the sanitizer pass runs this one, not the whole study).
+# Its restart checks, short (the sanitizer pass runs this one, not the whole study), and the
+# shared exchange on 2 ranks against 1.
 mpm_add_script_test(test_timeschemes_quick SCRIPT verification/test_timeschemes.py ARGS quick
                     LABELS "verification;mpi" TIMEOUT 600)
 # The least-squares wall at a moving traction interface (cases/fsi_gas_piston.ini): a slab

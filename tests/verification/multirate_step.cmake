@@ -5,6 +5,7 @@ mpm_add_script_test(test_multirate_step SCRIPT verification/test_multirate_step.
                     LABELS verification TIMEOUT 300)
 
 # Multirate's exchange at the face of a soft, fast slab under a Mach 2 shock
-# (cases/fsi_multirate_face.ini): coupling.exchange = shared against monolithic (~60 s).
+# (cases/fsi_multirate_face.ini): coupling.exchange = shared against monolithic, and the slab
+# clamped (the gas takes the clamp's velocity on the shared nodes) (~60 s).
 mpm_add_script_test(test_multirate_face SCRIPT verification/test_multirate_face.py
                     LABELS verification TIMEOUT 300)
