@@ -9,13 +9,15 @@
 #include "mpm_geometry.h"
 #include "mpm_module.h"
 #include "mpm_transfer.h"
+#include "solid_bulk_viscosity.h"
 #include "solid_material.h"
 #include "solid_prestress.h"
 
 #include <stdio.h>
 
 /* Field indices: x, v, F are always fields 0-2; sigma (rate-form stress) and hist (material
- * history) exist only when some body's model needs them (see solid_layout). */
+ * history) exist only when some body's model needs them, divv (the lagged tr D) only when some
+ * body has a bulk viscosity (see solid_layout). */
 enum { F_X, F_V, F_F };
 
 typedef struct {
@@ -26,11 +28,13 @@ typedef struct {
   double v[3];         /* rigid bodies: the prescribed velocity */
   mpm_region *region;  /* rigid bodies: the seeded region (the nodes it holds); else NULL */
   solid_prestress pre; /* the seeded state that carries the initial stress */
+  solid_bulkq q;       /* its bulk viscosity (off unless set) */
 } solid_body;
 
 typedef struct {
-  int f_sigma, f_C, f_m, f_V0, f_body, f_hist, f_fixed, f_fext; /* field indices (-1 if absent) */
-  int nhist; /* history components per particle */
+  int f_sigma, f_C, f_divv, f_m, f_V0, f_body, f_hist, f_fixed,
+      f_fext; /* field indices (-1 if absent) */
+  int nhist;  /* history components per particle */
 } solid_layout;
 
 /* A surface traction [traction.NAME]: constant nominal traction t (Pa) on the particles of

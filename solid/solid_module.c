@@ -1,13 +1,13 @@
 /* Solid module: its case keys, seeding, and the module phases of an MPM right-hand side. The
  * constraints (walls, clamps, rigid bodies) and surface tractions are in solid_constraints.c.
  *
- * Invariants: particle field order is x, v, F, [sigma], [C] | m, V0, body, [hist], [fixed],
- * [fext] (see solid_particles_new; bracketed fields exist only when a body's model, the APIC
- * transfer, a clamp or a traction needs them). body holds a small integer stored as a double.
- * The per-body index lists used for batched stress evaluation are rebuilt at each P2G, so they
- * never go stale after migration, sorting or injection. A rigid body's particles keep F = I,
- * C = 0 and their seeded velocity, and its region moves rigidly with that velocity: at time t
- * it is the seeded region translated by v t (wrapped through periodic faces). A body with an
+ * Invariants: particle field order is x, v, F, [sigma], [C], [divv] | m, V0, body, [hist],
+ * [fixed], [fext] (see solid_particles_new; bracketed fields exist only when a body's model, the
+ * APIC transfer, a bulk viscosity, a clamp or a traction needs them). body holds a small integer
+ * stored as a double. The per-body index lists used for batched stress evaluation are rebuilt at
+ * each P2G, so they never go stale after migration, sorting or injection. A rigid body's particles
+ * keep F = I, C = 0 and their seeded velocity, and its region moves rigidly with that velocity: at
+ * time t it is the seeded region translated by v t (wrapped through periodic faces). A body with an
  * initial stress is seeded at its state of solid_prestress.h: F = F0 (and sigma = sigma0 for a
  * rate-form model), V0 = seeded volume / det F0. */
 #include "solid_internal.h"
@@ -59,6 +59,15 @@ static mpm_key_spec solid_keys[] = {
      "uniform pressure of the body as seeded, Pa: the initial stress -p I (instead of "
      "initial_stress)",
      1, "Pa"},
+    {"solid.*.bulk_viscosity_linear", MPM_KEY_REAL, "0", 0, HUGE_VAL, 0, 0, NULL,
+     "linear coefficient c1 of the bulk (shock) viscosity q = rho l (c1 c |tr D| + c2 l "
+     "(tr D)^2) in compression (l the cell size, c the elastic wave speed), sigma -= q I; "
+     "LS-DYNA's default is 0.06; needs time.method = usl or musl (docs/solid.md)",
+     0, "-"},
+    {"solid.*.bulk_viscosity_quadratic", MPM_KEY_REAL, "0", 0, HUGE_VAL, 0, 0, NULL,
+     "quadratic coefficient c2 of the bulk viscosity (see bulk_viscosity_linear); LS-DYNA's "
+     "default is 1.5 (Abaqus/Explicit's 1.2)",
+     0, "-"},
     {"clamp.*.geometry", MPM_KEY_STRING, NULL, 0, 0, 0, 0, NULL,
      "region whose nodes and particles are held fixed (a [geometry.NAME])", 0, NULL},
     {"traction.*.geometry", MPM_KEY_STRING, NULL, 0, 0, 0, 0, NULL,
@@ -79,13 +88,15 @@ int solid_add_schema(mpm_config *cfg) {
 /* The particle fields the bodies' models need: sigma if any model is in rate form, hist
  * sized for the model with the most history. */
 static int solid_particles_new(mpm_particles **p, int dim, solid_layout *lay, int has_rate,
-                               int apic, int nhist, int fixed, int fext) {
-  mpm_field_desc fields[11] = {{"x", dim}, {"v", dim}, {"F", dim * dim}};
+                               int apic, int bulkq, int nhist, int fixed, int fext) {
+  mpm_field_desc fields[12] = {{"x", dim}, {"v", dim}, {"F", dim * dim}};
   int nf = 3;
   lay->f_sigma = has_rate ? nf : -1;
   if (has_rate) fields[nf++] = (mpm_field_desc){"sigma", dim * dim};
   lay->f_C = apic ? nf : -1;
   if (apic) fields[nf++] = (mpm_field_desc){"C", dim * dim};
+  lay->f_divv = bulkq ? nf : -1;
+  if (bulkq) fields[nf++] = (mpm_field_desc){"divv", 1};
   const int nstate = nf;
   lay->f_m = nf, fields[nf++] = (mpm_field_desc){"m", 1};
   lay->f_V0 = nf, fields[nf++] = (mpm_field_desc){"V0", 1};
@@ -216,6 +227,7 @@ static int seed_body(mpm_module *m, const mpm_config *cfg, int b, double *lp) {
       if (sc->lay.f_sigma >= 0)
         data[(size_t)(p->offset[sc->lay.f_sigma] + rc) * n + i] = pre->sigma0[rc];
     }
+    if (sc->lay.f_divv >= 0) data[(size_t)p->offset[sc->lay.f_divv] * n + i] = 0.0;
     /* Seeded where it is: the current volume V0 det F0 is the seeding volume. */
     data[(size_t)p->offset[sc->lay.f_m] * n + i] = sc->body[b].rho * vol;
     data[(size_t)p->offset[sc->lay.f_V0] * n + i] = vol / pre->J0;
@@ -298,9 +310,13 @@ static int solid_p2g(mpm_module *m, double t, const double *y) {
   mpm_timer_start(MPM_T_STRESS);
   group_by_body(m);
   const mpm_lidx *idx = sc->idx;
+  const double *mass = mpm_particles_comp(p, sc->lay.f_m, 0);
   for (int b = 0; b < sc->nbodies; ++b) {
     const solid_batch batch = batch_of(sc, p, y, sc->count[b], idx, sc->vsig);
     sc->body[b].mat->ops->stress(sc->body[b].mat, &batch);
+    if (solid_bulkq_on(&sc->body[b].q))
+      solid_bulkq_add(&sc->body[b].q, dim, n, sc->count[b], idx, mass,
+                      y + (size_t)p->offset[sc->lay.f_divv] * n, sc->vsig);
     idx += sc->count[b];
   }
   mpm_timer_stop(MPM_T_STRESS);
@@ -409,6 +425,21 @@ static int solid_remap(mpm_module *m, double t, const double *y, double h) {
   return 0;
 }
 
+/* The bulk viscosity's lagged rate: divv takes this step's tr L, as a rate over the step h
+ * (the classic update only; solid_bulk_viscosity.h). */
+static void lag_divv(const mpm_particles *p, int f_divv, const double *y, double *ydot,
+                     const double *L, double h) {
+  const int dim = p->dim;
+  const mpm_lidx n = p->n;
+  const double *divv = y + (size_t)p->offset[f_divv] * n;
+  double *rate = ydot + (size_t)p->offset[f_divv] * n;
+  for (mpm_lidx i = 0; i < n; ++i) {
+    double tr = 0.0;
+    for (int d = 0; d < dim; ++d) tr += L[(size_t)(d * dim + d) * n + i];
+    rate[i] = h > 0 ? (tr - divv[i]) / h : 0.0;
+  }
+}
+
 /* dx/dt = sum S v_i, dv/dt = sum S a_i, dF/dt = L F with L = sum v_i (x) grad S. */
 static int solid_g2p(mpm_module *m, double t, const double *y, double *ydot, double h) {
   (void)t;
@@ -417,8 +448,9 @@ static int solid_g2p(mpm_module *m, double t, const double *y, double *ydot, dou
   const int dim = p->dim;
   const mpm_lidx n = p->n;
   /* dF/dt = L F comes out of the kernel directly; L itself is kept only for rate-form
-   * models. */
-  double *L = sc->lay.f_sigma >= 0 ? sc->scratch + (size_t)2 * dim * n : NULL;
+   * models and the bulk viscosity's lagged tr L. */
+  double *L =
+      sc->lay.f_sigma >= 0 || sc->lay.f_divv >= 0 ? sc->scratch + (size_t)2 * dim * n : NULL;
   double *xdot[MPM_MAX_DIM] = {NULL}, *vdot[MPM_MAX_DIM] = {NULL};
   for (int d = 0; d < dim; ++d) {
     xdot[d] = ydot + (size_t)(p->offset[F_X] + d) * n;
@@ -438,6 +470,7 @@ static int solid_g2p(mpm_module *m, double t, const double *y, double *ydot, dou
     for (size_t k = 0; k < (size_t)dim * dim * (size_t)n; ++k) Cdot[k] = (Cdot[k] - C[k]) / h;
   }
   if (sc->lay.f_sigma >= 0) solid_stress_rates(m, y, ydot, L);
+  if (sc->lay.f_divv >= 0) lag_divv(p, sc->lay.f_divv, y, ydot, L, h);
   if (sc->lay.f_fixed >= 0) solid_hold_fixed(p, sc->lay.f_fixed, ydot);
   if (sc->nrigid) solid_move_rigid(sc, p, ydot);
   return 0;
@@ -517,6 +550,8 @@ static double solid_stable_dt(const mpm_module *m, const double *y) {
   const solid_content *sc = m->content;
   const mpm_particles *p = m->particles;
   const double *body = mpm_particles_comp(p, sc->lay.f_body, 0);
+  const double *divv = sc->lay.f_divv >= 0 ? y + (size_t)p->offset[sc->lay.f_divv] * p->n : NULL;
+  const double dx = m->grid->dx;
   double dt = HUGE_VAL;
   for (mpm_lidx i = 0; i < p->n; ++i) {
     double v2 = 0.0;
@@ -524,7 +559,9 @@ static double solid_stable_dt(const mpm_module *m, const double *y) {
       const double v = y[(size_t)(p->offset[F_V] + d) * p->n + i];
       v2 += v * v;
     }
-    dt = fmin(dt, m->grid->dx / (sc->body[(int)body[i]].c + sqrt(v2)));
+    const solid_body *bi = &sc->body[(int)body[i]];
+    const double s = divv ? solid_bulkq_speed(&bi->q, divv[i], dx) : 0.0;
+    dt = fmin(dt, dx / (bi->c + sqrt(v2) + s));
   }
   return dt;
 }
@@ -601,6 +638,28 @@ static const mpm_module_ops solid_ops = {
     .remap = solid_remap,
 };
 
+/* A body's bulk viscosity (solid_bulk_viscosity.h); the schema refuses negative values. */
+static int read_bulkq(const mpm_module *m, const mpm_config *cfg, solid_body *body) {
+  const solid_content *sc = m->content;
+  char key[160];
+  solid_key(key, sizeof key, body->section, "bulk_viscosity_linear");
+  MPM_CALL(mpm_config_get_real(cfg, key, &body->q.c1));
+  solid_key(key, sizeof key, body->section, "bulk_viscosity_quadratic");
+  MPM_CALL(mpm_config_get_real(cfg, key, &body->q.c2));
+  body->q.c = body->c;
+  body->q.l = m->grid->dx;
+  if (!solid_bulkq_on(&body->q)) return 0;
+  if (body->q.c1 > 0.0) /* errors name a key that is set */
+    solid_key(key, sizeof key, body->section, "bulk_viscosity_linear");
+  if (body->mat->ops->rigid)
+    return mpm_config_fail(cfg, key, "a rigid body has no stress to damp; remove the key");
+  if (!sc->tr.classic)
+    return mpm_config_fail(cfg, key,
+                           "the bulk viscosity reads the previous step's strain rate, which "
+                           "only time.method = usl or musl keep; set one or remove the key");
+  return 0;
+}
+
 /* Read the bodies' sections and build their materials. */
 static int read_bodies(mpm_module *m, const mpm_config *cfg) {
   solid_content *sc = m->content;
@@ -635,6 +694,7 @@ static int read_bodies(mpm_module *m, const mpm_config *cfg) {
   memcpy(sc->gravity, g, sizeof g);
   MPM_CALL(mpm_config_get_real(cfg, "physics.damping", &sc->damping));
   MPM_CALL(mpm_transfer_from_config(&sc->tr, cfg, NULL));
+  for (int b = 0; b < count; ++b) MPM_CALL(read_bulkq(m, cfg, &sc->body[b]));
   return 0;
 }
 
@@ -658,17 +718,18 @@ int solid_module_create(mpm_module **mp, const mpm_config *cfg, mpm_grid *grid, 
   int rc = mpm_grid_add_phase(grid, "solid", &m->phase);
   if (!rc) rc = read_bodies(m, cfg);
   if (!rc) {
-    int has_rate = 0, nhist = 0;
+    int has_rate = 0, nhist = 0, bulkq = 0;
     for (int b = 0; b < sc->nbodies; ++b) {
       const solid_material_ops *ops = sc->body[b].mat->ops;
       has_rate |= ops->rate != NULL;
+      bulkq |= solid_bulkq_on(&sc->body[b].q);
       if (ops->nhistory) nhist = MPM_MAX(nhist, ops->nhistory(grid->dim));
     }
     if (!rc) rc = solid_read_constraints(m, cfg);
     if (!rc) rc = solid_read_tractions(m, cfg);
     if (!rc)
-      rc = solid_particles_new(&m->particles, grid->dim, &sc->lay, has_rate, sc->tr.apic, nhist,
-                               sc->nclamps > 0, sc->ntractions > 0);
+      rc = solid_particles_new(&m->particles, grid->dim, &sc->lay, has_rate, sc->tr.apic, bulkq,
+                               nhist, sc->nclamps > 0, sc->ntractions > 0);
     if (!rc) solid_set_ranges(m->particles, &sc->lay, sc->nbodies);
   }
   for (int b = 0; !rc && b < sc->nbodies; ++b) {

@@ -6,7 +6,9 @@ linear_elastic slabs with nu = 0 (M = E) from the gas's face to a slip wall, dx 
   rigid: Mach 1.21 into (rho, p) = (1, 1); rho_s = 4000, E = 1e5: c_s = 5, Z_s / Z_g = 1.69e4.
   soft:  Mach 2 into (1, 1);             rho_s = 0.1,  E = 160: c_s = 40, Z_s / Z_g = 3.38.
 Each slab starts at rest, pre-stressed at the ambient p0 = 1 (solid.slab.initial_pressure), so
-gas and slab start in equilibrium.
+gas and slab start in equilibrium. Under usl and musl the soft slab runs with a bulk viscosity
+(solid.slab.bulk_viscosity_linear = 0.5, _quadratic = 1.5; docs/solid.md), which damps the wave
+train behind its transmitted shock; bs32 refuses it and runs the slab undamped.
 
 Exact answer: the code's small-strain model puts V0 sigma into the nodal forces, so in uniaxial
 strain its nominal stress is P(F) = M (F - 1) / F (the slab's ambient F, 160/161, measured to
@@ -87,10 +89,22 @@ Known failures, marked EXPECTED-FAIL (printed with the reason; not counted as fa
   behind it (-38 %).
 - the least-squares layer next to the soft slab: -3.0 % in p, -3.4 % in rho, the second column
   alike (not diagnosed; -3.9 %, -4.0 % with the moving-slab start).
-- the ringing behind the soft slab's shock (RMS 7.4 %, largest 21 %) and under bs32 (rigid
-  3.8 %, 15 %): the slab's own, not the interface's. It grows from 3.6 % RMS a metre behind the
+- the ringing behind the soft slab's shock without the bulk viscosity (bs32; under usl it
+  measured RMS 7.4 %, largest 21 %) and under bs32 behind the rigid one (3.8 %, 15 %): the
+  slab's own, not the interface's. It grows from 3.6 % RMS a metre behind the
   face to 8.6 % near the front (the wave train of a shock with no dissipation in the solid), and
   the pre-stressed start left it as large as the moving-slab start (5.0 %).
+  With the bulk viscosity (soft, usl; c1 = 0.5, c2 = 1.5) the RMS is 2.91 % (velocity) and
+  2.80 % (traction, least squares), an ordinary check for these two (the long list's soft
+  contact:usl, traction:usl and velocity:musl were not measured: expected to fail, XPASS tells);
+  the linear coefficient does the work (RMS velocity:usl: 0.06 -> 5.62 %, 0.3 -> 3.48 %,
+  1.0 -> 2.55 %; c2 1.2 or 1.5 alike: the strain jump is only 2.9 %), at the price of the
+  stable step (4042 steps -> 7141 at 0.5). LS-DYNA's defaults (0.06, 1.5) leave the RMS at
+  5.6 %. The largest deviation stays an expected failure: 17.2 % and 14.9 %, a cell 5 cells
+  behind the face (the impact's start, kept in the material there: velocity:usl RMS 6.4 % in
+  the first 0.5 m, 1.9-2.2 % and largest 3.8 % in each 0.5 m beyond, 5.2 % and 9.6 % in the last
+  0.3 m before the smeared front); 20.4 % there without the viscosity. The median moves from -1.61 %
+  to -1.02 % (velocity) and -1.09 % (traction, least squares), the force from -0.36 % to -0.19 %.
 
 Arguments: [long] [slab:scheme:method[:ls] ...]. Default (~80 s): the rigid slab under
 velocity:usl, contact:usl, traction:usl, traction:usl:ls (fluid.wall_treatment =
@@ -127,6 +141,11 @@ LAYER_REASON = ("the node a cell outside the solid's face carries its spline tai
 
 LS_REASON = ("next to the soft slab the least-squares layer sits 3 % low in p and rho (the first "
              "and second columns alike); not diagnosed")
+PEAK_REASON = ("the largest cell average lies 5 cells behind the soft slab's face (-17 %, -15 % "
+               "with the bulk viscosity; -20 % without): the impact's start, kept in the material "
+               "near the face; beyond it the cells stay within 10 %; see the docstring")
+# The soft combinations whose ringing RMS was measured with the bulk viscosity (docstring).
+DAMPED_MEASURED = {("velocity", "usl", False), ("traction", "usl", True)}
 RING_REASON = ("behind the soft slab's transmitted shock, and under bs32 behind either, the "
                "slab's cell averages ring beyond the bound: the wave train of a shock the solid "
                "does not damp, growing towards its front; see the docstring")
@@ -135,7 +154,7 @@ SLABS = {
     "rigid": dict(case="fsi_reflect_rigid.ini", mach=1.21, rho_s=4000.0, E=1e5, x_s=1.5,
                   x_i=1.7, L=3.0, t_end=0.5),
     "soft": dict(case="fsi_reflect_soft.ini", mach=2.0, rho_s=0.1, E=160.0, x_s=2.0, x_i=2.2,
-                 L=9.0, t_end=0.35),
+                 L=9.0, t_end=0.35, q=(0.5, 1.5)),
 }
 
 
@@ -160,6 +179,12 @@ def exact(sl):
                 t_hit=(sl["x_i"] - sl["x_s"]) / S)
 
 
+def damped(sl, method):
+    """Does the slab run with its bulk viscosity (the classic update only: the ERK pairs refuse
+    it)?"""
+    return "q" in sl and method in ("usl", "musl")
+
+
 def run(name, sl, ex, scheme, method, ls):
     tag = f"{name} {scheme} {method}" + (" least_squares" if ls else "")
     out = mt.outdir(tag.replace(" ", "_"))
@@ -171,6 +196,9 @@ def run(name, sl, ex, scheme, method, ls):
              f"time.t_end={sl['t_end']}"]
     if ls:
         extra.append("fluid.wall_treatment=least_squares")
+    if damped(sl, method):
+        extra += [f"solid.slab.bulk_viscosity_linear={sl['q'][0]!r}",
+                  f"solid.slab.bulk_viscosity_quadratic={sl['q'][1]!r}"]
     mt.run(["run", mt.case(sl["case"]), f"output.dir={out}", f"grid.dx={DX}",
             f"coupling.scheme={scheme}", f"time.method={method}", "run.progress=false"] + extra)
     print(f"cost {tag}: {mt.cost(out)}")
@@ -266,10 +294,16 @@ def measure(name, sl, ex, scheme, method, ls):
           f"{ex['ps']:.5f}: {100 * e_f:+.3f} % (<= {100 * TOL_FORCE:g} %)")
     check(abs(T - 1) <= TOL_T, f"{tag}: transmitted stress jump (median) {-med - P0:.5f} against "
           f"p* - p0 = {jump:.5f}: {100 * (T - 1):+.2f} % (<= {100 * TOL_T:g} %)")
-    verdict(rms <= TOL_RMS and dev <= TOL_MAX,
-            None if name == "rigid" and method in ("usl", "musl") else RING_REASON,
-            f"{tag}: ringing of the transmitted stress (cell averages): RMS {100 * rms:.2f} %, "
+    ring = (f"{tag}: ringing of the transmitted stress (cell averages): RMS {100 * rms:.2f} %, "
             f"largest {100 * dev:.2f} % of the jump (<= {100 * TOL_RMS:g} %, {100 * TOL_MAX:g} %)")
+    if not damped(sl, method):
+        verdict(rms <= TOL_RMS and dev <= TOL_MAX,
+                None if name == "rigid" and method in ("usl", "musl") else RING_REASON, ring)
+        return
+    measured = (scheme, method, ls) in DAMPED_MEASURED
+    verdict(rms <= TOL_RMS, None if measured else "not measured with the bulk viscosity",
+            ring + " [RMS, with the bulk viscosity]")
+    verdict(dev <= TOL_MAX, PEAK_REASON, ring + " [largest, with the bulk viscosity]")
 
 
 def variants():
