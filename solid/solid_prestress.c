@@ -12,6 +12,8 @@
 #include "mpm_error.h"
 #include "solid_tensor.h"
 
+#include <sundials/sundials_dense.h>
+
 #include <float.h>
 #include <math.h>
 #include <stdio.h>
@@ -111,33 +113,20 @@ static int ps_jacobian(const ps_ctx *c, const double *u, const double *r, double
   return 0;
 }
 
-/* Solve A x = b (n x n) by Gaussian elimination with partial pivoting; 1 if singular. */
+/* Solve A x = b (n x n) with SUNDIALS's dense LU (partial pivoting); 1 if a pivot falls below
+ * 1e-13 of A's largest entry (singular to roundoff). b is overwritten. */
 static int ps_linear_solve(int n, double A[6][6], double *b, double *x) {
-  double amax = 0.0;
-  for (int i = 0; i < n; ++i)
-    for (int j = 0; j < n; ++j) amax = fmax(amax, fabs(A[i][j]));
-  for (int col = 0; col < n; ++col) {
-    int piv = col;
-    for (int i = col + 1; i < n; ++i)
-      if (fabs(A[i][col]) > fabs(A[piv][col])) piv = i;
-    if (!(fabs(A[piv][col]) > 1e-13 * amax)) return 1;
-    for (int j = 0; j < n; ++j) {
-      const double t = A[col][j];
-      A[col][j] = A[piv][j], A[piv][j] = t;
-    }
-    const double t = b[col];
-    b[col] = b[piv], b[piv] = t;
-    for (int i = col + 1; i < n; ++i) {
-      const double f = A[i][col] / A[col][col];
-      for (int j = col; j < n; ++j) A[i][j] -= f * A[col][j];
-      b[i] -= f * b[col];
-    }
+  double amax = 0.0, colmajor[6][6], *cols[6];
+  sunindextype piv[6];
+  for (int j = 0; j < n; ++j) {
+    cols[j] = colmajor[j];
+    for (int i = 0; i < n; ++i) colmajor[j][i] = A[i][j], amax = fmax(amax, fabs(A[i][j]));
   }
-  for (int i = n - 1; i >= 0; --i) {
-    double s = b[i];
-    for (int j = i + 1; j < n; ++j) s -= A[i][j] * x[j];
-    x[i] = s / A[i][i];
-  }
+  if (SUNDlsMat_denseGETRF(cols, n, n, piv) != 0) return 1;
+  for (int k = 0; k < n; ++k)
+    if (!(fabs(cols[k][k]) > 1e-13 * amax)) return 1;
+  SUNDlsMat_denseGETRS(cols, n, piv, b);
+  memcpy(x, b, sizeof(double) * (size_t)n);
   return 0;
 }
 
