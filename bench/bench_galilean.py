@@ -90,7 +90,16 @@ def run(problem, N, rule):
 commit = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], capture_output=True,
                         text=True).stdout.strip()
 when = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
-L = [f"bench/bench_galilean.py --cells {','.join(map(str, CELLS))} --rules {','.join(RULES)}; "
+L = ["# Galilean invariance per volume-rate rule (bench/bench_galilean.py)", "",
+     "Toro's strong shock at rest (test 3) and moving across the grid at −19.6 (test 5), bs32 at "
+     "`time.cfl = 0.8`, one rank, N × 3 cells. L1: the cell-averaged particle density against "
+     "the exact solution (as test_sod). *From the spacing*: the same with each particle's "
+     "density from the distance between its two neighbours along its row (m / (V0 J_s)), the "
+     "density the motion gives whatever J says. Left plateau: the middle half between the "
+     "fan's tail and the contact, the mean particle density against ρ*_L = 0.5751 and the "
+     "mean (standard deviation) of J / J_s − 1 there. CPU: user + system of each run. "
+     "Discussion: docs/gas.md (flow across the grid).", "",
+     f"bench/bench_galilean.py --cells {','.join(map(str, CELLS))} --rules {','.join(RULES)}; "
      f"commit {commit} (+ working tree), {when}", "",
      "| cells | volume_rate | L1 at rest | L1 moving | **moving / rest** | L1 from the spacing, "
      "rest / moving (ratio) | moving: left plateau density | J / J_s − 1 (sd) | CPU s rest + moving |",
