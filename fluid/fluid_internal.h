@@ -62,6 +62,9 @@ typedef struct fluid_content {
   double *tscratch;   /* the classic transfer's a_p, scalars and APIC terms (see ensure_scratch) */
   double *lim;        /* the limiter's neighbour points (fluid_limiter.c) */
   mpm_lidx lim_cap;   /* their capacity */
+  int volume_domain;  /* fluid.volume_rate = domain (fluid_volume.c) */
+  double *vol;        /* its face points and rates */
+  mpm_lidx vol_cap;   /* their capacity in particles */
   double *node;       /* nodal scratch: time-centred velocity and scalars ((dim + 3) nnodes) */
   mpm_module_ops ops; /* the module's ops: p2g_rate only with the current strain rate */
 } fluid_content;
@@ -92,6 +95,12 @@ int fluid_mol_damping(mpm_module *m, const double *y, double *const *vdot, doubl
  * (fluid_limiter.c). */
 int fluid_limiter(mpm_module *m, const double *y, const double *const *v_i, const double *L,
                   double *psi);
+
+/* fluid.volume_rate = domain: the divergence of the nodal velocity v_i (whose gradient at the
+ * particles is L, dim^2 components of n) over each particle's domain, for dJ/dt; *rate points
+ * to n values in the module's scratch (fluid_volume.c). */
+int fluid_volume_rate(mpm_module *m, const double *y, const double *const *v_i, const double *L,
+                      const double **rate);
 
 /* Seed every [gas.NAME] region into the (empty) particle set (fluid_seed.c). */
 int fluid_seed(mpm_module *m, const mpm_config *cfg);

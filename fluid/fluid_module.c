@@ -81,6 +81,13 @@ static const mpm_key_spec fluid_keys[] = {
      "grid-scale mode that the method of lines grows from roundoff where particles sit off "
      "their lattice (docs/gas.md; 0.1 cures it); mass, momentum and total energy stay exact",
      0, "-"},
+    {"fluid.volume_rate", MPM_KEY_ENUM, "point", 0, 0, 0, 0, "point|domain",
+     "the rate dJ/dt = J tr L that moves a gas particle's volume: point (the nodal velocity's "
+     "divergence at the particle) or domain (its flux through the faces of the particle's "
+     "domain, a box of side min((J V0)^(1/dim), dx): keeps J with the particles' spacing where "
+     "the velocity ripples at the grid scale, as in hot gas at rest on the grid; only J, and so "
+     "the density and pressure, reads it; see docs/gas.md)",
+     0, NULL},
     {"fluid.ppc", MPM_KEY_INT, "2", 1, 8, 0, 0, NULL,
      "gas particles per cell per direction at seeding", 0, "-"},
     {"fluid.regularise_every", MPM_KEY_INT, "0", 0, HUGE_VAL, 0, 0, NULL,
@@ -490,7 +497,7 @@ static void as_rate(double *out, const double *src, const double *y, size_t coun
  * change what it reads: ARKODE also probes it at trial states). */
 static int volume_rate(mpm_module *m, const double *y, double *ydot, const double *L,
                        const double *const *v_i, double h) {
-  const fluid_content *fc = m->content;
+  fluid_content *fc = m->content;
   const mpm_particles *p = m->particles;
   const int dim = p->dim;
   const mpm_lidx n = p->n;
@@ -502,7 +509,9 @@ static int volume_rate(mpm_module *m, const double *y, double *ydot, const doubl
               : in_state      ? ydot + (size_t)p->offset[fc->lay.f_D] * n
                               : tr + n;
   rate_parts(dim, n, L, tr, D);
-  for (mpm_lidx i = 0; i < n; ++i) Jdot[i] = J[i] * tr[i];
+  const double *Jrate = tr; /* fluid.volume_rate: point, or over the particle's domain */
+  if (fc->volume_domain) MPM_CALL(fluid_volume_rate(m, y, v_i, L, &Jrate));
+  for (mpm_lidx i = 0; i < n; ++i) Jdot[i] = J[i] * Jrate[i];
   /* The limiter (riemann viscosity): with the current rate p2g_rate has set this RHS's. */
   double *psi = fc->lay.f_psi < 0 ? NULL : in_state ? fc->scratch + n : pending_psi(fc, p);
   if (psi && !fc->current_rate) MPM_CALL(fluid_limiter(m, y, v_i, L, psi));
@@ -686,7 +695,7 @@ static void fluid_destroy(mpm_module *m) {
     fluid_virtual_free(&fc->virt);
     free(fc->vsig), free(fc->scratch), free(fc->vnew), free(fc->Cnew), free(fc->power);
     free(fc->sub), free(fc->zero), free(fc->work);
-    free(fc->tscratch), free(fc->node), free(fc->cellsum), free(fc->lim);
+    free(fc->tscratch), free(fc->node), free(fc->cellsum), free(fc->lim), free(fc->vol);
     free(fc);
   }
   mpm_particles_destroy(&m->particles);
@@ -788,6 +797,9 @@ static int read_settings(fluid_content *fc, const mpm_config *cfg, const mpm_gri
                            "updates the stress last, with the rate of the step before; remove "
                            "the key or choose time.method = bs32");
   fc->current_rate = !fc->tr.classic && strcmp(rate, "current") == 0;
+  const char *vrate;
+  MPM_CALL(mpm_config_get_string(cfg, "fluid.volume_rate", &vrate));
+  fc->volume_domain = strcmp(vrate, "domain") == 0;
   MPM_CALL(mpm_config_get_real(cfg, "fluid.mol_damping", &fc->mol_damping));
   if (fc->tr.classic && mpm_config_has(cfg, "fluid.mol_damping"))
     return mpm_config_fail(cfg, "fluid.mol_damping",
