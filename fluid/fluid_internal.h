@@ -47,11 +47,8 @@ typedef struct fluid_content {
   double shift_J;            /* only particles with J >= shift_J move */
   int current_rate;          /* fluid.strain_rate = current (fluid_module.c) */
   double mol_damping;        /* fluid.mol_damping (fluid_transfer.c); 0: off */
-  int pressure_grid;         /* fluid.pressure_smoothing > 0 (fluid_pressure_grid.c) */
-  double pressure_share;     /* its value: the smoothed share w of the stress's pressure */
-  int filter_phase;          /* their scratch grid phase (-1: none) */
+  int filter_phase;          /* its scratch grid phase (-1: none) */
   double *work;              /* its particle scratch (4 dim cap) */
-  double *pwork;             /* pressure_grid: pbar and its scratch ((2 dim + 4) cap) */
   double *sub, *zero;        /* its viscous deposit: positions and stresses, zeros (cap each) */
   int stable_local;          /* fluid.stable_step = neighbourhood (fluid_stable.c) */
   double s_local;            /* its fastest signal for this step, m/s; < 0: not yet known */
@@ -92,17 +89,6 @@ void fluid_wall_rate_mol(const mpm_module *m, const double *y, double *const *vd
  * work: 4 dim n doubles of particle scratch. */
 int fluid_mol_damping(mpm_module *m, const double *y, double *const *vdot, double *power,
                       double *work);
-
-/* fluid.pressure_smoothing = w > 0 (fluid_pressure_grid.c): into pbar, p + w (A(p) - p), the
- * partly grid-smoothed pressure of every particle of state y with the fields of b; work: (2 dim +
- * 3) n doubles, kept for the heat below. Collective. */
-int fluid_pressure_grid(mpm_module *m, const double *y, const fluid_batch *b, double *work,
-                        double *pbar);
-/* Its energy booking: adds to power (de/dt) the change from the work of pbar to that of the
- * particle's own pressure plus its share of the difference, for the velocity gradient L of the
- * energy rate, with the pbar and work of the same state's fluid_pressure_grid. Collective. */
-int fluid_pressure_grid_heat(mpm_module *m, const double *y, const double *L, const double *pbar,
-                             double *work, double *power);
 
 /* The riemann viscosity's limiter psi (fluid_stress.h) of every particle of state y, from
  * the nodal velocity v_i whose gradient at the particles is L (dim^2 components of n)

@@ -88,14 +88,6 @@ static const mpm_key_spec fluid_keys[] = {
      "the velocity ripples at the grid scale, as in hot gas at rest on the grid; only J, and so "
      "the density and pressure, reads it; see docs/gas.md)",
      0, NULL},
-    {"fluid.pressure_smoothing", MPM_KEY_REAL, "0", 0, 1, 0, 0, NULL,
-     "the share w of the grid-smoothed pressure in each gas particle's stress: p + w (pbar - p), "
-     "pbar the volume-weighted nodal average of the particles' pressures interpolated back "
-     "(0: off, the particle's own p; one more deposit and gather per RHS, two with the energy "
-     "booking that keeps total energy exact). Measured worse than off on Sod and on the ERK "
-     "grid-scale mode, and 1 let particles clump at Sod's contact until one's energy ran out: "
-     "an experiment, not a cure (docs/gas.md)",
-     0, "-"},
     {"fluid.ppc", MPM_KEY_INT, "2", 1, 8, 0, 0, NULL,
      "gas particles per cell per direction at seeding", 0, "-"},
     {"fluid.regularise_every", MPM_KEY_INT, "0", 0, HUGE_VAL, 0, 0, NULL,
@@ -215,13 +207,12 @@ static int ensure_scratch(mpm_module *m) {
   const int dim = m->grid->dim;
   if (n <= fc->cap && fc->vsig) return 0;
   free(fc->vsig), free(fc->scratch), free(fc->vnew), free(fc->Cnew), free(fc->power);
-  free(fc->tscratch), free(fc->sub), free(fc->zero), free(fc->work), free(fc->pwork);
-  fc->vnew = fc->Cnew = fc->tscratch = fc->sub = fc->zero = fc->work = fc->pwork = NULL;
+  free(fc->tscratch), free(fc->sub), free(fc->zero), free(fc->work);
+  fc->vnew = fc->Cnew = fc->tscratch = fc->sub = fc->zero = fc->work = NULL;
   fc->cap = n + n / 4 + 16;
   MPM_ALLOC(fc->vsig, (size_t)dim * dim * fc->cap);
   MPM_ALLOC(fc->scratch, (size_t)(2 * dim + dim * dim) * fc->cap);
   if (fc->mol_damping > 0) MPM_ALLOC(fc->work, (size_t)4 * dim * fc->cap);
-  if (fc->pressure_grid) MPM_ALLOC(fc->pwork, (size_t)(2 * dim + 4) * fc->cap);
   MPM_ALLOC(fc->power, fc->cap);
   if (fc->tr.classic)
     MPM_ALLOC(fc->tscratch, (size_t)(dim + 3 + (fc->tr.apic ? dim * dim + 2 * dim : 0)) * fc->cap);
@@ -250,7 +241,7 @@ static int deposit(mpm_module *m, const double *y, const double *vsig, const flu
     a.gravity[d] = vsig ? fc->gravity[d] : 0.0;
   }
   mpm_kernels_get(dim)->p2g(m->grid, m->phase, &a);
-  if (fc->mol_damping > 0.0) { /* the particles' own m and m v, for fluid_mol_damping */
+  if (fc->filter_phase >= 0) { /* the particles' own m and m v, for fluid_mol_damping */
     const mpm_grid_phase *ph = &m->grid->phase[m->phase];
     mpm_grid_phase *fp = &m->grid->phase[fc->filter_phase];
     const size_t bytes = sizeof(double) * (size_t)m->grid->nnodes;
@@ -354,12 +345,6 @@ static int fluid_p2g(mpm_module *m, double t, const double *y) {
   fluid_content *fc = m->content;
   MPM_CALL(ensure_scratch(m));
   fluid_batch b = batch_of(m, y);
-  if (fc->pressure_grid) {
-    mpm_timer_start(MPM_T_STRESS);
-    MPM_CALL(fluid_pressure_grid(m, y, &b, fc->pwork + m->particles->n, fc->pwork));
-    b.p = fc->pwork;
-    mpm_timer_stop(MPM_T_STRESS);
-  }
   if (!fc->current_rate) {
     mpm_timer_start(MPM_T_STRESS);
     fluid_stress(&fc->gas, &b);
@@ -466,14 +451,6 @@ static void energy_rate(mpm_module *m, const double *L, const double *heat, doub
   }
 }
 
-/* fluid.pressure_smoothing > 0: the energy rate's share of the smoothed pressure's work
- * (fluid_pressure_grid.c). */
-static int pressure_heat(mpm_module *m, const double *y, const double *L) {
-  fluid_content *fc = m->content;
-  if (!fc->pressure_grid) return 0;
-  return fluid_pressure_grid_heat(m, y, L, fc->pwork, fc->pwork + m->particles->n, fc->power);
-}
-
 /* The classic step's transfer into the arrays o points to, and the energy rate. */
 static int classic_transfer(mpm_module *m, const double *y, double h, fluid_step_out *o) {
   fluid_content *fc = m->content;
@@ -481,7 +458,7 @@ static int classic_transfer(mpm_module *m, const double *y, double h, fluid_step
   o->heat = fc->power;
   fluid_classic_transfer(m, y, h, o);
   energy_rate(m, o->L, o->heat, h);
-  return pressure_heat(m, y, o->L);
+  return 0;
 }
 
 /* MUSL's second transfer (Sulsky, Zhou and Schreyer 1995): the particles take their new
@@ -571,7 +548,6 @@ static int fluid_g2p(mpm_module *m, double t, const double *y, double *ydot, dou
     energy_rate(m, L, NULL, h);
     if (!fc->tr.apic) fluid_wall_rate_mol(m, y, vdot, fc->power);
     MPM_CALL(fluid_mol_damping(m, y, vdot, fc->power, fc->work));
-    MPM_CALL(pressure_heat(m, y, L)); /* (after the damping: both use the filter phase) */
   } else if (!fc->tr.musl) {
     fluid_step_out o = {.C = Cdot};
     for (int d = 0; d < dim; ++d) o.vhat[d] = xdot[d], o.vnew[d] = vdot[d];
@@ -718,7 +694,7 @@ static void fluid_destroy(mpm_module *m) {
     fluid_wall_ls_free(&fc->wall);
     fluid_virtual_free(&fc->virt);
     free(fc->vsig), free(fc->scratch), free(fc->vnew), free(fc->Cnew), free(fc->power);
-    free(fc->sub), free(fc->zero), free(fc->work), free(fc->pwork);
+    free(fc->sub), free(fc->zero), free(fc->work);
     free(fc->tscratch), free(fc->node), free(fc->cellsum), free(fc->lim), free(fc->vol);
     free(fc);
   }
@@ -830,8 +806,6 @@ static int read_settings(fluid_content *fc, const mpm_config *cfg, const mpm_gri
                            "is read with the ERK pairs only: the classic update (usl, musl) "
                            "damps through fluid.pic_fraction; remove the key");
   if (fc->tr.classic || fc->tr.apic) fc->mol_damping = 0.0;
-  MPM_CALL(mpm_config_get_real(cfg, "fluid.pressure_smoothing", &fc->pressure_share));
-  fc->pressure_grid = fc->pressure_share > 0.0;
   const char *method;
   MPM_CALL(mpm_config_get_string(cfg, "time.method", &method));
   if (!fc->current_rate && strcmp(method, "ssprk2") == 0)
@@ -898,8 +872,7 @@ static int build(mpm_module *m, const mpm_config *cfg, int seed) {
   fc->filter_phase = -1;
   MPM_CALL(mpm_config_get_real(cfg, "fluid.light_node_mass", &g->phase[m->phase].light_fraction));
   MPM_CALL(read_settings(fc, cfg, g));
-  if (fc->mol_damping > 0.0 || fc->pressure_grid)
-    MPM_CALL(mpm_grid_add_phase(g, "fluid_filter", &fc->filter_phase));
+  if (fc->mol_damping > 0.0) MPM_CALL(mpm_grid_add_phase(g, "fluid_filter", &fc->filter_phase));
   MPM_CALL(mpm_walls_from_config(&walls, cfg, g->dim));
   MPM_CALL(mpm_constraints_add_walls(&fc->cons, &walls, g));
   fc->walls = walls;

@@ -41,8 +41,7 @@ typedef struct fluid_batch {
   const double *divv;           /* tr D */
   const double *D;              /* strain rate (dim*dim), or NULL when mu = 0 */
   const double *psi;            /* riemann form: the limiter (fluid_limiter.c), else NULL */
-  const double *p; /* the pressure in the stress (fluid_pressure_grid.c), or NULL: the EOS's */
-  double *vsig;    /* out: V sigma (dim*dim) */
+  double *vsig;                 /* out: V sigma (dim*dim) */
 } fluid_batch;
 
 /* The artificial kinematic viscosity per unit length, q / (rho du), of the velocity jump
