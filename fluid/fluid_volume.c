@@ -15,9 +15,14 @@
  * so that particles whose domains tile a region have volume rates that sum to the flux
  * through its boundary, as the divergence theorem has it. Only J reads it: the energy keeps
  * the point rate (the one the forces' work is made of), and the ideal gas's forces, p V =
- * (gamma - 1) m e, and its sound speed do not depend on J, so in the gas alone the motion is
- * unchanged and only the density and pressure the particles carry change; obstacles, open
- * faces, shifting and regularisation, which read J, see the new density.
+ * (gamma - 1) m e, and its sound speed do not depend on J, so in an inviscid gas alone the
+ * motion is unchanged and only the density and pressure the particles carry change; the
+ * viscous stress, obstacles, open faces, shifting and regularisation, which read J, see the
+ * new volume.
+ *
+ * Known defect (docs/gas.md): a face point's stencil reaches one node beyond the particle's,
+ * and a node the gas does not fill holds v = 0, so at the edge of gas moving into vacuum the
+ * rate is wrong; the option stays an experiment, off by default.
  *
  * A face point whose stencil would leave the rank's stored nodes is moved back to the last
  * point whose stencil is stored, as in fluid_limiter.c; a particle whose two face points
@@ -69,7 +74,7 @@ int fluid_volume_rate(mpm_module *m, const double *y, const double *const *v_i, 
     hi[d] = (g->box_lo[d] + g->box_n[d] - 2) * (1.0 - 1e-12);
   }
   for (mpm_lidx i = 0; i < n; ++i) {
-    const double V = J[i] * V0[i], side_l = dim == 2 ? sqrt(V) : dim == 3 ? cbrt(V) : V;
+    const double V = J[i] * V0[i], side_l = dim == 2 ? sqrt(V) : cbrt(V);
     const double half = 0.5 * fmin(side_l, g->dx) / g->dx;
     double xi[3] = {0, 0, 0}, w[3][MPM_SHAPE_MAX_SUPPORT], dw[3][MPM_SHAPE_MAX_SUPPORT];
     int base[3] = {0, 0, 0};

@@ -72,7 +72,10 @@ def strong_settings():
     """The double rarefaction's strong-expansion settings, as command-line keys."""
     ini = configparser.ConfigParser(inline_comment_prefixes=("#",))
     ini.read(mt.case("double_rarefaction.ini"))
-    return [f"fluid.{k}={ini['fluid'][k]}" for k in KEYS if k in ini["fluid"]]
+    missing = [k for k in KEYS if k not in ini["fluid"]]
+    if missing:  # the scene would silently lose a setting the bounds were measured with
+        sys.exit(f"test_wall_rarefaction: double_rarefaction.ini lacks fluid.{missing[0]}")
+    return [f"fluid.{k}={ini['fluid'][k]}" for k in KEYS]
 
 
 def run(N, extra, tag):
