@@ -21,10 +21,17 @@
 #   in test_obstacles and test_obstacles_energy), the gas tubes test_sod, test_strong_shock and
 #   the ERK pairs' time-order study test_gas_time_order (test_gas_output, test_gas_conservation,
 #   test_gas_boundaries), and test_gas_shear (the viscous stress: test_stable_step);
+# - gas studies: test_farfield_gauge (141 s under the sanitizers; the gauge and the sponge run
+#   there in test_farfield_gauge_ranks), test_mol_damping (131 s; the damping in
+#   test_mol_damping_shift), ssprk2's time order test_time_order_gas (31 s; ssprk2 runs there in
+#   test_ssprk2_input) and the wedge's particle noise test_gas_noise (32 s; the least-squares wall
+#   in test_obstacles, the output field rho_grid in every gas test's snapshots);
 # - coupled studies: test_fsi_waves (6 minutes under the sanitizers), test_fsi_reflection,
 #   test_fsi_resonator, test_multirate_face and test_prestress (15-80 s each plain, 140 s
 #   instrumented for the last; the initial stress's solve runs there in test_materials and
-#   test_bad_input, the interface in test_traction_ls, multirate in test_timeschemes_quick), test_piperno_farhat,
+#   test_bad_input, the interface in test_traction_ls, multirate in test_timeschemes_quick),
+#   multirate's coupling-step and predictor study test_multirate_step (63 s there; the damped
+#   viscous step and the predictor run in test_timeschemes_quick's restarts), test_piperno_farhat,
 #   test_timeschemes and test_timeschemes_mri (9.5 minutes there; test_timeschemes_quick runs
 #   every temporal scheme's cycles, checkpoint and restart on 1 and 2 ranks there),
 #   test_blowup_guard_coupled (three blow-ups of the main job's scene: the fault it guards
@@ -47,6 +54,7 @@ src=$(cd "$(dirname "$0")/.." && pwd)
 PLAIN_ONLY="wedge|forward_step|supersonic_bar|supersonic_bar_standoff|supersonic_bar_bs32"
 PLAIN_ONLY+="|near_vacuum_order"
 PLAIN_ONLY+="|slanted_wall|bluff_bodies|sod|strong_shock|gas_time_order|gas_shear"
+PLAIN_ONLY+="|farfield_gauge|mol_damping|time_order_gas|gas_noise|multirate_step"
 PLAIN_ONLY+="|fsi_waves|fsi_reflection|fsi_resonator|multirate_face|prestress"
 PLAIN_ONLY+="|piperno_farhat|timeschemes|timeschemes_mri|blowup_guard_coupled"
 PLAIN_ONLY+="|csm1|csm3_fast|axial_bar|cantilever3d|model_swap|ranks_solid|periodic|stability|disks"
