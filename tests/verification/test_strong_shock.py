@@ -11,7 +11,11 @@ the shock lies within 3 cells of the exact position x = 0.7822. The L1 density e
 reported. With the walls at rest the classic updates usl and musl must also conserve total
 energy to 1e-12 (relative): this case stresses the exact energy balance with kinetic and
 internal energies that differ by orders of magnitude between the two states.
-Default: 200 cells for bs32, usl and musl. `long`: 100, 200, 400 and 800 cells, where the L1
+Default: 200 cells for bs32, usl and musl, and bs32 at 400 cells as the case sets it (issue 50:
+L1 <= 2.23e-2 with the shock within 1 cell; measured 1.975e-2 and +0.18 cells with fixed-step
+bs32 at time.cfl = 0.99 and fluid.mol_damping = 0.3; the case's settings before, fixed bs32 at
+0.8 without the damping, gave 2.255e-2 and fail it. The bound is the issue's own, no margin
+added: the runs are deterministic to roundoff). `long`: 100, 200, 400 and 800 cells, where the L1
 error of bs32 and musl must also fall from 200 to 800 cells (by at least 25 %, well short of
 the 50 % of first order, since the shock in L1 converges at first order at best). usl's L1
 stalls there (measured 3.03e-2 at 200 cells, 2.53e-2 at 400, 2.79e-2 at 800), as it does on
@@ -53,7 +57,7 @@ def energy_drift(out):
 Ns = (100, 200, 400, 800) if LONG else (200,)
 for method in ("bs32", "usl", "musl"):
     l1s = {}
-    for N in Ns:
+    for N in Ns if LONG or method != "bs32" else (200, 400):
         out = shocktube.run("strong_shock.ini", N, method, T)
         l1, xs, _ = shocktube.measure(out, N, EXACT, T)
         l1s[N] = l1
@@ -64,6 +68,9 @@ for method in ("bs32", "usl", "musl"):
         off = (xs - XS) * N
         check(abs(off) <= 3.0, f"{method} N={N}: L1 {l1:.3e}, shock at {xs:.5f} ({off:+.2f} cells; "
               "within 3)")
+        if method == "bs32" and N == 400:
+            check(l1 <= 2.23e-2 and abs(off) <= 1.0, f"bs32 N=400 (the case's settings): L1 "
+                  f"{l1:.4e} <= 2.23e-2, shock {off:+.2f} cells (within 1)")
         if method != "bs32" and N == 200:
             dE = energy_drift(out)
             check(dE <= 1e-12, f"{method} N={N}: total energy drift {dE:.1e} (<= 1e-12)")
