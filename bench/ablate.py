@@ -11,7 +11,7 @@ records its wall time, steps and RHS evaluations, the interface energy the coupl
 (W_net, J, and relative to the case's --energy-scale if given), the largest interface momentum
 imbalance, and whether it stayed stable (exit 0, no blow-up) or failed, with the message; and
 its CPU time (cpu_s: the user + system time of mpiexec and its ranks, which a shared machine
-changes less than the wall time).
+changes less than the wall time; the first round's with --repeat).
 
 Combinations: temporal `monolithic` with usl, musl and bs32; `staggered` with coupling.order =
 solid_first, gas_first, parallel, and solid_first strongly coupled (`strong`: sub-iterations to
@@ -310,9 +310,9 @@ def history(out, quantity):
 # to the case, so the shock panel's references (coupling.time = multirate in its file) were
 # multirate runs at the reference step, not monolithic ones.
 # coupling.predictor = none in it and in every run but the predictor variant's: a case may set
-# the predictor for its own multirate runs (cases/shock_panel.ini does), and the other schemes
-# refuse the key away from its default, none.
-REFERENCE = ["coupling.time=monolithic", "time.method=usl"]
+# the predictor for its own multirate runs, and the other schemes refuse the key away from its
+# default, none.
+REFERENCE = ["coupling.time=monolithic", "time.method=usl", "coupling.predictor=none"]
 
 
 def reference_key(args):

@@ -38,9 +38,7 @@ from benchrun import ENV, ROOT, loglog  # noqa: E402
 
 CASE = os.path.join(ROOT, "cases", "shock_panel.ini")
 RESULTS = os.path.join(HERE, "results")
-# (MRIStep refuses coupling.predictor away from none, which the case sets for its classic runs)
-ERK = ["time.method=bs32", "time.adaptive=false", "fluid.pic_fraction=0",
-       "coupling.predictor=none"]
+ERK = ["time.method=bs32", "time.adaptive=false", "fluid.pic_fraction=0"]
 
 
 def parse():

@@ -150,10 +150,8 @@ def cost_side_by_side(binary, window_s, overrides):
 
     def start(scheme, k=0):
         wout = os.path.join(ROOT, "out", f"bench_shock_panel_{scheme}" + (f"_{k}" if k else ""))
-        # (monolithic refuses the case's coupling.predictor = linear, a multirate key)
         cmd = [binary, "run", CASE, f"output.dir={wout}", "output.overwrite=true",
-               f"coupling.time={scheme}"] + (["coupling.predictor=none"] if
-                                              scheme == "monolithic" else []) + window
+               f"coupling.time={scheme}"] + window
         return wout, subprocess.Popen(cmd, env=ENV, stdout=subprocess.DEVNULL,
                                       stderr=subprocess.PIPE, text=True)
 

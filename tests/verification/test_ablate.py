@@ -5,8 +5,7 @@ coupling.time = multirate, which the harness's reference inherited until 2026-11
 4 us: a few hundred steps).
 
 1. The reference is monolithic: its probes.csv is the one a run of the case with
-   coupling.time = monolithic, time.method = usl, coupling.predictor = none (the case sets
-   linear for its multirate runs) and the reference's time.cfl writes, to the
+   coupling.time = monolithic, time.method = usl and the reference's time.cfl writes, to the
    last digit (a multirate run takes other steps and writes other rows).
 2. The same sweep again reuses the reference and the finished row: nothing is run.
 3. The same sweep with one more override runs the reference again (the overrides changed) and
@@ -62,8 +61,7 @@ sweep([])
 ref = os.path.join(scratch, "reference-velocity")
 mono = mt.outdir("ablate_monolithic")
 mt.run(["run", CASE, f"output.dir={mono}", "output.interval=1e9", "coupling.scheme=velocity",
-        "coupling.time=monolithic", "time.method=usl", "time.cfl=0.2",
-        "coupling.predictor=none"] + COMMON)
+        "coupling.time=monolithic", "time.method=usl", "time.cfl=0.2"] + COMMON)
 multi = mt.outdir("ablate_multirate")
 mt.run(["run", CASE, f"output.dir={multi}", "output.interval=1e9", "coupling.scheme=velocity",
         "time.method=usl", "time.cfl=0.2"] + COMMON)
