@@ -9,12 +9,17 @@ its history from the reference's (interpolated to the reference's times). The qu
 probe column of probes.csv (--quantity, default the first probe's x displacement). Each run
 records its wall time, steps and RHS evaluations, the interface energy the coupling created
 (W_net, J, and relative to the case's --energy-scale if given), the largest interface momentum
-imbalance, and whether it stayed stable (exit 0, no blow-up) or failed, with the message.
+imbalance, and whether it stayed stable (exit 0, no blow-up) or failed, with the message; and
+its CPU time (cpu_s: the user + system time of mpiexec and its ranks, which a shared machine
+changes less than the wall time; the first round's with --repeat).
 
 Combinations: temporal `monolithic` with usl, musl and bs32; `staggered` with coupling.order =
 solid_first, gas_first, parallel, and solid_first strongly coupled (`strong`: sub-iterations to
 a relative interface residual of 1e-6, at most 60, Aitken relaxation), and `multirate` with
 coupling.load = held, interpolated, each with usl and musl (the subcycled classic update),
+`predictor` (held, with coupling.predictor = linear: the gas meets the solid's interface
+velocity extrapolated from its last two coupling steps; every other run, the references too,
+sets coupling.predictor = none, the default, whatever the case file says),
 `multirate` `lag` (coupling.slow_substeps = 0: both modules at the fast one's rate, the fast one
 held over the coupling step: what separates it from monolithic is the coupling lag (and the work
 between steps, done once per coupling step), and the rest of `held`'s error is the slow module's
@@ -45,7 +50,7 @@ Cost at equal error: for every run that is not monolithic, ablation.md gives the
 monolithic (the same spatial scheme and time method) would need for the same error,
 interpolated log-log between the two monolithic runs whose errors bracket it (extrapolated
 from the nearest two where none does, and marked so, by at most a factor 1.5 in error), and
-the ratio of the two.
+the ratio of the two; the same in CPU time (when every row has it) and in steps.
 
 Noise: the wall times of one run each are as noisy as the machine (on a shared 2-core machine
 the same run took 20.7 and 26.6 s minutes apart). --repeat N runs the sweep N times over, in
@@ -61,6 +66,7 @@ import json
 import math
 import os
 import re
+import resource
 import shutil
 import subprocess
 import sys
@@ -75,7 +81,7 @@ from benchrun import ENV, ROOT, loglog  # noqa: E402
 
 FIELDS = ["name", "spatial", "temporal", "variant", "method", "cfl", "status", "wall_s",
           "steps", "rhs_evals", "err_max", "err_rms", "err_rel", "W_net", "W_rel",
-          "imbalance", "message", "walls"]
+          "imbalance", "message", "walls", "cpu_s"]
 VARIANTS = [("monolithic", "", []),
             ("staggered", "solid_first", ["coupling.order=solid_first"]),
             ("staggered", "gas_first", ["coupling.order=gas_first"]),
@@ -83,6 +89,7 @@ VARIANTS = [("monolithic", "", []),
             ("staggered", "strong", ["coupling.order=solid_first", "coupling.iterations=60",
                                      "coupling.tolerance=1e-6"]),
             ("multirate", "held", ["coupling.load=held"]),
+            ("multirate", "predictor", ["coupling.load=held", "coupling.predictor=linear"]),
             ("multirate", "interpolated", ["coupling.load=interpolated"]),
             ("multirate", "lag", ["coupling.slow_substeps=0"]),
             ("multirate", "mristep", ["time.adaptive=false"])]
@@ -261,10 +268,12 @@ def run(args, out, extra):
            "output.interval=1e9"] + args.overrides + extra
     if args.ranks > 1:
         cmd = ["mpiexec", "-n", str(args.ranks)] + cmd
+    cpu0 = children_cpu()
     try:
         p = subprocess.run(cmd, env=ENV, capture_output=True, text=True, timeout=args.timeout)
     except subprocess.TimeoutExpired:
         return "timeout", f"stopped after {args.timeout:.0f} s", None
+    cpu = children_cpu() - cpu0
     if p.returncode == 2:
         line = next((x for x in p.stderr.splitlines() if "error" in x), p.stderr.strip()[-200:])
         return "not offered", line.split("error: ")[-1][:200], None
@@ -272,7 +281,17 @@ def run(args, out, extra):
         line = next((x for x in p.stderr.splitlines() if "error" in x), "")
         return "unstable", line.split("error: ")[-1][:200], None
     with open(os.path.join(out, "summary.json")) as f:
-        return "ok", "", json.load(f)
+        s = json.load(f)
+    s["cpu_s"] = cpu
+    return "ok", "", s
+
+
+def children_cpu():
+    """User + system CPU seconds of this process's finished children and theirs (mpiexec
+    waits for its ranks, so a run's ranks count): a run's CPU time is the difference over it,
+    which a loaded machine changes far less than its wall time."""
+    r = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return r.ru_utime + r.ru_stime
 
 
 def history(out, quantity):
@@ -290,7 +309,10 @@ def history(out, quantity):
 # The reference's time scheme, given whatever the case file sets: until 2026-11-29 it was left
 # to the case, so the shock panel's references (coupling.time = multirate in its file) were
 # multirate runs at the reference step, not monolithic ones.
-REFERENCE = ["coupling.time=monolithic", "time.method=usl"]
+# coupling.predictor = none in it and in every run but the predictor variant's: a case may set
+# the predictor for its own multirate runs, and the other schemes refuse the key away from its
+# default, none.
+REFERENCE = ["coupling.time=monolithic", "time.method=usl", "coupling.predictor=none"]
 
 
 def reference_key(args):
@@ -334,6 +356,8 @@ def combos(args):
                         continue
                     extra = [f"coupling.scheme={spatial}", f"coupling.time={temporal}",
                              f"time.method={method}", f"time.cfl={cfl}"] + keys
+                    if not any(k.startswith("coupling.predictor=") for k in keys):
+                        extra.append("coupling.predictor=none")  # (see REFERENCE)
                     yield name, spatial, temporal, variant, method, cfl, extra
 
 
@@ -407,7 +431,8 @@ def load_rows(path, scratch=None, verb="not tabulated"):
     if not lines:
         return {}, 0
     header, rows, dropped = lines[0], {}, 0
-    if header != FIELDS and header != FIELDS[:-1]:  # (files before 2026-11 have no walls)
+    # (files before 2026-11 have no walls, before 2026-12-02 no cpu_s)
+    if header not in (FIELDS, FIELDS[:-1], FIELDS[:-2]):
         fail(f"{path}: its header is not a runs.csv one ({','.join(FIELDS)}): give the results "
              "folder of a sweep, or move the file away to start afresh")
     for k, values in enumerate(lines[1:], 2):
@@ -509,19 +534,27 @@ def repeat_rounds(args, todo, done, table, scratch):
 EXTRAPOLATE = 1.5
 
 
-def equal_error(rows):
-    """Lines of ablation.md: each non-monolithic run's cost against monolithic's at its error."""
+# The costs compared at equal error: a column of runs.csv, what it is, its unit and format.
+COSTS = {"wall_s": ("wall time", "s", ".2f"), "cpu_s": ("CPU time (all ranks)", "s", ".2f"),
+         "steps": ("steps (coupling steps for the partitioned schemes)", "", ".0f")}
+
+
+def equal_error(rows, key="wall_s"):
+    """Lines of ablation.md: each non-monolithic run's cost (key: a column of COSTS) against
+    monolithic's at its error."""
+    what, unit, spec = COSTS[key]
+    unit = f" ({unit})" if unit else ""
     mono = {}
     for r in rows:
         if r["temporal"] == "monolithic":
             mono.setdefault((r["spatial"], r["method"]), []).append(
-                (float(r["err_max"]), float(r["wall_s"])))
+                (float(r["err_max"]), float(r[key])))
     lines = []
     for r in rows:
         ref = sorted(mono.get((r["spatial"], r["method"]), []))
         if r["temporal"] == "monolithic" or len(ref) < 2:
             continue
-        e, t = float(r["err_max"]), float(r["wall_s"])
+        e, t = float(r["err_max"]), float(r[key])
         # the bracketing pair by error, else the nearest two
         k = next((j for j in range(len(ref) - 1) if ref[j][0] <= e <= ref[j + 1][0]), None)
         extrap = k is None
@@ -531,19 +564,19 @@ def equal_error(rows):
         if not (e1 > 0 and e2 > 0 and e1 != e2 and e > 0):
             continue
         if extrap and not ref[0][0] / EXTRAPOLATE <= e <= ref[-1][0] * EXTRAPOLATE:
-            lines.append(f"| {r['name']} | {fmt(e)} | {fmt(t, '.2f')} | beyond monolithic's "
+            lines.append(f"| {r['name']} | {fmt(e)} | {fmt(t, spec)} | beyond monolithic's "
                          f"errors ({fmt(ref[0][0])} to {fmt(ref[-1][0])}) by more than "
                          f"{EXTRAPOLATE:g}x | |")
             continue
         tm = loglog(e, ref[k], ref[k + 1])
-        lines.append(f"| {r['name']} | {fmt(e)} | {fmt(t, '.2f')} | {fmt(tm, '.1f')}"
+        lines.append(f"| {r['name']} | {fmt(e)} | {fmt(t, spec)} | {fmt(tm, '.1f')}"
                      f"{' (extrapolated)' if extrap else ''} | {tm / t:.2f} |")
     if not lines:
         return []
-    return ["", "Cost at equal error: monolithic's wall time at each run's error (the same spatial "
+    return ["", f"Cost at equal error: monolithic's {what} at each run's error (the same spatial "
             "scheme and time method; log-log between the monolithic runs that bracket it):", "",
-            "| run | error max | wall (s) | monolithic at that error (s) | ratio |",
-            "|---|---|---|---|---|"] + lines
+            f"| run | error max | {what.split(' (')[0]}{unit} | monolithic at that error{unit} "
+            "| ratio |", "|---|---|---|---|---|"] + lines
 
 
 def fmt(x, spec=".3g"):
@@ -567,11 +600,12 @@ def report(args, rows, outdir, col, sweep_s, nruns, partial=""):
              f"{sum(sum(walls_of(r)) for r in rows):.0f} s (references not included)"
              + (f"; wall times are the median of {nrep} runs each, made in rounds"
                 if nrep > 1 else "") + ".", "",
-             "| run | status | wall (s) | steps | RHS | error max | error RMS | error / max | "
-             "W_net (J) | W_net rel. | imbalance |",
-             "|---|---|---|---|---|---|---|---|---|---|---|"]
+             "| run | status | wall (s) | CPU (s) | steps | RHS | error max | error RMS | "
+             "error / max | W_net (J) | W_net rel. | imbalance |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
-        lines.append(f"| {r['name']} | {r['status']} | {fmt(r['wall_s'], '.2f')} | {r['steps']} | "
+        lines.append(f"| {r['name']} | {r['status']} | {fmt(r['wall_s'], '.2f')} | "
+                     f"{fmt(r.get('cpu_s'), '.2f')} | {r['steps']} | "
                      f"{r['rhs_evals']} | {fmt(r['err_max'])} | {fmt(r['err_rms'])} | "
                      f"{fmt(r['err_rel'])} | {fmt(r['W_net'])} | {fmt(r['W_rel'])} | "
                      f"{fmt(r['imbalance'], '.1e')} |")
@@ -588,6 +622,9 @@ def report(args, rows, outdir, col, sweep_s, nruns, partial=""):
         lines += [f"- {k[0]}, cfl {k[1]}: {v['name']} ({fmt(v['err_max'])} in "
                   f"{fmt(v['wall_s'], '.2f')} s)" for k, v in sorted(best.items())]
         lines += equal_error(ok)
+        if all(r.get("cpu_s") not in (None, "") for r in ok):
+            lines += equal_error(ok, "cpu_s")
+        lines += equal_error(ok, "steps")
     lines += [partial] if partial else []
     write_atomic(os.path.join(outdir, "ablation.md"), lambda f: f.write("\n".join(lines) + "\n"))
     plot(ok, outdir, col, case_dim(args.case, args.overrides))
@@ -771,8 +808,11 @@ def main():
                 continue
         elif not reference_current(args, out):
             print(f"reference for {spatial} (monolithic usl, cfl {args.ref_cfl:g}) ...", flush=True)
-            status, msg, _ = run(args, out, REFERENCE + [f"coupling.scheme={spatial}",
+            status, msg, s = run(args, out, REFERENCE + [f"coupling.scheme={spatial}",
                                                          f"time.cfl={args.ref_cfl}"])
+            if s:
+                print(f"  reference: {s['steps']} steps, wall {float(s['wall_s']):.1f} s, "
+                      f"CPU {s['cpu_s']:.1f} s", flush=True)
             if status == "ok":
                 write_atomic(os.path.join(out, "reference.json"),
                              lambda f: json.dump(reference_key(args), f))
@@ -803,14 +843,14 @@ def main():
         row = dict(name=rname, spatial=spatial, temporal=temporal, variant=variant, method=method,
                    cfl=cfl, status=status, message=msg, wall_s="", steps="", rhs_evals="",
                    err_max="", err_rms="", err_rel="", W_net="", W_rel="", imbalance="",
-                   walls="")
+                   walls="", cpu_s="")
         if s:
             col, tr, ur = refs[spatial]
             _, t, u = history(out, col)
             diff = np.interp(tr, t, u) - ur
             scale = max(float(np.max(np.abs(ur))), 1e-300)
             row.update(wall_s=float(s["wall_s"]), walls=repr(float(s["wall_s"])), steps=s["steps"],
-                   rhs_evals=s["rhs_evals"],
+                       rhs_evals=s["rhs_evals"], cpu_s=s["cpu_s"],
                        err_max=float(np.max(np.abs(diff))),
                        err_rms=float(np.sqrt(np.mean(diff**2))),
                        err_rel=float(np.max(np.abs(diff))) / scale, W_net=s["coupling_work"],

@@ -83,10 +83,15 @@ void mpm_interface_predict_hold(mpm_interface *ifc, double t) {
   for (mpm_lidx l = 0; l < ifc->grid->nnodes; ++l) {
     const double m = ifc->m[l];
     const int known = inv > 0.0 && m > 0.0 && ifc->mprev[l] > 0.0;
+    /* The load over the larger of the two holds' masses, as the solid's advance spreads it
+     * (mpm_coupling_apply_load): where the solid left a node since the hold before, its mass
+     * now is roundoff (1e-13 of the heaviest node's on the shock panel) and load / m gave the
+     * gas a face moving at 1e4 m/s (+150 J booked in one coupling step at 1 mm). */
+    const double m_load = m > ifc->mprev[l] ? m : ifc->mprev[l];
     for (int d = 0; d < dim; ++d) {
       const double v = m > 0.0 ? ifc->mv[d][l] / m : 0.0;
       /* (no history: the held force, as without the predictor) */
-      ifc->accel[d][l] = known     ? (v - ifc->vprev[d][l]) * inv - ifc->load[d][l] / m
+      ifc->accel[d][l] = known     ? (v - ifc->vprev[d][l]) * inv - ifc->load[d][l] / m_load
                          : m > 0.0 ? ifc->f[d][l] / m
                                    : 0.0;
       ifc->vprev[d][l] = v;

@@ -1,6 +1,7 @@
 # Multirate's coupling step: the damped stable step of the gas (fluid.viscous_step) on the shock
 # panel, and the predictor of the solid's interface velocity (coupling.predictor) on the stiff
-# piston: its coupling error's order and momentum balance (~30 s).
+# piston: its coupling error's order and momentum balance, and where the panel leaves a node
+# (~50 s).
 mpm_add_script_test(test_multirate_step SCRIPT verification/test_multirate_step.py
                     LABELS verification TIMEOUT 300)
 
