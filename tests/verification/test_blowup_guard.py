@@ -139,7 +139,7 @@ def coupled_sections():
     main = ["grid.dx=0.006", "time.t_end=0.001", "output.interval=1e9", "coupling.time=multirate",
             "time.cfl=0.4", "run.progress=false", "fluid.refill_every=0",
             "fluid.light_node_mass=0", "fluid.stable_step=particle",
-            "geometry.base.hi=0.106 0.0015"]
+            "geometry.base.hi=0.106 0.0015", "fluid.pic_fraction=0"]
     for label, extra in (("traction multirate held",
                           ["coupling.scheme=traction", "coupling.load=held"]),
                          ("traction multirate interpolated",

@@ -20,21 +20,26 @@ run is the main job; its figures are in docs/main-job.md).
    (fluid.refill_every = 1). With refill every 30 steps, as before, this run had 19 and 24
    such cells in the wake at 0.4 and 0.8 ms.
 Argument `bs32` runs the scene under the adaptive pair instead (4 mm, to 0.3 ms, the case's
-time.rtol = 1e-3 and time.atol = 1e-6), for two faults it once had: it must complete (the
-artificial viscosity did negative work behind the bar, where a gas-only preview of the strain
-rate disagreed with the coupled velocity: the run stopped at 87 us with e < 0; fixed in
-671c992), and its step must not collapse: at most 5 times the steps of the starting CFL step
-(the bound 1 120; measured 580; with the wall rule as a scaling after each accepted step, until
-2026-11-28, 4 688, its step at 1e-10 s for 3 000 of them), and the interface balance as 2.
+time.rtol = 1e-3 and time.atol = 1e-6, and fluid.pic_fraction = 0: the ERK pairs refuse the
+case's PIC share), for two faults it once had: it must complete (the artificial viscosity did
+negative work behind the bar, where a gas-only preview of the strain rate disagreed with the
+coupled velocity: the run stopped at 87 us with e < 0; fixed in 671c992), and its step must not
+collapse: at most 5 times the steps of the starting CFL step (the bound 1 120; measured 580;
+with the wall rule as a scaling after each accepted step, until 2026-11-28, 4 688, its step at
+1e-10 s for 3 000 of them), and the interface balance as 2.
 Argument `standoff` runs check 3 alone. (With the bar 50 mm from the inflow, as the issue
 first placed it, this failed: the inviscid bow shock stands 52 mm ahead of the bar, so it sat
-on the inflow face; see cases/supersonic_bar.ini.) Measured: 42.9 mm at 0.8 ms (time.cfl = 0.6).
+on the inflow face; see cases/supersonic_bar.ini.) Measured: 50.0 mm at 0.8 ms (time.cfl = 0.6,
+the case's 2 % PIC share since 2026-12-02; 42.9 mm in pure FLIP, fluid.pic_fraction=0: 7.1 mm,
+under 2 cells, apart at 4 mm and 0.8 ms, equal at 0.4 ms; at 2 mm the two differ by at most
+1.3 mm from 1 ms on, docs/main-job.md).
 6. 2 ranks give the result of 1: the same particle ids in both phases (every refill, merge
    and regularisation decision the same, new ids included), and fields within 1e-6 of each
    field's largest value. The nodal sums are added in another order on 2 ranks, so the two
    differ by roundoff, which the shocks and FLIP's noise amplify over the run (measured at the
    case's time.cfl = 0.6: 9.7e-15 at 0.1 ms, growing about tenfold per 0.1 ms to 1.5e-9 of the
-   fields' largest values at 0.8 ms in the gas, 6e-14 in the bar); a decomposition fault (a
+   fields' largest values at 0.8 ms in the gas, 6e-14 in the bar; with the case's PIC share,
+   since 2026-12-02, 8.8e-11 and 2.6e-14); a decomposition fault (a
    lost halo sum, a particle on the wrong rank, a decision taken from one rank's half of a
    cell) changes the fields at the discretisation's level, 1e-3 and more, or the ids. The
    tolerance sits between the two. (Until 2026-11-28 the scale was what a 1e-15 change of the
@@ -80,8 +85,8 @@ if MODE == "standoff":
     sys.exit(check.finish())
 if MODE == "bs32":
     T_BS = 0.0003
-    p = mt.run(["run", CASE, f"output.dir={full}", "time.method=bs32", f"time.t_end={T_BS}"]
-               + ARGS, 2)
+    p = mt.run(["run", CASE, f"output.dir={full}", "time.method=bs32", "fluid.pic_fraction=0",
+                f"time.t_end={T_BS}"] + ARGS, 2)
     with open(os.path.join(full, "summary.json")) as f:
         s = json.load(f)
     d = np.genfromtxt(os.path.join(full, "diagnostics.csv"), delimiter=",", names=True)
