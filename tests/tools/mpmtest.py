@@ -1,5 +1,6 @@
 """Helpers for the end-to-end tests: run mpmfsi (serially or under mpiexec) and read its
 output. Run with Debian's /usr/bin/python3, which has h5py."""
+import csv
 import os
 import subprocess
 import sys
@@ -122,6 +123,18 @@ class Checks:
         more = f", {xf} expected to fail" if xf else ""
         print(f"{self.name}: {self.passed} passed, {self.failed} failed{more}")
         return 1 if self.failed else 0
+
+
+def coupling_energy_jump(outdir):
+    """The largest change of the booked interface work W_net in one coupling step, from the
+    run's coupling.csv: (jump in J, t at the end of that step, the solid's largest energy
+    E_solid in J, W_net at the end)."""
+    with open(os.path.join(outdir, "coupling.csv")) as f:
+        r = list(csv.DictReader(f))
+    w = np.array([float(x["W_net"]) for x in r])
+    k = int(np.argmax(np.abs(np.diff(w))))
+    e_max = max(float(x["E_solid"]) for x in r)
+    return abs(w[k + 1] - w[k]), float(r[k + 1]["t"]), e_max, float(w[-1])
 
 
 def time_mean(t, F, a, b):
