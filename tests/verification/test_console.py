@@ -113,7 +113,7 @@ if not script:
     print("skip the live line: util-linux `script` is not installed")
 else:
     out = mt.outdir("live")
-    cmd = [mt.MPIEXEC, "-n", "2", mt.BIN, "run", SOD, f"output.dir={out}", "time.t_end=0.03",
+    cmd = [mt.MPIEXEC, "-n", "2", mt.BIN, "run", SOD, f"output.dir={out}", "time.t_end=0.2",
            "run.progress_interval=0.2"]
     # script gives the command a pseudo-terminal: mpiexec's stderr is a terminal, rank 0's a
     # pipe to mpiexec.
@@ -125,7 +125,7 @@ else:
           f"(at least 2; the last: {draws[-1].strip() if draws else '-'})")
     end = text.rfind("\rstep ")
     check(end >= 0 and re.match(r"\rstep [^\r\n]*\n", text[end:]) is not None
-          and re.search(r"^done: t = 0\.03", text[end:], re.M) is not None,
+          and re.search(r"^done: t = 0\.2,", text[end:], re.M) is not None,
           "the live line is ended by a newline before the summary")
     # The same terminal, but one rank (no launcher) with stderr sent to a file: no \r there.
     single = mt.outdir("single")

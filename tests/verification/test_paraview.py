@@ -9,8 +9,11 @@ the bow shock stands in front of the bar) is opened in pvpython under xvfb-run:
    gas's colour field rho was not one of them; now the solid has rho too).
 2. The shipped script: the run folder's view.py (mpmfsi writes it; tools/paraview_view.py)
    renders the last snapshot to paraview_short.png in the build tree, with the default reader.
-   (a) The bar is visible: pixels of the bar's colour fill the lower bar's box (from the case
-       file) and there are none away from the bar.
+   (a) The bar is visible: pixels of the bar's colour fill at least 85 % of the lower bar's box
+       (from the case file) and there are none away from the bar. The check guards against a
+       bar hidden under the gas or not drawn (about 0 %); the rest of the box is the gas's
+       splats over its edges, 8 % in pure FLIP and 10 % since the case took a 2 % PIC share
+       (2026-12-02), so the bound is 85 %, not the 90 % it was.
    (b) The bow shock is visible: along the bar's mid-height line upstream of it, the density
        read back from the colours steps from the free stream (1.2) to post-shock (above 3.2;
        4.0 behind a normal shock at Mach 2.5) within a short distance (12 mm: 3 cells), at a
@@ -140,7 +143,7 @@ def main():
     near = box_mask(BAR[0] - r - 0.002, BAR[1] + r + 0.01, BAR[2] - r - 0.002, BAR[3] + r + 0.004)
     fill = is_bar[core].mean() if core.any() else 0.0
     stray = int((is_bar & ~near).sum())
-    check(fill > 0.9 and stray <= 0.01 * is_bar.sum() and is_bar.sum() > 0,
+    check(fill >= 0.85 and stray <= 0.01 * is_bar.sum() and is_bar.sum() > 0,
           f"bar visible: {fill:.0%} of the lower bar's box in the bar's colour, {is_bar.sum()} bar "
           f"pixels, {stray} away from the bar")
 
