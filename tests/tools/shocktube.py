@@ -46,8 +46,8 @@ def run(case, N, method, t_end, ranks=1, extra=(), x0=0.5):
     if method in CLASSIC_CFL and not any(e.startswith("time.cfl=") for e in extra):
         extra = list(extra) + [f"time.cfl={CLASSIC_CFL[method]}"]
     out = mt.outdir(f"{case.split('.')[0]}_{method}_N{N}_np{ranks}")
-    mt.run(["run", case_for(case, method, out), f"output.dir={out}", f"grid.dx={1.0 / N}", f"domain.hi=1 {h}",
-            f"geometry.left.hi={x0} {h}", f"geometry.right.lo={x0} 0",
+    mt.run(["run", case_for(case, method, out), f"output.dir={out}", f"grid.dx={1.0 / N}",
+            f"domain.hi=1 {h}", f"geometry.left.hi={x0} {h}", f"geometry.right.lo={x0} 0",
             f"geometry.right.hi=1 {h}", f"time.method={method}",
             f"time.t_end={t_end}", "run.progress=false"] + list(extra), ranks)
     return out
