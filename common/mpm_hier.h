@@ -1,0 +1,131 @@
+/* A refinement hierarchy over the shared grid and its conservative composite basis (the
+ * truncated hierarchical B-splines of DESIGN.md section 9), for quadratic B-splines.
+ *
+ * Levels. Level 0 is the shared grid (not owned here). Level l + 1 halves the spacing,
+ * h_{l+1} = h_l / 2, and puts its nodes on the nested dual lattice: its origin is
+ * o_{l+1} = o_l - h_{l+1} / 2 (o_0 = grid->lo), node j sits at o_{l+1} + j h_{l+1}. A quadratic
+ * B-spline's knot spans are the dual cells of the nodes: span i of level l is
+ * [o_l + (i - 1/2) h_l, o_l + (i + 1/2) h_l], indexed like node i, and it is exactly spans 2i and
+ * 2i + 1 of level l + 1, so the knot vectors nest and level l's B-splines are combinations of
+ * level l + 1's (the two-scale relation: coarse node i = 1/4, 3/4, 3/4, 1/4 of fine nodes
+ * 2i - 1 .. 2i + 2 per axis; a fine node j = 2m + r has parents m (3/4) and m - 1 + 2r (1/4)).
+ *
+ * Regions. The region of level l >= 1, Omega_l, is a union of level l - 1 spans; Omega_0 is
+ * everything. Omega_{l+1} lies inside Omega_l eroded by `buffer` level-l spans (proper nesting).
+ * A point belongs to the finest level whose region contains it (mpm_hier_level_of).
+ *
+ * Composite basis. Node j of level l is active when its support (spans j - 1 .. j + 1 per axis)
+ * lies in Omega_l (always at level 0) and not in Omega_{l+1}. The basis is the active nodes'
+ * B-splines, each truncated (minus its children that are active on a finer level). It is never
+ * formed: a particle deposits on its own level's lattice with the unchanged kernels
+ * (mpm_kernels.h); mpm_hier_restrict() then moves, from the finest level down, every inactive
+ * node's value onto its parents with the two-scale weights and zeroes it; the nodal solve runs
+ * on the active nodes of every level; mpm_hier_prolong(), the transpose, fills every inactive
+ * node from its parents, from level 1 up; a particle's G2P reads its own level. The weights are
+ * a partition of unity, non-negative and C1 across the interface between levels; the grid's
+ * mass and momentum equal the particles' to roundoff, summed over the active nodes of all
+ * levels.
+ *
+ * Storage. Level l >= 1 is one box of nodes per rank, an mpm_grid made by mpm_grid_box_new()
+ * (no communicator), so the P2G/G2P kernels run on it unchanged. Its box holds every node
+ * whose support meets Omega_l plus one layer. This version runs on one rank, with the
+ * quadratic B-spline only: mpm_hier_new() refuses anything else with a reason.
+ *
+ * Masks (one byte per box node of a level, indexed like its nodal fields): covered[l][i] is 1
+ * when span i of level l lies in Omega_l, refined[l][i] when it lies in Omega_{l+1}, active[l][i]
+ * when node i is active. */
+#ifndef MPM_HIER_H
+#define MPM_HIER_H
+
+#include "mpm_grid.h"
+#include "mpm_kernels.h"
+
+#include <stddef.h>
+
+#define MPM_HIER_MAX_LEVELS 5 /* level 0 and up to 4 finer levels */
+
+/* A refined box: Omega_level (level >= 1) includes every level - 1 span that meets the open
+ * box (lo, hi) (the box is snapped outwards to level - 1 spans). */
+typedef struct mpm_hier_box {
+  int level;
+  double lo[MPM_MAX_DIM], hi[MPM_MAX_DIM];
+} mpm_hier_box;
+
+typedef struct mpm_hier_level {
+  mpm_grid *grid; /* level 0: the shared grid (not owned); finer levels: owned box grids */
+  unsigned char *covered, *refined, *active;
+} mpm_hier_level;
+
+typedef struct mpm_hier {
+  int dim, nlevels, buffer;
+  mpm_hier_level level[MPM_HIER_MAX_LEVELS];
+  void *scratch; /* private to mpm_hier.c: per-level particle lists and gathered arrays */
+} mpm_hier;
+
+/* One composite weight of a point: node `node` (box index) of level `level`, its weight and
+ * its gradient (physical units, 1/length). */
+typedef struct mpm_hier_weight {
+  int level;
+  mpm_lidx node;
+  double w, dw[MPM_MAX_DIM];
+} mpm_hier_weight;
+
+/* Build the hierarchy over grid with nlevels levels (1 .. MPM_HIER_MAX_LEVELS; 1 is the grid
+ * alone) from nbox boxes, with `buffer` >= 1 level-l spans between Omega_{l+1} and the edge of
+ * Omega_l. Mirrors the grid's phases (mpm_hier_add_phases). On bad input returns MPM_ERR_INPUT
+ * and writes one sentence into why[why_len] naming the box (by its index in `box`) and what is
+ * wrong: a level outside 1 .. nlevels - 1, a box empty or outside the domain, a level without a
+ * box, a box not inside the coarser level's region by `buffer` spans, a grid on more than one
+ * rank or a shape other than the quadratic B-spline. Logs nothing: the caller names the key. */
+int mpm_hier_new(mpm_hier **h, mpm_grid *grid, int nlevels, const mpm_hier_box *box, int nbox,
+                 int buffer, char *why, size_t why_len);
+void mpm_hier_destroy(mpm_hier **h);
+
+/* Give every finer level the phases the grid has and it lacks (after a module adds one). */
+int mpm_hier_add_phases(mpm_hier *h);
+
+/* The finest level whose region contains x. */
+int mpm_hier_level_of(const mpm_hier *h, const double *x);
+
+/* The composite basis at x: writes the nonzero weights (each active node once) into w[max]
+ * and returns their number (at most 3^dim times the number of levels). */
+int mpm_hier_eval(const mpm_hier *h, const double *x, mpm_hier_weight *w, int max);
+
+/* Composite P2G of one phase: each particle deposits (a's fields, with the unchanged kernel) on
+ * the level mpm_hier_level_of gives for its position; adds, as the kernel does. Follow it with
+ * mpm_hier_restrict before the solve. */
+int mpm_hier_p2g(mpm_hier *h, int phase, const mpm_p2g_args *a);
+
+/* Per-level nodal scalars for a composite G2P: s_i[l][j] is scalar j on level l (level 0's
+ * entries are the g2p args' own s_i). */
+typedef struct mpm_hier_scalars {
+  const double *s_i[MPM_HIER_MAX_LEVELS][MPM_KERNELS_MAX_SCALARS];
+} mpm_hier_scalars;
+
+/* Composite G2P: a's v_i and a_i are NULL or the level-0 arrays of `phase` (each level then
+ * reads its own); with a->nscalar > 0, s gives every level's scalars (MPM_ERR_INTERNAL if not).
+ * Each particle reads the level of its position; the outputs land in a's arrays. Run after
+ * mpm_hier_prolong. */
+int mpm_hier_g2p(mpm_hier *h, int phase, const mpm_g2p_args *a, const mpm_hier_scalars *s);
+
+/* Restrict the deposit of a phase (m, m v, f and the mass gradient where deposited), finest
+ * level first; every inactive node ends at zero. */
+void mpm_hier_restrict(mpm_hier *h, int phase);
+/* Prolong a phase's v and a into every inactive node, level 1 first. */
+void mpm_hier_prolong(mpm_hier *h, int phase);
+/* The same for nf arrays of the caller: fine[k] on level l (>= 1), coarse[k] on level l - 1. */
+void mpm_hier_restrict_level(mpm_hier *h, int l, double *const *fine, double *const *coarse,
+                             int nf);
+void mpm_hier_prolong_level(mpm_hier *h, int l, const double *const *coarse, double *const *fine,
+                            int nf);
+
+/* The nodal solve of one phase on every level (mpm_grid_phase_update's rule, with the largest
+ * nodal mass taken over all levels): v = m v / m, a = f / m, v += h a on nodes heavier than the
+ * empty threshold, zero elsewhere (inactive nodes, being empty, are filled by the prolongation).
+ * Collective over the grid's communicator. */
+int mpm_hier_phase_update(mpm_hier *h, int phase, double hstep);
+
+/* Zero a phase's deposit on every level (mpm_grid_phase_zero on each). */
+void mpm_hier_phase_zero(mpm_hier *h, int phase);
+
+#endif
