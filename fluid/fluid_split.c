@@ -42,13 +42,13 @@
  * most parents a cell splits), linearly in the events, like the regularisation's. A merged
  * particle keeps its members' lowest id (after a split, the parent's own), drawing none.
  *
- * Memory. Merges write in place and drop members: they only shrink the set. A split adds
- * (2^dim - 1) k particles once, in one buffer of their data, then the edit rebuilds the block:
- * the peak is the old block, the new block and that buffer, (2 n + 2 (2^dim - 1) k) particles'
- * worth, for a final set of n + (2^dim - 1) k. A regrid merges before it splits, so the peak is
- * bounded by twice the larger of the sets before and after, never the 2^dim-fold peak of
- * splitting everything to the finest level and merging afterwards; a caller short of memory
- * splits in chunks (idx is any list). */
+ * Memory. Merges write in place and drop members: they only shrink the set. A split grows the
+ * set once by its (2^dim - 1) k children, whose data it writes straight into the new block (the
+ * edit appends them without data): the peak is the old block and the new one, n + (n + (2^dim
+ * - 1) k) particles, and the children's ids. A regrid merges before it splits, so the peak is
+ * bounded by the set before plus the set after, never the 2^dim-fold peak of splitting
+ * everything to the finest level and merging afterwards. (The set's spare block, kept between
+ * edits, makes a repeated regrid reuse that memory instead of faulting in new pages.) */
 #include "fluid_split.h"
 
 #include "fluid_internal.h"
@@ -169,45 +169,45 @@ static int child_offsets(const mpm_module *m, mpm_lidx i, double *x, double *del
   return shrunk;
 }
 
-/* The split itself, ids from first[a] = id_next + (cell S + r) (2^dim - 1). */
-static int split_apply(mpm_module *m, const mpm_lidx *idx, mpm_lidx k, const mpm_gidx *first,
+/* Fill the 2^dim - 1 appended children of parent idx[a] (child 0 is the parent, in place) in
+ * the set as grown by the edit; n0 particles before it. */
+static void split_fill(mpm_module *m, const mpm_lidx *idx, mpm_lidx a, mpm_lidx n0,
                        fluid_split_report *rep) {
   mpm_particles *p = m->particles;
   const fluid_content *fc = m->content;
-  const int dim = p->dim, nnew = (1 << dim) - 1, nc = p->ncomp;
+  const int dim = p->dim, nnew = (1 << dim) - 1;
   const int om = p->offset[fc->lay.f_m], oV = p->offset[fc->lay.f_V0];
   const double scale = 1.0 / (double)(1 << dim); /* exact */
+  const mpm_lidx i = idx[a], col = n0 + a * nnew;
+  double x[MPM_MAX_DIM] = {0}, delta[MPM_MAX_DIM] = {0};
+  rep->shrunk += child_offsets(m, i, x, delta);
+  for (int q = 0; q < p->ncomp; ++q) {
+    double *v = p->data + (size_t)q * p->n;
+    if (q == om || q == oV) v[i] *= scale;
+    for (int j = 0; j < nnew; ++j) v[col + j] = v[i];
+  }
+  for (int j = 0; j <= nnew; ++j)
+    for (int d = 0; d < dim; ++d)
+      mpm_particles_comp(p, FLUID_X, d)[j ? col + j - 1 : i] =
+          j >> d & 1 ? x[d] + delta[d] : x[d] - delta[d];
+}
+
+/* The split itself, ids from first[a] = id_next + (cell S + r) (2^dim - 1). The edit grows the
+ * set by the children without data, which are then filled in place: no copy of them is held
+ * beside the set. */
+static int split_apply(mpm_module *m, const mpm_lidx *idx, mpm_lidx k, const mpm_gidx *first,
+                       fluid_split_report *rep) {
+  mpm_particles *p = m->particles;
+  const int nnew = (1 << p->dim) - 1;
   const mpm_lidx n0 = p->n, nadd = k * nnew;
-  const size_t nd = (size_t)nadd * (size_t)nc;
   mpm_gidx *id;
   MPM_ALLOC(id, nadd);
-  double *data = malloc(sizeof *data * (nd ? nd : 1));
-  if (!data) {
-    free(id);
-    MPM_FAIL_OOM(sizeof *data * nd);
-  }
-  for (mpm_lidx a = 0; a < k; ++a) {
-    const mpm_lidx i = idx[a], col = a * nnew;
-    double x[MPM_MAX_DIM] = {0}, delta[MPM_MAX_DIM] = {0};
-    rep->shrunk += child_offsets(m, i, x, delta);
-    for (int q = 0; q < nc; ++q) {
-      double *v = p->data + (size_t)q * n0 + i;
-      if (q == om || q == oV) *v *= scale; /* the parent is child 0 */
-      for (int j = 0; j < nnew; ++j) data[(size_t)q * nadd + col + j] = *v;
-    }
-    for (int j = 0; j <= nnew; ++j)
-      for (int d = 0; d < dim; ++d) {
-        const double xc = j >> d & 1 ? x[d] + delta[d] : x[d] - delta[d];
-        if (j == 0)
-          mpm_particles_comp(p, FLUID_X, d)[i] = xc;
-        else
-          data[(size_t)(p->offset[FLUID_X] + d) * nadd + col + j - 1] = xc;
-      }
-    for (int j = 1; j <= nnew; ++j) id[col + j - 1] = first[a] + j - 1;
-  }
-  const int rc = mpm_particles_edit(p, NULL, nadd, id, data);
-  free(id), free(data);
+  for (mpm_lidx a = 0; a < k; ++a)
+    for (int j = 0; j < nnew; ++j) id[a * nnew + j] = first[a] + j;
+  const int rc = mpm_particles_edit(p, NULL, nadd, id, NULL);
+  free(id);
   MPM_CALL(rc);
+  for (mpm_lidx a = 0; a < k; ++a) split_fill(m, idx, a, n0, rep);
   rep->parents = k, rep->children = nadd;
   for (mpm_lidx a = 0; a < k; ++a) rep->away += is_away(m, idx[a]);
   for (mpm_lidx i = n0; i < p->n; ++i) rep->away += is_away(m, i);
