@@ -10,7 +10,8 @@
  *  (iii) split then merge of each parent with its children returns every field of every
  *        particle and its id; the same through the parent-slot groups (fluid_merge_groups)
  *        for gas seeded at the slots' centres;
- *  (iv)  a parent near a wall splits with shortened, symmetric offsets inside the domain.
+ *  (iv)  a parent near a wall splits with shortened, symmetric offsets inside the domain;
+ *  (v)   a group across a periodic face merges at its centre of mass across the face.
  * It also prints the cost of split + merge per particle and the memory the split holds at its
  * peak (no assertion on either).
  *
@@ -422,6 +423,31 @@ static void test_wall(void **state) {
   }
 }
 
+/* (v) a group across the periodic x faces merges at its centre of mass across them, not in the
+ * middle of the domain: members 0.01 and 0.03 inside the two faces, equal masses, at the face. */
+static void test_periodic(void **state) {
+  (void)state;
+  gas s;
+  const int nproc[3] = {1, 1, 1}, periodic[3] = {1, 0, 0};
+  memset(&s, 0, sizeof s);
+  assert_int_equal(mpm_grid_new_periodic(&s.m.grid, MPI_COMM_WORLD, 2, g_lo, g_hi, g_dx,
+                                         MPM_SHAPE_QUADRATIC, nproc, periodic),
+                   0);
+  assert_int_equal(fluid_particles_new(&s.m.particles, 2, &s.fc.lay, 1, 0, 0, 1), 0);
+  s.m.content = &s.fc;
+  gas_fill(&s, 2, 0.3, 50.0, 5u);
+  comp(&s, FLUID_X, 0)[0] = g_lo[0] + 0.01, comp(&s, FLUID_X, 0)[1] = g_hi[0] - 0.03;
+  comp(&s, s.fc.lay.f_m, 0)[0] = comp(&s, s.fc.lay.f_m, 0)[1] = 1.0;
+  const mpm_lidx start[2] = {0, 2}, member[2] = {0, 1};
+  fluid_split_report r;
+  assert_int_equal(fluid_merge(&s.m, start, member, 1, &r), 0);
+  assert_int_equal(s.m.particles->n, 1);
+  const double x = comp(&s, FLUID_X, 0)[0], want = g_hi[0] - 0.01;
+  printf("periodic merge: x = %.17g (want %.17g)\n", x, want);
+  assert_true(fabs(x - want) < 1e-14);
+  gas_free(&s);
+}
+
 static double now(void) {
   struct timespec t;
   clock_gettime(CLOCK_MONOTONIC, &t);
@@ -471,8 +497,9 @@ static void test_cost(void **state) {
 int main(int argc, char **argv) {
   MPI_Init(&argc, &argv);
   const struct CMUnitTest tests[] = {
-      cmocka_unit_test(test_split), cmocka_unit_test(test_merge), cmocka_unit_test(test_round_trip),
-      cmocka_unit_test(test_wall),  cmocka_unit_test(test_cost),
+      cmocka_unit_test(test_split),      cmocka_unit_test(test_merge),
+      cmocka_unit_test(test_round_trip), cmocka_unit_test(test_wall),
+      cmocka_unit_test(test_periodic),   cmocka_unit_test(test_cost),
   };
   const int rc = cmocka_run_group_tests(tests, NULL, NULL);
   MPI_Finalize();
