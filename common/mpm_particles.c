@@ -181,8 +181,8 @@ static void copy_kept(const mpm_particles *p, const unsigned char *keep, mpm_lid
 
 static int edit_now(mpm_particles *p, const unsigned char *keep, mpm_lidx nadd,
                     const mpm_gidx *add_id, const double *add_data) {
-  if (nadd < 0 || (nadd > 0 && (!add_id || !add_data)))
-    MPM_FAIL(MPM_ERR_INPUT, "particles: cannot add %d particles without ids and data", (int)nadd);
+  if (nadd < 0 || (nadd > 0 && !add_id))
+    MPM_FAIL(MPM_ERR_INPUT, "particles: cannot add %d particles without ids", (int)nadd);
   const mpm_lidx kept = count_kept(p, keep);
   if ((int64_t)kept + nadd > INT32_MAX)
     MPM_FAIL(MPM_ERR_INPUT, "particles: %d + %d particles exceed the local index range", (int)kept,
@@ -194,7 +194,7 @@ static int edit_now(mpm_particles *p, const unsigned char *keep, mpm_lidx nadd,
   MPM_CALL(block_get(p, nnew, &id, &data, &cap));
   copy_kept(p, keep, nnew, id, data);
   if (nadd > 0) memcpy(id + kept, add_id, (size_t)nadd * sizeof *id);
-  for (int c = 0; c < p->ncomp && nadd > 0; ++c)
+  for (int c = 0; c < p->ncomp && nadd > 0 && add_data; ++c)
     memcpy(data + (size_t)c * (size_t)nnew + (size_t)kept, add_data + (size_t)c * (size_t)nadd,
            (size_t)nadd * sizeof *data);
   install(p, nnew, id, data, cap);

@@ -83,7 +83,9 @@ static inline double *mpm_particles_comp(const mpm_particles *p, int f, int c) {
 int mpm_particles_find(const mpm_particles *p, const char *name);
 
 /* Keep the particles with keep[i] != 0 (all if keep is NULL), in order, and append nadd new
- * ones with ids add_id and data add_data (component-major: ncomp * nadd). Local. */
+ * ones with ids add_id and data add_data (component-major: ncomp * nadd). With add_data NULL
+ * the new particles' data is left undefined for the caller to fill in the new block (no copy
+ * of the new particles is held beside the set: the gas's split, fluid_split.c). Local. */
 int mpm_particles_edit(mpm_particles *p, const unsigned char *keep, mpm_lidx nadd,
                        const mpm_gidx *add_id, const double *add_data);
 

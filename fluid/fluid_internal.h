@@ -102,6 +102,12 @@ int fluid_limiter(mpm_module *m, const double *y, const double *const *v_i, cons
 int fluid_volume_rate(mpm_module *m, const double *y, const double *const *v_i, const double *L,
                       const double **rate);
 
+/* The gas's empty particle set and its layout: C with apic, D with viscous, psi with limiter,
+ * and the lagged strain rate in the state (lag_in_state, the classic update) or after a
+ * pending copy (the method of lines) (fluid_module.c). */
+int fluid_particles_new(mpm_particles **p, int dim, fluid_layout *lay, int apic, int viscous,
+                        int limiter, int lag_in_state);
+
 /* Seed every [gas.NAME] region into the (empty) particle set (fluid_seed.c). */
 int fluid_seed(mpm_module *m, const mpm_config *cfg);
 

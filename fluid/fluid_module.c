@@ -831,8 +831,8 @@ static void lag_fields(mpm_field_desc *f, int *nf, fluid_layout *lay, int dim, i
   if (limiter) f[(*nf)++] = (mpm_field_desc){"psi", 1};
 }
 
-static int particles_new(mpm_particles **p, int dim, fluid_layout *lay, int apic, int viscous,
-                         int limiter, int lag_in_state) {
+int fluid_particles_new(mpm_particles **p, int dim, fluid_layout *lay, int apic, int viscous,
+                        int limiter, int lag_in_state) {
   mpm_field_desc f[MPM_PARTICLES_MAX_FIELDS] = {{"x", dim}, {"v", dim}, {"J", 1}, {"e", 1}};
   int nf = 4;
   lay->f_C = apic ? nf : -1;
@@ -882,8 +882,8 @@ static int build(mpm_module *m, const mpm_config *cfg, int seed) {
   fc->virt.phase = -1;
   if (fluid_open_uses_virtual(fc->open)) MPM_CALL(fluid_virtual_init(&fc->virt, g));
   MPM_ALLOC(fc->node, (size_t)(g->dim + 3) * g->nnodes);
-  MPM_CALL(particles_new(&m->particles, g->dim, &fc->lay, fc->tr.apic, fc->gas.mu > 0,
-                         fc->gas.av_riemann, fc->tr.classic));
+  MPM_CALL(fluid_particles_new(&m->particles, g->dim, &fc->lay, fc->tr.apic, fc->gas.mu > 0,
+                               fc->gas.av_riemann, fc->tr.classic));
   /* What a checkpoint may hold: positive mass, volume, volume ratio and internal energy (the
    * module's check faults on any other). */
   mpm_particles_set_range(m->particles, fc->lay.f_m, 0.0, HUGE_VAL, MPM_FIELD_LO_OPEN);
