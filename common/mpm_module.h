@@ -39,6 +39,7 @@ typedef struct mpm_module_sums {
 } mpm_module_sums;
 
 typedef struct mpm_module mpm_module;
+struct mpm_hier;
 
 /* Which transfer a grid pass follows: the first (particles with their stress, gravity and
  * external forces) or MUSL's remap (mass and momentum only, after the first solve: no force
@@ -136,6 +137,10 @@ struct mpm_module {
    * step's last stage is stale once the step is accepted: the integrator's fixed steps start
    * from a fresh first stage instead of reusing it (mpm_integrator.c). */
   int commits_history;
+  /* The static refinement hierarchy over grid this module's phase lives on (mpm_hier.h), set
+   * by the sim after the modules are built; NULL without refinement. The coupler then zeroes,
+   * restricts, solves and prolongs the phase on every level (coupler/mpm_cycle.c). */
+  struct mpm_hier *hier;
 };
 
 /* Call ops->destroy and free the module; accepts NULL. */
