@@ -88,7 +88,8 @@ int mpm_hier_add_phases(mpm_hier *h);
 int mpm_hier_level_of(const mpm_hier *h, const double *x);
 
 /* The composite basis at x: writes the nonzero weights (each active node once) into w[max]
- * and returns their number (at most 3^dim times the number of levels). */
+ * and returns their number (at most 3^dim times the number of levels); -1 if max is too small
+ * or x lies so far outside the domain that its stencil leaves level 0's box. */
 int mpm_hier_eval(const mpm_hier *h, const double *x, mpm_hier_weight *w, int max);
 
 /* Composite P2G of one phase: each particle deposits (a's fields, with the unchanged kernel) on
