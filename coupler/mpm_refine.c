@@ -71,11 +71,11 @@ static int read_box(const mpm_config *cfg, const mpm_grid *g, const char *name, 
     if (count != g->dim)
       return mpm_config_fail(cfg, key[1 + j], "needs %d values, got %d", g->dim, count);
   }
-  const double gap = REFINE_FACE_CELLS * g->dx;
+  const double gap = REFINE_FACE_CELLS * g->dx, tol = 1e-9 * g->dx;
   for (int d = 0; d < g->dim; ++d) {
     if (g->periodic[d]) continue;
-    const int low = b->lo[d] < g->lo[d] + gap;
-    if (low || b->hi[d] > g->hi[d] - gap)
+    const int low = b->lo[d] < g->lo[d] + gap - tol;
+    if (low || b->hi[d] > g->hi[d] - gap + tol)
       return mpm_config_fail(cfg, key[low ? 1 : 2],
                              "the box comes within %d level-0 cells (%g) of the domain face %c = "
                              "%g, which is not periodic: walls and open faces act on level 0 "
@@ -129,6 +129,11 @@ int mpm_refine_build(mpm_hier **h, const mpm_config *cfg, mpm_grid *grid, mpm_mo
   free(box);
   if (rc == MPM_ERR_INPUT && why[0]) return fail_why(cfg, names, nbox, why);
   MPM_CALL(rc);
+  /* TEMPORARY: amr-thb's reserve() (mpm_hier_transfer.c) allocates its scratch struct with
+   * MPM_ALLOC(h->scratch, 1), which is sizeof(void) = 1 byte; hand it a zeroed block large
+   * enough for that struct (it frees it with free()) until that is fixed there. */
+  if (!(*h)->scratch && !((*h)->scratch = calloc(1, 256)))
+    MPM_FAIL(MPM_ERR_MEMORY, "out of memory for the refinement scratch");
   for (int k = 0; k < nmod; ++k) MPM_CALL(fluid_module_refine(mod[k], cfg, *h, seed));
   return 0;
 }

@@ -126,10 +126,10 @@ int fluid_shift(mpm_module *m, long step, double h, int *changed);
  * seed each level's own region on its lattice. Collective. */
 int fluid_seed_refined(mpm_module *m, const mpm_config *cfg);
 
-/* The transfers of a module that may be refined (fluid_refine.c): P2G of a into m's phase, on
+/* The transfers of a module that may be refined (fluid_refine.c): P2G of a into phase, on
  * the grid or composite (an error goes to *rc, which is left alone on success), and the G2P of
  * v, a and L (L_out may be NULL) from m's phase at the positions of state y. */
-void fluid_p2g_any(mpm_module *m, const mpm_p2g_args *a, int *rc);
+void fluid_p2g_any(mpm_module *m, int phase, const mpm_p2g_args *a, int *rc);
 int fluid_g2p_phase(mpm_module *m, const double *y, double *const *v_out, double *const *a_out,
                     double *L_out);
 /* The grid spacing of the finest level (the grid's without refinement). */

@@ -241,9 +241,9 @@ static int deposit(mpm_module *m, const double *y, const double *vsig, const flu
     a.gravity[d] = vsig ? fc->gravity[d] : 0.0;
   }
   int rc = 0;
-  fluid_p2g_any(m, &a, &rc);
+  fluid_p2g_any(m, m->phase, &a, &rc);
   MPM_CALL(rc);
-  if (fc->filter_phase >= 0) { /* the particles' own m and m v, for fluid_mol_damping */
+  if (fc->filter_phase >= 0 && !m->hier) { /* the particles' own m and m v, for mol_damping */
     const mpm_grid_phase *ph = &m->grid->phase[m->phase];
     mpm_grid_phase *fp = &m->grid->phase[fc->filter_phase];
     const size_t bytes = sizeof(double) * (size_t)m->grid->nnodes;
@@ -323,7 +323,7 @@ static int deposit_viscous(mpm_module *m, const double *y, const fluid_batch *b)
   mpm_p2g_args a = {.n = k, .m = fc->zero, .vsig = sig, .lp = fc->lp};
   for (int d = 0; d < dim; ++d) a.x[d] = xs + (size_t)d * cap, a.v[d] = fc->zero;
   int rc = 0;
-  fluid_p2g_any(m, &a, &rc);
+  fluid_p2g_any(m, m->phase, &a, &rc);
   return rc;
 }
 

@@ -4,17 +4,18 @@
  *
  * Carried: the plain transfers of the method-of-lines RHS (the ERK pairs): the deposit of mass,
  * momentum, pressure, gravity and the viscous stresses (fluid.strain_rate = current's preview
- * included) goes through mpm_hier_p2g, every gather of v, a and L through mpm_hier_g2p; the
- * coupler restricts, solves on every level and prolongs (coupler/mpm_cycle.c). The stable step
- * takes the finest level's spacing. Walls act on level 0 only: the sim keeps every box three
- * level-0 cells from the non-periodic faces (coupler/mpm_refine.c).
+ * and fluid.mol_damping's filter included) goes through mpm_hier_p2g, every gather of v, a and L
+ * through mpm_hier_g2p; the coupler restricts, solves on every level and prolongs
+ * (coupler/mpm_cycle.c). The stable step takes the finest level's spacing. Walls act on level 0
+ * only: the sim keeps every box three level-0 cells from the non-periodic faces
+ * (coupler/mpm_refine.c).
  *
  * Refused (fluid_refine_check), each naming its key: everything that reads or writes the gas's
  * nodal fields or the grid otherwise: the classic update (its time-centred nodal velocity, heat
- * shares and wall rule), the domain volume rate, the riemann viscosity's limiter, the filter of
- * fluid.mol_damping, shifting, regularisation and refill (cell counts), the neighbourhood stable
- * step, the light-node threshold, obstacles and open faces. An odd fluid.ppc puts level-0
- * particles on the span faces that bound the finer regions, so it is refused too.
+ * shares and wall rule), the domain volume rate, the riemann viscosity's limiter, shifting,
+ * regularisation and refill (cell counts), the neighbourhood stable step, the light-node threshold,
+ * obstacles and open faces. An odd fluid.ppc puts level-0 particles on the span faces that bound
+ * the finer regions, so it is refused too.
  *
  * Invariant: with m->hier NULL every call here is the plain kernel call (the refined path costs
  * one pointer test per transfer). */
@@ -29,12 +30,12 @@
 #include <stdio.h>
 #include <string.h>
 
-void fluid_p2g_any(mpm_module *m, const mpm_p2g_args *a, int *rc) {
+void fluid_p2g_any(mpm_module *m, int phase, const mpm_p2g_args *a, int *rc) {
   if (m->hier) {
-    if (!*rc) *rc = mpm_hier_p2g(m->hier, m->phase, a);
+    if (!*rc) *rc = mpm_hier_p2g(m->hier, phase, a);
     return;
   }
-  mpm_kernels_get(m->grid->dim)->p2g(m->grid, m->phase, a);
+  mpm_kernels_get(m->grid->dim)->p2g(m->grid, phase, a);
 }
 
 int fluid_g2p_phase(mpm_module *m, const double *y, double *const *v_out, double *const *a_out,
@@ -93,7 +94,6 @@ static const refusal g_refused[] = {
     {"fluid.volume_rate", "domain", "the domain rate samples the nodal velocity on level 0"},
     {"fluid.av_form", "riemann", "the riemann limiter reads the nodal velocity on level 0"},
     {"fluid.stable_step", "neighbourhood", "the neighbourhood step sums level-0 cells"},
-    {"fluid.mol_damping", NULL, "its filter deposits and gathers on level 0 alone"},
     {"fluid.shift", NULL, "shifting reads the nodal volume fraction on level 0"},
     {"fluid.regularise_every", NULL, "merging and splitting count particles in level-0 cells"},
     {"fluid.refill_every", NULL, "refilling counts particles in level-0 cells"},
@@ -128,7 +128,7 @@ int fluid_refine_check(const mpm_module *m, const mpm_config *cfg) {
     if (r->choice ? is_choice(cfg, r->key, r->choice) : is_positive(cfg, r->key))
       return refuse(cfg, r->key, r->why);
   }
-  if (fc->reg_every > 0) return refuse(cfg, "fluid.regularise_every", g_refused[7].why);
+  if (fc->reg_every > 0) return refuse(cfg, "fluid.regularise_every", g_refused[6].why);
   MPM_CALL(refuse_boundaries(cfg, fc, m->grid->dim));
   if (fc->ppc % 2)
     return mpm_config_fail(
