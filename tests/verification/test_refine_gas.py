@@ -15,7 +15,8 @@ pulse    A right-running acoustic pulse (amplitude 1e-3, c = 1, gaussian of widt
          along x; and conservation as above.
 input    Every refusal: exit 2, one line naming case.ini:LINE and the key (part d).
 identity refine.levels = 1 gives the same output as no [refine] section, bit for bit (part e).
-The figures and tolerances are stated at each check; see docs/refinement.md for the numbers.
+A second argument sets fluid.ppc of the uniform and pulse runs (2 by default; 4 in the long
+tests). The figures and tolerances are stated at each check and in docs/refinement.md.
 """
 import os
 import sys
@@ -27,6 +28,7 @@ sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "tools"))
 import mpmtest as mt  # noqa: E402
 
 PART = sys.argv[1] if len(sys.argv) > 1 else "uniform"
+PPC = int(sys.argv[2]) if len(sys.argv) > 2 else 2  # fluid.ppc of the uniform and pulse runs
 check = mt.Checks(f"test_refine_gas_{PART}")
 C0 = np.sqrt(1.4)  # sound speed of rho 1, p 1
 BOX = "[refine]\nlevels = 2\n\n[refine.box]\nlevel = 1\nlo = {x0} 0.15\nhi = {x1} 0.45\n"
@@ -97,6 +99,7 @@ def drifts(out):
 
 def twins(name, length, t_end, gas, x0, x1, extra=""):
     """The refined run and its coarse and fine uniform twins: {label: (out, wall s)}."""
+    extra += f"[fluid]\nppc = {PPC}\n"
     return {"refined": run(name + "_refined", case_text(length, t_end, gas,
                                                         BOX.format(x0=x0, x1=x1), extra=extra)),
             "coarse": run(name + "_coarse", case_text(length, t_end, gas, "", extra=extra)),
@@ -166,7 +169,8 @@ def part_pulse():
            f"velocity_field = {a}*{g}; 0")
     runs = twins("refine_pulse", 3, 2.4, gas, 1.6, 2.4)
     rest, _ = run("refine_rest", case_text(3, 2.4, "density = 1\npressure = 0.714285714285714",
-                                           BOX.format(x0=1.6, x1=2.4)))
+                                           BOX.format(x0=1.6, x1=2.4),
+                                           extra=f"[fluid]\nppc = {PPC}\n"))
     report_cost(runs)
     r = final(rest)
     print(f"info refined, gas at rest: largest |p - p0| / p0 {np.abs(r['p'] * 1.4 - 1).max():.2e},"
@@ -246,27 +250,32 @@ def part_identity():
           f"bit ({len(a['id'])} particles, fields {', '.join(k for k in a if k != 'time')})")
 
 
+# The measured figures, by fluid.ppc: the uniform stream's largest deviation at t = 1.4 and the
+# pulse's reflected energy fraction (docs/refinement.md). The box's corners push gas at rest
+# (the pulse part's run at rest) and the disturbance grows there, so neither reaches its target
+# (roundoff, as the twins get; the issue's 1 %): the checks assert the measured figure with 20 %
+# margin, so that a worse regression fails, and keep the target as an expected failure.
+MEASURED = {2: (1.48e-1, 0.516), 4: (2.47e-2, 2.93e-2)}
 if PART == "uniform":
     runs, dev = part_uniform()
-    # Measured 1.48e-1 at t = 1.4 (coarse twin 1.1e-13, fine 2.2e-13): the box's corners push gas
-    # at rest (part rest) and the disturbance grows there; asserted at the measured bound
-    # with 20 % margin so that a worse regression fails, and the roundoff target kept as an
-    # expected failure.
-    check(dev["refined"] <= 0.18, f"uniform gas across the box: deviation {dev['refined']:.2e} "
-          "<= 0.18 (measured 1.48e-1 at t = 1.4)")
-    check.expect_fail(dev["refined"] <= 1e-10, f"uniform gas across the box: deviation "
-                      f"{dev['refined']:.2e} at roundoff (<= 1e-10) like the coarse twin's "
-                      f"{dev['coarse']:.1e}", "the box corners' quadrature disturbs the gas")
-    conservation(runs, 1e-13, 1e-12, 1e-6)
+    got, bound = dev["refined"], 1.2 * MEASURED[PPC][0]
+    check(got <= bound, f"uniform gas across the box, ppc {PPC}: deviation {got:.2e} <= "
+          f"{bound:.3g} (measured {MEASURED[PPC][0]:.3g} at t = 1.4)")
+    check.expect_fail(got <= 1e-10, f"uniform gas across the box: deviation {got:.2e} at roundoff"
+                      f" (<= 1e-10) like the coarse twin's {dev['coarse']:.1e}",
+                      "the box corners' quadrature disturbs the gas")
+    # Mass: the sum of ~1e4 particle masses of two sizes in another order after sorting:
+    # n eps ~ 1e-12. Momentum: of the order of the twins' roundoff. Energy: bs32's rtol 1e-6.
+    conservation(runs, 1e-12, 1e-12, 1e-6)
 elif PART == "pulse":
     runs, frac = part_pulse()
-    check.expect_fail(frac["refined"] <= 1e-2, f"pulse: reflected energy fraction "
-                      f"{frac['refined']:.2e} <= 1e-2 (the issue's bar; coarse twin "
-                      f"{frac['coarse']:.1e}, fine {frac['fine']:.1e})",
+    got, bound = frac["refined"], 1.2 * MEASURED[PPC][1]
+    check.expect_fail(got <= 1e-2, f"pulse: reflected energy fraction {got:.2e} <= 1e-2 (the "
+                      f"issue's bar; coarse twin {frac['coarse']:.1e}, fine {frac['fine']:.1e})",
                       "the disturbance the box corners raise swamps the pulse")
-    check(frac["refined"] <= 0.7, f"pulse: reflected energy fraction {frac['refined']:.2e} <= "
-          "0.7 (measured 0.52)")
-    conservation(runs, 1e-13, 1e-12, 1e-6)
+    check(got <= bound, f"pulse, ppc {PPC}: reflected energy fraction {got:.2e} <= {bound:.3g} "
+          f"(measured {MEASURED[PPC][1]:.3g})")
+    conservation(runs, 1e-12, 1e-12, 1e-6)
 elif PART == "input":
     part_input()
 elif PART == "identity":
