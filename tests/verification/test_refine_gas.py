@@ -15,6 +15,8 @@ pulse    A right-running acoustic pulse (amplitude 1e-3, c = 1, gaussian of widt
          along x; and conservation as above.
 input    Every refusal: exit 2, one line naming case.ini:LINE and the key (part d).
 identity refine.levels = 1 gives the same output as no [refine] section, bit for bit (part e).
+Able to fail: with the restriction switched off (coupler/mpm_cycle.c) the uniform part's run
+blows up at t = 0.11.
 A second argument sets fluid.ppc of the uniform and pulse runs (2 by default; 4 in the long
 tests). The figures and tolerances are stated at each check and in docs/refinement.md.
 """
