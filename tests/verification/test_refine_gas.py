@@ -14,7 +14,8 @@ pulse    A right-running acoustic pulse (amplitude 1e-3, c = 1, gaussian of widt
          that of the pulse, after the pulse has left the box, from the particle p and u binned
          along x; and conservation as above.
 input    Every refusal: exit 2, one line naming case.ini:LINE and the key (part d).
-identity refine.levels = 1 gives the same output as no [refine] section, bit for bit (part e).
+identity refine.levels = 1 gives the same output as no [refine] section, bit for bit (part e);
+         a refined run restarted from its checkpoint ends bit for bit as the run through.
 Able to fail: with the restriction switched off (coupler/mpm_cycle.c) the uniform part's run
 blows up at t = 0.11.
 A second argument sets fluid.ppc of the uniform and pulse runs (2 by default; 4 in the long
@@ -250,6 +251,14 @@ def part_identity():
         np.array_equal(a[k], b[k], equal_nan=True) for k in a if k != "time")
     check(same, f"refine.levels = 1 and no [refine] section: final snapshots identical, bit for "
           f"bit ({len(a['id'])} particles, fields {', '.join(k for k in a if k != 'time')})")
+    # A refined run restarted from its checkpoint at T/2 ends as the run straight through.
+    out = mt.outdir("refine_restart_case")
+    path = os.path.join(out, "case.ini")
+    with open(path, "w") as f:
+        f.write(case_text(2, 0.2, gas, BOX.format(x0=0.8, x1=1.2)))
+    ids, worst, _ = mt.restart_difference(path, [], 0.2, "refine_restart", "fluid")
+    check(ids and worst == 0.0, f"refined run restarted at t = 0.1: the same particles, fields "
+          f"{worst:.1e} from the run straight through (bit for bit: 0)")
 
 
 # The measured figures, by fluid.ppc: the uniform stream's largest deviation at t = 1.4 and the
