@@ -15,12 +15,7 @@ int mpm_hier_parents(const mpm_grid *c, const int *gi, mpm_lidx *idx, double *w)
   for (int d = 0; d < c->dim; ++d) hier_parents_1d(gi[d], p[d]);
   const int np = 1 << c->dim;
   for (int k = 0; k < np; ++k) {
-    w[k] = 1.0;
-    for (int d = 0; d < c->dim; ++d) {
-      const int b = (k >> d) & 1;
-      q[d] = p[d][b];
-      w[k] *= b ? 0.25 : 0.75;
-    }
+    w[k] = hier_parent_k(c->dim, (const int(*)[2])p, k, q);
     idx[k] = mpm_grid_local_index(c, q);
   }
   return np;
@@ -151,8 +146,7 @@ static int push_down(entry *next, int n, int dim, const entry *e) {
   for (int d = 0; d < dim; ++d) hier_parents_1d(e->gi[d], p[d]);
   for (int k = 0; k < (1 << dim) && n >= 0; ++k) {
     int q[MPM_MAX_DIM] = {0, 0, 0};
-    double s = 1.0;
-    for (int d = 0; d < dim; ++d) q[d] = p[d][(k >> d) & 1], s *= (k >> d) & 1 ? 0.25 : 0.75;
+    const double s = hier_parent_k(dim, (const int(*)[2])p, k, q);
     n = merge(next, n, dim, q, s, e);
   }
   return n;

@@ -49,6 +49,19 @@ static inline void hier_parents_1d(int j, int p[2]) {
   p[0] = m, p[1] = m - 1 + 2 * (j - 2 * m);
 }
 
+/* Parent k (0 .. 2^dim - 1) of a fine node whose per-axis parents are p (hier_parents_1d):
+ * its global indices q (first dim entries) and its two-scale weight, the product over the axes
+ * of 3/4 (bit d of k clear: parent p[d][0]) or 1/4 (bit set: p[d][1]). */
+static inline double hier_parent_k(int dim, const int (*p)[2], int k, int *q) {
+  double w = 1.0;
+  for (int d = 0; d < dim; ++d) {
+    const int b = (k >> d) & 1;
+    q[d] = p[d][b];
+    w *= b ? 0.25 : 0.75;
+  }
+  return w;
+}
+
 /* The 2^dim parents on the coarse lattice c of the fine node gi (the two-scale relation: along
  * each axis fine node 2m + r has parents m, weight 3/4, and m - 1 + 2r, weight 1/4): their box
  * indices in c and weights; returns 2^dim. */

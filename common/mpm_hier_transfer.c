@@ -35,7 +35,11 @@ void mpm_hier_scratch_free(void *scratch) {
 
 /* Room for n particles (and a chunk of columns for them). */
 static int reserve(mpm_hier *h, mpm_lidx n) {
-  if (!h->scratch) MPM_ALLOC(h->scratch, 1);
+  if (!h->scratch) {
+    hier_scratch *fresh;
+    MPM_ALLOC(fresh, 1);
+    h->scratch = fresh;
+  }
   hier_scratch *s = h->scratch;
   if (n > s->cap_n) {
     free(s->lev), free(s->order);

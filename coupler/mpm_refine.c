@@ -129,11 +129,6 @@ int mpm_refine_build(mpm_hier **h, const mpm_config *cfg, mpm_grid *grid, mpm_mo
   free(box);
   if (rc == MPM_ERR_INPUT && why[0]) return fail_why(cfg, names, nbox, why);
   MPM_CALL(rc);
-  /* TEMPORARY: amr-thb's reserve() (mpm_hier_transfer.c) allocates its scratch struct with
-   * MPM_ALLOC(h->scratch, 1), which is sizeof(void) = 1 byte; hand it a zeroed block large
-   * enough for that struct (it frees it with free()) until that is fixed there. */
-  if (!(*h)->scratch && !((*h)->scratch = calloc(1, 256)))
-    MPM_FAIL(MPM_ERR_MEMORY, "out of memory for the refinement scratch");
   for (int k = 0; k < nmod; ++k) MPM_CALL(fluid_module_refine(mod[k], cfg, *h, seed));
   return 0;
 }
