@@ -263,6 +263,56 @@ int mpm_grid_new(mpm_grid **grid, MPI_Comm comm, int dim, const double *lo, cons
   return mpm_grid_new_periodic(grid, comm, dim, lo, hi, dx, shape, nproc, NULL);
 }
 
+/* The box grid's lattice: the stored nodes are owned; lo is node 0, hi and ncells the last
+ * stored node (at least 1), and one split per axis, so the ownership queries answer rank 0. */
+static int box_setup(mpm_grid *g, const double *origin, double dx, const int *box_lo,
+                     const int *box_n) {
+  double nnodes = 1;
+  for (int d = 0; d < g->dim; ++d) {
+    if (box_n[d] < 1)
+      MPM_FAIL(MPM_ERR_INPUT, "grid: a box of %d nodes along %c is empty", box_n[d], g_axis[d]);
+    g->lo[d] = origin[d];
+    g->ncells[d] = MPM_MAX(1, box_lo[d] + box_n[d] - 1);
+    g->hi[d] = origin[d] + g->ncells[d] * dx;
+    MPM_ALLOC(g->cell_split[d], 2);
+    g->cell_split[d][0] = 0, g->cell_split[d][1] = g->ncells[d];
+    g->box_lo[d] = g->own_lo[d] = box_lo[d];
+    g->box_n[d] = box_n[d];
+    g->own_hi[d] = box_lo[d] + box_n[d];
+    nnodes *= box_n[d];
+  }
+  if (nnodes > INT32_MAX)
+    MPM_FAIL(MPM_ERR_INPUT, "grid: a box of %.6g nodes exceeds the local index range (%d)", nnodes,
+             INT32_MAX);
+  g->nnodes = (mpm_lidx)nnodes;
+  return 0;
+}
+
+int mpm_grid_box_new(mpm_grid **grid, int dim, const double *origin, double dx,
+                     mpm_shape_kind shape, const int *box_lo, const int *box_n) {
+  mpm_grid *g;
+  *grid = NULL;
+  if ((unsigned)shape >= MPM_SHAPE_COUNT)
+    FAIL_INPUT("grid: unknown shape function kind %d", (int)shape);
+  if (dim < 1 || dim > MPM_MAX_DIM) FAIL_INPUT("grid: dimension %d is not 1-3", dim);
+  if (!(dx > 0) || !isfinite(dx))
+    FAIL_INPUT("grid: the cell size dx = %g must be positive and finite", dx);
+  MPM_ALLOC(g, 1);
+  g->comm = MPI_COMM_NULL;
+  set_unused_dims(g);
+  g->size = 1;
+  g->dim = dim;
+  g->shape = shape;
+  g->dx = dx;
+  const int rc = box_setup(g, origin, dx, box_lo, box_n);
+  if (rc) {
+    mpm_grid_destroy(&g);
+    return mpm_trace(__FILE__, __LINE__, __func__, rc);
+  }
+  *grid = g;
+  return 0;
+}
+
 static void phase_free(mpm_grid_phase *ph) {
   free(ph->m_i);
   for (int d = 0; d < MPM_MAX_DIM; ++d) {
@@ -474,8 +524,17 @@ static int exchange_dir(mpm_grid *g, int d, double *const *fields, int nfields,
   return 0;
 }
 
+/* A box grid (mpm_grid_box_new) has no neighbours to exchange with: calling an exchange on
+ * it is a bug of the caller. */
+static int check_halo(const mpm_grid *grid) {
+  if (grid->comm == MPI_COMM_NULL)
+    MPM_FAIL(MPM_ERR_INTERNAL, "grid: a halo exchange on a box grid, which has no communicator");
+  return 0;
+}
+
 int mpm_grid_halo_reverse(mpm_grid *grid, double *const *fields, int nfields) {
   const int gw = grid->ghost;
+  MPM_CALL(check_halo(grid));
   MPM_CALL(scratch_reserve(grid, nfields));
   for (int d = 0; d < grid->dim; ++d) {
     const int n = grid->box_n[d];
@@ -488,6 +547,7 @@ int mpm_grid_halo_reverse(mpm_grid *grid, double *const *fields, int nfields) {
 
 int mpm_grid_halo_forward(mpm_grid *grid, double *const *fields, int nfields) {
   const int gw = grid->ghost;
+  MPM_CALL(check_halo(grid));
   MPM_CALL(scratch_reserve(grid, nfields));
   for (int d = 0; d < grid->dim; ++d) {
     const int n = grid->box_n[d];

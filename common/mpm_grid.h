@@ -92,6 +92,13 @@ int mpm_grid_new_periodic(mpm_grid **grid, MPI_Comm comm, int dim, const double 
 /* mpm_grid_new_periodic() with no periodic axis. */
 int mpm_grid_new(mpm_grid **grid, MPI_Comm comm, int dim, const double *lo, const double *hi,
                  double dx, mpm_shape_kind shape, const int *nproc);
+/* A grid without a communicator (comm = MPI_COMM_NULL, size 1, rank 0) that stores the nodes
+ * [box_lo[d], box_lo[d] + box_n[d]) of the lattice with node i at origin + i dx: lo = origin,
+ * every stored node is owned, no ghost layers, no neighbours. A refinement level's box
+ * (mpm_hier.h): the kernels run on it unchanged; the halo exchanges refuse it
+ * (MPM_ERR_INTERNAL). */
+int mpm_grid_box_new(mpm_grid **g, int dim, const double *origin, double dx, mpm_shape_kind shape,
+                     const int *box_lo, const int *box_n);
 void mpm_grid_destroy(mpm_grid **grid);
 
 /* Add a set of nodal fields for a phase; returns its index in *index. */

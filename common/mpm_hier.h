@@ -16,15 +16,16 @@
  *
  * Composite basis. Node j of level l is active when its support (spans j - 1 .. j + 1 per axis)
  * lies in Omega_l (always at level 0) and not in Omega_{l+1}. The basis is the active nodes'
- * B-splines, each truncated (minus its children that are active on a finer level). It is never
- * formed: a particle deposits on its own level's lattice with the unchanged kernels
- * (mpm_kernels.h); mpm_hier_restrict() then moves, from the finest level down, every inactive
- * node's value onto its parents with the two-scale weights and zeroes it; the nodal solve runs
- * on the active nodes of every level; mpm_hier_prolong(), the transpose, fills every inactive
- * node from its parents, from level 1 up; a particle's G2P reads its own level. The weights are
- * a partition of unity, non-negative and C1 across the interface between levels; the grid's
- * mass and momentum equal the particles' to roundoff, summed over the active nodes of all
- * levels.
+ * B-splines, each truncated: written in level l + 1's B-splines (two-scale relation), it loses
+ * those whose support lies in Omega_{l+1} (active there, or refined further), and the rest are
+ * truncated in turn by the next level. It is never formed: a particle deposits on its own
+ * level's lattice with the unchanged kernels (mpm_kernels.h); mpm_hier_restrict() then moves,
+ * from the finest level down, every inactive node's value onto its parents with the two-scale
+ * weights and zeroes it; the nodal solve runs on the active nodes of every level;
+ * mpm_hier_prolong(), the transpose, fills every inactive node from its parents, from level 1
+ * up; a particle's G2P reads its own level. The weights are a partition of unity, non-negative
+ * and C1 across the interface between levels; the grid's mass and momentum equal the
+ * particles' to roundoff, summed over the active nodes of all levels.
  *
  * Storage. Level l >= 1 is one box of nodes per rank, an mpm_grid made by mpm_grid_box_new()
  * (no communicator), so the P2G/G2P kernels run on it unchanged. Its box holds every node
@@ -88,7 +89,8 @@ int mpm_hier_add_phases(mpm_hier *h);
 int mpm_hier_level_of(const mpm_hier *h, const double *x);
 
 /* The composite basis at x: writes the nonzero weights (each active node once) into w[max]
- * and returns their number (at most 3^dim times the number of levels). */
+ * and returns their number (at most 3^dim times the number of levels); -1 if max is too small
+ * or x lies so far outside the domain that its stencil leaves level 0's box. */
 int mpm_hier_eval(const mpm_hier *h, const double *x, mpm_hier_weight *w, int max);
 
 /* Composite P2G of one phase: each particle deposits (a's fields, with the unchanged kernel) on

@@ -46,27 +46,51 @@ static void owned_mass(const mpm_grid *g, const double *m, double mmin, double *
     }
 }
 
-int mpm_grid_phase_update(mpm_grid *grid, int phase, double h) {
-  mpm_grid_phase *ph = &grid->phase[phase];
-  double local = 0.0, mmax;
-  for (mpm_lidx l = 0; l < grid->nnodes; ++l) /* fmax without the call (NaN is skipped too) */
-    if (ph->m_i[l] > local) local = ph->m_i[l];
-  MPM_CALL_MPI(MPI_Allreduce(&local, &mmax, 1, MPI_DOUBLE, MPI_MAX, grid->comm));
+/* Largest nodal mass of a phase over ngrids grids, reduced over grids[0]'s communicator. */
+static int largest_mass(mpm_grid *const *grids, int ngrids, int phase, double *mmax) {
+  double local = 0.0;
+  for (int k = 0; k < ngrids; ++k) {
+    const double *m = grids[k]->phase[phase].m_i;
+    for (mpm_lidx l = 0; l < grids[k]->nnodes; ++l) /* fmax without the call (NaN is skipped) */
+      if (m[l] > local) local = m[l];
+  }
+  MPM_CALL_MPI(MPI_Allreduce(&local, mmax, 1, MPI_DOUBLE, MPI_MAX, grids[0]->comm));
+  return 0;
+}
+
+/* Mean mass of the owned nodes heavier than mmin over ngrids grids (0 if none). */
+static int mean_mass(mpm_grid *const *grids, int ngrids, int phase, double mmin, double *mean) {
+  double sum[2] = {0.0, 0.0}, all[2]; /* mass and count over the owned nodes with mass */
+  for (int k = 0; k < ngrids; ++k) owned_mass(grids[k], grids[k]->phase[phase].m_i, mmin, sum);
+  MPM_CALL_MPI(MPI_Allreduce(sum, all, 2, MPI_DOUBLE, MPI_SUM, grids[0]->comm));
+  *mean = all[1] > 0.0 ? all[0] / all[1] : 0.0;
+  return 0;
+}
+
+int mpm_grid_phase_update_many(mpm_grid *const *grids, int ngrids, int phase, double h) {
+  const mpm_grid_phase *ph0 = &grids[0]->phase[phase];
+  double mmax, mean = 0.0;
+  MPM_CALL(largest_mass(grids, ngrids, phase, &mmax));
   /* Nodes touched only by the far tail of a stencil carry roundoff-sized mass; dividing by it
    * would amplify noise, so they are treated as empty (a module may raise the fraction). */
-  ph->m_max = mmax;
-  double mmin = ph->empty_fraction * mmax;
-  if (ph->light_fraction > 0.0) {
-    double sum[2] = {0.0, 0.0}, all[2]; /* mass and count over the owned nodes with mass */
-    owned_mass(grid, ph->m_i, mmin, sum);
-    MPM_CALL_MPI(MPI_Allreduce(sum, all, 2, MPI_DOUBLE, MPI_SUM, grid->comm));
-    ph->m_mean = all[1] > 0.0 ? all[0] / all[1] : 0.0;
-    mmin = fmax(mmin, ph->light_fraction * ph->m_mean);
+  double mmin = ph0->empty_fraction * mmax;
+  if (ph0->light_fraction > 0.0) {
+    MPM_CALL(mean_mass(grids, ngrids, phase, mmin, &mean));
+    mmin = fmax(mmin, ph0->light_fraction * mean);
   }
-  ph->m_empty = mmin;
-  for (int d = 0; d < grid->dim; ++d)
-    node_update(grid->nnodes, ph->m_i, ph->mv_i[d], ph->f_i[d], ph->v_i[d], ph->a_i[d], mmin, h);
+  for (int k = 0; k < ngrids; ++k) {
+    mpm_grid *g = grids[k];
+    mpm_grid_phase *ph = &g->phase[phase];
+    ph->m_max = mmax, ph->m_empty = mmin;
+    if (ph0->light_fraction > 0.0) ph->m_mean = mean;
+    for (int d = 0; d < g->dim; ++d)
+      node_update(g->nnodes, ph->m_i, ph->mv_i[d], ph->f_i[d], ph->v_i[d], ph->a_i[d], mmin, h);
+  }
   return 0;
+}
+
+int mpm_grid_phase_update(mpm_grid *grid, int phase, double h) {
+  return mpm_grid_phase_update_many(&grid, 1, phase, h);
 }
 
 int mpm_fault_at(mpm_fault *fault, const mpm_particles *p, const double *y, mpm_lidx i,

@@ -39,6 +39,7 @@ typedef struct mpm_module_sums {
 } mpm_module_sums;
 
 typedef struct mpm_module mpm_module;
+struct mpm_hier;
 
 /* Which transfer a grid pass follows: the first (particles with their stress, gravity and
  * external forces) or MUSL's remap (mass and momentum only, after the first solve: no force
@@ -136,6 +137,10 @@ struct mpm_module {
    * step's last stage is stale once the step is accepted: the integrator's fixed steps start
    * from a fresh first stage instead of reusing it (mpm_integrator.c). */
   int commits_history;
+  /* The static refinement hierarchy over grid this module's phase lives on (mpm_hier.h), set
+   * by the sim after the modules are built; NULL without refinement. The coupler then zeroes,
+   * restricts, solves and prolongs the phase on every level (coupler/mpm_cycle.c). */
+  struct mpm_hier *hier;
 };
 
 /* Call ops->destroy and free the module; accepts NULL. */
@@ -146,6 +151,11 @@ void mpm_module_destroy(mpm_module **m);
  * Collective (the largest mass is reduced over the ranks, so the result does not depend on
  * the decomposition). */
 int mpm_grid_phase_update(mpm_grid *grid, int phase, double h);
+/* The same update on ngrids grids at once, as if their nodes were one grid's: the largest
+ * nodal mass and the mean of the light rule are taken over all of them, with the empty and
+ * light fractions of grids[0]'s phase; collective over grids[0]'s communicator (the others may
+ * have none: box grids, whose nodes all count as owned). A refinement hierarchy's levels. */
+int mpm_grid_phase_update_many(mpm_grid *const *grids, int ngrids, int phase, double h);
 
 /* Record a fault at particle i of p (positions from y) with a printf-style cause; returns 1. */
 int mpm_fault_at(mpm_fault *fault, const mpm_particles *p, const double *y, mpm_lidx i,

@@ -2,6 +2,7 @@
 #include "mpm_cycle.h"
 
 #include "mpm_error.h"
+#include "mpm_hier.h"
 #include "mpm_timer.h"
 
 #include <stdlib.h>
@@ -54,6 +55,31 @@ static int interact(const mpm_cycle *c, double t, double hs, mpm_pass pass) {
   return 0;
 }
 
+/* ---- a refined module (mpm_module.h, hier): its phase on every level ------------------------- */
+
+/* The nodal solve of a module's phase: on the grid, or on every level of its hierarchy. */
+static int solve(mpm_grid *grid, const mpm_module *m, double hs) {
+  return m->hier ? mpm_hier_phase_update(m->hier, m->phase, hs)
+                 : mpm_grid_phase_update(grid, m->phase, hs);
+}
+
+/* Zero a module's phase before its deposit, on every level where it has a hierarchy. */
+static void zero(mpm_grid *grid, const mpm_module *m) {
+  if (m->hier)
+    mpm_hier_phase_zero(m->hier, m->phase);
+  else
+    mpm_grid_phase_zero(grid, m->phase);
+}
+
+/* Move the deposits on the finer levels' inactive nodes onto their parents, for every refined
+ * module (rate_only: those whose p2g_rate deposited more; restriction is linear and leaves the
+ * inactive nodes at zero, so a second call moves only what was added since). */
+static void restrict_deposits(const mpm_cycle *c, int rate_only) {
+  for (int k = 0; k < c->nmod; ++k)
+    if (c->mod[k]->hier && (!rate_only || c->mod[k]->ops->p2g_rate))
+      mpm_hier_restrict(c->mod[k]->hier, c->mod[k]->phase);
+}
+
 /* The grid work between the transfers. The solve takes the step only in the first pass. */
 static int grid_pass(const mpm_cycle *c, double t, double h, mpm_pass pass) {
   const double hs = pass == MPM_PASS_FIRST ? h : 0.0;
@@ -68,7 +94,7 @@ static int grid_pass(const mpm_cycle *c, double t, double h, mpm_pass pass) {
   if (cap) mpm_interface_capture_begin(cap);
   mpm_coupling_capture(c->coupling, cap);
   if (hooks) MPM_CALL(mpm_coupling_before_solve(c->coupling, t, hs, pass));
-  for (int k = 0; k < c->nmod; ++k) MPM_CALL(mpm_grid_phase_update(c->grid, c->mod[k]->phase, hs));
+  for (int k = 0; k < c->nmod; ++k) MPM_CALL(solve(c->grid, c->mod[k], hs));
   if (hm) MPM_CALL(mpm_grid_phase_update(c->grid, hm->phase, hs));
   MPM_CALL(interact(c, t, hs, pass));
   for (int k = 0; k < c->nmod; ++k) MPM_CALL(c->mod[k]->ops->constrain(c->mod[k], t, h, pass));
@@ -78,7 +104,10 @@ static int grid_pass(const mpm_cycle *c, double t, double h, mpm_pass pass) {
     mpm_coupling_record_inside(c->coupling);
   mpm_coupling_capture(c->coupling, NULL);
   mpm_timer_stop(MPM_T_GRID);
-  return halo(c, 0);
+  MPM_CALL(halo(c, 0));
+  for (int k = 0; k < c->nmod; ++k)
+    if (c->mod[k]->hier) mpm_hier_prolong(c->mod[k]->hier, c->mod[k]->phase);
+  return 0;
 }
 
 /* ---- the velocity preview (mpm_module.h, p2g_rate) ---------------------------------------- */
@@ -130,10 +159,13 @@ static int preview(const mpm_cycle *c, double t, double *const *y) {
 /* Every module's deposit at (t, y), with the velocity preview where a module asks for it. */
 static int deposit(const mpm_cycle *c, double t, double *const *y) {
   for (int k = 0; k < c->nmod; ++k) {
-    mpm_grid_phase_zero(c->grid, c->mod[k]->phase);
+    zero(c->grid, c->mod[k]);
     MPM_CALL(c->mod[k]->ops->p2g(c->mod[k], t, y[k]));
   }
-  return preview(c, t, y);
+  restrict_deposits(c, 0);
+  MPM_CALL(preview(c, t, y));
+  restrict_deposits(c, 1); /* what p2g_rate added */
+  return 0;
 }
 
 int mpm_cycle_deposit(const mpm_cycle *c, double t, double *const *y) {

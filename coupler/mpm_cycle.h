@@ -13,6 +13,14 @@
  * (mpm_grid_phase_update); each module completes its forces before it and constrains its
  * nodes after it, and the coupling scheme acts between.
  *
+ * A module on a refinement hierarchy (mpm_module.h, hier; the gas alone, one rank) has its
+ * phase zeroed on every level, deposits composite (mpm_hier_p2g), and the coupler restricts
+ * the deposits onto the active nodes before the reverse halo (again after p2g_rate, which
+ * deposits more), solves on every level (mpm_hier_phase_update) and prolongs v and a after the
+ * forward halo; forces and constraints act on level 0, and the module's G2P reads every level
+ * (mpm_hier_g2p). The preview's copies are level 0's: the grid pass writes only v and a on the
+ * finer levels. Without a hierarchy each of these costs one pointer test per module and call.
+ *
  * A time scheme calls the cycle with the state blocks of the modules it advances, in one of
  * three modes (mpm_timescheme.h):
  *   joint   every module advances and the spatial scheme acts on all of them (monolithic);

@@ -15,6 +15,7 @@
 #include "mpm_timescheme.h"
 #include "mpm_output.h"
 #include "mpm_probe.h"
+#include "mpm_refine.h"
 #include "mpm_rundir.h"
 #include "mpm_safefile.h"
 #include "mpm_scene.h"
@@ -47,6 +48,7 @@ struct mpm_sim {
   mpm_module *mod[SIM_MAX_MODULES];
   int nmod;
   mpm_coupling *coupling; /* NULL: one phase, or scheme = none */
+  mpm_hier *hier;         /* the static refinement hierarchy (mpm_refine.h); NULL: none */
   mpm_timescheme *it;     /* the temporal coupling scheme */
   mpm_guard guard;
   double energy;      /* total energy at the last diagnostics row */
@@ -149,6 +151,7 @@ int mpm_sim_add_schema(mpm_config *cfg) {
   MPM_CALL(mpm_config_add_schema(cfg, mpm_guard_keys, mpm_guard_nkeys));
   MPM_CALL(mpm_config_add_schema(cfg, mpm_budget_keys, mpm_budget_nkeys));
   MPM_CALL(mpm_config_add_schema(cfg, mpm_probe_keys, mpm_probe_nkeys));
+  MPM_CALL(mpm_config_add_schema(cfg, mpm_refine_keys, mpm_refine_nkeys));
   MPM_CALL(mpm_config_add_schema(cfg, mpm_geometry_keys, mpm_geometry_nkeys));
   MPM_CALL(mpm_config_add_schema(cfg, mpm_bc_keys, mpm_bc_nkeys));
   MPM_CALL(mpm_coupling_add_schema(cfg));
@@ -280,7 +283,8 @@ static int build_modules(mpm_sim *s, int seed) {
     if (s->mod[k]->ops->attach_wall)
       MPM_CALL(s->mod[k]->ops->attach_wall(s->mod[k], s->cfg, NULL, &taken));
   }
-  return 0;
+  /* The hierarchy over the built grid and phases; the gas reseeds its finer regions. */
+  return mpm_refine_build(&s->hier, s->cfg, s->grid, s->mod, s->nmod, seed);
 }
 
 static const char *const g_diag_cols[] = {"t",       "step",     "dt",    "particles",
@@ -492,6 +496,7 @@ void mpm_sim_destroy(mpm_sim **sp) {
   mpm_timescheme_destroy(&s->it);
   mpm_coupling_destroy(&s->coupling);
   for (int k = 0; k < s->nmod; ++k) mpm_module_destroy(&s->mod[k]);
+  mpm_hier_destroy(&s->hier);
   mpm_output_destroy(&s->out);
   mpm_diag_close(&s->diag);
   mpm_diag_close(&s->coupling_csv);

@@ -10,6 +10,7 @@
 
 #include "mpm_bc.h"
 #include "mpm_config.h"
+#include "mpm_kernels.h"
 #include "mpm_module.h"
 #include "mpm_transfer.h"
 
@@ -126,6 +127,21 @@ int fluid_regularise(mpm_module *m, long step, int *changed);
  * of shift_every and shift > 0; only positions change (fluid_shift.c). Sets *changed if any
  * particle moved. Collective. */
 int fluid_shift(mpm_module *m, long step, double h, int *changed);
+
+/* Seed the finer levels of m->hier (fluid_seed.c): drop the level-0 particles inside them and
+ * seed each level's own region on its lattice. Collective. */
+int fluid_seed_refined(mpm_module *m, const mpm_config *cfg);
+
+/* The transfers of a module that may be refined (fluid_refine.c): P2G of a into phase, on
+ * the grid or composite (an error goes to *rc, which is left alone on success), and the G2P of
+ * v, a and L (L_out may be NULL) from m's phase at the positions of state y. */
+void fluid_p2g_any(mpm_module *m, int phase, const mpm_p2g_args *a, int *rc);
+int fluid_g2p_phase(mpm_module *m, const double *y, double *const *v_out, double *const *a_out,
+                    double *L_out);
+/* The grid spacing of the finest level (the grid's without refinement). */
+double fluid_finest_dx(const mpm_module *m);
+/* Refuse, naming the key, every gas setting the refined levels do not carry (fluid_refine.c). */
+int fluid_refine_check(const mpm_module *m, const mpm_config *cfg);
 
 /* Refresh the output fields rho, p, mach, T, s from the particle data (before output). */
 int fluid_output_fields(mpm_module *m);

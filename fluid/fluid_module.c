@@ -240,8 +240,10 @@ static int deposit(mpm_module *m, const double *y, const double *vsig, const flu
     a.v[d] = state(p, y, FLUID_V) + (size_t)d * n;
     a.gravity[d] = vsig ? fc->gravity[d] : 0.0;
   }
-  mpm_kernels_get(dim)->p2g(m->grid, m->phase, &a);
-  if (fc->filter_phase >= 0) { /* the particles' own m and m v, for fluid_mol_damping */
+  int rc = 0;
+  fluid_p2g_any(m, m->phase, &a, &rc);
+  MPM_CALL(rc);
+  if (fc->filter_phase >= 0 && !m->hier) { /* the particles' own m and m v, for mol_damping */
     const mpm_grid_phase *ph = &m->grid->phase[m->phase];
     mpm_grid_phase *fp = &m->grid->phase[fc->filter_phase];
     const size_t bytes = sizeof(double) * (size_t)m->grid->nnodes;
@@ -320,8 +322,9 @@ static int deposit_viscous(mpm_module *m, const double *y, const fluid_batch *b)
   }
   mpm_p2g_args a = {.n = k, .m = fc->zero, .vsig = sig, .lp = fc->lp};
   for (int d = 0; d < dim; ++d) a.x[d] = xs + (size_t)d * cap, a.v[d] = fc->zero;
-  mpm_kernels_get(dim)->p2g(m->grid, m->phase, &a);
-  return 0;
+  int rc = 0;
+  fluid_p2g_any(m, m->phase, &a, &rc);
+  return rc;
 }
 
 /* The stress batch of the state y: its fields and the lagged rate (divv, D). */
@@ -382,8 +385,9 @@ static int fluid_p2g_rate(mpm_module *m, double t, const double *y) {
   double *vout[MPM_MAX_DIM], *aout[MPM_MAX_DIM], *L = fc->scratch + (size_t)2 * dim * n;
   for (int d = 0; d < dim; ++d)
     vout[d] = fc->scratch + (size_t)d * n, aout[d] = fc->scratch + (size_t)(dim + d) * n;
-  mpm_transfer_g2p(m->grid, m->phase, p, y, fc->lp, vout, aout, L, NULL);
+  const int rc = fluid_g2p_phase(m, y, vout, aout, L);
   mpm_timer_stop(MPM_T_G2P);
+  MPM_CALL(rc);
   if (fc->lay.f_psi >= 0) { /* this RHS's limiter, into pending (g2p keeps it) */
     const double *v_i[MPM_MAX_DIM];
     for (int d = 0; d < dim; ++d) v_i[d] = m->grid->phase[m->phase].v_i[d];
@@ -544,7 +548,7 @@ static int fluid_g2p(mpm_module *m, double t, const double *y, double *ydot, dou
   double *Cdot = fc->tr.apic ? ydot + (size_t)p->offset[fc->lay.f_C] * n : NULL;
   const double *v = state(p, y, FLUID_V), *C = fc->tr.apic ? state(p, y, fc->lay.f_C) : NULL;
   if (!(h > 0)) {
-    mpm_transfer_g2p(m->grid, m->phase, p, y, fc->lp, xdot, vdot, L, NULL);
+    MPM_CALL(fluid_g2p_phase(m, y, xdot, vdot, L));
     energy_rate(m, L, NULL, h);
     if (!fc->tr.apic) fluid_wall_rate_mol(m, y, vdot, fc->power);
     MPM_CALL(fluid_mol_damping(m, y, vdot, fc->power, fc->work));
@@ -623,7 +627,7 @@ static double fluid_stable_dt(const mpm_module *m, const double *y) {
     return fc->s_local > 0.0 ? m->grid->dx / fc->s_local : HUGE_VAL;
   const mpm_particles *p = m->particles;
   const mpm_lidx n = p->n;
-  const double dx = m->grid->dx, gamma = fc->gas.gamma;
+  const double dx = fluid_finest_dx(m), gamma = fc->gas.gamma; /* one step for every level */
   const double *mass = mpm_particles_comp(p, fc->lay.f_m, 0);
   const double *V0 = mpm_particles_comp(p, fc->lay.f_V0, 0);
   const double *divv = field(p, y, fc->lay.f_divv);

@@ -20,4 +20,12 @@ int fluid_add_schema(mpm_config *cfg);
  * is NULL if the case has no [gas.*] section. Collective. */
 int fluid_module_create(mpm_module **m, const mpm_config *cfg, mpm_grid *grid, int seed);
 
+struct mpm_hier;
+
+/* Put the module's phase on the static refinement hierarchy h (mpm_hier.h, built over its grid
+ * after the modules): refuse, naming the key, every gas setting the finer levels do not carry
+ * (docs/refinement.md), then with seed = 1 reseed the finer regions at their levels' spacing.
+ * Collective. */
+int fluid_module_refine(mpm_module *m, const mpm_config *cfg, struct mpm_hier *h, int seed);
+
 #endif

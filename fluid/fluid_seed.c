@@ -6,13 +6,20 @@
  * contains it; later sections skip it. So a uniform background region listed last fills
  * whatever the others leave. Each section takes a fresh block of ids as wide as the seeding
  * lattice, so an id does not depend on the number of ranks. No particle is seeded inside an
- * obstacle (phi < 0). */
+ * obstacle (phi < 0).
+ *
+ * Refinement (fluid_seed_refined, after the sim built the hierarchy): the level-0 particles
+ * inside the finer regions go, and each level l >= 1 seeds its own region less the finer ones
+ * on its lattice: ppc points per axis in each level-l span, of volume (h_l / ppc)^dim, with the
+ * same first-section-wins rule. A level-0 span is whole for an even ppc, so the region's
+ * level-0 particles leave no part behind. */
 #include "fluid_eos.h"
 #include "fluid_internal.h"
 
 #include "mpm_error.h"
 #include "mpm_expr.h"
 #include "mpm_geometry.h"
+#include "mpm_hier.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -165,17 +172,13 @@ static void fill(const fluid_content *fc, const mpm_particles *p, const gas_stat
   }
 }
 
-/* Seed section k into the particle set. */
-static int seed_one(mpm_module *m, const mpm_config *cfg, gas_state *s, int k) {
+/* Claim, fill and append the n points x (ids id) of section k as particles of volume vol; the
+ * number kept over all ranks goes to *total. Collective. */
+static int add_points(mpm_module *m, const mpm_config *cfg, gas_state *s, int k, mpm_lidx n,
+                      const double *x, const mpm_gidx *id, double vol, mpm_gidx *total) {
   const fluid_content *fc = m->content;
   mpm_particles *p = m->particles;
   const mpm_grid *g = m->grid;
-  MPM_CALL(check_inside(&s[k], cfg, g));
-  mpm_lidx n;
-  double *x;
-  mpm_gidx *id;
-  const mpm_gidx id_base = p->id_next;
-  MPM_CALL(mpm_region_seed(s[k].region, g, fc->ppc, id_base, &n, &x, &id));
   unsigned char *keep = malloc((size_t)(n ? n : 1));
   mpm_gidx *kid = malloc(sizeof *kid * (size_t)(n ? n : 1));
   double *data = calloc((size_t)p->ncomp * (size_t)(n ? n : 1), sizeof *data);
@@ -186,18 +189,35 @@ static int seed_one(mpm_module *m, const mpm_config *cfg, gas_state *s, int k) {
     nk = claim(s, k, &fc->obs, g->dim, n, x, keep);
     for (mpm_lidx i = 0, j = 0; i < n; ++i)
       if (keep[i]) kid[j++] = id[i];
-    fill(fc, p, &s[k], pow(g->dx / fc->ppc, g->dim), n, x, keep, nk, data, minv, where);
+    fill(fc, p, &s[k], vol, n, x, keep, nk, data, minv, where);
   }
   /* Collective checks first, so that every rank takes the same path. */
   if (!rc) rc = check_finite(cfg, g, &s[k], n, x, keep);
   if (!rc && s[k].rho_f) rc = check_positive(cfg, g, s[k].section, "density", minv[0], where[0]);
   if (!rc && s[k].p_f) rc = check_positive(cfg, g, s[k].section, "pressure", minv[1], where[1]);
   if (!rc) rc = mpm_particles_edit(p, NULL, nk, kid, data);
-  free(keep), free(kid), free(data), free(x), free(id);
+  free(keep), free(kid), free(data);
+  MPM_CALL(rc);
+  mpm_gidx local = nk;
+  MPM_CALL_MPI(MPI_Allreduce(&local, total, 1, MPM_MPI_GIDX, MPI_SUM, g->comm));
+  return 0;
+}
+
+/* Seed section k into the particle set. */
+static int seed_one(mpm_module *m, const mpm_config *cfg, gas_state *s, int k) {
+  const fluid_content *fc = m->content;
+  mpm_particles *p = m->particles;
+  const mpm_grid *g = m->grid;
+  MPM_CALL(check_inside(&s[k], cfg, g));
+  mpm_lidx n;
+  double *x;
+  mpm_gidx *id, total = 0;
+  const mpm_gidx id_base = p->id_next;
+  MPM_CALL(mpm_region_seed(s[k].region, g, fc->ppc, id_base, &n, &x, &id));
+  const int rc = add_points(m, cfg, s, k, n, x, id, pow(g->dx / fc->ppc, g->dim), &total);
+  free(x), free(id);
   MPM_CALL(rc);
   p->id_next = id_base + mpm_region_seed_span(g, fc->ppc);
-  mpm_gidx local = nk, total;
-  MPM_CALL_MPI(MPI_Allreduce(&local, &total, 1, MPM_MPI_GIDX, MPI_SUM, g->comm));
   if (total == 0) {
     char key[160];
     key_of(key, sizeof key, s[k].section, "geometry");
@@ -212,21 +232,119 @@ static int seed_one(mpm_module *m, const mpm_config *cfg, gas_state *s, int k) {
   return 0;
 }
 
-int fluid_seed(mpm_module *m, const mpm_config *cfg) {
+/* Read every [gas.NAME] section into *sp (count of them in *count); free with states_free. */
+static int states_read(const mpm_module *m, const mpm_config *cfg, gas_state **sp,
+                       char (**secp)[96], int *count) {
   const char *const *names;
-  int count;
-  MPM_CALL(mpm_config_instances(cfg, "gas", &names, &count));
-  gas_state *s = calloc((size_t)count, sizeof *s);
-  char(*sections)[96] = calloc((size_t)count, sizeof *sections);
-  int rc = s && sections ? 0 : MPM_ERR_MEMORY;
-  for (int k = 0; !rc && k < count; ++k) {
+  MPM_CALL(mpm_config_instances(cfg, "gas", &names, count));
+  gas_state *s = calloc((size_t)*count + 1, sizeof *s);
+  char(*sections)[96] = calloc((size_t)*count + 1, sizeof *sections);
+  *sp = s, *secp = sections;
+  if (!s || !sections) MPM_FAIL(MPM_ERR_MEMORY, "out of memory reading the gas sections");
+  for (int k = 0; k < *count; ++k) {
     snprintf(sections[k], sizeof sections[k], "gas.%s", names[k]);
     s[k].section = sections[k];
-    rc = read_state(&s[k], cfg, m->grid->dim);
+    MPM_CALL(read_state(&s[k], cfg, m->grid->dim));
   }
-  for (int k = 0; !rc && k < count; ++k) rc = seed_one(m, cfg, s, k);
+  return 0;
+}
+
+static void states_free(gas_state *s, char (*sections)[96], int count) {
   for (int k = 0; s && k < count; ++k) state_free(&s[k]);
   free(s);
   free(sections);
+}
+
+int fluid_seed(mpm_module *m, const mpm_config *cfg) {
+  gas_state *s = NULL;
+  char(*sections)[96] = NULL;
+  int count = 0;
+  int rc = states_read(m, cfg, &s, &sections, &count);
+  for (int k = 0; !rc && k < count; ++k) rc = seed_one(m, cfg, s, k);
+  states_free(s, sections, count);
+  return rc ? mpm_trace(__FILE__, __LINE__, __func__, rc) : 0;
+}
+
+/* ---- the finer levels of a refinement hierarchy ---------------------------------------------- */
+
+/* The lattice of level l inside section k's region: ppc points per axis in every level-l span
+ * of the level's box, at o_l + (i - 1/2 + (q + 1/2) / ppc) h_l, kept where the point lies in
+ * the domain, in the region and on level l (mpm_hier_level_of). Into *x (component-major) and
+ * *n; the points generated (kept or not) into *span, for the ids. */
+static int level_points(const mpm_module *m, const gas_state *s, int l, double **xp, mpm_lidx *np,
+                        mpm_gidx *span) {
+  const fluid_content *fc = m->content;
+  const mpm_hier *h = m->hier;
+  const mpm_grid *lg = h->level[l].grid, *g = m->grid;
+  const int dim = g->dim, ppc = fc->ppc;
+  int per[MPM_MAX_DIM] = {1, 1, 1};
+  mpm_lidx cap = 1;
+  for (int d = 0; d < dim; ++d) per[d] = lg->box_n[d] * ppc, cap *= per[d];
+  double *x;
+  MPM_ALLOC(x, (size_t)dim * cap);
+  mpm_lidx n = 0;
+  for (mpm_lidx q = 0; q < cap; ++q) {
+    double xq[3] = {0, 0, 0};
+    int in = 1;
+    mpm_lidx rest = q;
+    for (int d = 0; d < dim; ++d) {
+      const int r = (int)(rest % per[d]), j = lg->box_lo[d] + r / ppc, k = r % ppc;
+      rest /= per[d];
+      xq[d] = lg->lo[d] + (j - 0.5 + (k + 0.5) / ppc) * lg->dx;
+      in &= xq[d] > g->lo[d] && xq[d] < g->hi[d];
+    }
+    if (!in || !mpm_region_contains(s->region, xq) || mpm_hier_level_of(h, xq) != l) continue;
+    for (int d = 0; d < dim; ++d) x[(size_t)d * cap + n] = xq[d];
+    ++n;
+  }
+  for (int d = 1; d < dim; ++d) memmove(x + (size_t)d * n, x + (size_t)d * cap, sizeof *x * n);
+  *xp = x, *np = n, *span = cap;
+  return 0;
+}
+
+/* Drop the level-0 particles inside the finer regions. */
+static int drop_refined(mpm_module *m) {
+  mpm_particles *p = m->particles;
+  unsigned char *keep;
+  MPM_ALLOC(keep, p->n);
+  for (mpm_lidx i = 0; i < p->n; ++i) {
+    double xq[3] = {0, 0, 0};
+    for (int d = 0; d < p->dim; ++d) xq[d] = mpm_particles_comp(p, FLUID_X, d)[i];
+    keep[i] = mpm_hier_level_of(m->hier, xq) == 0;
+  }
+  const int rc = mpm_particles_edit(p, keep, 0, NULL, NULL);
+  free(keep);
+  return rc;
+}
+
+/* Seed section k on level l. */
+static int seed_level(mpm_module *m, const mpm_config *cfg, gas_state *s, int k, int l) {
+  const fluid_content *fc = m->content;
+  mpm_particles *p = m->particles;
+  const mpm_grid *lg = m->hier->level[l].grid;
+  double *x = NULL;
+  mpm_lidx n = 0;
+  mpm_gidx span = 0, total = 0, *id = NULL;
+  MPM_CALL(level_points(m, &s[k], l, &x, &n, &span));
+  int rc = 0;
+  if (!(id = malloc(sizeof *id * (size_t)(n ? n : 1)))) rc = MPM_ERR_MEMORY;
+  for (mpm_lidx i = 0; !rc && i < n; ++i) id[i] = p->id_next + i;
+  if (!rc) rc = add_points(m, cfg, s, k, n, x, id, pow(lg->dx / fc->ppc, lg->dim), &total);
+  free(x), free(id);
+  MPM_CALL(rc);
+  p->id_next += span;
+  mpm_log(MPM_LOG_INFO, "gas %s: %lld particles on level %d", s[k].section, (long long)total, l);
+  return 0;
+}
+
+int fluid_seed_refined(mpm_module *m, const mpm_config *cfg) {
+  gas_state *s = NULL;
+  char(*sections)[96] = NULL;
+  int count = 0;
+  int rc = states_read(m, cfg, &s, &sections, &count);
+  if (!rc) rc = drop_refined(m);
+  for (int l = 1; !rc && l < m->hier->nlevels; ++l)
+    for (int k = 0; !rc && k < count; ++k) rc = seed_level(m, cfg, s, k, l);
+  states_free(s, sections, count);
   return rc ? mpm_trace(__FILE__, __LINE__, __func__, rc) : 0;
 }

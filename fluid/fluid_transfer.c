@@ -81,6 +81,7 @@
 #include "fluid_internal.h"
 
 #include "mpm_error.h"
+#include "mpm_hier.h"
 #include "mpm_kernels.h"
 
 #include <math.h>
@@ -314,6 +315,13 @@ void fluid_wall_rate_mol(const mpm_module *m, const double *y, double *const *vd
  * 1 - P ~ (kx dx)^2 / 4 per axis, squared here: the pulse's peak lost 0.07 % in four crossings
  * (1.4 % with one filter at half the rate). */
 
+/* v = m v / m on the nn nodes of phase ph (0 where empty). */
+static void mean_velocity(mpm_grid_phase *ph, mpm_lidx nn, int dim) {
+  for (int d = 0; d < dim; ++d)
+    for (mpm_lidx l = 0; l < nn; ++l)
+      ph->v_i[d][l] = ph->m_i[l] > 0.0 ? ph->mv_i[d][l] / ph->m_i[l] : 0.0;
+}
+
 /* The filtered velocity P s of particle velocities s: deposit m s into the filter's phase, sum
  * the ranks' halos, divide by the nodal mass and interpolate back. sum_p m_p (P s)_p =
  * sum_i (m s)_i = sum_p m_p s_p exactly, whatever the walls and other phases do, because the
@@ -328,20 +336,25 @@ static int filter(mpm_module *m, const double *y, double *const *s, double *cons
   mpm_grid_phase *ph = &g->phase[fc->filter_phase];
   mpm_p2g_args a = {.n = n, .m = mpm_particles_comp(p, fc->lay.f_m, 0), .lp = fc->lp};
   for (int d = 0; d < dim; ++d) a.x[d] = y + (size_t)(p->offset[FLUID_X] + d) * n, a.v[d] = s[d];
-  if (!deposited) { /* (the velocities' own deposit was copied here by fluid_p2g) */
-    mpm_grid_phase_zero(g, fc->filter_phase);
-    mpm_kernels_get(dim)->p2g(g, fc->filter_phase, &a);
+  if (!deposited || m->hier) { /* (else fluid_p2g copied the velocities' own deposit here) */
+    int rc = 0;
+    if (m->hier)
+      mpm_hier_phase_zero(m->hier, fc->filter_phase);
+    else
+      mpm_grid_phase_zero(g, fc->filter_phase);
+    fluid_p2g_any(m, fc->filter_phase, &a, &rc);
+    MPM_CALL(rc);
   }
+  if (m->hier) mpm_hier_restrict(m->hier, fc->filter_phase);
   double *f[1 + MPM_MAX_DIM];
   f[0] = ph->m_i;
   for (int d = 0; d < dim; ++d) f[1 + d] = ph->mv_i[d];
   MPM_CALL(mpm_grid_halo_reverse(g, f, 1 + dim));
   /* No empty-node threshold: m s / m is a weighted mean of the s that reached the node. */
-  for (int d = 0; d < dim; ++d) {
-    for (mpm_lidx l = 0; l < g->nnodes; ++l)
-      ph->v_i[d][l] = ph->m_i[l] > 0.0 ? ph->mv_i[d][l] / ph->m_i[l] : 0.0;
-    f[d] = ph->v_i[d];
-  }
+  for (int l = 0; l < (m->hier ? m->hier->nlevels : 1); ++l)
+    mean_velocity(l ? &m->hier->level[l].grid->phase[fc->filter_phase] : ph,
+                  l ? m->hier->level[l].grid->nnodes : g->nnodes, dim);
+  for (int d = 0; d < dim; ++d) f[d] = ph->v_i[d];
   MPM_CALL(mpm_grid_halo_forward(g, f, dim));
   mpm_g2p_args b = {.n = n, .lp = fc->lp};
   for (int d = 0; d < dim; ++d) {
@@ -349,8 +362,12 @@ static int filter(mpm_module *m, const double *y, double *const *s, double *cons
     b.v_i[d] = b.a_i[d] = ph->v_i[d];
     b.v_out[d] = out[d], b.a_out[d] = dummy + (size_t)d * n;
   }
-  mpm_kernels_get(dim)->g2p(g, &b);
-  return 0;
+  if (!m->hier) {
+    mpm_kernels_get(dim)->g2p(g, &b);
+    return 0;
+  }
+  mpm_hier_prolong(m->hier, fc->filter_phase);
+  return mpm_hier_g2p(m->hier, fc->filter_phase, &b, NULL);
 }
 
 int fluid_mol_damping(mpm_module *m, const double *y, double *const *vdot, double *power,

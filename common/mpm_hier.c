@@ -1,0 +1,322 @@
+/* The refinement hierarchy (mpm_hier.h): construction from boxes, the regions and masks of
+ * every level, the level of a point, and the per-level phases and nodal solve.
+ *
+ * Invariants kept here:
+ * - Level l >= 1 is built from level l - 1: its origin o_l = o_{l-1} - h_l / 2, its regions'
+ *   boxes snapped outwards to whole level-(l-1) spans, its node box the smallest box holding,
+ *   for every refined box with level-(l-1) spans [a, z] (i.e. level-l spans [2a, 2z + 1]), the
+ *   nodes whose support meets those spans, [2a - 1, 2z + 2], plus one layer: [2a - 2, 2z + 3].
+ * - Proper nesting (buffer >= 1 spans) puts the parents of every level-l box node, level-(l-1)
+ *   nodes [a - 2, z + 2], inside level l - 1's box, so restriction and prolongation never
+ *   leave a box (on level 0 the domain check and the grid's pad do the same).
+ * - Masks outside a box: on level 0 every span is covered and none refined (the grid's own
+ *   pad edges keep the plain rule); on finer levels nothing outside the box is covered. */
+#include "mpm_hier_impl.h"
+
+#include "mpm_error.h"
+#include "mpm_module.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static const char g_axis[MPM_MAX_DIM] = {'x', 'y', 'z'};
+
+/* Level-(level-1) span index range [a[d], z[d]] of each box. */
+typedef struct box_spans {
+  int a[MPM_MAX_DIM], z[MPM_MAX_DIM];
+} box_spans;
+
+/* Refuse bad input: one sentence into why, nothing logged (the caller names the key). */
+static int refuse(char *why, size_t why_len, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+static int refuse(char *why, size_t why_len, const char *fmt, ...) {
+  va_list ap;
+  va_start(ap, fmt);
+  if (why && why_len) vsnprintf(why, why_len, fmt, ap);
+  va_end(ap);
+  return MPM_ERR_INPUT;
+}
+
+/* ---- input checks ----------------------------------------------------------------------- */
+
+static int check_setup(const mpm_grid *grid, int nlevels, int buffer, char *why, size_t len) {
+  if (nlevels < 1 || nlevels > MPM_HIER_MAX_LEVELS)
+    return refuse(why, len, "%d levels: give 1 to %d (level 0 is the grid)", nlevels,
+                  MPM_HIER_MAX_LEVELS);
+  if (grid->size != 1)
+    return refuse(why, len,
+                  "refinement runs on one rank for now (its levels are not split over ranks), "
+                  "and the grid is split over %d: run on one rank",
+                  grid->size);
+  if (grid->shape != MPM_SHAPE_QUADRATIC)
+    return refuse(why, len,
+                  "refinement needs the quadratic B-spline shape (its nested levels use that "
+                  "spline's two-scale relation), not %s: set the shape to quadratic",
+                  mpm_shape_name(grid->shape));
+  if (buffer < 1)
+    return refuse(why, len,
+                  "a buffer of %d spans between levels: give at least 1 (the restriction needs "
+                  "one coarse span around every finer region)",
+                  buffer);
+  return 0;
+}
+
+/* One box alone: its level, extent and place in the domain. */
+static int check_box(const mpm_grid *grid, int nlevels, const mpm_hier_box *b, int k, char *why,
+                     size_t len) {
+  if (b->level < 1 || b->level >= nlevels)
+    return refuse(why, len, "box %d has level %d; with %d levels a box's level is 1 to %d", k,
+                  b->level, nlevels, nlevels - 1);
+  const double tol = 1e-9 * grid->dx;
+  for (int d = 0; d < grid->dim; ++d) {
+    if (!(b->hi[d] > b->lo[d]) || !isfinite(b->lo[d]) || !isfinite(b->hi[d]))
+      return refuse(why, len, "box %d (level %d) is empty along %c ([%g, %g]): give lo < hi", k,
+                    b->level, g_axis[d], b->lo[d], b->hi[d]);
+    if (b->lo[d] < grid->lo[d] - tol || b->hi[d] > grid->hi[d] + tol)
+      return refuse(why, len,
+                    "box %d (level %d) spans [%g, %g] along %c, outside the domain [%g, %g]: "
+                    "move or shrink it into the domain",
+                    k, b->level, b->lo[d], b->hi[d], g_axis[d], grid->lo[d], grid->hi[d]);
+  }
+  return 0;
+}
+
+static int check_boxes(const mpm_grid *grid, int nlevels, const mpm_hier_box *box, int nbox,
+                       char *why, size_t len) {
+  int has[MPM_HIER_MAX_LEVELS] = {0};
+  for (int k = 0; k < nbox; ++k) {
+    const int rc = check_box(grid, nlevels, &box[k], k, why, len);
+    if (rc) return rc;
+    has[box[k].level] = 1;
+  }
+  for (int l = 1; l < nlevels; ++l)
+    if (!has[l])
+      return refuse(why, len, "level %d has no box: give every level 1 to %d at least one box", l,
+                    nlevels - 1);
+  return 0;
+}
+
+/* ---- regions ---------------------------------------------------------------------------- */
+
+/* The spans of coarse lattice c that meet the open box (lo, hi), snapped outwards; a box face
+ * within 1e-9 spans of a span face does not take in the next span. */
+static box_spans snap_box(const mpm_grid *c, const mpm_hier_box *b) {
+  const double eps = 1e-9;
+  box_spans s = {{0, 0, 0}, {0, 0, 0}};
+  for (int d = 0; d < c->dim; ++d) {
+    s.a[d] = (int)floor(hier_xi(c, d, b->lo[d]) - 0.5 + eps) + 1;
+    s.z[d] = (int)ceil(hier_xi(c, d, b->hi[d]) + 0.5 - eps) - 1;
+  }
+  return s;
+}
+
+/* Set mask to 1 on the box nodes with global indices in [a, z] (clipped to the box). */
+static void mark(const mpm_grid *g, unsigned char *mask, const int *a, const int *z) {
+  int gi[MPM_MAX_DIM];
+  for (mpm_lidx l = 0; l < g->nnodes; ++l) {
+    hier_node_of(g, l, gi);
+    int in = 1;
+    for (int d = 0; d < g->dim; ++d) in &= gi[d] >= a[d] && gi[d] <= z[d];
+    if (in) mask[l] = 1;
+  }
+}
+
+/* Is every span in [a, z] covered on level l? */
+static int all_covered(const mpm_hier *h, int l, const int *a, const int *z) {
+  const mpm_grid *g = h->level[l].grid;
+  int lo[MPM_MAX_DIM] = {0, 0, 0}, hi[MPM_MAX_DIM] = {0, 0, 0}, gi[MPM_MAX_DIM];
+  for (int d = 0; d < h->dim; ++d) lo[d] = a[d], hi[d] = z[d];
+  if (l == 0) return 1;
+  for (gi[2] = lo[2]; gi[2] <= hi[2]; ++gi[2])
+    for (gi[1] = lo[1]; gi[1] <= hi[1]; ++gi[1])
+      for (gi[0] = lo[0]; gi[0] <= hi[0]; ++gi[0])
+        if (!hier_in_box(g, gi) || !h->level[l].covered[mpm_grid_local_index(g, gi)]) return 0;
+  return 1;
+}
+
+/* Mask value of span gi on level l, with the rule outside the box of the file comment. */
+static int span_flag(const mpm_hier *h, int l, const unsigned char *mask, const int *gi, int out) {
+  const mpm_grid *g = h->level[l].grid;
+  return hier_in_box(g, gi) ? mask[mpm_grid_local_index(g, gi)] : out;
+}
+
+/* Node gi of level l is active: spans gi - 1 .. gi + 1 all covered, not all refined. */
+static int node_active(const mpm_hier *h, int l, const int *gi) {
+  int s[MPM_MAX_DIM] = {0, 0, 0}, off[MPM_MAX_DIM] = {0, 0, 0}, refined = 1;
+  const int n3 = h->dim == 2 ? 9 : 27;
+  for (int q = 0; q < n3; ++q) {
+    for (int d = 0, r = q; d < h->dim; ++d, r /= 3) off[d] = r % 3 - 1, s[d] = gi[d] + off[d];
+    if (!span_flag(h, l, h->level[l].covered, s, l == 0)) return 0;
+    refined &= span_flag(h, l, h->level[l].refined, s, 0);
+  }
+  return !refined;
+}
+
+static void set_active(mpm_hier *h, int l) {
+  const mpm_grid *g = h->level[l].grid;
+  int gi[MPM_MAX_DIM];
+  for (mpm_lidx n = 0; n < g->nnodes; ++n) {
+    hier_node_of(g, n, gi);
+    h->level[l].active[n] = (unsigned char)node_active(h, l, gi);
+  }
+}
+
+static int alloc_masks(mpm_hier_level *lv) {
+  const mpm_lidx n = lv->grid->nnodes;
+  MPM_ALLOC(lv->covered, n);
+  MPM_ALLOC(lv->refined, n);
+  MPM_ALLOC(lv->active, n);
+  return 0;
+}
+
+/* ---- levels ----------------------------------------------------------------------------- */
+
+/* The box grid of level l (>= 1) holding the boxes of that level, its covered mask, and the
+ * refined mask of level l - 1 from the same boxes. */
+static int make_level(mpm_hier *h, int l, const mpm_hier_box *box, const box_spans *sp, int nbox) {
+  const mpm_grid *c = h->level[l - 1].grid;
+  int lo[MPM_MAX_DIM] = {0, 0, 0}, hi[MPM_MAX_DIM] = {0, 0, 0}, n[MPM_MAX_DIM] = {1, 1, 1},
+      first = 1;
+  double origin[MPM_MAX_DIM] = {0, 0, 0};
+  for (int k = 0; k < nbox; ++k) {
+    if (box[k].level != l) continue;
+    for (int d = 0; d < h->dim; ++d) {
+      lo[d] = first ? 2 * sp[k].a[d] - 2 : MPM_MIN(lo[d], 2 * sp[k].a[d] - 2);
+      hi[d] = first ? 2 * sp[k].z[d] + 3 : MPM_MAX(hi[d], 2 * sp[k].z[d] + 3);
+    }
+    first = 0;
+  }
+  const double hf = 0.5 * c->dx;
+  for (int d = 0; d < h->dim; ++d) origin[d] = c->lo[d] - 0.5 * hf, n[d] = hi[d] - lo[d] + 1;
+  mpm_hier_level *lv = &h->level[l];
+  MPM_CALL(mpm_grid_box_new(&lv->grid, h->dim, origin, hf, c->shape, lo, n));
+  MPM_CALL(alloc_masks(lv));
+  for (int k = 0; k < nbox; ++k) {
+    if (box[k].level != l) continue;
+    int fa[MPM_MAX_DIM] = {0, 0, 0}, fz[MPM_MAX_DIM] = {0, 0, 0};
+    for (int d = 0; d < h->dim; ++d) fa[d] = 2 * sp[k].a[d], fz[d] = 2 * sp[k].z[d] + 1;
+    mark(lv->grid, lv->covered, fa, fz);
+    mark(c, h->level[l - 1].refined, sp[k].a, sp[k].z);
+  }
+  return 0;
+}
+
+/* Every box of level l lies in Omega_{l-1} with `buffer` level-(l-1) spans to spare. */
+static int check_nesting(const mpm_hier *h, int l, const box_spans *sp, const mpm_hier_box *box,
+                         int nbox, char *why, size_t len) {
+  for (int k = 0; k < nbox; ++k) {
+    if (box[k].level != l) continue;
+    int a[MPM_MAX_DIM] = {0, 0, 0}, z[MPM_MAX_DIM] = {0, 0, 0};
+    for (int d = 0; d < h->dim; ++d) a[d] = sp[k].a[d] - h->buffer, z[d] = sp[k].z[d] + h->buffer;
+    if (!all_covered(h, l - 1, a, z))
+      return refuse(why, len,
+                    "box %d (level %d) is not inside the region of level %d with a margin of %d "
+                    "level-%d spans (%g long each): enlarge the level-%d boxes around it, or "
+                    "shrink or move it",
+                    k, l, l - 1, h->buffer, l - 1, h->level[l - 1].grid->dx, l - 1);
+  }
+  return 0;
+}
+
+/* Levels 1 .. nlevels - 1 in turn (each snaps its boxes to the level before); why is set on an
+ * input error. */
+static int build_levels(mpm_hier *h, const mpm_hier_box *box, int nbox, char *why, size_t len) {
+  box_spans *sp;
+  MPM_ALLOC(sp, nbox);
+  int rc = 0;
+  for (int l = 1; l < h->nlevels && !rc; ++l) {
+    for (int k = 0; k < nbox; ++k)
+      if (box[k].level == l) sp[k] = snap_box(h->level[l - 1].grid, &box[k]);
+    rc = check_nesting(h, l, sp, box, nbox, why, len);
+    if (!rc) rc = make_level(h, l, box, sp, nbox);
+  }
+  free(sp);
+  for (int l = 0; l < h->nlevels && !rc; ++l) set_active(h, l);
+  return rc;
+}
+
+int mpm_hier_new(mpm_hier **hp, mpm_grid *grid, int nlevels, const mpm_hier_box *box, int nbox,
+                 int buffer, char *why, size_t why_len) {
+  *hp = NULL;
+  if (why && why_len) why[0] = '\0';
+  int rc = check_setup(grid, nlevels, buffer, why, why_len);
+  if (!rc) rc = check_boxes(grid, nlevels, box, nbox, why, why_len);
+  if (rc) return rc;
+  mpm_hier *h;
+  MPM_ALLOC(h, 1);
+  h->dim = grid->dim, h->nlevels = nlevels, h->buffer = buffer;
+  h->level[0].grid = grid;
+  rc = alloc_masks(&h->level[0]);
+  if (!rc) memset(h->level[0].covered, 1, (size_t)grid->nnodes);
+  if (!rc) rc = build_levels(h, box, nbox, why, why_len);
+  if (!rc) rc = mpm_hier_add_phases(h);
+  if (rc) {
+    mpm_hier_destroy(&h);
+    return rc;
+  }
+  *hp = h;
+  return 0;
+}
+
+void mpm_hier_destroy(mpm_hier **hp) {
+  if (!hp || !*hp) return;
+  mpm_hier *h = *hp;
+  for (int l = 0; l < MPM_HIER_MAX_LEVELS; ++l) {
+    mpm_hier_level *lv = &h->level[l];
+    if (l > 0) mpm_grid_destroy(&lv->grid);
+    free(lv->covered), free(lv->refined), free(lv->active);
+  }
+  mpm_hier_scratch_free(h->scratch);
+  free(h);
+  *hp = NULL;
+}
+
+/* ---- points ----------------------------------------------------------------------------- */
+
+int mpm_hier_level_of(const mpm_hier *h, const double *x) {
+  int l = 0, gi[MPM_MAX_DIM] = {0, 0, 0};
+  for (; l + 1 < h->nlevels; ++l) {
+    const mpm_grid *g = h->level[l].grid;
+    for (int d = 0; d < h->dim; ++d) {
+      const double xi = hier_xi(g, d, x[d]);
+      /* Also false for NaN: such a point stays where it is. */
+      if (!(xi > g->box_lo[d] - 1.0 && xi < g->box_lo[d] + g->box_n[d])) return l;
+      gi[d] = hier_span_of(xi);
+    }
+    if (!hier_in_box(g, gi) || !h->level[l].refined[mpm_grid_local_index(g, gi)]) return l;
+  }
+  return l;
+}
+
+/* ---- phases ----------------------------------------------------------------------------- */
+
+int mpm_hier_add_phases(mpm_hier *h) {
+  const mpm_grid *g0 = h->level[0].grid;
+  for (int l = 1; l < h->nlevels; ++l) {
+    mpm_grid *g = h->level[l].grid;
+    for (int p = g->nphases; p < g0->nphases; ++p) {
+      MPM_CALL(mpm_grid_add_phase(g, g0->phase[p].name, NULL));
+      g->phase[p].empty_fraction = g0->phase[p].empty_fraction;
+      g->phase[p].light_fraction = g0->phase[p].light_fraction;
+    }
+  }
+  return 0;
+}
+
+void mpm_hier_phase_zero(mpm_hier *h, int phase) {
+  const int normals = h->level[0].grid->phase[phase].normals;
+  for (int l = 0; l < h->nlevels; ++l) {
+    h->level[l].grid->phase[phase].normals = normals;
+    mpm_grid_phase_zero(h->level[l].grid, phase);
+  }
+}
+
+int mpm_hier_phase_update(mpm_hier *h, int phase, double hstep) {
+  mpm_grid *grids[MPM_HIER_MAX_LEVELS];
+  for (int l = 0; l < h->nlevels; ++l) grids[l] = h->level[l].grid;
+  MPM_CALL(mpm_grid_phase_update_many(grids, h->nlevels, phase, hstep));
+  return 0;
+}

@@ -1,0 +1,187 @@
+/* The composite basis of the hierarchy (mpm_hier.h): the two-scale relation between levels,
+ * restriction (fine inactive nodes onto their parents) and its transpose, prolongation, and
+ * the composite weights of one point.
+ *
+ * Invariants: restriction and prolongation visit every inactive node of a level box, ghost
+ * layer included, and read or write only its 2^dim parents, which lie in the coarser box (see
+ * mpm_hier.c); restriction leaves every inactive node at exactly zero. mpm_hier_eval pushes
+ * weights down exactly as P2G followed by restriction does, so the two agree to roundoff. */
+#include "mpm_hier_impl.h"
+
+#include <string.h>
+
+int mpm_hier_parents(const mpm_grid *c, const int *gi, mpm_lidx *idx, double *w) {
+  int p[MPM_MAX_DIM][2] = {{0, 0}, {0, 0}, {0, 0}}, q[MPM_MAX_DIM] = {0, 0, 0};
+  for (int d = 0; d < c->dim; ++d) hier_parents_1d(gi[d], p[d]);
+  const int np = 1 << c->dim;
+  for (int k = 0; k < np; ++k) {
+    w[k] = hier_parent_k(c->dim, (const int(*)[2])p, k, q);
+    idx[k] = mpm_grid_local_index(c, q);
+  }
+  return np;
+}
+
+void mpm_hier_restrict_level(mpm_hier *h, int l, double *const *fine, double *const *coarse,
+                             int nf) {
+  const mpm_grid *f = h->level[l].grid, *c = h->level[l - 1].grid;
+  const unsigned char *active = h->level[l].active;
+  int gi[MPM_MAX_DIM];
+  mpm_lidx idx[8];
+  double w[8];
+  for (mpm_lidx n = 0; n < f->nnodes; ++n) {
+    if (active[n]) continue;
+    hier_node_of(f, n, gi);
+    const int np = mpm_hier_parents(c, gi, idx, w);
+    for (int k = 0; k < nf; ++k) {
+      const double v = fine[k][n];
+      for (int q = 0; q < np; ++q) coarse[k][idx[q]] += w[q] * v;
+      fine[k][n] = 0.0;
+    }
+  }
+}
+
+void mpm_hier_prolong_level(mpm_hier *h, int l, const double *const *coarse, double *const *fine,
+                            int nf) {
+  const mpm_grid *f = h->level[l].grid, *c = h->level[l - 1].grid;
+  const unsigned char *active = h->level[l].active;
+  int gi[MPM_MAX_DIM];
+  mpm_lidx idx[8];
+  double w[8];
+  for (mpm_lidx n = 0; n < f->nnodes; ++n) {
+    if (active[n]) continue;
+    hier_node_of(f, n, gi);
+    const int np = mpm_hier_parents(c, gi, idx, w);
+    for (int k = 0; k < nf; ++k) {
+      double v = 0.0;
+      for (int q = 0; q < np; ++q) v += w[q] * coarse[k][idx[q]];
+      fine[k][n] = v;
+    }
+  }
+}
+
+/* The deposit fields of a phase on one level: m, m v, f and, when deposited, the mass
+ * gradient; returns their number. */
+static int deposit_fields(mpm_grid *g, int phase, int normals, double **out) {
+  mpm_grid_phase *ph = &g->phase[phase];
+  int n = 0;
+  out[n++] = ph->m_i;
+  for (int d = 0; d < g->dim; ++d) out[n++] = ph->mv_i[d], out[n++] = ph->f_i[d];
+  for (int d = 0; normals && d < g->dim; ++d) out[n++] = ph->normal_i[d];
+  return n;
+}
+
+void mpm_hier_restrict(mpm_hier *h, int phase) {
+  const int normals = h->level[0].grid->phase[phase].normals;
+  double *fine[1 + 3 * MPM_MAX_DIM], *coarse[1 + 3 * MPM_MAX_DIM];
+  for (int l = h->nlevels - 1; l >= 1; --l) {
+    const int nf = deposit_fields(h->level[l].grid, phase, normals, fine);
+    deposit_fields(h->level[l - 1].grid, phase, normals, coarse);
+    mpm_hier_restrict_level(h, l, fine, coarse, nf);
+  }
+}
+
+void mpm_hier_prolong(mpm_hier *h, int phase) {
+  const double *coarse[2 * MPM_MAX_DIM];
+  double *fine[2 * MPM_MAX_DIM];
+  for (int l = 1; l < h->nlevels; ++l) {
+    const mpm_grid_phase *pc = &h->level[l - 1].grid->phase[phase];
+    mpm_grid_phase *pf = &h->level[l].grid->phase[phase];
+    for (int d = 0; d < h->dim; ++d) {
+      coarse[d] = pc->v_i[d], coarse[h->dim + d] = pc->a_i[d];
+      fine[d] = pf->v_i[d], fine[h->dim + d] = pf->a_i[d];
+    }
+    mpm_hier_prolong_level(h, l, coarse, fine, 2 * h->dim);
+  }
+}
+
+/* ---- composite weights of one point ----------------------------------------------------- */
+
+/* One weight on the way down: node gi of the level being processed. */
+typedef struct entry {
+  int gi[MPM_MAX_DIM];
+  double w, dw[MPM_MAX_DIM];
+} entry;
+
+enum { MAX_ENTRIES = 27 }; /* 3 nodes per axis per level: see the merge in push_down */
+
+/* The quadratic stencil of x on lattice g: 3^dim entries (weights, gradients in 1/length). */
+static int stencil(const mpm_grid *g, const double *x, entry *e) {
+  double w[MPM_MAX_DIM][MPM_SHAPE_MAX_SUPPORT], dw[MPM_MAX_DIM][MPM_SHAPE_MAX_SUPPORT];
+  int base[MPM_MAX_DIM];
+  for (int d = 0; d < g->dim; ++d) {
+    base[d] = mpm_shape_1d(MPM_SHAPE_QUADRATIC, hier_xi(g, d, x[d]), 0.0, w[d], dw[d]);
+    for (int k = 0; k < 3; ++k) dw[d][k] *= 1.0 / g->dx;
+  }
+  const int n = g->dim == 2 ? 9 : 27;
+  for (int q = 0; q < n; ++q) {
+    int o[MPM_MAX_DIM] = {0, 0, 0};
+    e[q].gi[2] = 0;
+    for (int d = 0, r = q; d < g->dim; ++d, r /= 3) o[d] = r % 3, e[q].gi[d] = base[d] + o[d];
+    e[q].w = 1.0;
+    for (int d = 0; d < g->dim; ++d) e[q].w *= w[d][o[d]], e[q].dw[d] = dw[d][o[d]];
+    for (int d = 0; d < g->dim; ++d)
+      for (int b = 0; b < g->dim; ++b)
+        if (b != d) e[q].dw[d] *= w[b][o[b]];
+  }
+  return n;
+}
+
+/* Add s times entry e at node gi to the list (merging with an entry of the same node). */
+static int merge(entry *list, int n, int dim, const int *gi, double s, const entry *e) {
+  int k = 0;
+  while (k < n && memcmp(list[k].gi, gi, sizeof list[k].gi) != 0) ++k;
+  if (k == n) {
+    if (n == MAX_ENTRIES) return -1;
+    memset(&list[k], 0, sizeof list[k]);
+    memcpy(list[k].gi, gi, sizeof list[k].gi), ++n;
+  }
+  list[k].w += s * e->w;
+  for (int d = 0; d < dim; ++d) list[k].dw[d] += s * e->dw[d];
+  return n;
+}
+
+/* Move entry e of a fine node onto its 2^dim parents in next; returns the new count. */
+static int push_down(entry *next, int n, int dim, const entry *e) {
+  int p[MPM_MAX_DIM][2] = {{0, 0}, {0, 0}, {0, 0}};
+  for (int d = 0; d < dim; ++d) hier_parents_1d(e->gi[d], p[d]);
+  for (int k = 0; k < (1 << dim) && n >= 0; ++k) {
+    int q[MPM_MAX_DIM] = {0, 0, 0};
+    const double s = hier_parent_k(dim, (const int(*)[2])p, k, q);
+    n = merge(next, n, dim, q, s, e);
+  }
+  return n;
+}
+
+/* Does entry e carry anything (a weight or a gradient)? */
+static int nonzero(const entry *e, int dim) {
+  int any = e->w != 0.0;
+  for (int d = 0; d < dim; ++d) any |= e->dw[d] != 0.0;
+  return any;
+}
+
+int mpm_hier_eval(const mpm_hier *h, const double *x, mpm_hier_weight *w, int max) {
+  entry cur[MAX_ENTRIES], next[MAX_ENTRIES];
+  const int l0 = mpm_hier_level_of(h, x);
+  int ncur = stencil(h->level[l0].grid, x, cur), nout = 0;
+  for (int l = l0; l >= 0 && ncur > 0; --l) {
+    const mpm_grid *g = h->level[l].grid;
+    int nnext = 0;
+    for (int k = 0; k < ncur; ++k) {
+      if (!hier_in_box(g, cur[k].gi)) return -1;
+      const mpm_lidx node = mpm_grid_local_index(g, cur[k].gi);
+      if (!h->level[l].active[node]) {
+        /* Level 0's inactive nodes lie under level 1 and never carry a weight here. */
+        if (l > 0 && (nnext = push_down(next, nnext, h->dim, &cur[k])) < 0) return -1;
+        continue;
+      }
+      if (!nonzero(&cur[k], h->dim)) continue;
+      if (nout == max) return -1;
+      mpm_hier_weight *o = &w[nout++];
+      o->level = l, o->node = node, o->w = cur[k].w;
+      for (int d = 0; d < MPM_MAX_DIM; ++d) o->dw[d] = d < h->dim ? cur[k].dw[d] : 0.0;
+    }
+    memcpy(cur, next, (size_t)nnext * sizeof *next);
+    ncur = nnext;
+  }
+  return nout;
+}

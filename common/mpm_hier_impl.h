@@ -1,0 +1,73 @@
+/* What the files of the refinement hierarchy share (mpm_hier.c: construction, regions and
+ * phases; mpm_hier_basis.c: the two-scale relation, restriction, prolongation and the
+ * composite basis; mpm_hier_transfer.c: composite P2G and G2P). Not for other modules.
+ *
+ * Invariants the three files rely on: level l's lattice is the box grid level[l].grid (the
+ * shared grid at l = 0) with lo = o_l and dx = h_l; a point's position along d in level units
+ * is computed exactly as the kernels compute it (hier_xi), so the span a point is assigned
+ * to here is the span whose stencil the kernel uses, bit for bit. */
+#ifndef MPM_HIER_IMPL_H
+#define MPM_HIER_IMPL_H
+
+#include "mpm_hier.h"
+
+/* x along d in units of g's spacing from its node 0, as mpm_kernels_dim.c computes it. */
+static inline double hier_xi(const mpm_grid *g, int d, double x) {
+  return (x - g->lo[d]) * (1.0 / g->dx);
+}
+
+/* The span (dual cell) of g's lattice holding xi: the centre node of the quadratic stencil,
+ * whose first node the kernels take as floor(xi - 1/2). */
+static inline int hier_span_of(double xi) {
+  return mpm_shape_floor(xi - 0.5) + 1;
+}
+
+/* floor(a / 2) for either sign. */
+static inline int hier_half(int a) {
+  return a >= 0 ? a / 2 : -((1 - a) / 2);
+}
+
+/* Does box node gi (global indices of g, first dim entries) lie in g's box? */
+static inline int hier_in_box(const mpm_grid *g, const int *gi) {
+  for (int d = 0; d < g->dim; ++d)
+    if (gi[d] < g->box_lo[d] || gi[d] >= g->box_lo[d] + g->box_n[d]) return 0;
+  return 1;
+}
+
+/* Global indices gi (first dim entries; 0 beyond) of g's box node l. */
+static inline void hier_node_of(const mpm_grid *g, mpm_lidx l, int *gi) {
+  for (int d = 0; d < MPM_MAX_DIM; ++d) {
+    gi[d] = d < g->dim ? g->box_lo[d] + (int)(l % g->box_n[d]) : 0;
+    l /= g->box_n[d];
+  }
+}
+
+/* The two parents of fine node j along one axis: p[0] = floor(j / 2) with weight 3/4 and
+ * p[1] = p[0] - 1 + 2 (j mod 2) with weight 1/4. */
+static inline void hier_parents_1d(int j, int p[2]) {
+  const int m = hier_half(j);
+  p[0] = m, p[1] = m - 1 + 2 * (j - 2 * m);
+}
+
+/* Parent k (0 .. 2^dim - 1) of a fine node whose per-axis parents are p (hier_parents_1d):
+ * its global indices q (first dim entries) and its two-scale weight, the product over the axes
+ * of 3/4 (bit d of k clear: parent p[d][0]) or 1/4 (bit set: p[d][1]). */
+static inline double hier_parent_k(int dim, const int (*p)[2], int k, int *q) {
+  double w = 1.0;
+  for (int d = 0; d < dim; ++d) {
+    const int b = (k >> d) & 1;
+    q[d] = p[d][b];
+    w *= b ? 0.25 : 0.75;
+  }
+  return w;
+}
+
+/* The 2^dim parents on the coarse lattice c of the fine node gi (the two-scale relation: along
+ * each axis fine node 2m + r has parents m, weight 3/4, and m - 1 + 2r, weight 1/4): their box
+ * indices in c and weights; returns 2^dim. */
+int mpm_hier_parents(const mpm_grid *c, const int *gi, mpm_lidx *idx, double *w);
+
+/* Release the transfer scratch (mpm_hier_transfer.c). */
+void mpm_hier_scratch_free(void *scratch);
+
+#endif

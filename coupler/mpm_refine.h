@@ -1,0 +1,23 @@
+/* The [refine] section: a static refinement hierarchy over the shared grid (mpm_hier.h), given
+ * by boxes in the case file, for a gas-only case on one rank (docs/refinement.md):
+ *   [refine]              levels = 2 (1: off, the default), buffer = 2
+ *   [refine.NAME]         level = 1, lo = x y, hi = x y
+ * The sim builds it after the modules and hands it to the gas (fluid_module_refine), which then
+ * deposits, solves and gathers on every level (coupler/mpm_cycle.c). */
+#ifndef MPM_REFINE_H
+#define MPM_REFINE_H
+
+#include "mpm_config.h"
+#include "mpm_hier.h"
+#include "mpm_module.h"
+
+extern const mpm_key_spec mpm_refine_keys[];
+extern const int mpm_refine_nkeys;
+
+/* Build the hierarchy the case asks for over grid (*h = NULL with refine.levels = 1) and put
+ * the modules on it; with seed = 1 the gas reseeds the finer regions. Every setting this slice
+ * does not carry is refused with one line naming its key (MPM_ERR_INPUT). Collective. */
+int mpm_refine_build(mpm_hier **h, const mpm_config *cfg, mpm_grid *grid, mpm_module **mod,
+                     int nmod, int seed);
+
+#endif

@@ -1,0 +1,147 @@
+/* The gas on a static refinement hierarchy (mpm_hier.h; docs/refinement.md): what of the gas
+ * this slice carries to the finer levels, the transfers that go through the hierarchy, and the
+ * seeding of the finer levels.
+ *
+ * Carried: the plain transfers of the method-of-lines RHS (the ERK pairs): the deposit of mass,
+ * momentum, pressure, gravity and the viscous stresses (fluid.strain_rate = current's preview
+ * and fluid.mol_damping's filter included) goes through mpm_hier_p2g, every gather of v, a and L
+ * through mpm_hier_g2p; the coupler restricts, solves on every level and prolongs
+ * (coupler/mpm_cycle.c). The stable step takes the finest level's spacing. Walls act on level 0
+ * only: the sim keeps every box three level-0 cells from the non-periodic faces
+ * (coupler/mpm_refine.c).
+ *
+ * Refused (fluid_refine_check), each naming its key: everything that reads or writes the gas's
+ * nodal fields or the grid otherwise: the classic update (its time-centred nodal velocity, heat
+ * shares and wall rule), the domain volume rate, the riemann viscosity's limiter, shifting,
+ * regularisation and refill (cell counts), the neighbourhood stable step, the light-node threshold,
+ * obstacles and open faces. An odd fluid.ppc puts level-0 particles on the span faces that bound
+ * the finer regions, so it is refused too.
+ *
+ * Invariant: with m->hier NULL every call here is the plain kernel call (the refined path costs
+ * one pointer test per transfer). */
+#include "fluid_internal.h"
+#include "fluid_module.h"
+
+#include "mpm_error.h"
+#include "mpm_hier.h"
+#include "mpm_kernels.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+void fluid_p2g_any(mpm_module *m, int phase, const mpm_p2g_args *a, int *rc) {
+  if (m->hier) {
+    if (!*rc) *rc = mpm_hier_p2g(m->hier, phase, a);
+    return;
+  }
+  mpm_kernels_get(m->grid->dim)->p2g(m->grid, phase, a);
+}
+
+int fluid_g2p_phase(mpm_module *m, const double *y, double *const *v_out, double *const *a_out,
+                    double *L_out) {
+  if (!m->hier) {
+    mpm_transfer_g2p(m->grid, m->phase, m->particles, y, ((fluid_content *)m->content)->lp, v_out,
+                     a_out, L_out, NULL);
+    return 0;
+  }
+  const mpm_particles *p = m->particles;
+  const mpm_grid_phase *ph = &m->grid->phase[m->phase];
+  mpm_g2p_args a = {.n = p->n, .lp = ((fluid_content *)m->content)->lp, .L_out = L_out};
+  for (int d = 0; d < p->dim; ++d) {
+    a.x[d] = y + (size_t)(p->offset[FLUID_X] + d) * p->n;
+    a.v_i[d] = ph->v_i[d], a.a_i[d] = ph->a_i[d];
+    a.v_out[d] = v_out[d], a.a_out[d] = a_out[d];
+  }
+  return mpm_hier_g2p(m->hier, m->phase, &a, NULL);
+}
+
+double fluid_finest_dx(const mpm_module *m) {
+  const mpm_hier *h = m->hier;
+  return h ? h->level[h->nlevels - 1].grid->dx : m->grid->dx;
+}
+
+/* ---- what the slice refuses ------------------------------------------------------------------ */
+
+static int refuse(const mpm_config *cfg, const char *key, const char *why) {
+  return mpm_config_fail(cfg, key,
+                         "not carried to the refined levels (refine.levels > 1): %s; remove the "
+                         "key or set refine.levels = 1 (docs/refinement.md)",
+                         why);
+}
+
+/* A key set to a value other than off: an enum choice, or a number above zero. */
+static int is_choice(const mpm_config *cfg, const char *key, const char *choice) {
+  const char *v;
+  return mpm_config_get_string(cfg, key, &v) == 0 && strcmp(v, choice) == 0;
+}
+
+static int is_positive(const mpm_config *cfg, const char *key) {
+  double v = 0.0;
+  return mpm_config_get_real(cfg, key, &v) == 0 && v > 0.0;
+}
+
+typedef struct refusal {
+  const char *key, *choice; /* choice NULL: refused when > 0 */
+  const char *why;
+} refusal;
+
+static const refusal g_refused[] = {
+    {"time.method", "usl",
+     "the classic update's transfer reads a time-centred nodal velocity, heat shares and a wall "
+     "rule on level 0's nodes"},
+    {"time.method", "musl", "MUSL's remap deposits on level 0's nodes"},
+    {"fluid.volume_rate", "domain", "the domain rate samples the nodal velocity on level 0"},
+    {"fluid.av_form", "riemann", "the riemann limiter reads the nodal velocity on level 0"},
+    {"fluid.stable_step", "neighbourhood", "the neighbourhood step sums level-0 cells"},
+    {"fluid.shift", NULL, "shifting reads the nodal volume fraction on level 0"},
+    {"fluid.regularise_every", NULL, "merging and splitting count particles in level-0 cells"},
+    {"fluid.refill_every", NULL, "refilling counts particles in level-0 cells"},
+    {"fluid.light_node_mass", NULL, "the mean nodal mass is level 0's"},
+};
+
+/* The first obstacle, or open face, of the case: refused with its key. */
+static int refuse_boundaries(const mpm_config *cfg, const fluid_content *fc, int dim) {
+  const char *const *names;
+  int count;
+  MPM_CALL(mpm_config_instances(cfg, "obstacle", &names, &count));
+  if (count > 0) {
+    char key[160];
+    snprintf(key, sizeof key, "obstacle.%s.shape", names[0]);
+    return refuse(cfg, key, "obstacles constrain and deposit on level 0's nodes");
+  }
+  for (int d = 0; d < dim; ++d)
+    for (int s = 0; s < 2; ++s)
+      if (mpm_wall_is_open_gas(fc->walls.face[d][s])) {
+        char key[32];
+        snprintf(key, sizeof key, "boundary.%c_%s", "xyz"[d], s ? "hi" : "lo");
+        return refuse(cfg, key,
+                      "open faces (inflow, outflow, far field) are not carried in this slice");
+      }
+  return 0;
+}
+
+int fluid_refine_check(const mpm_module *m, const mpm_config *cfg) {
+  const fluid_content *fc = m->content;
+  for (size_t k = 0; k < sizeof g_refused / sizeof g_refused[0]; ++k) {
+    const refusal *r = &g_refused[k];
+    if (r->choice ? is_choice(cfg, r->key, r->choice) : is_positive(cfg, r->key))
+      return refuse(cfg, r->key, r->why);
+  }
+  if (fc->reg_every > 0) return refuse(cfg, "fluid.regularise_every", g_refused[6].why);
+  MPM_CALL(refuse_boundaries(cfg, fc, m->grid->dim));
+  if (fc->ppc % 2)
+    return mpm_config_fail(
+        cfg, "fluid.ppc",
+        "with refinement the gas needs an even count, so that no level-0 particle "
+        "sits on the faces of the refined region (an odd lattice puts one "
+        "there); use %d",
+        fc->ppc + 1);
+  return 0;
+}
+
+int fluid_module_refine(mpm_module *m, const mpm_config *cfg, mpm_hier *h, int seed) {
+  MPM_CALL(fluid_refine_check(m, cfg));
+  m->hier = h;
+  return seed ? fluid_seed_refined(m, cfg) : 0;
+}

@@ -1,0 +1,8 @@
+# The refinement hierarchy (common/mpm_hier.h) on one rank: the composite basis (partition of
+# unity, C1 across levels, adjoint restriction and prolongation, refusals of bad boxes) and the
+# composite transfers (conservation, P2G = the basis, affine reproduction, the nodal solve; the
+# cost against the plain kernel is printed).
+mpm_add_test(test_hier_basis SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/unit/test_hier_basis.c
+             LABELS unit RANKS 1)
+mpm_add_test(test_hier_transfer SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/unit/test_hier_transfer.c
+             LABELS unit RANKS 1)
