@@ -6,3 +6,6 @@ mpm_add_test(test_hier_basis SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/unit/test_hier_
              LABELS unit RANKS 1)
 mpm_add_test(test_hier_transfer SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/unit/test_hier_transfer.c
              LABELS unit RANKS 1)
+# The refusal of a grid split over ranks (the hierarchy runs on one rank for now).
+mpm_add_test(test_hier_ranks SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/unit/test_hier_ranks.c
+             LABELS mpi RANKS 2)

@@ -20,8 +20,8 @@
  *      orders); restriction zeroes exactly the inactive nodes and leaves active ones alone.
  *  (7) Bad input: every refusal of mpm_hier_new returns MPM_ERR_INPUT, creates nothing and
  *      names the box (by its index) or the level at fault; the buffer check is exact (a box
- *      that fits with buffer 2 fails with 3). A grid split over ranks cannot be made in this
- *      one-rank test. A box grid refuses the halo exchanges. */
+ *      that fits with buffer 2 fails with 3). A grid split over ranks is test_hier_ranks's (it
+ *      needs two). A box grid refuses the halo exchanges. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>

@@ -493,6 +493,16 @@ static void test_cost(void **state) {
          1e3 * lev1_plain[1]);
   printf("  2 levels, all particles on level 1    %7.1f / %7.1f\n", 1e3 * lev1[0], 1e3 * lev1[1]);
   printf("  2 levels, particles on both           %7.1f / %7.1f\n", 1e3 * mix[0], 1e3 * mix[1]);
+  double tr = HUGE_VAL, tp = HUGE_VAL;
+  for (int r = 0; r < 3; ++r) {
+    const double t0 = now();
+    mpm_hier_restrict(h2, ph);
+    const double t1 = now();
+    mpm_hier_prolong(h2, ph);
+    tr = fmin(tr, t1 - t0), tp = fmin(tp, now() - t1);
+  }
+  printf("  restriction / prolongation (%d + %d nodes) %5.1f / %7.1f\n", (int)g->nnodes,
+         (int)h2->level[1].grid->nnodes, 1e3 * tr, 1e3 * tp);
   pset_free(&out), pset_free(&in), pset_free(&mixed);
   mpm_hier_destroy(&h1), mpm_hier_destroy(&h2);
   mpm_grid_destroy(&g);
