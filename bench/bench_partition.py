@@ -16,7 +16,9 @@ from real block maps and weights without running them.
    p2g, g2p, stress, check, boundary, migrate and post_step per particle-step), or --node-cost.
 4. Partitions (bench/partition_methods.py): sfc (weighted Morton curve over all blocks: what
    p4est_partition does), box (today's Cartesian level 0, finer blocks to the owner beneath),
-   wbox (the same with its planes moved to balance the weight); quality per P and method.
+   wbox (the same with its planes moved to balance the weight), hybrid (box's level 0, the
+   finer blocks on the weighted curve filling each rank to the mean); quality per P and method.
+   --p4est cross-checks the 2-D maps with libp4est (bench/p4est_check.c, built with mpicc).
 
 Writes the table page (--md, default bench/results/partition_quality.md) and the raw rows as
 JSON and CSV (--out, default out/partition_quality/).
@@ -307,6 +309,16 @@ def fmt_p4est(rows):
     return out + [""]
 
 
+def cost_text(meta):
+    c = meta["node_cost_from"]
+    if "given" in c:
+        return "the node cost given on the command line"
+    return (f"the main job's own timers: the grid phase {c['grid_ns_per_node_step']:.0f} ns per "
+            f"node-step over the particle phases' {c['ns_per_particle_step']:.0f} ns per "
+            f"particle-step ({c['steps']} steps, {c['nodes']:.0f} box nodes, "
+            f"{c['particle_steps'] / 1e6:.0f} M particle-steps)")
+
+
 def write_md(path, meta, scenes, rows):
     """The results page: the tables only; the reading and the recommendation are written by
     hand below the marker and kept on regeneration."""
@@ -321,8 +333,7 @@ def write_md(path, meta, scenes, rows):
              "a geometric 3-D estimate; nothing runs on 64-1024 ranks. Method and choices: the "
              "driver's docstring and [below](#how-the-maps-are-made). Raw rows: "
              "`out/partition_quality/partition_quality.{json,csv}` (not tracked).", "",
-             f"Weights: particles + {meta['node_cost']:.3f} x nodes "
-             f"(node-step cost over particle-step cost, {meta['node_cost_from']}). "
+             f"Weights: particles + {meta['node_cost']:.3f} x nodes, {cost_text(meta)}. "
              f"Ghost width {meta['ghost']} nodes at every level.", ""]
     for s in scenes:
         n0 = "x".join(map(str, s["N0"]))
