@@ -132,7 +132,9 @@ class Hierarchy:
         self.present = [None] * L
         self.present[0] = np.ones(self.nb[0], bool)
         for l in range(L - 1, 0, -1):
-            p = self._touching(need[l], l) if need.get(l) is not None else np.zeros(self.nb[l], bool)
+            p = np.zeros(self.nb[l], bool)
+            if need.get(l) is not None:
+                p |= self._touching(need[l], l)
             if l + 1 < L:
                 p |= self._buffered_parents(l)
             self.present[l] = p
