@@ -404,7 +404,7 @@ void mpm_coupling_book_constrained(mpm_coupling *c, const mpm_interface *ifc, do
   for (int d = 0; d < c->grid->dim; ++d)
     for (mpm_lidx l = 0; l < c->grid->nnodes; ++l) {
       const double f = ifc->capture[d][l], v = s->v_i[d][l], v0 = ifc->v_solved[d][l];
-      if (!c->owned[l] || f == 0.0 || v == v0) continue;
+      if (!c->owned[l] || (f == 0.0 && ifc->booked[d][l] == 0.0) || v == v0) continue;
       const double vn = v0 - h * ifc->a_solved[d][l]; /* the exchanges keep v - h a */
       *power += f * 0.5 * (vn + v) - ifc->booked[d][l];
     }

@@ -218,8 +218,7 @@ static int seed_body(mpm_module *m, const mpm_config *cfg, int b, double *lp) {
   for (mpm_lidx i = 0; i < n; ++i) {
     double xp[3] = {0, 0, 0};
     for (int d = 0; d < dim; ++d) xp[d] = x[(size_t)d * n + i];
-    /* A clamped particle is held in place, at rest whatever the body's velocity (solid_internal.h).
-     */
+    /* A clamped particle is held in place: at rest, whatever its body's velocity. */
     const int fixed = sc->lay.f_fixed >= 0 && solid_in_clamp(sc, xp);
     for (int d = 0; d < dim; ++d) {
       data[(size_t)(p->offset[F_X] + d) * n + i] = xp[d];
