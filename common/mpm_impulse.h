@@ -22,21 +22,31 @@
 
 /* Set node l of ph to v' = v1 (dim values) and, in the method of lines (h = 0), a' = a1 (NULL
  * keeps a); in the classic update a' = a + (v1 - v) / h. Writes m (a' - a) to force (dim values)
- * and returns the energy rate it puts into the node's material as the gas's energy balance
- * counts it: classic, force . (v^n + v') / 2 (time-centred); method of lines,
- * force . v + m a . (v - v') (the particles gain a' . m v, the stress works on v'). */
-static inline double mpm_impulse_apply(mpm_grid_phase *ph, int dim, mpm_lidx l, const double *v1,
-                                       const double *a1, double h, double *force) {
+ * and the energy rate it puts into the node's material, component by component, to power (dim
+ * values), as the gas's energy balance counts it: classic, force . (v^n + v') / 2
+ * (time-centred); method of lines, force . v + m a . (v - v') (the particles gain a' . m v, the
+ * stress works on v'). */
+static inline void mpm_impulse_apply_parts(mpm_grid_phase *ph, int dim, mpm_lidx l,
+                                           const double *v1, const double *a1, double h,
+                                           double *force, double *power) {
   const double m = ph->m_i[l];
-  double power = 0.0;
   for (int d = 0; d < dim; ++d) {
     const double v0 = ph->v_i[d][l], a0 = ph->a_i[d][l];
     const double da = h > 0 ? (v1[d] - v0) / h : (a1 ? a1[d] - a0 : 0.0);
     ph->v_i[d][l] = v1[d];
     ph->a_i[d][l] = a0 + da;
     force[d] = m * da;
-    power += h > 0 ? force[d] * 0.5 * (v0 - h * a0 + v1[d]) : force[d] * v0 + m * a0 * (v0 - v1[d]);
+    power[d] =
+        h > 0 ? force[d] * 0.5 * (v0 - h * a0 + v1[d]) : force[d] * v0 + m * a0 * (v0 - v1[d]);
   }
+}
+
+/* The same, returning the power summed over the components. */
+static inline double mpm_impulse_apply(mpm_grid_phase *ph, int dim, mpm_lidx l, const double *v1,
+                                       const double *a1, double h, double *force) {
+  double parts[MPM_MAX_DIM], power = 0.0;
+  mpm_impulse_apply_parts(ph, dim, l, v1, a1, h, force, parts);
+  for (int d = 0; d < dim; ++d) power += parts[d];
   return power;
 }
 

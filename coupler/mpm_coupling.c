@@ -302,11 +302,13 @@ void mpm_coupling_exchange_force(mpm_coupling *c, mpm_role role, mpm_lidx l, con
   mpm_grid_phase *ph = &c->grid->phase[c->phase[role]];
   const int dim = c->grid->dim;
   const double m = ph->m_i[l];
-  double force[MPM_MAX_DIM];
-  const double power = mpm_impulse_apply(ph, dim, l, v, a, h, force);
+  double force[MPM_MAX_DIM], parts[MPM_MAX_DIM], power = 0.0;
+  mpm_impulse_apply_parts(ph, dim, l, v, a, h, force, parts);
+  for (int d = 0; d < dim; ++d) power += parts[d];
   for (int d = 0; f && d < dim; ++d) f[d] = force[d];
   if (c->capture && role == MPM_ROLE_SOLID)
-    for (int d = 0; d < dim; ++d) c->capture->capture[d][l] += force[d];
+    for (int d = 0; d < dim; ++d)
+      c->capture->capture[d][l] += force[d], c->capture->booked[d][l] += parts[d];
   if (c->recording && c->nbodies && role == MPM_ROLE_SOLID)
     for (int d = 0; d < dim; ++d) c->da[d][l] += force[d] / m;
   if (!c->recording || !c->owned[l]) return;
@@ -318,7 +320,8 @@ void mpm_coupling_exchange_force(mpm_coupling *c, mpm_role role, mpm_lidx l, con
 void mpm_coupling_record_force(mpm_coupling *c, mpm_role role, mpm_lidx l, const double *f,
                                const double *v) {
   if (c->capture && role == MPM_ROLE_SOLID)
-    for (int d = 0; d < c->grid->dim; ++d) c->capture->capture[d][l] += f[d];
+    for (int d = 0; d < c->grid->dim; ++d)
+      c->capture->capture[d][l] += f[d], c->capture->booked[d][l] += f[d] * v[d];
   if (c->recording && c->nbodies && role == MPM_ROLE_SOLID)
     for (int d = 0; d < c->grid->dim; ++d)
       c->da[d][l] += f[d] / mpm_coupling_phase(c, role)->m_i[l];
@@ -390,6 +393,21 @@ void mpm_coupling_apply_shared(mpm_coupling *c, double h, const double *m_gas,
     mpm_coupling_exchange(c, MPM_ROLE_SOLID, l, v, NULL, h);
   }
   c->recording = 0;
+  mpm_timer_stop(MPM_T_COUPLING);
+}
+
+void mpm_coupling_book_constrained(mpm_coupling *c, const mpm_interface *ifc, double h) {
+  if (!(h > 0)) return;
+  mpm_timer_start(MPM_T_COUPLING);
+  const mpm_grid_phase *s = mpm_coupling_phase(c, MPM_ROLE_SOLID);
+  double *power = &c->rec[c->which.latest].power[MPM_ROLE_SOLID];
+  for (int d = 0; d < c->grid->dim; ++d)
+    for (mpm_lidx l = 0; l < c->grid->nnodes; ++l) {
+      const double f = ifc->capture[d][l], v = s->v_i[d][l], v0 = ifc->v_solved[d][l];
+      if (!c->owned[l] || (f == 0.0 && ifc->booked[d][l] == 0.0) || v == v0) continue;
+      const double vn = v0 - h * ifc->a_solved[d][l]; /* the exchanges keep v - h a */
+      *power += f * 0.5 * (vn + v) - ifc->booked[d][l];
+    }
   mpm_timer_stop(MPM_T_COUPLING);
 }
 

@@ -172,6 +172,13 @@ void mpm_coupling_follow_solid(mpm_coupling *c, mpm_lidx l, double h, unsigned a
 void mpm_coupling_apply_shared(mpm_coupling *c, double h, const double *m_gas,
                                const double *const *f_gas, const double *const *v_gas,
                                double *const *v_out, unsigned char *touched);
+/* A loaded RHS (classic update), after the solid's constraints: on every owned node and
+ * component where a constraint changed the velocity the exchanges (the load, the shared nodes)
+ * left (ifc->v_solved), the constraint took their impulse, and their power on the solid is booked
+ * time-centred at the velocity it left, force (v^n + v) / 2, in place of what they booked
+ * (ifc->booked), as the solid's wall books an impulse a constraint takes (mpm_solid_wall.c).
+ * The force stays the interface's: the balance is unchanged (mpm_interface.h, constraints). */
+void mpm_coupling_book_constrained(mpm_coupling *c, const mpm_interface *ifc, double h);
 /* The gas's half of the same, in its step over the coupling step t -> t + h (a follow RHS): the
  * gas takes velocity v at every node marked in touched where it has mass, as an exchange, and
  * what it gives up there is captured for the solid. Starts this RHS's record. */

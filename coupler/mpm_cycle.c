@@ -97,7 +97,12 @@ static int grid_pass(const mpm_cycle *c, double t, double h, mpm_pass pass) {
   for (int k = 0; k < c->nmod; ++k) MPM_CALL(solve(c->grid, c->mod[k], hs));
   if (hm) MPM_CALL(mpm_grid_phase_update(c->grid, hm->phase, hs));
   MPM_CALL(interact(c, t, hs, pass));
+  /* A loaded first pass books its exchanges where the constraints override them at the
+   * constrained velocity (mpm_interface.h, constraints). */
+  const int loaded = c->mode == MPM_CYCLE_LOADED && pass == MPM_PASS_FIRST;
+  if (loaded) mpm_interface_solved(c->iface);
   for (int k = 0; k < c->nmod; ++k) MPM_CALL(c->mod[k]->ops->constrain(c->mod[k], t, h, pass));
+  if (loaded) mpm_coupling_book_constrained(c->coupling, c->iface, hs);
   if (hm) MPM_CALL(hm->ops->constrain(hm, t, h, pass));
   if (hooks) MPM_CALL(mpm_coupling_after_constrain(c->coupling, t, hs, pass));
   if (c->mode == MPM_CYCLE_FOLLOW && pass == MPM_PASS_FIRST)

@@ -20,6 +20,9 @@ int mpm_interface_new(mpm_interface **ifcp, mpm_grid *grid, int phase) {
     MPM_ALLOC(ifc->mv[d], nn);
     MPM_ALLOC(ifc->f[d], nn);
     MPM_ALLOC(ifc->capture[d], nn);
+    MPM_ALLOC(ifc->booked[d], nn);
+    MPM_ALLOC(ifc->v_solved[d], nn);
+    MPM_ALLOC(ifc->a_solved[d], nn);
     MPM_ALLOC(ifc->impulse[d], nn);
     MPM_ALLOC(ifc->load[d], nn);
     if (grid->phase[phase].normals) MPM_ALLOC(ifc->normal[d], nn);
@@ -34,6 +37,7 @@ void mpm_interface_destroy(mpm_interface **ifcp) {
   for (int d = 0; d < MPM_MAX_DIM; ++d) {
     free(ifc->mv[d]), free(ifc->f[d]), free(ifc->normal[d]);
     free(ifc->capture[d]), free(ifc->impulse[d]), free(ifc->load[d]);
+    free(ifc->booked[d]), free(ifc->v_solved[d]), free(ifc->a_solved[d]);
     free(ifc->trend[d]), free(ifc->prev[d]), free(ifc->now[d]), free(ifc->moved[d]);
     free(ifc->vprev[d]), free(ifc->accel[d]);
     free(ifc->f_gas[d]), free(ifc->v_gas[d]), free(ifc->v_now[d]);
@@ -139,8 +143,16 @@ void mpm_interface_share(mpm_interface *ifc, int gas_phase) {
 }
 
 void mpm_interface_capture_begin(mpm_interface *ifc) {
+  const size_t bytes = sizeof(double) * (size_t)ifc->grid->nnodes;
   for (int d = 0; d < ifc->grid->dim; ++d)
-    memset(ifc->capture[d], 0, sizeof(double) * (size_t)ifc->grid->nnodes);
+    memset(ifc->capture[d], 0, bytes), memset(ifc->booked[d], 0, bytes);
+}
+
+void mpm_interface_solved(mpm_interface *ifc) {
+  const mpm_grid_phase *ph = &ifc->grid->phase[ifc->phase];
+  const size_t bytes = sizeof(double) * (size_t)ifc->grid->nnodes;
+  for (int d = 0; d < ifc->grid->dim; ++d)
+    memcpy(ifc->v_solved[d], ph->v_i[d], bytes), memcpy(ifc->a_solved[d], ph->a_i[d], bytes);
 }
 
 void mpm_interface_capture_accept(mpm_interface *ifc, double h, int sign) {

@@ -107,7 +107,12 @@ void solid_hold_rigid_nodes(const solid_body *body, mpm_grid *g, int phase, doub
       }
 }
 
-/* Clamped particles keep their place and velocity. Their deformation gradient (and stress)
+/* Clamped particles keep their place and velocity, which is zero: they are seeded at rest
+ * whatever their body's velocity (solid_module.c). A clamp over a body given a velocity kept it
+ * on its particles, and their P2G put that momentum on the nodes at the clamp's edge, which the
+ * clamp does not hold: where the solid advances those nodes alone (multirate's held exchange)
+ * they moved at it, stretching the face layer of a clamped slab by 13 % and pulling the gas
+ * into it (tests/verification/test_multirate_face.py). Their deformation gradient (and stress)
  * still follows the grid: those at the edge of a clamp carry the reaction stress, which a
  * frozen F would drop, turning the clamp's edge into a hinge. */
 void solid_hold_fixed(const mpm_particles *p, int f_fixed, double *ydot) {

@@ -94,7 +94,8 @@ void solid_traction_force(solid_content *sc, const mpm_region *body, int dim, do
                           const double *xp, mpm_gidx id, double *f);
 /* After the nodal solve: a rigid body holds the nodes inside its moving region at time t. */
 void solid_hold_rigid_nodes(const solid_body *body, mpm_grid *g, int phase, double t);
-/* In G2P: clamped particles keep their place and velocity; rigid bodies move with theirs. */
+/* In G2P: clamped particles keep their place and velocity (zero: seeded at rest); rigid bodies
+ * move with theirs. */
 void solid_hold_fixed(const mpm_particles *p, int f_fixed, double *ydot);
 void solid_move_rigid(const solid_content *sc, const mpm_particles *p, double *ydot);
 /* MUSL's new particle velocities: a rigid body's keep its velocity. */

@@ -218,9 +218,13 @@ static int seed_body(mpm_module *m, const mpm_config *cfg, int b, double *lp) {
   for (mpm_lidx i = 0; i < n; ++i) {
     double xp[3] = {0, 0, 0};
     for (int d = 0; d < dim; ++d) xp[d] = x[(size_t)d * n + i];
+    /* A clamped particle is held in place: at rest, whatever its body's velocity. */
+    const int fixed = sc->lay.f_fixed >= 0 && solid_in_clamp(sc, xp);
     for (int d = 0; d < dim; ++d) {
       data[(size_t)(p->offset[F_X] + d) * n + i] = xp[d];
-      data[(size_t)(p->offset[F_V] + d) * n + i] = vfield ? mpm_expr_eval(vfield, d, xp) : v0[d];
+      data[(size_t)(p->offset[F_V] + d) * n + i] = fixed    ? 0.0
+                                                   : vfield ? mpm_expr_eval(vfield, d, xp)
+                                                            : v0[d];
     }
     for (int rc = 0; rc < dim * dim; ++rc) {
       data[(size_t)(p->offset[F_F] + rc) * n + i] = pre->F0[rc];
@@ -232,8 +236,7 @@ static int seed_body(mpm_module *m, const mpm_config *cfg, int b, double *lp) {
     data[(size_t)p->offset[sc->lay.f_m] * n + i] = sc->body[b].rho * vol;
     data[(size_t)p->offset[sc->lay.f_V0] * n + i] = vol / pre->J0;
     data[(size_t)p->offset[sc->lay.f_body] * n + i] = b;
-    if (sc->lay.f_fixed >= 0)
-      data[(size_t)p->offset[sc->lay.f_fixed] * n + i] = solid_in_clamp(sc, xp);
+    if (sc->lay.f_fixed >= 0) data[(size_t)p->offset[sc->lay.f_fixed] * n + i] = fixed;
     if (sc->lay.f_fext >= 0 && !sc->body[b].mat->ops->rigid) {
       double f[3] = {0, 0, 0};
       solid_traction_force(sc, region, dim, g->dx / ppc, xp, id[i], f);
