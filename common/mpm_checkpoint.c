@@ -574,7 +574,7 @@ static int check_layout(const mpm_checkpoint *ck, hid_t g, const char *phase,
   if (!st && ck->hashed && hash != text_hash(names, NULL))
     note(why, ck, "checksum mismatch in the field names of phase '%s' (text_hash)", phase);
   for (int f = 0; !st && !why[0] && f < nstored; ++f) /* a size no field has: damaged */
-    if (ncomp[f] < 1 || ncomp[f] > 9) st = -1;
+    if (ncomp[f] < 1 || ncomp[f] > MPM_PARTICLES_MAX_NCOMP) st = -1;
   if (!st && !why[0]) { /* "x,v,m" with ncomp {2,2,1} -> "x(2) v(2) m(1)" */
     size_t k = 0;
     char *save = NULL;

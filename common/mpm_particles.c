@@ -39,8 +39,10 @@ static int check_fields(int dim, const mpm_field_desc *fields, int nfields, int 
   if (fields[0].ncomp != dim || fields[1].ncomp != dim)
     MPM_FAIL(MPM_ERR_INPUT, "particles: fields 0 and 1 (x and v) need %d components", dim);
   for (int f = 0; f < nfields; ++f) {
-    if (!fields[f].name || !fields[f].name[0] || fields[f].ncomp < 1 || fields[f].ncomp > 9)
-      MPM_FAIL(MPM_ERR_INPUT, "particles: field %d needs a name and 1 to 9 components", f);
+    if (!fields[f].name || !fields[f].name[0] || fields[f].ncomp < 1 ||
+        fields[f].ncomp > MPM_PARTICLES_MAX_NCOMP)
+      MPM_FAIL(MPM_ERR_INPUT, "particles: field %d needs a name and 1 to %d components", f,
+               MPM_PARTICLES_MAX_NCOMP);
     for (int e = 0; e < f; ++e)
       if (strcmp(fields[e].name, fields[f].name) == 0)
         MPM_FAIL(MPM_ERR_INPUT, "particles: field '%s' is listed twice", fields[f].name);

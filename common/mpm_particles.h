@@ -16,11 +16,19 @@
 #include "mpm_grid.h"
 #include "mpm_types.h"
 
+#include <limits.h>
 #include <stddef.h>
 
-#define MPM_PARTICLES_MAX_FIELDS 16
-/* Components of all fields at most (a field has at most dim^2 = 9). */
-#define MPM_PARTICLES_MAX_COMPONENTS (MPM_PARTICLES_MAX_FIELDS * 9)
+/* Fields of a set at most. The gas under an ERK pair with viscosity and the riemann limiter
+ * needs 18 (tests/unit/test_layouts.c builds every module's layouts); the derived and scratch
+ * masks below hold one bit per field. */
+#define MPM_PARTICLES_MAX_FIELDS 32
+/* Components of one field at most: a dim x dim tensor. A quantity with more is several fields
+ * (the gas's pending strain rate is pending_divv, pending_D, pending_psi); the checkpoint
+ * reader takes a larger stored size for damage. */
+#define MPM_PARTICLES_MAX_NCOMP (MPM_MAX_DIM * MPM_MAX_DIM)
+/* Components of all fields at most. */
+#define MPM_PARTICLES_MAX_COMPONENTS (MPM_PARTICLES_MAX_FIELDS * MPM_PARTICLES_MAX_NCOMP)
 
 typedef struct mpm_field_desc {
   const char *name;
@@ -67,6 +75,9 @@ typedef struct mpm_particles {
     double *data; /* component-major, stride nadd */
   } later;
 } mpm_particles;
+
+_Static_assert(MPM_PARTICLES_MAX_FIELDS <= sizeof(unsigned) * CHAR_BIT,
+               "the derived and scratch masks need a bit per field");
 
 /* A set with no particles. The first nstate_fields fields are the state; fields 0 and 1
  * must be x and v with dim components each. */

@@ -18,9 +18,10 @@
 enum { FLUID_X, FLUID_V, FLUID_J, FLUID_E };
 
 typedef struct fluid_layout {
-  int f_C, f_m, f_V0, f_divv, f_D;              /* field indices; -1 if absent */
-  int f_psi;                                    /* riemann viscosity: its limiter (after divv, D) */
-  int f_pending;                                /* method of lines: this RHS's tr D (and D) */
+  int f_C, f_m, f_V0, f_divv, f_D; /* field indices; -1 if absent */
+  int f_psi;                       /* riemann viscosity: its limiter (after divv, D) */
+  int f_pending; /* method of lines: the first of this RHS's pending_divv, [pending_D],
+                  * [pending_psi], which precede divv, D, psi in the same order */
   int f_rho, f_p, f_mach, f_T, f_s, f_rho_grid; /* output fields */
 } fluid_layout;
 

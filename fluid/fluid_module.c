@@ -367,10 +367,10 @@ static int fluid_p2g(mpm_module *m, double t, const double *y) {
   return 0;
 }
 
-/* The limiter's slot in the field pending: after tr and D. */
-static double *pending_psi(const fluid_content *fc, const mpm_particles *p) {
-  return mpm_particles_comp(p, fc->lay.f_pending, 0) +
-         (size_t)p->n * (1 + (fc->lay.f_D >= 0 ? p->dim * p->dim : 0));
+/* The pending copy of the lagged field f (divv, D or psi): the copies precede those fields in
+ * the same order (fluid_particles_new). */
+static double *pending_of(const fluid_content *fc, const mpm_particles *p, int f) {
+  return mpm_particles_comp(p, fc->lay.f_pending + (f - fc->lay.f_divv), 0);
 }
 
 /* The current rate from the previewed nodal velocity (above), and the viscous deposit. */
@@ -391,7 +391,7 @@ static int fluid_p2g_rate(mpm_module *m, double t, const double *y) {
   if (fc->lay.f_psi >= 0) { /* this RHS's limiter, into pending (g2p keeps it) */
     const double *v_i[MPM_MAX_DIM];
     for (int d = 0; d < dim; ++d) v_i[d] = m->grid->phase[m->phase].v_i[d];
-    double *psi = pending_psi(fc, p);
+    double *psi = pending_of(fc, p, fc->lay.f_psi);
     MPM_CALL(fluid_limiter(m, y, v_i, L, psi));
     b.psi = psi;
   }
@@ -497,8 +497,8 @@ static void as_rate(double *out, const double *src, const double *y, size_t coun
 
 /* dJ/dt = J tr L. The strain rate is kept for the next stress evaluation and stable step:
  * in the classic update as the state's rate (new - old) / h; in the method-of-lines RHS in the
- * field `pending`, which fluid_post_step commits after an accepted step (the RHS must not
- * change what it reads: ARKODE also probes it at trial states). */
+ * fields pending_divv, pending_D, pending_psi, which fluid_post_step commits after an accepted step
+ * (the RHS must not change what it reads: ARKODE also probes it at trial states). */
 static int volume_rate(mpm_module *m, const double *y, double *ydot, const double *L,
                        const double *const *v_i, double h) {
   fluid_content *fc = m->content;
@@ -508,16 +508,18 @@ static int volume_rate(mpm_module *m, const double *y, double *ydot, const doubl
   const int in_state = fc->lay.f_pending < 0;
   const double *J = state(p, y, FLUID_J);
   double *Jdot = ydot + (size_t)p->offset[FLUID_J] * n;
-  double *tr = in_state ? fc->scratch : mpm_particles_comp(p, fc->lay.f_pending, 0);
+  double *tr = in_state ? fc->scratch : pending_of(fc, p, fc->lay.f_divv);
   double *D = fc->lay.f_D < 0 ? NULL
               : in_state      ? ydot + (size_t)p->offset[fc->lay.f_D] * n
-                              : tr + n;
+                              : pending_of(fc, p, fc->lay.f_D);
   rate_parts(dim, n, L, tr, D);
   const double *Jrate = tr; /* fluid.volume_rate: point, or over the particle's domain */
   if (fc->volume_domain) MPM_CALL(fluid_volume_rate(m, y, v_i, L, &Jrate));
   for (mpm_lidx i = 0; i < n; ++i) Jdot[i] = J[i] * Jrate[i];
   /* The limiter (riemann viscosity): with the current rate p2g_rate has set this RHS's. */
-  double *psi = fc->lay.f_psi < 0 ? NULL : in_state ? fc->scratch + n : pending_psi(fc, p);
+  double *psi = fc->lay.f_psi < 0 ? NULL
+                : in_state        ? fc->scratch + n
+                                  : pending_of(fc, p, fc->lay.f_psi);
   if (psi && !fc->current_rate) MPM_CALL(fluid_limiter(m, y, v_i, L, psi));
   if (!in_state) return 0;
   as_rate(ydot + (size_t)p->offset[fc->lay.f_divv] * n, tr, field(p, y, fc->lay.f_divv), n, h);
@@ -584,9 +586,9 @@ static int fluid_g2p(mpm_module *m, double t, const double *y, double *ydot, dou
 static int fluid_post_step(mpm_module *m, double t, double h, int *changed) {
   fluid_content *fc = m->content;
   const mpm_particles *p = m->particles;
-  if (fc->lay.f_pending >= 0) { /* divv and D follow pending in the particle data */
-    const size_t count = (size_t)p->n * (1 + (fc->lay.f_D >= 0 ? p->dim * p->dim : 0) +
-                                         (fc->lay.f_psi >= 0 ? 1 : 0));
+  if (fc->lay.f_pending >= 0) { /* divv, D, psi follow their pending copies in the data */
+    const size_t count =
+        (size_t)p->n * (size_t)(p->offset[fc->lay.f_divv] - p->offset[fc->lay.f_pending]);
     memcpy(mpm_particles_comp(p, fc->lay.f_divv, 0), mpm_particles_comp(p, fc->lay.f_pending, 0),
            sizeof(double) * count);
   }
@@ -825,32 +827,40 @@ static int read_settings(fluid_content *fc, const mpm_config *cfg, const mpm_gri
  * rate is (new - old) / h, so the stress and the stable step of the next step read it from
  * y_{n+1}. The step size the driver sets and the one the RHS computed for the same state are
  * then the same, which the exact energy balance needs; a restart also gets it bit for bit. In
- * the method-of-lines RHS it is an ordinary field the RHS overwrites (the previous stage's). */
-static void lag_fields(mpm_field_desc *f, int *nf, fluid_layout *lay, int dim, int viscous,
-                       int limiter) {
-  lay->f_divv = *nf, f[(*nf)++] = (mpm_field_desc){"divv", 1};
-  lay->f_D = viscous ? *nf : -1;
-  if (viscous) f[(*nf)++] = (mpm_field_desc){"D", dim * dim};
-  lay->f_psi = limiter ? *nf : -1;
-  if (limiter) f[(*nf)++] = (mpm_field_desc){"psi", 1};
+ * the method-of-lines RHS it is an ordinary field the RHS overwrites (the previous stage's).
+ * Appends divv, [D], [psi] (pending: their pending_ copies) to f; returns the first's index. */
+static int lag_fields(mpm_field_desc *f, int *nf, int dim, int viscous, int limiter, int pending) {
+  static const char *const names[2][3] = {{"divv", "D", "psi"},
+                                          {"pending_divv", "pending_D", "pending_psi"}};
+  const int first = *nf;
+  f[(*nf)++] = (mpm_field_desc){names[pending][0], 1};
+  if (viscous) f[(*nf)++] = (mpm_field_desc){names[pending][1], dim * dim};
+  if (limiter) f[(*nf)++] = (mpm_field_desc){names[pending][2], 1};
+  return first;
 }
+
+/* The fields at most: x, v, J, e, C; m, V0; the six output fields; divv, D, psi and their
+ * pending copies. */
+enum { FLUID_MAX_FIELDS = 4 + 1 + 2 + 6 + 2 * 3 };
+_Static_assert(FLUID_MAX_FIELDS <= MPM_PARTICLES_MAX_FIELDS, "the gas's fields fit a set");
 
 int fluid_particles_new(mpm_particles **p, int dim, fluid_layout *lay, int apic, int viscous,
                         int limiter, int lag_in_state) {
-  mpm_field_desc f[MPM_PARTICLES_MAX_FIELDS] = {{"x", dim}, {"v", dim}, {"J", 1}, {"e", 1}};
+  mpm_field_desc f[FLUID_MAX_FIELDS] = {{"x", dim}, {"v", dim}, {"J", 1}, {"e", 1}};
   int nf = 4;
   lay->f_C = apic ? nf : -1;
   if (apic) f[nf++] = (mpm_field_desc){"C", dim * dim};
-  if (lag_in_state) lag_fields(f, &nf, lay, dim, viscous, limiter);
+  if (lag_in_state) lay->f_divv = lag_fields(f, &nf, dim, viscous, limiter, 0);
   const int nstate = nf;
   lay->f_m = nf, f[nf++] = (mpm_field_desc){"m", 1};
   lay->f_V0 = nf, f[nf++] = (mpm_field_desc){"V0", 1};
   lay->f_pending = -1;
-  if (!lag_in_state) { /* pending directly before divv, D, psi: post_step copies one block */
-    lay->f_pending = nf,
-    f[nf++] = (mpm_field_desc){"pending", 1 + (viscous ? dim * dim : 0) + (limiter ? 1 : 0)};
-    lag_fields(f, &nf, lay, dim, viscous, limiter);
+  if (!lag_in_state) { /* the pending copies directly before divv, D, psi: one block to copy */
+    lay->f_pending = lag_fields(f, &nf, dim, viscous, limiter, 1);
+    lay->f_divv = lag_fields(f, &nf, dim, viscous, limiter, 0);
   }
+  lay->f_D = viscous ? lay->f_divv + 1 : -1;
+  lay->f_psi = limiter ? lay->f_divv + 1 + (viscous ? 1 : 0) : -1;
   lay->f_rho = nf, f[nf++] = (mpm_field_desc){"rho", 1};
   lay->f_p = nf, f[nf++] = (mpm_field_desc){"p", 1};
   lay->f_mach = nf, f[nf++] = (mpm_field_desc){"mach", 1};
@@ -863,7 +873,7 @@ int fluid_particles_new(mpm_particles **p, int dim, fluid_layout *lay, int apic,
   for (int k = lay->f_rho; k <= lay->f_rho_grid; ++k) mpm_particles_set_derived(*p, k);
   /* Every RHS writes the pending strain rate before the step commits it: a restart from a
    * checkpoint of usl or musl, which have none, needs none. */
-  if (lay->f_pending >= 0) mpm_particles_set_scratch(*p, lay->f_pending);
+  for (int k = lay->f_pending; k >= 0 && k < lay->f_divv; ++k) mpm_particles_set_scratch(*p, k);
   return 0;
 }
 

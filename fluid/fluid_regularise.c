@@ -533,7 +533,7 @@ static int refill_split(mpm_module *m, const mpm_lidx *perm, int k, const int *e
     if (mass[i] > mass[h] || (mass[i] == mass[h] && p->id[i] < p->id[h])) h = i;
   }
   mass[h] *= 0.5, V0[h] *= 0.5;
-  double row[MPM_PARTICLES_MAX_FIELDS * 16];
+  double row[MPM_PARTICLES_MAX_COMPONENTS];
   const int nc = p->ncomp;
   if (nc > (int)(sizeof row / sizeof row[0]))
     MPM_FAIL(MPM_ERR_INTERNAL, "refill: %d components per particle", nc);

@@ -268,8 +268,8 @@ static merge_rule rule_of(const fluid_layout *lay, const mpm_particles *p, int f
   if (f == FLUID_J) return MERGE_J;
   if (f == FLUID_E) return MERGE_E;
   if (f == lay->f_m || f == lay->f_V0) return MERGE_SUM;
-  if (f == lay->f_divv || f == lay->f_D || f == lay->f_psi || f == lay->f_pending)
-    return MERGE_VOLUME;
+  const int pending = lay->f_pending >= 0 && f >= lay->f_pending && f < lay->f_divv;
+  if (f == lay->f_divv || f == lay->f_D || f == lay->f_psi || pending) return MERGE_VOLUME;
   return MERGE_MASS; /* x, v, C, and any field the gas adds later: per unit mass */
 }
 

@@ -37,6 +37,12 @@ typedef struct {
   int nhist;  /* history components per particle */
 } solid_layout;
 
+/* The solid's empty particle set and its layout (solid_module.c): sigma if any model is in
+ * rate form, C with APIC, divv with a bulk viscosity, hist of nhist components (the model
+ * with the most history; 0: none), fixed with clamps, fext with tractions. */
+int solid_particles_new(mpm_particles **p, int dim, solid_layout *lay, int has_rate, int apic,
+                        int bulkq, int nhist, int fixed, int fext);
+
 /* A surface traction [traction.NAME]: constant nominal traction t (Pa) on the particles of
  * the deformable bodies inside `region` at seeding. Seeding counts what it tagged here. */
 typedef struct {

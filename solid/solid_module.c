@@ -85,11 +85,9 @@ int solid_add_schema(mpm_config *cfg) {
   return mpm_config_add_schema(cfg, solid_keys, (int)(sizeof solid_keys / sizeof solid_keys[0]));
 }
 
-/* The particle fields the bodies' models need: sigma if any model is in rate form, hist
- * sized for the model with the most history. */
-static int solid_particles_new(mpm_particles **p, int dim, solid_layout *lay, int has_rate,
-                               int apic, int bulkq, int nhist, int fixed, int fext) {
-  mpm_field_desc fields[12] = {{"x", dim}, {"v", dim}, {"F", dim * dim}};
+int solid_particles_new(mpm_particles **p, int dim, solid_layout *lay, int has_rate, int apic,
+                        int bulkq, int nhist, int fixed, int fext) {
+  mpm_field_desc fields[MPM_PARTICLES_MAX_FIELDS] = {{"x", dim}, {"v", dim}, {"F", dim * dim}};
   int nf = 3;
   lay->f_sigma = has_rate ? nf : -1;
   if (has_rate) fields[nf++] = (mpm_field_desc){"sigma", dim * dim};

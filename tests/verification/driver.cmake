@@ -67,6 +67,9 @@ mpm_add_script_test(test_gas_output SCRIPT verification/test_gas_output.py
                     LABELS "verification;mpi" TIMEOUT 600)
 mpm_add_script_test(test_gas_shear SCRIPT verification/test_gas_shear.py LABELS verification
                     TIMEOUT 600)
+# The viscous wave in 3-D under bs32 (a gas layout the particle store could not hold before).
+mpm_add_script_test(test_gas_shear_3d SCRIPT verification/test_gas_shear.py ARGS 3d
+                    LABELS verification TIMEOUT 600)
 # The inviscid shear wave at 64 cells goes unstable under FLIP (usl, musl, bs32: kinetic energy
 # x1e6 by t = 1, onset t = 0.43; Brackbill's ringing instability once the particle columns have
 # slid a quarter cell past each other). APIC is stable; particle regularisation does not fix FLIP
