@@ -10,6 +10,7 @@
 
 #include "mpm_bc.h"
 #include "mpm_config.h"
+#include "mpm_hier.h"
 #include "mpm_kernels.h"
 #include "mpm_module.h"
 #include "mpm_transfer.h"
@@ -24,6 +25,8 @@ typedef struct fluid_layout {
                   * [pending_psi], which precede divv, D, psi in the same order */
   int f_rho, f_p, f_mach, f_T, f_s, f_rho_grid; /* output fields */
 } fluid_layout;
+
+typedef struct fluid_gridp fluid_gridp; /* fluid.pressure = grid (fluid_gridp.c) */
 
 typedef struct fluid_content {
   fluid_gas gas;
@@ -69,6 +72,7 @@ typedef struct fluid_content {
   mpm_lidx vol_cap;   /* their capacity in particles */
   double *node;       /* nodal scratch: time-centred velocity and scalars ((dim + 3) nnodes) */
   mpm_module_ops ops; /* the module's ops: p2g_rate only with the current strain rate */
+  fluid_gridp *gridp; /* fluid.pressure = grid, or NULL */
 } fluid_content;
 
 /* What the classic step's transfer gives each particle (component-major, stride n). */
@@ -104,6 +108,22 @@ int fluid_limiter(mpm_module *m, const double *y, const double *const *v_i, cons
 int fluid_volume_rate(mpm_module *m, const double *y, const double *const *v_i, const double *L,
                       const double **rate);
 
+/* fluid.pressure = grid (fluid_gridp.c). read: the key and its refusals, each naming its key
+ * (after the other settings and the walls); init: its grid phase (in the build); deposit: in
+ * the RHS's P2G after fluid_stress_pressure, keeps m p and zeroes the pressure's stress in b;
+ * forces: before the walls fold the deposit (first pass), adds the nodal pressure's force;
+ * nodal_rate: after the solve, the nodal volume rate per unit mass on every level, into s for
+ * the G2P that fills the particles' rate (fluid_gridp_rate_out); work: adds the pressure's
+ * de/dt to power, then turns that rate into dJ/dt / J in place. */
+int fluid_gridp_read(fluid_content *fc, const mpm_config *cfg, const mpm_grid *g);
+int fluid_gridp_init(mpm_module *m);
+void fluid_gridp_destroy(fluid_content *fc);
+int fluid_gridp_deposit(mpm_module *m, const double *y, const fluid_batch *b);
+int fluid_gridp_forces(mpm_module *m);
+int fluid_gridp_nodal_rate(mpm_module *m, mpm_hier_scalars *s);
+double *fluid_gridp_rate_out(const fluid_content *fc);
+void fluid_gridp_work(const mpm_module *m, const double *y, double *power);
+
 /* The gas's empty particle set and its layout: C with apic, D with viscous, psi with limiter,
  * and the lagged strain rate in the state (lag_in_state, the classic update) or after a
  * pending copy (the method of lines) (fluid_module.c). */
@@ -135,10 +155,11 @@ int fluid_seed_refined(mpm_module *m, const mpm_config *cfg);
 
 /* The transfers of a module that may be refined (fluid_refine.c): P2G of a into phase, on
  * the grid or composite (an error goes to *rc, which is left alone on success), and the G2P of
- * v, a and L (L_out may be NULL) from m's phase at the positions of state y. */
+ * v, a and L (L_out may be NULL) from m's phase at the positions of state y, with s_out set also
+ * the nodal scalar s->s_i[l][0] of every level l. */
 void fluid_p2g_any(mpm_module *m, int phase, const mpm_p2g_args *a, int *rc);
 int fluid_g2p_phase(mpm_module *m, const double *y, double *const *v_out, double *const *a_out,
-                    double *L_out);
+                    double *L_out, const mpm_hier_scalars *s, double *s_out);
 /* The grid spacing of the finest level (the grid's without refinement). */
 double fluid_finest_dx(const mpm_module *m);
 /* Refuse, naming the key, every gas setting the refined levels do not carry (fluid_refine.c). */

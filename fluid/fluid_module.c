@@ -88,6 +88,13 @@ static const mpm_key_spec fluid_keys[] = {
      "the velocity ripples at the grid scale, as in hot gas at rest on the grid; only J, and so "
      "the density and pressure, reads it; see docs/gas.md)",
      0, NULL},
+    {"fluid.pressure", MPM_KEY_ENUM, "particle", 0, 0, 0, 0, "particle|grid",
+     "where the pressure's force is integrated: particle (each particle's V p at its point, "
+     "the classic MPM quadrature) or grid (the nodal pressure, a mass-weighted mean of the "
+     "particles', integrated exactly over the grid's cells, with each particle's volume "
+     "following its nodes' volume rate): keeps gas at rest and uniform streams exact across "
+     "refined regions; ERK pairs, quadratic shape and a gas alone; see docs/refinement.md",
+     0, NULL},
     {"fluid.ppc", MPM_KEY_INT, "2", 1, 8, 0, 0, NULL,
      "gas particles per cell per direction at seeding", 0, "-"},
     {"fluid.regularise_every", MPM_KEY_INT, "0", 0, HUGE_VAL, 0, 0, NULL,
@@ -362,6 +369,7 @@ static int fluid_p2g(mpm_module *m, double t, const double *y) {
   fluid_stress_pressure(&fc->gas, &b);
   mpm_timer_stop(MPM_T_STRESS);
   mpm_timer_start(MPM_T_P2G);
+  if (fc->gridp) MPM_CALL(fluid_gridp_deposit(m, y, &b));
   MPM_CALL(deposit(m, y, fc->vsig, NULL));
   mpm_timer_stop(MPM_T_P2G);
   return 0;
@@ -385,7 +393,7 @@ static int fluid_p2g_rate(mpm_module *m, double t, const double *y) {
   double *vout[MPM_MAX_DIM], *aout[MPM_MAX_DIM], *L = fc->scratch + (size_t)2 * dim * n;
   for (int d = 0; d < dim; ++d)
     vout[d] = fc->scratch + (size_t)d * n, aout[d] = fc->scratch + (size_t)(dim + d) * n;
-  const int rc = fluid_g2p_phase(m, y, vout, aout, L);
+  const int rc = fluid_g2p_phase(m, y, vout, aout, L, NULL, NULL);
   mpm_timer_stop(MPM_T_G2P);
   MPM_CALL(rc);
   if (fc->lay.f_psi >= 0) { /* this RHS's limiter, into pending (g2p keeps it) */
@@ -413,6 +421,7 @@ static int fluid_p2g_rate(mpm_module *m, double t, const double *y) {
 static int fluid_forces(mpm_module *m, double t, double h, mpm_pass pass) {
   fluid_content *fc = m->content;
   const int first = pass == MPM_PASS_FIRST;
+  if (first && fc->gridp) MPM_CALL(fluid_gridp_forces(m));
   if (first) {
     MPM_CALL(fluid_obstacles_begin(&fc->obs, m->grid, m->phase, t, h, 1));
     MPM_CALL(fluid_virtual_forces(&fc->virt, m->grid, m->phase, NULL, 0));
@@ -515,6 +524,7 @@ static int volume_rate(mpm_module *m, const double *y, double *ydot, const doubl
   rate_parts(dim, n, L, tr, D);
   const double *Jrate = tr; /* fluid.volume_rate: point, or over the particle's domain */
   if (fc->volume_domain) MPM_CALL(fluid_volume_rate(m, y, v_i, L, &Jrate));
+  if (fc->gridp) Jrate = fluid_gridp_rate_out(fc); /* fluid_gridp_work made it dJ/dt / J */
   for (mpm_lidx i = 0; i < n; ++i) Jdot[i] = J[i] * Jrate[i];
   /* The limiter (riemann viscosity): with the current rate p2g_rate has set this RHS's. */
   double *psi = fc->lay.f_psi < 0 ? NULL
@@ -550,8 +560,15 @@ static int fluid_g2p(mpm_module *m, double t, const double *y, double *ydot, dou
   double *Cdot = fc->tr.apic ? ydot + (size_t)p->offset[fc->lay.f_C] * n : NULL;
   const double *v = state(p, y, FLUID_V), *C = fc->tr.apic ? state(p, y, fc->lay.f_C) : NULL;
   if (!(h > 0)) {
-    MPM_CALL(fluid_g2p_phase(m, y, xdot, vdot, L));
+    mpm_hier_scalars rate;
+    double *rate_out = NULL;
+    if (fc->gridp) {
+      MPM_CALL(fluid_gridp_nodal_rate(m, &rate));
+      rate_out = fluid_gridp_rate_out(fc);
+    }
+    MPM_CALL(fluid_g2p_phase(m, y, xdot, vdot, L, &rate, rate_out));
     energy_rate(m, L, NULL, h);
+    if (fc->gridp) fluid_gridp_work(m, y, fc->power);
     if (!fc->tr.apic) fluid_wall_rate_mol(m, y, vdot, fc->power);
     MPM_CALL(fluid_mol_damping(m, y, vdot, fc->power, fc->work));
   } else if (!fc->tr.musl) {
@@ -698,6 +715,7 @@ static void fluid_destroy(mpm_module *m) {
     fluid_open_destroy(&fc->open);
     fluid_obstacles_free(&fc->obs);
     fluid_wall_ls_free(&fc->wall);
+    fluid_gridp_destroy(fc);
     fluid_virtual_free(&fc->virt);
     free(fc->vsig), free(fc->scratch), free(fc->vnew), free(fc->Cnew), free(fc->power);
     free(fc->sub), free(fc->zero), free(fc->work);
@@ -890,6 +908,8 @@ static int build(mpm_module *m, const mpm_config *cfg, int seed) {
   MPM_CALL(mpm_walls_from_config(&walls, cfg, g->dim));
   MPM_CALL(mpm_constraints_add_walls(&fc->cons, &walls, g));
   fc->walls = walls;
+  MPM_CALL(fluid_gridp_read(fc, cfg, g));
+  MPM_CALL(fluid_gridp_init(m));
   MPM_CALL(fluid_open_new(&fc->open, m, cfg, &walls, fc->gas.gamma, fc->ppc));
   MPM_CALL(fluid_obstacles_build(&fc->obs, cfg, g, fc->ppc, (const unsigned char(*)[2])m->open));
   MPM_CALL(fluid_wall_ls_init(m, cfg, fc->tr.classic));

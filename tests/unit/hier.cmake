@@ -9,3 +9,6 @@ mpm_add_test(test_hier_transfer SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/unit/test_hi
 # The refusal of a grid split over ranks (the hierarchy runs on one rank for now).
 mpm_add_test(test_hier_ranks SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/unit/test_hier_ranks.c
              LABELS mpi RANKS 2)
+# The exact span integrals the grid pressure uses (common/mpm_span.h): adjointness, constant and
+# linear fields, halved spans at a wall, in 2-D and 3-D.
+mpm_add_test(test_span SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/unit/test_span.c LABELS unit RANKS 1)

@@ -1,0 +1,281 @@
+/* fluid.pressure = grid: the gas's pressure acts through the nodes, integrated exactly over the
+ * grid's spans, in place of the particles' one-point quadrature.
+ *
+ * The method. Each particle deposits m_p p_p as it deposits its mass; the nodal pressure is
+ * p_j = sum_p m_p N_j(x_p) p_p / m_j, a mass-weighted mean, and p_h = sum_j N_j p_j the field it
+ * spans. The nodal force is f_i = integral of p_h grad N_i (-grad p in weak form), and the nodal
+ * volume rate D_j = integral of N_j div v_h, both exact (common/mpm_span.h). A particle's volume
+ * grows by its share of its nodes' rates, dV_p/dt = m_p sum_j N_j(x_p) D_j / m_j, and its internal
+ * energy by the pressure's work on that volume, de_p/dt = -p_p dV_p/dt / m_p. Summed over the
+ * particles that work is -sum_j p_j D_j, minus the nodal forces' power sum_i f_i . v_i (the two
+ * span integrals are adjoint), so total energy stays exact as with the particles' quadrature; so
+ * does momentum (sum_i grad N_i = 0), and mass is untouched. The viscous stresses (physical and
+ * artificial) stay on the particles. Why: a constant pressure then gives no force and a constant
+ * velocity no volume change at any node whose support lies inside the gas, whatever the
+ * particles' positions; the particles' quadrature is exact there only by the symmetry of a
+ * uniform lattice, which the corners of a refined region break (docs/refinement.md).
+ *
+ * On a refinement hierarchy (mpm_hier.h) the deposit of m p is restricted with the mass, the
+ * nodal pressure is formed on the active nodes and prolonged, each level integrates over its own
+ * spans (those of its region not refined further; level 0 over the domain, halved at the walls),
+ * and the level forces and rates are restricted onto the active nodes, the transposes of the
+ * prolongations: the composite basis is integrated exactly.
+ *
+ * Walls. Level 0's pad nodes take part like any node (their pressure and rate from their own
+ * unfolded mass); the walls then fold their forces as they fold the particles' deposits.
+ *
+ * Scope (fluid_gridp_read refuses the rest): the method-of-lines ERK pairs with the current
+ * strain rate, the quadratic B-spline, a gas alone (no solid, obstacle or open face), no
+ * shifting, the point volume rate. */
+#include "fluid_internal.h"
+
+#include "mpm_error.h"
+#include "mpm_hier.h"
+#include "mpm_span.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+struct fluid_gridp {
+  int phase;  /* grid phase whose m_i takes the deposit of m p */
+  int nlev;   /* levels (1 without a hierarchy) */
+  double *mp; /* m p of each particle (cap) */
+  double *s;  /* sum_j N_j D_j / m_j at each particle (cap) */
+  double *zero;
+  mpm_lidx cap;
+  /* Per level: nodal pressure, then rate per unit mass (P), forces (F, dim), rates (D), the
+   * mass they divide by (M: level 0's before the walls fold it), and the spans it skips. */
+  double *P[MPM_HIER_MAX_LEVELS], *F[MPM_HIER_MAX_LEVELS][MPM_MAX_DIM], *D[MPM_HIER_MAX_LEVELS];
+  double *M0;
+  unsigned char *skip[MPM_HIER_MAX_LEVELS];
+  mpm_span_set set[MPM_HIER_MAX_LEVELS];
+};
+
+static int refuse(const mpm_config *cfg, const char *key, const char *why) {
+  return mpm_config_fail(cfg, key, "fluid.pressure = grid %s; set fluid.pressure = particle", why);
+}
+
+int fluid_gridp_read(fluid_content *fc, const mpm_config *cfg, const mpm_grid *g) {
+  const char *form;
+  MPM_CALL(mpm_config_get_string(cfg, "fluid.pressure", &form));
+  if (strcmp(form, "grid") != 0) return 0;
+  if (fc->tr.classic)
+    return refuse(cfg, "time.method", "is carried by the ERK pairs (the method of lines) only");
+  if (!fc->current_rate)
+    return refuse(cfg, "fluid.strain_rate", "needs the current strain rate (the default)");
+  if (g->shape != MPM_SHAPE_QUADRATIC)
+    return refuse(cfg, "grid.shape", "integrates the quadratic B-spline's spans");
+  if (fc->volume_domain)
+    return refuse(cfg, "fluid.volume_rate", "sets the volume rate itself (from the nodes)");
+  if (fc->shift > 0.0) return refuse(cfg, "fluid.shift", "is not carried with shifting");
+  const char *const *names;
+  int count;
+  MPM_CALL(mpm_config_instances(cfg, "solid", &names, &count));
+  if (count > 0)
+    return refuse(cfg, "fluid.pressure",
+                  "integrates over every span of the domain, and the case has a solid");
+  MPM_CALL(mpm_config_instances(cfg, "obstacle", &names, &count));
+  if (count > 0) {
+    char key[160];
+    snprintf(key, sizeof key, "obstacle.%s.shape", names[0]);
+    return refuse(cfg, key, "integrates over every span of the domain, obstacles included");
+  }
+  for (int d = 0; d < g->dim; ++d)
+    for (int s = 0; s < 2; ++s)
+      if (mpm_wall_is_open_gas(fc->walls.face[d][s])) {
+        char key[32];
+        snprintf(key, sizeof key, "boundary.%c_%s", "xyz"[d], s ? "hi" : "lo");
+        return refuse(cfg, key, "is not carried with open faces (their particles' pressure)");
+      }
+  MPM_ALLOC(fc->gridp, 1);
+  memset(fc->gridp, 0, sizeof *fc->gridp);
+  return 0;
+}
+
+int fluid_gridp_init(mpm_module *m) {
+  fluid_content *fc = m->content;
+  if (fc->gridp) MPM_CALL(mpm_grid_add_phase(m->grid, "fluid_pressure", &fc->gridp->phase));
+  return 0;
+}
+
+void fluid_gridp_destroy(fluid_content *fc) {
+  fluid_gridp *gp = fc->gridp;
+  if (!gp) return;
+  free(gp->mp), free(gp->s), free(gp->zero), free(gp->M0);
+  for (int l = 0; l < MPM_HIER_MAX_LEVELS; ++l) {
+    free(gp->P[l]), free(gp->D[l]), free(gp->skip[l]);
+    for (int d = 0; d < MPM_MAX_DIM; ++d) free(gp->F[l][d]);
+  }
+  free(gp);
+  fc->gridp = NULL;
+}
+
+static const mpm_grid *level_grid(const mpm_module *m, int l) {
+  return m->hier ? m->hier->level[l].grid : m->grid;
+}
+
+/* The per-level arrays and span sets, on first use (the hierarchy is static). */
+static int ensure_levels(mpm_module *m, fluid_gridp *gp) {
+  if (gp->P[0]) return 0;
+  const mpm_hier *h = m->hier;
+  gp->nlev = h ? h->nlevels : 1;
+  for (int l = 0; l < gp->nlev; ++l) {
+    const mpm_grid *g = level_grid(m, l);
+    const size_t nn = (size_t)g->nnodes;
+    MPM_ALLOC(gp->P[l], nn);
+    MPM_ALLOC(gp->D[l], nn);
+    for (int d = 0; d < g->dim; ++d) MPM_ALLOC(gp->F[l][d], nn);
+    if (l == 0) {
+      MPM_ALLOC(gp->M0, nn);
+      if (h) {
+        MPM_ALLOC(gp->skip[0], nn);
+        memcpy(gp->skip[0], h->level[0].refined, nn);
+      }
+      gp->set[0] = mpm_span_owned(g, gp->skip[0]);
+      continue;
+    }
+    MPM_ALLOC(gp->skip[l], nn);
+    for (size_t n = 0; n < nn; ++n)
+      gp->skip[l][n] = !h->level[l].covered[n] || h->level[l].refined[n];
+    mpm_span_set *s = &gp->set[l];
+    *s = (mpm_span_set){.skip = gp->skip[l]};
+    for (int d = 0; d < g->dim; ++d)
+      s->lo[d] = g->box_lo[d], s->hi[d] = g->box_lo[d] + g->box_n[d] - 1;
+  }
+  return 0;
+}
+
+static int ensure_particles(fluid_gridp *gp, mpm_lidx cap) {
+  if (gp->cap >= cap && gp->mp) return 0;
+  free(gp->mp), free(gp->s), free(gp->zero);
+  gp->mp = gp->s = gp->zero = NULL;
+  MPM_ALLOC(gp->mp, (size_t)cap);
+  MPM_ALLOC(gp->s, (size_t)cap);
+  gp->zero = calloc((size_t)cap, sizeof(double));
+  if (!gp->zero) MPM_FAIL(MPM_ERR_MEMORY, "out of memory for %ld particles", (long)cap);
+  gp->cap = cap;
+  return 0;
+}
+
+int fluid_gridp_deposit(mpm_module *m, const double *y, const fluid_batch *b) {
+  fluid_content *fc = m->content;
+  fluid_gridp *gp = fc->gridp;
+  const mpm_particles *p = m->particles;
+  const int dim = p->dim;
+  const mpm_lidx n = p->n;
+  MPM_CALL(ensure_levels(m, gp));
+  MPM_CALL(ensure_particles(gp, fc->cap));
+  /* vsig holds -V p on its diagonal (fluid_stress_pressure): keep m p, deposit no stress. */
+  for (mpm_lidx i = 0; i < n; ++i) {
+    const double V = b->V0[i] * b->J[i];
+    gp->mp[i] = -b->m[i] * b->vsig[i] / V;
+  }
+  memset(b->vsig, 0, sizeof(double) * (size_t)dim * dim * n);
+  if (m->hier)
+    mpm_hier_phase_zero(m->hier, gp->phase);
+  else
+    mpm_grid_phase_zero(m->grid, gp->phase);
+  mpm_p2g_args a = {.n = n, .m = gp->mp, .lp = fc->lp};
+  for (int d = 0; d < dim; ++d)
+    a.x[d] = y + (size_t)(p->offset[FLUID_X] + d) * n, a.v[d] = gp->zero;
+  int rc = 0;
+  fluid_p2g_any(m, gp->phase, &a, &rc);
+  return rc;
+}
+
+/* Restrict level arrays a[l][0 .. nf) onto the active nodes (finest level first) and sum level
+ * 0's ghosts into their owners. */
+static int restrict_all(mpm_module *m, double *a[][MPM_MAX_DIM], int nf) {
+  for (int l = m->hier ? m->hier->nlevels - 1 : 0; l >= 1; --l)
+    mpm_hier_restrict_level(m->hier, l, a[l], a[l - 1], nf);
+  return mpm_grid_halo_reverse(m->grid, a[0], nf);
+}
+
+/* Fill level 0's ghosts from their owners and prolong the scalar a[l] into the inactive
+ * nodes. */
+static int prolong_all(mpm_module *m, double **a) {
+  MPM_CALL(mpm_grid_halo_forward(m->grid, &a[0], 1));
+  for (int l = 1; m->hier && l < m->hier->nlevels; ++l)
+    mpm_hier_prolong_level(m->hier, l, (const double *const *)&a[l - 1], &a[l], 1);
+  return 0;
+}
+
+/* out[l] = num[l] / mass on the active nodes with mass, 0 elsewhere. */
+static void per_mass(const mpm_module *m, const fluid_gridp *gp, double *const *num,
+                     double *const *out) {
+  for (int l = 0; l < gp->nlev; ++l) {
+    const mpm_grid *g = level_grid(m, l);
+    const double *mass = l == 0 ? gp->M0 : g->phase[m->phase].m_i;
+    const unsigned char *act = m->hier ? m->hier->level[l].active : NULL;
+    for (mpm_lidx k = 0; k < g->nnodes; ++k)
+      out[l][k] = (!act || act[k]) && mass[k] > 0.0 ? num[l][k] / mass[k] : 0.0;
+  }
+}
+
+int fluid_gridp_forces(mpm_module *m) {
+  fluid_content *fc = m->content;
+  fluid_gridp *gp = fc->gridp;
+  const int dim = m->grid->dim;
+  double *Q[MPM_HIER_MAX_LEVELS][MPM_MAX_DIM] = {{NULL}};
+  if (m->hier) mpm_hier_restrict(m->hier, gp->phase);
+  for (int l = 0; l < gp->nlev; ++l) Q[l][0] = level_grid(m, l)->phase[gp->phase].m_i;
+  MPM_CALL(mpm_grid_halo_reverse(m->grid, Q[0], 1));
+  /* Level 0's mass as the rates will divide by it (the walls fold the phase's own next). */
+  memcpy(gp->M0, m->grid->phase[m->phase].m_i, sizeof(double) * (size_t)m->grid->nnodes);
+  double *q[MPM_HIER_MAX_LEVELS];
+  for (int l = 0; l < gp->nlev; ++l) q[l] = Q[l][0];
+  per_mass(m, gp, q, gp->P);
+  MPM_CALL(prolong_all(m, gp->P));
+  for (int l = 0; l < gp->nlev; ++l) {
+    const mpm_grid *g = level_grid(m, l);
+    for (int d = 0; d < dim; ++d) memset(gp->F[l][d], 0, sizeof(double) * (size_t)g->nnodes);
+    mpm_span_force(g, &gp->set[l], gp->P[l], gp->F[l]);
+  }
+  MPM_CALL(restrict_all(m, gp->F, dim));
+  for (int l = 0; l < gp->nlev; ++l) {
+    const mpm_grid *g = level_grid(m, l);
+    const mpm_grid_phase *ph = &g->phase[m->phase];
+    for (int d = 0; d < dim; ++d)
+      for (mpm_lidx k = 0; k < g->nnodes; ++k) ph->f_i[d][k] += gp->F[l][d][k];
+  }
+  return 0;
+}
+
+int fluid_gridp_nodal_rate(mpm_module *m, mpm_hier_scalars *s) {
+  fluid_content *fc = m->content;
+  fluid_gridp *gp = fc->gridp;
+  double *D[MPM_HIER_MAX_LEVELS][MPM_MAX_DIM] = {{NULL}};
+  for (int l = 0; l < gp->nlev; ++l) {
+    const mpm_grid *g = level_grid(m, l);
+    const double *v[MPM_MAX_DIM];
+    for (int d = 0; d < g->dim; ++d) v[d] = g->phase[m->phase].v_i[d];
+    memset(gp->D[l], 0, sizeof(double) * (size_t)g->nnodes);
+    mpm_span_divergence(g, &gp->set[l], v, gp->D[l]);
+    D[l][0] = gp->D[l];
+  }
+  MPM_CALL(restrict_all(m, D, 1));
+  per_mass(m, gp, gp->D, gp->P); /* P now holds the rate per unit mass */
+  MPM_CALL(prolong_all(m, gp->P));
+  memset(s, 0, sizeof *s);
+  for (int l = 0; l < gp->nlev; ++l) s->s_i[l][0] = gp->P[l];
+  return 0;
+}
+
+void fluid_gridp_work(const mpm_module *m, const double *y, double *power) {
+  const fluid_content *fc = m->content;
+  const fluid_gridp *gp = fc->gridp;
+  const mpm_particles *p = m->particles;
+  const mpm_lidx n = p->n;
+  const double *mass = mpm_particles_comp(p, fc->lay.f_m, 0);
+  const double *V0 = mpm_particles_comp(p, fc->lay.f_V0, 0);
+  const double *J = y + (size_t)p->offset[FLUID_J] * n;
+  for (mpm_lidx i = 0; i < n; ++i) {
+    power[i] -= gp->mp[i] / mass[i] * gp->s[i];
+    gp->s[i] *= mass[i] / (V0[i] * J[i]);
+  }
+}
+
+double *fluid_gridp_rate_out(const fluid_content *fc) {
+  return fc->gridp->s;
+}
