@@ -230,6 +230,29 @@ def part_input():
     with_solid = refined.replace("geometry = strip", "geometry = air")
     cases.append(("solid module", with_solid.replace("[refine]", solid + "\n[refine]"),
                   "refine.levels", "levels = 2", "solid"))
+    # fluid.pressure = grid's own refusals (fluid/fluid_gridp.c), on the strip without [refine].
+    grid = "[fluid]\npressure = grid\n"
+    plain = case_text(2, 0.1, gas, "", extra=grid)
+    for key, value, words in [("time.method", "usl", "ERK pairs"),
+                              ("fluid.strain_rate", "lagged", "current strain rate"),
+                              ("grid.shape", "linear", "quadratic"),
+                              ("fluid.shift", "0.375", "shifting"),
+                              ("fluid.volume_rate", "domain", "volume rate")]:
+        sec, k = key.split(".")
+        if sec == "fluid":
+            text = plain.replace("pressure = grid", f"pressure = grid\n{k} = {value}")
+        elif sec == "time":
+            text = plain.replace("t_end = 0.1", f"t_end = 0.1\n{k} = {value}")
+        else:
+            text = plain.replace("dx = 0.05", f"dx = 0.05\n{k} = {value}")
+        cases.append((f"grid pressure with {key} = {value}", text, key, f"{k} = {value}", words))
+    cases.append(("grid pressure with an obstacle", plain + "\n" + obstacle,
+                  "obstacle.post.shape", "shape = circle", "obstacles"))
+    cases.append(("grid pressure with an open face", openface.replace(
+        "[refine]", grid + "\n[refine]"), "boundary.y_hi", "y_hi = outflow", "open faces"))
+    cases.append(("grid pressure with a solid", case_text(2, 0.1, gas, solid).replace(
+        "geometry = strip", "geometry = air") + "\n" + grid, "fluid.pressure", "pressure = grid",
+        "solid"))
     for name, text, key, start, words in cases:
         mt.expect_input_error(check, name, text, key, mt.line_starting(text, start), words)
     # Two ranks: one line from rank 0, exit 2.
