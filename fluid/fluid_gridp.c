@@ -53,13 +53,14 @@ struct fluid_gridp {
 };
 
 static int refuse(const mpm_config *cfg, const char *key, const char *why) {
-  return mpm_config_fail(cfg, key, "fluid.pressure = grid %s; set fluid.pressure = particle", why);
+  return mpm_config_fail(cfg, key,
+                         "the grid pressure (fluid.pressure = grid, or auto with refinement) %s; "
+                         "change this key, or set fluid.pressure = particle without refinement",
+                         why);
 }
 
-int fluid_gridp_read(fluid_content *fc, const mpm_config *cfg, const mpm_grid *g) {
-  const char *form;
-  MPM_CALL(mpm_config_get_string(cfg, "fluid.pressure", &form));
-  if (strcmp(form, "grid") != 0) return 0;
+/* The refusals of the grid pressure; the first found names its key. */
+static int check_scope(const fluid_content *fc, const mpm_config *cfg, const mpm_grid *g) {
   if (fc->tr.classic)
     return refuse(cfg, "time.method", "is carried by the ERK pairs (the method of lines) only");
   if (!fc->current_rate)
@@ -88,15 +89,34 @@ int fluid_gridp_read(fluid_content *fc, const mpm_config *cfg, const mpm_grid *g
         snprintf(key, sizeof key, "boundary.%c_%s", "xyz"[d], s ? "hi" : "lo");
         return refuse(cfg, key, "is not carried with open faces (their particles' pressure)");
       }
-  MPM_ALLOC(fc->gridp, 1);
-  memset(fc->gridp, 0, sizeof *fc->gridp);
   return 0;
 }
 
-int fluid_gridp_init(mpm_module *m) {
+/* Check the scope, then set the grid pressure up with its grid phase. */
+static int enable(mpm_module *m, const mpm_config *cfg) {
   fluid_content *fc = m->content;
-  if (fc->gridp) MPM_CALL(mpm_grid_add_phase(m->grid, "fluid_pressure", &fc->gridp->phase));
-  return 0;
+  MPM_CALL(check_scope(fc, cfg, m->grid));
+  MPM_ALLOC(fc->gridp, 1);
+  memset(fc->gridp, 0, sizeof *fc->gridp);
+  return mpm_grid_add_phase(m->grid, "fluid_pressure", &fc->gridp->phase);
+}
+
+int fluid_gridp_init(mpm_module *m, const mpm_config *cfg) {
+  const char *form;
+  MPM_CALL(mpm_config_get_string(cfg, "fluid.pressure", &form));
+  return strcmp(form, "grid") == 0 ? enable(m, cfg) : 0;
+}
+
+int fluid_gridp_refine(mpm_module *m, const mpm_config *cfg, mpm_hier *h) {
+  const char *form;
+  MPM_CALL(mpm_config_get_string(cfg, "fluid.pressure", &form));
+  if (strcmp(form, "particle") == 0)
+    return mpm_config_fail(cfg, "fluid.pressure",
+                           "the particles' quadrature is not exact at the corners of a refined "
+                           "region and disturbs the gas there (docs/refinement.md); remove the "
+                           "key or set fluid.pressure = grid");
+  if (!((fluid_content *)m->content)->gridp) MPM_CALL(enable(m, cfg));
+  return mpm_hier_add_phases(h);
 }
 
 void fluid_gridp_destroy(fluid_content *fc) {

@@ -108,15 +108,17 @@ int fluid_limiter(mpm_module *m, const double *y, const double *const *v_i, cons
 int fluid_volume_rate(mpm_module *m, const double *y, const double *const *v_i, const double *L,
                       const double **rate);
 
-/* fluid.pressure = grid (fluid_gridp.c). read: the key and its refusals, each naming its key
- * (after the other settings and the walls); init: its grid phase (in the build); deposit: in
- * the RHS's P2G after fluid_stress_pressure, keeps m p and zeroes the pressure's stress in b;
- * forces: before the walls fold the deposit (first pass), adds the nodal pressure's force;
- * nodal_rate: after the solve, the nodal volume rate per unit mass on every level, into s for
- * the G2P that fills the particles' rate (fluid_gridp_rate_out); work: adds the pressure's
- * de/dt to power, then turns that rate into dJ/dt / J in place. */
-int fluid_gridp_read(fluid_content *fc, const mpm_config *cfg, const mpm_grid *g);
-int fluid_gridp_init(mpm_module *m);
+/* fluid.pressure = grid (fluid_gridp.c). init: in the build, after the other settings and the
+ * walls, sets it up (its grid phase) when the key asks for grid, refusing what it does not carry
+ * with the key at fault; refine: on a refinement hierarchy, where auto means grid and particle is
+ * refused, sets it up if init did not and gives the hierarchy its phase; deposit: in the RHS's
+ * P2G after fluid_stress_pressure, keeps m p and zeroes the pressure's stress in b; forces:
+ * before the walls fold the deposit (first pass), adds the nodal pressure's force; nodal_rate:
+ * after the solve, the nodal volume rate per unit mass on every level, into s for the G2P that
+ * fills the particles' rate (fluid_gridp_rate_out); work: adds the pressure's de/dt to power,
+ * then turns that rate into dJ/dt / J in place. */
+int fluid_gridp_init(mpm_module *m, const mpm_config *cfg);
+int fluid_gridp_refine(mpm_module *m, const mpm_config *cfg, mpm_hier *h);
 void fluid_gridp_destroy(fluid_content *fc);
 int fluid_gridp_deposit(mpm_module *m, const double *y, const fluid_batch *b);
 int fluid_gridp_forces(mpm_module *m);
@@ -148,6 +150,11 @@ int fluid_regularise(mpm_module *m, long step, int *changed);
  * of shift_every and shift > 0; only positions change (fluid_shift.c). Sets *changed if any
  * particle moved. Collective. */
 int fluid_shift(mpm_module *m, long step, double h, int *changed);
+
+/* After an accepted step on a hierarchy: split the particles that entered a finer level and
+ * merge, 2^dim at a time, those that left one (fluid_relevel.c); sets *changed when the set
+ * changed. One rank (the hierarchy's). */
+int fluid_relevel(mpm_module *m, int *changed);
 
 /* Seed the finer levels of m->hier (fluid_seed.c): drop the level-0 particles inside them and
  * seed each level's own region on its lattice. Collective. */

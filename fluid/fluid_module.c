@@ -88,12 +88,13 @@ static const mpm_key_spec fluid_keys[] = {
      "the velocity ripples at the grid scale, as in hot gas at rest on the grid; only J, and so "
      "the density and pressure, reads it; see docs/gas.md)",
      0, NULL},
-    {"fluid.pressure", MPM_KEY_ENUM, "particle", 0, 0, 0, 0, "particle|grid",
+    {"fluid.pressure", MPM_KEY_ENUM, "auto", 0, 0, 0, 0, "auto|particle|grid",
      "where the pressure's force is integrated: particle (each particle's V p at its point, "
-     "the classic MPM quadrature) or grid (the nodal pressure, a mass-weighted mean of the "
+     "the classic MPM quadrature), grid (the nodal pressure, a mass-weighted mean of the "
      "particles', integrated exactly over the grid's cells, with each particle's volume "
-     "following its nodes' volume rate): keeps gas at rest and uniform streams exact across "
-     "refined regions; ERK pairs, quadratic shape and a gas alone; see docs/refinement.md",
+     "following its nodes' volume rate: gas at rest and uniform streams stay exact across "
+     "refined regions; ERK pairs, quadratic shape and a gas alone) or auto (grid with "
+     "refine.levels > 1, where particle is refused; else particle); see docs/refinement.md",
      0, NULL},
     {"fluid.ppc", MPM_KEY_INT, "2", 1, 8, 0, 0, NULL,
      "gas particles per cell per direction at seeding", 0, "-"},
@@ -618,6 +619,7 @@ static int fluid_post_step(mpm_module *m, double t, double h, int *changed) {
   if (shifted && fc->refill_every > 0 && m->step % fc->refill_every == 0)
     MPM_CALL(mpm_cells_count(m->grid, m->phase, m->particles));
   *changed |= shifted;
+  if (m->hier) MPM_CALL(fluid_relevel(m, changed));
   return fluid_regularise(m, m->step, changed);
 }
 
@@ -908,8 +910,7 @@ static int build(mpm_module *m, const mpm_config *cfg, int seed) {
   MPM_CALL(mpm_walls_from_config(&walls, cfg, g->dim));
   MPM_CALL(mpm_constraints_add_walls(&fc->cons, &walls, g));
   fc->walls = walls;
-  MPM_CALL(fluid_gridp_read(fc, cfg, g));
-  MPM_CALL(fluid_gridp_init(m));
+  MPM_CALL(fluid_gridp_init(m, cfg));
   MPM_CALL(fluid_open_new(&fc->open, m, cfg, &walls, fc->gas.gamma, fc->ppc));
   MPM_CALL(fluid_obstacles_build(&fc->obs, cfg, g, fc->ppc, (const unsigned char(*)[2])m->open));
   MPM_CALL(fluid_wall_ls_init(m, cfg, fc->tr.classic));

@@ -142,6 +142,7 @@ int fluid_refine_check(const mpm_module *m, const mpm_config *cfg) {
 
 int fluid_module_refine(mpm_module *m, const mpm_config *cfg, mpm_hier *h, int seed) {
   MPM_CALL(fluid_refine_check(m, cfg));
+  MPM_CALL(fluid_gridp_refine(m, cfg, h));
   m->hier = h;
   return seed ? fluid_seed_refined(m, cfg) : 0;
 }

@@ -6,11 +6,6 @@ foreach(part uniform pulse input identity)
   mpm_add_script_test(test_refine_gas_${part} SCRIPT verification/test_refine_gas.py ARGS ${part}
                       LABELS verification TIMEOUT 300)
 endforeach()
-# The first two with fluid.pressure = grid, which meets their targets (~8 and ~17 s).
-foreach(part uniform pulse)
-  mpm_add_script_test(test_refine_gas_${part}_grid SCRIPT verification/test_refine_gas.py
-                      ARGS ${part} 2 grid LABELS verification TIMEOUT 300)
-endforeach()
 foreach(part uniform pulse)
   mpm_add_script_test(test_refine_gas_${part}_ppc4 SCRIPT verification/test_refine_gas.py
                       ARGS ${part} 4 LABELS verification long TIMEOUT 300)

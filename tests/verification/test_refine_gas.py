@@ -2,7 +2,8 @@
 
 A 2-D strip, periodic along x, slip walls along y, level 0 at dx = 0.05; one level-1 box (spacing
 0.025) in its middle, three cells clear of the walls. Default gas settings (bs32, strain rate
-current). Each run is compared with its uniform twins: the same strip without refinement at
+current; fluid.pressure = auto, so the refined runs integrate the pressure on the grid and their
+particles split and merge as they cross the box's edge). Each run is compared with its uniform twins: the same strip without refinement at
 dx = 0.05 (coarse) and at dx = 0.025 (fine). The argument picks the part (one ctest each):
 
 uniform  A uniform gas (rho 1, p 1, u = 0.5 c along x) crossing the box about three times its
@@ -19,9 +20,7 @@ identity refine.levels = 1 gives the same output as no [refine] section, bit for
 Able to fail: with the restriction switched off (coupler/mpm_cycle.c) the uniform part's run
 blows up at t = 0.11.
 A second argument sets fluid.ppc of the uniform and pulse runs (2 by default; 4 in the long
-tests), a third their fluid.pressure (particle by default; grid: the pressure integrated on the
-grid's spans, which meets the targets). The figures and tolerances are stated at each check and
-in docs/refinement.md.
+tests). The figures and tolerances are stated at each check and in docs/refinement.md.
 """
 import os
 import sys
@@ -34,9 +33,8 @@ import mpmtest as mt  # noqa: E402
 
 PART = sys.argv[1] if len(sys.argv) > 1 else "uniform"
 PPC = int(sys.argv[2]) if len(sys.argv) > 2 else 2  # fluid.ppc of the uniform and pulse runs
-FORM = sys.argv[3] if len(sys.argv) > 3 else "particle"  # fluid.pressure of those runs
-check = mt.Checks(f"test_refine_gas_{PART}" + ("" if FORM == "particle" else f"_{FORM}"))
-FLUID = f"[fluid]\nppc = {PPC}\npressure = {FORM}\n"
+check = mt.Checks(f"test_refine_gas_{PART}")
+FLUID = f"[fluid]\nppc = {PPC}\n"
 C0 = np.sqrt(1.4)  # sound speed of rho 1, p 1
 BOX = "[refine]\nlevels = 2\n\n[refine.box]\nlevel = 1\nlo = {x0} 0.15\nhi = {x1} 0.45\n"
 
@@ -250,6 +248,9 @@ def part_input():
                   "obstacle.post.shape", "shape = circle", "obstacles"))
     cases.append(("grid pressure with an open face", openface.replace(
         "[refine]", grid + "\n[refine]"), "boundary.y_hi", "y_hi = outflow", "open faces"))
+    cases.append(("particle pressure with refinement", case_text(
+        2, 0.1, gas, box, extra="[fluid]\npressure = particle\n"), "fluid.pressure",
+        "pressure = particle", "corners"))
     cases.append(("grid pressure with a solid", case_text(2, 0.1, gas, solid).replace(
         "geometry = strip", "geometry = air") + "\n" + grid, "fluid.pressure", "pressure = grid",
         "solid"))
@@ -288,50 +289,35 @@ def part_identity():
           f"{worst:.1e} from the run straight through (bit for bit: 0)")
 
 
-# The measured figures of fluid.pressure = particle, by fluid.ppc: the uniform stream's largest
-# deviation at t = 1.4 and the pulse's reflected energy fraction (docs/refinement.md). The box's
-# corners push gas at rest there (the pulse part's run at rest) and the disturbance grows, so
-# neither reaches its target (roundoff, as the twins get; the issue's 1 %): the checks assert the
-# measured figure with 20 % margin, so that a worse regression fails, and keep the target as an
-# expected failure. fluid.pressure = grid integrates the composite basis exactly and meets both
-# targets: ordinary checks.
-MEASURED = {2: (1.48e-1, 0.516), 4: (2.47e-2, 2.93e-2)}
-GRID = FORM == "grid"
-
-
-def target(ok, text, why):
-    """The issue's target: an ordinary check with the grid pressure, else an expected failure."""
-    if GRID:
-        check(ok, text)
-    else:
-        check.expect_fail(ok, text, why)
-
-
 if PART == "uniform":
     runs, dev = part_uniform()
     got = dev["refined"]
-    if not GRID:
-        bound = 1.2 * MEASURED[PPC][0]
-        check(got <= bound, f"uniform gas across the box, ppc {PPC}: deviation {got:.2e} <= "
-              f"{bound:.3g} (measured {MEASURED[PPC][0]:.3g} at t = 1.4)")
-    # Roundoff: every particle keeps rho, p, v to a few ulps (1e-15 measured); 1e-10 leaves room
-    # for the ~300 steps' accumulation and fails on any disturbance the corners raise (0.15).
-    target(got <= 1e-10, f"uniform gas across the box ({FORM}): deviation {got:.2e} at roundoff"
-           f" (<= 1e-10) like the coarse twin's {dev['coarse']:.1e}",
-           "the box corners' quadrature disturbs the gas")
+    # Roundoff: every particle keeps rho, p, v to a few ulps (1e-14 measured); 1e-10 leaves room
+    # for the ~600 steps' accumulation and fails on any disturbance the box raises (the particle
+    # pressure's quadrature gave 0.15, docs/refinement.md).
+    check(got <= 1e-10, f"uniform gas across the box: deviation {got:.2e} at roundoff (<= 1e-10)"
+          f" like the coarse twin's {dev['coarse']:.1e}")
+    # The particles follow the levels: the count changed during the run (splits and merges) and
+    # at t = 1.4, the stream having crossed the box 1.4 times, every particle has its level's
+    # size. Level 1's region is the box snapped outwards to level-0 spans (centred on the nodes).
+    out = runs["refined"][0]
+    counts = set(diagnostics(out)["particles"].astype(int))
+    p = final(out)
+    size = np.rint(np.log2((0.05 / PPC) ** 2 * p["rho"].ravel() / p["m"].ravel()) / 2)
+    x, y = p["x"][:, 0], p["x"][:, 1]
+    inside = (x > 0.775) & (x < 1.225) & (y > 0.125) & (y < 0.475)
+    wrong = int(np.sum(size != inside))
+    check(len(counts) > 1 and wrong == 0, f"particles follow the levels: {len(counts)} distinct "
+          f"particle counts in the run; at t = 1.4, {wrong} of {len(size)} particles with another "
+          f"level's size (want 0)")
     # Mass: the sum of ~1e4 particle masses of two sizes in another order after sorting:
     # n eps ~ 1e-12. Momentum: of the order of the twins' roundoff. Energy: bs32's rtol 1e-6.
     conservation(runs, 1e-12, 1e-12, 1e-6)
 elif PART == "pulse":
     runs, frac = part_pulse()
     got = frac["refined"]
-    target(got <= 1e-2, f"pulse ({FORM}): reflected energy fraction {got:.2e} <= 1e-2 (the "
-           f"issue's bar; coarse twin {frac['coarse']:.1e}, fine {frac['fine']:.1e})",
-           "the disturbance the box corners raise swamps the pulse")
-    if not GRID:
-        bound = 1.2 * MEASURED[PPC][1]
-        check(got <= bound, f"pulse, ppc {PPC}: reflected energy fraction {got:.2e} <= "
-              f"{bound:.3g} (measured {MEASURED[PPC][1]:.3g})")
+    check(got <= 1e-2, f"pulse: reflected energy fraction {got:.2e} <= 1e-2 (the issue's bar; "
+          f"coarse twin {frac['coarse']:.1e}, fine {frac['fine']:.1e})")
     conservation(runs, 1e-12, 1e-12, 1e-6)
 elif PART == "input":
     part_input()

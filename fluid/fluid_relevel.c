@@ -1,0 +1,94 @@
+/* Gas particles that follow the refinement (issue 51, item 3): after every accepted step, a
+ * particle whose size is that of a coarser level than the level of its position splits into
+ * 2^dim children (fluid_split), and the particles of a finer size than their position's level
+ * merge back, 2^dim at a time (fluid_merge), so that every level holds particles of its own
+ * spacing. Mass, momentum, total energy and the centre of mass stay exact (fluid_split.h).
+ *
+ * Size. A gas particle's level of size follows from its reference volume: seeding gives level l
+ * particles V0 = (h_l / ppc)^dim, a split divides V0 by 2^dim and a merge sums it, so the level
+ * is round(log2(V0_level0 / V0) / dim). No field is stored, and a restart needs nothing.
+ *
+ * Merging. The candidates of one level of size L are grouped by the slots of the coarser
+ * particle lattice (spacing h_{L-1} / ppc, fluid_merge_groups); only full groups of 2^dim merge,
+ * so every merged particle has the coarser level's size. A slot lies wholly inside or outside
+ * each refined region (the regions are unions of coarser spans, whose faces are slot faces for
+ * an even ppc), so the merged particle sits on the level of its members. A part-filled slot
+ * waits for the rest of its particles; in a flow that never fills it they stay fine.
+ *
+ * Splitting. The children sit at +-s/4 of the parent (s its size): a parent that has just
+ * crossed into a finer region may leave some children outside it, which then wait (their slot
+ * is not full) and enter with the flow.
+ *
+ * Merges first, then splits (fluid_split.h): a merge removes particles and renumbers the set. */
+#include "fluid_internal.h"
+#include "fluid_split.h"
+
+#include "mpm_error.h"
+#include "mpm_hier.h"
+
+#include <math.h>
+#include <stdlib.h>
+
+/* The level of size of particle i (0 .. nlevels - 1). */
+static int size_level(const mpm_module *m, double V0_0, mpm_lidx i) {
+  const fluid_content *fc = m->content;
+  const double V0 = mpm_particles_comp(m->particles, fc->lay.f_V0, 0)[i];
+  const long l = lround(log2(V0_0 / V0) / m->grid->dim);
+  return (int)(l < 0 ? 0 : l >= m->hier->nlevels ? m->hier->nlevels - 1 : l);
+}
+
+/* The level of the position of particle i. */
+static int position_level(const mpm_module *m, mpm_lidx i) {
+  const mpm_particles *p = m->particles;
+  double x[MPM_MAX_DIM];
+  for (int d = 0; d < p->dim; ++d) x[d] = mpm_particles_comp(p, FLUID_X, d)[i];
+  return mpm_hier_level_of(m->hier, x);
+}
+
+/* Merge the full groups of the particles of size level L that lie on a coarser level. */
+static int merge_level(mpm_module *m, double V0_0, int L, mpm_lidx *idx, mpm_lidx *merged) {
+  const fluid_content *fc = m->content;
+  const mpm_lidx n = m->particles->n;
+  mpm_lidx k = 0;
+  for (mpm_lidx i = 0; i < n; ++i)
+    if (size_level(m, V0_0, i) == L && position_level(m, i) < L) idx[k++] = i;
+  if (k == 0) return 0;
+  mpm_lidx *start, *member, ng;
+  const double H = m->hier->level[L - 1].grid->dx / fc->ppc;
+  MPM_CALL(fluid_merge_groups(m, idx, k, H, &start, &member, &ng));
+  const mpm_lidx full = (mpm_lidx)1 << m->grid->dim;
+  mpm_lidx kept = 0, at = 0;
+  for (mpm_lidx g = 0; g < ng; ++g) { /* keep the full groups, in place */
+    const mpm_lidx a = start[g], size = start[g + 1] - a;
+    if (size != full) continue;
+    start[kept++] = at;
+    for (mpm_lidx j = 0; j < size; ++j) member[at++] = member[a + j];
+  }
+  start[kept] = at;
+  fluid_split_report rep = {0};
+  const int rc = kept ? fluid_merge(m, start, member, kept, &rep) : 0;
+  free(start), free(member);
+  *merged += rep.groups;
+  return rc;
+}
+
+int fluid_relevel(mpm_module *m, int *changed) {
+  const fluid_content *fc = m->content;
+  const mpm_hier *h = m->hier;
+  if (!h || h->nlevels < 2) return 0;
+  const double V0_0 = pow(h->level[0].grid->dx / fc->ppc, m->grid->dim);
+  mpm_lidx *idx;
+  MPM_ALLOC(idx, m->particles->n > 0 ? m->particles->n : 1);
+  mpm_lidx merged = 0;
+  int rc = 0;
+  for (int L = h->nlevels - 1; !rc && L >= 1; --L) rc = merge_level(m, V0_0, L, idx, &merged);
+  mpm_lidx k = 0;
+  for (mpm_lidx i = 0; !rc && i < m->particles->n; ++i)
+    if (size_level(m, V0_0, i) < position_level(m, i)) idx[k++] = i;
+  fluid_split_report rep = {0};
+  if (!rc) rc = fluid_split(m, idx, k, &rep);
+  free(idx);
+  MPM_CALL(rc);
+  *changed |= merged > 0 || rep.parents > 0;
+  return 0;
+}
