@@ -1,8 +1,8 @@
 # The gas on a static refinement hierarchy (docs/refinement.md): a uniform stream across a
-# level-1 box and an acoustic pulse through it against their uniform twins (~10 and ~20 s), every
-# refusal of the slice (~12 s), and refine.levels = 1 against no [refine] section (~2 s); the
-# first two again with fluid.ppc = 4 (~25 and ~35 s: long).
-foreach(part uniform pulse input identity)
+# level-1 box and an acoustic pulse through it against their uniform twins (~10 and ~20 s), the
+# uniform stream in 3-D (~12 s), every refusal of the slice (~12 s), and refine.levels = 1
+# against no [refine] section (~2 s); the first two again with fluid.ppc = 4 (long).
+foreach(part uniform pulse uniform3d input identity)
   mpm_add_script_test(test_refine_gas_${part} SCRIPT verification/test_refine_gas.py ARGS ${part}
                       LABELS verification TIMEOUT 300)
 endforeach()
