@@ -26,6 +26,22 @@ const mpm_key_spec mpm_refine_keys[] = {
     {"refine.buffer", MPM_KEY_INT, "2", 1, 64, 0, 0, NULL,
      "level-l cells kept between the region of level l + 1 and the edge of level l's region", 0,
      "-"},
+    {"refine.criterion", MPM_KEY_ENUM, "none", 0, 0, 0, 0, "none|density",
+     "dynamic refinement: none (the [refine.NAME] boxes, static) or density (refine where the "
+     "gas density of neighbouring level-0 cells differs by more than refine.threshold, and "
+     "regrid every refine.every steps)",
+     0, NULL},
+    {"refine.threshold", MPM_KEY_REAL, "0", 0, HUGE_VAL, 0, 0, NULL,
+     "the criterion's threshold: the relative density difference between neighbouring level-0 "
+     "cells that refines them (required with refine.criterion; e.g. 0.05)",
+     0, "-"},
+    {"refine.every", MPM_KEY_INT, "10", 1, 1000000, 0, 0, NULL,
+     "steps between regrids of a dynamic refinement (a regrid also runs before every checkpoint)",
+     0, "-"},
+    {"refine.dilate", MPM_KEY_INT, "2", 1, 64, 0, 0, NULL,
+     "level-0 cells added around the flagged cells, per level: level l's region is the flags "
+     "dilated by dilate (levels - l) cells (at least refine.buffer / 2)",
+     0, "-"},
     {"refine.*.level", MPM_KEY_INT, NULL, 1, MPM_HIER_MAX_LEVELS - 1, 0, 0, NULL,
      "the level this box refines to (1 .. refine.levels - 1); a box of level l > 1 must lie "
      "inside level l - 1's region by refine.buffer cells",
@@ -104,6 +120,159 @@ static int read_boxes(const mpm_config *cfg, const mpm_grid *g, const char *cons
   return 0;
 }
 
+/* ---- dynamic refinement: the regions from the criterion's flags --------------------------- */
+
+/* Level-0 cells a dynamic region keeps from every domain face (the static boxes' rule, met by
+ * construction: span i's lower face is at (i - 1/2) dx). */
+#define REFINE_CLIP 4
+
+typedef struct dynamic {
+  int levels, buffer, every, dilate;
+  double threshold;
+} dynamic;
+
+/* The dynamic settings, or 0 in *on when refine.criterion = none. */
+static int read_dynamic(const mpm_config *cfg, dynamic *dy, int *on) {
+  const char *criterion;
+  MPM_CALL(mpm_config_get_string(cfg, "refine.criterion", &criterion));
+  *on = strcmp(criterion, "none") != 0;
+  MPM_CALL(mpm_config_get_int(cfg, "refine.levels", &dy->levels));
+  MPM_CALL(mpm_config_get_int(cfg, "refine.buffer", &dy->buffer));
+  MPM_CALL(mpm_config_get_int(cfg, "refine.every", &dy->every));
+  MPM_CALL(mpm_config_get_int(cfg, "refine.dilate", &dy->dilate));
+  MPM_CALL(mpm_config_get_real(cfg, "refine.threshold", &dy->threshold));
+  if (!*on) return 0;
+  if (!(dy->threshold > 0))
+    return mpm_config_fail(cfg, "refine.criterion",
+                           "%s needs a threshold: set refine.threshold > 0 (the relative density "
+                           "difference between neighbouring cells that refines them, e.g. 0.05)",
+                           criterion);
+  if (2 * dy->dilate < dy->buffer)
+    return mpm_config_fail(cfg, "refine.dilate",
+                           "is %d, and the levels' regions must nest with refine.buffer = %d "
+                           "cells of the finer level between them; set refine.dilate >= %d",
+                           dy->dilate, dy->buffer, (dy->buffer + 1) / 2);
+  return 0;
+}
+
+/* Spans per axis of the flag lattice (fluid_refine_density_flags). */
+static size_t flag_lattice(const mpm_grid *g, int *n) {
+  size_t total = 1;
+  for (int d = 0; d < MPM_MAX_DIM; ++d) n[d] = 1;
+  for (int d = 0; d < g->dim; ++d)
+    n[d] = g->ncells[d] + (g->periodic[d] ? 0 : 1), total *= (size_t)n[d];
+  return total;
+}
+
+/* Dilate mask by r spans along every axis (a box of side 2 r + 1), into out; tmp as scratch. */
+static void dilate(const int *n, int dim, int r, const unsigned char *mask, unsigned char *out,
+                   unsigned char *tmp) {
+  const size_t total = (size_t)n[0] * n[1] * n[2];
+  memcpy(out, mask, total);
+  size_t stride = 1;
+  for (int d = 0; d < dim; stride *= (size_t)n[d], ++d) {
+    memcpy(tmp, out, total);
+    for (size_t s = 0; s < total; ++s) {
+      if (!tmp[s]) continue;
+      const int i = (int)(s / stride % (size_t)n[d]);
+      for (int j = MPM_MAX(0, i - r); j <= MPM_MIN(n[d] - 1, i + r); ++j)
+        out[s + ((size_t)j - (size_t)i) * stride] = 1;
+    }
+  }
+}
+
+/* Append the boxes of level l covering mask (runs along x, one row at a time) to *box. */
+static int mask_boxes(const mpm_grid *g, const int *n, int l, double eps, const unsigned char *mask,
+                      mpm_hier_box **box, int *nbox, int *cap) {
+  const size_t rows = (size_t)n[1] * n[2];
+  for (size_t row = 0; row < rows; ++row) {
+    const int j[2] = {(int)(row % (size_t)n[1]), (int)(row / (size_t)n[1])};
+    const unsigned char *m = mask + row * (size_t)n[0];
+    for (int a = 0; a < n[0]; ++a) {
+      if (!m[a]) continue;
+      int z = a;
+      while (z + 1 < n[0] && m[z + 1]) ++z;
+      if (*nbox == *cap) {
+        *cap = 2 * *cap + 16;
+        mpm_hier_box *grown = realloc(*box, sizeof **box * (size_t)*cap);
+        if (!grown) MPM_FAIL_OOM(sizeof **box * (size_t)*cap);
+        *box = grown;
+      }
+      mpm_hier_box *b = &(*box)[(*nbox)++];
+      const int first[3] = {a, j[0], j[1]}, last[3] = {z, j[0], j[1]};
+      b->level = l;
+      for (int d = 0; d < g->dim; ++d) {
+        b->lo[d] = g->lo[d] + (first[d] - 0.5) * g->dx + eps;
+        b->hi[d] = g->lo[d] + (last[d] + 0.5) * g->dx - eps;
+      }
+      a = z;
+    }
+  }
+  return 0;
+}
+
+/* The hierarchy the gas's flags ask for (*h = NULL when nothing is flagged). Level l's region
+ * is the flags dilated by dilate (levels - l) spans, clipped to REFINE_CLIP + (l - 1) dilate
+ * spans from every face, so that each level nests in the one below with its buffer. */
+static int make_dynamic(mpm_hier **h, const dynamic *dy, mpm_grid *grid, mpm_module *gas) {
+  int n[MPM_MAX_DIM];
+  const size_t total = flag_lattice(grid, n);
+  unsigned char *flag = malloc(3 * total);
+  if (!flag) MPM_FAIL_OOM(3 * total);
+  unsigned char *mask = flag + total, *tmp = mask + total;
+  fluid_refine_density_flags(gas, dy->threshold, n, flag);
+  mpm_hier_box *box = NULL;
+  int nbox = 0, cap = 0, used = 1, rc = 0;
+  const double eps = 1e-6 * ldexp(grid->dx, -dy->levels);
+  for (int l = 1; l < dy->levels && !rc; ++l) {
+    dilate(n, grid->dim, dy->dilate * (dy->levels - l), flag, mask, tmp);
+    const int clip = REFINE_CLIP + (l - 1) * dy->dilate;
+    int any = 0;
+    for (size_t s = 0; s < total; ++s) {
+      int in = 1;
+      for (int d = 0, r = (int)s; d < grid->dim; r /= n[d], ++d)
+        in &= r % n[d] >= clip && r % n[d] <= grid->ncells[d] - clip;
+      mask[s] &= (unsigned char)in;
+      any |= mask[s];
+    }
+    if (!any) break;
+    used = l + 1;
+    rc = mask_boxes(grid, n, l, eps, mask, &box, &nbox, &cap);
+  }
+  free(flag);
+  char why[512] = "";
+  *h = NULL;
+  if (!rc && used > 1) rc = mpm_hier_new(h, grid, used, box, nbox, dy->buffer, why, sizeof why);
+  free(box);
+  if (rc == MPM_ERR_INPUT) MPM_FAIL(MPM_ERR_INTERNAL, "regrid: %s", why);
+  return rc;
+}
+
+int mpm_refine_dynamic(const mpm_config *cfg) {
+  const char *criterion;
+  int levels;
+  if (mpm_config_get_string(cfg, "refine.criterion", &criterion) ||
+      mpm_config_get_int(cfg, "refine.levels", &levels))
+    return 0;
+  return levels > 1 && strcmp(criterion, "none") != 0;
+}
+
+int mpm_refine_regrid(mpm_hier **h, const mpm_config *cfg, mpm_grid *grid, mpm_module **mod,
+                      int nmod, long step, int force, int *changed) {
+  *changed = 0;
+  dynamic dy;
+  int on;
+  MPM_CALL(read_dynamic(cfg, &dy, &on));
+  if (!on || nmod < 1 || (!force && step % dy.every != 0)) return 0;
+  mpm_hier *next;
+  MPM_CALL(make_dynamic(&next, &dy, grid, mod[0]));
+  for (int k = 0; k < nmod; ++k) fluid_module_rehier(mod[k], next);
+  mpm_hier_destroy(h);
+  *h = next;
+  *changed = 1;
+  return 0;
+}
+
 int mpm_refine_build(mpm_hier **h, const mpm_config *cfg, mpm_grid *grid, mpm_module **mod,
                      int nmod, int seed) {
   int levels, buffer, nbox;
@@ -121,6 +290,21 @@ int mpm_refine_build(mpm_hier **h, const mpm_config *cfg, mpm_grid *grid, mpm_mo
   }
   if (levels == 1) return 0;
   MPM_CALL(check_case(cfg, grid, mod, nmod));
+  dynamic dy;
+  int on;
+  MPM_CALL(read_dynamic(cfg, &dy, &on));
+  if (on && nbox > 0) {
+    char key[160];
+    snprintf(key, sizeof key, "refine.%s.level", names[0]);
+    return mpm_config_fail(cfg, key,
+                           "is a static box, and refine.criterion refines dynamically: remove "
+                           "the [refine.NAME] boxes or set refine.criterion = none");
+  }
+  if (on) { /* from the seeded gas (on a restart the sim regrids once the particles are read) */
+    MPM_CALL(make_dynamic(h, &dy, grid, mod[0]));
+    for (int k = 0; k < nmod; ++k) MPM_CALL(fluid_module_refine(mod[k], cfg, *h, seed));
+    return 0;
+  }
   mpm_hier_box *box;
   MPM_ALLOC(box, nbox);
   int rc = read_boxes(cfg, grid, names, nbox, box);

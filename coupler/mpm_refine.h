@@ -1,7 +1,9 @@
-/* The [refine] section: a static refinement hierarchy over the shared grid (mpm_hier.h), given
- * by boxes in the case file, for a gas-only case on one rank (docs/refinement.md):
+/* The [refine] section: a refinement hierarchy over the shared grid (mpm_hier.h), given by
+ * boxes in the case file or by a criterion, for a gas-only case on one rank
+ * (docs/refinement.md):
  *   [refine]              levels = 2 (1: off, the default), buffer = 2
- *   [refine.NAME]         level = 1, lo = x y, hi = x y
+ *                         criterion = density, threshold = 0.05, every = 10, dilate = 2
+ *   [refine.NAME]         level = 1, lo = x y, hi = x y (static boxes, without a criterion)
  * The sim builds it after the modules and hands it to the gas (fluid_module_refine), which then
  * deposits, solves and gathers on every level (coupler/mpm_cycle.c). */
 #ifndef MPM_REFINE_H
@@ -19,5 +21,15 @@ extern const int mpm_refine_nkeys;
  * does not carry is refused with one line naming its key (MPM_ERR_INPUT). Collective. */
 int mpm_refine_build(mpm_hier **h, const mpm_config *cfg, mpm_grid *grid, mpm_module **mod,
                      int nmod, int seed);
+
+/* Dynamic refinement (refine.criterion): is it on? */
+int mpm_refine_dynamic(const mpm_config *cfg);
+
+/* Between steps of a dynamic refinement: every refine.every steps (or now, with force) rebuild
+ * *h from the gas's flags and move the modules onto it (*h may become NULL: nothing flagged);
+ * *changed says a regrid ran (the integrator must then restart its RHS). The particles are not
+ * touched: they follow the new levels after the next step (fluid_relevel.c). One rank. */
+int mpm_refine_regrid(mpm_hier **h, const mpm_config *cfg, mpm_grid *grid, mpm_module **mod,
+                      int nmod, long step, int force, int *changed);
 
 #endif

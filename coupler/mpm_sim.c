@@ -48,7 +48,8 @@ struct mpm_sim {
   mpm_module *mod[SIM_MAX_MODULES];
   int nmod;
   mpm_coupling *coupling; /* NULL: one phase, or scheme = none */
-  mpm_hier *hier;         /* the static refinement hierarchy (mpm_refine.h); NULL: none */
+  mpm_hier *hier;         /* the refinement hierarchy (mpm_refine.h); NULL: none */
+  int dynamic;            /* it regrids (refine.criterion) */
   mpm_timescheme *it;     /* the temporal coupling scheme */
   mpm_guard guard;
   double energy;      /* total energy at the last diagnostics row */
@@ -357,6 +358,7 @@ static int sim_alloc(mpm_sim **sp, mpm_config *cfg) {
   MPM_ALLOC(s, 1);
   *sp = s;
   s->cfg = cfg;
+  s->dynamic = mpm_refine_dynamic(cfg);
   s->comm = MPI_COMM_WORLD;
   MPI_Comm_rank(s->comm, &s->rank);
   MPI_Comm_size(s->comm, &s->size);
@@ -478,6 +480,10 @@ int mpm_sim_restart(mpm_sim **sp, mpm_config *cfg, const char *path) {
       isfinite(s->ckpt_interval) ? (long)floor(s->t / s->ckpt_interval * (1 + 1e-12)) + 1 : 1;
   for (int k = 0; !rc && k < s->nmod; ++k)
     rc = mpm_particles_migrate(s->mod[k]->particles, s->grid, NULL);
+  /* A dynamic refinement's hierarchy, from the particles as the run regridded before writing. */
+  int regridded = 0;
+  if (!rc && s->dynamic)
+    rc = mpm_refine_regrid(&s->hier, cfg, s->grid, s->mod, s->nmod, s->step, 1, &regridded);
   /* The time scheme's own state (a partitioned scheme's owed momentum) follows the particles. */
   if (!rc) rc = mpm_timescheme_new(&s->it, cfg, s->grid, s->mod, s->nmod, s->coupling);
   if (!rc) rc = mpm_timescheme_restore(s->it, ck);
@@ -697,6 +703,19 @@ static int after_step(mpm_sim *s, double h) {
   return 0;
 }
 
+/* A dynamic refinement's regrid (mpm_refine.h), after the step's own work: every refine.every
+ * steps, and before a checkpoint (force), so that a restart, which regrids from the checkpoint's
+ * particles, continues on the same hierarchy. The integrator restarts its RHS on the new one. */
+static int regrid(mpm_sim *s, int force) {
+  int changed = 0;
+  if (!s->dynamic) return 0;
+  mpm_timer_start(MPM_T_POST);
+  int rc = mpm_refine_regrid(&s->hier, s->cfg, s->grid, s->mod, s->nmod, s->step, force, &changed);
+  if (!rc && changed) rc = mpm_timescheme_resize(s->it, s->t);
+  mpm_timer_stop(MPM_T_POST);
+  return rc;
+}
+
 /* The step count, refined once the run has taken ESTIMATE_AFTER steps. The starting state's
  * stable step (the budget's estimate, mpm_budget.h) is often not the step the run settles to:
  * the artificial viscosity that limits the step at a shock needs the velocity divergence,
@@ -882,6 +901,8 @@ int mpm_sim_run(mpm_sim *s) {
     s->step++;
     refine_estimate(s, dt);
     MPM_CALL(after_step(s, dt));
+    const int ckpt_due = s->t >= t_ckpt * (1 - 1e-14) && s->t < t_stop;
+    MPM_CALL(regrid(s, ckpt_due));
     MPM_CALL(diagnostics(s, dt));
     MPM_CALL(guard(s, dt, tstop));
     progress(s, dt, wall0, 0);

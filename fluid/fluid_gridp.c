@@ -116,17 +116,26 @@ int fluid_gridp_refine(mpm_module *m, const mpm_config *cfg, mpm_hier *h) {
                            "region and disturbs the gas there (docs/refinement.md); remove the "
                            "key or set fluid.pressure = grid");
   if (!((fluid_content *)m->content)->gridp) MPM_CALL(enable(m, cfg));
-  return mpm_hier_add_phases(h);
+  return h ? mpm_hier_add_phases(h) : 0;
+}
+
+void fluid_gridp_reset(fluid_content *fc) {
+  fluid_gridp *gp = fc->gridp;
+  if (!gp) return;
+  free(gp->M0);
+  gp->M0 = NULL;
+  for (int l = 0; l < MPM_HIER_MAX_LEVELS; ++l) {
+    free(gp->P[l]), free(gp->D[l]), free(gp->skip[l]);
+    gp->P[l] = gp->D[l] = NULL, gp->skip[l] = NULL;
+    for (int d = 0; d < MPM_MAX_DIM; ++d) free(gp->F[l][d]), gp->F[l][d] = NULL;
+  }
 }
 
 void fluid_gridp_destroy(fluid_content *fc) {
   fluid_gridp *gp = fc->gridp;
   if (!gp) return;
-  free(gp->mp), free(gp->s), free(gp->zero), free(gp->M0);
-  for (int l = 0; l < MPM_HIER_MAX_LEVELS; ++l) {
-    free(gp->P[l]), free(gp->D[l]), free(gp->skip[l]);
-    for (int d = 0; d < MPM_MAX_DIM; ++d) free(gp->F[l][d]);
-  }
+  fluid_gridp_reset(fc);
+  free(gp->mp), free(gp->s), free(gp->zero);
   free(gp);
   fc->gridp = NULL;
 }

@@ -73,6 +73,7 @@ typedef struct fluid_content {
   double *node;       /* nodal scratch: time-centred velocity and scalars ((dim + 3) nnodes) */
   mpm_module_ops ops; /* the module's ops: p2g_rate only with the current strain rate */
   fluid_gridp *gridp; /* fluid.pressure = grid, or NULL */
+  int refined;        /* on a refinement (its particles follow the levels: fluid_relevel.c) */
 } fluid_content;
 
 /* What the classic step's transfer gives each particle (component-major, stride n). */
@@ -118,8 +119,10 @@ int fluid_volume_rate(mpm_module *m, const double *y, const double *const *v_i, 
  * fills the particles' rate (fluid_gridp_rate_out); work: adds the pressure's de/dt to power,
  * then turns that rate into dJ/dt / J in place. */
 int fluid_gridp_init(mpm_module *m, const mpm_config *cfg);
-int fluid_gridp_refine(mpm_module *m, const mpm_config *cfg, mpm_hier *h);
+int fluid_gridp_refine(mpm_module *m, const mpm_config *cfg, mpm_hier *h); /* h may be NULL */
 void fluid_gridp_destroy(fluid_content *fc);
+/* Forget the per-level arrays: the hierarchy changed (a regrid). */
+void fluid_gridp_reset(fluid_content *fc);
 int fluid_gridp_deposit(mpm_module *m, const double *y, const fluid_batch *b);
 int fluid_gridp_forces(mpm_module *m);
 int fluid_gridp_nodal_rate(mpm_module *m, mpm_hier_scalars *s);
@@ -151,7 +154,7 @@ int fluid_regularise(mpm_module *m, long step, int *changed);
  * particle moved. Collective. */
 int fluid_shift(mpm_module *m, long step, double h, int *changed);
 
-/* After an accepted step on a hierarchy: split the particles that entered a finer level and
+/* After an accepted step of a refined gas: split the particles that entered a finer level and
  * merge, 2^dim at a time, those that left one (fluid_relevel.c); sets *changed when the set
  * changed. One rank (the hierarchy's). */
 int fluid_relevel(mpm_module *m, int *changed);

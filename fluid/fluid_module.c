@@ -619,7 +619,7 @@ static int fluid_post_step(mpm_module *m, double t, double h, int *changed) {
   if (shifted && fc->refill_every > 0 && m->step % fc->refill_every == 0)
     MPM_CALL(mpm_cells_count(m->grid, m->phase, m->particles));
   *changed |= shifted;
-  if (m->hier) MPM_CALL(fluid_relevel(m, changed));
+  MPM_CALL(fluid_relevel(m, changed));
   return fluid_regularise(m, m->step, changed);
 }
 

@@ -22,10 +22,23 @@ int fluid_module_create(mpm_module **m, const mpm_config *cfg, mpm_grid *grid, i
 
 struct mpm_hier;
 
-/* Put the module's phase on the static refinement hierarchy h (mpm_hier.h, built over its grid
- * after the modules): refuse, naming the key, every gas setting the finer levels do not carry
- * (docs/refinement.md), then with seed = 1 reseed the finer regions at their levels' spacing.
+/* Put the module's phase on the refinement hierarchy h (mpm_hier.h, built over its grid after
+ * the modules; NULL: refined, but no region yet): refuse, naming the key, every gas setting the
+ * finer levels do not carry (docs/refinement.md), then with seed = 1 reseed the finer regions at
+ * their levels' spacing. From then on the particles follow the levels (fluid_relevel.c).
  * Collective. */
 int fluid_module_refine(mpm_module *m, const mpm_config *cfg, struct mpm_hier *h, int seed);
+
+/* A regrid: move the module onto the new hierarchy h (may be NULL); the particles follow it
+ * after the next step. */
+void fluid_module_rehier(mpm_module *m, struct mpm_hier *h);
+
+/* The refinement flags of the density criterion over the level-0 spans (node-centred cells) of
+ * the global lattice, x fastest, n[d] spans per axis (ncells along a periodic axis, ncells + 1
+ * otherwise): a span is flagged, with each axis neighbour, where their densities (the gas's mass
+ * over its volume, of the particles whose nearest node it is) differ by more than threshold
+ * times the smaller. flag has prod n[d] bytes. One rank. */
+void fluid_refine_density_flags(const mpm_module *m, double threshold, const int *n,
+                                unsigned char *flag);
 
 #endif

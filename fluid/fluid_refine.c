@@ -27,6 +27,7 @@
 #include "mpm_kernels.h"
 
 #include <math.h>
+#include <stdlib.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -143,6 +144,58 @@ int fluid_refine_check(const mpm_module *m, const mpm_config *cfg) {
 int fluid_module_refine(mpm_module *m, const mpm_config *cfg, mpm_hier *h, int seed) {
   MPM_CALL(fluid_refine_check(m, cfg));
   MPM_CALL(fluid_gridp_refine(m, cfg, h));
+  ((fluid_content *)m->content)->refined = 1;
   m->hier = h;
-  return seed ? fluid_seed_refined(m, cfg) : 0;
+  return seed && h ? fluid_seed_refined(m, cfg) : 0;
+}
+
+void fluid_module_rehier(mpm_module *m, mpm_hier *h) {
+  m->hier = h;
+  fluid_gridp_reset(m->content);
+}
+
+/* ---- the density criterion (mpm_refine.c regrids with it) --------------------------------- */
+
+/* The span of x along axis d: its nearest node, wrapped along a periodic axis, clamped. */
+static int span_of(const mpm_grid *g, int d, double x, int n) {
+  long i = lround((x - g->lo[d]) / g->dx);
+  if (g->periodic[d]) i = ((i % n) + n) % n;
+  return (int)(i < 0 ? 0 : i >= n ? n - 1 : i);
+}
+
+void fluid_refine_density_flags(const mpm_module *m, double threshold, const int *n,
+                                unsigned char *flag) {
+  const fluid_content *fc = m->content;
+  const mpm_particles *p = m->particles;
+  const mpm_grid *g = m->grid;
+  const int dim = g->dim;
+  size_t total = 1, stride[MPM_MAX_DIM] = {1, 1, 1};
+  for (int d = 0; d < dim; ++d) stride[d] = total, total *= (size_t)n[d];
+  memset(flag, 0, total);
+  double *mass = calloc(2 * total, sizeof(double)), *vol = mass + total;
+  if (!mass) return; /* flags nothing: the run goes on unrefined */
+  const double *pm = mpm_particles_comp(p, fc->lay.f_m, 0);
+  const double *V0 = mpm_particles_comp(p, fc->lay.f_V0, 0);
+  const double *J = mpm_particles_comp(p, FLUID_J, 0);
+  for (mpm_lidx i = 0; i < p->n; ++i) {
+    size_t s = 0;
+    for (int d = 0; d < dim; ++d)
+      s += stride[d] * (size_t)span_of(g, d, mpm_particles_comp(p, FLUID_X, d)[i], n[d]);
+    mass[s] += pm[i], vol[s] += V0[i] * J[i];
+  }
+  for (size_t s = 0; s < total; ++s) {
+    if (!(vol[s] > 0)) continue;
+    const double rs = mass[s] / vol[s];
+    for (int d = 0; d < dim; ++d) {
+      const int i = (int)(s / stride[d] % (size_t)n[d]);
+      int j = i + 1;
+      if (j == n[d] && g->periodic[d]) j = 0;
+      if (j >= n[d]) continue;
+      const size_t t = s + ((size_t)j - (size_t)i) * stride[d];
+      if (!(vol[t] > 0)) continue;
+      const double rt = mass[t] / vol[t];
+      if (fabs(rt - rs) > threshold * fmin(rt, rs)) flag[s] = flag[t] = 1;
+    }
+  }
+  free(mass);
 }

@@ -19,6 +19,9 @@
  * crossed into a finer region may leave some children outside it, which then wait (their slot
  * is not full) and enter with the flow.
  *
+ * Without a hierarchy (a regrid found nothing to refine) every position is level 0 and the fine
+ * particles merge back.
+ *
  * Merges first, then splits (fluid_split.h): a merge removes particles and renumbers the set. */
 #include "fluid_internal.h"
 #include "fluid_split.h"
@@ -29,17 +32,18 @@
 #include <math.h>
 #include <stdlib.h>
 
-/* The level of size of particle i (0 .. nlevels - 1). */
+/* The level of size of particle i (0 .. MPM_HIER_MAX_LEVELS - 1). */
 static int size_level(const mpm_module *m, double V0_0, mpm_lidx i) {
   const fluid_content *fc = m->content;
   const double V0 = mpm_particles_comp(m->particles, fc->lay.f_V0, 0)[i];
   const long l = lround(log2(V0_0 / V0) / m->grid->dim);
-  return (int)(l < 0 ? 0 : l >= m->hier->nlevels ? m->hier->nlevels - 1 : l);
+  return (int)(l < 0 ? 0 : l >= MPM_HIER_MAX_LEVELS ? MPM_HIER_MAX_LEVELS - 1 : l);
 }
 
-/* The level of the position of particle i. */
+/* The level of the position of particle i (0 without a hierarchy). */
 static int position_level(const mpm_module *m, mpm_lidx i) {
   const mpm_particles *p = m->particles;
+  if (!m->hier) return 0;
   double x[MPM_MAX_DIM];
   for (int d = 0; d < p->dim; ++d) x[d] = mpm_particles_comp(p, FLUID_X, d)[i];
   return mpm_hier_level_of(m->hier, x);
@@ -54,7 +58,7 @@ static int merge_level(mpm_module *m, double V0_0, int L, mpm_lidx *idx, mpm_lid
     if (size_level(m, V0_0, i) == L && position_level(m, i) < L) idx[k++] = i;
   if (k == 0) return 0;
   mpm_lidx *start, *member, ng;
-  const double H = m->hier->level[L - 1].grid->dx / fc->ppc;
+  const double H = ldexp(m->grid->dx, 1 - L) / fc->ppc; /* level L - 1's particle spacing */
   MPM_CALL(fluid_merge_groups(m, idx, k, H, &start, &member, &ng));
   const mpm_lidx full = (mpm_lidx)1 << m->grid->dim;
   mpm_lidx kept = 0, at = 0;
@@ -74,14 +78,14 @@ static int merge_level(mpm_module *m, double V0_0, int L, mpm_lidx *idx, mpm_lid
 
 int fluid_relevel(mpm_module *m, int *changed) {
   const fluid_content *fc = m->content;
-  const mpm_hier *h = m->hier;
-  if (!h || h->nlevels < 2) return 0;
-  const double V0_0 = pow(h->level[0].grid->dx / fc->ppc, m->grid->dim);
+  if (!fc->refined) return 0;
+  const double V0_0 = pow(m->grid->dx / fc->ppc, m->grid->dim);
   mpm_lidx *idx;
   MPM_ALLOC(idx, m->particles->n > 0 ? m->particles->n : 1);
   mpm_lidx merged = 0;
   int rc = 0;
-  for (int L = h->nlevels - 1; !rc && L >= 1; --L) rc = merge_level(m, V0_0, L, idx, &merged);
+  for (int L = MPM_HIER_MAX_LEVELS - 1; !rc && L >= 1; --L)
+    rc = merge_level(m, V0_0, L, idx, &merged);
   mpm_lidx k = 0;
   for (mpm_lidx i = 0; !rc && i < m->particles->n; ++i)
     if (size_level(m, V0_0, i) < position_level(m, i)) idx[k++] = i;

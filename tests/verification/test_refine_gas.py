@@ -17,6 +17,12 @@ pulse    A right-running acoustic pulse (amplitude 1e-3, c = 1, gaussian of widt
 uniform3d The uniform stream in 3-D (x and z periodic, slip walls along y; a level-1 box in the
          middle) to t = 0.45 (the box crossed once and a half): the same deviation, level and
          conservation checks; the same source as 2-D.
+dynamic  A nonlinear pulse (amplitude 5e-2) refined dynamically (refine.criterion = density,
+         threshold 4e-3, a regrid every 10 steps) to t = 1.2: the refined region follows the pulse
+         (the densest particle of the rows the region can reach, 4 cells from the walls, is a
+         level-1 particle at the start and at the end, 1.1 m further on), mass, momentum and energy are conserved across every regrid, and a restart from a
+         checkpoint between regrids ends bit for bit as the run straight through. Its density
+         along the box's rows against the uniform twins' is printed.
 input    Every refusal: exit 2, one line naming case.ini:LINE and the key (part d).
 identity refine.levels = 1 gives the same output as no [refine] section, bit for bit (part e);
          a refined run restarted from its checkpoint ends bit for bit as the run through.
@@ -246,6 +252,55 @@ def part_pulse():
     return runs, frac
 
 
+DYNAMIC = "[refine]\nlevels = 2\ncriterion = density\nthreshold = 0.004\nevery = 10\n"
+PULSE_5 = ("density_field = 1 + 5e-2*exp(-(x-0.6)^2/0.04)\n"
+           "pressure_field = 0.714285714285714 + 5e-2*exp(-(x-0.6)^2/0.04)\n"
+           "velocity_field = 5e-2*exp(-(x-0.6)^2/0.04); 0")
+
+
+def row_density(out, nbins=60):
+    """The gas density binned along x over the rows 0.2 < y < 0.4 (inside the refined band)."""
+    p = final(out)
+    x, y = p["x"][:, 0], p["x"][:, 1]
+    sel = (y > 0.2) & (y < 0.4)
+    k = np.minimum((x[sel] / 3 * nbins).astype(int), nbins - 1)
+    return (np.bincount(k, p["m"].ravel()[sel], nbins) /
+            np.bincount(k, (p["m"] / p["rho"]).ravel()[sel], nbins))
+
+
+def part_dynamic():
+    runs = {"refined": run("refine_dynamic", case_text(3, 1.2, PULSE_5, DYNAMIC)),
+            "coarse": run("refine_dynamic_coarse", case_text(3, 1.2, PULSE_5, "")),
+            "fine": run("refine_dynamic_fine", case_text(3, 1.2, PULSE_5, "", 0.025))}
+    report_cost(runs)
+    out = runs["refined"][0]
+    size0 = (0.05 / 2) ** 2
+    for t, f in (mt.snapshots(out)[0], mt.snapshots(out)[-1]):
+        p = mt.particles(f, "fluid")
+        band = np.flatnonzero((p["x"][:, 1] > 0.2) & (p["x"][:, 1] < 0.4))
+        k = band[int(np.argmax(p["rho"][band, 0]))]
+        level = int(np.rint(np.log2(size0 * p["rho"][k, 0] / p["m"][k, 0]) / 2))
+        check(level == 1, f"t = {p['time']:g}: the densest particle of the rows 0.2 < y < 0.4 "
+              f"(x = {p['x'][k, 0]:.3f}) is a level-{level} particle (want 1: the region follows "
+              f"the pulse; the region keeps 4 level-0 cells from the walls)")
+    counts = set(diagnostics(out)["particles"].astype(int))
+    check(len(counts) > 2, f"{len(counts)} distinct particle counts over the run (regrids, splits "
+          f"and merges; want more than 2)")
+    ref = row_density(runs["fine"][0])
+    for label in ("refined", "coarse"):
+        err = np.abs(row_density(runs[label][0]) - ref).mean()
+        print(f"info {label}: mean |rho - rho_fine| over the rows 0.2 < y < 0.4 at t = 1.2: "
+              f"{err:.2e}")
+    conservation(runs, 1e-12, 1e-12, 1e-6)
+    # A restart at t = 0.3 (step ~130, between regrids) of the run to 0.6.
+    case = os.path.join(mt.outdir("refine_dynamic_restart_case"), "case.ini")
+    with open(case, "w") as f:
+        f.write(case_text(3, 0.6, PULSE_5, DYNAMIC))
+    ids, worst, _ = mt.restart_difference(case, [], 0.6, "refine_dynamic_restart", "fluid")
+    check(ids and worst == 0.0, f"dynamic refinement restarted at t = 0.3: the same particles, "
+          f"fields {worst:.1e} from the run straight through (bit for bit: 0)")
+
+
 def part_input():
     gas = "density = 1\npressure = 1"
     box = BOX.format(x0=0.8, x1=1.2)
@@ -315,6 +370,20 @@ def part_input():
         "solid"))
     for name, text, key, start, words in cases:
         mt.expect_input_error(check, name, text, key, mt.line_starting(text, start), words)
+    # Dynamic refinement's own refusals.
+    dyn = case_text(2, 0.1, gas, DYNAMIC)
+    cases_dyn = [
+        ("criterion without a threshold", dyn.replace("threshold = 0.004\n", ""),
+         "refine.criterion", "criterion = density", "threshold"),
+        ("dilate too small for the buffer", dyn.replace("every = 10", "every = 10\nbuffer = 4\n"
+                                                        "dilate = 1"), "refine.dilate",
+         "dilate = 1", "refine.dilate >= 2"),
+        ("criterion with a static box", case_text(2, 0.1, gas, box.replace(
+            "levels = 2", "levels = 2\ncriterion = density\nthreshold = 0.01")),
+         "refine.box.level", "level = 1", "static box"),
+    ]
+    for name, text, key, start, words in cases_dyn:
+        mt.expect_input_error(check, name, text, key, mt.line_starting(text, start), words)
     # Two ranks: one line from rank 0, exit 2.
     out = mt.outdir("refine_ranks")
     path = os.path.join(out, "case.ini")
@@ -380,6 +449,8 @@ elif PART == "pulse":
     conservation(runs, 1e-12, 1e-12, 1e-6)
 elif PART == "uniform3d":
     part_uniform3d()
+elif PART == "dynamic":
+    part_dynamic()
 elif PART == "input":
     part_input()
 elif PART == "identity":
