@@ -45,6 +45,10 @@
 #   (every case's restart, 3 minutes there; test_restart, test_gas_output,
 #   test_coupling_ranks) and test_run_safety (output folders, locks, signals: test_restart,
 #   test_output);
+# - refinement studies: test_refine_gas_pulse, test_refine_gas_uniform3d and
+#   test_refine_gas_dynamic (10-25 s each plain; the hierarchy, the grid pressure, splits,
+#   merges and regrids run there in test_refine_gas_uniform, _restart, _identity, test_span and
+#   test_hier_*);
 # - test_euler_reference: the inviscid aerofoil reference in numpy, which runs no mpmfsi at all.
 # The input refusal drivers (test_input_safety, test_bad_input, test_cases) run under the
 # sanitizers without the leak check at exit (NO_LEAK_CHECK in tests/CMakeLists.txt).
@@ -59,6 +63,7 @@ PLAIN_ONLY+="|fsi_waves|fsi_reflection|fsi_resonator|multirate_face|prestress"
 PLAIN_ONLY+="|piperno_farhat|timeschemes|timeschemes_mri|blowup_guard_coupled"
 PLAIN_ONLY+="|csm1|csm3_fast|axial_bar|cantilever3d|model_swap|ranks_solid|periodic|stability|disks"
 PLAIN_ONLY+="|decomposition|restart_cases|run_safety|euler_reference"
+PLAIN_ONLY+="|refine_gas_pulse|refine_gas_uniform3d|refine_gas_dynamic"
 BOTH="checkpoint_integrity"
 
 # The tests also need clang-format (test_format) and ParaView under Xvfb (test_paraview), and
