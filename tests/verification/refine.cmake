@@ -6,6 +6,11 @@ foreach(part uniform pulse input identity)
   mpm_add_script_test(test_refine_gas_${part} SCRIPT verification/test_refine_gas.py ARGS ${part}
                       LABELS verification TIMEOUT 300)
 endforeach()
+# The refined output (issue 51 item 6): levels in the snapshots and the XDMF index, the
+# particle level, the per-level counts, the timers, ParaView opening it when pvpython is there
+# (~8 s).
+mpm_add_script_test(test_refine_gas_output SCRIPT verification/test_refine_gas.py ARGS output
+                    LABELS verification TIMEOUT 300)
 # The first two with fluid.pressure = grid, which meets their targets (~8 and ~17 s).
 foreach(part uniform pulse)
   mpm_add_script_test(test_refine_gas_${part}_grid SCRIPT verification/test_refine_gas.py
