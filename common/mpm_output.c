@@ -25,6 +25,10 @@
  *   default XDMF reader (Xdmf3ReaderS) draws all phases as one dataset that keeps only the
  *   fields every phase has, so without it the gas's colour field rho is dropped and the whole
  *   picture is drawn white (mpm_xdmf.h). It is output only: never read back.
+ * - A refinement hierarchy (mpm_output_set_hier, one rank) adds to a snapshot and nothing
+ *   else: the particle field level, and with the grid fields /levels/<l> after /grid, each
+ *   level over its own lattice (level 0's is /grid's, whose phases it does not repeat). A run
+ *   without one writes the same objects in the same order as before the hierarchy existed.
  * - The output folder holds view.py, the ParaView script that shows the run (colour range,
  *   colour map, the bar on top: what XDMF cannot carry), rewritten by every run. */
 #define _POSIX_C_SOURCE 200809L /* mkdir, stat, access */

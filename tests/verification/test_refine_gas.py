@@ -558,6 +558,10 @@ def part_output():
     check(not problems, f"grid.xmf: {nsnap} snapshots with blocks fluid_grid, fluid_grid_l1, "
           f"fluid_grid_l2 (m, v, active, own), every item the shape of its dataset; series.xmf "
           f"lists the particle level" + "".join("\n     " + q for q in problems[:10]))
+    tool = subprocess.run([sys.executable, os.path.join(mt.SOURCE, "tools", "check_snapshot.py"),
+                           out], capture_output=True, text=True)
+    check(tool.returncode == 0, f"tools/check_snapshot.py accepts the refined folder "
+          f"(exit {tool.returncode}){tool.stdout[-300:] if tool.returncode else ''}")
     timers = dict(np.genfromtxt(os.path.join(out, "timers.csv"), delimiter=",", names=True,
                                 dtype=None, encoding=None)[["phase", "mean_s"]].tolist())
     check(timers.get("restrict", 0) > 0 and timers.get("prolong", 0) > 0,
