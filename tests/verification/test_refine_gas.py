@@ -548,9 +548,10 @@ def part_output():
         n, margin = n + k, min(margin, m)
     check(not problems and len(snaps) == 3,
           f"{len(snaps)} snapshots: /levels/0..2 with the level's spacing, an origin on its node "
-          f"lattice, masks and m, v of matching shapes, own where the boxes put the level, the particles' mass and momentum on the active nodes of all levels (1e-12); the particle level of all {n} rows equal "
-          f"to the level of the position computed from the boxes (nearest particle "
-          f"{margin:.1e} from a region face) and inside its level's own mask; the counts "
+          f"lattice, masks and m, v of matching shapes, own where the boxes put the level, the "
+          f"particles' mass and momentum on the active nodes of all levels (1e-12); the particle "
+          f"level of all {n} rows equal to the level of the position computed from the boxes "
+          f"(nearest particle {margin:.1e} from a region face) and inside its level's own mask; the counts "
           f"diagnostics.csv gives at the snapshot's step equal to the level field's"
           + "".join("\n     " + q for q in problems[:10]))
     problems = []
