@@ -551,7 +551,8 @@ def part_output():
           f"lattice, masks and m, v of matching shapes, own where the boxes put the level, the "
           f"particles' mass and momentum on the active nodes of all levels (1e-12); the particle "
           f"level of all {n} rows equal to the level of the position computed from the boxes "
-          f"(nearest particle {margin:.1e} from a region face) and inside its level's own mask; the counts "
+          f"(nearest particle {margin:.1e} from a region face) and inside its level's own "
+          f"mask; the counts "
           f"diagnostics.csv gives at the snapshot's step equal to the level field's"
           + "".join("\n     " + q for q in problems[:10]))
     problems = []
