@@ -338,11 +338,11 @@ static int open_outputs(mpm_sim *s) {
   open_log(s, append);
   MPM_CALL(mpm_config_resolved_text(s->cfg, &s->config_text));
   MPM_CALL(mpm_output_new(&s->out, s->comm, s->dir, s->config_text, s->grid->dim, append, s->t));
+  MPM_CALL(mpm_output_set_hier(s->out, s->hier)); /* NULL: unrefined */
   snprintf(path, sizeof path, "%s/diagnostics.csv", s->dir);
   const char *dcols[NDIAG + MPM_HIER_MAX_LEVELS];
   const int nd = diag_columns(s, dcols);
   MPM_CALL(mpm_diag_open(&s->diag, s->comm, path, nd, dcols, append, s->t));
-  MPM_CALL(mpm_output_set_hier(s->out, s->hier));
   if (s->probes.n > 0) {
     const char *pcols[MPM_PROBE_MAX * 2 * MPM_MAX_DIM + 1];
     const int np = mpm_probes_columns(&s->probes, pcols);
