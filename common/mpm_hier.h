@@ -40,6 +40,7 @@
 
 #include "mpm_grid.h"
 #include "mpm_kernels.h"
+#include "mpm_particles.h"
 
 #include <stddef.h>
 
@@ -87,6 +88,12 @@ int mpm_hier_add_phases(mpm_hier *h);
 
 /* The finest level whose region contains x. */
 int mpm_hier_level_of(const mpm_hier *h, const double *x);
+
+/* The level of every particle of p (mpm_hier_level_of at its field "x") into level[p->n]
+ * (mpm_hier_census.c). */
+void mpm_hier_particle_levels(const mpm_hier *h, const mpm_particles *p, double *level);
+/* Add the number of p's particles on level l to count[l], l = 0 .. nlevels - 1. */
+void mpm_hier_count_levels(const mpm_hier *h, const mpm_particles *p, double *count);
 
 /* The composite basis at x: writes the nonzero weights (each active node once) into w[max]
  * and returns their number (at most 3^dim times the number of levels); -1 if max is too small

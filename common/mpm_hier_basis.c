@@ -5,8 +5,11 @@
  * Invariants: restriction and prolongation visit every inactive node of a level box, ghost
  * layer included, and read or write only its 2^dim parents, which lie in the coarser box (see
  * mpm_hier.c); restriction leaves every inactive node at exactly zero. mpm_hier_eval pushes
- * weights down exactly as P2G followed by restriction does, so the two agree to roundoff. */
+ * weights down exactly as P2G followed by restriction does, so the two agree to roundoff.
+ * Every call of the per-level restriction and prolongation is timed (MPM_T_RESTRICT and
+ * MPM_T_PROLONG, mpm_timer.h), whoever calls it. */
 #include "mpm_hier_impl.h"
+#include "mpm_timer.h"
 
 #include <string.h>
 
@@ -28,6 +31,7 @@ void mpm_hier_restrict_level(mpm_hier *h, int l, double *const *fine, double *co
   int gi[MPM_MAX_DIM];
   mpm_lidx idx[8];
   double w[8];
+  mpm_timer_start(MPM_T_RESTRICT);
   for (mpm_lidx n = 0; n < f->nnodes; ++n) {
     if (active[n]) continue;
     hier_node_of(f, n, gi);
@@ -38,6 +42,7 @@ void mpm_hier_restrict_level(mpm_hier *h, int l, double *const *fine, double *co
       fine[k][n] = 0.0;
     }
   }
+  mpm_timer_stop(MPM_T_RESTRICT);
 }
 
 void mpm_hier_prolong_level(mpm_hier *h, int l, const double *const *coarse, double *const *fine,
@@ -47,6 +52,7 @@ void mpm_hier_prolong_level(mpm_hier *h, int l, const double *const *coarse, dou
   int gi[MPM_MAX_DIM];
   mpm_lidx idx[8];
   double w[8];
+  mpm_timer_start(MPM_T_PROLONG);
   for (mpm_lidx n = 0; n < f->nnodes; ++n) {
     if (active[n]) continue;
     hier_node_of(f, n, gi);
@@ -57,6 +63,7 @@ void mpm_hier_prolong_level(mpm_hier *h, int l, const double *const *coarse, dou
       fine[k][n] = v;
     }
   }
+  mpm_timer_stop(MPM_T_PROLONG);
 }
 
 /* The deposit fields of a phase on one level: m, m v, f and, when deposited, the mass

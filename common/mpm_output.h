@@ -9,10 +9,19 @@
  *                     [Nz][Ny][Nx][dim] over the global node lattice including pad layers
  *   /xdmf/<phase>     int64 [N] = 0 .. N-1, the connectivity of the phase's Polyvertex
  *                     grid in series.xmf (phase names 'grid' and 'xdmf' are reserved)
+ * With a refinement hierarchy (mpm_output_set_hier; nothing of this otherwise):
+ *   /<phase>/level    double [N][1], the level of each particle's position (mpm_hier_level_of)
+ *   /levels/<l>       (with the grid fields) for l = 0 .. nlevels - 1: attributes level (int),
+ *                     origin (double [dim], the position of the datasets' first node) and
+ *                     spacing; masks active (node l is active) and own (its span lies in
+ *                     level l's region and no finer one's: the points of level l), uint8
+ *                     [Nz][Ny][Nx]. Level 0's lattice is /grid's; a finer level's is its box.
+ *   /levels/<l>/<phase>/m, v  (l >= 1) that level's nodal mass and velocity, as /grid's
+ *                     ('levels' is then a reserved phase name, 'level' a reserved field)
  * OUTDIR/series.xmf indexes the particles of every snapshot written so far, OUTDIR/grid.xmf
- * the grid fields of those that have them (absent when none has); mpm_xdmf.h gives their
- * layout. Both are rewritten atomically after each snapshot, so they are valid XML at
- * every moment.
+ * the grid fields of those that have them (absent when none has; with a hierarchy, one block
+ * per phase and level); mpm_xdmf.h gives their layout. Both are rewritten atomically after each
+ * snapshot, so they are valid XML at every moment.
  *
  * Checkpoint (any path; written to PATH.tmp, then renamed by rank 0 once complete):
  *   /  attributes format ("mpmfsi checkpoint 2"), config (string), text_hash (uint64, FNV-1a
@@ -29,6 +38,7 @@
 #define MPM_OUTPUT_H
 
 #include "mpm_grid.h"
+#include "mpm_hier.h"
 #include "mpm_particles.h"
 
 typedef struct mpm_output mpm_output;
@@ -47,6 +57,11 @@ int mpm_output_snapshot(mpm_output *out, double t, long step, const mpm_particle
 
 /* Number of snapshots written (or kept from an earlier run); the next gets this index. */
 int mpm_output_count(const mpm_output *out);
+
+/* Write the refinement hierarchy h (NULL: none, the default) with every later snapshot: the
+ * particles' level and, beside the grid fields, the levels (layout above). h must outlive
+ * the output's use of it; on more than one rank it is refused (MPM_ERR_INTERNAL). */
+int mpm_output_set_hier(mpm_output *out, const mpm_hier *h);
 
 /* Write a checkpoint atomically. Collective. */
 int mpm_checkpoint_write(MPI_Comm comm, const char *path, const char *config_text,

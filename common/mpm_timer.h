@@ -1,5 +1,9 @@
 /* Wall-clock timers per phase of a step. One process-wide table: phases may nest (the
- * stress update runs inside P2G's caller, say), but a phase is never started twice. */
+ * stress update runs inside P2G's caller, say), but a phase is never started twice.
+ *
+ * restrict and prolong (the refinement hierarchy's transfers between levels, mpm_hier.h) are
+ * details: they are timed wherever they run, also inside another phase (the grid pressure's run
+ * inside grid), so the report leaves them out of the sum it subtracts from total for (other). */
 #ifndef MPM_TIMER_H
 #define MPM_TIMER_H
 
@@ -18,6 +22,8 @@
   X(MPM_T_BOUNDARY, "boundary")                                                                    \
   X(MPM_T_MIGRATE, "migrate")                                                                      \
   X(MPM_T_POST, "post_step")                                                                       \
+  X(MPM_T_RESTRICT, "restrict")                                                                    \
+  X(MPM_T_PROLONG, "prolong")                                                                      \
   X(MPM_T_IO, "io")                                                                                \
   X(MPM_T_TOTAL, "total")
 

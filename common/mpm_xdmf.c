@@ -146,16 +146,22 @@ static int push_entry(mpm_xdmf *x, double time, int index, char *xml) {
  * phase lists the first it has as its only Scalar attribute (see mpm_xdmf.h). */
 static const char *const g_colour_fields[] = {"rho"};
 
-static void data_item(strbuf *b, const char *indent, const char *dims, const char *type,
-                      const char *file, const char *group, const char *name) {
-  sb_printf(b, "%s<DataItem Dimensions=\"%s\" NumberType=\"%s\" Precision=\"8\" Format=\"HDF\">",
-            indent, dims, type);
+/* An HDF DataItem of precision bytes per number. */
+static void data_item_p(strbuf *b, const char *indent, const char *dims, const char *type,
+                        int precision, const char *file, const char *group, const char *name) {
+  sb_printf(b, "%s<DataItem Dimensions=\"%s\" NumberType=\"%s\" Precision=\"%d\" Format=\"HDF\">",
+            indent, dims, type, precision);
   sb_escaped(b, file);
   sb_printf(b, ":/");
   sb_escaped(b, group);
   sb_printf(b, "/");
   sb_escaped(b, name);
   sb_printf(b, "</DataItem>\n");
+}
+
+static void data_item(strbuf *b, const char *indent, const char *dims, const char *type,
+                      const char *file, const char *group, const char *name) {
+  data_item_p(b, indent, dims, type, 8, file, group, name);
 }
 
 /* The one-grid temporal collection that gives a block a stable place, and its grid's Time
@@ -289,12 +295,26 @@ static void render_phase(strbuf *b, const char *file, const mpm_xdmf_phase *ph, 
   close_block(b);
 }
 
+/* A refinement level's masks as node attributes (mpm_xdmf.h). */
+static void render_masks(strbuf *b, const char *file, const mpm_xdmf_mesh *m, const char *dims) {
+  static const char *const mask[2] = {"active", "own"};
+  char group[32];
+  snprintf(group, sizeof group, MPM_XDMF_LEVELS "/%d", m->level);
+  for (int k = 0; k < 2; ++k) {
+    sb_printf(b, "            <Attribute Name=\"%s\" AttributeType=\"Scalar\" Center=\"Node\">\n",
+              mask[k]);
+    data_item_p(b, "              ", dims, "UChar", 1, file, group, mask[k]);
+    sb_printf(b, "            </Attribute>\n");
+  }
+}
+
 /* XDMF lists structured extents, origins and spacings slowest axis first (z y x). */
 static void render_mesh(strbuf *b, const char *file, const mpm_xdmf_mesh *m, int dim, double time) {
-  char dims[96], group[96];
+  char dims[96], group[96], suffix[32] = "_grid";
   const double dz = m->spacing; /* also for the single layer of a 2-D lattice */
   snprintf(dims, sizeof dims, "%d %d %d", m->n[2], m->n[1], m->n[0]);
-  open_block(b, m->name, "_grid", time);
+  if (m->level) snprintf(suffix, sizeof suffix, "_grid_l%d", m->level);
+  open_block(b, m->name, suffix, time);
   sb_printf(b, "            <Topology TopologyType=\"3DCoRectMesh\" Dimensions=\"%s\"/>\n", dims);
   sb_printf(b, "            <Geometry GeometryType=\"ORIGIN_DXDYDZ\">\n");
   sb_printf(b,
@@ -306,7 +326,10 @@ static void render_mesh(strbuf *b, const char *file, const mpm_xdmf_mesh *m, int
             "Precision=\"8\" Format=\"XML\">%.17g %.17g %.17g</DataItem>\n",
             dz, m->spacing, m->spacing);
   sb_printf(b, "            </Geometry>\n");
-  snprintf(group, sizeof group, "grid/%s", m->name); /* names are checked to fit */
+  if (m->level) /* names are checked to fit */
+    snprintf(group, sizeof group, MPM_XDMF_LEVELS "/%d/%s", m->level, m->name);
+  else
+    snprintf(group, sizeof group, "grid/%s", m->name);
   sb_printf(b, "            <Attribute Name=\"m\" AttributeType=\"Scalar\" Center=\"Node\">\n");
   data_item(b, "              ", dims, "Float", file, group, "m");
   sb_printf(b, "            </Attribute>\n");
@@ -314,6 +337,8 @@ static void render_mesh(strbuf *b, const char *file, const mpm_xdmf_mesh *m, int
   snprintf(dims, sizeof dims, "%d %d %d %d", m->n[2], m->n[1], m->n[0], dim);
   data_item(b, "              ", dims, "Float", file, group, "v");
   sb_printf(b, "            </Attribute>\n");
+  snprintf(dims, sizeof dims, "%d %d %d", m->n[2], m->n[1], m->n[0]);
+  if (m->masks) render_masks(b, file, m, dims);
   close_block(b);
 }
 

@@ -51,7 +51,12 @@
  *   reader places a 2DCoRectMesh in the y-z plane and mis-sizes the selection of its
  *   2-component node vectors). The output layer keeps them in an index of their own
  *   (grid.xmf): in the particle index the lattice's surface covers the particles, and
- *   Xdmf3ReaderS merges it with them so that no particle field can colour them. */
+ *   Xdmf3ReaderS merges it with them so that no particle field can colour them.
+ * - Refinement levels: a refined run's grid.xmf has, per grid phase, a block NAME_grid (level
+ *   0) and one NAME_grid_l<l> per finer level, each its own 3DCoRectMesh over that level's
+ *   box with m, v and the level's masks active and own (UChar) as attributes; ParaView shows
+ *   them as separate blocks of the snapshot's spatial collection (threshold own = 1 to see
+ *   each level where it holds the points). */
 #ifndef MPM_XDMF_H
 #define MPM_XDMF_H
 
@@ -76,12 +81,19 @@ typedef struct mpm_xdmf_phase {
   const mpm_xdmf_field *field;
 } mpm_xdmf_phase;
 
+/* Where the output layer writes a refinement hierarchy's levels: the group /MPM_XDMF_LEVELS/<l>
+ * holds level l's masks (uint8 active, own) and, for l >= 1, its grid phases. */
+#define MPM_XDMF_LEVELS "levels"
+
 /* Nodal mass m and velocity v of one grid phase: n[d] nodes along d (x first; n[2] = 1 in
- * 2-D), node (0,0,0) at origin, uniform spacing. */
+ * 2-D), node (0,0,0) at origin, uniform spacing. Level 0 is /grid/<name> (block NAME_grid), a
+ * finer level l /levels/<l>/<name> (block NAME_grid_l<l>); with masks set, the level's masks
+ * /levels/<l>/active and own are attributes too. */
 typedef struct mpm_xdmf_mesh {
   const char *name;
   int n[3];
   double origin[3], spacing;
+  int level, masks;
 } mpm_xdmf_mesh;
 
 int mpm_xdmf_new(mpm_xdmf **x, int dim);

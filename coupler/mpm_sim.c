@@ -292,6 +292,17 @@ static const char *const g_diag_cols[] = {"t",       "step",     "dt",    "parti
                                           "mass",    "px",       "py",    "pz",
                                           "kinetic", "internal", "total", "rhs_evals"};
 enum { NDIAG = (int)(sizeof g_diag_cols / sizeof g_diag_cols[0]) };
+/* Appended when refined: the particles on each level (mpm_hier_count_levels). */
+static const char *const g_level_cols[MPM_HIER_MAX_LEVELS] = {
+    "particles_l0", "particles_l1", "particles_l2", "particles_l3", "particles_l4"};
+
+/* diagnostics.csv's columns: g_diag_cols, then one per level when refined. */
+static int diag_columns(const mpm_sim *s, const char **cols) {
+  int n = 0;
+  for (int k = 0; k < NDIAG; ++k) cols[n++] = g_diag_cols[k];
+  for (int l = 0; s->hier && l < s->hier->nlevels; ++l) cols[n++] = g_level_cols[l];
+  return n;
+}
 
 /* coupling.csv: the interface force on each phase (the momentum the other gives it per unit
  * time; they cancel), the power of each, their sum (the energy rate the coupling creates), its
@@ -328,8 +339,11 @@ static int open_outputs(mpm_sim *s) {
   open_log(s, append);
   MPM_CALL(mpm_config_resolved_text(s->cfg, &s->config_text));
   MPM_CALL(mpm_output_new(&s->out, s->comm, s->dir, s->config_text, s->grid->dim, append, s->t));
+  MPM_CALL(mpm_output_set_hier(s->out, s->hier)); /* NULL: unrefined */
   snprintf(path, sizeof path, "%s/diagnostics.csv", s->dir);
-  MPM_CALL(mpm_diag_open(&s->diag, s->comm, path, NDIAG, g_diag_cols, append, s->t));
+  const char *dcols[NDIAG + MPM_HIER_MAX_LEVELS];
+  const int nd = diag_columns(s, dcols);
+  MPM_CALL(mpm_diag_open(&s->diag, s->comm, path, nd, dcols, append, s->t));
   if (s->probes.n > 0) {
     const char *pcols[MPM_PROBE_MAX * 2 * MPM_MAX_DIM + 1];
     const int np = mpm_probes_columns(&s->probes, pcols);
@@ -604,8 +618,12 @@ static int coupling_row(mpm_sim *s, double dt, const double *energy) {
   return mpm_diag_row(s->coupling_csv, row);
 }
 
+/* The sums of a diagnostics row: [0] particles, [1] mass, [2..4] momentum, [5] kinetic, [6]
+ * internal, [8 + role] each role's total energy, then ROW_LEVELS.. the particles per level. */
+enum { ROW_LEVELS = 10, ROW_SUMS = ROW_LEVELS + MPM_HIER_MAX_LEVELS };
+
 static int diagnostics_row(mpm_sim *s, double dt) {
-  double local[10] = {0}, sum[10];
+  double local[ROW_SUMS] = {0}, sum[ROW_SUMS];
   for (int k = 0; k < s->nmod; ++k) {
     mpm_module_sums m;
     s->mod[k]->ops->sums(s->mod[k], &m);
@@ -615,13 +633,15 @@ static int diagnostics_row(mpm_sim *s, double dt) {
     local[5] += m.kinetic;
     local[6] += m.internal;
     local[8 + s->mod[k]->role] += m.kinetic + m.internal;
+    if (s->hier) mpm_hier_count_levels(s->hier, s->mod[k]->particles, local + ROW_LEVELS);
   }
-  MPM_CALL_MPI(MPI_Allreduce(local, sum, 10, MPI_DOUBLE, MPI_SUM, s->comm));
+  MPM_CALL_MPI(MPI_Allreduce(local, sum, ROW_SUMS, MPI_DOUBLE, MPI_SUM, s->comm));
   s->energy = sum[5] + sum[6], s->kinetic = sum[5];
   if (s->coupling) MPM_CALL(coupling_row(s, dt, sum + 8));
-  const double row[NDIAG] = {
+  double row[NDIAG + MPM_HIER_MAX_LEVELS] = {
       s->t,   (double)s->step, dt,     sum[0], sum[1],          sum[2],
       sum[3], sum[4],          sum[5], sum[6], sum[5] + sum[6], rhs_evals(s)};
+  for (int l = 0; s->hier && l < s->hier->nlevels; ++l) row[NDIAG + l] = sum[ROW_LEVELS + l];
   if (dt > 0) s->particle_steps += sum[0]; /* the row at t = 0 is not a step */
   if (s->probes.n > 0) {
     double prow[MPM_PROBE_MAX * 2 * MPM_MAX_DIM + 1];

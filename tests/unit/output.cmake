@@ -1,4 +1,5 @@
-# Output layer: snapshots, the XDMF index and checkpoints, on 1, 2 and 3 ranks. Each run
+# Output layer: snapshots, the XDMF index and checkpoints, on 1, 2 and 3 ranks (with a
+# refinement hierarchy on one rank: its levels and the particles' level; refused on more). Each run
 # writes under its own directory, which tools/check_snapshot.py then inspects (a fixture,
 # so the check runs after the test that produced the files and is skipped if it failed).
 foreach(np 1 2 3)

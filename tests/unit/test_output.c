@@ -9,6 +9,10 @@
  *   and on one made by mpm_grid.c; `h5dump -H` opens every file, `xmllint --noout` accepts
  *   series.xmf, which names every snapshot; no .tmp file is left;
  * - restart: append keeps the entries with t <= t_restart and numbers on after them;
+ * - refinement (hier_fixture.h's three levels, one rank): every level's masks equal the
+ *   hierarchy's, the finer levels' m and v are their box nodes', each particle's level is
+ *   mpm_hier_level_of of its position, grid.xmf has a block per level; on more ranks
+ *   mpm_output_set_hier refuses the hierarchy;
  * - checkpoints: bitwise round trip of ids and data on the same rank count; reading on a
  *   different rank count (written on a sub-communicator) gives even chunks in rank order;
  *   a missing file, a text file, an HDF5 file that is not a checkpoint, a missing
@@ -24,6 +28,7 @@
 
 #include <cmocka.h>
 
+#include "hier_fixture.h"
 #include "mpm_error.h"
 #include "mpm_output.h"
 
@@ -629,6 +634,133 @@ static void test_snapshot_real_grid(void **state) {
   mpm_grid_destroy(&g);
 }
 
+/* ---- a refinement hierarchy ------------------------------------------------------------ */
+
+static const set_spec g_levels2 = {"test", 2, 3, {{"x", 2}, {"v", 2}, {"p", 1}}};
+
+/* Node values of a level: node_value of the global node plus 1000 per level. */
+static void fill_level(mpm_grid *g, int phase, int level) {
+  int gi[3];
+  for (gi[2] = g->box_lo[2]; gi[2] < g->box_lo[2] + g->box_n[2]; ++gi[2])
+    for (gi[1] = g->box_lo[1]; gi[1] < g->box_lo[1] + g->box_n[1]; ++gi[1])
+      for (gi[0] = g->box_lo[0]; gi[0] < g->box_lo[0] + g->box_n[0]; ++gi[0]) {
+        const mpm_lidx l = mpm_grid_local_index(g, gi);
+        g->phase[phase].m_i[l] = node_value(gi, 0) + 1000.0 * level;
+        for (int d = 0; d < g->dim; ++d)
+          g->phase[phase].v_i[d][l] = node_value(gi, d + 1) + 1000.0 * level;
+      }
+}
+
+/* n particles at the fixture's random points (half of them over the refined boxes). */
+static mpm_particles *points_set(const fixture *f, int n) {
+  mpm_particles *p = make_empty_set(&g_levels2);
+  uint64_t rng = 12345;
+  p->n = n;
+  p->id = realloc(p->id, (size_t)n * sizeof *p->id);
+  p->data = realloc(p->data, (size_t)n * p->ncomp * sizeof *p->data);
+  for (int i = 0; i < n; ++i) {
+    double x[3];
+    fixture_point(f, &rng, i, x);
+    p->id[i] = i;
+    for (int c = 0; c < p->ncomp; ++c) p->data[(size_t)c * n + i] = c < 2 ? x[c] : 0.5;
+  }
+  p->id_next = n;
+  return p;
+}
+
+/* Level l of the snapshot against the hierarchy: masks over the level's lattice (level 0's
+ * owned nodes from -pad, a finer level's box) and, on finer levels, m and v. */
+static void check_level(hid_t file, const mpm_hier *h, int l) {
+  const mpm_grid *g = h->level[l].grid;
+  const int first[2] = {l ? g->box_lo[0] : g->own_lo[0], l ? g->box_lo[1] : g->own_lo[1]};
+  const int last[2] = {l ? g->box_lo[0] + g->box_n[0] : g->own_hi[0],
+                       l ? g->box_lo[1] + g->box_n[1] : g->own_hi[1]};
+  char name[64];
+  int rank;
+  hsize_t dims[4];
+  snprintf(name, sizeof name, "/levels/%d/active", l);
+  unsigned char *act = read_all(file, name, H5T_NATIVE_UCHAR, &rank, dims);
+  snprintf(name, sizeof name, "/levels/%d/own", l);
+  unsigned char *own = read_all(file, name, H5T_NATIVE_UCHAR, &rank, dims);
+  assert_int_equal(dims[0], last[1] - first[1]);
+  assert_int_equal(dims[1], last[0] - first[0]);
+  double *m = NULL, *v = NULL;
+  if (l) {
+    snprintf(name, sizeof name, "/levels/%d/test/m", l);
+    m = read_all(file, name, H5T_NATIVE_DOUBLE, &rank, dims);
+    snprintf(name, sizeof name, "/levels/%d/test/v", l);
+    v = read_all(file, name, H5T_NATIVE_DOUBLE, &rank, dims);
+  }
+  size_t q = 0;
+  int gi[3] = {0, 0, 0};
+  for (gi[1] = first[1]; gi[1] < last[1]; ++gi[1])
+    for (gi[0] = first[0]; gi[0] < last[0]; ++gi[0], ++q) {
+      const mpm_lidx k = mpm_grid_local_index(g, gi);
+      assert_int_equal(act[q], h->level[l].active[k]);
+      assert_int_equal(own[q], h->level[l].covered[k] && !h->level[l].refined[k]);
+      if (!l) continue;
+      assert_true(m[q] == node_value(gi, 0) + 1000.0 * l);
+      for (int d = 0; d < 2; ++d) assert_true(v[2 * q + d] == node_value(gi, d + 1) + 1000.0 * l);
+    }
+  free(act), free(own), free(m), free(v);
+}
+
+/* The particles' level: mpm_hier_level_of of each position; every level has some. */
+static void check_particle_levels(hid_t file, const mpm_hier *h, const mpm_particles *p) {
+  int rank, seen[MPM_HIER_MAX_LEVELS] = {0};
+  hsize_t dims[4];
+  double *level = read_all(file, "/test/level", H5T_NATIVE_DOUBLE, &rank, dims);
+  assert_int_equal(rank, 2);
+  assert_int_equal(dims[0], p->n);
+  for (mpm_lidx i = 0; i < p->n; ++i) {
+    const double x[3] = {p->data[i], p->data[(size_t)p->n + i], 0.0};
+    assert_true(level[i] == mpm_hier_level_of(h, x));
+    seen[(int)level[i]] = 1;
+  }
+  for (int l = 0; l < h->nlevels; ++l) assert_true(seen[l]);
+  free(level);
+}
+
+static void test_snapshot_levels(void **state) {
+  (void)state;
+  char dir[4200], path[4600];
+  snap_dir(dir, sizeof dir, "levels");
+  fixture f;
+  assert_int_equal(fixture_make(&f, HIER_3LEV), 0);
+  assert_int_equal(mpm_hier_add_phases(f.h), 0);
+  for (int l = 0; l < f.h->nlevels; ++l) fill_level(f.h->level[l].grid, f.phase, l);
+  mpm_particles *p = points_set(&f, 400);
+  const mpm_particles *phases[1] = {p};
+  const char *names[1] = {"test"};
+  mpm_output *out;
+  assert_int_equal(mpm_output_new(&out, MPI_COMM_WORLD, dir, "", 2, 0, 0.0), 0);
+  if (g_size > 1) { /* the hierarchy runs on one rank */
+    assert_int_equal(mpm_output_set_hier(out, f.h), MPM_ERR_INTERNAL);
+  } else {
+    assert_int_equal(mpm_output_set_hier(out, f.h), 0);
+    assert_int_equal(mpm_output_snapshot(out, 0.5, 3, phases, names, 1, f.grid), 0);
+    path_of(path, sizeof path, dir, "snap_000000.h5");
+    const hid_t file = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
+    assert_true(file >= 0);
+    for (int l = 0; l < f.h->nlevels; ++l) check_level(file, f.h, l);
+    check_particle_levels(file, f.h, p);
+    H5Fclose(file);
+    path_of(path, sizeof path, dir, "grid.xmf");
+    char *xmf = read_text(path);
+    assert_non_null(xmf);
+    assert_int_equal(count_occurrences(xmf, "Name=\"test_grid_l2\" GridType=\"Uniform\""), 1);
+    for (int l = 0; l < f.h->nlevels; ++l) { /* each block reads its own level's masks */
+      char item[64];
+      snprintf(item, sizeof item, "snap_000000.h5:/levels/%d/own", l);
+      assert_int_equal(count_occurrences(xmf, item), 1);
+    }
+    free(xmf);
+  }
+  mpm_output_destroy(&out);
+  free_set(&p);
+  fixture_free(&f);
+}
+
 /* ---- checkpoints ----------------------------------------------------------------------- */
 
 static const char *g_ckconfig = "[run]\nname = checkpoint test\n";
@@ -811,6 +943,7 @@ int main(int argc, char **argv) {
       cmocka_unit_test(test_snapshot_3d),
       cmocka_unit_test(test_snapshot_append),
       cmocka_unit_test(test_snapshot_real_grid),
+      cmocka_unit_test(test_snapshot_levels),
       cmocka_unit_test(test_output_dir_errors),
       cmocka_unit_test(test_checkpoint_roundtrip),
       cmocka_unit_test(test_checkpoint_other_rank_count),

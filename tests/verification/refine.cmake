@@ -7,6 +7,11 @@ foreach(part uniform pulse uniform3d dynamic restart input identity)
   mpm_add_script_test(test_refine_gas_${part} SCRIPT verification/test_refine_gas.py ARGS ${part}
                       LABELS verification TIMEOUT 300)
 endforeach()
+# The refined output (issue 51 item 6): levels in the snapshots and the XDMF index, the
+# particle level, the per-level counts, the timers, ParaView opening it when pvpython is there
+# (~8 s).
+mpm_add_script_test(test_refine_gas_output SCRIPT verification/test_refine_gas.py ARGS output
+                    LABELS verification TIMEOUT 300)
 foreach(part uniform pulse)
   mpm_add_script_test(test_refine_gas_${part}_ppc4 SCRIPT verification/test_refine_gas.py
                       ARGS ${part} 4 LABELS verification long TIMEOUT 300)

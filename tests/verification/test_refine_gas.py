@@ -29,16 +29,59 @@ restart  The same dynamic run to t = 0.4, restarted from its checkpoint at t = 0
 input    Every refusal: exit 2, one line naming case.ini:LINE and the key (part d).
 identity refine.levels = 1 gives the same output as no [refine] section, bit for bit (part e);
          a refined run restarted from its checkpoint ends bit for bit as the run through.
+output   The refined output (issue 51 item 6): a three-level run with grid fields checked file by
+         file: /levels/<l> of every snapshot (lattice, spacing, origin on the level's node
+         lattice, masks, m and v), the particle field level against the level of each position
+         computed here from the boxes, and against the own mask; diagnostics.csv's per-level
+         counts (sum and the snapshot's); timers.csv's restrict and prolong; the XDMF index of
+         every level; and, when pvpython is on the PATH, ParaView's three XDMF readers opening
+         each level as its own block. An unrefined twin keeps the old columns and layout.
 Able to fail: with the restriction switched off (coupler/mpm_cycle.c) the uniform part's run
 blows up at t = 0.11.
 A second argument sets fluid.ppc of the uniform and pulse runs (2 by default; 4 in the long
 tests). The figures and tolerances are stated at each check and in docs/refinement.md.
 """
 import os
+import shutil
+import subprocess
 import sys
 import time
 
-import numpy as np
+READERS = ("XDMFReader", "Xdmf3ReaderS", "Xdmf3ReaderT")
+
+
+def paraview_blocks(index):
+    """Under pvpython: one line per reader and block at the last time (name points arrays, and
+    the sum of the mask own)."""
+    from paraview import servermanager as sm
+    from paraview import simple
+    for name in READERS:
+        if name == "XDMFReader":
+            reader = simple.XDMFReader(FileNames=[index])
+        else:
+            reader = getattr(simple, name)(FileName=[index])
+        t = list(reader.TimestepValues)[-1]
+        reader.UpdatePipeline(t)
+        d = sm.Fetch(reader)
+        it = d.NewIterator()
+        it.UnRegister(None)
+        it.InitTraversal()
+        while not it.IsDoneWithTraversal():
+            o, pd = it.GetCurrentDataObject(), it.GetCurrentDataObject().GetPointData()
+            arrays = sorted(pd.GetArrayName(k) for k in range(pd.GetNumberOfArrays()))
+            own = pd.GetArray("own")
+            total = sum(own.GetValue(k) for k in range(own.GetNumberOfTuples())) if own else -1
+            print(f"PV {name} {o.GetNumberOfPoints()} {','.join(arrays)} {total}")
+            it.GoToNextItem()
+        simple.Delete(reader)
+
+
+if len(sys.argv) == 3 and sys.argv[1] == "--in-paraview":
+    paraview_blocks(sys.argv[2])
+    sys.exit(0)
+
+import h5py  # noqa: E402
+import numpy as np  # noqa: E402
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "tools"))
 import mpmtest as mt  # noqa: E402
@@ -423,6 +466,261 @@ def part_identity():
           f"{worst:.1e} from the run straight through (bit for bit: 0)")
 
 
+# ---- output --------------------------------------------------------------------------------
+
+H0 = 0.05  # level 0's spacing in case_text
+LEVELS3 = ("[refine]\nlevels = 3\n\n[refine.box]\nlevel = 1\nlo = 0.8 0.15\nhi = 1.4 0.45\n\n"
+           "[refine.inner]\nlevel = 2\nlo = 1.0 0.25\nhi = 1.2 0.35\n")
+BOXES = [(1, (0.8, 0.15), (1.4, 0.45)), (2, (1.0, 0.25), (1.2, 0.35))]
+DIAG_COLS = ["t", "step", "dt", "particles", "mass", "px", "py", "pz", "kinetic", "internal",
+             "total", "rhs_evals"]
+
+
+def level_origin(level):
+    """o_l of mpm_hier.h: o_0 = the domain's lo (0, 0), o_{l+1} = o_l - h_{l+1} / 2."""
+    o = np.zeros(2)
+    for m in range(1, level + 1):
+        o -= H0 / 2 ** m / 2
+    return o
+
+
+def regions():
+    """Each box's region as [lo, hi] per axis: the level l - 1 spans (dual cells of its nodes,
+    [o + (i - 1/2) h, o + (i + 1/2) h]) that meet the open box, as mpm_hier.h defines them."""
+    out = []
+    for level, lo, hi in BOXES:
+        o, h = level_origin(level - 1), H0 / 2 ** (level - 1)
+        a = np.floor((np.array(lo) - o) / h - 0.5 + 1e-9) + 1
+        z = np.ceil((np.array(hi) - o) / h + 0.5 - 1e-9) - 1
+        out.append((level, o + (a - 0.5) * h, o + (z + 0.5) * h))
+    return out
+
+
+def expected_levels(x):
+    """The finest level whose region holds each position (the regions nest); and the least
+    distance of a particle to a region's face (a particle on a face could go either way)."""
+    level, margin = np.zeros(len(x), dtype=int), np.inf
+    for lv, lo, hi in regions():
+        inside = np.all((x > lo) & (x < hi), axis=1)
+        level = np.where(inside, np.maximum(level, lv), level)
+        margin = min(margin, np.abs(np.concatenate([x - lo, x - hi])).min())
+    return level, margin
+
+
+def check_level_group(f, snap, level, problems):
+    """/levels/<level> of one snapshot: shapes, spacing, origin on the level's lattice."""
+    g = f[f"levels/{level}"]
+    h, o = H0 / 2 ** level, level_origin(level)
+    shape = (f["grid/fluid/m"] if level == 0 else g["fluid/m"]).shape
+    origin = np.asarray(g.attrs["origin"])
+    steps = (origin - o) / h
+    if g.attrs["level"] != level or abs(g.attrs["spacing"] - h) > 1e-15:
+        problems.append(f"{snap} level {level}: attributes {dict(g.attrs)}")
+    if np.abs(steps - np.round(steps)).max() > 1e-9:
+        problems.append(f"{snap} level {level}: origin {origin} is not a node of o_l + i h_l")
+    if level == 0 and (not np.allclose(origin, f["grid"].attrs["origin"]) or "fluid" in g):
+        problems.append(f"{snap} level 0: origin {origin} or a grid phase beside /grid's")
+    if level > 0 and g["fluid/v"].shape != shape + (2,):
+        problems.append(f"{snap} level {level}: v {g['fluid/v'].shape} for m {shape}")
+    for mask in ("active", "own"):
+        if g[mask].shape != shape or g[mask].dtype != np.uint8:
+            problems.append(f"{snap} level {level}: {mask} {g[mask].shape} {g[mask].dtype}")
+    return g, origin, h
+
+
+def own_of(groups, level, x):
+    """The own mask of the span holding each position on its level (span i is node i's dual
+    cell: the nearest node). Level 0's lattice has its pad layers and, along the periodic x,
+    writes the nodes 0 .. ncells - 1 only (the rest are their images): wrap onto them."""
+    g, origin, h = groups[level]
+    j = np.round((x - origin) / h).astype(int)
+    if level == 0:
+        pad, ncells = int(round(-origin[0] / h)), int(round(2 / h))  # case_text(2, ...)
+        j[:, 0] = (j[:, 0] - pad) % ncells + pad
+    own = g["own"][()]
+    ok = (j >= 0).all(axis=1) & (j[:, 0] < own.shape[1]) & (j[:, 1] < own.shape[0])
+    out = np.zeros(len(x), dtype=int)
+    out[ok] = own[j[ok, 1], j[ok, 0]]
+    return out
+
+
+def check_own(groups, level, snap, problems):
+    """The mask own of a level is 1 exactly at the nodes whose span (centred on the node) has
+    that level by the boxes (level 0: the periodic x's written nodes 0 .. ncells - 1 only)."""
+    g, origin, h = groups[level]
+    own = g["own"][()]
+    jy, jx = np.meshgrid(np.arange(own.shape[0]), np.arange(own.shape[1]), indexing="ij")
+    x = np.stack([origin[0] + jx.ravel() * h, origin[1] + jy.ravel() * h], axis=1)
+    want = (expected_levels(x)[0] == level).reshape(own.shape)
+    if level == 0:
+        pad, ncells = int(round(-origin[0] / h)), int(round(2 / h))
+        own, want = own[:, pad:pad + ncells], want[:, pad:pad + ncells]
+    if not np.array_equal(own.astype(bool), want):
+        problems.append(f"{snap} level {level}: own differs from the boxes' regions at "
+                        f"{np.count_nonzero(own.astype(bool) != want)} nodes")
+
+
+def check_grid_sums(f, groups, snap, problems):
+    """The composite grid holds the particles' mass and momentum on the active nodes of all
+    levels, and nothing on the inactive ones (mpm_hier.h). Mass: a sum of ~3000 terms, 1e-12
+    relative. Momentum: the stream is uniform, so the deposit the grid keeps (from the last
+    right-hand side, at a stage's positions) has the particles' momentum to roundoff too."""
+    mass = f["fluid/m"][()].sum()
+    mom = (f["fluid/m"][()] * f["fluid/v"][()]).sum(axis=0)
+    gm, gp, stray = 0.0, np.zeros(2), 0.0
+    for lv in range(3):
+        g = groups[lv][0]
+        m = (f["grid/fluid/m"] if lv == 0 else g["fluid/m"])[()]
+        v = (f["grid/fluid/v"] if lv == 0 else g["fluid/v"])[()]
+        act = g["active"][()].astype(bool)
+        gm += m[act].sum()
+        gp += (m[act][:, None] * v[act]).sum(axis=0)
+        stray = max(stray, np.abs(m[~act]).max() if (~act).any() else 0.0)
+    dm, dp = abs(gm - mass) / mass, np.abs(gp - mom).max() / np.abs(mom).max()
+    if dm > 1e-12 or dp > 1e-12 or stray != 0.0:
+        problems.append(f"{snap}: grid mass {gm!r} against the particles' {mass!r} ({dm:.1e}), "
+                        f"momentum {dp:.1e}, inactive nodes up to {stray:.1e}")
+
+
+def check_snapshot(path, diag, problems):
+    """Levels, particle levels and counts of one snapshot; returns (particles, margin)."""
+    with h5py.File(path, "r") as f:
+        snap, step = os.path.basename(path), int(f.attrs["step"])
+        groups = {lv: check_level_group(f, snap, lv, problems) for lv in range(3)}
+        x, level = f["fluid/x"][()], f["fluid/level"][()]
+        if level.shape != (len(x), 1):
+            problems.append(f"{snap}: level {level.shape} for {len(x)} particles")
+        level = level[:, 0].astype(int)
+        want, margin = expected_levels(x)
+        if not np.array_equal(level, want):
+            problems.append(f"{snap}: {np.count_nonzero(level != want)} particles' level differs "
+                            f"from their position's")
+        for lv in range(3):
+            check_own(groups, lv, snap, problems)
+            mine = level == lv
+            if not own_of(groups, lv, x[mine]).all():
+                problems.append(f"{snap}: particles of level {lv} outside its own mask")
+        if step > 0:  # the grid holds the last deposit (none before the first step)
+            check_grid_sums(f, groups, snap, problems)
+        row = diag[diag["step"] == step][-1]
+        counts = [int(row[f"particles_l{lv}"]) for lv in range(3)]
+        if counts != np.bincount(level, minlength=3).tolist():
+            problems.append(f"{snap}: diagnostics.csv counts {counts} at step {step}, the level "
+                            f"field {np.bincount(level, minlength=3).tolist()}")
+        return len(x), margin
+
+
+def check_index(out, problems):
+    """grid.xmf: per snapshot the blocks fluid_grid, fluid_grid_l1, _l2, every HDF item a
+    dataset of that shape; series.xmf lists the particle level."""
+    import xml.etree.ElementTree as ET
+    root = ET.parse(os.path.join(out, "grid.xmf")).getroot()
+    snaps = root.find("Domain/Grid").findall("Grid")
+    for snap in snaps:
+        names = [b.get("Name") for b in snap.findall("Grid")]
+        if names != ["fluid_grid", "fluid_grid_l1", "fluid_grid_l2"]:
+            problems.append(f"grid.xmf {snap.get('Name')}: blocks {names}")
+        for block in snap.findall("Grid/Grid"):
+            attrs = [a.get("Name") for a in block.findall("Attribute")]
+            if attrs != ["m", "v", "active", "own"]:
+                problems.append(f"grid.xmf {block.get('Name')}: attributes {attrs}")
+    for item in root.iter("DataItem"):
+        if item.get("Format") != "HDF":
+            continue
+        fname, _, dset = item.text.strip().partition(":")
+        dims = tuple(int(d) for d in item.get("Dimensions").split() if d != "1")
+        with h5py.File(os.path.join(out, fname), "r") as f:
+            shape = tuple(d for d in f[dset].shape if d != 1) if dset in f else None
+        if shape != dims:
+            problems.append(f"grid.xmf: {fname}:{dset} {shape} for Dimensions {dims}")
+    series = ET.parse(os.path.join(out, "series.xmf")).getroot()
+    levels = [a for a in series.iter("Attribute") if a.get("Name") == "level"]
+    if len(levels) != len(snaps):
+        problems.append(f"series.xmf: {len(levels)} level attributes for {len(snaps)} snapshots")
+    return len(snaps)
+
+
+def check_paraview(out):
+    """ParaView's three readers on grid.xmf: three blocks each, of the levels' node counts, with
+    m, v, active, own, and the mask own read as stored."""
+    with h5py.File(mt.snapshots(out)[-1][1], "r") as f:
+        want = [(f["grid/fluid/m"].size, int(f["levels/0/own"][()].sum()))]
+        want += [(f[f"levels/{lv}/fluid/m"].size, int(f[f"levels/{lv}/own"][()].sum()))
+                 for lv in (1, 2)]
+    p = subprocess.run(["pvpython", os.path.abspath(__file__), "--in-paraview",
+                        os.path.join(out, "grid.xmf")], capture_output=True, text=True, timeout=120)
+    seen = {r: [] for r in READERS}
+    for line in p.stdout.splitlines():
+        f = line.split()
+        if len(f) == 5 and f[0] == "PV":
+            seen[f[1]].append((int(f[2]), f[3], int(f[4])))
+    for r in READERS:
+        got = sorted((n, own) for n, arrays, own in seen[r] if arrays == "active,m,own,v")
+        check(p.returncode == 0 and got == sorted(want) and len(seen[r]) == 3,
+              f"ParaView {r} opens grid.xmf: blocks (points, own nodes) {seen[r]} "
+              f"(want {sorted(want)} with m, v, active, own)")
+
+
+def part_output():
+    gas = "density = 1\npressure = 1\nvelocity = 0.6 0"
+    extra = "[fluid]\nppc = 2\npressure = grid\n"
+    text = case_text(2, 0.3, gas, LEVELS3, extra=extra).replace(
+        "interval = 0.15", "interval = 0.15\ngrid_fields = true")
+    out, wall = run("refine_output", text)
+    print(f"info refined run: {wall:.2f} s wall")
+    diag = diagnostics(out)
+    cols = list(diag.dtype.names)
+    check(cols == DIAG_COLS + ["particles_l0", "particles_l1", "particles_l2"],
+          f"diagnostics.csv: the unrefined columns, then particles_l0 .. l2 ({', '.join(cols)})")
+    total = sum(diag[f"particles_l{lv}"] for lv in range(3))
+    check(np.array_equal(total, diag["particles"]) and (diag["particles_l2"] > 0).all(),
+          f"diagnostics.csv: the per-level counts sum to the particles in all {len(diag)} rows "
+          f"(last row {[int(diag[f'particles_l{lv}'][-1]) for lv in range(3)]})")
+    problems, n, margin = [], 0, np.inf
+    snaps = mt.snapshots(out)
+    for _, path in snaps:
+        k, m = check_snapshot(path, diag, problems)
+        n, margin = n + k, min(margin, m)
+    check(not problems and len(snaps) == 3,
+          f"{len(snaps)} snapshots: /levels/0..2 with the level's spacing, an origin on its node "
+          f"lattice, masks and m, v of matching shapes, own where the boxes put the level, the "
+          f"particles' mass and momentum on the active nodes of all levels (1e-12); the particle "
+          f"level of all {n} rows equal to the level of the position computed from the boxes "
+          f"(nearest particle {margin:.1e} from a region face) and inside its level's own "
+          f"mask; the counts "
+          f"diagnostics.csv gives at the snapshot's step equal to the level field's"
+          + "".join("\n     " + q for q in problems[:10]))
+    problems = []
+    nsnap = check_index(out, problems)
+    check(not problems, f"grid.xmf: {nsnap} snapshots with blocks fluid_grid, fluid_grid_l1, "
+          f"fluid_grid_l2 (m, v, active, own), every item the shape of its dataset; series.xmf "
+          f"lists the particle level" + "".join("\n     " + q for q in problems[:10]))
+    tool = subprocess.run([sys.executable, os.path.join(mt.SOURCE, "tools", "check_snapshot.py"),
+                           out], capture_output=True, text=True)
+    check(tool.returncode == 0, f"tools/check_snapshot.py accepts the refined folder "
+          f"(exit {tool.returncode}){tool.stdout[-300:] if tool.returncode else ''}")
+    timers = dict(np.genfromtxt(os.path.join(out, "timers.csv"), delimiter=",", names=True,
+                                dtype=None, encoding=None)[["phase", "mean_s"]].tolist())
+    check(timers.get("restrict", 0) > 0 and timers.get("prolong", 0) > 0,
+          f"timers.csv: restrict {timers.get('restrict')} s, prolong {timers.get('prolong')} s")
+    if shutil.which("pvpython"):
+        check_paraview(out)
+    else:
+        print("info pvpython is not on the PATH: ParaView's readers not tried")
+    # The unrefined strip: the columns and the layout as before, no level anywhere.
+    plain, _ = run("refine_output_plain", case_text(2, 0.1, gas, "", extra=extra).replace(
+        "interval = 0.05", "interval = 0.05\ngrid_fields = true"))
+    with h5py.File(mt.snapshots(plain)[-1][1], "r") as f:
+        top, fields = sorted(f.keys()), sorted(f["fluid"].keys())
+    with open(os.path.join(plain, "grid.xmf")) as f:
+        xmf = f.read()
+    cols = list(diagnostics(plain).dtype.names)
+    check(cols == DIAG_COLS and top == ["fluid", "grid", "xdmf"] and "level" not in fields
+          and "levels" not in xmf and "_l1" not in xmf,
+          f"unrefined: diagnostics.csv columns {len(cols)} as before, snapshot groups {top}, no "
+          f"particle level, grid.xmf without levels")
+
+
 if PART == "uniform":
     runs, dev = part_uniform()
     got = dev["refined"]
@@ -463,6 +761,8 @@ elif PART == "input":
     part_input()
 elif PART == "identity":
     part_identity()
+elif PART == "output":
+    part_output()
 else:
     raise SystemExit(f"unknown part {PART}")
 sys.exit(check.finish())
