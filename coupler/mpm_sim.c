@@ -50,6 +50,7 @@ struct mpm_sim {
   mpm_coupling *coupling; /* NULL: one phase, or scheme = none */
   mpm_hier *hier;         /* the refinement hierarchy (mpm_refine.h); NULL: none */
   int dynamic;            /* it regrids (refine.criterion) */
+  int diag_levels;        /* per-level particle counts in diagnostics.csv (0: unrefined) */
   mpm_timescheme *it;     /* the temporal coupling scheme */
   mpm_guard guard;
   double energy;      /* total energy at the last diagnostics row */
@@ -296,12 +297,16 @@ enum { NDIAG = (int)(sizeof g_diag_cols / sizeof g_diag_cols[0]) };
 static const char *const g_level_cols[MPM_HIER_MAX_LEVELS] = {
     "particles_l0", "particles_l1", "particles_l2", "particles_l3", "particles_l4"};
 
-/* diagnostics.csv's columns: g_diag_cols, then one per level when refined. */
-static int diag_columns(const mpm_sim *s, const char **cols) {
-  int n = 0;
+/* diagnostics.csv's columns: g_diag_cols, then one per level when refined (refine.levels of
+ * them when regridding: a regrid may build fewer levels, or none, for a while). */
+static int diag_columns(mpm_sim *s, const char **cols, int *ncols) {
+  int n = 0, levels = 0;
   for (int k = 0; k < NDIAG; ++k) cols[n++] = g_diag_cols[k];
-  for (int l = 0; s->hier && l < s->hier->nlevels; ++l) cols[n++] = g_level_cols[l];
-  return n;
+  if (s->dynamic) MPM_CALL(mpm_config_get_int(s->cfg, "refine.levels", &levels));
+  s->diag_levels = s->dynamic ? levels : s->hier ? s->hier->nlevels : 0;
+  for (int l = 0; l < s->diag_levels; ++l) cols[n++] = g_level_cols[l];
+  *ncols = n;
+  return 0;
 }
 
 /* coupling.csv: the interface force on each phase (the momentum the other gives it per unit
@@ -342,7 +347,8 @@ static int open_outputs(mpm_sim *s) {
   MPM_CALL(mpm_output_set_hier(s->out, s->hier)); /* NULL: unrefined */
   snprintf(path, sizeof path, "%s/diagnostics.csv", s->dir);
   const char *dcols[NDIAG + MPM_HIER_MAX_LEVELS];
-  const int nd = diag_columns(s, dcols);
+  int nd = 0;
+  MPM_CALL(diag_columns(s, dcols, &nd));
   MPM_CALL(mpm_diag_open(&s->diag, s->comm, path, nd, dcols, append, s->t));
   if (s->probes.n > 0) {
     const char *pcols[MPM_PROBE_MAX * 2 * MPM_MAX_DIM + 1];
@@ -633,7 +639,10 @@ static int diagnostics_row(mpm_sim *s, double dt) {
     local[5] += m.kinetic;
     local[6] += m.internal;
     local[8 + s->mod[k]->role] += m.kinetic + m.internal;
-    if (s->hier) mpm_hier_count_levels(s->hier, s->mod[k]->particles, local + ROW_LEVELS);
+    if (s->hier)
+      mpm_hier_count_levels(s->hier, s->mod[k]->particles, local + ROW_LEVELS);
+    else if (s->diag_levels) /* a regridded run with nothing refined just now */
+      local[ROW_LEVELS] += (double)s->mod[k]->particles->n;
   }
   MPM_CALL_MPI(MPI_Allreduce(local, sum, ROW_SUMS, MPI_DOUBLE, MPI_SUM, s->comm));
   s->energy = sum[5] + sum[6], s->kinetic = sum[5];
@@ -641,7 +650,7 @@ static int diagnostics_row(mpm_sim *s, double dt) {
   double row[NDIAG + MPM_HIER_MAX_LEVELS] = {
       s->t,   (double)s->step, dt,     sum[0], sum[1],          sum[2],
       sum[3], sum[4],          sum[5], sum[6], sum[5] + sum[6], rhs_evals(s)};
-  for (int l = 0; s->hier && l < s->hier->nlevels; ++l) row[NDIAG + l] = sum[ROW_LEVELS + l];
+  for (int l = 0; l < s->diag_levels; ++l) row[NDIAG + l] = sum[ROW_LEVELS + l];
   if (dt > 0) s->particle_steps += sum[0]; /* the row at t = 0 is not a step */
   if (s->probes.n > 0) {
     double prow[MPM_PROBE_MAX * 2 * MPM_MAX_DIM + 1];
@@ -731,6 +740,7 @@ static int regrid(mpm_sim *s, int force) {
   if (!s->dynamic) return 0;
   mpm_timer_start(MPM_T_POST);
   int rc = mpm_refine_regrid(&s->hier, s->cfg, s->grid, s->mod, s->nmod, s->step, force, &changed);
+  if (!rc && changed) rc = mpm_output_set_hier(s->out, s->hier);
   if (!rc && changed) rc = mpm_timescheme_resize(s->it, s->t);
   mpm_timer_stop(MPM_T_POST);
   return rc;

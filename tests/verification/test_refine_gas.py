@@ -329,9 +329,14 @@ def part_dynamic():
         check(level == 1, f"t = {p['time']:g}: the densest particle of the rows 0.2 < y < 0.4 "
               f"(x = {p['x'][k, 0]:.3f}) is a level-{level} particle (want 1: the region follows "
               f"the pulse; the region keeps 4 level-0 cells from the walls)")
-    counts = set(diagnostics(out)["particles"].astype(int))
+    d = diagnostics(out)
+    counts = set(d["particles"].astype(int))
     check(len(counts) > 2, f"{len(counts)} distinct particle counts over the run (regrids, splits "
           f"and merges; want more than 2)")
+    per_level = d["particles_l0"] + d["particles_l1"]
+    check(np.array_equal(per_level, d["particles"]) and d["particles_l1"].min() > 0,
+          f"diagnostics.csv: the per-level counts sum to the particle count in all {len(d)} rows "
+          f"(level 1 holds {int(d['particles_l1'].min())} to {int(d['particles_l1'].max())})")
     ref = row_density(runs["fine"][0])
     for label in ("refined", "coarse"):
         err = np.abs(row_density(runs[label][0]) - ref).mean()
