@@ -63,7 +63,8 @@ static int report(const double *max, const double *mean, const char *path) {
   for (int k = 0; k < MPM_T_COUNT; ++k) {
     mpm_log(MPM_LOG_INFO, "%-11s %12.4f %12.4f %7.1f%%", g_names[k], max[k], mean[k],
             100.0 * max[k] / total);
-    if (k != MPM_T_TOTAL && k != MPM_T_RESTRICT && k != MPM_T_PROLONG) parts += mean[k];
+    if (k != MPM_T_TOTAL && k != MPM_T_RESTRICT && k != MPM_T_PROLONG && k != MPM_T_RELEVEL)
+      parts += mean[k];
   }
   /* Integrator vector operations, set-up and whatever else no phase covers. */
   mpm_log(MPM_LOG_INFO, "%-11s %12s %12.4f %7.1f%%", "(other)", "", mean[MPM_T_TOTAL] - parts,

@@ -3,7 +3,9 @@
  *
  * restrict and prolong (the refinement hierarchy's transfers between levels, mpm_hier.h) are
  * details: they are timed wherever they run, also inside another phase (the grid pressure's run
- * inside grid), so the report leaves them out of the sum it subtracts from total for (other). */
+ * inside grid), so the report leaves them out of the sum it subtracts from total for (other);
+ * likewise relevel (a refined gas's splits and merges, inside post_step). regrid (a dynamic
+ * refinement's rebuild of the hierarchy) runs between steps on its own. */
 #ifndef MPM_TIMER_H
 #define MPM_TIMER_H
 
@@ -24,6 +26,8 @@
   X(MPM_T_POST, "post_step")                                                                       \
   X(MPM_T_RESTRICT, "restrict")                                                                    \
   X(MPM_T_PROLONG, "prolong")                                                                      \
+  X(MPM_T_RELEVEL, "relevel")                                                                      \
+  X(MPM_T_REGRID, "regrid")                                                                        \
   X(MPM_T_IO, "io")                                                                                \
   X(MPM_T_TOTAL, "total")
 

@@ -738,11 +738,11 @@ static int after_step(mpm_sim *s, double h) {
 static int regrid(mpm_sim *s, int force) {
   int changed = 0;
   if (!s->dynamic) return 0;
-  mpm_timer_start(MPM_T_POST);
+  mpm_timer_start(MPM_T_REGRID);
   int rc = mpm_refine_regrid(&s->hier, s->cfg, s->grid, s->mod, s->nmod, s->step, force, &changed);
   if (!rc && changed) rc = mpm_output_set_hier(s->out, s->hier);
   if (!rc && changed) rc = mpm_timescheme_resize(s->it, s->t);
-  mpm_timer_stop(MPM_T_POST);
+  mpm_timer_stop(MPM_T_REGRID);
   return rc;
 }
 

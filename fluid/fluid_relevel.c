@@ -28,6 +28,7 @@
 
 #include "mpm_error.h"
 #include "mpm_hier.h"
+#include "mpm_timer.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -76,9 +77,8 @@ static int merge_level(mpm_module *m, double V0_0, int L, mpm_lidx *idx, mpm_lid
   return rc;
 }
 
-int fluid_relevel(mpm_module *m, int *changed) {
+static int relevel(mpm_module *m, int *changed) {
   const fluid_content *fc = m->content;
-  if (!fc->refined) return 0;
   const double V0_0 = pow(m->grid->dx / fc->ppc, m->grid->dim);
   mpm_lidx *idx;
   MPM_ALLOC(idx, m->particles->n > 0 ? m->particles->n : 1);
@@ -95,4 +95,13 @@ int fluid_relevel(mpm_module *m, int *changed) {
   MPM_CALL(rc);
   *changed |= merged > 0 || rep.parents > 0;
   return 0;
+}
+
+int fluid_relevel(mpm_module *m, int *changed) {
+  const fluid_content *fc = m->content;
+  if (!fc->refined) return 0;
+  mpm_timer_start(MPM_T_RELEVEL);
+  const int rc = relevel(m, changed);
+  mpm_timer_stop(MPM_T_RELEVEL);
+  return rc;
 }
