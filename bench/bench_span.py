@@ -68,8 +68,8 @@ def report(a, lines, walls, steps):
     med = {k: statistics.median(v) for k, v in walls.items()}
     out = [
         "# Cost of the exact span integrals (fluid.pressure = grid)", "",
-        f"Made by `/usr/bin/python3 bench/bench_span.py --old {a.old_label} --rounds {a.rounds}` "
-        f"at commit {git_head()} (new) against {a.old_label}, "
+        f"Made by `/usr/bin/python3 bench/bench_span.py --old OLD --rounds {a.rounds}` at commit "
+        f"{git_head()} (new), OLD being mpmfsi built the same way at {a.old_label}, "
         f"{datetime.datetime.now(datetime.timezone.utc):%Y-%m-%d %H:%M} UTC, on a shared 2-core "
         "machine (other jobs running: compare ratios, not absolute times).", "",
         "## The integrals alone (bench/bench_span.c, one process, old and new alternating)", "",
@@ -102,7 +102,7 @@ def report(a, lines, walls, steps):
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawTextHelpFormatter)
     ap.add_argument("--old", required=True, help="mpmfsi built from the code before (baseline)")
-    ap.add_argument("--old-label", default=None, help="how to name the baseline in OUT")
+    ap.add_argument("--old-label", default=None, help="how to name the baseline in OUT (its commit)")
     ap.add_argument("--new", default=os.path.join(ROOT, "build", "app", "mpmfsi"))
     ap.add_argument("--build", default=os.path.join(ROOT, "build"), help="this checkout's build")
     ap.add_argument("--rounds", type=int, default=5)
