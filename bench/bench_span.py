@@ -22,6 +22,7 @@ import shutil
 import statistics
 import subprocess
 import sys
+import tempfile
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
@@ -113,7 +114,13 @@ def main():
         sys.exit("bench_span.py: mpicc not found (it builds bench/bench_span.c)")
     lines = micro(a.build)
     print("\n".join(lines), flush=True)
-    walls, steps = sod(a.old, a.new, a.rounds)
+    runs = os.path.join(a.build, "bench_span", "runs")  # bench_build_ab.run's run folders
+    os.makedirs(runs, exist_ok=True)
+    tempfile.tempdir = runs
+    try:
+        walls, steps = sod(a.old, a.new, a.rounds)
+    finally:
+        shutil.rmtree(runs, ignore_errors=True)
     text = report(a, lines, walls, steps)
     with open(a.out, "w") as f:
         f.write(text)
