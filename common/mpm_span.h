@@ -9,13 +9,15 @@
  *                                                    weak form; adds, per component)
  *   divergence:  D_i += integral of N_i div v_h        (adds)
  *
- * both over the spans of the set. The integrands are of degree at most 4 per axis, so the
- * three-point Gauss rule per axis is exact (to roundoff). The two are adjoint on any span set:
+ * both over the spans of the set. On a span each is a product of exact 1-D integrals of the
+ * B-splines (polynomials of degree at most 4 per axis; the same as a three-point Gauss rule per
+ * axis gives, to roundoff). The two are adjoint on any span set:
  * sum_i f_i . v_i = sum_j p_j D_j, which is what lets a module book the force's work as the
  * particles' pressure work exactly (fluid/fluid_gridp.c). A constant p gives f_i = 0 at every
  * node whose support lies in the set's interior, and a constant v gives D = 0 everywhere.
  *
- * Cost: (3 x 3)^dim products per span and per field, without a particle. */
+ * Cost: by sum factorisation, about 3^dim x 3 x dim^2 products per span and per field (650
+ * in 3-D), without a particle (bench/results/span_cost.md). */
 #ifndef MPM_SPAN_H
 #define MPM_SPAN_H
 

@@ -11,7 +11,13 @@
  *      the interior nodes, to 1e-13 relative.
  *  (4) Half spans: with the spans at x = 0 and x = 10 h halved (a wall through their nodes),
  *      sum_i D_i is the integral of div v over the clipped box, c (10 h) (8 h)[(8 h)], to 1e-13
- *      relative; the full spans give c (11 h) ... instead. */
+ *      relative; the full spans give c (11 h) ... instead.
+ *  (5) Half spans on every axis (spans 0 .. 10 along x, 0 .. 7 along the others, all ends
+ *      halved) and two interior spans skipped, each axis d in turn: v = c x_d e_d gives sum_i D_i
+ *      = c |V| (V the spans integrated), and a constant p = a gives sum_i f_d,i x_d,i = a |V|
+ *      (the B-splines reproduce x_d, so that sum is the integral of p d x_d/dx_d), to 1e-13
+ *      relative; and sum f.v = sum p D for random fields, as in (1). A wrong half, or a skipped
+ *      span still integrated, along any axis misses these by a span's share of |V|. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -177,12 +183,72 @@ static void test_divergence(void **state) {
   divergence(2), divergence(3);
 }
 
+/* The set of (5): all ends halved, the spans of nodes (3, 3, 3) and (5, 2, 4) skipped. Returns
+ * the measure of what it integrates. */
+static double halved_set(fixture *x, int dim, unsigned char *skip) {
+  const int gap[2][3] = {{3, 3, 3}, {5, 2, 4}};
+  x->set = (mpm_span_set){.lo = {0, 0, 0}, .hi = {10, 7, 7}, .skip = skip};
+  double vol = 10 * H;
+  for (int d = 0; d < dim; ++d) x->set.half_lo[d] = x->set.half_hi[d] = 1;
+  for (int d = 1; d < dim; ++d) vol *= 7 * H;
+  for (int k = 0; k < 2; ++k) skip[mpm_grid_local_index(x->g, gap[k])] = 1;
+  return vol - 2 * pow(H, dim);
+}
+
+static void halved(int dim) {
+  fixture x;
+  make(&x, dim);
+  const size_t nn = (size_t)x.g->nnodes;
+  unsigned char *skip = calloc(nn, 1);
+  const double vol = halved_set(&x, dim, skip), a = 2.0, c = 1.5;
+  for (int d = 0; d < dim; ++d) {
+    memset(x.D, 0, sizeof(double) * nn), memset(x.f[d], 0, sizeof(double) * nn);
+    for (mpm_lidx k = 0; k < x.g->nnodes; ++k) {
+      int gi[3];
+      node_of(x.g, k, gi);
+      x.p[k] = a, x.v[d][k] = c * gi[d] * H;
+    }
+    mpm_span_force(x.g, &x.set, x.p, x.f);
+    mpm_span_divergence(x.g, &x.set, (const double *const *)x.v, x.D);
+    double fx = 0, sd = 0;
+    for (mpm_lidx k = 0; k < x.g->nnodes; ++k) fx += x.f[d][k] * x.v[d][k] / c, sd += x.D[k];
+    printf("%d-D halved, axis %d: sum D %.15e, sum f x %.15e, want %.15e, %.15e\n", dim, d, sd, fx,
+           c * vol, a * vol);
+    assert_true(fabs(sd - c * vol) <= 1e-13 * c * vol);
+    assert_true(fabs(fx - a * vol) <= 1e-13 * a * vol);
+    memset(x.v[d], 0, sizeof(double) * nn);
+  }
+  uint64_t s = 5;
+  memset(x.D, 0, sizeof(double) * nn);
+  for (mpm_lidx k = 0; k < x.g->nnodes; ++k) {
+    x.p[k] = uniform(&s);
+    for (int d = 0; d < dim; ++d) x.v[d][k] = uniform(&s), x.f[d][k] = 0;
+  }
+  mpm_span_force(x.g, &x.set, x.p, x.f);
+  mpm_span_divergence(x.g, &x.set, (const double *const *)x.v, x.D);
+  double fv = 0, pd = 0, scale = 0;
+  for (mpm_lidx k = 0; k < x.g->nnodes; ++k) {
+    for (int d = 0; d < dim; ++d) fv += x.f[d][k] * x.v[d][k], scale += fabs(x.f[d][k] * x.v[d][k]);
+    pd += x.p[k] * x.D[k];
+  }
+  printf("%d-D halved, skipped: sum f.v = %.15e, sum p D = %.15e\n", dim, fv, pd);
+  assert_true(fabs(fv - pd) <= 1e-13 * scale);
+  free(skip);
+  done(&x);
+}
+
+static void test_halved(void **state) {
+  (void)state;
+  halved(2), halved(3);
+}
+
 int main(int argc, char **argv) {
   MPI_Init(&argc, &argv);
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_adjoint),
       cmocka_unit_test(test_pressure),
       cmocka_unit_test(test_divergence),
+      cmocka_unit_test(test_halved),
   };
   const int rc = cmocka_run_group_tests(tests, NULL, NULL);
   MPI_Finalize();
