@@ -113,15 +113,17 @@ static box_spans snap_box(const mpm_grid *c, const mpm_hier_box *b) {
   return s;
 }
 
-/* Set mask to 1 on the box nodes with global indices in [a, z] (clipped to the box). */
+/* Set mask to 1 on the box nodes with global indices in [a, z] (clipped to the box). Visits
+ * those nodes only: a regrid builds a level from many small boxes. */
 static void mark(const mpm_grid *g, unsigned char *mask, const int *a, const int *z) {
-  int gi[MPM_MAX_DIM];
-  for (mpm_lidx l = 0; l < g->nnodes; ++l) {
-    hier_node_of(g, l, gi);
-    int in = 1;
-    for (int d = 0; d < g->dim; ++d) in &= gi[d] >= a[d] && gi[d] <= z[d];
-    if (in) mask[l] = 1;
+  int lo[MPM_MAX_DIM] = {0, 0, 0}, hi[MPM_MAX_DIM] = {0, 0, 0}, gi[MPM_MAX_DIM];
+  for (int d = 0; d < g->dim; ++d) {
+    lo[d] = MPM_MAX(a[d], g->box_lo[d]), hi[d] = MPM_MIN(z[d], g->box_lo[d] + g->box_n[d] - 1);
+    if (lo[d] > hi[d]) return;
   }
+  for (gi[2] = lo[2]; gi[2] <= hi[2]; ++gi[2])
+    for (gi[1] = lo[1]; gi[1] <= hi[1]; ++gi[1])
+      for (gi[0] = lo[0]; gi[0] <= hi[0]; ++gi[0]) mask[mpm_grid_local_index(g, gi)] = 1;
 }
 
 /* Is every span in [a, z] covered on level l? */

@@ -89,13 +89,12 @@ static int read_box(const mpm_config *cfg, const mpm_grid *g, const char *name, 
   }
   const double gap = REFINE_FACE_CELLS * g->dx, tol = 1e-9 * g->dx;
   for (int d = 0; d < g->dim; ++d) {
-    if (g->periodic[d]) continue;
     const int low = b->lo[d] < g->lo[d] + gap - tol;
     if (low || b->hi[d] > g->hi[d] - gap + tol)
       return mpm_config_fail(cfg, key[low ? 1 : 2],
                              "the box comes within %d level-0 cells (%g) of the domain face %c = "
-                             "%g, which is not periodic: walls and open faces act on level 0 "
-                             "only; keep the box inside [%g, %g] along %c",
+                             "%g: walls, open faces and the periodic wrap act on level 0 only; "
+                             "keep the box inside [%g, %g] along %c",
                              REFINE_FACE_CELLS, gap, "xyz"[d], low ? g->lo[d] : g->hi[d],
                              g->lo[d] + gap, g->hi[d] - gap, "xyz"[d]);
   }
@@ -220,9 +219,9 @@ static int make_dynamic(mpm_hier **h, const dynamic *dy, mpm_grid *grid, mpm_mod
   unsigned char *flag = malloc(3 * total);
   if (!flag) MPM_FAIL_OOM(3 * total);
   unsigned char *mask = flag + total, *tmp = mask + total;
-  fluid_refine_density_flags(gas, dy->threshold, n, flag);
   mpm_hier_box *box = NULL;
-  int nbox = 0, cap = 0, used = 1, rc = 0;
+  int nbox = 0, cap = 0, used = 1;
+  int rc = fluid_refine_density_flags(gas, dy->threshold, n, flag);
   const double eps = 1e-6 * ldexp(grid->dx, -dy->levels);
   for (int l = 1; l < dy->levels && !rc; ++l) {
     dilate(n, grid->dim, dy->dilate * (dy->levels - l), flag, mask, tmp);
@@ -248,6 +247,20 @@ static int make_dynamic(mpm_hier **h, const dynamic *dy, mpm_grid *grid, mpm_mod
   return rc;
 }
 
+/* Do a and b (either may be NULL) have the same levels and regions? */
+static int same_regions(const mpm_hier *a, const mpm_hier *b) {
+  if (!a || !b) return a == b;
+  if (a->nlevels != b->nlevels) return 0;
+  if (memcmp(a->level[0].refined, b->level[0].refined, (size_t)a->level[0].grid->nnodes)) return 0;
+  for (int l = 1; l < a->nlevels; ++l) {
+    const mpm_grid *ga = a->level[l].grid, *gb = b->level[l].grid;
+    for (int d = 0; d < a->dim; ++d)
+      if (ga->box_lo[d] != gb->box_lo[d] || ga->box_n[d] != gb->box_n[d]) return 0;
+    if (memcmp(a->level[l].covered, b->level[l].covered, (size_t)ga->nnodes)) return 0;
+  }
+  return 1;
+}
+
 int mpm_refine_dynamic(const mpm_config *cfg) {
   const char *criterion;
   int levels;
@@ -266,6 +279,10 @@ int mpm_refine_regrid(mpm_hier **h, const mpm_config *cfg, mpm_grid *grid, mpm_m
   if (!on || nmod < 1 || (!force && step % dy.every != 0)) return 0;
   mpm_hier *next;
   MPM_CALL(make_dynamic(&next, &dy, grid, mod[0]));
+  if (same_regions(next, *h)) { /* keep the hierarchy, and the integrator's state */
+    mpm_hier_destroy(&next);
+    return 0;
+  }
   for (int k = 0; k < nmod; ++k) fluid_module_rehier(mod[k], next);
   mpm_hier_destroy(h);
   *h = next;

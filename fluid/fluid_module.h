@@ -38,7 +38,7 @@ void fluid_module_rehier(mpm_module *m, struct mpm_hier *h);
  * otherwise): a span is flagged, with each axis neighbour, where their densities (the gas's mass
  * over its volume, of the particles whose nearest node it is) differ by more than threshold
  * times the smaller. flag has prod n[d] bytes. One rank. */
-void fluid_refine_density_flags(const mpm_module *m, double threshold, const int *n,
-                                unsigned char *flag);
+int fluid_refine_density_flags(const mpm_module *m, double threshold, const int *n,
+                               unsigned char *flag);
 
 #endif

@@ -145,7 +145,7 @@ int fluid_module_refine(mpm_module *m, const mpm_config *cfg, mpm_hier *h, int s
   MPM_CALL(fluid_refine_check(m, cfg));
   MPM_CALL(fluid_gridp_refine(m, cfg, h));
   ((fluid_content *)m->content)->refined = 1;
-  m->hier = h;
+  fluid_module_rehier(m, h);
   return seed && h ? fluid_seed_refined(m, cfg) : 0;
 }
 
@@ -163,8 +163,8 @@ static int span_of(const mpm_grid *g, int d, double x, int n) {
   return (int)(i < 0 ? 0 : i >= n ? n - 1 : i);
 }
 
-void fluid_refine_density_flags(const mpm_module *m, double threshold, const int *n,
-                                unsigned char *flag) {
+int fluid_refine_density_flags(const mpm_module *m, double threshold, const int *n,
+                               unsigned char *flag) {
   const fluid_content *fc = m->content;
   const mpm_particles *p = m->particles;
   const mpm_grid *g = m->grid;
@@ -173,7 +173,7 @@ void fluid_refine_density_flags(const mpm_module *m, double threshold, const int
   for (int d = 0; d < dim; ++d) stride[d] = total, total *= (size_t)n[d];
   memset(flag, 0, total);
   double *mass = calloc(2 * total, sizeof(double)), *vol = mass + total;
-  if (!mass) return; /* flags nothing: the run goes on unrefined */
+  if (!mass) MPM_FAIL_OOM(2 * total * sizeof(double));
   const double *pm = mpm_particles_comp(p, fc->lay.f_m, 0);
   const double *V0 = mpm_particles_comp(p, fc->lay.f_V0, 0);
   const double *J = mpm_particles_comp(p, FLUID_J, 0);
@@ -198,4 +198,5 @@ void fluid_refine_density_flags(const mpm_module *m, double threshold, const int
     }
   }
   free(mass);
+  return 0;
 }

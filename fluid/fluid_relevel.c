@@ -9,15 +9,17 @@
  * is round(log2(V0_level0 / V0) / dim). No field is stored, and a restart needs nothing.
  *
  * Merging. The candidates of one level of size L are grouped by the slots of the coarser
- * particle lattice (spacing h_{L-1} / ppc, fluid_merge_groups); only full groups of 2^dim merge,
- * so every merged particle has the coarser level's size. A slot lies wholly inside or outside
+ * particle lattice (spacing h_{L-1} / ppc, fluid_merge_groups): a slot of c candidates gives
+ * floor(c / 2^dim) groups of exactly 2^dim, so every merged particle has the coarser level's
+ * size. A slot lies wholly inside or outside
  * each refined region (the regions are unions of coarser spans, whose faces are slot faces for
  * an even ppc), so the merged particle sits on the level of its members. A part-filled slot
  * waits for the rest of its particles; in a flow that never fills it they stay fine.
  *
  * Splitting. The children sit at +-s/4 of the parent (s its size): a parent that has just
  * crossed into a finer region may leave some children outside it, which then wait (their slot
- * is not full) and enter with the flow.
+ * is not full) and enter with the flow. Splits repeat until no particle is coarser than its
+ * level (a regrid may put one two levels below).
  *
  * Without a hierarchy (a regrid found nothing to refine) every position is level 0 and the fine
  * particles merge back.
@@ -60,18 +62,9 @@ static int merge_level(mpm_module *m, double V0_0, int L, mpm_lidx *idx, mpm_lid
   if (k == 0) return 0;
   mpm_lidx *start, *member, ng;
   const double H = ldexp(m->grid->dx, 1 - L) / fc->ppc; /* level L - 1's particle spacing */
-  MPM_CALL(fluid_merge_groups(m, idx, k, H, &start, &member, &ng));
-  const mpm_lidx full = (mpm_lidx)1 << m->grid->dim;
-  mpm_lidx kept = 0, at = 0;
-  for (mpm_lidx g = 0; g < ng; ++g) { /* keep the full groups, in place */
-    const mpm_lidx a = start[g], size = start[g + 1] - a;
-    if (size != full) continue;
-    start[kept++] = at;
-    for (mpm_lidx j = 0; j < size; ++j) member[at++] = member[a + j];
-  }
-  start[kept] = at;
+  MPM_CALL(fluid_merge_groups(m, idx, k, H, 1, &start, &member, &ng));
   fluid_split_report rep = {0};
-  const int rc = kept ? fluid_merge(m, start, member, kept, &rep) : 0;
+  const int rc = ng ? fluid_merge(m, start, member, ng, &rep) : 0;
   free(start), free(member);
   *merged += rep.groups;
   return rc;
@@ -86,14 +79,28 @@ static int relevel(mpm_module *m, int *changed) {
   int rc = 0;
   for (int L = MPM_HIER_MAX_LEVELS - 1; !rc && L >= 1; --L)
     rc = merge_level(m, V0_0, L, idx, &merged);
-  mpm_lidx k = 0;
-  for (mpm_lidx i = 0; !rc && i < m->particles->n; ++i)
-    if (size_level(m, V0_0, i) < position_level(m, i)) idx[k++] = i;
-  fluid_split_report rep = {0};
-  if (!rc) rc = fluid_split(m, idx, k, &rep);
+  /* Split until every particle has its level's size: a regrid may put a particle two levels
+   * below its new level (idx grows with the set). */
+  mpm_lidx split = 0;
+  for (int pass = 0; !rc && pass < MPM_HIER_MAX_LEVELS; ++pass) {
+    mpm_lidx k = 0;
+    for (mpm_lidx i = 0; i < m->particles->n; ++i)
+      if (size_level(m, V0_0, i) < position_level(m, i)) idx[k++] = i;
+    fluid_split_report rep = {0};
+    rc = fluid_split(m, idx, k, &rep); /* collective: every rank calls, k = 0 too */
+    split += rep.parents;
+    if (!rc && k == 0) break;
+    if (!rc && pass + 1 < MPM_HIER_MAX_LEVELS) {
+      mpm_lidx *grown = realloc(idx, sizeof *idx * (size_t)MPM_MAX(m->particles->n, 1));
+      if (!grown)
+        rc = MPM_ERR_MEMORY;
+      else
+        idx = grown;
+    }
+  }
   free(idx);
   MPM_CALL(rc);
-  *changed |= merged > 0 || rep.parents > 0;
+  *changed |= merged > 0 || split > 0;
   return 0;
 }
 

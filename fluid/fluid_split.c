@@ -406,16 +406,17 @@ static mpm_gidx slot_of(const mpm_grid *g, const mpm_particles *p, mpm_lidx i, d
 
 /* The CSR groups of the sorted keys: each run of one slot of c >= 2 splits into
  * ceil(c / size) groups, the first c mod that count one larger. */
-static void groups_of_runs(const split_key *key, mpm_lidx k, int size, const mpm_lidx *idx,
-                           mpm_lidx *start, mpm_lidx *member, mpm_lidx *ngroups) {
+static void groups_of_runs(const split_key *key, mpm_lidx k, int size, int full,
+                           const mpm_lidx *idx, mpm_lidx *start, mpm_lidx *member,
+                           mpm_lidx *ngroups) {
   mpm_lidx ng = 0, nm = 0;
   start[0] = 0;
   for (mpm_lidx b = 0; b < k;) {
     mpm_lidx e = b + 1;
     while (e < k && key[e].cell == key[b].cell) ++e;
-    const mpm_lidx c = e - b, parts = (c + size - 1) / size;
+    const mpm_lidx c = e - b, parts = full ? c / size : (c + size - 1) / size;
     for (mpm_lidx t = 0, at = b; c >= 2 && t < parts; ++t) {
-      const mpm_lidx len = c / parts + (t < c % parts);
+      const mpm_lidx len = full ? size : c / parts + (t < c % parts);
       for (mpm_lidx u = 0; u < len; ++u) member[nm++] = idx[key[at + u].a];
       at += len, start[++ng] = nm;
     }
@@ -424,7 +425,7 @@ static void groups_of_runs(const split_key *key, mpm_lidx k, int size, const mpm
   *ngroups = ng;
 }
 
-int fluid_merge_groups(const mpm_module *m, const mpm_lidx *idx, mpm_lidx k, double H,
+int fluid_merge_groups(const mpm_module *m, const mpm_lidx *idx, mpm_lidx k, double H, int full,
                        mpm_lidx **start, mpm_lidx **member, mpm_lidx *ngroups) {
   const mpm_particles *p = m->particles;
   const mpm_grid *g = m->grid;
@@ -449,7 +450,7 @@ int fluid_merge_groups(const mpm_module *m, const mpm_lidx *idx, mpm_lidx k, dou
     *start = NULL, *member = NULL;
     MPM_FAIL_OOM(sizeof **member * (size_t)k);
   }
-  groups_of_runs(key, k, 1 << g->dim, idx, *start, *member, ngroups);
+  groups_of_runs(key, k, 1 << g->dim, full, idx, *start, *member, ngroups);
   free(key);
   return 0;
 }

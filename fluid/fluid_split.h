@@ -60,9 +60,10 @@ int fluid_merge(mpm_module *m, const mpm_lidx *start, const mpm_lidx *member, mp
  * candidates sharing a parent slot, the cell of the lattice of spacing H from the domain's
  * lower corner (H: the particle spacing of the coarser level, dx_l / fluid.ppc; seeded gas
  * sits at the slots' centres, and a parent's children in its slot). A slot of c candidates
- * gives ceil(c / 2^dim) groups of as equal sizes as can be, in id order; slots of one
+ * gives ceil(c / 2^dim) groups of as equal sizes as can be, in id order, or with full set
+ * floor(c / 2^dim) groups of exactly 2^dim, in id order, the rest left out; slots of one
  * candidate give none. *start (ngroups + 1) and *member (from malloc) are the caller's. Local. */
-int fluid_merge_groups(const mpm_module *m, const mpm_lidx *idx, mpm_lidx k, double H,
+int fluid_merge_groups(const mpm_module *m, const mpm_lidx *idx, mpm_lidx k, double H, int full,
                        mpm_lidx **start, mpm_lidx **member, mpm_lidx *ngroups);
 
 #endif

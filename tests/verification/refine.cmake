@@ -7,6 +7,9 @@ foreach(part uniform pulse uniform3d dynamic restart input identity)
   mpm_add_script_test(test_refine_gas_${part} SCRIPT verification/test_refine_gas.py ARGS ${part}
                       LABELS verification TIMEOUT 300)
 endforeach()
+# The grid pressure on 1 and 2 ranks (~5 s).
+mpm_add_script_test(test_refine_gas_ranks SCRIPT verification/test_refine_gas.py ARGS ranks
+                    LABELS "verification;mpi" TIMEOUT 300)
 # The refined output (issue 51 item 6): levels in the snapshots and the XDMF index, the
 # particle level, the per-level counts, the timers, ParaView opening it when pvpython is there
 # (~8 s).

@@ -26,6 +26,9 @@ dynamic  A nonlinear pulse (amplitude 5e-2) refined dynamically (refine.criterio
 restart  The same dynamic run to t = 0.4, restarted from its checkpoint at t = 0.2 (between
          regrids): it ends bit for bit as the run straight through (short: it also runs under
          the sanitizers).
+ranks    The grid pressure without refinement on 1 and 2 ranks (the pulse of `dynamic` to
+         t = 0.5, no [refine], fixed bs32 steps): the same particles, fields within 1e-12 (the
+         level-0 halos of its nodal pressure, forces and rates; the sums only change order).
 input    Every refusal: exit 2, one line naming case.ini:LINE and the key (part d).
 identity refine.levels = 1 gives the same output as no [refine] section, bit for bit (part e);
          a refined run restarted from its checkpoint ends bit for bit as the run through.
@@ -333,6 +336,15 @@ def part_dynamic():
     counts = set(d["particles"].astype(int))
     check(len(counts) > 2, f"{len(counts)} distinct particle counts over the run (regrids, splits "
           f"and merges; want more than 2)")
+    # After the last step no particle is coarser than its level (splits repeat), and only those
+    # waiting for the rest of a merge group (a slot holding fewer than 2^dim of them) are finer.
+    p = final(out)
+    size = np.rint(np.log2(size0 * p["rho"].ravel() / p["m"].ravel()) / 2)
+    level = p["level"].ravel()
+    coarser, finer = int(np.sum(size < level)), int(np.sum(size > level))
+    check(coarser == 0 and finer <= 0.01 * len(size), f"t = 1.2: {coarser} particles coarser "
+          f"than their level (want 0), {finer} of {len(size)} finer (waiting to merge; want at "
+          f"most 1 %)")
     per_level = d["particles_l0"] + d["particles_l1"]
     check(np.array_equal(per_level, d["particles"]) and d["particles_l1"].min() > 0,
           f"diagnostics.csv: the per-level counts sum to the particle count in all {len(d)} rows "
@@ -355,6 +367,22 @@ def part_restart():
           f"fields {worst:.1e} from the run straight through (bit for bit: 0)")
 
 
+def part_ranks():
+    text = case_text(3, 0.5, PULSE_5, "", extra="[fluid]\npressure = grid\n").replace(
+        "t_end = 0.5", "t_end = 0.5\nadaptive = false\ncfl = 0.8")
+    finals = [final(run(f"refine_gridp_np{n}", text, ranks=n)[0]) for n in (1, 2)]
+    worst = 0.0
+    ia, ib = (np.argsort(f["id"].ravel()) for f in finals)
+    same = np.array_equal(finals[0]["id"][ia], finals[1]["id"][ib])
+    for k in ("x", "v", "rho", "p"):
+        va, vb = finals[0][k][ia], finals[1][k][ib]
+        worst = max(worst, float(np.abs(va - vb).max() / max(np.abs(va).max(), 1e-300)))
+    # Roundoff: the halo sums change the order of additions (measured 2.4e-15); fixed steps, as
+    # the adaptive controller's norm, summed in another order, moves its steps (1e-9 then).
+    check(same and worst <= 1e-12, f"grid pressure on 2 ranks against 1: the same particles, "
+          f"fields within {worst:.1e} (relative; bound 1e-12)")
+
+
 def part_input():
     gas = "density = 1\npressure = 1"
     box = BOX.format(x0=0.8, x1=1.2)
@@ -364,7 +392,12 @@ def part_input():
         ("box with levels = 1", case_text(2, 0.1, gas, box.replace("levels = 2", "levels = 1")),
          "refine.box.level", "level = 1", "refine.levels = 1"),
         ("box near a wall", case_text(2, 0.1, gas, box.replace("lo = 0.8 0.15", "lo = 0.8 0.1")),
-         "refine.box.lo", "lo = 0.8 0.1", "not periodic"),
+         "refine.box.lo", "lo = 0.8 0.1", "act on level 0 only"),
+        # The levels do not wrap: a box at a periodic face was integrated twice there (+3 % of
+        # the kinetic energy of a stream in 1.4 s).
+        ("box near a periodic face", case_text(2, 0.1, gas, box.replace("hi = 1.2 0.45",
+                                                                         "hi = 1.95 0.45")),
+         "refine.box.hi", "hi = 1.95 0.45", "periodic wrap"),
         ("box of level 2 outside level 1", case_text(2, 0.1, gas, box.replace(
             "levels = 2", "levels = 3") + "\n[refine.inner]\nlevel = 2\nlo = 0.5 0.2\n"
             "hi = 0.7 0.3\n"), "refine.inner.lo", "lo = 0.5 0.2", "not inside"),
@@ -748,20 +781,26 @@ if PART == "uniform":
           f"particle counts in the run; at t = 1.4, {wrong} of {len(size)} particles with another "
           f"level's size (want 0)")
     # Mass: the sum of ~1e4 particle masses of two sizes in another order after sorting:
-    # n eps ~ 1e-12. Momentum: of the order of the twins' roundoff. Energy: bs32's rtol 1e-6.
-    conservation(runs, 1e-12, 1e-12, 1e-6)
+    # n eps ~ 1e-12. Momentum: of the order of the twins' roundoff. Energy: measured 7e-15 (the
+    # stream is steady); 1e-10 fails on a work-energy mismatch of the grid pressure, which grows
+    # with the disturbance it creates (+0.2 % by t = 0.75 in the one met while building it).
+    conservation(runs, 1e-12, 1e-12, 1e-10)
 elif PART == "pulse":
     runs, frac = part_pulse()
     got = frac["refined"]
     check(got <= 1e-2, f"pulse: reflected energy fraction {got:.2e} <= 1e-2 (the issue's bar; "
           f"coarse twin {frac['coarse']:.1e}, fine {frac['fine']:.1e})")
-    conservation(runs, 1e-12, 1e-12, 1e-6)
+    # Energy: measured 8.5e-14 (ppc 2) and 3.3e-13 (ppc 4); bs32's error on this smooth,
+    # small pulse is far below its rtol (1e-6). 1e-10, as for the stream.
+    conservation(runs, 1e-12, 1e-12, 1e-10)
 elif PART == "uniform3d":
     part_uniform3d()
 elif PART == "dynamic":
     part_dynamic()
 elif PART == "restart":
     part_restart()
+elif PART == "ranks":
+    part_ranks()
 elif PART == "input":
     part_input()
 elif PART == "identity":

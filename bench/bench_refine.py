@@ -1,0 +1,254 @@
+"""Cost of the refined gas against its uniform twins (issue 51's benchmarks): for each case the
+refined run, the same scene without refinement at level 0's spacing (coarse) and at the finest
+level's (fine): particles, steps, RHS evaluations, wall time, peak memory, the error the case
+measures, and the refinement's overhead (timers restrict, prolong, relevel, regrid) as a share
+of the wall time.
+
+Cases (the scenes of tests/verification/test_refine_gas.py):
+  stream    2-D strip, periodic along x, slip walls; a static level-1 box; a uniform stream
+            (u = 0.5 c) to t = 1.4. Error: the largest deviation of rho, p, v from the stream.
+  pulse     cases/refine_pulse.ini: a pulse of amplitude 5e-2 followed by a regridded band.
+            Error: the mean |rho - rho_fine| over the band's rows 0.2 < y < 0.4 at t = 1.2,
+            binned along x into 60 cells (the fine twin is the reference: its error is 0).
+  stream3d  the stream in 3-D (x and z periodic), to t = 0.45.
+
+Each run is a separate mpmfsi process under /usr/bin/time (peak resident memory). The runs go
+one after another, the twins of a case next to each other, so compare within a case. Writes the
+rows as JSON and CSV under --out (default out/bench_refine/) and the page --md (default
+bench/results/refine_cost.md).
+  /usr/bin/python3 bench/bench_refine.py [--binary build/app/mpmfsi] [--cases stream,pulse,...]
+"""
+import argparse
+import csv
+import datetime
+import json
+import os
+import subprocess
+import sys
+
+import numpy as np
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.join(ROOT, "tests", "tools"))
+import mpmtest as mt  # noqa: E402
+
+U0 = 0.5 * np.sqrt(1.4)
+STREAM_2D = """[run]
+name = bench_refine_stream
+
+[domain]
+dim = 2
+lo = 0 0
+hi = 2 0.6
+
+[grid]
+dx = {dx}
+
+[boundary]
+x_lo = periodic
+x_hi = periodic
+y_lo = slip
+y_hi = slip
+
+[time]
+t_end = 1.4
+
+[output]
+interval = 1.4
+
+[geometry.strip]
+type = box
+lo = 0 0
+hi = 2 0.6
+
+[gas.air]
+geometry = strip
+density = 1
+pressure = 1
+velocity = {u0!r} 0
+{refine}"""
+BOX_2D = "[refine]\nlevels = 2\n\n[refine.box]\nlevel = 1\nlo = 0.8 0.15\nhi = 1.2 0.45\n"
+STREAM_3D = """[run]
+name = bench_refine_stream3d
+
+[domain]
+dim = 3
+lo = 0 0 0
+hi = 1.2 0.6 0.6
+
+[grid]
+dx = {dx}
+
+[boundary]
+x_lo = periodic
+x_hi = periodic
+y_lo = slip
+y_hi = slip
+z_lo = periodic
+z_hi = periodic
+
+[time]
+t_end = 0.45
+
+[output]
+interval = 0.45
+
+[geometry.strip]
+type = box
+lo = 0 0 0
+hi = 1.2 0.6 0.6
+
+[gas.air]
+geometry = strip
+density = 1
+pressure = 1
+velocity = {u0!r} 0 0
+{refine}"""
+BOX_3D = "[refine]\nlevels = 2\n\n[refine.box]\nlevel = 1\nlo = 0.45 0.25 0.2\nhi = 0.75 0.35 0.4\n"
+TIMERS = ("restrict", "prolong", "relevel", "regrid")
+
+
+def run(binary, out, case, overrides):
+    """One run: its summary, timers, peak memory (MB) and output folder."""
+    os.makedirs(out, exist_ok=True)
+    cmd = ["/usr/bin/time", "-f", "%M", binary, "run", case, f"output.dir={out}/run",
+           "output.overwrite=true", "run.progress=false"] + overrides
+    p = subprocess.run(cmd, capture_output=True, text=True)
+    if p.returncode != 0:
+        raise SystemExit(f"{' '.join(cmd)} failed:\n{p.stderr[-2000:]}")
+    rss_mb = int(p.stderr.strip().splitlines()[-1]) / 1024.0
+    run_dir = os.path.join(out, "run")
+    with open(os.path.join(run_dir, "summary.json")) as f:
+        summary = json.load(f)
+    timers = {}
+    with open(os.path.join(run_dir, "timers.csv")) as f:
+        for row in csv.DictReader(f):
+            timers[row["phase"]] = float(row["mean_s"])
+    d = np.genfromtxt(os.path.join(run_dir, "diagnostics.csv"), delimiter=",", names=True)
+    return {"steps": int(d["step"][-1]), "rhs": int(d["rhs_evals"][-1]),
+            "particles_start": int(d["particles"][0]), "particles_end": int(d["particles"][-1]),
+            "particle_steps": summary["particle_steps"], "wall_s": summary["wall_s"],
+            "rss_mb": rss_mb, "timers": timers, "dir": run_dir}
+
+
+def final(run_dir):
+    return mt.particles(mt.snapshots(run_dir)[-1][1], "fluid")
+
+
+def stream_error(run_dir, dim):
+    p = final(run_dir)
+    return float(max(np.abs(p["rho"] - 1).max(), np.abs(p["p"] - 1).max(),
+                     np.abs(p["v"][:, 0] - U0).max() / U0,
+                     np.abs(p["v"][:, 1:dim]).max() / U0))
+
+
+def band_density(run_dir, nbins=60):
+    p = final(run_dir)
+    x, y = p["x"][:, 0], p["x"][:, 1]
+    sel = (y > 0.2) & (y < 0.4)
+    k = np.minimum((x[sel] / 3 * nbins).astype(int), nbins - 1)
+    return (np.bincount(k, p["m"].ravel()[sel], nbins) /
+            np.bincount(k, (p["m"] / p["rho"]).ravel()[sel], nbins))
+
+
+def case_stream(binary, out, dim):
+    text, box, dx = (STREAM_2D, BOX_2D, 0.05) if dim == 2 else (STREAM_3D, BOX_3D, 0.075)
+    rows = {}
+    for label, refine, h in (("refined", box, dx), ("coarse", "", dx), ("fine", "", dx / 2)):
+        d = os.path.join(out, f"stream{dim}d_{label}")
+        os.makedirs(d, exist_ok=True)
+        path = os.path.join(d, "case.ini")
+        with open(path, "w") as f:
+            f.write(text.format(dx=h, u0=U0, refine=refine))
+        r = run(binary, d, path, [])
+        r["error"] = stream_error(r["dir"], dim)
+        rows[label] = r
+    return rows
+
+
+def case_pulse(binary, out):
+    case = os.path.join(ROOT, "cases", "refine_pulse.ini")
+    rows = {}
+    for label, over in (("refined", []), ("coarse", ["refine.levels=1", "refine.criterion=none"]),
+                        ("fine", ["refine.levels=1", "refine.criterion=none", "grid.dx=0.025"])):
+        rows[label] = run(binary, os.path.join(out, f"pulse_{label}"), case, over)
+    ref = band_density(rows["fine"]["dir"])
+    for r in rows.values():
+        r["error"] = float(np.abs(band_density(r["dir"]) - ref).mean())
+    return rows
+
+
+ERRORS = {"stream": "largest deviation of rho, p, v (relative)",
+          "stream3d": "largest deviation of rho, p, v (relative)",
+          "pulse": "mean |rho - rho_fine| over the band's rows (fine: the reference)"}
+
+
+def page(results, commit, command):
+    now = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
+    lines = ["# Cost of the refined gas against its uniform twins", "",
+             f"Made by `{command}` at commit {commit}, {now}, on a shared 2-core machine "
+             "(compare within a case: its runs went one after another). One rank. Wall time "
+             "from each run's summary, peak memory from /usr/bin/time. The overhead columns are "
+             "the refinement's timers as a share of the run's wall time (restrict and prolong "
+             "run inside the grid and transfer phases, relevel, the particles' splits and merges, "
+             "inside post_step, regrid between steps).", ""]
+    for name, rows in results.items():
+        lines += [f"## {name}", "", f"Error: {ERRORS[name]}.", "",
+                  "| run | particles (start / end) | steps | RHS | wall s | peak MB | error | "
+                  "restrict | prolong | relevel | regrid |",
+                  "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
+        for label, r in rows.items():
+            t = r["timers"]
+            share = [f"{100 * t.get(k, 0.0) / r['wall_s']:.1f} %" for k in TIMERS]
+            lines.append(f"| {label} | {r['particles_start']} / {r['particles_end']} | "
+                         f"{r['steps']} | {r['rhs']} | {r['wall_s']:.2f} | {r['rss_mb']:.0f} | "
+                         f"{r['error']:.2e} | " + " | ".join(share) + " |")
+        ref, fine = rows["refined"], rows["fine"]
+        lines += ["", f"Refined against fine: {ref['wall_s'] / fine['wall_s']:.2f}× the wall "
+                  f"time, {ref['particle_steps'] / fine['particle_steps']:.2f}× the "
+                  f"particle-steps, {ref['rss_mb'] / fine['rss_mb']:.2f}× the peak memory.", ""]
+    return "\n".join(lines)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--binary", default=os.path.join(ROOT, "build", "app", "mpmfsi"))
+    ap.add_argument("--cases", default="stream,pulse,stream3d")
+    ap.add_argument("--out", default=os.path.join(ROOT, "out", "bench_refine"))
+    ap.add_argument("--md", default=os.path.join(ROOT, "bench", "results", "refine_cost.md"))
+    a = ap.parse_args()
+    os.environ["MPMFSI_BIN"] = a.binary
+    results = {}
+    for name in a.cases.split(","):
+        if name == "stream":
+            results[name] = case_stream(a.binary, a.out, 2)
+        elif name == "stream3d":
+            results[name] = case_stream(a.binary, a.out, 3)
+        elif name == "pulse":
+            results[name] = case_pulse(a.binary, a.out)
+        else:
+            raise SystemExit(f"unknown case {name}: choose among stream, pulse, stream3d")
+        for label, r in results[name].items():
+            print(f"{name} {label}: {r['steps']} steps, {r['wall_s']:.2f} s, {r['rss_mb']:.0f} MB,"
+                  f" error {r['error']:.2e}", flush=True)
+    os.makedirs(a.out, exist_ok=True)
+    flat = [dict(case=n, run=label, **{k: v for k, v in r.items() if k not in ("timers", "dir")},
+                 **{f"t_{k}": r["timers"].get(k, 0.0) for k in TIMERS})
+            for n, rows in results.items() for label, r in rows.items()]
+    with open(os.path.join(a.out, "refine_cost.json"), "w") as f:
+        json.dump(flat, f, indent=1)
+    with open(os.path.join(a.out, "refine_cost.csv"), "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=list(flat[0].keys()))
+        w.writeheader()
+        w.writerows(flat)
+    commit = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"],
+                            capture_output=True, text=True).stdout.strip()
+    command = "/usr/bin/python3 bench/bench_refine.py" + (
+        f" --cases {a.cases}" if a.cases != "stream,pulse,stream3d" else "")
+    with open(a.md, "w") as f:
+        f.write(page(results, commit, command) + "\n")
+    print(f"wrote {a.md}")
+
+
+if __name__ == "__main__":
+    main()
