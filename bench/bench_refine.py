@@ -104,7 +104,7 @@ density = 1
 pressure = 1
 velocity = {u0!r} 0 0
 {refine}"""
-BOX_3D = "[refine]\nlevels = 2\n\n[refine.box]\nlevel = 1\nlo = 0.45 0.25 0.2\nhi = 0.75 0.35 0.4\n"
+BOX_3D = "[refine]\nlevels = 2\n\n[refine.box]\nlevel = 1\nlo = 0.45 0.25 0.25\nhi = 0.75 0.35 0.35\n"
 TIMERS = ("restrict", "prolong", "relevel", "regrid")
 
 

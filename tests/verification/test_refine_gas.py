@@ -222,7 +222,7 @@ density = 1
 pressure = 1
 velocity = {u0!r} 0 0
 {refine}"""
-BOX_3D = "[refine]\nlevels = 2\n\n[refine.box]\nlevel = 1\nlo = 0.45 0.25 0.2\nhi = 0.75 0.35 0.4\n"
+BOX_3D = "[refine]\nlevels = 2\n\n[refine.box]\nlevel = 1\nlo = 0.45 0.25 0.25\nhi = 0.75 0.35 0.35\n"
 
 
 def part_uniform3d():
@@ -239,7 +239,7 @@ def part_uniform3d():
     check(got <= 1e-10 and len(counts) > 1, f"3-D uniform gas across the box: deviation "
           f"{got:.2e} <= 1e-10 at t = {p['time']:g}; {len(counts)} distinct particle counts "
           f"(splits and merges)")
-    conservation(runs, 1e-12, 1e-12, 1e-6)
+    conservation(runs, 1e-12, 1e-12, 1e-10)  # energy measured 7e-15: as in 2-D
 
 
 def part_uniform():
@@ -354,7 +354,9 @@ def part_dynamic():
         err = np.abs(row_density(runs[label][0]) - ref).mean()
         print(f"info {label}: mean |rho - rho_fine| over the rows 0.2 < y < 0.4 at t = 1.2: "
               f"{err:.2e}")
-    conservation(runs, 1e-12, 1e-12, 1e-6)
+    # Energy: measured 6.4e-11, bs32's error (rtol 1e-6) on a steepening pulse; 1e-8 keeps a
+    # margin for the machine's other steps and fails on a work-energy mismatch.
+    conservation(runs, 1e-12, 1e-12, 1e-8)
 
 
 def part_restart():
