@@ -76,7 +76,7 @@
 
 typedef struct fluid_obstacle {
   char name[64];
-  char shape_key[96]; /* obstacle.NAME.shape, for messages */
+  char shape_key[256]; /* obstacle.NAME.shape, for messages (as long as the keys it builds) */
   mpm_sdf sdf;
   int no_slip;
   int has_ref;             /* reference area given: write Cd and Cl */
