@@ -31,80 +31,10 @@ import numpy as np
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, "tests", "tools"))
 import mpmtest as mt  # noqa: E402
+from refine_scenes import BOX, BOX_3D, C0, CASE_3D, case_text  # noqa: E402
 
-U0 = 0.5 * np.sqrt(1.4)
-STREAM_2D = """[run]
-name = bench_refine_stream
-
-[domain]
-dim = 2
-lo = 0 0
-hi = 2 0.6
-
-[grid]
-dx = {dx}
-
-[boundary]
-x_lo = periodic
-x_hi = periodic
-y_lo = slip
-y_hi = slip
-
-[time]
-t_end = 1.4
-
-[output]
-interval = 1.4
-
-[geometry.strip]
-type = box
-lo = 0 0
-hi = 2 0.6
-
-[gas.air]
-geometry = strip
-density = 1
-pressure = 1
-velocity = {u0!r} 0
-{refine}"""
-BOX_2D = "[refine]\nlevels = 2\n\n[refine.box]\nlevel = 1\nlo = 0.8 0.15\nhi = 1.2 0.45\n"
-STREAM_3D = """[run]
-name = bench_refine_stream3d
-
-[domain]
-dim = 3
-lo = 0 0 0
-hi = 1.2 0.6 0.6
-
-[grid]
-dx = {dx}
-
-[boundary]
-x_lo = periodic
-x_hi = periodic
-y_lo = slip
-y_hi = slip
-z_lo = periodic
-z_hi = periodic
-
-[time]
-t_end = 0.45
-
-[output]
-interval = 0.45
-
-[geometry.strip]
-type = box
-lo = 0 0 0
-hi = 1.2 0.6 0.6
-
-[gas.air]
-geometry = strip
-density = 1
-pressure = 1
-velocity = {u0!r} 0 0
-{refine}"""
-BOX_3D = "[refine]\nlevels = 2\n\n[refine.box]\nlevel = 1\nlo = 0.45 0.25 0.25\nhi = 0.75 0.35 0.35\n"
+U0 = 0.5 * C0
+GAS_STREAM = f"density = 1\npressure = 1\nvelocity = {U0!r} 0"
 TIMERS = ("restrict", "prolong", "relevel", "regrid")
 
 
@@ -152,14 +82,16 @@ def band_density(run_dir, nbins=60):
 
 
 def case_stream(binary, out, dim):
-    text, box, dx = (STREAM_2D, BOX_2D, 0.05) if dim == 2 else (STREAM_3D, BOX_3D, 0.075)
+    dx = 0.05 if dim == 2 else 0.075
+    refine = BOX.format(x0=0.8, x1=1.2) if dim == 2 else BOX_3D
     rows = {}
-    for label, refine, h in (("refined", box, dx), ("coarse", "", dx), ("fine", "", dx / 2)):
+    for label, box, h in (("refined", refine, dx), ("coarse", "", dx), ("fine", "", dx / 2)):
         d = os.path.join(out, f"stream{dim}d_{label}")
         os.makedirs(d, exist_ok=True)
         path = os.path.join(d, "case.ini")
         with open(path, "w") as f:
-            f.write(text.format(dx=h, u0=U0, refine=refine))
+            f.write(case_text(2, 1.4, GAS_STREAM, box, h) if dim == 2 else
+                    CASE_3D.format(u0=U0, refine=box, dx=h))
         r = run(binary, d, path, [])
         r["error"] = stream_error(r["dir"], dim)
         rows[label] = r

@@ -88,51 +88,12 @@ import numpy as np  # noqa: E402
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "tools"))
 import mpmtest as mt  # noqa: E402
+from refine_scenes import BOX, BOX_3D, C0, CASE_3D, DYNAMIC, PULSE_5, case_text  # noqa: E402
 
 PART = sys.argv[1] if len(sys.argv) > 1 else "uniform"
 PPC = int(sys.argv[2]) if len(sys.argv) > 2 else 2  # fluid.ppc of the uniform and pulse runs
 check = mt.Checks(f"test_refine_gas_{PART}")
 FLUID = f"[fluid]\nppc = {PPC}\n"
-C0 = np.sqrt(1.4)  # sound speed of rho 1, p 1
-BOX = "[refine]\nlevels = 2\n\n[refine.box]\nlevel = 1\nlo = {x0} 0.15\nhi = {x1} 0.45\n"
-
-
-def case_text(length, t_end, gas, refine, dx=0.05, extra=""):
-    return f"""[run]
-name = refine_gas
-
-[domain]
-dim = 2
-lo = 0 0
-hi = {length} 0.6
-
-[grid]
-dx = {dx}
-
-[boundary]
-x_lo = periodic
-x_hi = periodic
-y_lo = slip
-y_hi = slip
-
-[time]
-t_end = {t_end}
-
-[output]
-interval = {t_end / 2}
-
-[geometry.strip]
-type = box
-lo = 0 0
-hi = {length} 0.6
-
-[gas.air]
-geometry = strip
-{gas}
-{extra}
-{refine}"""
-
-
 def run(name, text, ranks=1):
     out = mt.outdir(name)
     path = os.path.join(out, "case.ini")
@@ -186,49 +147,12 @@ def conservation(runs, tol_mass, tol_p, tol_e):
         check(de <= tol_e, f"refined: total energy drift {de:.2e} <= {tol_e:g}")
 
 
-CASE_3D = """[run]
-name = refine_gas_3d
-
-[domain]
-dim = 3
-lo = 0 0 0
-hi = 1.2 0.6 0.6
-
-[grid]
-dx = 0.075
-
-[boundary]
-x_lo = periodic
-x_hi = periodic
-y_lo = slip
-y_hi = slip
-z_lo = periodic
-z_hi = periodic
-
-[time]
-t_end = 0.45
-
-[output]
-interval = 0.45
-
-[geometry.strip]
-type = box
-lo = 0 0 0
-hi = 1.2 0.6 0.6
-
-[gas.air]
-geometry = strip
-density = 1
-pressure = 1
-velocity = {u0!r} 0 0
-{refine}"""
-BOX_3D = "[refine]\nlevels = 2\n\n[refine.box]\nlevel = 1\nlo = 0.45 0.25 0.25\nhi = 0.75 0.35 0.35\n"
 
 
 def part_uniform3d():
     u0 = 0.5 * C0
-    runs = {"refined": run("refine_uniform3d", CASE_3D.format(u0=u0, refine=BOX_3D)),
-            "coarse": run("refine_uniform3d_coarse", CASE_3D.format(u0=u0, refine=""))}
+    runs = {"refined": run("refine_uniform3d", CASE_3D.format(u0=u0, refine=BOX_3D, dx=0.075)),
+            "coarse": run("refine_uniform3d_coarse", CASE_3D.format(u0=u0, refine="", dx=0.075))}
     report_cost(runs)
     p = final(runs["refined"][0])
     got = max(np.abs(p["rho"] - 1).max(), np.abs(p["p"] - 1).max(),
@@ -301,10 +225,6 @@ def part_pulse():
     return runs, frac
 
 
-DYNAMIC = "[refine]\nlevels = 2\ncriterion = density\nthreshold = 0.004\nevery = 10\n"
-PULSE_5 = ("density_field = 1 + 5e-2*exp(-(x-0.6)^2/0.04)\n"
-           "pressure_field = 0.714285714285714 + 5e-2*exp(-(x-0.6)^2/0.04)\n"
-           "velocity_field = 5e-2*exp(-(x-0.6)^2/0.04); 0")
 
 
 def row_density(out, nbins=60):

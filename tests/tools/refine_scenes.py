@@ -1,0 +1,86 @@
+"""The refinement's test scenes (docs/refinement.md), shared by tests/verification/test_refine_gas.py
+and bench/bench_refine.py: a 2-D strip periodic along x with slip walls along y (level 0 at
+dx = 0.05), its static level-1 box, the 3-D strip and box, and the regridded pulse."""
+import numpy as np
+
+C0 = np.sqrt(1.4)  # sound speed of rho 1, p 1
+BOX = "[refine]\nlevels = 2\n\n[refine.box]\nlevel = 1\nlo = {x0} 0.15\nhi = {x1} 0.45\n"
+
+
+def case_text(length, t_end, gas, refine, dx=0.05, extra=""):
+    return f"""[run]
+name = refine_gas
+
+[domain]
+dim = 2
+lo = 0 0
+hi = {length} 0.6
+
+[grid]
+dx = {dx}
+
+[boundary]
+x_lo = periodic
+x_hi = periodic
+y_lo = slip
+y_hi = slip
+
+[time]
+t_end = {t_end}
+
+[output]
+interval = {t_end / 2}
+
+[geometry.strip]
+type = box
+lo = 0 0
+hi = {length} 0.6
+
+[gas.air]
+geometry = strip
+{gas}
+{extra}
+{refine}"""
+
+
+CASE_3D = """[run]
+name = refine_gas_3d
+
+[domain]
+dim = 3
+lo = 0 0 0
+hi = 1.2 0.6 0.6
+
+[grid]
+dx = {dx}
+
+[boundary]
+x_lo = periodic
+x_hi = periodic
+y_lo = slip
+y_hi = slip
+z_lo = periodic
+z_hi = periodic
+
+[time]
+t_end = 0.45
+
+[output]
+interval = 0.45
+
+[geometry.strip]
+type = box
+lo = 0 0 0
+hi = 1.2 0.6 0.6
+
+[gas.air]
+geometry = strip
+density = 1
+pressure = 1
+velocity = {u0!r} 0 0
+{refine}"""
+BOX_3D = "[refine]\nlevels = 2\n\n[refine.box]\nlevel = 1\nlo = 0.45 0.25 0.25\nhi = 0.75 0.35 0.35\n"
+DYNAMIC = "[refine]\nlevels = 2\ncriterion = density\nthreshold = 0.004\nevery = 10\n"
+PULSE_5 = ("density_field = 1 + 5e-2*exp(-(x-0.6)^2/0.04)\n"
+           "pressure_field = 0.714285714285714 + 5e-2*exp(-(x-0.6)^2/0.04)\n"
+           "velocity_field = 5e-2*exp(-(x-0.6)^2/0.04); 0")
