@@ -26,14 +26,16 @@ const mpm_key_spec mpm_refine_keys[] = {
     {"refine.buffer", MPM_KEY_INT, "2", 1, 64, 0, 0, NULL,
      "level-l cells kept between the region of level l + 1 and the edge of level l's region", 0,
      "-"},
-    {"refine.criterion", MPM_KEY_ENUM, "none", 0, 0, 0, 0, "none|density",
-     "dynamic refinement: none (the [refine.NAME] boxes, static) or density (refine where the "
-     "gas density of neighbouring level-0 cells differs by more than refine.threshold, and "
-     "regrid every refine.every steps)",
+    {"refine.criterion", MPM_KEY_ENUM, "none", 0, 0, 0, 0, "none|density|compression",
+     "dynamic refinement, regridded every refine.every steps: none (the [refine.NAME] boxes, "
+     "static), density (refine where the gas density of neighbouring level-0 cells differs by "
+     "more than refine.threshold times the smaller) or compression (where the velocity normal "
+     "to their face falls by more than refine.threshold times the sound speed: shocks)",
      0, NULL},
     {"refine.threshold", MPM_KEY_REAL, "0", 0, HUGE_VAL, 0, 0, NULL,
-     "the criterion's threshold: the relative density difference between neighbouring level-0 "
-     "cells that refines them (required with refine.criterion; e.g. 0.05)",
+     "the criterion's threshold: a relative density difference (density, e.g. 0.05) or a "
+     "velocity drop over the sound speed (compression, e.g. 0.05) between neighbouring level-0 "
+     "cells (required with refine.criterion)",
      0, "-"},
     {"refine.every", MPM_KEY_INT, "10", 1, 1000000, 0, 0, NULL,
      "steps between regrids of a dynamic refinement (a regrid also runs before every checkpoint)",
@@ -128,6 +130,7 @@ static int read_boxes(const mpm_config *cfg, const mpm_grid *g, const char *cons
 typedef struct dynamic {
   int levels, buffer, every, dilate;
   double threshold;
+  fluid_refine_criterion criterion;
 } dynamic;
 
 /* The dynamic settings, or 0 in *on when refine.criterion = none. */
@@ -135,6 +138,8 @@ static int read_dynamic(const mpm_config *cfg, dynamic *dy, int *on) {
   const char *criterion;
   MPM_CALL(mpm_config_get_string(cfg, "refine.criterion", &criterion));
   *on = strcmp(criterion, "none") != 0;
+  dy->criterion =
+      strcmp(criterion, "compression") == 0 ? FLUID_REFINE_COMPRESSION : FLUID_REFINE_DENSITY;
   MPM_CALL(mpm_config_get_int(cfg, "refine.levels", &dy->levels));
   MPM_CALL(mpm_config_get_int(cfg, "refine.buffer", &dy->buffer));
   MPM_CALL(mpm_config_get_int(cfg, "refine.every", &dy->every));
@@ -143,8 +148,9 @@ static int read_dynamic(const mpm_config *cfg, dynamic *dy, int *on) {
   if (!*on) return 0;
   if (!(dy->threshold > 0))
     return mpm_config_fail(cfg, "refine.criterion",
-                           "%s needs a threshold: set refine.threshold > 0 (the relative density "
-                           "difference between neighbouring cells that refines them, e.g. 0.05)",
+                           "%s needs a threshold: set refine.threshold > 0 (the jump between "
+                           "neighbouring cells that refines them, e.g. 0.05; see the key "
+                           "reference)",
                            criterion);
   if (2 * dy->dilate < dy->buffer)
     return mpm_config_fail(cfg, "refine.dilate",
@@ -154,7 +160,7 @@ static int read_dynamic(const mpm_config *cfg, dynamic *dy, int *on) {
   return 0;
 }
 
-/* Spans per axis of the flag lattice (fluid_refine_density_flags). */
+/* Spans per axis of the flag lattice (fluid_refine_flags). */
 static size_t flag_lattice(const mpm_grid *g, int *n) {
   size_t total = 1;
   for (int d = 0; d < MPM_MAX_DIM; ++d) n[d] = 1;
@@ -221,7 +227,7 @@ static int make_dynamic(mpm_hier **h, const dynamic *dy, mpm_grid *grid, mpm_mod
   unsigned char *mask = flag + total, *tmp = mask + total;
   mpm_hier_box *box = NULL;
   int nbox = 0, cap = 0, used = 1;
-  int rc = fluid_refine_density_flags(gas, dy->threshold, n, flag);
+  int rc = fluid_refine_flags(gas, dy->criterion, dy->threshold, n, flag);
   const double eps = 1e-6 * ldexp(grid->dx, -dy->levels);
   for (int l = 1; l < dy->levels && !rc; ++l) {
     dilate(n, grid->dim, dy->dilate * (dy->levels - l), flag, mask, tmp);

@@ -33,12 +33,16 @@ int fluid_module_refine(mpm_module *m, const mpm_config *cfg, struct mpm_hier *h
  * after the next step. */
 void fluid_module_rehier(mpm_module *m, struct mpm_hier *h);
 
-/* The refinement flags of the density criterion over the level-0 spans (node-centred cells) of
- * the global lattice, x fastest, n[d] spans per axis (ncells along a periodic axis, ncells + 1
- * otherwise): a span is flagged, with each axis neighbour, where their densities (the gas's mass
- * over its volume, of the particles whose nearest node it is) differ by more than threshold
- * times the smaller. flag has prod n[d] bytes. One rank. */
-int fluid_refine_density_flags(const mpm_module *m, double threshold, const int *n,
-                               unsigned char *flag);
+/* A regrid's criterion (refine.criterion). */
+typedef enum { FLUID_REFINE_DENSITY, FLUID_REFINE_COMPRESSION } fluid_refine_criterion;
+
+/* The refinement flags over the level-0 spans (node-centred cells) of the global lattice, x
+ * fastest, n[d] spans per axis (ncells along a periodic axis, ncells + 1 otherwise), from the
+ * gas binned by each particle's nearest node: a span is flagged, with its axis neighbour, where
+ * across the face between them the density changes by more than threshold times the smaller
+ * (density), or the normal velocity falls by more than threshold times the smaller sound speed
+ * (compression: shocks and steepening waves). flag has prod n[d] bytes. One rank. */
+int fluid_refine_flags(const mpm_module *m, fluid_refine_criterion criterion, double threshold,
+                       const int *n, unsigned char *flag);
 
 #endif

@@ -19,6 +19,7 @@
  *
  * Invariant: with m->hier NULL every call here is the plain kernel call (the refined path costs
  * one pointer test per transfer). */
+#include "fluid_eos.h"
 #include "fluid_internal.h"
 #include "fluid_module.h"
 
@@ -154,7 +155,7 @@ void fluid_module_rehier(mpm_module *m, mpm_hier *h) {
   fluid_gridp_reset(m->content);
 }
 
-/* ---- the density criterion (mpm_refine.c regrids with it) --------------------------------- */
+/* ---- the refinement criteria (mpm_refine.c regrids with them) ---------------------------- */
 
 /* The span of x along axis d: its nearest node, wrapped along a periodic axis, clamped. */
 static int span_of(const mpm_grid *g, int d, double x, int n) {
@@ -163,8 +164,26 @@ static int span_of(const mpm_grid *g, int d, double x, int n) {
   return (int)(i < 0 ? 0 : i >= n ? n - 1 : i);
 }
 
-int fluid_refine_density_flags(const mpm_module *m, double threshold, const int *n,
-                               unsigned char *flag) {
+/* Does the face between spans s and t (t above s along d) ask for refinement? sums: mass,
+ * volume, internal energy m e, then momentum per axis, each of total entries. */
+static int face_flag(const fluid_gas *gas, fluid_refine_criterion criterion, double threshold,
+                     const double *sums, size_t total, int d, size_t s, size_t t) {
+  const double *mass = sums, *vol = sums + total, *me = sums + 2 * total;
+  const double rs = mass[s] / vol[s], rt = mass[t] / vol[t];
+  if (criterion == FLUID_REFINE_DENSITY) return fabs(rt - rs) > threshold * fmin(rt, rs);
+  /* compression: the normal velocity falls across the face by more than threshold times the
+   * slower sound speed of the two */
+  const double *mv = sums + (size_t)(3 + d) * total;
+  const double du = mv[t] / mass[t] - mv[s] / mass[s];
+  const double cs =
+      fluid_sound_speed(gas->gamma, rs, fluid_pressure(gas->gamma, rs, me[s] / mass[s]));
+  const double ct =
+      fluid_sound_speed(gas->gamma, rt, fluid_pressure(gas->gamma, rt, me[t] / mass[t]));
+  return -du > threshold * fmin(cs, ct);
+}
+
+int fluid_refine_flags(const mpm_module *m, fluid_refine_criterion criterion, double threshold,
+                       const int *n, unsigned char *flag) {
   const fluid_content *fc = m->content;
   const mpm_particles *p = m->particles;
   const mpm_grid *g = m->grid;
@@ -172,31 +191,34 @@ int fluid_refine_density_flags(const mpm_module *m, double threshold, const int 
   size_t total = 1, stride[MPM_MAX_DIM] = {1, 1, 1};
   for (int d = 0; d < dim; ++d) stride[d] = total, total *= (size_t)n[d];
   memset(flag, 0, total);
-  double *mass = calloc(2 * total, sizeof(double)), *vol = mass + total;
-  if (!mass) MPM_FAIL_OOM(2 * total * sizeof(double));
+  const size_t nsums = 3 + (size_t)dim; /* mass, volume, m e, m v */
+  double *sums = calloc(nsums * total, sizeof(double));
+  if (!sums) MPM_FAIL_OOM(nsums * total * sizeof(double));
   const double *pm = mpm_particles_comp(p, fc->lay.f_m, 0);
   const double *V0 = mpm_particles_comp(p, fc->lay.f_V0, 0);
   const double *J = mpm_particles_comp(p, FLUID_J, 0);
+  const double *e = mpm_particles_comp(p, FLUID_E, 0);
   for (mpm_lidx i = 0; i < p->n; ++i) {
     size_t s = 0;
     for (int d = 0; d < dim; ++d)
       s += stride[d] * (size_t)span_of(g, d, mpm_particles_comp(p, FLUID_X, d)[i], n[d]);
-    mass[s] += pm[i], vol[s] += V0[i] * J[i];
+    sums[s] += pm[i], sums[total + s] += V0[i] * J[i], sums[2 * total + s] += pm[i] * e[i];
+    for (int d = 0; d < dim; ++d)
+      sums[(3 + (size_t)d) * total + s] += pm[i] * mpm_particles_comp(p, FLUID_V, d)[i];
   }
+  const double *vol = sums + total;
   for (size_t s = 0; s < total; ++s) {
     if (!(vol[s] > 0)) continue;
-    const double rs = mass[s] / vol[s];
     for (int d = 0; d < dim; ++d) {
       const int i = (int)(s / stride[d] % (size_t)n[d]);
       int j = i + 1;
       if (j == n[d] && g->periodic[d]) j = 0;
       if (j >= n[d]) continue;
       const size_t t = s + ((size_t)j - (size_t)i) * stride[d];
-      if (!(vol[t] > 0)) continue;
-      const double rt = mass[t] / vol[t];
-      if (fabs(rt - rs) > threshold * fmin(rt, rs)) flag[s] = flag[t] = 1;
+      if (vol[t] > 0 && face_flag(&fc->gas, criterion, threshold, sums, total, d, s, t))
+        flag[s] = flag[t] = 1;
     }
   }
-  free(mass);
+  free(sums);
   return 0;
 }

@@ -23,6 +23,10 @@ dynamic  A nonlinear pulse (amplitude 5e-2) refined dynamically (refine.criterio
          level-1 particle at the start and at the end, 1.1 m further on), and mass, momentum and
          energy are conserved across every regrid; its density along the box's rows against the
          uniform twins' is printed.
+compression The same pulse regridded by the compression criterion (threshold 3e-3: the pulse's
+         front drops the velocity by 1e-2 of c per cell at the start, 4e-3 at t = 1.2): at every
+         snapshot the particles of the band's rows within a cell of the steepest velocity drop
+         are on level 1; conservation as above (~3 s).
 restart  The same dynamic run to t = 0.4, restarted from its checkpoint at t = 0.2 (between
          regrids): it ends bit for bit as the run straight through (short: it also runs under
          the sanitizers).
@@ -277,6 +281,31 @@ def part_dynamic():
     # Energy: measured 6.4e-11, bs32's error (rtol 1e-6) on a steepening pulse; 1e-8 keeps a
     # margin for the machine's other steps and fails on a work-energy mismatch.
     conservation(runs, 1e-12, 1e-12, 1e-8)
+
+
+def part_compression():
+    text = case_text(3, 1.2, PULSE_5, DYNAMIC.replace("criterion = density", "criterion = "
+                                                      "compression").replace("0.004", "0.003"))
+    out, _ = run("refine_compression", text)
+    for t, f in mt.snapshots(out):
+        p = mt.particles(f, "fluid")
+        x, y = p["x"][:, 0], p["x"][:, 1]
+        band = (y > 0.2) & (y < 0.4)
+        k = np.minimum((x[band] / 0.05).astype(int), 59)
+        u = (np.bincount(k, (p["m"].ravel() * p["v"][:, 0])[band], 60) /
+             np.bincount(k, p["m"].ravel()[band], 60))
+        front = 0.05 * (np.argmin(np.diff(u)) + 1)  # the face of the steepest drop
+        near = band & (np.abs(x - front) < 0.05)
+        levels = set(p["level"].ravel()[near].astype(int))
+        check(levels == {1}, f"compression, t = {p['time']:g}: the band's particles within a cell "
+              f"of the steepest velocity drop (x = {front:.2f}) are on levels {sorted(levels)} "
+              f"(want [1])")
+    d = diagnostics(out)
+    check(len(set(d["particles"].astype(int))) > 2, "compression: the particle count changes "
+          "(regrids, splits, merges)")
+    dm, dp, de, _ = drifts(out)
+    check(dm <= 1e-12 and dp <= 1e-12 and de <= 1e-8, f"compression: drifts of mass {dm:.1e}, "
+          f"momentum {dp:.1e}, energy {de:.1e} (bounds 1e-12, 1e-12, 1e-8 as for density)")
 
 
 def part_restart():
@@ -721,6 +750,8 @@ elif PART == "dynamic":
     part_dynamic()
 elif PART == "restart":
     part_restart()
+elif PART == "compression":
+    part_compression()
 elif PART == "ranks":
     part_ranks()
 elif PART == "input":
