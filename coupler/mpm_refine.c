@@ -26,16 +26,17 @@ const mpm_key_spec mpm_refine_keys[] = {
     {"refine.buffer", MPM_KEY_INT, "2", 1, 64, 0, 0, NULL,
      "level-l cells kept between the region of level l + 1 and the edge of level l's region", 0,
      "-"},
-    {"refine.criterion", MPM_KEY_ENUM, "none", 0, 0, 0, 0, "none|density|compression",
+    {"refine.criterion", MPM_KEY_ENUM, "none", 0, 0, 0, 0, "none|density|compression|vorticity",
      "dynamic refinement, regridded every refine.every steps: none (the [refine.NAME] boxes, "
      "static), density (refine where the gas density of neighbouring level-0 cells differs by "
-     "more than refine.threshold times the smaller) or compression (where the velocity normal "
-     "to their face falls by more than refine.threshold times the sound speed: shocks)",
+     "more than refine.threshold times the smaller), compression (where the velocity normal "
+     "to their face falls by more than refine.threshold times the sound speed: shocks) or "
+     "vorticity (where a velocity along their face jumps by that much: shear layers)",
      0, NULL},
     {"refine.threshold", MPM_KEY_REAL, "0", 0, HUGE_VAL, 0, 0, NULL,
      "the criterion's threshold: a relative density difference (density, e.g. 0.05) or a "
-     "velocity drop over the sound speed (compression, e.g. 0.05) between neighbouring level-0 "
-     "cells (required with refine.criterion)",
+     "velocity drop or jump over the sound speed (compression, vorticity, e.g. 0.05) between "
+     "neighbouring level-0 cells (required with refine.criterion)",
      0, "-"},
     {"refine.every", MPM_KEY_INT, "10", 1, 1000000, 0, 0, NULL,
      "steps between regrids of a dynamic refinement (a regrid also runs before every checkpoint)",
@@ -138,8 +139,9 @@ static int read_dynamic(const mpm_config *cfg, dynamic *dy, int *on) {
   const char *criterion;
   MPM_CALL(mpm_config_get_string(cfg, "refine.criterion", &criterion));
   *on = strcmp(criterion, "none") != 0;
-  dy->criterion =
-      strcmp(criterion, "compression") == 0 ? FLUID_REFINE_COMPRESSION : FLUID_REFINE_DENSITY;
+  dy->criterion = strcmp(criterion, "compression") == 0 ? FLUID_REFINE_COMPRESSION
+                  : strcmp(criterion, "vorticity") == 0 ? FLUID_REFINE_VORTICITY
+                                                        : FLUID_REFINE_DENSITY;
   MPM_CALL(mpm_config_get_int(cfg, "refine.levels", &dy->levels));
   MPM_CALL(mpm_config_get_int(cfg, "refine.buffer", &dy->buffer));
   MPM_CALL(mpm_config_get_int(cfg, "refine.every", &dy->every));

@@ -34,14 +34,19 @@ int fluid_module_refine(mpm_module *m, const mpm_config *cfg, struct mpm_hier *h
 void fluid_module_rehier(mpm_module *m, struct mpm_hier *h);
 
 /* A regrid's criterion (refine.criterion). */
-typedef enum { FLUID_REFINE_DENSITY, FLUID_REFINE_COMPRESSION } fluid_refine_criterion;
+typedef enum {
+  FLUID_REFINE_DENSITY,
+  FLUID_REFINE_COMPRESSION,
+  FLUID_REFINE_VORTICITY
+} fluid_refine_criterion;
 
 /* The refinement flags over the level-0 spans (node-centred cells) of the global lattice, x
  * fastest, n[d] spans per axis (ncells along a periodic axis, ncells + 1 otherwise), from the
  * gas binned by each particle's nearest node: a span is flagged, with its axis neighbour, where
  * across the face between them the density changes by more than threshold times the smaller
- * (density), or the normal velocity falls by more than threshold times the smaller sound speed
- * (compression: shocks and steepening waves). flag has prod n[d] bytes. One rank. */
+ * (density), the normal velocity falls by more than threshold times the smaller sound speed
+ * (compression: shocks and steepening waves), or a tangential velocity jumps by more than that
+ * (vorticity: shear layers, h |omega| > threshold c). flag has prod n[d] bytes. One rank. */
 int fluid_refine_flags(const mpm_module *m, fluid_refine_criterion criterion, double threshold,
                        const int *n, unsigned char *flag);
 

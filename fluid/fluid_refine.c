@@ -167,19 +167,24 @@ static int span_of(const mpm_grid *g, int d, double x, int n) {
 /* Does the face between spans s and t (t above s along d) ask for refinement? sums: mass,
  * volume, internal energy m e, then momentum per axis, each of total entries. */
 static int face_flag(const fluid_gas *gas, fluid_refine_criterion criterion, double threshold,
-                     const double *sums, size_t total, int d, size_t s, size_t t) {
+                     const double *sums, size_t total, int dim, int d, size_t s, size_t t) {
   const double *mass = sums, *vol = sums + total, *me = sums + 2 * total;
   const double rs = mass[s] / vol[s], rt = mass[t] / vol[t];
   if (criterion == FLUID_REFINE_DENSITY) return fabs(rt - rs) > threshold * fmin(rt, rs);
-  /* compression: the normal velocity falls across the face by more than threshold times the
-   * slower sound speed of the two */
-  const double *mv = sums + (size_t)(3 + d) * total;
-  const double du = mv[t] / mass[t] - mv[s] / mass[s];
+  /* The velocities against threshold times the slower sound speed of the two. */
   const double cs =
       fluid_sound_speed(gas->gamma, rs, fluid_pressure(gas->gamma, rs, me[s] / mass[s]));
   const double ct =
       fluid_sound_speed(gas->gamma, rt, fluid_pressure(gas->gamma, rt, me[t] / mass[t]));
-  return -du > threshold * fmin(cs, ct);
+  const double bound = threshold * fmin(cs, ct);
+  double jump = 0.0;
+  for (int e = 0; e < dim; ++e) {
+    const double *mv = sums + (size_t)(3 + e) * total;
+    const double du = mv[t] / mass[t] - mv[s] / mass[s];
+    if (criterion == FLUID_REFINE_COMPRESSION && e == d) return -du > bound; /* normal, falls */
+    if (e != d) jump = fmax(jump, fabs(du)); /* vorticity: a tangential jump, h |omega| */
+  }
+  return jump > bound;
 }
 
 int fluid_refine_flags(const mpm_module *m, fluid_refine_criterion criterion, double threshold,
@@ -215,7 +220,7 @@ int fluid_refine_flags(const mpm_module *m, fluid_refine_criterion criterion, do
       if (j == n[d] && g->periodic[d]) j = 0;
       if (j >= n[d]) continue;
       const size_t t = s + ((size_t)j - (size_t)i) * stride[d];
-      if (vol[t] > 0 && face_flag(&fc->gas, criterion, threshold, sums, total, d, s, t))
+      if (vol[t] > 0 && face_flag(&fc->gas, criterion, threshold, sums, total, dim, d, s, t))
         flag[s] = flag[t] = 1;
     }
   }

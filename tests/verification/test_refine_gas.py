@@ -27,6 +27,10 @@ compression The same pulse regridded by the compression criterion (threshold 3e-
          front drops the velocity by 1e-2 of c per cell at the start, 4e-3 at t = 1.2): at every
          snapshot the particles of the band's rows within a cell of the steepest velocity drop
          are on level 1; conservation as above (~3 s).
+vorticity A shear layer (u = 0.3 tanh((y - 0.3) / 0.05), the velocity jumping by up to 0.23 c
+         between neighbouring cells) regridded by the vorticity criterion to t = 0.3: with
+         threshold 0.05 the particles within half a cell of the layer's middle are on level 1,
+         with threshold 0.5 (above every jump) no particle is refined (~3 s).
 restart  The same dynamic run to t = 0.4, restarted from its checkpoint at t = 0.2 (between
          regrids): it ends bit for bit as the run straight through (short: it also runs under
          the sanitizers).
@@ -306,6 +310,25 @@ def part_compression():
     dm, dp, de, _ = drifts(out)
     check(dm <= 1e-12 and dp <= 1e-12 and de <= 1e-8, f"compression: drifts of mass {dm:.1e}, "
           f"momentum {dp:.1e}, energy {de:.1e} (bounds 1e-12, 1e-12, 1e-8 as for density)")
+
+
+def part_vorticity():
+    gas = "density = 1\npressure = 0.714285714285714\nvelocity_field = 0.3*tanh((y-0.3)/0.05); 0"
+    counts = {}
+    for thr in ("0.05", "0.5"):
+        refine = DYNAMIC.replace("criterion = density", "criterion = vorticity").replace(
+            "0.004", thr)
+        out, _ = run(f"refine_vorticity_{thr}", case_text(3, 0.3, gas, refine))
+        p = final(out)
+        x, y = p["x"][:, 0], p["x"][:, 1]
+        mid = (np.abs(y - 0.3) < 0.025) & (x > 0.3) & (x < 2.7)  # 4 cells clear of x = 0, 3
+        # (a run never refined writes no particle level: its hierarchy never existed)
+        levels = p["level"].ravel()[mid] if "level" in p else np.zeros(int(mid.sum()))
+        counts[thr] = (set(levels.astype(int)), int(diagnostics(out)["particles_l1"].max()))
+    check(counts["0.05"][0] == {1}, f"vorticity, threshold 0.05: the particles at the layer's "
+          f"middle are on levels {sorted(counts['0.05'][0])} at t = 0.3 (want [1])")
+    check(counts["0.5"][1] == 0, f"vorticity, threshold 0.5: at most {counts['0.5'][1]} "
+          f"particles on level 1 over the run (want 0: no jump reaches it)")
 
 
 def part_restart():
@@ -752,6 +775,8 @@ elif PART == "restart":
     part_restart()
 elif PART == "compression":
     part_compression()
+elif PART == "vorticity":
+    part_vorticity()
 elif PART == "ranks":
     part_ranks()
 elif PART == "input":
