@@ -27,12 +27,18 @@ import h5py
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "tools"))
 import mpmtest as mt  # noqa: E402
 
-# Snapshots every 0.5 s and a checkpoint every 1 s, about 32 kB each (and a write reserves
-# about 100 kB more while it runs): the disk fills after the first checkpoint, on this code and
-# on the code before the fix alike.
-RUN = ["output.interval=0.5", "output.checkpoint_interval=1", "time.t_end=10",
-       "run.progress=false"]
-SIZE = {"tmpfs": "360k", "shim": 800 * 1024}
+# A checkpoint every 1 s and snapshots about 32 kB each; a write reserves about 100 kB more
+# while it runs, and series.xmf grows by about 4 kB a snapshot. On a tmpfs, with a snapshot
+# every 0.1 s, the first checkpoint completes from about 700 kB and the second needs about
+# 1070 kB: 880 kB sits in the middle of the window where the disk fills during a snapshot after
+# the first checkpoint, about 170 kB from either side. (A snapshot every 0.5 s on 360 kB left
+# a window 20 kB wide, which closed on another machine.) The shim counts its own pages and
+# reservations: with a snapshot every 0.5 s, budgets from 700 kB to 1400 kB all fill during a
+# snapshot after a checkpoint.
+RUN = {"tmpfs": ["output.interval=0.1"], "shim": ["output.interval=0.5"]}
+RUN = {k: v + ["output.checkpoint_interval=1", "time.t_end=10", "run.progress=false"]
+       for k, v in RUN.items()}
+SIZE = {"tmpfs": "880k", "shim": 880 * 1024}
 TIMEOUT = 90  # a hang becomes a failure: the run itself takes a few seconds
 WATCHDOG = "30"  # mpm_iowatch.h: the last resort, which this test must never need
 
@@ -47,8 +53,8 @@ def env(extra=None):
     return e
 
 
-def command(ranks, out, args=None):
-    cmd = [mt.BIN, "run", mt.case("axial_bar.ini"), f"output.dir={out}"] + (args or RUN)
+def command(ranks, out, args):
+    cmd = [mt.BIN, "run", mt.case("axial_bar.ini"), f"output.dir={out}"] + args
     return ([mt.MPIEXEC, "-n", str(ranks)] + cmd) if ranks > 1 else cmd
 
 
@@ -61,7 +67,7 @@ def tmpfs_works(tmp):
     return p.returncode == 0, (p.stderr or p.stdout).strip()
 
 
-def run_tmpfs(ranks, work, args=None, size=SIZE["tmpfs"]):
+def run_tmpfs(ranks, work, args=RUN["tmpfs"], size=SIZE["tmpfs"]):
     """The run on a tmpfs of size; its output folder is copied to work/out afterwards (the
     mount vanishes with its namespace). (exit status, seconds, output)."""
     mnt = os.path.join(work, "mnt")
@@ -76,7 +82,7 @@ def run_tmpfs(ranks, work, args=None, size=SIZE["tmpfs"]):
     return p.returncode, time.time() - t0, p.stdout + p.stderr
 
 
-def run_shim(ranks, work, shim, args=None):
+def run_shim(ranks, work, shim, args=RUN["shim"]):
     """The run under the shim with a budget of SIZE bytes for work/out."""
     out = os.path.join(os.path.realpath(work), "out")
     os.makedirs(out)
@@ -152,8 +158,8 @@ def other_writers(check, kind, tmp, shim):
     go past an LD_PRELOAD shim)."""
     work = os.path.join(tmp, f"{kind}_checkpoint_np2")
     os.makedirs(work)
-    args = RUN + ["output.snapshots=false"]
-    rc, seconds, text = (run_tmpfs(2, work, args, "300k") if kind == "tmpfs"
+    args = RUN[kind] + ["output.snapshots=false"]
+    rc, seconds, text = (run_tmpfs(2, work, args, "480k") if kind == "tmpfs"
                          else run_shim(2, work, shim, args))
     out = os.path.join(work, "out")
     if os.path.isdir(out):
@@ -194,7 +200,7 @@ def watchdog(check, tmp, shim):
              "ASAN_OPTIONS": os.environ.get("ASAN_OPTIONS", "") + ":verify_asan_link_order=0"}
     t0 = time.time()
     try:
-        p = subprocess.run(command(2, out), capture_output=True, text=True, env=env(extra),
+        p = subprocess.run(command(2, out, RUN["shim"]), capture_output=True, text=True, env=env(extra),
                            timeout=TIMEOUT)
         rc, text = p.returncode, p.stdout + p.stderr
     except subprocess.TimeoutExpired:
