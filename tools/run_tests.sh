@@ -20,7 +20,8 @@
 #   and test_bluff_bodies (45-100 s each under the sanitizers; the least-squares fit runs there
 #   in test_obstacles and test_obstacles_energy), the gas tubes test_sod, test_strong_shock and
 #   the ERK pairs' time-order study test_gas_time_order (test_gas_output, test_gas_conservation,
-#   test_gas_boundaries), and test_gas_shear (the viscous stress: test_stable_step);
+#   test_gas_boundaries), and test_gas_shear and test_gas_shear_3d (the viscous stress:
+#   test_stable_step; the 3-D gas: test_obstacles_3d);
 # - gas studies: test_farfield_gauge (141 s under the sanitizers; the gauge and the sponge run
 #   there in test_farfield_gauge_ranks), test_mol_damping (131 s; the damping in
 #   test_mol_damping_shift), ssprk2's time order test_time_order_gas (31 s; ssprk2 runs there in
@@ -57,7 +58,7 @@ set -euo pipefail
 src=$(cd "$(dirname "$0")/.." && pwd)
 PLAIN_ONLY="wedge|forward_step|supersonic_bar|supersonic_bar_standoff|supersonic_bar_bs32"
 PLAIN_ONLY+="|near_vacuum_order"
-PLAIN_ONLY+="|slanted_wall|bluff_bodies|sod|strong_shock|gas_time_order|gas_shear"
+PLAIN_ONLY+="|slanted_wall|bluff_bodies|sod|strong_shock|gas_time_order|gas_shear|gas_shear_3d"
 PLAIN_ONLY+="|farfield_gauge|mol_damping|time_order_gas|gas_noise|multirate_step"
 PLAIN_ONLY+="|fsi_waves|fsi_reflection|fsi_resonator|multirate_face|prestress"
 PLAIN_ONLY+="|piperno_farhat|timeschemes|timeschemes_mri|blowup_guard_coupled"
