@@ -96,7 +96,8 @@ import numpy as np  # noqa: E402
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "tools"))
 import mpmtest as mt  # noqa: E402
-from refine_scenes import BOX, BOX_3D, C0, CASE_3D, DYNAMIC, PULSE_5, case_text  # noqa: E402
+from refine_scenes import (BOX, BOX_3D, C0, CASE_3D, DYNAMIC, EXPAND_V, EXPANSION,  # noqa: E402
+                           PULSE_5, STARVE, case_text)
 
 PART = sys.argv[1] if len(sys.argv) > 1 else "uniform"
 PPC = int(sys.argv[2]) if len(sys.argv) > 2 else 2  # fluid.ppc of the uniform and pulse runs
@@ -329,6 +330,86 @@ def part_vorticity():
           f"middle are on levels {sorted(counts['0.05'][0])} at t = 0.3 (want [1])")
     check(counts["0.5"][1] == 0, f"vorticity, threshold 0.5: at most {counts['0.5'][1]} "
           f"particles on level 1 over the run (want 0: no jump reaches it)")
+
+
+def centre_counts(p):
+    """The particles in each of the 9 x 9 level-0 cells (nearest node) around the centre of the
+    expansion (1, 1): within 0.225 of it along each axis."""
+    j = np.rint(p["x"] / 0.05).astype(int) - 16
+    inside = ((j >= 0) & (j < 9)).all(axis=1)
+    c = np.zeros((9, 9), int)
+    np.add.at(c, (j[inside, 1], j[inside, 0]), 1)
+    return c
+
+
+def expansion_run(name, refine, geometry="all", velocity=EXPAND_V, t_end=1.2):
+    """The expansion scene: (folder, [(t, smallest centre count, particles, level-1 particles,
+    the largest distance of one from the centre)] per snapshot)."""
+    text = EXPANSION.format(t_end=t_end, interval=t_end / 4, geometry=geometry,
+                            velocity=velocity, refine=refine)
+    out, _ = run(name, text)
+    rows = []
+    for _, f in mt.snapshots(out):
+        p = mt.particles(f, "fluid")
+        l1 = p["level"].ravel() == 1 if "level" in p else np.zeros(len(p["x"]), bool)
+        r = np.hypot(p["x"][:, 0] - 1, p["x"][:, 1] - 1)
+        rows.append((p["time"], int(centre_counts(p).min()), len(p["x"]), int(l1.sum()),
+                     float(r[l1].max()) if l1.any() else 0.0))
+    for r in rows:
+        print(f"info {name}: t = {r[0]:.2f}: fewest particles in a centre cell {r[1]}, "
+              f"{r[2]} particles, {r[3]} on level 1 (the farthest {r[4]:.2f} from the centre)")
+    return out, rows
+
+
+def part_starvation():
+    k = 2  # half the 2 x 2 particles a cell is seeded with
+    comp = STARVE.replace("starvation\n", "compression, starvation\nthreshold = 0.05\n")
+    runs = {"starvation": expansion_run("refine_starvation", STARVE),
+            "none": expansion_run("refine_starvation_none", ""),
+            "compression, starvation": expansion_run("refine_starvation_both", comp),
+            "compression": expansion_run("refine_starvation_comp", comp.replace(
+                ", starvation", "").replace("min_particles = 2.5\n", ""))}
+    fewest = {label: min(r[1] for r in rows) for label, (_, rows) in runs.items()}
+    check(fewest["none"] < k and fewest["compression"] < k,
+          f"unrefined and compression alone: the centre's cells fall to {fewest['none']} and "
+          f"{fewest['compression']} particles by t = 1.2 (want < {k}: the gas starves)")
+    for label in ("starvation", "compression, starvation"):
+        check(fewest[label] >= k, f"{label}: the centre's cells keep at least {fewest[label]} "
+              f"particles at every snapshot (want >= {k}: split before they empty)")
+    # The union of the flags: the compression ring's level-1 particles and the centre's.
+    last = {label: rows[-1] for label, (_, rows) in runs.items()}
+    both, alone = last["compression, starvation"][3], (last["compression"][3],
+                                                       last["starvation"][3])
+    check(both >= max(alone) and both > min(alone) > 0, f"compression, starvation: {both} "
+          f"particles on level 1 at t = 1.2, compression alone {alone[0]}, starvation alone "
+          f"{alone[1]} (want at least either: the union of their regions)")
+    # Starvation flags the thinned centre alone: beyond r = 0.6 the gas barely moves (|u| <
+    # 0.011) and keeps its 4 particles a cell, while the flags (dilated by 2 cells) reach r = 0.5.
+    far = max(r[4] for r in runs["starvation"][1])
+    check(0 < far < 0.6, f"starvation: the farthest level-1 particle over the run is {far:.2f} "
+          f"from the centre (want < 0.6: the centre is refined, not the resting gas around it)")
+    # A disc of gas at rest in empty space: its edge cells hold few particles but border empty
+    # cells, and empty cells are never flagged, so nothing is refined.
+    disc, _ = expansion_run("refine_starvation_disc", STARVE, "disc", "velocity = 0 0", 0.05)
+    l1 = int(diagnostics(disc)["particles_l1"].max())
+    check(l1 == 0, f"starvation, a disc of gas in empty space: {l1} particles on level 1 over "
+          f"the run (want 0: neither its edge nor the empty space is starved)")
+    for label in ("starvation", "compression, starvation", "none"):
+        out = runs[label][0]
+        d = diagnostics(out)
+        scale = np.sqrt(2 * d["mass"][0] * d["kinetic"][0])  # >= sum m |v|: the start is at rest
+        dp = max(abs(d["px"]).max(), abs(d["py"]).max()) / scale  # on the whole
+        dm = abs(d["mass"] - d["mass"][0]).max() / d["mass"][0]
+        de = abs(d["total"] - d["total"][0]).max() / d["total"][0]
+        regrids = len(set(d["particles"].astype(int)))
+        if label == "none":
+            print(f"info unrefined: drifts of mass {dm:.1e}, momentum {dp:.1e}, energy {de:.1e}")
+            continue
+        # As for the pulse: mass and momentum to roundoff, energy to bs32's error (the run
+        # without refinement drifts as much, 2.3e-9).
+        check(dm <= 1e-12 and dp <= 1e-12 and de <= 1e-8 and regrids > 2,
+              f"{label}: drifts of mass {dm:.1e}, momentum {dp:.1e} (of sqrt(2 M K)), energy "
+              f"{de:.1e} (bounds 1e-12, 1e-12, 1e-8) over {regrids} particle counts")
 
 
 def part_restart():
@@ -777,6 +858,8 @@ elif PART == "compression":
     part_compression()
 elif PART == "vorticity":
     part_vorticity()
+elif PART == "starvation":
+    part_starvation()
 elif PART == "ranks":
     part_ranks()
 elif PART == "input":
