@@ -200,14 +200,20 @@ static int read_thresholds(const mpm_config *cfg, dynamic *dy) {
                            "neighbouring cells that refines them, e.g. 0.05; one value per "
                            "density, compression or vorticity criterion; see the key reference)",
                            g_criteria[dy->crit[dy->crit[0] == FLUID_REFINE_STARVATION]]);
+  if (has_threshold && ngas == 0)
+    return mpm_config_fail(cfg, "refine.threshold",
+                           "is set, and refine.criterion lists none of its readers (density, "
+                           "compression, vorticity); remove the key or list one of them");
   if (has_threshold && count != ngas)
     return mpm_config_fail(cfg, "refine.threshold",
                            "has %d value%s for the %d criteria of refine.criterion that read it "
                            "(density, compression, vorticity); give one per such criterion, in "
-                           "the list's order%s",
-                           count, count == 1 ? "" : "s", ngas, ngas ? "" : ", or remove the key");
+                           "the list's order",
+                           count, count == 1 ? "" : "s", ngas);
   if (starve && !(min_particles > 0))
-    return mpm_config_fail(cfg, "refine.criterion",
+    return mpm_config_fail(cfg,
+                           mpm_config_has(cfg, "refine.min_particles") ? "refine.min_particles"
+                                                                       : "refine.criterion",
                            "starvation needs a threshold: set refine.min_particles > 0 (the "
                            "level-0 particles per cell below which a cell inside the gas is "
                            "refined, e.g. half of fluid.ppc^dim)");

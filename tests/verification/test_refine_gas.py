@@ -523,6 +523,34 @@ def part_input():
         ("criterion with a static box", case_text(2, 0.1, gas, box.replace(
             "levels = 2", "levels = 2\ncriterion = density\nthreshold = 0.01")),
          "refine.box.level", "level = 1", "static box"),
+        # Lists of criteria (compression, starvation; docs/refinement.md).
+        ("unknown criterion", dyn.replace("criterion = density", "criterion = density, shock"),
+         "refine.criterion", "criterion = density, shock", "'shock' is not a criterion"),
+        ("criterion listed twice", dyn.replace("criterion = density",
+                                               "criterion = density,density"),
+         "refine.criterion", "criterion = density,density", "density twice"),
+        ("none with another criterion", dyn.replace("criterion = density",
+                                                    "criterion = none, density"),
+         "refine.criterion", "criterion = none, density", "none alone"),
+        ("starvation without min_particles", dyn.replace("criterion = density",
+                                                         "criterion = density starvation"),
+         "refine.criterion", "criterion = density starvation", "refine.min_particles > 0"),
+        ("two criteria, one threshold", dyn.replace(
+            "criterion = density", "criterion = density, compression"), "refine.threshold",
+         "threshold = 0.004", "1 value for the 2 criteria"),
+        ("a threshold no criterion reads", dyn.replace(
+            "criterion = density", "criterion = starvation\nmin_particles = 2"),
+         "refine.threshold", "threshold = 0.004", "lists none of its readers"),
+        ("a threshold of 0", dyn.replace("criterion = density", "criterion = vorticity, "
+                                         "density").replace("0.004", "0.05 0"),
+         "refine.threshold", "threshold = 0.05 0", "is 0 for density"),
+        ("min_particles = 0", dyn.replace("criterion = density", "criterion = starvation\n"
+                                          "min_particles = 0").replace("threshold = 0.004\n",
+                                                                        ""),
+         "refine.min_particles", "min_particles = 0", "starvation needs a threshold"),
+        ("min_particles without starvation", dyn.replace("threshold = 0.004",
+                                                         "threshold = 0.004\nmin_particles = 2"),
+         "refine.min_particles", "min_particles = 2", "does not list starvation"),
     ]
     for name, text, key, start, words in cases_dyn:
         mt.expect_input_error(check, name, text, key, mt.line_starting(text, start), words)
