@@ -194,7 +194,7 @@ static int read_thresholds(const mpm_config *cfg, dynamic *dy) {
   for (int k = 0; k < dy->ncrit; ++k) starve += dy->crit[k] == FLUID_REFINE_STARVATION;
   ngas = dy->ncrit - starve;
   const int has_threshold = mpm_config_has(cfg, "refine.threshold");
-  if (ngas > 0 && !has_threshold)
+  if (ngas > 0 && !has_threshold) /* named: the first gas-state criterion (starvation is once) */
     return mpm_config_fail(cfg, "refine.criterion",
                            "%s needs a threshold: set refine.threshold > 0 (the jump between "
                            "neighbouring cells that refines them, e.g. 0.05; one value per "
