@@ -26,17 +26,25 @@ const mpm_key_spec mpm_refine_keys[] = {
     {"refine.buffer", MPM_KEY_INT, "2", 1, 64, 0, 0, NULL,
      "level-l cells kept between the region of level l + 1 and the edge of level l's region", 0,
      "-"},
-    {"refine.criterion", MPM_KEY_ENUM, "none", 0, 0, 0, 0, "none|density|compression|vorticity",
+    {"refine.criterion", MPM_KEY_NAMES, "none", 0, 0, 0, 0, NULL,
      "dynamic refinement, regridded every refine.every steps: none (the [refine.NAME] boxes, "
-     "static), density (refine where the gas density of neighbouring level-0 cells differs by "
-     "more than refine.threshold times the smaller), compression (where the velocity normal "
-     "to their face falls by more than refine.threshold times the sound speed: shocks) or "
-     "vorticity (where a velocity along their face jumps by that much: shear layers)",
+     "static) or a list of criteria (e.g. compression, starvation) whose flags are joined: "
+     "density (refine where the gas density of neighbouring level-0 cells differs by more than "
+     "refine.threshold times the smaller), compression (where the velocity normal to their "
+     "face falls by more than refine.threshold times the sound speed: shocks), vorticity "
+     "(where a velocity along their face jumps by that much: shear layers), starvation (a "
+     "level-0 cell inside the gas holding fewer than refine.min_particles level-0 particles)",
      0, NULL},
-    {"refine.threshold", MPM_KEY_REAL, "0", 0, HUGE_VAL, 0, 0, NULL,
-     "the criterion's threshold: a relative density difference (density, e.g. 0.05) or a "
-     "velocity drop or jump over the sound speed (compression, vorticity, e.g. 0.05) between "
-     "neighbouring level-0 cells (required with refine.criterion)",
+    {"refine.threshold", MPM_KEY_REALS, "0", 0, HUGE_VAL, 0, 3, NULL,
+     "one threshold per listed density, compression or vorticity criterion, in the list's "
+     "order: a relative density difference (density, e.g. 0.05) or a velocity drop or jump "
+     "over the sound speed (compression, vorticity, e.g. 0.05) between neighbouring level-0 "
+     "cells (required with those criteria)",
+     0, "-"},
+    {"refine.min_particles", MPM_KEY_REAL, "0", 0, HUGE_VAL, 0, 0, NULL,
+     "the starvation criterion's threshold: a level-0 cell whose gas neighbours it on every side "
+     "is refined when it holds fewer particles than this, a level-l particle counting 2^-(dim l) "
+     "(fluid.ppc^dim fill a cell at the start; e.g. half that; required with starvation)",
      0, "-"},
     {"refine.every", MPM_KEY_INT, "10", 1, 1000000, 0, 0, NULL,
      "steps between regrids of a dynamic refinement (a regrid also runs before every checkpoint)",
@@ -128,32 +136,112 @@ static int read_boxes(const mpm_config *cfg, const mpm_grid *g, const char *cons
  * construction: span i's lower face is at (i - 1/2) dx). */
 #define REFINE_CLIP 4
 
+/* The criteria refine.criterion may list, in fluid_refine_criterion's order; the first
+ * REFINE_NGAS read refine.threshold, starvation reads refine.min_particles. */
+static const char *const g_criteria[] = {"density", "compression", "vorticity", "starvation"};
+#define REFINE_NCRIT ((int)(sizeof g_criteria / sizeof g_criteria[0]))
+#define REFINE_NGAS  3
+
 typedef struct dynamic {
   int levels, buffer, every, dilate;
-  double threshold;
-  fluid_refine_criterion criterion;
+  int ncrit; /* criteria listed (0: none) */
+  fluid_refine_criterion crit[REFINE_NCRIT];
+  double threshold[REFINE_NCRIT]; /* each one's threshold */
 } dynamic;
+
+/* The criteria of refine.criterion into dy->crit (none: ncrit = 0), each known and listed
+ * once, none alone. */
+static int read_criteria(const mpm_config *cfg, dynamic *dy) {
+  const char *list;
+  MPM_CALL(mpm_config_get_string(cfg, "refine.criterion", &list));
+  int none = 0, seen[REFINE_NCRIT] = {0};
+  dy->ncrit = 0;
+  for (const char *s = list + strspn(list, " \t,"); *s; s += strspn(s, " \t,")) {
+    const int len = (int)strcspn(s, " \t,");
+    int k = 0;
+    while (k < REFINE_NCRIT &&
+           !(strncmp(s, g_criteria[k], (size_t)len) == 0 && g_criteria[k][len] == '\0'))
+      ++k;
+    if (len == 4 && strncmp(s, "none", 4) == 0)
+      none = 1;
+    else if (k == REFINE_NCRIT)
+      return mpm_config_fail(cfg, "refine.criterion",
+                             "'%.*s' is not a criterion; list none, or one or more of density, "
+                             "compression, vorticity and starvation, separated by commas",
+                             len, s);
+    else if (seen[k]++)
+      return mpm_config_fail(cfg, "refine.criterion", "lists %s twice; list each criterion once",
+                             g_criteria[k]);
+    else
+      dy->crit[dy->ncrit++] = (fluid_refine_criterion)k;
+    s += len;
+  }
+  if (none && dy->ncrit > 0)
+    return mpm_config_fail(cfg, "refine.criterion",
+                           "lists none with other criteria; give none alone (no dynamic "
+                           "refinement) or remove it from the list");
+  return 0;
+}
+
+/* The thresholds of the listed criteria: refine.threshold's values, one per gas-state
+ * criterion in the list's order, and refine.min_particles for starvation; each required and
+ * > 0, and neither key set without a criterion reading it. */
+static int read_thresholds(const mpm_config *cfg, dynamic *dy) {
+  double value[REFINE_NGAS], min_particles;
+  int count, ngas = 0, starve = 0;
+  MPM_CALL(mpm_config_get_reals(cfg, "refine.threshold", value, REFINE_NGAS, &count));
+  MPM_CALL(mpm_config_get_real(cfg, "refine.min_particles", &min_particles));
+  for (int k = 0; k < dy->ncrit; ++k) starve += dy->crit[k] == FLUID_REFINE_STARVATION;
+  ngas = dy->ncrit - starve;
+  const int has_threshold = mpm_config_has(cfg, "refine.threshold");
+  if (ngas > 0 && !has_threshold) /* named: the first gas-state criterion (starvation is once) */
+    return mpm_config_fail(cfg, "refine.criterion",
+                           "%s needs a threshold: set refine.threshold > 0 (the jump between "
+                           "neighbouring cells that refines them, e.g. 0.05; one value per "
+                           "density, compression or vorticity criterion; see the key reference)",
+                           g_criteria[dy->crit[dy->crit[0] == FLUID_REFINE_STARVATION]]);
+  if (has_threshold && ngas == 0)
+    return mpm_config_fail(cfg, "refine.threshold",
+                           "is set, and refine.criterion lists none of its readers (density, "
+                           "compression, vorticity); remove the key or list one of them");
+  if (has_threshold && count != ngas)
+    return mpm_config_fail(cfg, "refine.threshold",
+                           "has %d value%s for the %d criteria of refine.criterion that read it "
+                           "(density, compression, vorticity); give one per such criterion, in "
+                           "the list's order",
+                           count, count == 1 ? "" : "s", ngas);
+  if (starve && !(min_particles > 0))
+    return mpm_config_fail(cfg,
+                           mpm_config_has(cfg, "refine.min_particles") ? "refine.min_particles"
+                                                                       : "refine.criterion",
+                           "starvation needs a threshold: set refine.min_particles > 0 (the "
+                           "level-0 particles per cell below which a cell inside the gas is "
+                           "refined, e.g. half of fluid.ppc^dim)");
+  if (!starve && mpm_config_has(cfg, "refine.min_particles"))
+    return mpm_config_fail(cfg, "refine.min_particles",
+                           "is set, and refine.criterion does not list starvation, its only "
+                           "reader; add starvation to the list or remove the key");
+  for (int k = 0, j = 0; k < dy->ncrit; ++k) {
+    const int gas = dy->crit[k] != FLUID_REFINE_STARVATION;
+    dy->threshold[k] = gas ? value[j++] : min_particles;
+    if (!(dy->threshold[k] > 0))
+      return mpm_config_fail(cfg, "refine.threshold",
+                             "is 0 for %s; give each criterion a threshold > 0 (e.g. 0.05)",
+                             g_criteria[dy->crit[k]]);
+  }
+  return 0;
+}
 
 /* The dynamic settings, or 0 in *on when refine.criterion = none. */
 static int read_dynamic(const mpm_config *cfg, dynamic *dy, int *on) {
-  const char *criterion;
-  MPM_CALL(mpm_config_get_string(cfg, "refine.criterion", &criterion));
-  *on = strcmp(criterion, "none") != 0;
-  dy->criterion = strcmp(criterion, "compression") == 0 ? FLUID_REFINE_COMPRESSION
-                  : strcmp(criterion, "vorticity") == 0 ? FLUID_REFINE_VORTICITY
-                                                        : FLUID_REFINE_DENSITY;
+  MPM_CALL(read_criteria(cfg, dy));
+  *on = dy->ncrit > 0;
   MPM_CALL(mpm_config_get_int(cfg, "refine.levels", &dy->levels));
   MPM_CALL(mpm_config_get_int(cfg, "refine.buffer", &dy->buffer));
   MPM_CALL(mpm_config_get_int(cfg, "refine.every", &dy->every));
   MPM_CALL(mpm_config_get_int(cfg, "refine.dilate", &dy->dilate));
-  MPM_CALL(mpm_config_get_real(cfg, "refine.threshold", &dy->threshold));
   if (!*on) return 0;
-  if (!(dy->threshold > 0))
-    return mpm_config_fail(cfg, "refine.criterion",
-                           "%s needs a threshold: set refine.threshold > 0 (the jump between "
-                           "neighbouring cells that refines them, e.g. 0.05; see the key "
-                           "reference)",
-                           criterion);
+  MPM_CALL(read_thresholds(cfg, dy));
   if (2 * dy->dilate < dy->buffer)
     return mpm_config_fail(cfg, "refine.dilate",
                            "is %d, and the levels' regions must nest with refine.buffer = %d "
@@ -229,7 +317,12 @@ static int make_dynamic(mpm_hier **h, const dynamic *dy, mpm_grid *grid, mpm_mod
   unsigned char *mask = flag + total, *tmp = mask + total;
   mpm_hier_box *box = NULL;
   int nbox = 0, cap = 0, used = 1;
-  int rc = fluid_refine_flags(gas, dy->criterion, dy->threshold, n, flag);
+  int rc = 0;
+  memset(flag, 0, total);
+  for (int k = 0; k < dy->ncrit && !rc; ++k) { /* the union of the criteria's flags */
+    rc = fluid_refine_flags(gas, dy->crit[k], dy->threshold[k], n, tmp);
+    for (size_t s = 0; s < total && !rc; ++s) flag[s] |= tmp[s];
+  }
   const double eps = 1e-6 * ldexp(grid->dx, -dy->levels);
   for (int l = 1; l < dy->levels && !rc; ++l) {
     dilate(n, grid->dim, dy->dilate * (dy->levels - l), flag, mask, tmp);
@@ -275,7 +368,8 @@ int mpm_refine_dynamic(const mpm_config *cfg) {
   if (mpm_config_get_string(cfg, "refine.criterion", &criterion) ||
       mpm_config_get_int(cfg, "refine.levels", &levels))
     return 0;
-  return levels > 1 && strcmp(criterion, "none") != 0;
+  const char *first = criterion + strspn(criterion, " \t,");
+  return levels > 1 && !(strncmp(first, "none", 4) == 0 && strcspn(first, " \t,") == 4);
 }
 
 int mpm_refine_regrid(mpm_hier **h, const mpm_config *cfg, mpm_grid *grid, mpm_module **mod,

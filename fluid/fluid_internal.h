@@ -159,6 +159,10 @@ int fluid_shift(mpm_module *m, long step, double h, int *changed);
  * changed. One rank (the hierarchy's). */
 int fluid_relevel(mpm_module *m, int *changed);
 
+/* The level of size of gas particle i (0 .. MPM_HIER_MAX_LEVELS - 1) from its reference volume,
+ * V0_0 = (dx / ppc)^dim being level 0's: round(log2(V0_0 / V0) / dim) (fluid_relevel.c). */
+int fluid_size_level(const mpm_module *m, double V0_0, mpm_lidx i);
+
 /* Seed the finer levels of m->hier (fluid_seed.c): drop the level-0 particles inside them and
  * seed each level's own region on its lattice. Collective. */
 int fluid_seed_refined(mpm_module *m, const mpm_config *cfg);

@@ -33,11 +33,12 @@ int fluid_module_refine(mpm_module *m, const mpm_config *cfg, struct mpm_hier *h
  * after the next step. */
 void fluid_module_rehier(mpm_module *m, struct mpm_hier *h);
 
-/* A regrid's criterion (refine.criterion). */
+/* A regrid's criterion (one of the list refine.criterion). */
 typedef enum {
   FLUID_REFINE_DENSITY,
   FLUID_REFINE_COMPRESSION,
-  FLUID_REFINE_VORTICITY
+  FLUID_REFINE_VORTICITY,
+  FLUID_REFINE_STARVATION
 } fluid_refine_criterion;
 
 /* The refinement flags over the level-0 spans (node-centred cells) of the global lattice, x
@@ -46,7 +47,9 @@ typedef enum {
  * across the face between them the density changes by more than threshold times the smaller
  * (density), the normal velocity falls by more than threshold times the smaller sound speed
  * (compression: shocks and steepening waves), or a tangential velocity jumps by more than that
- * (vorticity: shear layers, h |omega| > threshold c). flag has prod n[d] bytes. One rank. */
+ * (vorticity: shear layers, h |omega| > threshold c); or a span holding fewer than threshold
+ * level-0 particles (starvation: a particle of size level l counts 2^(-dim l)) whose 2 dim axis
+ * neighbours all hold gas (not the gas's edge). flag has prod n[d] bytes. One rank. */
 int fluid_refine_flags(const mpm_module *m, fluid_refine_criterion criterion, double threshold,
                        const int *n, unsigned char *flag);
 

@@ -187,6 +187,49 @@ static int face_flag(const fluid_gas *gas, fluid_refine_criterion criterion, dou
   return jump > bound;
 }
 
+/* The span of particle i on the flag lattice (strides stride). */
+static size_t span_index(const mpm_module *m, const int *n, const size_t *stride, mpm_lidx i) {
+  size_t s = 0;
+  for (int d = 0; d < m->grid->dim; ++d)
+    s += stride[d] *
+         (size_t)span_of(m->grid, d, mpm_particles_comp(m->particles, FLUID_X, d)[i], n[d]);
+  return s;
+}
+
+/* Does every axis neighbour of span s hold gas (count > 0)? A neighbour past a non-periodic
+ * end of the lattice does not. */
+static int neighbours_hold_gas(const mpm_grid *g, const int *n, const size_t *stride,
+                               const double *count, size_t s) {
+  for (int d = 0; d < g->dim; ++d) {
+    const int i = (int)(s / stride[d] % (size_t)n[d]);
+    for (int side = -1; side <= 1; side += 2) {
+      int j = i + side;
+      if (g->periodic[d]) j = (j + n[d]) % n[d];
+      if (j < 0 || j >= n[d] || !(count[s + ((size_t)j - (size_t)i) * stride[d]] > 0)) return 0;
+    }
+  }
+  return 1;
+}
+
+/* Starvation: each span's particles in level-0 particles (a particle of size level l counts
+ * 2^(-dim l), so that a split, which keeps the gas's sampling of level 0, keeps the count and
+ * the region stays while the gas is sparse), flagged below threshold where the gas surrounds
+ * the span (a span on the gas's edge is not starved, and empty space is never flagged). */
+static int starved_flags(const mpm_module *m, double threshold, const int *n, const size_t *stride,
+                         size_t total, unsigned char *flag) {
+  const fluid_content *fc = m->content;
+  const int dim = m->grid->dim;
+  const double V0_0 = pow(m->grid->dx / fc->ppc, dim);
+  double *count = calloc(total, sizeof(double));
+  if (!count) MPM_FAIL_OOM(total * sizeof(double));
+  for (mpm_lidx i = 0; i < m->particles->n; ++i)
+    count[span_index(m, n, stride, i)] += ldexp(1.0, -dim * fluid_size_level(m, V0_0, i));
+  for (size_t s = 0; s < total; ++s)
+    flag[s] = count[s] < threshold && neighbours_hold_gas(m->grid, n, stride, count, s);
+  free(count);
+  return 0;
+}
+
 int fluid_refine_flags(const mpm_module *m, fluid_refine_criterion criterion, double threshold,
                        const int *n, unsigned char *flag) {
   const fluid_content *fc = m->content;
@@ -196,6 +239,8 @@ int fluid_refine_flags(const mpm_module *m, fluid_refine_criterion criterion, do
   size_t total = 1, stride[MPM_MAX_DIM] = {1, 1, 1};
   for (int d = 0; d < dim; ++d) stride[d] = total, total *= (size_t)n[d];
   memset(flag, 0, total);
+  if (criterion == FLUID_REFINE_STARVATION)
+    return starved_flags(m, threshold, n, stride, total, flag);
   const size_t nsums = 3 + (size_t)dim; /* mass, volume, m e, m v */
   double *sums = calloc(nsums * total, sizeof(double));
   if (!sums) MPM_FAIL_OOM(nsums * total * sizeof(double));
@@ -204,9 +249,7 @@ int fluid_refine_flags(const mpm_module *m, fluid_refine_criterion criterion, do
   const double *J = mpm_particles_comp(p, FLUID_J, 0);
   const double *e = mpm_particles_comp(p, FLUID_E, 0);
   for (mpm_lidx i = 0; i < p->n; ++i) {
-    size_t s = 0;
-    for (int d = 0; d < dim; ++d)
-      s += stride[d] * (size_t)span_of(g, d, mpm_particles_comp(p, FLUID_X, d)[i], n[d]);
+    const size_t s = span_index(m, n, stride, i);
     sums[s] += pm[i], sums[total + s] += V0[i] * J[i], sums[2 * total + s] += pm[i] * e[i];
     for (int d = 0; d < dim; ++d)
       sums[(3 + (size_t)d) * total + s] += pm[i] * mpm_particles_comp(p, FLUID_V, d)[i];

@@ -35,8 +35,7 @@
 #include <math.h>
 #include <stdlib.h>
 
-/* The level of size of particle i (0 .. MPM_HIER_MAX_LEVELS - 1). */
-static int size_level(const mpm_module *m, double V0_0, mpm_lidx i) {
+int fluid_size_level(const mpm_module *m, double V0_0, mpm_lidx i) {
   const fluid_content *fc = m->content;
   const double V0 = mpm_particles_comp(m->particles, fc->lay.f_V0, 0)[i];
   const long l = lround(log2(V0_0 / V0) / m->grid->dim);
@@ -58,7 +57,7 @@ static int merge_level(mpm_module *m, double V0_0, int L, mpm_lidx *idx, mpm_lid
   const mpm_lidx n = m->particles->n;
   mpm_lidx k = 0;
   for (mpm_lidx i = 0; i < n; ++i)
-    if (size_level(m, V0_0, i) == L && position_level(m, i) < L) idx[k++] = i;
+    if (fluid_size_level(m, V0_0, i) == L && position_level(m, i) < L) idx[k++] = i;
   if (k == 0) return 0;
   mpm_lidx *start, *member, ng;
   const double H = ldexp(m->grid->dx, 1 - L) / fc->ppc; /* level L - 1's particle spacing */
@@ -85,7 +84,7 @@ static int relevel(mpm_module *m, int *changed) {
   for (int pass = 0; !rc && pass < MPM_HIER_MAX_LEVELS; ++pass) {
     mpm_lidx k = 0;
     for (mpm_lidx i = 0; i < m->particles->n; ++i)
-      if (size_level(m, V0_0, i) < position_level(m, i)) idx[k++] = i;
+      if (fluid_size_level(m, V0_0, i) < position_level(m, i)) idx[k++] = i;
     fluid_split_report rep = {0};
     rc = fluid_split(m, idx, k, &rep); /* collective: every rank calls, k = 0 too */
     split += rep.parents;

@@ -1,6 +1,7 @@
 """The refinement's test scenes (docs/refinement.md), shared by tests/verification/test_refine_gas.py
 and bench/bench_refine.py: a 2-D strip periodic along x with slip walls along y (level 0 at
-dx = 0.05), its static level-1 box, the 3-D strip and box, and the regridded pulse."""
+dx = 0.05), its static level-1 box, the 3-D strip and box, the regridded pulse, and a radial expansion for the starvation
+criterion."""
 import numpy as np
 
 C0 = np.sqrt(1.4)  # sound speed of rho 1, p 1
@@ -84,3 +85,51 @@ DYNAMIC = "[refine]\nlevels = 2\ncriterion = density\nthreshold = 0.004\nevery =
 PULSE_5 = ("density_field = 1 + 5e-2*exp(-(x-0.6)^2/0.04)\n"
            "pressure_field = 0.714285714285714 + 5e-2*exp(-(x-0.6)^2/0.04)\n"
            "velocity_field = 5e-2*exp(-(x-0.6)^2/0.04); 0")
+
+# A 2-D square periodic on all faces (dx = 0.05, 40 x 40 cells, fluid.ppc = 2) filled with gas
+# of low pressure (c = 0.12) whose centre expands: u = (x - xc) exp(-r^2 / 0.09), a divergence
+# of 2 at the centre, so that the particles there spread apart (the centre's density falls to
+# 0.24 by t = 1.2) and the gas piles up in a ring around it; {refine} is the [refine] section.
+EXPANSION = """[run]
+name = refine_starvation
+
+[domain]
+dim = 2
+lo = 0 0
+hi = 2 2
+
+[grid]
+dx = 0.05
+
+[boundary]
+x_lo = periodic
+x_hi = periodic
+y_lo = periodic
+y_hi = periodic
+
+[time]
+t_end = {t_end}
+
+[output]
+interval = {interval}
+
+[geometry.all]
+type = box
+lo = 0 0
+hi = 2 2
+
+[geometry.disc]
+type = disk
+center = 1 1
+radius = 0.5
+
+[gas.air]
+geometry = {geometry}
+density = 1
+pressure = 0.01
+{velocity}
+
+{refine}"""
+EXPAND_V = ("velocity_field = (x-1)*exp(-((x-1)^2+(y-1)^2)/0.09); "
+            "(y-1)*exp(-((x-1)^2+(y-1)^2)/0.09)")
+STARVE = "[refine]\nlevels = 2\ncriterion = starvation\nmin_particles = 2.5\nevery = 10\n"

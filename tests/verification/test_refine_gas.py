@@ -31,6 +31,15 @@ vorticity A shear layer (u = 0.3 tanh((y - 0.3) / 0.05), the velocity jumping by
          between neighbouring cells) regridded by the vorticity criterion to t = 0.3: with
          threshold 0.05 the particles within half a cell of the layer's middle are on level 1,
          with threshold 0.5 (above every jump) no particle is refined (~3 s).
+starvation An expanding gas (refine_scenes.EXPANSION: a square periodic on every face whose
+         centre expands) regridded by starvation (min_particles 2.5), by compression (0.05)
+         alone and by both: with starvation listed the 9 x 9 cells around the centre keep at
+         least 2 particles at every snapshot, without it they empty; the combined run refines
+         at least what either does alone; starvation's region stays in the centre; a disc of
+         gas at rest in empty space is not refined; a restart of the combined run is bit for
+         bit; mass, momentum and energy as for dynamic (~8 s). Able to fail: with the
+         starvation flags switched off the centre empties (4 checks fail); without the
+         neighbour rule the disc's edge and the empty space are refined.
 restart  The same dynamic run to t = 0.4, restarted from its checkpoint at t = 0.2 (between
          regrids): it ends bit for bit as the run straight through (short: it also runs under
          the sanitizers).
@@ -96,7 +105,8 @@ import numpy as np  # noqa: E402
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "tools"))
 import mpmtest as mt  # noqa: E402
-from refine_scenes import BOX, BOX_3D, C0, CASE_3D, DYNAMIC, PULSE_5, case_text  # noqa: E402
+from refine_scenes import (BOX, BOX_3D, C0, CASE_3D, DYNAMIC, EXPAND_V, EXPANSION,  # noqa: E402
+                           PULSE_5, STARVE, case_text)
 
 PART = sys.argv[1] if len(sys.argv) > 1 else "uniform"
 PPC = int(sys.argv[2]) if len(sys.argv) > 2 else 2  # fluid.ppc of the uniform and pulse runs
@@ -331,6 +341,95 @@ def part_vorticity():
           f"particles on level 1 over the run (want 0: no jump reaches it)")
 
 
+def centre_counts(p):
+    """The particles in each of the 9 x 9 level-0 cells (nearest node) around the centre of the
+    expansion (1, 1): within 0.225 of it along each axis."""
+    j = np.rint(p["x"] / 0.05).astype(int) - 16
+    inside = ((j >= 0) & (j < 9)).all(axis=1)
+    c = np.zeros((9, 9), int)
+    np.add.at(c, (j[inside, 1], j[inside, 0]), 1)
+    return c
+
+
+def expansion_run(name, refine, geometry="all", velocity=EXPAND_V, t_end=1.2):
+    """The expansion scene: (folder, [(t, smallest centre count, particles, level-1 particles,
+    the largest distance of one from the centre)] per snapshot)."""
+    text = EXPANSION.format(t_end=t_end, interval=t_end / 4, geometry=geometry,
+                            velocity=velocity, refine=refine)
+    out, _ = run(name, text)
+    rows = []
+    for _, f in mt.snapshots(out):
+        p = mt.particles(f, "fluid")
+        l1 = p["level"].ravel() == 1 if "level" in p else np.zeros(len(p["x"]), bool)
+        r = np.hypot(p["x"][:, 0] - 1, p["x"][:, 1] - 1)
+        rows.append((p["time"], int(centre_counts(p).min()), len(p["x"]), int(l1.sum()),
+                     float(r[l1].max()) if l1.any() else 0.0))
+    for r in rows:
+        print(f"info {name}: t = {r[0]:.2f}: fewest particles in a centre cell {r[1]}, "
+              f"{r[2]} particles, {r[3]} on level 1 (the farthest {r[4]:.2f} from the centre)")
+    return out, rows
+
+
+def part_starvation():
+    k = 2  # half the 2 x 2 particles a cell is seeded with
+    comp = STARVE.replace("starvation\n", "compression, starvation\nthreshold = 0.05\n")
+    runs = {"starvation": expansion_run("refine_starvation", STARVE),
+            "none": expansion_run("refine_starvation_none", ""),
+            "compression, starvation": expansion_run("refine_starvation_both", comp),
+            "compression": expansion_run("refine_starvation_comp", comp.replace(
+                ", starvation", "").replace("min_particles = 2.5\n", ""))}
+    fewest = {label: min(r[1] for r in rows) for label, (_, rows) in runs.items()}
+    check(fewest["none"] < k and fewest["compression"] < k,
+          f"unrefined and compression alone: the centre's cells fall to {fewest['none']} and "
+          f"{fewest['compression']} particles by t = 1.2 (want < {k}: the gas starves)")
+    for label in ("starvation", "compression, starvation"):
+        check(fewest[label] >= k, f"{label}: the centre's cells keep at least {fewest[label]} "
+              f"particles at every snapshot (want >= {k}: split before they empty)")
+    # The union of the flags: the compression ring's level-1 particles and the centre's.
+    last = {label: rows[-1] for label, (_, rows) in runs.items()}
+    both, alone = last["compression, starvation"][3], (last["compression"][3],
+                                                       last["starvation"][3])
+    check(both >= max(alone) and both > min(alone) > 0, f"compression, starvation: {both} "
+          f"particles on level 1 at t = 1.2, compression alone {alone[0]}, starvation alone "
+          f"{alone[1]} (want at least either: the union of their regions)")
+    # Starvation flags the thinned centre alone: beyond r = 0.6 the gas barely moves (|u| <
+    # 0.011) and keeps its 4 particles a cell, while the flags (dilated by 2 cells) reach r = 0.5.
+    far = max(r[4] for r in runs["starvation"][1])
+    check(0 < far < 0.6, f"starvation: the farthest level-1 particle over the run is {far:.2f} "
+          f"from the centre (want < 0.6: the centre is refined, not the resting gas around it)")
+    # A disc of gas at rest in empty space: its edge cells hold few particles but border empty
+    # cells, and empty cells are never flagged, so nothing is refined.
+    disc, _ = expansion_run("refine_starvation_disc", STARVE, "disc", "velocity = 0 0", 0.05)
+    l1 = int(diagnostics(disc)["particles_l1"].max())
+    check(l1 == 0, f"starvation, a disc of gas in empty space: {l1} particles on level 1 over "
+          f"the run (want 0: neither its edge nor the empty space is starved)")
+    # A restart between regrids of the combined run (t = 0.3 of 0.6) ends bit for bit as the
+    # run straight through: the flags come from the checkpoint's particles alone.
+    case = os.path.join(mt.outdir("refine_starvation_restart_case"), "case.ini")
+    with open(case, "w") as f:
+        f.write(EXPANSION.format(t_end=0.6, interval=0.3, geometry="all", velocity=EXPAND_V,
+                                 refine=comp))
+    ids, worst, _ = mt.restart_difference(case, [], 0.6, "refine_starvation_restart", "fluid")
+    check(ids and worst == 0.0, f"compression, starvation restarted at t = 0.3: the same "
+          f"particles, fields {worst:.1e} from the run straight through (bit for bit: 0)")
+    for label in ("starvation", "compression, starvation", "none"):
+        out = runs[label][0]
+        d = diagnostics(out)
+        scale = np.sqrt(2 * d["mass"][0] * d["kinetic"][0])  # >= sum m |v|: the start is at rest
+        dp = max(abs(d["px"]).max(), abs(d["py"]).max()) / scale  # on the whole
+        dm = abs(d["mass"] - d["mass"][0]).max() / d["mass"][0]
+        de = abs(d["total"] - d["total"][0]).max() / d["total"][0]
+        regrids = len(set(d["particles"].astype(int)))
+        if label == "none":
+            print(f"info unrefined: drifts of mass {dm:.1e}, momentum {dp:.1e}, energy {de:.1e}")
+            continue
+        # As for the pulse: mass and momentum to roundoff, energy to bs32's error (the run
+        # without refinement drifts as much, 2.3e-9).
+        check(dm <= 1e-12 and dp <= 1e-12 and de <= 1e-8 and regrids > 2,
+              f"{label}: drifts of mass {dm:.1e}, momentum {dp:.1e} (of sqrt(2 M K)), energy "
+              f"{de:.1e} (bounds 1e-12, 1e-12, 1e-8) over {regrids} particle counts")
+
+
 def part_restart():
     # A restart at t = 0.2 (step ~85, between regrids) of the run to 0.4.
     case = os.path.join(mt.outdir("refine_dynamic_restart_case"), "case.ini")
@@ -442,6 +541,34 @@ def part_input():
         ("criterion with a static box", case_text(2, 0.1, gas, box.replace(
             "levels = 2", "levels = 2\ncriterion = density\nthreshold = 0.01")),
          "refine.box.level", "level = 1", "static box"),
+        # Lists of criteria (compression, starvation; docs/refinement.md).
+        ("unknown criterion", dyn.replace("criterion = density", "criterion = density, shock"),
+         "refine.criterion", "criterion = density, shock", "'shock' is not a criterion"),
+        ("criterion listed twice", dyn.replace("criterion = density",
+                                               "criterion = density,density"),
+         "refine.criterion", "criterion = density,density", "density twice"),
+        ("none with another criterion", dyn.replace("criterion = density",
+                                                    "criterion = none, density"),
+         "refine.criterion", "criterion = none, density", "none alone"),
+        ("starvation without min_particles", dyn.replace("criterion = density",
+                                                         "criterion = density starvation"),
+         "refine.criterion", "criterion = density starvation", "refine.min_particles > 0"),
+        ("two criteria, one threshold", dyn.replace(
+            "criterion = density", "criterion = density, compression"), "refine.threshold",
+         "threshold = 0.004", "1 value for the 2 criteria"),
+        ("a threshold no criterion reads", dyn.replace(
+            "criterion = density", "criterion = starvation\nmin_particles = 2"),
+         "refine.threshold", "threshold = 0.004", "lists none of its readers"),
+        ("a threshold of 0", dyn.replace("criterion = density", "criterion = vorticity, "
+                                         "density").replace("0.004", "0.05 0"),
+         "refine.threshold", "threshold = 0.05 0", "is 0 for density"),
+        ("min_particles = 0", dyn.replace("criterion = density", "criterion = starvation\n"
+                                          "min_particles = 0").replace("threshold = 0.004\n",
+                                                                        ""),
+         "refine.min_particles", "min_particles = 0", "starvation needs a threshold"),
+        ("min_particles without starvation", dyn.replace("threshold = 0.004",
+                                                         "threshold = 0.004\nmin_particles = 2"),
+         "refine.min_particles", "min_particles = 2", "does not list starvation"),
     ]
     for name, text, key, start, words in cases_dyn:
         mt.expect_input_error(check, name, text, key, mt.line_starting(text, start), words)
@@ -777,6 +904,8 @@ elif PART == "compression":
     part_compression()
 elif PART == "vorticity":
     part_vorticity()
+elif PART == "starvation":
+    part_starvation()
 elif PART == "ranks":
     part_ranks()
 elif PART == "input":
