@@ -23,19 +23,28 @@ fine (dx = 0.5) grids gives what dispersion and the free end leave in L without 
 Parts (one ctest each):
 wave    The reflected fraction of the refined bar (the issue's bar: below 1 %) against its
         twins'; mass and momentum in diagnostics.csv; the total energy against the twins' (the
-        drift of all three is the same ~1.4e-3, lost while the pulse forms at the free end,
-        docs/refinement.md); the particle count never changes (solid particles do not split);
+        drift of all three is the same ~1.4e-3, lost while the pulse forms at the free end, so
+        the check is on the change while the pulse crosses the box); the particle count never changes (solid particles do not split);
         and, on every snapshot of the refined run (output.grid_fields = true), the grid's mass
         and momentum summed over the active nodes of both levels against the particles', with
         nothing on the inactive nodes (part a of the brief; the snapshot at t = 0 precedes every
         deposit and is skipped).
+stream  A block translating at 0.5 c across the box, particles crossing the interface both ways:
+        velocity, F and displacement stay exact to roundoff.
+prestress A block under a uniform initial pressure held by slip walls, a box inside it: the
+        particles' quadrature at the box's edges in the solid disturbs the rest state a little
+        and boundedly (a limitation, measured and guarded).
+usl     The same bar refined and coarse under time.method = usl (FLIP): the reflected fraction
+        below the issue's bar, mass and momentum.
 restart The refined bar to t = 40, restarted from its checkpoint at t = 20: bit for bit the run
         straight through.
 input   Every refusal of a solid on a hierarchy: exit 2, one line naming case.ini:LINE and the
         key.
-Able to fail: with the solid's deposit and gather kept on level 0 (solid/solid_refine.c's
-solid_deposit and solid_gather calling the plain kernel) the wave part fails its grid sums and
-its reflected fraction (measured while building it; see docs/refinement.md).
+Able to fail (both measured while building it): with the solid's deposit and gather kept on
+level 0 (solid/solid_refine.c calling the plain kernel) the wave part fails its grid sums (mass
+off by 10 %); with the restriction switched off (coupler/mpm_cycle.c) it fails every check but
+the particle count (reflected fraction 0.35, energy +400 %), and the stream part its
+translation (F - I 0.66).
 """
 import os
 import sys
@@ -121,9 +130,16 @@ def characteristics(p):
     return v + eps, v - eps
 
 
-def reflected_fraction(out):
+def reflected_fraction(out, split=None):
+    """sum L^2 / sum R^2 at the last snapshot; with split, also the parts of it from x < split
+    and x >= split."""
     L, R = characteristics(mt.particles(mt.snapshots(out)[-1][1]))
-    return float((L ** 2).sum() / (R ** 2).sum())
+    whole = float((L ** 2).sum() / (R ** 2).sum())
+    if split is None:
+        return whole
+    k = int((split - X0) * 2)
+    return whole, float((L[:k] ** 2).sum() / (R ** 2).sum()), float((L[k:] ** 2).sum() /
+                                                                    (R ** 2).sum())
 
 
 def grid_sums(path):
@@ -160,6 +176,11 @@ def part_wave():
     # exit reflects the part of the pulse the coarse grid cannot carry, the entry far less.
     check(frac["refined"] <= 1e-2, f"reflected energy fraction {frac['refined']:.2e} <= 1e-2 "
           f"(the issue's bar; coarse twin {frac['coarse']:.1e}, fine {frac['fine']:.1e})")
+    # Where it comes from: the entry's reflection is centred on x ~ 30 at t = 116, the exit's
+    # on x ~ 64 (2 x_interface - 3 - t); split halfway.
+    _, entry, leave = reflected_fraction(runs["refined"], 47.0)
+    print(f"info refined: reflected fraction from x < 47 (the entry at x = 74.5) {entry:.2e}, "
+          f"from x >= 47 (the exit at x = 91.5) {leave:.2e}")
     out = runs["refined"]
     d = diagnostics(out)
     dm = abs(d["mass"] - d["mass"][0]).max() / d["mass"][0]
@@ -167,15 +188,20 @@ def part_wave():
     # Mass: constant particle masses summed in another order; momentum: a free bar's internal
     # forces sum to zero node by node, so what is left is the sums' roundoff (measured 3e-15).
     check(dm <= 1e-12 and dp <= 1e-12, f"mass drift {dm:.1e}, momentum drift {dp:.1e} <= 1e-12")
-    # Energy: all three lose ~1.4e-3 while the pulse forms at the free end (t < 16, the same
-    # on both grids and at time.rtol = 1e-9: not the interface). The interface's own share is
-    # the refined run's difference from its coarse twin: measured 9e-5 of the total after the
-    # pulse has crossed (the twins differ by 8e-5 from each other). 5e-4 fails on an interface
-    # that loses or gains a third of the reflected fraction's worth of energy.
-    de = abs(d["total"][-1] - diagnostics(runs["coarse"])["total"][-1]) / d["total"][0]
-    check(de <= 5e-4, f"total energy at t = {T_WAVE:g} against the coarse twin: {de:.1e} <= 5e-4 "
-          f"(drifts refined {drift['refined']:.2e}, coarse {drift['coarse']:.2e}, fine "
-          f"{drift['fine']:.2e})")
+    # Energy: all three lose ~1.4e-3 while the pulse forms at the free end (t < 16; the same on
+    # both grids and at time.rtol = 1e-9: not the interface). What the crossing does is the
+    # change from t = 40 (the pulse formed, 30 cells before the box) to the end: measured
+    # +2.5e-5 of the initial energy refined, -6.5e-5 coarse and -3.4e-5 fine (bs32's slow loss).
+    # 1e-4 fails on an interface that gains or loses a quarter of the reflected energy.
+    window = {}
+    for label, o in runs.items():
+        dd = diagnostics(o)
+        k = np.searchsorted(dd["t"], 40.0)
+        window[label] = (dd["total"][-1] - dd["total"][k]) / dd["total"][0]
+    check(abs(window["refined"]) <= 1e-4, f"total energy change from t = 40 to {T_WAVE:g}: "
+          f"{window['refined']:.1e} <= 1e-4 in size (coarse twin {window['coarse']:.1e}, fine "
+          f"{window['fine']:.1e}; drifts from t = 0: refined {drift['refined']:.2e}, coarse "
+          f"{drift['coarse']:.2e}, fine {drift['fine']:.2e})")
     counts = set(d["particles"].astype(int))
     check(len(counts) == 1, f"solid particles never split or merge: counts {sorted(counts)}")
     worst = [0.0, 0.0, 0.0]
@@ -187,6 +213,126 @@ def part_wave():
           f"grid mass and momentum on the active nodes against the particles', {len(snaps)} "
           f"snapshots: mass {worst[0]:.1e}, momentum {worst[1]:.1e} (<= 1e-12), inactive nodes "
           f"{worst[2]:.1e} (want 0)")
+
+
+def part_stream():
+    """A block 25 x 2 translating at 0.5 c across the box: level-0 particles enter the level-1
+    region and level-1 particles leave it, each keeping its mass and volume. The composite
+    basis is a partition of unity whose gradients sum to zero, so the stress-free translation
+    stays exact: every velocity, F and displacement at roundoff."""
+    u0, t_end = 0.5, 40.0
+    text = bar(t_end, BOX).replace(f"lo = {X0} 6\nhi = {LENGTH + X0} 8", "lo = 60 6\nhi = 85 8")
+    text = text.replace(f"velocity_field = {AMP}*exp(-((x-{X0})/{WIDTH})^2); 0",
+                        f"velocity = {u0} 0")
+    out = run("refine_solid_stream", text)
+    snaps = mt.snapshots(out)
+    p0, p = (mt.particles(snaps[k][1]) for k in (0, -1))
+    lv0, lv = p0["level"].ravel(), p["level"].ravel()
+    dv = np.abs(p["v"] - [u0, 0]).max() / u0
+    dF = np.abs(p["F"] - [1, 0, 0, 1]).max()
+    dx = np.abs(p["x"] - p0["x"] - [u0 * p["time"], 0]).max()
+    print(f"info {mt.cost(out)}; particles that changed level: {int((lv0 != lv).sum())} of "
+          f"{len(lv)} ({int(((lv0 == 1) & (lv == 0)).sum())} left level 1)")
+    # Roundoff: measured 5e-17 in v, 9e-17 in F and 1.1e-12 in x (positions ~100 summed over
+    # 300 steps). Without the restriction (coupler/mpm_cycle.c) F - I reaches 0.66.
+    check(((lv0 == 0) & (lv == 1)).any() and ((lv0 == 1) & (lv == 0)).any(),
+          "particles crossed the interface both ways")
+    check(dv <= 1e-12 and dF <= 1e-12 and dx <= 1e-10,
+          f"uniform translation across the levels: velocity {dv:.1e} (relative), F - I {dF:.1e}"
+          f" (<= 1e-12), displacement {dx:.1e} (<= 1e-10)")
+
+
+PRESTRESS = """[run]
+name = refine_solid_prestress
+
+[domain]
+dim = 2
+lo = 0 0
+hi = 20 12
+
+[grid]
+dx = 1
+
+[boundary]
+x_lo = slip
+x_hi = slip
+y_lo = slip
+y_hi = slip
+
+[time]
+t_end = 200
+
+[output]
+interval = 10
+
+[geometry.all]
+type = box
+lo = 0 0
+hi = 20 12
+
+[solid.block]
+geometry = all
+material = linear_elastic
+density = 1
+E = 1
+nu = 0.3
+initial_pressure = 1e-3
+{refine}"""
+
+
+def part_prestress():
+    """A block filling a box of slip walls under a uniform initial pressure (1e-3 E, held by the
+    walls: at rest, in equilibrium), with a level-1 box whose edges and corners lie inside the
+    solid. The particles' one-point quadrature of the composite basis is not exact where the
+    box's edges meet in the solid (as for the gas's particle pressure, docs/refinement.md):
+    the block does not stay at rest to roundoff, as its unrefined twin does, but the
+    disturbance stays small and bounded (elastic waves, no growth)."""
+    box = "[refine]\nlevels = 2\n\n[refine.box]\nlevel = 1\nlo = 7 4\nhi = 13 8\n"
+    peak = {}
+    for label, refine in (("refined", box), ("unrefined", "")):
+        out = run(f"refine_solid_prestress_{label}", PRESTRESS.format(refine=refine))
+        v, dF = [], []
+        for _, path in mt.snapshots(out):
+            p = mt.particles(path)
+            v.append(np.abs(p["v"]).max())
+            dF.append(np.abs(p["F"] - p["F"][0]).max())
+        peak[label] = (max(v), max(dF), max(v[:len(v) // 2]), max(v[len(v) // 2:]))
+        d = diagnostics(out)
+        de = abs(d["total"] - d["total"][0]).max() / d["total"][0]
+        print(f"info {label}: {mt.cost(out)}; largest |v| {peak[label][0]:.2e} (t <= 100: "
+              f"{peak[label][2]:.2e}, after: {peak[label][3]:.2e}), |F - F0| {peak[label][1]:.2e},"
+              f" total energy drift {de:.1e}")
+    # Measured (ppc 2): |v| 7.1e-6 (0.6 % of c eps0, c = 1.16, eps0 ~ 1e-3), |F - F0| 1.6e-5
+    # (1.6 % of the prestrain), the same before and after t = 100; 4x less with ppc = 4 (the
+    # midpoint rule's h^2). The bounds, 3x the measured, fail on a growing disturbance (the
+    # gas's particle pressure grew six-fold per unit time) or a worse quadrature.
+    r = peak["refined"]
+    check(r[0] <= 2e-5 and r[1] <= 5e-5 and r[3] <= 2 * r[2],
+          f"prestressed block at rest across the box: |v| {r[0]:.1e} <= 2e-5, |F - F0| "
+          f"{r[1]:.1e} <= 5e-5 over t = 200, not growing (second half {r[3]:.1e} against the "
+          f"first {r[2]:.1e}); unrefined |v| {peak['unrefined'][0]:.1e}")
+
+
+def part_usl():
+    """The same bar under the classic update (time.method = usl, FLIP): the reflected fraction
+    against the coarse twin's, and mass and momentum."""
+    usl = "[time]\nt_end = {0}\nmethod = usl".format(T_WAVE)
+    runs = {"refined": run("refine_solid_usl", bar(T_WAVE, BOX).replace(
+                f"[time]\nt_end = {T_WAVE}", usl)),
+            "coarse": run("refine_solid_usl_coarse", bar(T_WAVE, "").replace(
+                f"[time]\nt_end = {T_WAVE}", usl))}
+    frac = {label: reflected_fraction(out) for label, out in runs.items()}
+    for label, out in runs.items():
+        print(f"info {label}: {mt.cost(out)}; reflected energy fraction {frac[label]:.3e}")
+    # Measured 5.8e-5 against the coarse twin's 1.5e-4 (the refined run takes the fine level's
+    # step, which the classic update's error follows); the issue's bar.
+    check(frac["refined"] <= 1e-2, f"usl: reflected energy fraction {frac['refined']:.2e} <= "
+          f"1e-2 (coarse twin {frac['coarse']:.1e})")
+    d = diagnostics(runs["refined"])
+    dm = abs(d["mass"] - d["mass"][0]).max() / d["mass"][0]
+    dp = abs(d["px"] - d["px"][0]).max() / abs(d["px"][0])
+    check(dm <= 1e-12 and dp <= 1e-12, f"usl: mass drift {dm:.1e}, momentum drift {dp:.1e} "
+          f"<= 1e-12")
 
 
 def part_restart():
@@ -237,6 +383,12 @@ def part_input():
 
 if PART == "wave":
     part_wave()
+elif PART == "stream":
+    part_stream()
+elif PART == "prestress":
+    part_prestress()
+elif PART == "usl":
+    part_usl()
 elif PART == "restart":
     part_restart()
 elif PART == "input":
