@@ -9,7 +9,9 @@
  * keep F = I, C = 0 and their seeded velocity, and its region moves rigidly with that velocity: at
  * time t it is the seeded region translated by v t (wrapped through periodic faces). A body with an
  * initial stress is seeded at its state of solid_prestress.h: F = F0 (and sigma = sigma0 for a
- * rate-form model), V0 = seeded volume / det F0. */
+ * rate-form model), V0 = seeded volume / det F0. On a refinement hierarchy (m->hier) the P2G and
+ * G2P go through it and the finer levels are seeded by solid_refine.c; without one they are the
+ * plain kernel calls. */
 #include "solid_internal.h"
 #include "solid_module.h"
 #include "solid_tensor.h"

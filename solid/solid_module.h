@@ -29,7 +29,5 @@ struct mpm_hier;
  * and, with seed = 1, drops the level-0 particles inside the finer regions and seeds each
  * level's region at its own spacing. */
 int solid_module_refine(mpm_module *m, const mpm_config *cfg, struct mpm_hier *h, int seed);
-/* The refusals alone (no hierarchy is touched). */
-int solid_refine_check(const mpm_module *m, const mpm_config *cfg);
 
 #endif

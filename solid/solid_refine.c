@@ -15,7 +15,7 @@
  * split or merge: one that moves into another level's region later keeps its mass and volume
  * and deposits on, and reads from, the level of its position.
  *
- * Refused (solid_refine_check), each naming its key: a body with a bulk viscosity (its length
+ * Refused (refine_check), each naming its key: a body with a bulk viscosity (its length
  * scale and lagged rate are level 0's), a rigid body and a clamp (they hold level-0 nodes), an
  * odd ppc (a level-0 particle would sit on a face of the refined region), time.method = musl
  * (the remap deposits on level 0), and a traction whose region reaches a refined region (the
@@ -85,7 +85,7 @@ static int check_body(const mpm_config *cfg, const solid_body *body) {
   return 0;
 }
 
-int solid_refine_check(const mpm_module *m, const mpm_config *cfg) {
+static int refine_check(const mpm_module *m, const mpm_config *cfg) {
   const solid_content *sc = m->content;
   if (sc->tr.musl) return refuse(cfg, "time.method", "MUSL's remap deposits on level 0's nodes");
   for (int b = 0; b < sc->nbodies; ++b) MPM_CALL(check_body(cfg, &sc->body[b]));
@@ -149,7 +149,7 @@ static int seed_level(mpm_module *m, const mpm_config *cfg, int b, int l) {
 }
 
 int solid_module_refine(mpm_module *m, const mpm_config *cfg, mpm_hier *h, int seed) {
-  MPM_CALL(solid_refine_check(m, cfg));
+  MPM_CALL(refine_check(m, cfg));
   m->hier = h;
   if (!seed || !h) return 0;
   mpm_particles *p = m->particles;
