@@ -13,7 +13,7 @@
  * (mpm_grid_phase_update); each module completes its forces before it and constrains its
  * nodes after it, and the coupling scheme acts between.
  *
- * A module on a refinement hierarchy (mpm_module.h, hier; the gas alone, one rank) has its
+ * A module on a refinement hierarchy (mpm_module.h, hier; a gas or a solid alone, one rank) has its
  * phase zeroed on every level, deposits composite (mpm_hier_p2g), and the coupler restricts
  * the deposits onto the active nodes before the reverse halo (again after p2g_rate, which
  * deposits more), solves on every level (mpm_hier_phase_update) and prolongs v and a after the

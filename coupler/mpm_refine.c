@@ -1,14 +1,15 @@
 /* The [refine] section and the build of the static hierarchy (see mpm_refine.h).
  *
  * What the slice refuses here, one line each naming the key: boxes without refine.levels > 1,
- * a solid module, more than one rank, a shape other than the quadratic B-spline, and a box
- * within three level-0 cells of a non-periodic domain face (walls and open faces act on level
- * 0 alone). mpm_hier_new's own reasons name the box's key. The gas refuses its own settings
- * (fluid/fluid_refine.c). */
+ * a solid beside a gas, a solid with dynamic regrids, more than one rank, a shape other than the
+ * quadratic B-spline, and a box within three level-0 cells of a non-periodic domain face (walls and
+ * open faces act on level 0 alone). mpm_hier_new's own reasons name the box's key. The gas and the
+ * solid refuse their own settings (fluid/fluid_refine.c, solid/solid_refine.c). */
 #include "mpm_refine.h"
 
 #include "fluid_module.h"
 #include "mpm_error.h"
+#include "solid_module.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -21,7 +22,8 @@
 const mpm_key_spec mpm_refine_keys[] = {
     {"refine.levels", MPM_KEY_INT, "1", 1, MPM_HIER_MAX_LEVELS, 0, 0, NULL,
      "levels of the static refinement hierarchy, each halving the spacing of the one below (1: "
-     "off); gas-only cases on one rank with the quadratic shape, see docs/refinement.md",
+     "off); gas-only or solid-only cases on one rank with the quadratic shape, see "
+     "docs/refinement.md",
      0, "-"},
     {"refine.buffer", MPM_KEY_INT, "2", 1, 64, 0, 0, NULL,
      "level-l cells kept between the region of level l + 1 and the edge of level l's region", 0,
@@ -65,14 +67,20 @@ const mpm_key_spec mpm_refine_keys[] = {
 };
 const int mpm_refine_nkeys = (int)(sizeof mpm_refine_keys / sizeof mpm_refine_keys[0]);
 
-/* The case-wide refusals: a solid, several ranks, another shape. */
-static int check_case(const mpm_config *cfg, const mpm_grid *grid, mpm_module **mod, int nmod) {
+/* The solid module of the case, or NULL. */
+static const mpm_module *solid_of(mpm_module **mod, int nmod) {
   for (int k = 0; k < nmod; ++k)
-    if (mod[k]->role != MPM_ROLE_FLUID)
-      return mpm_config_fail(cfg, "refine.levels",
-                             "refinement carries the gas alone in this slice, and the case has "
-                             "a %s module; remove the [solid.NAME] sections or set levels = 1",
-                             mod[k]->name);
+    if (mod[k]->role == MPM_ROLE_SOLID) return mod[k];
+  return NULL;
+}
+
+/* The case-wide refusals: a solid beside a gas, several ranks, another shape. */
+static int check_case(const mpm_config *cfg, const mpm_grid *grid, mpm_module **mod, int nmod) {
+  if (solid_of(mod, nmod) && nmod > 1)
+    return mpm_config_fail(cfg, "refine.levels",
+                           "refinement carries a gas alone or a solid alone in this slice, and "
+                           "the case has both; remove the [solid.NAME] or the [gas.NAME] "
+                           "sections, or set levels = 1");
   if (grid->size > 1)
     return mpm_config_fail(cfg, "refine.levels",
                            "refinement runs on one rank in this slice, and the run has %d; run "
@@ -412,6 +420,10 @@ int mpm_refine_build(mpm_hier **h, const mpm_config *cfg, mpm_grid *grid, mpm_mo
   dynamic dy;
   int on;
   MPM_CALL(read_dynamic(cfg, &dy, &on));
+  if (on && solid_of(mod, nmod))
+    return mpm_config_fail(cfg, "refine.criterion",
+                           "regrids follow the gas, and a solid runs on static boxes only in "
+                           "this slice; set refine.criterion = none and give [refine.NAME] boxes");
   if (on && nbox > 0) {
     char key[160];
     snprintf(key, sizeof key, "refine.%s.level", names[0]);
@@ -432,6 +444,8 @@ int mpm_refine_build(mpm_hier **h, const mpm_config *cfg, mpm_grid *grid, mpm_mo
   free(box);
   if (rc == MPM_ERR_INPUT && why[0]) return fail_why(cfg, names, nbox, why);
   MPM_CALL(rc);
-  for (int k = 0; k < nmod; ++k) MPM_CALL(fluid_module_refine(mod[k], cfg, *h, seed));
+  for (int k = 0; k < nmod; ++k)
+    MPM_CALL(mod[k]->role == MPM_ROLE_SOLID ? solid_module_refine(mod[k], cfg, *h, seed)
+                                            : fluid_module_refine(mod[k], cfg, *h, seed));
   return 0;
 }

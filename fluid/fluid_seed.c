@@ -20,6 +20,7 @@
 #include "mpm_expr.h"
 #include "mpm_geometry.h"
 #include "mpm_hier.h"
+#include "mpm_hier_seed.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -267,56 +268,6 @@ int fluid_seed(mpm_module *m, const mpm_config *cfg) {
 
 /* ---- the finer levels of a refinement hierarchy ---------------------------------------------- */
 
-/* The lattice of level l inside section k's region: ppc points per axis in every level-l span
- * of the level's box, at o_l + (i - 1/2 + (q + 1/2) / ppc) h_l, kept where the point lies in
- * the domain, in the region and on level l (mpm_hier_level_of). Into *x (component-major) and
- * *n; the points generated (kept or not) into *span, for the ids. */
-static int level_points(const mpm_module *m, const gas_state *s, int l, double **xp, mpm_lidx *np,
-                        mpm_gidx *span) {
-  const fluid_content *fc = m->content;
-  const mpm_hier *h = m->hier;
-  const mpm_grid *lg = h->level[l].grid, *g = m->grid;
-  const int dim = g->dim, ppc = fc->ppc;
-  int per[MPM_MAX_DIM] = {1, 1, 1};
-  mpm_lidx cap = 1;
-  for (int d = 0; d < dim; ++d) per[d] = lg->box_n[d] * ppc, cap *= per[d];
-  double *x;
-  MPM_ALLOC(x, (size_t)dim * cap);
-  mpm_lidx n = 0;
-  for (mpm_lidx q = 0; q < cap; ++q) {
-    double xq[3] = {0, 0, 0};
-    int in = 1;
-    mpm_lidx rest = q;
-    for (int d = 0; d < dim; ++d) {
-      const int r = (int)(rest % per[d]), j = lg->box_lo[d] + r / ppc, k = r % ppc;
-      rest /= per[d];
-      xq[d] = lg->lo[d] + (j - 0.5 + (k + 0.5) / ppc) * lg->dx;
-      in &= xq[d] > g->lo[d] && xq[d] < g->hi[d];
-    }
-    if (!in || !mpm_region_contains(s->region, xq) || mpm_hier_level_of(h, xq) != l) continue;
-    for (int d = 0; d < dim; ++d) x[(size_t)d * cap + n] = xq[d];
-    ++n;
-  }
-  for (int d = 1; d < dim; ++d) memmove(x + (size_t)d * n, x + (size_t)d * cap, sizeof *x * n);
-  *xp = x, *np = n, *span = cap;
-  return 0;
-}
-
-/* Drop the level-0 particles inside the finer regions. */
-static int drop_refined(mpm_module *m) {
-  mpm_particles *p = m->particles;
-  unsigned char *keep;
-  MPM_ALLOC(keep, p->n);
-  for (mpm_lidx i = 0; i < p->n; ++i) {
-    double xq[3] = {0, 0, 0};
-    for (int d = 0; d < p->dim; ++d) xq[d] = mpm_particles_comp(p, FLUID_X, d)[i];
-    keep[i] = mpm_hier_level_of(m->hier, xq) == 0;
-  }
-  const int rc = mpm_particles_edit(p, keep, 0, NULL, NULL);
-  free(keep);
-  return rc;
-}
-
 /* Seed section k on level l. */
 static int seed_level(mpm_module *m, const mpm_config *cfg, gas_state *s, int k, int l) {
   const fluid_content *fc = m->content;
@@ -325,7 +276,7 @@ static int seed_level(mpm_module *m, const mpm_config *cfg, gas_state *s, int k,
   double *x = NULL;
   mpm_lidx n = 0;
   mpm_gidx span = 0, total = 0, *id = NULL;
-  MPM_CALL(level_points(m, &s[k], l, &x, &n, &span));
+  MPM_CALL(mpm_hier_lattice(m->hier, l, fc->ppc, s[k].region, &x, &n, &span));
   int rc = 0;
   if (!(id = malloc(sizeof *id * (size_t)(n ? n : 1)))) rc = MPM_ERR_MEMORY;
   for (mpm_lidx i = 0; !rc && i < n; ++i) id[i] = p->id_next + i;
@@ -342,7 +293,7 @@ int fluid_seed_refined(mpm_module *m, const mpm_config *cfg) {
   char(*sections)[96] = NULL;
   int count = 0;
   int rc = states_read(m, cfg, &s, &sections, &count);
-  if (!rc) rc = drop_refined(m);
+  if (!rc) rc = mpm_hier_drop_refined(m->hier, m->particles, FLUID_X);
   for (int l = 1; !rc && l < m->hier->nlevels; ++l)
     for (int k = 0; !rc && k < count; ++k) rc = seed_level(m, cfg, s, k, l);
   states_free(s, sections, count);

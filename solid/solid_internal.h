@@ -6,7 +6,9 @@
 
 #include "mpm_bc.h"
 #include "mpm_config.h"
+#include "mpm_expr.h"
 #include "mpm_geometry.h"
+#include "mpm_kernels.h"
 #include "mpm_module.h"
 #include "mpm_transfer.h"
 #include "solid_bulk_viscosity.h"
@@ -82,6 +84,31 @@ static inline void solid_key(char *key, size_t size, const char *section, const 
 
 /* A body's `velocity` key: dim values (solid_module.c). */
 int solid_body_velocity(const mpm_config *cfg, const char *section, int dim, double v[3]);
+
+/* What seeding body b reads from its section (solid_seed_open); free with solid_seed_close. */
+typedef struct solid_seed {
+  int b, ppc;
+  const char *geom;   /* its [geometry.NAME] */
+  mpm_region *region; /* that region */
+  mpm_expr *vfield;   /* velocity_field, or NULL: the constant v0 */
+  double v0[3];
+  char vkey[160]; /* the velocity_field key */
+} solid_seed;
+int solid_seed_open(mpm_module *m, const mpm_config *cfg, int b, solid_seed *s);
+void solid_seed_close(solid_seed *s);
+/* Append n particles of body s->b at x (component-major, stride n) with ids id, on a lattice
+ * of spacing `spacing` (volume spacing^dim): the body's initial state, clamps and tractions. */
+int solid_seed_append(mpm_module *m, const mpm_config *cfg, const solid_seed *s, mpm_lidx n,
+                      const double *x, const mpm_gidx *id, double spacing);
+
+/* ---- solid_refine.c: the solid on a refinement hierarchy (m->hier; docs/refinement.md) ---- */
+
+/* P2G of the solid's phase: through the hierarchy when m->hier is set, else the plain kernel. */
+int solid_deposit(mpm_module *m, const mpm_p2g_args *a);
+/* G2P of the solid's phase (a's v_i, a_i: level 0's arrays), likewise. */
+int solid_gather(mpm_module *m, const mpm_g2p_args *a);
+/* The spacing of the finest level (the grid's without a hierarchy). */
+double solid_finest_dx(const mpm_module *m);
 
 /* ---- solid_constraints.c ------------------------------------------------------------------ */
 

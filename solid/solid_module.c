@@ -9,7 +9,9 @@
  * keep F = I, C = 0 and their seeded velocity, and its region moves rigidly with that velocity: at
  * time t it is the seeded region translated by v t (wrapped through periodic faces). A body with an
  * initial stress is seeded at its state of solid_prestress.h: F = F0 (and sigma = sigma0 for a
- * rate-form model), V0 = seeded volume / det F0. */
+ * rate-form model), V0 = seeded volume / det F0. On a refinement hierarchy (m->hier) the P2G and
+ * G2P go through it and the finer levels are seeded by solid_refine.c; without one they are the
+ * plain kernel calls. */
 #include "solid_internal.h"
 #include "solid_module.h"
 #include "solid_tensor.h"
@@ -18,6 +20,7 @@
 #include "mpm_error.h"
 #include "mpm_expr.h"
 #include "mpm_geometry.h"
+#include "mpm_hier.h"
 #include "mpm_kernels.h"
 #include "mpm_timer.h"
 #include "mpm_transfer.h"
@@ -158,60 +161,43 @@ int solid_body_velocity(const mpm_config *cfg, const char *section, int dim, dou
   return 0;
 }
 
-/* Seed one body and append it to the particle set. */
-static int seed_body(mpm_module *m, const mpm_config *cfg, int b, double *lp) {
+int solid_seed_open(mpm_module *m, const mpm_config *cfg, int b, solid_seed *s) {
+  const solid_content *sc = m->content;
+  const int dim = m->grid->dim;
+  char key[160];
+  memset(s, 0, sizeof *s);
+  s->b = b;
+  solid_key(key, sizeof key, sc->body[b].section, "geometry");
+  MPM_CALL(mpm_config_get_string(cfg, key, &s->geom));
+  solid_key(key, sizeof key, sc->body[b].section, "ppc");
+  MPM_CALL(mpm_config_get_int(cfg, key, &s->ppc));
+  MPM_CALL(solid_body_velocity(cfg, sc->body[b].section, dim, s->v0));
+  solid_key(key, sizeof key, sc->body[b].section, "velocity");
+  solid_key(s->vkey, sizeof s->vkey, sc->body[b].section, "velocity_field");
+  if (mpm_config_has(cfg, s->vkey)) {
+    if (mpm_config_has(cfg, key))
+      return mpm_config_fail(cfg, s->vkey, "give either velocity or velocity_field, not both");
+    MPM_CALL(mpm_expr_from_config(&s->vfield, cfg, s->vkey, dim));
+  }
+  return mpm_region_from_config(&s->region, cfg, dim, s->geom);
+}
+
+void solid_seed_close(solid_seed *s) {
+  mpm_expr_destroy(&s->vfield);
+  mpm_region_destroy(&s->region);
+}
+
+int solid_seed_append(mpm_module *m, const mpm_config *cfg, const solid_seed *s, mpm_lidx n,
+                      const double *x, const mpm_gidx *id, double spacing) {
   solid_content *sc = m->content;
   mpm_particles *p = m->particles;
-  const mpm_grid *g = m->grid;
-  const int dim = g->dim;
-  char key[160];
-  const char *geom;
-  int ppc;
-  double v0[3] = {0, 0, 0};
-  solid_key(key, sizeof key, sc->body[b].section, "geometry");
-  MPM_CALL(mpm_config_get_string(cfg, key, &geom));
-  solid_key(key, sizeof key, sc->body[b].section, "ppc");
-  MPM_CALL(mpm_config_get_int(cfg, key, &ppc));
-  MPM_CALL(solid_body_velocity(cfg, sc->body[b].section, dim, v0));
-  solid_key(key, sizeof key, sc->body[b].section, "velocity");
-  mpm_expr *vfield = NULL;
-  char vkey[160];
-  solid_key(vkey, sizeof vkey, sc->body[b].section, "velocity_field");
-  if (mpm_config_has(cfg, vkey)) {
-    if (mpm_config_has(cfg, key))
-      return mpm_config_fail(cfg, vkey, "give either velocity or velocity_field, not both");
-    MPM_CALL(mpm_expr_from_config(&vfield, cfg, vkey, dim));
-  }
-  *lp = fmin(*lp, 0.5 / ppc);
-
-  mpm_region *region = NULL;
-  MPM_CALL(mpm_region_from_config(&region, cfg, dim, geom));
-  double rlo[3], rhi[3];
-  mpm_region_bounds(region, rlo, rhi);
-  for (int d = 0; d < dim; ++d)
-    if (rlo[d] < g->lo[d] || rhi[d] > g->hi[d]) {
-      mpm_region_destroy(&region);
-      solid_key(key, sizeof key, sc->body[b].section, "geometry");
-      return mpm_config_fail(cfg, key,
-                             "region '%s' spans [%g, %g] along axis %d, outside the domain "
-                             "[%g, %g]; move the region or enlarge [domain]",
-                             geom, rlo[d], rhi[d], d, g->lo[d], g->hi[d]);
-    }
-  mpm_lidx n;
-  double *x;
-  mpm_gidx *id;
-  /* Each body takes a fresh block of ids as wide as its seeding lattice. */
-  const mpm_gidx id_base = p->id_next;
-  int rc = mpm_region_seed(region, g, ppc, id_base, &n, &x, &id);
+  const int dim = m->grid->dim, b = s->b;
   /* A velocity_field must be finite at every particle (1/0, sqrt(-1) and log(0) are not). */
-  if (!rc && vfield && (rc = mpm_expr_check_finite(vfield, cfg, vkey, g->comm, dim, n, x, NULL)))
-    free(x), free(id);
-  if (rc) mpm_expr_destroy(&vfield), mpm_region_destroy(&region);
-  MPM_CALL(rc);
-
+  if (s->vfield)
+    MPM_CALL(mpm_expr_check_finite(s->vfield, cfg, s->vkey, m->grid->comm, dim, n, x, NULL));
   double *data;
   MPM_ALLOC(data, (size_t)p->ncomp * (size_t)(n ? n : 1));
-  const double vol = pow(g->dx / ppc, dim);
+  const double vol = pow(spacing, dim);
   const solid_prestress *pre = &sc->body[b].pre;
   for (mpm_lidx i = 0; i < n; ++i) {
     double xp[3] = {0, 0, 0};
@@ -220,9 +206,9 @@ static int seed_body(mpm_module *m, const mpm_config *cfg, int b, double *lp) {
     const int fixed = sc->lay.f_fixed >= 0 && solid_in_clamp(sc, xp);
     for (int d = 0; d < dim; ++d) {
       data[(size_t)(p->offset[F_X] + d) * n + i] = xp[d];
-      data[(size_t)(p->offset[F_V] + d) * n + i] = fixed    ? 0.0
-                                                   : vfield ? mpm_expr_eval(vfield, d, xp)
-                                                            : v0[d];
+      data[(size_t)(p->offset[F_V] + d) * n + i] = fixed       ? 0.0
+                                                   : s->vfield ? mpm_expr_eval(s->vfield, d, xp)
+                                                               : s->v0[d];
     }
     for (int rc = 0; rc < dim * dim; ++rc) {
       data[(size_t)(p->offset[F_F] + rc) * n + i] = pre->F0[rc];
@@ -237,20 +223,54 @@ static int seed_body(mpm_module *m, const mpm_config *cfg, int b, double *lp) {
     if (sc->lay.f_fixed >= 0) data[(size_t)p->offset[sc->lay.f_fixed] * n + i] = fixed;
     if (sc->lay.f_fext >= 0 && !sc->body[b].mat->ops->rigid) {
       double f[3] = {0, 0, 0};
-      solid_traction_force(sc, region, dim, g->dx / ppc, xp, id[i], f);
+      solid_traction_force(sc, s->region, dim, spacing, xp, id[i], f);
       for (int d = 0; d < dim; ++d) data[(size_t)(p->offset[sc->lay.f_fext] + d) * n + i] = f[d];
     }
   }
-  mpm_region_destroy(&region);
   init_history(sc, b, dim, n, data + (size_t)p->offset[F_F] * n,
                sc->lay.f_hist >= 0 ? data + (size_t)p->offset[sc->lay.f_hist] * n : NULL);
-  mpm_expr_destroy(&vfield);
-  rc = mpm_particles_edit(p, NULL, n, id, data);
+  const int rc = mpm_particles_edit(p, NULL, n, id, data);
   free(data);
-  free(x);
-  free(id);
+  return rc;
+}
+
+/* Seed one body and append it to the particle set. */
+static int seed_body(mpm_module *m, const mpm_config *cfg, int b, double *lp) {
+  solid_content *sc = m->content;
+  mpm_particles *p = m->particles;
+  const mpm_grid *g = m->grid;
+  const int dim = g->dim;
+  char key[160];
+  solid_seed s;
+  int rc = solid_seed_open(m, cfg, b, &s);
+  if (rc) solid_seed_close(&s);
   MPM_CALL(rc);
-  p->id_next = id_base + mpm_region_seed_span(g, ppc);
+  *lp = fmin(*lp, 0.5 / s.ppc);
+
+  double rlo[3], rhi[3];
+  mpm_region_bounds(s.region, rlo, rhi);
+  for (int d = 0; d < dim; ++d)
+    if (rlo[d] < g->lo[d] || rhi[d] > g->hi[d]) {
+      solid_seed_close(&s);
+      solid_key(key, sizeof key, sc->body[b].section, "geometry");
+      return mpm_config_fail(cfg, key,
+                             "region '%s' spans [%g, %g] along axis %d, outside the domain "
+                             "[%g, %g]; move the region or enlarge [domain]",
+                             s.geom, rlo[d], rhi[d], d, g->lo[d], g->hi[d]);
+    }
+  mpm_lidx n;
+  double *x;
+  mpm_gidx *id;
+  /* Each body takes a fresh block of ids as wide as its seeding lattice. */
+  const mpm_gidx id_base = p->id_next;
+  rc = mpm_region_seed(s.region, g, s.ppc, id_base, &n, &x, &id);
+  if (!rc) {
+    rc = solid_seed_append(m, cfg, &s, n, x, id, g->dx / s.ppc);
+    free(x), free(id);
+  }
+  solid_seed_close(&s);
+  MPM_CALL(rc);
+  p->id_next = id_base + mpm_region_seed_span(g, s.ppc);
   mpm_gidx local = n, total;
   MPM_CALL_MPI(MPI_Allreduce(&local, &total, 1, MPM_MPI_GIDX, MPI_SUM, g->comm));
   if (total == 0) {
@@ -258,7 +278,7 @@ static int seed_body(mpm_module *m, const mpm_config *cfg, int b, double *lp) {
     return mpm_config_fail(cfg, key,
                            "body '%s' has no particles: region '%s' is thinner than "
                            "the particle spacing %g; refine grid.dx or raise ppc",
-                           sc->body[b].section, geom, g->dx / ppc);
+                           sc->body[b].section, s.geom, g->dx / s.ppc);
   }
   mpm_log(MPM_LOG_INFO, "solid body %s: %lld particles, material %s", sc->body[b].section,
           (long long)total, sc->body[b].mat->ops->name);
@@ -334,9 +354,9 @@ static int solid_p2g(mpm_module *m, double t, const double *y) {
     a.gravity[d] = sc->gravity[d];
     a.fext[d] = sc->lay.f_fext >= 0 ? mpm_particles_comp(p, sc->lay.f_fext, d) : NULL;
   }
-  mpm_kernels_get(dim)->p2g(m->grid, m->phase, &a);
+  const int rc = solid_deposit(m, &a);
   mpm_timer_stop(MPM_T_P2G);
-  return 0;
+  return rc;
 }
 
 /* Mass-proportional damping, a force -alpha m v on every node: each mode's amplitude decays
@@ -347,13 +367,22 @@ static void damp(mpm_grid *grid, int phase, double alpha) {
     for (mpm_lidx l = 0; l < grid->nnodes; ++l) ph->f_i[d][l] -= alpha * ph->mv_i[d][l];
 }
 
+/* The damping on every level of a hierarchy (restricted: the inactive nodes hold nothing). */
+static void damp_all(const mpm_module *m, double alpha) {
+  if (!m->hier) {
+    damp(m->grid, m->phase, alpha);
+    return;
+  }
+  for (int l = 0; l < m->hier->nlevels; ++l) damp(m->hier->level[l].grid, m->phase, alpha);
+}
+
 /* Before the nodal solve: mirrored pad nodes folded into the walls, and damping (first pass
  * only: after MUSL's remap no force acts). */
 static int solid_forces(mpm_module *m, double t, double h, mpm_pass pass) {
   (void)t, (void)h;
   solid_content *sc = m->content;
   mpm_constraints_fold(&sc->cons, m->grid, m->phase);
-  if (sc->damping > 0 && pass == MPM_PASS_FIRST) damp(m->grid, m->phase, sc->damping);
+  if (sc->damping > 0 && pass == MPM_PASS_FIRST) damp_all(m, sc->damping);
   return 0;
 }
 
@@ -372,8 +401,8 @@ static void solid_stress_rates(mpm_module *m, const double *y, double *ydot, con
 
 /* G2P: v_out = sum S v_i, a_out = sum S a_i, and optionally L, the APIC C and dF/dt = L F
  * (NULL: not wanted). */
-static void g2p_velocity(mpm_module *m, const double *y, double *const *v_out, double *const *a_out,
-                         double *L_out, double *C_out, double *Fdot) {
+static int g2p_velocity(mpm_module *m, const double *y, double *const *v_out, double *const *a_out,
+                        double *L_out, double *C_out, double *Fdot) {
   const solid_content *sc = m->content;
   const mpm_particles *p = m->particles;
   const mpm_grid_phase *ph = &m->grid->phase[m->phase];
@@ -390,7 +419,7 @@ static void g2p_velocity(mpm_module *m, const double *y, double *const *v_out, d
     a.v_out[d] = v_out[d];
     a.a_out[d] = a_out[d];
   }
-  mpm_kernels_get(p->dim)->g2p(m->grid, &a);
+  return solid_gather(m, &a);
 }
 
 /* MUSL's second transfer (Sulsky, Zhou and Schreyer 1995): the particles take their new
@@ -408,7 +437,7 @@ static int solid_remap(mpm_module *m, double t, const double *y, double h) {
   for (int d = 0; d < dim; ++d)
     vg[d] = sc->scratch + (size_t)d * n, ag[d] = sc->scratch + (size_t)(dim + d) * n;
   double *C = sc->tr.apic ? sc->scratch + (size_t)2 * dim * n : NULL; /* the L slot */
-  g2p_velocity(m, y, vg, ag, NULL, C, NULL);
+  MPM_CALL(g2p_velocity(m, y, vg, ag, NULL, C, NULL));
   const double pic = sc->tr.apic ? 1.0 : sc->tr.pic;
   for (int d = 0; d < dim; ++d) {
     const double *v = y + (size_t)(p->offset[F_V] + d) * n;
@@ -458,7 +487,7 @@ static int solid_g2p(mpm_module *m, double t, const double *y, double *ydot, dou
     vdot[d] = ydot + (size_t)(p->offset[F_V] + d) * n;
   }
   double *Cdot = sc->tr.apic ? ydot + (size_t)p->offset[sc->lay.f_C] * n : NULL;
-  g2p_velocity(m, y, xdot, vdot, L, Cdot, ydot + (size_t)p->offset[F_F] * n);
+  MPM_CALL(g2p_velocity(m, y, xdot, vdot, L, Cdot, ydot + (size_t)p->offset[F_F] * n));
   if (sc->tr.musl && !sc->tr.apic && h > 0)
     for (int d = 0; d < dim; ++d) { /* the velocity solid_remap gave the particles */
       const double *v = y + (size_t)(p->offset[F_V] + d) * n, *vn = sc->vnew + (size_t)d * n;
@@ -510,6 +539,8 @@ static int solid_body_loads(mpm_module *m, const double *y, const double *const 
   const int dim = p->dim;
   const mpm_lidx n = p->n;
   const double *mass = mpm_particles_comp(p, sc->lay.f_m, 0);
+  if (m->hier) /* the coupling is refused on a hierarchy (solid_refine.c) */
+    MPM_FAIL(MPM_ERR_INTERNAL, "solid body loads on a refinement hierarchy");
   mpm_g2p_args a = {.n = n, .lp = sc->lp};
   for (int d = 0; d < dim; ++d) {
     a.x[d] = y + (size_t)(p->offset[F_X] + d) * n;
@@ -552,7 +583,7 @@ static double solid_stable_dt(const mpm_module *m, const double *y) {
   const mpm_particles *p = m->particles;
   const double *body = mpm_particles_comp(p, sc->lay.f_body, 0);
   const double *divv = sc->lay.f_divv >= 0 ? y + (size_t)p->offset[sc->lay.f_divv] * p->n : NULL;
-  const double dx = m->grid->dx;
+  const double dx = solid_finest_dx(m);
   double dt = HUGE_VAL;
   for (mpm_lidx i = 0; i < p->n; ++i) {
     double v2 = 0.0;

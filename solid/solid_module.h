@@ -22,4 +22,12 @@ int solid_add_schema(mpm_config *cfg);
  * fills it). *m is NULL if the case has no [solid.*] section. Collective. */
 int solid_module_create(mpm_module **m, const mpm_config *cfg, mpm_grid *grid, int seed);
 
+struct mpm_hier;
+
+/* The solid on the static refinement hierarchy h (solid_refine.c; docs/refinement.md): refuses
+ * what the slice does not carry (an input error naming the key), puts the module's phase on h,
+ * and, with seed = 1, drops the level-0 particles inside the finer regions and seeds each
+ * level's region at its own spacing. */
+int solid_module_refine(mpm_module *m, const mpm_config *cfg, struct mpm_hier *h, int seed);
+
 #endif

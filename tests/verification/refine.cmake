@@ -22,3 +22,11 @@ foreach(part uniform pulse)
   mpm_add_script_test(test_refine_gas_${part}_ppc4 SCRIPT verification/test_refine_gas.py
                       ARGS ${part} 4 LABELS verification long TIMEOUT 300)
 endforeach()
+# The solid on a static hierarchy (issue 51): an elastic pulse along a bar crossing a level-1
+# box against its uniform twins, with the grid sums (~4 s), and under usl (~2 s); a block
+# translating across the box (~1 s); a prestressed block with a box inside it (~2 s); a
+# restart (~3 s); every refusal (~3 s).
+foreach(part wave stream prestress usl restart input)
+  mpm_add_script_test(test_refine_solid_${part} SCRIPT verification/test_refine_solid.py
+                      ARGS ${part} LABELS verification TIMEOUT 300)
+endforeach()
