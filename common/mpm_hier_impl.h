@@ -27,6 +27,26 @@ static inline int hier_half(int a) {
   return a >= 0 ? a / 2 : -((1 - a) / 2);
 }
 
+/* i mod n in [0, n), for either sign of i (n > 0). */
+static inline int hier_mod(int i, int n) {
+  const int r = i % n;
+  return r < 0 ? r + n : r;
+}
+
+/* Move gi (global indices of level lv's lattice, first dim entries) onto its image in
+ * [0, period[d]) along every axis where the level has a period (mpm_hier.h, periodic axes). */
+static inline void hier_canon(const mpm_hier_level *lv, int dim, int *gi) {
+  for (int d = 0; d < dim; ++d)
+    if (lv->period[d]) gi[d] = hier_mod(gi[d], lv->period[d]);
+}
+
+/* x into out, wrapped into the domain along the periodic axes when the hierarchy wraps (a
+ * level stores a whole period); a plain copy otherwise. */
+static inline void hier_wrap_point(const mpm_hier *h, const double *x, double *out) {
+  for (int d = 0; d < MPM_MAX_DIM; ++d) out[d] = d < h->dim ? x[d] : 0.0;
+  if (h->wraps) mpm_grid_wrap(h->level[0].grid, out);
+}
+
 /* Does box node gi (global indices of g, first dim entries) lie in g's box? */
 static inline int hier_in_box(const mpm_grid *g, const int *gi) {
   for (int d = 0; d < g->dim; ++d)

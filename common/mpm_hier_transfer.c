@@ -6,7 +6,9 @@
  * Invariants: the scratch (h->scratch) grows and never shrinks, so a steady run allocates
  * nothing per step; a chunk holds at most CHUNK particles, so the gathered columns stay in
  * cache and their memory is bounded whatever the particle count; when every particle lies on
- * level 0 the kernel runs on the caller's arrays directly (the plain kernel call). */
+ * level 0 the kernel runs on the caller's arrays directly (the plain kernel call). On a level
+ * that stores a whole period along an axis (mpm_hier.h) the gathered positions are wrapped
+ * into the domain along it, so every stencil lies in the level's box. */
 #include "mpm_hier_impl.h"
 
 #include "mpm_error.h"
@@ -98,6 +100,27 @@ static const double *gather(chunk *c, const double *src, int ncomp) {
   return dst;
 }
 
+/* x wrapped into [lo, hi) when it lies at most a period outside, as mpm_grid_wrap does. */
+static double wrap_coord(double x, double lo, double hi) {
+  const double len = hi - lo;
+  if (x >= hi && x < hi + len) return x - len;
+  if (x < lo && x >= lo - len) return x + len < hi ? x + len : lo;
+  return x;
+}
+
+/* Gather the positions of a chunk on level l, wrapped into the domain along every axis where
+ * the level (>= 1) stores a whole period. */
+static void gather_x(const mpm_hier *h, int l, chunk *c, const double *const *x,
+                     const double **out) {
+  const mpm_grid *g0 = h->level[0].grid;
+  for (int d = 0; d < h->dim; ++d) {
+    double *o = c->next;
+    out[d] = gather(c, x[d], 1);
+    if (l > 0 && h->level[l].period[d]) /* level 0's halo takes its images */
+      for (mpm_lidx i = 0; i < c->nc; ++i) o[i] = wrap_coord(o[i], g0->lo[d], g0->hi[d]);
+  }
+}
+
 /* Fresh output columns for ncomp components (always: the kernel writes v and a). */
 static double *column(chunk *c, int ncomp) {
   double *dst = c->next;
@@ -121,7 +144,8 @@ static void p2g_chunk(mpm_hier *h, int l, int phase, const mpm_p2g_args *a, chun
   const int D = h->dim;
   mpm_p2g_args b = *a;
   b.n = c->nc;
-  for (int d = 0; d < D; ++d) b.x[d] = gather(c, a->x[d], 1), b.v[d] = gather(c, a->v[d], 1);
+  gather_x(h, l, c, a->x, b.x);
+  for (int d = 0; d < D; ++d) b.v[d] = gather(c, a->v[d], 1);
   b.m = gather(c, a->m, 1);
   b.vsig = gather(c, a->vsig, D * D);
   b.C = gather(c, a->C, D * D);
@@ -167,10 +191,8 @@ static void g2p_chunk(mpm_hier *h, int l, const mpm_g2p_args *lv, const mpm_g2p_
   const int D = h->dim, DD = D * D;
   mpm_g2p_args b = *lv;
   b.n = c->nc;
-  for (int d = 0; d < D; ++d) {
-    b.x[d] = gather(c, a->x[d], 1);
-    b.v_out[d] = column(c, 1), b.a_out[d] = column(c, 1);
-  }
+  gather_x(h, l, c, a->x, b.x);
+  for (int d = 0; d < D; ++d) b.v_out[d] = column(c, 1), b.a_out[d] = column(c, 1);
   b.F = a->LF_out ? gather(c, a->F, DD) : NULL;
   b.L_out = a->L_out ? column(c, DD) : NULL;
   b.C_out = a->C_out ? column(c, DD) : NULL;
