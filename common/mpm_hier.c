@@ -84,9 +84,11 @@ static int check_box(const mpm_grid *grid, int nlevels, const mpm_hier_box *b, i
     const double reach = grid->periodic[d] ? grid->hi[d] - grid->lo[d] : 0.0;
     if (b->lo[d] < grid->lo[d] - reach - tol || b->hi[d] > grid->hi[d] + reach + tol)
       return refuse(why, len,
-                    "box %d (level %d) spans [%g, %g] along %c, outside the domain [%g, %g]: "
+                    "box %d (level %d) spans [%g, %g] along %c, %s the domain [%g, %g]: "
                     "move or shrink it into the domain",
-                    k, b->level, b->lo[d], b->hi[d], g_axis[d], grid->lo[d], grid->hi[d]);
+                    k, b->level, b->lo[d], b->hi[d], g_axis[d],
+                    reach > 0 ? "more than a period beyond the periodic faces of" : "outside",
+                    grid->lo[d], grid->hi[d]);
   }
   return 0;
 }

@@ -1,20 +1,21 @@
 """The refinement's test scenes (docs/refinement.md), shared by tests/verification/test_refine_gas.py
 and bench/bench_refine.py: a 2-D strip periodic along x with slip walls along y (level 0 at
-dx = 0.05), its static level-1 box, the 3-D strip and box, and the regridded pulse."""
+dx = 0.05), its static level-1 box, the 3-D strip and box, and the regridded pulse; with
+y = "periodic" the strip is periodic along y too (the levels then wrap across its faces)."""
 import numpy as np
 
 C0 = np.sqrt(1.4)  # sound speed of rho 1, p 1
 BOX = "[refine]\nlevels = 2\n\n[refine.box]\nlevel = 1\nlo = {x0} 0.15\nhi = {x1} 0.45\n"
 
 
-def case_text(length, t_end, gas, refine, dx=0.05, extra=""):
+def case_text(length, t_end, gas, refine, dx=0.05, extra="", y="slip", height=0.6):
     return f"""[run]
 name = refine_gas
 
 [domain]
 dim = 2
 lo = 0 0
-hi = {length} 0.6
+hi = {length} {height}
 
 [grid]
 dx = {dx}
@@ -22,8 +23,8 @@ dx = {dx}
 [boundary]
 x_lo = periodic
 x_hi = periodic
-y_lo = slip
-y_hi = slip
+y_lo = {y}
+y_hi = {y}
 
 [time]
 t_end = {t_end}
@@ -34,7 +35,7 @@ interval = {t_end / 2}
 [geometry.strip]
 type = box
 lo = 0 0
-hi = {length} 0.6
+hi = {length} {height}
 
 [gas.air]
 geometry = strip

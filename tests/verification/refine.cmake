@@ -1,10 +1,12 @@
 # The gas on a refinement hierarchy (docs/refinement.md): a uniform stream across a static
 # level-1 box and an acoustic pulse through it against their uniform twins (~10 and ~20 s), the
 # uniform stream in 3-D (~12 s), a pulse refined dynamically (~25 s), the compression and
-# vorticity criteria (~4 s each), a restart (~5 s), every refusal (~15 s), and
+# vorticity criteria (~4 s each), a restart (~5 s), every refusal (~15 s), levels across
+# periodic faces (static ~5 s, regridded ~5 s), and
 # refine.levels = 1 against no [refine] section (~2 s); the first two again with fluid.ppc = 4
 # (long).
-foreach(part uniform pulse uniform3d dynamic compression vorticity restart input identity)
+foreach(part uniform pulse uniform3d dynamic compression vorticity restart input identity periodic
+             wrap)
   mpm_add_script_test(test_refine_gas_${part} SCRIPT verification/test_refine_gas.py ARGS ${part}
                       LABELS verification TIMEOUT 300)
 endforeach()
