@@ -35,14 +35,6 @@
 #include <math.h>
 #include <stdlib.h>
 
-/* The level of size of particle i (0 .. MPM_HIER_MAX_LEVELS - 1). */
-static int size_level(const mpm_module *m, double V0_0, mpm_lidx i) {
-  const fluid_content *fc = m->content;
-  const double V0 = mpm_particles_comp(m->particles, fc->lay.f_V0, 0)[i];
-  const long l = lround(log2(V0_0 / V0) / m->grid->dim);
-  return (int)(l < 0 ? 0 : l >= MPM_HIER_MAX_LEVELS ? MPM_HIER_MAX_LEVELS - 1 : l);
-}
-
 /* The level of the position of particle i (0 without a hierarchy). */
 static int position_level(const mpm_module *m, mpm_lidx i) {
   const mpm_particles *p = m->particles;
@@ -53,12 +45,12 @@ static int position_level(const mpm_module *m, mpm_lidx i) {
 }
 
 /* Merge the full groups of the particles of size level L that lie on a coarser level. */
-static int merge_level(mpm_module *m, double V0_0, int L, mpm_lidx *idx, mpm_lidx *merged) {
+static int merge_level(mpm_module *m, int L, mpm_lidx *idx, mpm_lidx *merged) {
   const fluid_content *fc = m->content;
   const mpm_lidx n = m->particles->n;
   mpm_lidx k = 0;
   for (mpm_lidx i = 0; i < n; ++i)
-    if (size_level(m, V0_0, i) == L && position_level(m, i) < L) idx[k++] = i;
+    if (fluid_size_level(m, i) == L && position_level(m, i) < L) idx[k++] = i;
   if (k == 0) return 0;
   mpm_lidx *start, *member, ng;
   const double H = ldexp(m->grid->dx, 1 - L) / fc->ppc; /* level L - 1's particle spacing */
@@ -71,21 +63,18 @@ static int merge_level(mpm_module *m, double V0_0, int L, mpm_lidx *idx, mpm_lid
 }
 
 static int relevel(mpm_module *m, int *changed) {
-  const fluid_content *fc = m->content;
-  const double V0_0 = pow(m->grid->dx / fc->ppc, m->grid->dim);
   mpm_lidx *idx;
   MPM_ALLOC(idx, m->particles->n > 0 ? m->particles->n : 1);
   mpm_lidx merged = 0;
   int rc = 0;
-  for (int L = MPM_HIER_MAX_LEVELS - 1; !rc && L >= 1; --L)
-    rc = merge_level(m, V0_0, L, idx, &merged);
+  for (int L = MPM_HIER_MAX_LEVELS - 1; !rc && L >= 1; --L) rc = merge_level(m, L, idx, &merged);
   /* Split until every particle has its level's size: a regrid may put a particle two levels
    * below its new level (idx grows with the set). */
   mpm_lidx split = 0;
   for (int pass = 0; !rc && pass < MPM_HIER_MAX_LEVELS; ++pass) {
     mpm_lidx k = 0;
     for (mpm_lidx i = 0; i < m->particles->n; ++i)
-      if (size_level(m, V0_0, i) < position_level(m, i)) idx[k++] = i;
+      if (fluid_size_level(m, i) < position_level(m, i)) idx[k++] = i;
     fluid_split_report rep = {0};
     rc = fluid_split(m, idx, k, &rep); /* collective: every rank calls, k = 0 too */
     split += rep.parents;
