@@ -51,8 +51,9 @@ const mpm_key_spec mpm_refine_keys[] = {
      "inside level l - 1's region by refine.buffer cells",
      0, "-"},
     {"refine.*.lo", MPM_KEY_REALS, NULL, -HUGE_VAL, HUGE_VAL, 0, 3, NULL,
-     "lower corner of the box, m (dim values; snapped outwards to the coarser level's cells)", 0,
-     "m"},
+     "lower corner of the box, m (dim values; snapped outwards to the coarser level's cells; "
+     "along a periodic axis the box may cross the faces, up to a period beyond them)",
+     0, "m"},
     {"refine.*.hi", MPM_KEY_REALS, NULL, -HUGE_VAL, HUGE_VAL, 0, 3, NULL,
      "upper corner of the box, m (dim values)", 0, "m"},
 };
