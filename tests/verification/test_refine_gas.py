@@ -47,8 +47,9 @@ wrap     Regrids on a periodic strip: the nonlinear pulse of `dynamic` on a stri
          periodic along x and y (quasi-1-D, as the shock-tube cases), starting at x = 2.6 and
          running through the x faces, refined by the density criterion every 10 steps at a fixed
          bs32 step: the region spans the period along y at every snapshot, crosses the x faces
-         when the pulse does, and mass, momentum and energy are conserved across every regrid
-         (~5 s).
+         when the pulse does, and mass, momentum and energy are conserved across every regrid;
+         a restart at t = 0.25 (the region across the x faces) ends bit for bit as the run
+         through, to t = 0.5 (~5 s).
 input    Every refusal: exit 2, one line naming case.ini:LINE and the key (part d).
 identity refine.levels = 1 gives the same output as no [refine] section, bit for bit (part e);
          a refined run restarted from its checkpoint ends bit for bit as the run through.
@@ -400,6 +401,13 @@ def part_wrap():
     # Splits and merges conserve exactly; the regrid moves no particle. Energy: bs32's own error
     # at a fixed step on a steepening pulse (the dynamic part measures 6e-11 adaptive).
     conservation(runs, 1e-12, 1e-12, 1e-8)
+    # A restart at t = 0.25, the region across the x faces (the pulse crosses at t = 0.34).
+    case = os.path.join(mt.outdir("refine_wrap_restart_case"), "case.ini")
+    with open(case, "w") as f:
+        f.write(text)
+    ids, worst, _ = mt.restart_difference(case, [], 0.5, "refine_wrap_restart", "fluid")
+    check(ids and worst == 0.0, f"regridded across the periodic faces, restarted at t = 0.25: "
+          f"the same particles, fields {worst:.1e} from the run straight through (bit for bit: 0)")
 
 
 def part_restart():
