@@ -173,9 +173,6 @@ int fluid_g2p_phase(mpm_module *m, const double *y, double *const *v_out, double
                     double *L_out, const mpm_hier_scalars *s, double *s_out);
 /* The grid spacing of the finest level (the grid's without refinement). */
 double fluid_finest_dx(const mpm_module *m);
-/* The level of particle i's size: seeding gives level l's particles V0 = (h_l / ppc)^dim, a
- * split divides V0 by 2^dim and a merge sums it (0 .. MPM_HIER_MAX_LEVELS - 1). */
-int fluid_size_level(const mpm_module *m, mpm_lidx i);
 /* The spacing of the level particle i of state y deposits on (its position's; the grid's
  * without a hierarchy). */
 double fluid_level_spacing(const mpm_module *m, const double *y, mpm_lidx i);

@@ -65,14 +65,6 @@ double fluid_finest_dx(const mpm_module *m) {
   return h ? h->level[h->nlevels - 1].grid->dx : m->grid->dx;
 }
 
-int fluid_size_level(const mpm_module *m, mpm_lidx i) {
-  const fluid_content *fc = m->content;
-  const double V0_0 = pow(m->grid->dx / fc->ppc, m->grid->dim);
-  const double V0 = mpm_particles_comp(m->particles, fc->lay.f_V0, 0)[i];
-  const long l = lround(log2(V0_0 / V0) / m->grid->dim);
-  return (int)(l < 0 ? 0 : l >= MPM_HIER_MAX_LEVELS ? MPM_HIER_MAX_LEVELS - 1 : l);
-}
-
 double fluid_level_spacing(const mpm_module *m, const double *y, mpm_lidx i) {
   const mpm_particles *p = m->particles;
   if (!m->hier) return m->grid->dx;
