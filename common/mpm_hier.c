@@ -151,7 +151,8 @@ static void mark(const mpm_hier_level *lv, unsigned char *mask, const int *a, co
 
 /* Mask value of span gi on level l, looked up at its image along the level's periodic axes,
  * with the rule outside the box of the file comment. */
-static int span_flag(const mpm_hier *h, int l, const unsigned char *mask, const int *gi, int out) {
+static inline int span_flag(const mpm_hier *h, int l, const unsigned char *mask, const int *gi,
+                            int out) {
   const mpm_grid *g = h->level[l].grid;
   int c[MPM_MAX_DIM] = {gi[0], gi[1], gi[2]};
   hier_canon(&h->level[l], h->dim, c);

@@ -122,6 +122,12 @@ void mpm_hier_count_levels(const mpm_hier *h, const mpm_particles *p, double *co
  * or x lies so far outside the domain that its stencil leaves level 0's box. */
 int mpm_hier_eval(const mpm_hier *h, const double *x, mpm_hier_weight *w, int max);
 
+/* Levels the caller vouches for: until the next call, a composite transfer (mpm_hier_p2g,
+ * mpm_hier_g2p) whose positions are the array x0 (its x[0]) with n particles takes level[i]
+ * (mpm_hier_level_of of particle i's position, kept by the caller) instead of finding it again.
+ * x0 NULL forgets them. The caller calls again, or forgets, before those positions change. */
+void mpm_hier_levels_known(mpm_hier *h, const double *x0, mpm_lidx n, const unsigned char *level);
+
 /* Composite P2G of one phase: each particle deposits (a's fields, with the unchanged kernel) on
  * the level mpm_hier_level_of gives for its position; adds, as the kernel does. Follow it with
  * mpm_hier_restrict before the solve. */

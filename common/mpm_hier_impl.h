@@ -36,15 +36,28 @@ static inline int hier_mod(int i, int n) {
 /* Move gi (global indices of level lv's lattice, first dim entries) onto its image in
  * [0, period[d]) along every axis where the level has a period (mpm_hier.h, periodic axes). */
 static inline void hier_canon(const mpm_hier_level *lv, int dim, int *gi) {
-  for (int d = 0; d < dim; ++d)
-    if (lv->period[d]) gi[d] = hier_mod(gi[d], lv->period[d]);
+  for (int d = 0; d < dim; ++d) {
+    const int P = lv->period[d]; /* (the division only for an image: this is a hot path) */
+    if (P && (gi[d] < 0 || gi[d] >= P)) gi[d] = hier_mod(gi[d], P);
+  }
+}
+
+/* x wrapped into [lo, hi) when it lies at most a period outside, as mpm_grid_wrap does (inline:
+ * a hot path). */
+static inline double hier_wrap_coord(double x, double lo, double hi) {
+  const double len = hi - lo;
+  if (x >= hi && x < hi + len) return x - len;
+  if (x < lo && x >= lo - len) return x + len < hi ? x + len : lo;
+  return x;
 }
 
 /* x into out, wrapped into the domain along the periodic axes when the hierarchy wraps (a
  * level stores a whole period); a plain copy otherwise. */
 static inline void hier_wrap_point(const mpm_hier *h, const double *x, double *out) {
+  const mpm_grid *g = h->level[0].grid;
   for (int d = 0; d < MPM_MAX_DIM; ++d) out[d] = d < h->dim ? x[d] : 0.0;
-  if (h->wraps) mpm_grid_wrap(h->level[0].grid, out);
+  for (int d = 0; h->wraps && d < h->dim; ++d)
+    if (g->periodic[d]) out[d] = hier_wrap_coord(out[d], g->lo[d], g->hi[d]);
 }
 
 /* Does box node gi (global indices of g, first dim entries) lie in g's box? */

@@ -75,6 +75,7 @@ typedef struct fluid_content {
   fluid_gridp *gridp; /* fluid.pressure = grid, or NULL */
   int refined;        /* on a refinement (its particles follow the levels: fluid_relevel.c) */
   double *av_l;       /* refined: each particle's artificial viscosity length (cap) */
+  unsigned char *lev; /* refined: the level of each particle's position in this RHS (cap) */
 } fluid_content;
 
 /* What the classic step's transfer gives each particle (component-major, stride n). */
@@ -176,8 +177,10 @@ double fluid_finest_dx(const mpm_module *m);
 /* The spacing of the level particle i of state y deposits on (its position's; the grid's
  * without a hierarchy). */
 double fluid_level_spacing(const mpm_module *m, const double *y, mpm_lidx i);
-/* On a refinement, each particle's artificial viscosity length, fluid_level_spacing, into
- * fc->av_l (capacity fc->cap); a no-op unrefined. */
+/* On a refinement, at the start of an RHS: the level of each particle's position in state y
+ * into fc->lev, handed to the hierarchy for this RHS's transfers (mpm_hier_levels_known; the
+ * RHS's last phase forgets them), and each particle's artificial viscosity length, its level's
+ * spacing, into fc->av_l (capacity fc->cap); a no-op unrefined. */
 void fluid_av_lengths(mpm_module *m, const double *y);
 /* Refuse, naming the key, every gas setting the refined levels do not carry (fluid_refine.c). */
 int fluid_refine_check(const mpm_module *m, const mpm_config *cfg);

@@ -215,14 +215,16 @@ static int ensure_scratch(mpm_module *m) {
   const int dim = m->grid->dim;
   if (n <= fc->cap && fc->vsig && (!fc->refined || fc->av_l)) return 0;
   free(fc->vsig), free(fc->scratch), free(fc->vnew), free(fc->Cnew), free(fc->power);
-  free(fc->tscratch), free(fc->sub), free(fc->zero), free(fc->work), free(fc->av_l);
+  free(fc->tscratch), free(fc->sub), free(fc->zero), free(fc->work), free(fc->av_l), free(fc->lev);
   fc->vnew = fc->Cnew = fc->tscratch = fc->sub = fc->zero = fc->work = fc->av_l = NULL;
+  fc->lev = NULL;
   fc->cap = n + n / 4 + 16;
   MPM_ALLOC(fc->vsig, (size_t)dim * dim * fc->cap);
   MPM_ALLOC(fc->scratch, (size_t)(2 * dim + dim * dim) * fc->cap);
   if (fc->mol_damping > 0) MPM_ALLOC(fc->work, (size_t)4 * dim * fc->cap);
   MPM_ALLOC(fc->power, fc->cap);
   if (fc->refined) MPM_ALLOC(fc->av_l, fc->cap);
+  if (fc->refined) MPM_ALLOC(fc->lev, fc->cap);
   if (fc->tr.classic)
     MPM_ALLOC(fc->tscratch, (size_t)(dim + 3 + (fc->tr.apic ? dim * dim + 2 * dim : 0)) * fc->cap);
   if (fc->tr.musl) MPM_ALLOC(fc->vnew, (size_t)dim * fc->cap);
@@ -547,8 +549,8 @@ static int volume_rate(mpm_module *m, const double *y, double *ydot, const doubl
  * the classic USL step: the transfer of fluid_transfer.c as rates over h; MUSL after its
  * second deposit: positions and J move with the new nodal velocities, v, C and e take what
  * fluid_remap computed. */
-static int fluid_g2p(mpm_module *m, double t, const double *y, double *ydot, double h) {
-  (void)t;
+/* The rates of the RHS (fluid_g2p, its last phase). */
+static int g2p_rates(mpm_module *m, const double *y, double *ydot, double h) {
   fluid_content *fc = m->content;
   const mpm_particles *p = m->particles;
   const int dim = p->dim;
@@ -600,6 +602,13 @@ static int fluid_g2p(mpm_module *m, double t, const double *y, double *ydot, dou
   fluid_open_sponge(fc->open, m, y, ydot);
   fluid_obstacles_list_done(&fc->obs);
   return 0;
+}
+
+static int fluid_g2p(mpm_module *m, double t, const double *y, double *ydot, double h) {
+  (void)t;
+  const int rc = g2p_rates(m, y, ydot, h);
+  if (m->hier) mpm_hier_levels_known(m->hier, NULL, 0, NULL); /* the RHS's levels end here */
+  return rc;
 }
 
 /* After an accepted step: commit the ERK pairs' pending strain rate, then shift and
@@ -756,7 +765,7 @@ static void fluid_destroy(mpm_module *m) {
     fluid_gridp_destroy(fc);
     fluid_virtual_free(&fc->virt);
     free(fc->vsig), free(fc->scratch), free(fc->vnew), free(fc->Cnew), free(fc->power);
-    free(fc->av_l);
+    free(fc->av_l), free(fc->lev);
     free(fc->sub), free(fc->zero), free(fc->work);
     free(fc->tscratch), free(fc->node), free(fc->cellsum), free(fc->lim), free(fc->vol);
     free(fc);

@@ -75,8 +75,20 @@ double fluid_level_spacing(const mpm_module *m, const double *y, mpm_lidx i) {
 
 void fluid_av_lengths(mpm_module *m, const double *y) {
   fluid_content *fc = m->content;
+  const mpm_particles *p = m->particles;
   if (!fc->refined) return;
-  for (mpm_lidx i = 0; i < m->particles->n; ++i) fc->av_l[i] = fluid_level_spacing(m, y, i);
+  if (!m->hier) {
+    for (mpm_lidx i = 0; i < p->n; ++i) fc->av_l[i] = m->grid->dx;
+    return;
+  }
+  const double *x = y + (size_t)p->offset[FLUID_X] * p->n;
+  for (mpm_lidx i = 0; i < p->n; ++i) {
+    double xp[MPM_MAX_DIM] = {0, 0, 0};
+    for (int d = 0; d < p->dim; ++d) xp[d] = x[(size_t)d * p->n + i];
+    fc->lev[i] = (unsigned char)mpm_hier_level_of(m->hier, xp);
+    fc->av_l[i] = m->hier->level[fc->lev[i]].grid->dx;
+  }
+  mpm_hier_levels_known(m->hier, x, p->n, fc->lev);
 }
 
 /* ---- what the slice refuses ------------------------------------------------------------------ */
