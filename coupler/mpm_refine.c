@@ -218,10 +218,9 @@ static int mask_boxes(const mpm_grid *g, const int *n, int l, double eps, const 
       mpm_hier_box *b = &(*box)[(*nbox)++];
       const int first[3] = {a, j[0], j[1]}, last[3] = {z, j[0], j[1]};
       b->level = l;
-      for (int d = 0; d < g->dim; ++d) { /* span 0 of a periodic axis straddles its face */
+      for (int d = 0; d < g->dim; ++d) { /* (span 0 of a periodic axis crosses its face) */
         b->lo[d] = g->lo[d] + (first[d] - 0.5) * g->dx + eps;
         b->hi[d] = g->lo[d] + (last[d] + 0.5) * g->dx - eps;
-        if (g->periodic[d]) b->lo[d] = fmax(b->lo[d], g->lo[d]);
       }
       a = z;
     }

@@ -45,8 +45,10 @@ periodic Levels across periodic faces (the strip periodic along x and y): a unif
          momentum and energy are conserved (~5 s).
 wrap     Regrids on a periodic strip: the nonlinear pulse of `dynamic` on a strip 3 cells high,
          periodic along x and y (quasi-1-D, as the shock-tube cases), starting at x = 2.6 and
-         running through the x faces, refined by the density criterion every 10 steps at a fixed
-         bs32 step: the region spans the period along y at every snapshot, crosses the x faces
+         running through the x faces, refined to 3 levels by the density criterion every 10
+         steps at a fixed bs32 step: levels 1 and 2 hold every particle row of the period along
+         y at every snapshot (a level-2 region once lost the rows of the half span below y = 0),
+         the refined region crosses the x faces
          when the pulse does, and mass, momentum and energy are conserved across every regrid;
          a restart at t = 0.25 (the region across the x faces) ends bit for bit as the run
          through, to t = 0.5 (~5 s).
@@ -378,23 +380,31 @@ def part_periodic():
 
 
 def part_wrap():
-    text = case_text(3, 1.2, PULSE_5.replace("x-0.6", "x-2.6"), DYNAMIC, y="periodic",
-                     height=0.15)
+    text = case_text(3, 1.2, PULSE_5.replace("x-0.6", "x-2.6"),
+                     DYNAMIC.replace("levels = 2", "levels = 3"), y="periodic", height=0.15)
     text = text.replace("interval = 0.6", "interval = 0.1").replace(
         "t_end = 1.2", "t_end = 1.2\nadaptive = false")
     runs = {"refined": run("refine_wrap", text)}
     report_cost(runs)
     out = runs["refined"][0]
-    across, spans = 0, True
+    across, spans, rows = 0, True, set()
     for t, f in mt.snapshots(out):
         p = mt.particles(f, "fluid")
-        on = p["level"].ravel() == 1
-        x, y = p["x"][on, 0], p["x"][on, 1]
-        if on.any():
-            spans &= bool(np.any(y < 0.025) and np.any(y > 0.125))
-            across += bool(np.any(x < 0.05) and np.any(x > 2.95))
-    check(spans and across >= 2, f"the level-1 region spans the period along y at every snapshot "
-          f"({spans}) and crosses the x faces at {across} of the snapshots (want >= 2)")
+        for level in (1, 2):
+            on = p["level"].ravel() == level
+            x, y = p["x"][on, 0], p["x"][on, 1]
+            if not on.any():
+                continue
+            # Every particle row of the level's lattice (2 per cell of 0.05 / 2^level) is there:
+            # a region that lost the half span below y = 0 (its image at the top) misses rows.
+            got = len(np.unique(np.round(y * 2 ** (level + 1) / 0.05 - 0.5)))
+            spans &= got == 3 * 2 ** (level + 1)
+            rows.add(got)
+        x = p["x"][p["level"].ravel() >= 1, 0]
+        across += bool(np.any(x < 0.05) and np.any(x > 2.95))
+    check(spans and across >= 2, f"levels 1 and 2 hold every particle row of the period along y "
+          f"at every snapshot ({spans}; rows seen {sorted(rows)}) and the refined region crosses "
+          f"the x faces at {across} of the snapshots (want >= 2)")
     d = diagnostics(out)
     check(len(set(d["particles"].astype(int))) > 2, "the particle count changes (regrids, splits "
           "and merges)")
