@@ -23,8 +23,7 @@ foreach(part uniform pulse)
                       ARGS ${part} 4 LABELS verification long TIMEOUT 300)
 endforeach()
 # Sod with a fine region following the waves against its uniform twin at the finest spacing
-# (issue 51's acceptance, L1 within 10 %): 2 levels (~3 s); 3 levels under long (~20 s), an
-# expected failure inside the driver (EXPECTED-FAIL; the figures in its header).
+# (issue 51's acceptance, L1 within 10 %): 2 levels (~3 s); 3 levels under long (~15 s).
 mpm_add_script_test(test_refine_sod SCRIPT verification/test_refine_sod.py LABELS verification
                     TIMEOUT 300)
 mpm_add_script_test(test_refine_sod_long SCRIPT verification/test_refine_sod.py ARGS long
