@@ -11,6 +11,12 @@ Cases (the scenes of tests/verification/test_refine_gas.py):
             Error: the mean |rho - rho_fine| over the band's rows 0.2 < y < 0.4 at t = 1.2,
             binned along x into 60 cells (the fine twin is the reference: its error is 0).
   stream3d  the stream in 3-D (x and z periodic), to t = 0.45.
+  sod, sod3 cases/sod.ini over 100 level-0 cells, 3 across (periodic in y: every level wraps),
+            regridded by the density criterion (refine_scenes.sod_refine) with 2 and 3 levels,
+            against the uniform twins at the finest spacing on the same strip, with the grid
+            pressure the refined run takes (fine) and the default particle pressure
+            (fine_particle). Error: the density's L1 on the finest cells (tests/tools/
+            shocktube.py, as tests/verification/test_refine_sod.py).
 
 Each run is a separate mpmfsi process under /usr/bin/time (peak resident memory). The runs go
 one after another, the twins of a case next to each other, so compare within a case. Writes the
@@ -31,11 +37,14 @@ import numpy as np
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, "tests", "tools"))
 import mpmtest as mt  # noqa: E402
-from refine_scenes import BOX, BOX_3D, C0, CASE_3D, case_text  # noqa: E402
+import shocktube  # noqa: E402
+from refine_scenes import BOX, BOX_3D, C0, CASE_3D, SOD_COARSE, case_text, sod_refine  # noqa: E402
+from riemann import Riemann  # noqa: E402
 
 U0 = 0.5 * C0
 GAS_STREAM = f"density = 1\npressure = 1\nvelocity = {U0!r} 0"
 TIMERS = ("restrict", "prolong", "relevel", "regrid")
+DEFAULT_CASES = "stream,pulse,stream3d,sod,sod3"
 
 
 def run(binary, out, case, overrides):
@@ -110,9 +119,29 @@ def case_pulse(binary, out):
     return rows
 
 
+def case_sod(binary, out, levels):
+    fine = SOD_COARSE * 2 ** (levels - 1)
+    exact = Riemann((1.0, 0.0, 1.0), (0.125, 0.0, 0.1), gamma=1.4, x0=0.5)
+    case = os.path.join(ROOT, "cases", "sod.ini")
+    height = 3.0 / SOD_COARSE
+    rows = {}
+    for label, N, extra in (("refined", SOD_COARSE, sod_refine(levels)),
+                            ("coarse", SOD_COARSE, []),
+                            ("fine", fine, ["fluid.pressure=grid"]),
+                            ("fine_particle", fine, [])):
+        over = [o for o in shocktube.overrides(N, "bs32", 0.2, height=height)
+                if not o.startswith("run.progress")] + ["output.interval=0.2"]
+        r = run(binary, os.path.join(out, f"sod{levels}_{label}"), case, over + extra)
+        r["error"] = shocktube.measure(r["dir"], fine, exact, 0.2)[0]
+        rows[label] = r
+    return rows
+
+
 ERRORS = {"stream": "largest deviation of rho, p, v (relative)",
           "stream3d": "largest deviation of rho, p, v (relative)",
-          "pulse": "mean |rho - rho_fine| over the band's rows (fine: the reference)"}
+          "pulse": "mean |rho - rho_fine| over the band's rows (fine: the reference)",
+          "sod": "L1 of the density on the finest cells (fine: grid pressure, as refined)",
+          "sod3": "L1 of the density on the finest cells (fine: grid pressure, as refined)"}
 
 
 def page(results, commit, command):
@@ -138,14 +167,19 @@ def page(results, commit, command):
         ref, fine = rows["refined"], rows["fine"]
         lines += ["", f"Refined against fine: {ref['wall_s'] / fine['wall_s']:.2f}× the wall "
                   f"time, {ref['particle_steps'] / fine['particle_steps']:.2f}× the "
-                  f"particle-steps, {ref['rss_mb'] / fine['rss_mb']:.2f}× the peak memory.", ""]
+                  f"particle-steps, {ref['rss_mb'] / fine['rss_mb']:.2f}× the peak memory, "
+                  f"{ref['error'] / fine['error']:.2f}× the error" if name.startswith("sod") else
+                  f"Refined against fine: {ref['wall_s'] / fine['wall_s']:.2f}× the wall "
+                  f"time, {ref['particle_steps'] / fine['particle_steps']:.2f}× the "
+                  f"particle-steps, {ref['rss_mb'] / fine['rss_mb']:.2f}× the peak memory", ""]
+        lines[-2] += "."
     return "\n".join(lines)
 
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--binary", default=os.path.join(ROOT, "build", "app", "mpmfsi"))
-    ap.add_argument("--cases", default="stream,pulse,stream3d")
+    ap.add_argument("--cases", default=DEFAULT_CASES)
     ap.add_argument("--out", default=os.path.join(ROOT, "out", "bench_refine"))
     ap.add_argument("--md", default=os.path.join(ROOT, "bench", "results", "refine_cost.md"))
     a = ap.parse_args()
@@ -158,8 +192,10 @@ def main():
             results[name] = case_stream(a.binary, a.out, 3)
         elif name == "pulse":
             results[name] = case_pulse(a.binary, a.out)
+        elif name in ("sod", "sod3"):
+            results[name] = case_sod(a.binary, a.out, 3 if name == "sod3" else 2)
         else:
-            raise SystemExit(f"unknown case {name}: choose among stream, pulse, stream3d")
+            raise SystemExit(f"unknown case {name}: choose among {DEFAULT_CASES}")
         for label, r in results[name].items():
             print(f"{name} {label}: {r['steps']} steps, {r['wall_s']:.2f} s, {r['rss_mb']:.0f} MB,"
                   f" error {r['error']:.2e}", flush=True)
@@ -176,7 +212,7 @@ def main():
     commit = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"],
                             capture_output=True, text=True).stdout.strip()
     command = "/usr/bin/python3 bench/bench_refine.py" + (
-        f" --cases {a.cases}" if a.cases != "stream,pulse,stream3d" else "")
+        f" --cases {a.cases}" if a.cases != DEFAULT_CASES else "")
     with open(a.md, "w") as f:
         f.write(page(results, commit, command) + "\n")
     print(f"wrote {a.md}")

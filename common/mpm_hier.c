@@ -10,7 +10,12 @@
  *   nodes [a - 2, z + 2], inside level l - 1's box, so restriction and prolongation never
  *   leave a box (on level 0 the domain check and the grid's pad do the same).
  * - Masks outside a box: on level 0 every span is covered and none refined (the grid's own
- *   pad edges keep the plain rule); on finer levels nothing outside the box is covered. */
+ *   pad edges keep the plain rule); on finer levels nothing outside the box is covered.
+ * - Periodic axes (mpm_hier.h): masks are marked on every image of a span in the box, and
+ *   looked up at the image in [0, period) along the axes where a level has a period, so the
+ *   masks of images equal those of their nodes; a level's period is set when its box would
+ *   reach a node outside [0, N_l) (then it stores the whole period), and a level without one
+ *   along a periodic axis lies wholly inside [0, N_l), so it has no images there. */
 #include "mpm_hier_impl.h"
 
 #include "mpm_error.h"
@@ -75,11 +80,15 @@ static int check_box(const mpm_grid *grid, int nlevels, const mpm_hier_box *b, i
     if (!(b->hi[d] > b->lo[d]) || !isfinite(b->lo[d]) || !isfinite(b->hi[d]))
       return refuse(why, len, "box %d (level %d) is empty along %c ([%g, %g]): give lo < hi", k,
                     b->level, g_axis[d], b->lo[d], b->hi[d]);
-    if (b->lo[d] < grid->lo[d] - tol || b->hi[d] > grid->hi[d] + tol)
+    /* Along a periodic axis a box may cross the faces, by up to a period. */
+    const double reach = grid->periodic[d] ? grid->hi[d] - grid->lo[d] : 0.0;
+    if (b->lo[d] < grid->lo[d] - reach - tol || b->hi[d] > grid->hi[d] + reach + tol)
       return refuse(why, len,
-                    "box %d (level %d) spans [%g, %g] along %c, outside the domain [%g, %g]: "
+                    "box %d (level %d) spans [%g, %g] along %c, %s the domain [%g, %g]: "
                     "move or shrink it into the domain",
-                    k, b->level, b->lo[d], b->hi[d], g_axis[d], grid->lo[d], grid->hi[d]);
+                    k, b->level, b->lo[d], b->hi[d], g_axis[d],
+                    reach > 0 ? "more than a period beyond the periodic faces of" : "outside",
+                    grid->lo[d], grid->hi[d]);
   }
   return 0;
 }
@@ -113,36 +122,53 @@ static box_spans snap_box(const mpm_grid *c, const mpm_hier_box *b) {
   return s;
 }
 
-/* Set mask to 1 on the box nodes with global indices in [a, z] (clipped to the box). Visits
- * those nodes only: a regrid builds a level from many small boxes. */
-static void mark(const mpm_grid *g, unsigned char *mask, const int *a, const int *z) {
+/* Is index j in [a, z], taken modulo the period P (0: none)? */
+static int in_range(int j, int a, int z, int P) {
+  if (!P) return j >= a && j <= z;
+  return z - a + 1 >= P || hier_mod(j - a, P) <= z - a;
+}
+
+/* Set mask to 1 on the box nodes of level lv with global indices in [a, z] (clipped to the
+ * box), and on their images along the axes where the level has a period. Visits those nodes
+ * only (the whole box along a periodic axis): a regrid builds a level from many small boxes. */
+static void mark(const mpm_hier_level *lv, unsigned char *mask, const int *a, const int *z) {
+  const mpm_grid *g = lv->grid;
   int lo[MPM_MAX_DIM] = {0, 0, 0}, hi[MPM_MAX_DIM] = {0, 0, 0}, gi[MPM_MAX_DIM];
   for (int d = 0; d < g->dim; ++d) {
-    lo[d] = MPM_MAX(a[d], g->box_lo[d]), hi[d] = MPM_MIN(z[d], g->box_lo[d] + g->box_n[d] - 1);
+    const int top = g->box_lo[d] + g->box_n[d] - 1;
+    lo[d] = lv->period[d] ? g->box_lo[d] : MPM_MAX(a[d], g->box_lo[d]);
+    hi[d] = lv->period[d] ? top : MPM_MIN(z[d], top);
     if (lo[d] > hi[d]) return;
   }
   for (gi[2] = lo[2]; gi[2] <= hi[2]; ++gi[2])
     for (gi[1] = lo[1]; gi[1] <= hi[1]; ++gi[1])
-      for (gi[0] = lo[0]; gi[0] <= hi[0]; ++gi[0]) mask[mpm_grid_local_index(g, gi)] = 1;
+      for (gi[0] = lo[0]; gi[0] <= hi[0]; ++gi[0]) {
+        int in = 1;
+        for (int d = 0; d < g->dim; ++d) in &= in_range(gi[d], a[d], z[d], lv->period[d]);
+        if (in) mask[mpm_grid_local_index(g, gi)] = 1;
+      }
 }
 
-/* Is every span in [a, z] covered on level l? */
-static int all_covered(const mpm_hier *h, int l, const int *a, const int *z) {
+/* Mask value of span gi on level l, looked up at its image along the level's periodic axes,
+ * with the rule outside the box of the file comment. */
+static inline int span_flag(const mpm_hier *h, int l, const unsigned char *mask, const int *gi,
+                            int out) {
   const mpm_grid *g = h->level[l].grid;
+  int c[MPM_MAX_DIM] = {gi[0], gi[1], gi[2]};
+  hier_canon(&h->level[l], h->dim, c);
+  return hier_in_box(g, c) ? mask[mpm_grid_local_index(g, c)] : out;
+}
+
+/* Is every span in [a, z] covered on level l (periodically)? */
+static int all_covered(const mpm_hier *h, int l, const int *a, const int *z) {
   int lo[MPM_MAX_DIM] = {0, 0, 0}, hi[MPM_MAX_DIM] = {0, 0, 0}, gi[MPM_MAX_DIM];
   for (int d = 0; d < h->dim; ++d) lo[d] = a[d], hi[d] = z[d];
   if (l == 0) return 1;
   for (gi[2] = lo[2]; gi[2] <= hi[2]; ++gi[2])
     for (gi[1] = lo[1]; gi[1] <= hi[1]; ++gi[1])
       for (gi[0] = lo[0]; gi[0] <= hi[0]; ++gi[0])
-        if (!hier_in_box(g, gi) || !h->level[l].covered[mpm_grid_local_index(g, gi)]) return 0;
+        if (!span_flag(h, l, h->level[l].covered, gi, 0)) return 0;
   return 1;
-}
-
-/* Mask value of span gi on level l, with the rule outside the box of the file comment. */
-static int span_flag(const mpm_hier *h, int l, const unsigned char *mask, const int *gi, int out) {
-  const mpm_grid *g = h->level[l].grid;
-  return hier_in_box(g, gi) ? mask[mpm_grid_local_index(g, gi)] : out;
 }
 
 /* Node gi of level l is active: spans gi - 1 .. gi + 1 all covered, not all refined. */
@@ -174,6 +200,40 @@ static int alloc_masks(mpm_hier_level *lv) {
   return 0;
 }
 
+/* The images of level l >= 1 (its nodes outside [0, period) along an axis with a period). */
+static int find_images(mpm_hier_level *lv, int dim) {
+  const mpm_grid *g = lv->grid;
+  int any = 0, gi[MPM_MAX_DIM], c[MPM_MAX_DIM];
+  for (int d = 0; d < dim; ++d) any |= lv->period[d] != 0;
+  if (!any) return 0;
+  MPM_ALLOC(lv->is_image, g->nnodes);
+  for (int pass = 0; pass < 2; ++pass) {
+    lv->nimage = 0;
+    for (mpm_lidx n = 0; n < g->nnodes; ++n) {
+      hier_node_of(g, n, gi);
+      memcpy(c, gi, sizeof c);
+      hier_canon(lv, dim, c);
+      if (!memcmp(c, gi, sizeof c)) continue;
+      if (pass) lv->image[lv->nimage] = n, lv->canon[lv->nimage] = mpm_grid_local_index(g, c);
+      lv->is_image[n] = 1, lv->nimage++;
+    }
+    if (!pass) MPM_ALLOC(lv->image, lv->nimage > 0 ? lv->nimage : 1);
+    if (!pass) MPM_ALLOC(lv->canon, lv->nimage > 0 ? lv->nimage : 1);
+  }
+  return 0;
+}
+
+/* Along the periodic axes, level l stores the whole period when its box [lo, hi] would reach a
+ * node outside [0, N_l): then [-1, N_l + 2^(l-1) + 2], which holds the stencil of every point
+ * of the domain (at 2^(l-1) - 1 + [0, N_l + 2] on level l's lattice) with a node to spare. */
+static void wrap_level(const mpm_grid *g0, int l, int *lo, int *hi, int *period) {
+  for (int d = 0; d < g0->dim; ++d) {
+    const int N = g0->ncells[d] << l;
+    if (!g0->periodic[d] || (lo[d] >= 0 && hi[d] <= N - 1)) continue;
+    lo[d] = -1, hi[d] = N + (1 << (l - 1)) + 2, period[d] = N;
+  }
+}
+
 /* ---- levels ----------------------------------------------------------------------------- */
 
 /* The box grid of level l (>= 1) holding the boxes of that level, its covered mask, and the
@@ -192,16 +252,19 @@ static int make_level(mpm_hier *h, int l, const mpm_hier_box *box, const box_spa
     first = 0;
   }
   const double hf = 0.5 * c->dx;
-  for (int d = 0; d < h->dim; ++d) origin[d] = c->lo[d] - 0.5 * hf, n[d] = hi[d] - lo[d] + 1;
   mpm_hier_level *lv = &h->level[l];
+  wrap_level(h->level[0].grid, l, lo, hi, lv->period);
+  for (int d = 0; d < h->dim; ++d) h->wraps |= lv->period[d] != 0;
+  for (int d = 0; d < h->dim; ++d) origin[d] = c->lo[d] - 0.5 * hf, n[d] = hi[d] - lo[d] + 1;
   MPM_CALL(mpm_grid_box_new(&lv->grid, h->dim, origin, hf, c->shape, lo, n));
   MPM_CALL(alloc_masks(lv));
+  MPM_CALL(find_images(lv, h->dim));
   for (int k = 0; k < nbox; ++k) {
     if (box[k].level != l) continue;
     int fa[MPM_MAX_DIM] = {0, 0, 0}, fz[MPM_MAX_DIM] = {0, 0, 0};
     for (int d = 0; d < h->dim; ++d) fa[d] = 2 * sp[k].a[d], fz[d] = 2 * sp[k].z[d] + 1;
-    mark(lv->grid, lv->covered, fa, fz);
-    mark(c, h->level[l - 1].refined, sp[k].a, sp[k].z);
+    mark(lv, lv->covered, fa, fz);
+    mark(&h->level[l - 1], h->level[l - 1].refined, sp[k].a, sp[k].z);
   }
   return 0;
 }
@@ -251,6 +314,8 @@ int mpm_hier_new(mpm_hier **hp, mpm_grid *grid, int nlevels, const mpm_hier_box 
   MPM_ALLOC(h, 1);
   h->dim = grid->dim, h->nlevels = nlevels, h->buffer = buffer;
   h->level[0].grid = grid;
+  for (int d = 0; d < grid->dim; ++d)
+    h->level[0].period[d] = grid->periodic[d] ? grid->ncells[d] : 0;
   rc = alloc_masks(&h->level[0]);
   if (!rc) memset(h->level[0].covered, 1, (size_t)grid->nnodes);
   if (!rc) rc = build_levels(h, box, nbox, why, why_len);
@@ -270,6 +335,7 @@ void mpm_hier_destroy(mpm_hier **hp) {
     mpm_hier_level *lv = &h->level[l];
     if (l > 0) mpm_grid_destroy(&lv->grid);
     free(lv->covered), free(lv->refined), free(lv->active);
+    free(lv->image), free(lv->canon), free(lv->is_image);
   }
   mpm_hier_scratch_free(h->scratch);
   free(h);
@@ -278,8 +344,10 @@ void mpm_hier_destroy(mpm_hier **hp) {
 
 /* ---- points ----------------------------------------------------------------------------- */
 
-int mpm_hier_level_of(const mpm_hier *h, const double *x) {
+int mpm_hier_level_of(const mpm_hier *h, const double *xp) {
   int l = 0, gi[MPM_MAX_DIM] = {0, 0, 0};
+  double x[MPM_MAX_DIM];
+  hier_wrap_point(h, xp, x);
   for (; l + 1 < h->nlevels; ++l) {
     const mpm_grid *g = h->level[l].grid;
     for (int d = 0; d < h->dim; ++d) {
@@ -288,7 +356,7 @@ int mpm_hier_level_of(const mpm_hier *h, const double *x) {
       if (!(xi > g->box_lo[d] - 1.0 && xi < g->box_lo[d] + g->box_n[d])) return l;
       gi[d] = hier_span_of(xi);
     }
-    if (!hier_in_box(g, gi) || !h->level[l].refined[mpm_grid_local_index(g, gi)]) return l;
+    if (!span_flag(h, l, h->level[l].refined, gi, 0)) return l;
   }
   return l;
 }

@@ -32,6 +32,21 @@
  * whose support meets Omega_l plus one layer. This version runs on one rank, with the
  * quadratic B-spline only: mpm_hier_new() refuses anything else with a reason.
  *
+ * Periodic axes. Along a periodic axis d of the grid, level l's lattice wraps with a period of
+ * N_l = ncells[d] 2^l nodes (and spans), and a region may touch, cross or span the periodic
+ * faces (a box may then reach up to a period outside the domain along d). The regions and
+ * masks are periodic: a span or node index is looked up at its image in [0, N_l). A level whose
+ * region comes within two of its nodes of a periodic face (in particular a band spanning the
+ * whole period) stores the whole period along d: period[d] = N_l, its box is
+ * [-1, N_l + 2^(l-1) + 2] along d, which holds the stencil of every position of the domain, and
+ * its nodes outside [0, N_l) are images of those inside, like level 0's ghosts: the restriction
+ * first folds (adds) every image into its node and zeroes it, and restricts the nodes in
+ * [0, N_l) only; the prolongation fills those and then copies every node into its images.
+ * Particles on such a level deposit and read with their position wrapped into the domain along
+ * d. Level 0 always has period[d] = ncells[d] along its periodic axes (its halo folds it).
+ * Elsewhere period[d] = 0, and nothing changes: a hierarchy that stays clear of the periodic
+ * faces computes bit for bit what it did before they were carried.
+ *
  * Masks (one byte per box node of a level, indexed like its nodal fields): covered[l][i] is 1
  * when span i of level l lies in Omega_l, refined[l][i] when it lies in Omega_{l+1}, active[l][i]
  * when node i is active. */
@@ -56,10 +71,16 @@ typedef struct mpm_hier_box {
 typedef struct mpm_hier_level {
   mpm_grid *grid; /* level 0: the shared grid (not owned); finer levels: owned box grids */
   unsigned char *covered, *refined, *active;
+  int period[MPM_MAX_DIM]; /* nodes per period where the box holds the whole period, else 0 */
+  /* Levels >= 1 with a period: the box nodes that are images (image[k], a box index) and the
+   * node in [0, N_l) each is an image of (canon[k]); is_image[n] marks them (NULL: none). */
+  mpm_lidx nimage, *image, *canon;
+  unsigned char *is_image;
 } mpm_hier_level;
 
 typedef struct mpm_hier {
   int dim, nlevels, buffer;
+  int wraps; /* some level >= 1 stores a whole period (mpm_hier_level.period) */
   mpm_hier_level level[MPM_HIER_MAX_LEVELS];
   void *scratch; /* private to mpm_hier.c: per-level particle lists and gathered arrays */
 } mpm_hier;
@@ -86,7 +107,8 @@ void mpm_hier_destroy(mpm_hier **h);
 /* Give every finer level the phases the grid has and it lacks (after a module adds one). */
 int mpm_hier_add_phases(mpm_hier *h);
 
-/* The finest level whose region contains x. */
+/* The finest level whose region contains x (wrapped into the domain along the periodic axes
+ * when the hierarchy wraps). */
 int mpm_hier_level_of(const mpm_hier *h, const double *x);
 
 /* The level of every particle of p (mpm_hier_level_of at its field "x") into level[p->n]
@@ -99,6 +121,12 @@ void mpm_hier_count_levels(const mpm_hier *h, const mpm_particles *p, double *co
  * and returns their number (at most 3^dim times the number of levels); -1 if max is too small
  * or x lies so far outside the domain that its stencil leaves level 0's box. */
 int mpm_hier_eval(const mpm_hier *h, const double *x, mpm_hier_weight *w, int max);
+
+/* Levels the caller vouches for: until the next call, a composite transfer (mpm_hier_p2g,
+ * mpm_hier_g2p) whose positions are the array x0 (its x[0]) with n particles takes level[i]
+ * (mpm_hier_level_of of particle i's position, kept by the caller) instead of finding it again.
+ * x0 NULL forgets them. The caller calls again, or forgets, before those positions change. */
+void mpm_hier_levels_known(mpm_hier *h, const double *x0, mpm_lidx n, const unsigned char *level);
 
 /* Composite P2G of one phase: each particle deposits (a's fields, with the unchanged kernel) on
  * the level mpm_hier_level_of gives for its position; adds, as the kernel does. Follow it with

@@ -6,6 +6,10 @@
  * layer included, and read or write only its 2^dim parents, which lie in the coarser box (see
  * mpm_hier.c); restriction leaves every inactive node at exactly zero. mpm_hier_eval pushes
  * weights down exactly as P2G followed by restriction does, so the two agree to roundoff.
+ * On a level that stores a whole period (mpm_hier.h, periodic axes) the restriction first
+ * folds every image into its node and the prolongation ends by copying every node into its
+ * images; both skip the images otherwise (their parents may lie outside the coarser box), and
+ * mpm_hier_eval moves every node onto its image before it looks it up.
  * Every call of the per-level restriction and prolongation is timed (MPM_T_RESTRICT and
  * MPM_T_PROLONG, mpm_timer.h), whoever calls it. */
 #include "mpm_hier_impl.h"
@@ -24,16 +28,37 @@ int mpm_hier_parents(const mpm_grid *c, const int *gi, mpm_lidx *idx, double *w)
   return np;
 }
 
+/* Add every image of level lv into its node and zero it, for nf arrays. */
+static void fold_images(const mpm_hier_level *lv, double *const *a, int nf) {
+  for (int k = 0; k < nf; ++k)
+    for (mpm_lidx q = 0; q < lv->nimage; ++q) {
+      a[k][lv->canon[q]] += a[k][lv->image[q]];
+      a[k][lv->image[q]] = 0.0;
+    }
+}
+
+/* Copy every node of level lv into its images, for nf arrays. */
+static void copy_images(const mpm_hier_level *lv, double *const *a, int nf) {
+  for (int k = 0; k < nf; ++k)
+    for (mpm_lidx q = 0; q < lv->nimage; ++q) a[k][lv->image[q]] = a[k][lv->canon[q]];
+}
+
+/* Does the restriction or prolongation skip node n of level lv (active, or an image)? */
+static int skips(const mpm_hier_level *lv, mpm_lidx n) {
+  return lv->active[n] || (lv->is_image && lv->is_image[n]);
+}
+
 void mpm_hier_restrict_level(mpm_hier *h, int l, double *const *fine, double *const *coarse,
                              int nf) {
-  const mpm_grid *f = h->level[l].grid, *c = h->level[l - 1].grid;
-  const unsigned char *active = h->level[l].active;
+  const mpm_hier_level *lv = &h->level[l];
+  const mpm_grid *f = lv->grid, *c = h->level[l - 1].grid;
   int gi[MPM_MAX_DIM];
   mpm_lidx idx[8];
   double w[8];
   mpm_timer_start(MPM_T_RESTRICT);
+  fold_images(lv, fine, nf);
   for (mpm_lidx n = 0; n < f->nnodes; ++n) {
-    if (active[n]) continue;
+    if (skips(lv, n)) continue;
     hier_node_of(f, n, gi);
     const int np = mpm_hier_parents(c, gi, idx, w);
     for (int k = 0; k < nf; ++k) {
@@ -47,14 +72,14 @@ void mpm_hier_restrict_level(mpm_hier *h, int l, double *const *fine, double *co
 
 void mpm_hier_prolong_level(mpm_hier *h, int l, const double *const *coarse, double *const *fine,
                             int nf) {
-  const mpm_grid *f = h->level[l].grid, *c = h->level[l - 1].grid;
-  const unsigned char *active = h->level[l].active;
+  const mpm_hier_level *lv = &h->level[l];
+  const mpm_grid *f = lv->grid, *c = h->level[l - 1].grid;
   int gi[MPM_MAX_DIM];
   mpm_lidx idx[8];
   double w[8];
   mpm_timer_start(MPM_T_PROLONG);
   for (mpm_lidx n = 0; n < f->nnodes; ++n) {
-    if (active[n]) continue;
+    if (skips(lv, n)) continue;
     hier_node_of(f, n, gi);
     const int np = mpm_hier_parents(c, gi, idx, w);
     for (int k = 0; k < nf; ++k) {
@@ -63,6 +88,7 @@ void mpm_hier_prolong_level(mpm_hier *h, int l, const double *const *coarse, dou
       fine[k][n] = v;
     }
   }
+  copy_images(lv, fine, nf);
   mpm_timer_stop(MPM_T_PROLONG);
 }
 
@@ -147,13 +173,23 @@ static int merge(entry *list, int n, int dim, const int *gi, double s, const ent
   return n;
 }
 
-/* Move entry e of a fine node onto its 2^dim parents in next; returns the new count. */
-static int push_down(entry *next, int n, int dim, const entry *e) {
+/* The node of gi on level lv as the hierarchy looks it up: its image in the period where
+ * the hierarchy wraps, gi itself otherwise. */
+static void lookup_node(const mpm_hier *h, const mpm_hier_level *lv, int *gi) {
+  if (h->wraps) hier_canon(lv, h->dim, gi);
+}
+
+/* Move entry e of a fine node onto its 2^dim parents (on coarse level cv) in next; returns
+ * the new count. */
+static int push_down(const mpm_hier *h, const mpm_hier_level *cv, entry *next, int n,
+                     const entry *e) {
+  const int dim = h->dim;
   int p[MPM_MAX_DIM][2] = {{0, 0}, {0, 0}, {0, 0}};
   for (int d = 0; d < dim; ++d) hier_parents_1d(e->gi[d], p[d]);
   for (int k = 0; k < (1 << dim) && n >= 0; ++k) {
     int q[MPM_MAX_DIM] = {0, 0, 0};
     const double s = hier_parent_k(dim, (const int(*)[2])p, k, q);
+    lookup_node(h, cv, q);
     n = merge(next, n, dim, q, s, e);
   }
   return n;
@@ -166,10 +202,13 @@ static int nonzero(const entry *e, int dim) {
   return any;
 }
 
-int mpm_hier_eval(const mpm_hier *h, const double *x, mpm_hier_weight *w, int max) {
+int mpm_hier_eval(const mpm_hier *h, const double *xp, mpm_hier_weight *w, int max) {
   entry cur[MAX_ENTRIES], next[MAX_ENTRIES];
+  double x[MPM_MAX_DIM];
+  hier_wrap_point(h, xp, x);
   const int l0 = mpm_hier_level_of(h, x);
   int ncur = stencil(h->level[l0].grid, x, cur), nout = 0;
+  for (int k = 0; k < ncur; ++k) lookup_node(h, &h->level[l0], cur[k].gi);
   for (int l = l0; l >= 0 && ncur > 0; --l) {
     const mpm_grid *g = h->level[l].grid;
     int nnext = 0;
@@ -178,7 +217,7 @@ int mpm_hier_eval(const mpm_hier *h, const double *x, mpm_hier_weight *w, int ma
       const mpm_lidx node = mpm_grid_local_index(g, cur[k].gi);
       if (!h->level[l].active[node]) {
         /* Level 0's inactive nodes lie under level 1 and never carry a weight here. */
-        if (l > 0 && (nnext = push_down(next, nnext, h->dim, &cur[k])) < 0) return -1;
+        if (l > 0 && (nnext = push_down(h, &h->level[l - 1], next, nnext, &cur[k])) < 0) return -1;
         continue;
       }
       if (!nonzero(&cur[k], h->dim)) continue;

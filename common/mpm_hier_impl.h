@@ -27,6 +27,39 @@ static inline int hier_half(int a) {
   return a >= 0 ? a / 2 : -((1 - a) / 2);
 }
 
+/* i mod n in [0, n), for either sign of i (n > 0). */
+static inline int hier_mod(int i, int n) {
+  const int r = i % n;
+  return r < 0 ? r + n : r;
+}
+
+/* Move gi (global indices of level lv's lattice, first dim entries) onto its image in
+ * [0, period[d]) along every axis where the level has a period (mpm_hier.h, periodic axes). */
+static inline void hier_canon(const mpm_hier_level *lv, int dim, int *gi) {
+  for (int d = 0; d < dim; ++d) {
+    const int P = lv->period[d]; /* (the division only for an image: this is a hot path) */
+    if (P && (gi[d] < 0 || gi[d] >= P)) gi[d] = hier_mod(gi[d], P);
+  }
+}
+
+/* x wrapped into [lo, hi) when it lies at most a period outside, as mpm_grid_wrap does (inline:
+ * a hot path). */
+static inline double hier_wrap_coord(double x, double lo, double hi) {
+  const double len = hi - lo;
+  if (x >= hi && x < hi + len) return x - len;
+  if (x < lo && x >= lo - len) return x + len < hi ? x + len : lo;
+  return x;
+}
+
+/* x into out, wrapped into the domain along the periodic axes when the hierarchy wraps (a
+ * level stores a whole period); a plain copy otherwise. */
+static inline void hier_wrap_point(const mpm_hier *h, const double *x, double *out) {
+  const mpm_grid *g = h->level[0].grid;
+  for (int d = 0; d < MPM_MAX_DIM; ++d) out[d] = d < h->dim ? x[d] : 0.0;
+  for (int d = 0; h->wraps && d < h->dim; ++d)
+    if (g->periodic[d]) out[d] = hier_wrap_coord(out[d], g->lo[d], g->hi[d]);
+}
+
 /* Does box node gi (global indices of g, first dim entries) lie in g's box? */
 static inline int hier_in_box(const mpm_grid *g, const int *gi) {
   for (int d = 0; d < g->dim; ++d)

@@ -6,7 +6,10 @@
  * Invariants: the scratch (h->scratch) grows and never shrinks, so a steady run allocates
  * nothing per step; a chunk holds at most CHUNK particles, so the gathered columns stay in
  * cache and their memory is bounded whatever the particle count; when every particle lies on
- * level 0 the kernel runs on the caller's arrays directly (the plain kernel call). */
+ * level 0 the kernel runs on the caller's arrays directly (the plain kernel call); levels a
+ * caller vouches for (mpm_hier_levels_known) are taken as given for its positions alone. On a level
+ * that stores a whole period along an axis (mpm_hier.h) the gathered positions are wrapped
+ * into the domain along it, so every stencil lies in the level's box. */
 #include "mpm_hier_impl.h"
 
 #include "mpm_error.h"
@@ -20,11 +23,14 @@ enum {
 };
 
 typedef struct hier_scratch {
-  mpm_lidx cap_n;     /* particles lev and order hold */
-  unsigned char *lev; /* level of each particle */
-  mpm_lidx *order;    /* particle indices, level 0's first, then level 1's, ... */
-  size_t cap_buf;     /* doubles in buf */
-  double *buf;        /* gathered columns of one chunk */
+  mpm_lidx cap_n;        /* particles lev and order hold */
+  unsigned char *lev;    /* level of each particle */
+  mpm_lidx *order;       /* particle indices, level 0's first, then level 1's, ... */
+  size_t cap_buf;        /* doubles in buf */
+  double *buf;           /* gathered columns of one chunk */
+  const double *known_x; /* mpm_hier_levels_known: positions, count and their levels */
+  mpm_lidx known_n;
+  const unsigned char *known;
 } hier_scratch;
 
 void mpm_hier_scratch_free(void *scratch) {
@@ -33,14 +39,27 @@ void mpm_hier_scratch_free(void *scratch) {
   free(s->lev), free(s->order), free(s->buf), free(s);
 }
 
-/* Room for n particles (and a chunk of columns for them). */
-static int reserve(mpm_hier *h, mpm_lidx n) {
+/* The scratch, made on first use. */
+static int scratch_of(mpm_hier *h, hier_scratch **s) {
   if (!h->scratch) {
     hier_scratch *fresh;
     MPM_ALLOC(fresh, 1);
     h->scratch = fresh;
   }
-  hier_scratch *s = h->scratch;
+  *s = h->scratch;
+  return 0;
+}
+
+void mpm_hier_levels_known(mpm_hier *h, const double *x0, mpm_lidx n, const unsigned char *level) {
+  hier_scratch *s = NULL;
+  if (scratch_of(h, &s)) return; /* (out of memory: the transfers find the levels) */
+  s->known_x = x0, s->known_n = x0 ? n : 0, s->known = x0 ? level : NULL;
+}
+
+/* Room for n particles (and a chunk of columns for them). */
+static int reserve(mpm_hier *h, mpm_lidx n) {
+  hier_scratch *s = NULL;
+  MPM_CALL(scratch_of(h, &s));
   if (n > s->cap_n) {
     free(s->lev), free(s->order);
     s->lev = NULL, s->order = NULL, s->cap_n = 0;
@@ -63,10 +82,11 @@ static int reserve(mpm_hier *h, mpm_lidx n) {
 static int classify(mpm_hier *h, mpm_lidx n, const double *const *x, mpm_lidx *first) {
   hier_scratch *s = h->scratch;
   mpm_lidx count[MPM_HIER_MAX_LEVELS + 1] = {0};
+  const int known = s->known && s->known_x == x[0] && s->known_n == n;
   for (mpm_lidx p = 0; p < n; ++p) {
     double xp[MPM_MAX_DIM] = {0, 0, 0};
-    for (int d = 0; d < h->dim; ++d) xp[d] = x[d][p];
-    s->lev[p] = (unsigned char)mpm_hier_level_of(h, xp);
+    for (int d = 0; d < h->dim && !known; ++d) xp[d] = x[d][p];
+    s->lev[p] = known ? s->known[p] : (unsigned char)mpm_hier_level_of(h, xp);
     count[s->lev[p] + 1]++;
   }
   first[0] = 0;
@@ -98,6 +118,19 @@ static const double *gather(chunk *c, const double *src, int ncomp) {
   return dst;
 }
 
+/* Gather the positions of a chunk on level l, wrapped into the domain along every axis where
+ * the level (>= 1) stores a whole period. */
+static void gather_x(const mpm_hier *h, int l, chunk *c, const double *const *x,
+                     const double **out) {
+  const mpm_grid *g0 = h->level[0].grid;
+  for (int d = 0; d < h->dim; ++d) {
+    double *o = c->next;
+    out[d] = gather(c, x[d], 1);
+    if (l > 0 && h->level[l].period[d]) /* level 0's halo takes its images */
+      for (mpm_lidx i = 0; i < c->nc; ++i) o[i] = hier_wrap_coord(o[i], g0->lo[d], g0->hi[d]);
+  }
+}
+
 /* Fresh output columns for ncomp components (always: the kernel writes v and a). */
 static double *column(chunk *c, int ncomp) {
   double *dst = c->next;
@@ -121,7 +154,8 @@ static void p2g_chunk(mpm_hier *h, int l, int phase, const mpm_p2g_args *a, chun
   const int D = h->dim;
   mpm_p2g_args b = *a;
   b.n = c->nc;
-  for (int d = 0; d < D; ++d) b.x[d] = gather(c, a->x[d], 1), b.v[d] = gather(c, a->v[d], 1);
+  gather_x(h, l, c, a->x, b.x);
+  for (int d = 0; d < D; ++d) b.v[d] = gather(c, a->v[d], 1);
   b.m = gather(c, a->m, 1);
   b.vsig = gather(c, a->vsig, D * D);
   b.C = gather(c, a->C, D * D);
@@ -167,10 +201,8 @@ static void g2p_chunk(mpm_hier *h, int l, const mpm_g2p_args *lv, const mpm_g2p_
   const int D = h->dim, DD = D * D;
   mpm_g2p_args b = *lv;
   b.n = c->nc;
-  for (int d = 0; d < D; ++d) {
-    b.x[d] = gather(c, a->x[d], 1);
-    b.v_out[d] = column(c, 1), b.a_out[d] = column(c, 1);
-  }
+  gather_x(h, l, c, a->x, b.x);
+  for (int d = 0; d < D; ++d) b.v_out[d] = column(c, 1), b.a_out[d] = column(c, 1);
   b.F = a->LF_out ? gather(c, a->F, DD) : NULL;
   b.L_out = a->L_out ? column(c, DD) : NULL;
   b.C_out = a->C_out ? column(c, DD) : NULL;

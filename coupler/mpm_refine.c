@@ -3,8 +3,10 @@
  * What the slice refuses here, one line each naming the key: boxes without refine.levels > 1,
  * a solid beside a gas, a solid with dynamic regrids, more than one rank, a shape other than the
  * quadratic B-spline, and a box within three level-0 cells of a non-periodic domain face (walls and
- * open faces act on level 0 alone). mpm_hier_new's own reasons name the box's key. The gas and the
- * solid refuse their own settings (fluid/fluid_refine.c, solid/solid_refine.c). */
+ * open faces act on level 0 alone). Along a periodic axis a box or a dynamic region may touch,
+ * cross or span the periodic faces (the levels wrap there, mpm_hier.h). mpm_hier_new's own reasons
+ * name the box's key. The gas and the solid refuse their own settings (fluid/fluid_refine.c,
+ * solid/solid_refine.c). */
 #include "mpm_refine.h"
 
 #include "fluid_module.h"
@@ -60,8 +62,9 @@ const mpm_key_spec mpm_refine_keys[] = {
      "inside level l - 1's region by refine.buffer cells",
      0, "-"},
     {"refine.*.lo", MPM_KEY_REALS, NULL, -HUGE_VAL, HUGE_VAL, 0, 3, NULL,
-     "lower corner of the box, m (dim values; snapped outwards to the coarser level's cells)", 0,
-     "m"},
+     "lower corner of the box, m (dim values; snapped outwards to the coarser level's cells; "
+     "along a periodic axis the box may cross the faces, up to a period beyond them)",
+     0, "m"},
     {"refine.*.hi", MPM_KEY_REALS, NULL, -HUGE_VAL, HUGE_VAL, 0, 3, NULL,
      "upper corner of the box, m (dim values)", 0, "m"},
 };
@@ -93,7 +96,8 @@ static int check_case(const mpm_config *cfg, const mpm_grid *grid, mpm_module **
   return 0;
 }
 
-/* Box NAME from its section, kept REFINE_FACE_CELLS level-0 cells from non-periodic faces. */
+/* Box NAME from its section, kept REFINE_FACE_CELLS level-0 cells from non-periodic faces
+ * (along a periodic axis mpm_hier_new takes it up to a period beyond the faces). */
 static int read_box(const mpm_config *cfg, const mpm_grid *g, const char *name, mpm_hier_box *b) {
   char key[3][160];
   static const char *const part[3] = {"level", "lo", "hi"};
@@ -108,12 +112,13 @@ static int read_box(const mpm_config *cfg, const mpm_grid *g, const char *name, 
   }
   const double gap = REFINE_FACE_CELLS * g->dx, tol = 1e-9 * g->dx;
   for (int d = 0; d < g->dim; ++d) {
+    if (g->periodic[d]) continue;
     const int low = b->lo[d] < g->lo[d] + gap - tol;
     if (low || b->hi[d] > g->hi[d] - gap + tol)
       return mpm_config_fail(cfg, key[low ? 1 : 2],
                              "the box comes within %d level-0 cells (%g) of the domain face %c = "
-                             "%g: walls, open faces and the periodic wrap act on level 0 only; "
-                             "keep the box inside [%g, %g] along %c",
+                             "%g: walls and open faces act on level 0 only; keep the box inside "
+                             "[%g, %g] along %c (or make the axis periodic)",
                              REFINE_FACE_CELLS, gap, "xyz"[d], low ? g->lo[d] : g->hi[d],
                              g->lo[d] + gap, g->hi[d] - gap, "xyz"[d]);
   }
@@ -140,8 +145,9 @@ static int read_boxes(const mpm_config *cfg, const mpm_grid *g, const char *cons
 
 /* ---- dynamic refinement: the regions from the criterion's flags --------------------------- */
 
-/* Level-0 cells a dynamic region keeps from every domain face (the static boxes' rule, met by
- * construction: span i's lower face is at (i - 1/2) dx). */
+/* Level-0 cells a dynamic region keeps from every non-periodic domain face (the static boxes'
+ * rule, met by construction: span i's lower face is at (i - 1/2) dx); along a periodic axis
+ * the region wraps. */
 #define REFINE_CLIP 4
 
 /* The criteria refine.criterion may list, in fluid_refine_criterion's order; the first
@@ -267,19 +273,24 @@ static size_t flag_lattice(const mpm_grid *g, int *n) {
   return total;
 }
 
-/* Dilate mask by r spans along every axis (a box of side 2 r + 1), into out; tmp as scratch. */
-static void dilate(const int *n, int dim, int r, const unsigned char *mask, unsigned char *out,
-                   unsigned char *tmp) {
+/* Dilate mask by r spans along every axis (a box of side 2 r + 1), wrapping along the
+ * periodic ones, into out; tmp as scratch. */
+static void dilate(const mpm_grid *g, const int *n, int r, const unsigned char *mask,
+                   unsigned char *out, unsigned char *tmp) {
   const size_t total = (size_t)n[0] * n[1] * n[2];
   memcpy(out, mask, total);
   size_t stride = 1;
-  for (int d = 0; d < dim; stride *= (size_t)n[d], ++d) {
+  for (int d = 0; d < g->dim; stride *= (size_t)n[d], ++d) {
     memcpy(tmp, out, total);
+    const int wrap = g->periodic[d];
     for (size_t s = 0; s < total; ++s) {
       if (!tmp[s]) continue;
       const int i = (int)(s / stride % (size_t)n[d]);
-      for (int j = MPM_MAX(0, i - r); j <= MPM_MIN(n[d] - 1, i + r); ++j)
-        out[s + ((size_t)j - (size_t)i) * stride] = 1;
+      const int a = wrap ? i - r : MPM_MAX(0, i - r), z = wrap ? i + r : MPM_MIN(n[d] - 1, i + r);
+      for (int j = a; j <= z; ++j) {
+        const int k = ((j % n[d]) + n[d]) % n[d];
+        out[s + ((size_t)k - (size_t)i) * stride] = 1;
+      }
     }
   }
 }
@@ -304,7 +315,7 @@ static int mask_boxes(const mpm_grid *g, const int *n, int l, double eps, const 
       mpm_hier_box *b = &(*box)[(*nbox)++];
       const int first[3] = {a, j[0], j[1]}, last[3] = {z, j[0], j[1]};
       b->level = l;
-      for (int d = 0; d < g->dim; ++d) {
+      for (int d = 0; d < g->dim; ++d) { /* (span 0 of a periodic axis crosses its face) */
         b->lo[d] = g->lo[d] + (first[d] - 0.5) * g->dx + eps;
         b->hi[d] = g->lo[d] + (last[d] + 0.5) * g->dx - eps;
       }
@@ -316,7 +327,8 @@ static int mask_boxes(const mpm_grid *g, const int *n, int l, double eps, const 
 
 /* The hierarchy the gas's flags ask for (*h = NULL when nothing is flagged). Level l's region
  * is the flags dilated by dilate (levels - l) spans, clipped to REFINE_CLIP + (l - 1) dilate
- * spans from every face, so that each level nests in the one below with its buffer. */
+ * spans from every non-periodic face, so that each level nests in the one below with its
+ * buffer; along a periodic axis the dilation wraps and nothing is clipped. */
 static int make_dynamic(mpm_hier **h, const dynamic *dy, mpm_grid *grid, mpm_module *gas) {
   int n[MPM_MAX_DIM];
   const size_t total = flag_lattice(grid, n);
@@ -333,13 +345,13 @@ static int make_dynamic(mpm_hier **h, const dynamic *dy, mpm_grid *grid, mpm_mod
   }
   const double eps = 1e-6 * ldexp(grid->dx, -dy->levels);
   for (int l = 1; l < dy->levels && !rc; ++l) {
-    dilate(n, grid->dim, dy->dilate * (dy->levels - l), flag, mask, tmp);
+    dilate(grid, n, dy->dilate * (dy->levels - l), flag, mask, tmp);
     const int clip = REFINE_CLIP + (l - 1) * dy->dilate;
     int any = 0;
     for (size_t s = 0; s < total; ++s) {
       int in = 1;
       for (int d = 0, r = (int)s; d < grid->dim; r /= n[d], ++d)
-        in &= r % n[d] >= clip && r % n[d] <= grid->ncells[d] - clip;
+        in &= grid->periodic[d] || (r % n[d] >= clip && r % n[d] <= grid->ncells[d] - clip);
       mask[s] &= (unsigned char)in;
       any |= mask[s];
     }

@@ -19,7 +19,9 @@
  * nodal pressure is formed on the active nodes and prolonged, each level integrates over its own
  * spans (those of its region not refined further; level 0 over the domain, halved at the walls),
  * and the level forces and rates are restricted onto the active nodes, the transposes of the
- * prolongations: the composite basis is integrated exactly.
+ * prolongations: the composite basis is integrated exactly. A level that stores a whole period
+ * (mpm_hier.h, periodic axes) integrates each span once, over [0, N_l) along that axis; the
+ * restriction folds what lands on its images.
  *
  * Walls. Level 0's pad nodes take part like any node (their pressure and rate from their own
  * unfolded mass); the walls then fold their forces as they fold the particles' deposits.
@@ -169,8 +171,10 @@ static int ensure_levels(mpm_module *m, fluid_gridp *gp) {
       gp->skip[l][n] = !h->level[l].covered[n] || h->level[l].refined[n];
     mpm_span_set *s = &gp->set[l];
     *s = (mpm_span_set){.skip = gp->skip[l]};
-    for (int d = 0; d < g->dim; ++d)
-      s->lo[d] = g->box_lo[d], s->hi[d] = g->box_lo[d] + g->box_n[d] - 1;
+    for (int d = 0; d < g->dim; ++d) { /* the spans in [0, N_l) where the level wraps */
+      const int N = h->level[l].period[d];
+      s->lo[d] = N ? 0 : g->box_lo[d], s->hi[d] = N ? N - 1 : g->box_lo[d] + g->box_n[d] - 1;
+    }
   }
   return 0;
 }

@@ -74,6 +74,8 @@ typedef struct fluid_content {
   mpm_module_ops ops; /* the module's ops: p2g_rate only with the current strain rate */
   fluid_gridp *gridp; /* fluid.pressure = grid, or NULL */
   int refined;        /* on a refinement (its particles follow the levels: fluid_relevel.c) */
+  double *av_l;       /* refined: each particle's artificial viscosity length (cap) */
+  unsigned char *lev; /* refined: the level of each particle's position in this RHS (cap) */
 } fluid_content;
 
 /* What the classic step's transfer gives each particle (component-major, stride n). */
@@ -176,6 +178,14 @@ int fluid_g2p_phase(mpm_module *m, const double *y, double *const *v_out, double
                     double *L_out, const mpm_hier_scalars *s, double *s_out);
 /* The grid spacing of the finest level (the grid's without refinement). */
 double fluid_finest_dx(const mpm_module *m);
+/* The spacing of the level particle i of state y deposits on (its position's; the grid's
+ * without a hierarchy). */
+double fluid_level_spacing(const mpm_module *m, const double *y, mpm_lidx i);
+/* On a refinement, at the start of an RHS: the level of each particle's position in state y
+ * into fc->lev, handed to the hierarchy for this RHS's transfers (mpm_hier_levels_known; the
+ * RHS's last phase forgets them), and each particle's artificial viscosity length, its level's
+ * spacing, into fc->av_l (capacity fc->cap); a no-op unrefined. */
+void fluid_av_lengths(mpm_module *m, const double *y);
 /* Refuse, naming the key, every gas setting the refined levels do not carry (fluid_refine.c). */
 int fluid_refine_check(const mpm_module *m, const mpm_config *cfg);
 

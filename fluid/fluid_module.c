@@ -213,15 +213,18 @@ static int ensure_scratch(mpm_module *m) {
   fluid_content *fc = m->content;
   const mpm_lidx n = m->particles->n;
   const int dim = m->grid->dim;
-  if (n <= fc->cap && fc->vsig) return 0;
+  if (n <= fc->cap && fc->vsig && (!fc->refined || fc->av_l)) return 0;
   free(fc->vsig), free(fc->scratch), free(fc->vnew), free(fc->Cnew), free(fc->power);
-  free(fc->tscratch), free(fc->sub), free(fc->zero), free(fc->work);
-  fc->vnew = fc->Cnew = fc->tscratch = fc->sub = fc->zero = fc->work = NULL;
+  free(fc->tscratch), free(fc->sub), free(fc->zero), free(fc->work), free(fc->av_l), free(fc->lev);
+  fc->vnew = fc->Cnew = fc->tscratch = fc->sub = fc->zero = fc->work = fc->av_l = NULL;
+  fc->lev = NULL;
   fc->cap = n + n / 4 + 16;
   MPM_ALLOC(fc->vsig, (size_t)dim * dim * fc->cap);
   MPM_ALLOC(fc->scratch, (size_t)(2 * dim + dim * dim) * fc->cap);
   if (fc->mol_damping > 0) MPM_ALLOC(fc->work, (size_t)4 * dim * fc->cap);
   MPM_ALLOC(fc->power, fc->cap);
+  if (fc->refined) MPM_ALLOC(fc->av_l, fc->cap);
+  if (fc->refined) MPM_ALLOC(fc->lev, fc->cap);
   if (fc->tr.classic)
     MPM_ALLOC(fc->tscratch, (size_t)(dim + 3 + (fc->tr.apic ? dim * dim + 2 * dim : 0)) * fc->cap);
   if (fc->tr.musl) MPM_ALLOC(fc->vnew, (size_t)dim * fc->cap);
@@ -348,6 +351,7 @@ static fluid_batch batch_of(const mpm_module *m, const double *y) {
                        .divv = field(p, y, fc->lay.f_divv),
                        .D = fc->lay.f_D >= 0 ? field(p, y, fc->lay.f_D) : NULL,
                        .psi = fc->lay.f_psi >= 0 ? field(p, y, fc->lay.f_psi) : NULL,
+                       .l = fc->refined ? fc->av_l : NULL,
                        .vsig = fc->vsig};
 }
 
@@ -355,6 +359,7 @@ static int fluid_p2g(mpm_module *m, double t, const double *y) {
   (void)t;
   fluid_content *fc = m->content;
   MPM_CALL(ensure_scratch(m));
+  fluid_av_lengths(m, y);
   fluid_batch b = batch_of(m, y);
   if (!fc->current_rate) {
     mpm_timer_start(MPM_T_STRESS);
@@ -544,8 +549,8 @@ static int volume_rate(mpm_module *m, const double *y, double *ydot, const doubl
  * the classic USL step: the transfer of fluid_transfer.c as rates over h; MUSL after its
  * second deposit: positions and J move with the new nodal velocities, v, C and e take what
  * fluid_remap computed. */
-static int fluid_g2p(mpm_module *m, double t, const double *y, double *ydot, double h) {
-  (void)t;
+/* The rates of the RHS (fluid_g2p, its last phase). */
+static int g2p_rates(mpm_module *m, const double *y, double *ydot, double h) {
   fluid_content *fc = m->content;
   const mpm_particles *p = m->particles;
   const int dim = p->dim;
@@ -599,6 +604,13 @@ static int fluid_g2p(mpm_module *m, double t, const double *y, double *ydot, dou
   return 0;
 }
 
+static int fluid_g2p(mpm_module *m, double t, const double *y, double *ydot, double h) {
+  (void)t;
+  const int rc = g2p_rates(m, y, ydot, h);
+  if (m->hier) mpm_hier_levels_known(m->hier, NULL, 0, NULL); /* the RHS's levels end here */
+  return rc;
+}
+
 /* After an accepted step: commit the ERK pairs' pending strain rate, then shift and
  * regularise. */
 static int fluid_post_step(mpm_module *m, double t, double h, int *changed) {
@@ -640,6 +652,38 @@ static int fluid_output(mpm_module *m) {
   return 0;
 }
 
+/* The stable step of a refined gas: the smallest over the particles of their level's spacing h
+ * (fluid_level_spacing) over their signal speed, each computed as on a uniform grid of spacing h
+ * (the artificial viscosity's length h too), returned as dx_finest / smax. */
+static double refined_stable_dt(const mpm_module *m, const double *y, double dx) {
+  const fluid_content *fc = m->content;
+  const mpm_particles *p = m->particles;
+  const mpm_lidx n = p->n;
+  const double gamma = fc->gas.gamma;
+  const double *mass = mpm_particles_comp(p, fc->lay.f_m, 0);
+  const double *V0 = mpm_particles_comp(p, fc->lay.f_V0, 0);
+  const double *divv = field(p, y, fc->lay.f_divv);
+  const double *psi = fc->lay.f_psi >= 0 ? field(p, y, fc->lay.f_psi) : NULL;
+  const double *J = state(p, y, FLUID_J), *e = state(p, y, FLUID_E);
+  double smax = 0.0;
+  for (mpm_lidx i = 0; i < n; ++i) {
+    double v2 = 0.0;
+    for (int d = 0; d < p->dim; ++d) {
+      const double v = state(p, y, FLUID_V)[(size_t)d * n + i];
+      v2 += v * v;
+    }
+    const double h = fluid_level_spacing(m, y, i);
+    const fluid_gas g = fluid_gas_at(&fc->gas, &h, 0);
+    const double rho = mass[i] / (V0[i] * J[i]);
+    const double c = sqrt(gamma * (gamma - 1.0) * fabs(e[i]));
+    const double q = psi ? psi[i] : 0.0;
+    const double s = g.damped_step ? sqrt(v2) + fluid_signal_speed(&g, rho, c, divv[i], q, h)
+                                   : c + sqrt(v2) + fluid_viscous_speed(&g, rho, c, divv[i], q, h);
+    smax = fmax(smax, s * (dx / h));
+  }
+  return smax > 0.0 ? dx / smax : HUGE_VAL;
+}
+
 static double fluid_stable_dt(const mpm_module *m, const double *y) {
   fluid_content *fc = m->content;
   if (fc->stable_local && fc->s_local < 0.0 && fluid_neighbourhood_signal(m, &fc->s_local) != 0)
@@ -655,6 +699,7 @@ static double fluid_stable_dt(const mpm_module *m, const double *y) {
   const double *psi = fc->lay.f_psi >= 0 ? field(p, y, fc->lay.f_psi) : NULL;
   const double *J = state(p, y, FLUID_J), *e = state(p, y, FLUID_E);
   const int viscous = fc->gas.mu > 0.0;
+  if (fc->refined) return refined_stable_dt(m, y, dx);
   double smax = 0.0; /* the fastest signal: dt = dx / smax */
   for (mpm_lidx i = 0; i < n; ++i) {
     double v2 = 0.0;
@@ -720,6 +765,7 @@ static void fluid_destroy(mpm_module *m) {
     fluid_gridp_destroy(fc);
     fluid_virtual_free(&fc->virt);
     free(fc->vsig), free(fc->scratch), free(fc->vnew), free(fc->Cnew), free(fc->power);
+    free(fc->av_l), free(fc->lev);
     free(fc->sub), free(fc->zero), free(fc->work);
     free(fc->tscratch), free(fc->node), free(fc->cellsum), free(fc->lim), free(fc->vol);
     free(fc);

@@ -6,9 +6,11 @@
  * momentum, pressure, gravity and the viscous stresses (fluid.strain_rate = current's preview
  * and fluid.mol_damping's filter included) goes through mpm_hier_p2g, every gather of v, a and L
  * through mpm_hier_g2p; the coupler restricts, solves on every level and prolongs
- * (coupler/mpm_cycle.c). The stable step takes the finest level's spacing. Walls act on level 0
- * only: the sim keeps every box three level-0 cells from the non-periodic faces
- * (coupler/mpm_refine.c).
+ * (coupler/mpm_cycle.c). The artificial viscosity of a particle takes the spacing of the level
+ * it deposits on (its position's) as its length, as on a uniform grid of that spacing, and the
+ * stable step is the smallest over the particles of that spacing over their signal speed
+ * (fluid_module.c). Walls act on level 0 only: the sim keeps every box three level-0 cells from the
+ * non-periodic faces (coupler/mpm_refine.c).
  *
  * Refused (fluid_refine_check), each naming its key: everything that reads or writes the gas's
  * nodal fields or the grid otherwise: the classic update (its time-centred nodal velocity, heat
@@ -61,6 +63,32 @@ int fluid_g2p_phase(mpm_module *m, const double *y, double *const *v_out, double
 double fluid_finest_dx(const mpm_module *m) {
   const mpm_hier *h = m->hier;
   return h ? h->level[h->nlevels - 1].grid->dx : m->grid->dx;
+}
+
+double fluid_level_spacing(const mpm_module *m, const double *y, mpm_lidx i) {
+  const mpm_particles *p = m->particles;
+  if (!m->hier) return m->grid->dx;
+  double x[MPM_MAX_DIM] = {0, 0, 0};
+  for (int d = 0; d < p->dim; ++d) x[d] = y[(size_t)(p->offset[FLUID_X] + d) * p->n + i];
+  return m->hier->level[mpm_hier_level_of(m->hier, x)].grid->dx;
+}
+
+void fluid_av_lengths(mpm_module *m, const double *y) {
+  fluid_content *fc = m->content;
+  const mpm_particles *p = m->particles;
+  if (!fc->refined) return;
+  if (!m->hier) {
+    for (mpm_lidx i = 0; i < p->n; ++i) fc->av_l[i] = m->grid->dx;
+    return;
+  }
+  const double *x = y + (size_t)p->offset[FLUID_X] * p->n;
+  for (mpm_lidx i = 0; i < p->n; ++i) {
+    double xp[MPM_MAX_DIM] = {0, 0, 0};
+    for (int d = 0; d < p->dim; ++d) xp[d] = x[(size_t)d * p->n + i];
+    fc->lev[i] = (unsigned char)mpm_hier_level_of(m->hier, xp);
+    fc->av_l[i] = m->hier->level[fc->lev[i]].grid->dx;
+  }
+  mpm_hier_levels_known(m->hier, x, p->n, fc->lev);
 }
 
 /* ---- what the slice refuses ------------------------------------------------------------------ */

@@ -24,7 +24,9 @@
  * Without a hierarchy (a regrid found nothing to refine) every position is level 0 and the fine
  * particles merge back.
  *
- * Merges first, then splits (fluid_split.h): a merge removes particles and renumbers the set. */
+ * Merges first, then splits (fluid_split.h): a merge removes particles and renumbers the set.
+ * The size and position level of every particle are found once and again only after the set
+ * changed (a level of position costs a walk down the hierarchy). */
 #include "fluid_internal.h"
 #include "fluid_split.h"
 
@@ -35,6 +37,7 @@
 #include <math.h>
 #include <stdlib.h>
 
+/* The level of size of particle i (0 .. MPM_HIER_MAX_LEVELS - 1), V0_0 level 0's volume. */
 int fluid_size_level(const mpm_module *m, double V0_0, mpm_lidx i) {
   const fluid_content *fc = m->content;
   const double V0 = mpm_particles_comp(m->particles, fc->lay.f_V0, 0)[i];
@@ -51,13 +54,31 @@ static int position_level(const mpm_module *m, mpm_lidx i) {
   return mpm_hier_level_of(m->hier, x);
 }
 
-/* Merge the full groups of the particles of size level L that lie on a coarser level. */
-static int merge_level(mpm_module *m, double V0_0, int L, mpm_lidx *idx, mpm_lidx *merged) {
+/* The size and position levels of every particle: lev[2 i] and lev[2 i + 1] (room for the set,
+ * grown as it grows). */
+static int classify(const mpm_module *m, unsigned char **lev) {
+  const fluid_content *fc = m->content;
+  const mpm_lidx n = m->particles->n;
+  unsigned char *grown = realloc(*lev, 2 * (size_t)MPM_MAX(n, 1));
+  if (!grown) MPM_FAIL_OOM(2 * (size_t)MPM_MAX(n, 1));
+  *lev = grown;
+  const double V0_0 = pow(m->grid->dx / fc->ppc, m->grid->dim);
+  for (mpm_lidx i = 0; i < n; ++i) {
+    grown[2 * i] = (unsigned char)fluid_size_level(m, V0_0, i);
+    grown[2 * i + 1] = (unsigned char)position_level(m, i);
+  }
+  return 0;
+}
+
+/* Merge the full groups of the particles of size level L that lie on a coarser level (lev from
+ * classify); *merged grows by the groups merged. */
+static int merge_level(mpm_module *m, int L, const unsigned char *lev, mpm_lidx *idx,
+                       mpm_lidx *merged) {
   const fluid_content *fc = m->content;
   const mpm_lidx n = m->particles->n;
   mpm_lidx k = 0;
   for (mpm_lidx i = 0; i < n; ++i)
-    if (fluid_size_level(m, V0_0, i) == L && position_level(m, i) < L) idx[k++] = i;
+    if (lev[2 * i] == L && lev[2 * i + 1] < L) idx[k++] = i;
   if (k == 0) return 0;
   mpm_lidx *start, *member, ng;
   const double H = ldexp(m->grid->dx, 1 - L) / fc->ppc; /* level L - 1's particle spacing */
@@ -70,21 +91,24 @@ static int merge_level(mpm_module *m, double V0_0, int L, mpm_lidx *idx, mpm_lid
 }
 
 static int relevel(mpm_module *m, int *changed) {
-  const fluid_content *fc = m->content;
-  const double V0_0 = pow(m->grid->dx / fc->ppc, m->grid->dim);
   mpm_lidx *idx;
   MPM_ALLOC(idx, m->particles->n > 0 ? m->particles->n : 1);
+  unsigned char *lev = NULL;
   mpm_lidx merged = 0;
-  int rc = 0;
-  for (int L = MPM_HIER_MAX_LEVELS - 1; !rc && L >= 1; --L)
-    rc = merge_level(m, V0_0, L, idx, &merged);
+  int rc = classify(m, &lev);
+  for (int L = MPM_HIER_MAX_LEVELS - 1; !rc && L >= 1; --L) {
+    const mpm_lidx before = merged;
+    rc = merge_level(m, L, lev, idx, &merged);
+    if (!rc && merged > before) rc = classify(m, &lev); /* the set changed */
+  }
   /* Split until every particle has its level's size: a regrid may put a particle two levels
    * below its new level (idx grows with the set). */
   mpm_lidx split = 0;
   for (int pass = 0; !rc && pass < MPM_HIER_MAX_LEVELS; ++pass) {
     mpm_lidx k = 0;
+    if (pass > 0 && (rc = classify(m, &lev)) != 0) break; /* after the last pass's splits */
     for (mpm_lidx i = 0; i < m->particles->n; ++i)
-      if (fluid_size_level(m, V0_0, i) < position_level(m, i)) idx[k++] = i;
+      if (lev[2 * i] < lev[2 * i + 1]) idx[k++] = i;
     fluid_split_report rep = {0};
     rc = fluid_split(m, idx, k, &rep); /* collective: every rank calls, k = 0 too */
     split += rep.parents;
@@ -97,7 +121,7 @@ static int relevel(mpm_module *m, int *changed) {
         idx = grown;
     }
   }
-  free(idx);
+  free(idx), free(lev);
   MPM_CALL(rc);
   *changed |= merged > 0 || split > 0;
   return 0;

@@ -16,8 +16,9 @@ static void pressure_stress(const fluid_gas *g, const fluid_batch *b, int av) {
   for (mpm_lidx i = 0; i < n; ++i) {
     const double V = b->V0[i] * b->J[i], rho = b->m[i] / V;
     const double p = fluid_pressure(g->gamma, rho, b->e[i]);
-    const double q = av ? fluid_av_pressure(g, rho, fluid_sound_speed(g->gamma, rho, p), b->divv[i],
-                                            b->psi ? b->psi[i] : 0.0)
+    const fluid_gas gi = fluid_gas_at(g, b->l, i);
+    const double q = av ? fluid_av_pressure(&gi, rho, fluid_sound_speed(g->gamma, rho, p),
+                                            b->divv[i], b->psi ? b->psi[i] : 0.0)
                         : 0.0;
     s00[i] = -V * (p + q);
   }
@@ -65,7 +66,8 @@ int fluid_stress_viscous(const fluid_gas *g, const fluid_batch *b, mpm_lidx i, d
   if (!out) return 1;
   const double V = b->V0[i] * b->J[i], rho = b->m[i] / V;
   const double c = fluid_sound_speed(g->gamma, rho, fluid_pressure(g->gamma, rho, b->e[i]));
-  const double q = av ? fluid_av_pressure(g, rho, c, b->divv[i], b->psi ? b->psi[i] : 0.0) : 0.0;
+  const fluid_gas gi = fluid_gas_at(g, b->l, i);
+  const double q = av ? fluid_av_pressure(&gi, rho, c, b->divv[i], b->psi ? b->psi[i] : 0.0) : 0.0;
   for (int r = 0; r < dim; ++r)
     for (int k = 0; k < dim; ++k) {
       const double D = viscous ? b->D[(size_t)(r * dim + k) * n + i] : 0.0;

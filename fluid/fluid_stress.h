@@ -8,7 +8,8 @@
  *            a = (gamma + 1) / 4 (Kuropatenko's two-shock form, as in Caramana, Shashkov and
  *            Whalen 1998, with a Christensen limiter psi in [0, 1]: fluid_limiter.c),
  *
- * for tr D < 0, else q = 0, with du = l |tr D| the velocity jump over l, the cell size. The
+ * for tr D < 0, else q = 0, with du = l |tr D| the velocity jump over l, the cell size (on a
+ * refinement the spacing of the particle's own level: fluid_batch.l, fluid_refine.c). The
  * riemann form is the pressure jump of a shock of speed jump du in a gas of sound speed c; psi
  * is 1 (q off) where the compression is as strong one cell either side (smooth compression)
  * and 0 at a shock. tr(D)/3 is the deviator of the physical 3-D rate: a 2-D run is plane flow
@@ -41,8 +42,16 @@ typedef struct fluid_batch {
   const double *divv;           /* tr D */
   const double *D;              /* strain rate (dim*dim), or NULL when mu = 0 */
   const double *psi;            /* riemann form: the limiter (fluid_limiter.c), else NULL */
+  const double *l;              /* per particle artificial viscosity length, else NULL: g->l */
   double *vsig;                 /* out: V sigma (dim*dim) */
 } fluid_batch;
+
+/* The gas as particle i of a batch with per-particle lengths l sees it (l NULL: g). */
+static inline fluid_gas fluid_gas_at(const fluid_gas *g, const double *l, mpm_lidx i) {
+  fluid_gas a = *g;
+  if (l) a.l = l[i];
+  return a;
+}
 
 /* The artificial kinematic viscosity per unit length, q / (rho du), of the velocity jump
  * du = l |tr D| >= 0 at sound speed c and limiter psi (riemann form only; see above). */

@@ -39,17 +39,23 @@ def case_for(case, method, out):
     return copy
 
 
-def run(case, N, method, t_end, ranks=1, extra=(), x0=0.5):
-    """Run `case` with N cells along x (3 across) to t_end, the diaphragm between its left
-    and right regions at x0; returns the output folder."""
-    h = 3.0 / N
+def overrides(N, method, t_end, x0=0.5, height=None):
+    """The command-line settings of a run with N cells along x to t_end, the diaphragm at x0, on
+    a strip `height` high (default 3 cells: 3 / N)."""
+    h = 3.0 / N if height is None else height
+    return [f"grid.dx={1.0 / N}", f"domain.hi=1 {h}", f"geometry.left.hi={x0} {h}",
+            f"geometry.right.lo={x0} 0", f"geometry.right.hi=1 {h}", f"time.method={method}",
+            f"time.t_end={t_end}", "run.progress=false"]
+
+
+def run(case, N, method, t_end, ranks=1, extra=(), x0=0.5, height=None):
+    """Run `case` with N cells along x (3 across, or `height` high) to t_end, the diaphragm
+    between its left and right regions at x0; returns the output folder."""
     if method in CLASSIC_CFL and not any(e.startswith("time.cfl=") for e in extra):
         extra = list(extra) + [f"time.cfl={CLASSIC_CFL[method]}"]
     out = mt.outdir(f"{case.split('.')[0]}_{method}_N{N}_np{ranks}")
-    mt.run(["run", case_for(case, method, out), f"output.dir={out}", f"grid.dx={1.0 / N}",
-            f"domain.hi=1 {h}", f"geometry.left.hi={x0} {h}", f"geometry.right.lo={x0} 0",
-            f"geometry.right.hi=1 {h}", f"time.method={method}",
-            f"time.t_end={t_end}", "run.progress=false"] + list(extra), ranks)
+    mt.run(["run", case_for(case, method, out), f"output.dir={out}"] +
+           overrides(N, method, t_end, x0, height) + list(extra), ranks)
     return out
 
 

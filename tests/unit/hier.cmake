@@ -12,3 +12,7 @@ mpm_add_test(test_hier_ranks SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/unit/test_hier_
 # The exact span integrals the grid pressure uses (common/mpm_span.h): adjointness, constant and
 # linear fields, halved spans at a wall, in 2-D and 3-D.
 mpm_add_test(test_span SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/unit/test_span.c LABELS unit RANKS 1)
+# Levels across periodic faces (a band spanning the period, regions crossing the faces, 2-D and
+# 3-D): partition of unity, periodicity of the basis, conservation, P2G = eval, reproduction.
+mpm_add_test(test_hier_periodic SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/unit/test_hier_periodic.c
+             LABELS unit RANKS 1)

@@ -2,11 +2,12 @@
 # level-1 box and an acoustic pulse through it against their uniform twins (~10 and ~20 s), the
 # uniform stream in 3-D (~12 s), a pulse refined dynamically (~25 s), the compression and
 # vorticity criteria (~4 s each), the starvation criterion alone and with compression on an
-# expanding gas (~8 s), a restart (~5 s), every refusal (~15 s), and
+# expanding gas (~8 s), a restart (~5 s), every refusal (~15 s), levels across periodic faces
+# (static ~5 s, regridded ~5 s), and
 # refine.levels = 1 against no [refine] section (~2 s); the first two again with fluid.ppc = 4
 # (long).
 foreach(part uniform pulse uniform3d dynamic compression vorticity starvation restart input
-             identity)
+             identity periodic wrap)
   mpm_add_script_test(test_refine_gas_${part} SCRIPT verification/test_refine_gas.py ARGS ${part}
                       LABELS verification TIMEOUT 300)
 endforeach()
@@ -30,3 +31,9 @@ foreach(part wave stream prestress usl restart input)
   mpm_add_script_test(test_refine_solid_${part} SCRIPT verification/test_refine_solid.py
                       ARGS ${part} LABELS verification TIMEOUT 300)
 endforeach()
+# Sod with a fine region following the waves against its uniform twin at the finest spacing
+# (issue 51's acceptance, L1 within 10 %): 2 levels (~3 s); 3 levels under long (~15 s).
+mpm_add_script_test(test_refine_sod SCRIPT verification/test_refine_sod.py LABELS verification
+                    TIMEOUT 300)
+mpm_add_script_test(test_refine_sod_long SCRIPT verification/test_refine_sod.py ARGS long
+                    LABELS "verification;long" TIMEOUT 600)
