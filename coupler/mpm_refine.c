@@ -23,7 +23,8 @@
 
 const mpm_key_spec mpm_refine_keys[] = {
     {"refine.levels", MPM_KEY_INT, "1", 1, MPM_HIER_MAX_LEVELS, 0, 0, NULL,
-     "levels of the static refinement hierarchy, each halving the spacing of the one below (1: "
+     "levels of the refinement hierarchy (static boxes, or regridded with refine.criterion), each "
+     "halving the spacing of the one below (1: "
      "off); gas-only or solid-only cases on one rank with the quadratic shape, see "
      "docs/refinement.md",
      0, "-"},
@@ -41,7 +42,8 @@ const mpm_key_spec mpm_refine_keys[] = {
      0, NULL},
     {"refine.threshold", MPM_KEY_REALS, "0", 0, HUGE_VAL, 0, 3, NULL,
      "one threshold per listed density, compression or vorticity criterion, in the list's "
-     "order: a relative density difference (density, e.g. 0.05) or a velocity drop or jump "
+     "order: a relative density difference (density, e.g. 0.02 for Sod, 0.004 for a 5 % pulse) or "
+     "a velocity drop or jump "
      "over the sound speed (compression, vorticity, e.g. 0.05) between neighbouring level-0 "
      "cells (required with those criteria)",
      0, "-"},
