@@ -9,7 +9,9 @@ dx = 0.05 (coarse) and at dx = 0.025 (fine). The argument picks the part (one ct
 uniform  A uniform gas (rho 1, p 1, u = 0.5 c along x) crossing the box about three times its
          width: the largest deviation of the particles' density, pressure and velocity from the
          initial state (relative), and the conservation of mass, momentum and total energy in
-         diagnostics.csv (part c of the brief).
+         diagnostics.csv (part c of the brief); at every snapshot no particle of another
+         level's size beyond one coarse particle spacing of the box's faces (the lag split and
+         merge leave at a face the stream crosses).
 pulse    A right-running acoustic pulse (amplitude 1e-3, c = 1, gaussian of width 0.2 = 4 coarse
          cells) crossing the box: the energy of the left-running (reflected) component against
          that of the pulse, after the pulse has left the box, from the particle p and u binned
@@ -976,7 +978,6 @@ if PART == "uniform":
         size = np.rint(np.log2((0.05 / PPC) ** 2 * p["rho"].ravel() / p["m"].ravel()) / 2)
         x, y = p["x"][:, 0], p["x"][:, 1]
         inside = (x > 0.775) & (x < 1.225) & (y > 0.125) & (y < 0.475)
-        # distance to the region's boundary (from outside or inside)
         out_dist = np.hypot(np.maximum(np.maximum(0.775 - x, x - 1.225), 0),
                             np.maximum(np.maximum(0.125 - y, y - 0.475), 0))
         in_dist = np.minimum(np.minimum(x - 0.775, 1.225 - x), np.minimum(y - 0.125, 0.475 - y))
