@@ -16,6 +16,13 @@
  * an even ppc), so the merged particle sits on the level of its members. A part-filled slot
  * waits for the rest of its particles; in a flow that never fills it they stay fine.
  *
+ * Lag at a face. Split and merge keep the centre of mass, so a parent or group straddling a
+ * region's face always leaves particles of the wrong size on the wrong side: children of a
+ * parent that has just entered wait outside within s / 4 of the face, and a fine particle that
+ * has just left waits in its slot (within H = h_{L-1} / ppc of the face) for its partners. A
+ * snapshot may show them (docs/refinement.md; tests/verification/test_refine_gas.py bounds
+ * them to H of the face in a uniform stream).
+ *
  * Splitting. The children sit at +-s/4 of the parent (s its size): a parent that has just
  * crossed into a finer region may leave some children outside it, which then wait (their slot
  * is not full) and enter with the flow. Splits repeat until no particle is coarser than its

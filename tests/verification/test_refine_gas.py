@@ -9,7 +9,9 @@ dx = 0.05 (coarse) and at dx = 0.025 (fine). The argument picks the part (one ct
 uniform  A uniform gas (rho 1, p 1, u = 0.5 c along x) crossing the box about three times its
          width: the largest deviation of the particles' density, pressure and velocity from the
          initial state (relative), and the conservation of mass, momentum and total energy in
-         diagnostics.csv (part c of the brief).
+         diagnostics.csv (part c of the brief); at every snapshot no particle of another
+         level's size beyond one coarse particle spacing of the box's faces (the lag split and
+         merge leave at a face the stream crosses).
 pulse    A right-running acoustic pulse (amplitude 1e-3, c = 1, gaussian of width 0.2 = 4 coarse
          cells) crossing the box: the energy of the left-running (reflected) component against
          that of the pulse, after the pulse has left the box, from the particle p and u binned
@@ -958,18 +960,35 @@ if PART == "uniform":
     check(got <= 1e-10, f"uniform gas across the box: deviation {got:.2e} at roundoff (<= 1e-10)"
           f" like the coarse twin's {dev['coarse']:.1e}")
     # The particles follow the levels: the count changed during the run (splits and merges) and
-    # at t = 1.4, the stream having crossed the box 1.4 times, every particle has its level's
-    # size. Level 1's region is the box snapped outwards to level-0 spans (centred on the nodes).
+    # at every snapshot (t = 0, 0.7, 1.4) every particle has its level's size, but for the lag
+    # at the faces the stream crosses, which split and merge cannot avoid (docs/refinement.md,
+    # "Particles follow the levels"): both keep the centre of mass, so a parent or group whose
+    # particles straddle a face leaves some on the wrong side. Children of a parent that has
+    # just entered wait outside within s / 4 of the face; a fine particle that has just left
+    # waits in its coarser slot for its partners (in this stream within H / 2 of the face), H =
+    # level 0's particle spacing 0.05 / ppc. So: none beyond H of the region's boundary (merges
+    # switched off leave whole fine columns downstream; at ppc 4, t = 1.4, one column of 56
+    # waits 1.3e-4 past the right face). Level 1's region is the box snapped outwards to level-0
+    # spans (centred on the nodes).
     out = runs["refined"][0]
     counts = set(diagnostics(out)["particles"].astype(int))
-    p = final(out)
-    size = np.rint(np.log2((0.05 / PPC) ** 2 * p["rho"].ravel() / p["m"].ravel()) / 2)
-    x, y = p["x"][:, 0], p["x"][:, 1]
-    inside = (x > 0.775) & (x < 1.225) & (y > 0.125) & (y < 0.475)
-    wrong = int(np.sum(size != inside))
-    check(len(counts) > 1 and wrong == 0, f"particles follow the levels: {len(counts)} distinct "
-          f"particle counts in the run; at t = 1.4, {wrong} of {len(size)} particles with another "
-          f"level's size (want 0)")
+    H = 0.05 / PPC
+    for t, path in mt.snapshots(out):
+        p = mt.particles(path, "fluid")
+        size = np.rint(np.log2((0.05 / PPC) ** 2 * p["rho"].ravel() / p["m"].ravel()) / 2)
+        x, y = p["x"][:, 0], p["x"][:, 1]
+        inside = (x > 0.775) & (x < 1.225) & (y > 0.125) & (y < 0.475)
+        out_dist = np.hypot(np.maximum(np.maximum(0.775 - x, x - 1.225), 0),
+                            np.maximum(np.maximum(0.125 - y, y - 0.475), 0))
+        in_dist = np.minimum(np.minimum(x - 0.775, 1.225 - x), np.minimum(y - 0.125, 0.475 - y))
+        dist = np.where(inside, in_dist, out_dist)
+        wrong = size != inside
+        far = int(np.sum(wrong & (dist > H)))
+        lag = dist[wrong].max() / H if wrong.any() else 0.0
+        check(len(counts) > 1 and far == 0, f"particles follow the levels: {len(counts)} "
+              f"distinct particle counts in the run; at t = {p['time']:g}, {int(wrong.sum())} of "
+              f"{len(size)} particles with another level's size, {far} of them beyond one "
+              f"particle spacing H of a face (want 0; farthest {lag:.3f} H)")
     # Mass: the sum of ~1e4 particle masses of two sizes in another order after sorting:
     # n eps ~ 1e-12. Momentum: of the order of the twins' roundoff. Energy: measured 7e-15 (the
     # stream is steady); 1e-10 fails on a work-energy mismatch of the grid pressure, which grows
