@@ -16,13 +16,15 @@ stream   A uniform stream (u = 0.5 c) along x, parallel to the slip walls of the
          along the wall and energy conserved to roundoff (~4 s).
 pulse    An acoustic pulse (amplitude 1e-3, gaussian of width 0.2) running down (-y) onto the
          slip wall y_lo of a strip periodic along x, through a level-1 band y in [0, 1.2] that
-         touches the wall, to t = 1.2 (reflected, back at its start): the reflected (up-running)
-         pulse's energy and peak against the uniform fine twin (dx = 0.025) and the coarse one;
-         mass, momentum along the wall (x) and energy (~5 s).
+         touches the wall (and spans the x period), to t = 1.2 (reflected, back at its start):
+         the reflected (up-running) pulse's energy, peak and profile against the uniform fine
+         twin (dx = 0.025), the coarse twin printed; all three with the grid pressure; mass,
+         momentum along the wall (x) and energy (~4 s).
 dynamic  The nonlinear pulse of test_refine_gas's dynamic part (along x, over the strip's whole
          height) regridded by density: the regions now reach the walls (level-1 particles within
-         half a cell of both walls at the start and the end), and mass, momentum and energy are
-         conserved across every regrid (~10 s).
+         half a cell of both walls at the start and the end), the gas does not press into the
+         walls (|v_y| as the uniform twins'), and mass, momentum and energy are conserved across
+         every regrid (~3 s).
 Able to fail: with mpm_hier_walls_fold / mpm_hier_walls_apply switched off (fluid/fluid_module.c)
 every part fails (figures in docs/refinement.md). Tolerances are stated at each check.
 """
@@ -192,10 +194,8 @@ def profile(out):
 
 def part_pulse():
     runs = {"refined": run("walls_pulse", pulse_case(BAND, 0.05)),
-            "coarse": run("walls_pulse_coarse", pulse_case("", 0.05)),
-            "fine": run("walls_pulse_fine", pulse_case("", 0.025, GRIDP)),
-            "fine_particle": run("walls_pulse_finep", pulse_case("", 0.025)),
-            "coarse_grid": run("walls_pulse_coarseg", pulse_case("", 0.05, GRIDP))}
+            "coarse": run("walls_pulse_coarse", pulse_case("", 0.05, GRIDP)),
+            "fine": run("walls_pulse_fine", pulse_case("", 0.025, GRIDP))}
     up, down, energy, peak = {}, {}, {}, {}
     for label, out in runs.items():
         up[label], down[label] = profile(out)
@@ -209,14 +209,17 @@ def part_pulse():
     err_c = np.abs(up["coarse"] - up["fine"]).max() / peak["fine"]
     print(f"info coarse twin: energy / fine {energy['coarse'] / energy['fine']:.4f}, peak / fine "
           f"{peak['coarse'] / peak['fine']:.4f}, largest |up - up_fine| / peak {err_c:.2e}")
-    # Measured: energy 0.9999, peak 1.0000, profile 1.6e-3 of the peak against the fine twin
-    # (the coarse twin: 2.5e-3). 1 % on energy and peak and 1e-2 on the profile leave room for
-    # the machine's step sequence and fail on a wall rule that is off on level 1 (the pulse then
-    # leaks into the wall: 41 % of the energy is lost).
-    check(abs(ratio_e - 1) <= 1e-2 and abs(ratio_p - 1) <= 1e-2 and err <= 1e-2,
+    # Measured against the fine twin: energy 0.986, peak 0.981, profile 2.0e-2 of the peak (the
+    # coarse twin: 0.908, 0.845, 0.35). Level 1's wall is a knot, the fine twin's a node: the
+    # reflection loses 2.6 % of the energy against the same band's free propagation (no wall),
+    # the fine twin 1.2 %, the coarse one 3.8 %; without a wall the band matches the fine twin
+    # to 1e-5 in energy. 3 % on energy and peak and 4e-2 on the profile keep the refined
+    # reflection well closer to the fine twin than the coarse one; with the wall rule off on
+    # level 1 the run blows up (energy ratio 1e5).
+    check(abs(ratio_e - 1) <= 3e-2 and abs(ratio_p - 1) <= 3e-2 and err <= 4e-2,
           f"reflected pulse in a band touching the slip wall against the uniform fine twin: "
-          f"energy ratio {ratio_e:.4f}, peak ratio {ratio_p:.4f} (want within 1 %), largest "
-          f"profile difference {err:.2e} of the peak (want <= 1e-2)")
+          f"energy ratio {ratio_e:.4f}, peak ratio {ratio_p:.4f} (want within 3 %), largest "
+          f"profile difference {err:.2e} of the peak (want <= 4e-2)")
     # Energy: bs32 on a small smooth pulse, far below its rtol (measured 1e-14); 1e-10 as in
     # test_refine_gas's pulse. Momentum along the wall only: the wall pushes the gas along y.
     conservation("pulse", runs["refined"], "x", 1e-10)
@@ -229,6 +232,11 @@ def part_dynamic():
         n = near_walls(p, 1, [(1, 0.0), (1, 0.6)])
         check(min(n) > 0, f"regridded, t = {p['time']:g}: level-1 particles within half a cell "
               f"of y_lo and y_hi {n} (the regions reach the walls)")
+    vy = np.abs(p["v"][:, 1]).max()  # c = 1
+    # The pulse runs along the walls, uniform across the strip; the grid pressure's own v_y on
+    # this nonlinear pulse is 1.1e-4 c (coarse twin) and 1.0e-4 c (fine twin), measured 7.7e-5 c
+    # here; 2e-4 fails when the gas presses into the walls (the finer levels' wall rule off).
+    check(vy <= 2e-4, f"regridded, t = {p['time']:g}: largest |v_y| / c {vy:.2e} <= 2e-4")
     # Energy: as test_refine_gas's dynamic part (bs32 on a steepening pulse, measured 6e-11
     # clear of the walls), 1e-8.
     conservation("regridded", out, "xy", 1e-8)
