@@ -13,7 +13,8 @@ rest     Gas at rest (rho 1, p 1/1.4, c = 1) in a closed box with walls on all f
 stream   A uniform stream (u = 0.5 c) along x, parallel to the slip walls of the strip (periodic
          along x): a level-1 band x in [0.8, 1.2] over the whole height and a level-2 box against
          y_lo in it, to t = 1.4 (1.4 crossings of the strip): uniform to roundoff; mass, momentum
-         along the wall and energy conserved to roundoff (~4 s).
+         along the wall and energy conserved to roundoff; the same in 3-D (test_refine_gas's
+         uniform3d with its box moved onto the wall y_lo, to t = 0.45) (~7 s).
 pulse    An acoustic pulse (amplitude 1e-3, gaussian of width 0.2) running down (-y) onto the
          slip wall y_lo of a strip periodic along x, through a level-1 band y in [0, 1.2] that
          touches the wall (and spans the x period), to t = 1.2 (reflected, back at its start):
@@ -35,7 +36,7 @@ import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "tools"))
 import mpmtest as mt  # noqa: E402
-from refine_scenes import C0, DYNAMIC, PULSE_5, case_text  # noqa: E402
+from refine_scenes import BOX_3D, C0, CASE_3D, DYNAMIC, PULSE_5, case_text  # noqa: E402
 
 PART = sys.argv[1] if len(sys.argv) > 1 else "rest"
 check = mt.Checks(f"test_refine_walls_{PART}")
@@ -166,6 +167,17 @@ def part_stream():
     check(min(n) > 0, f"particles of level 1 at y_lo, y_hi and level 2 at y_lo: {n}")
     # Energy: steady stream, roundoff (measured 2e-14 on two levels).
     conservation("stream", out, "x", 1e-12)
+    box3 = BOX_3D.replace("lo = 0.45 0.25 0.25", "lo = 0.45 0 0.25")
+    out = run("walls_stream3d", CASE_3D.format(u0=u0, refine=box3, dx=0.075))
+    p = final(out)
+    got = max(np.abs(p["rho"] - 1).max(), np.abs(p["p"] - 1).max(),
+              np.abs(p["v"][:, 0] - u0).max() / u0, np.abs(p["v"][:, 1:]).max() / u0)
+    n = near_walls(p, 1, [(1, 0.0)], h=0.0375)
+    # Roundoff (measured 2.2e-15), as in 2-D.
+    check(got <= 1e-10 and n[0] > 0, f"3-D stream along the slip wall y_lo, a level-1 box on it: "
+          f"deviation {got:.2e} <= 1e-10 at t = {p['time']:g}; {n[0]} level-1 particles within "
+          f"half a cell of the wall")
+    conservation("3-D stream", out, "x", 1e-12)
 
 
 def pulse_case(refine, dx, extra=""):
