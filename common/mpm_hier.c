@@ -358,6 +358,25 @@ void mpm_hier_destroy(mpm_hier **hp) {
 
 /* ---- points ----------------------------------------------------------------------------- */
 
+/* Does h carry a wall (mpm_hier.h, walls)? */
+static int walled(const mpm_hier *h) {
+  int any = 0;
+  for (int d = 0; d < h->dim; ++d) any |= h->wall[d][0] | h->wall[d][1];
+  return any;
+}
+
+/* Does g's box hold the quadratic stencil of x? Only a point beyond a wall can fail it: its
+ * mirrored masks may send it to a finer level whose box stops two nodes past the wall (a point
+ * in an integrator's stage may step past a wall before the walls return it); it then stays on
+ * the coarser level, whose pad holds it. */
+static int stencil_in_box(const mpm_grid *g, const double *x) {
+  for (int d = 0; d < g->dim; ++d) {
+    const int first = hier_span_of(hier_xi(g, d, x[d])) - 1;
+    if (first < g->box_lo[d] || first + 2 > g->box_lo[d] + g->box_n[d] - 1) return 0;
+  }
+  return 1;
+}
+
 int mpm_hier_level_of(const mpm_hier *h, const double *xp) {
   int l = 0, gi[MPM_MAX_DIM] = {0, 0, 0};
   double x[MPM_MAX_DIM];
@@ -371,6 +390,7 @@ int mpm_hier_level_of(const mpm_hier *h, const double *xp) {
       gi[d] = hier_span_of(xi);
     }
     if (!span_flag(h, l, h->level[l].refined, gi, 0)) return l;
+    if (walled(h) && !stencil_in_box(h->level[l + 1].grid, x)) return l;
   }
   return l;
 }

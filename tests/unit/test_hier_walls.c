@@ -9,7 +9,8 @@
  *      the walls (the first nodes inside the corner are active on levels 1 and 2, level 0's
  *      corner node is refined). Exact (flags).
  *  (2) Partition of unity at 10,000 random points, half within 0.15 of a wall: sum w = 1 to
- *      1e-14, w >= 0, every level holds points (test_hier_basis's tolerance).
+ *      1e-14, w >= 0, every level holds points (test_hier_basis's tolerance); a point past a
+ *      wall stays on a level whose box holds its stencil.
  *  (3) Fold: 20,000 random particles deposited and restricted, the finer levels folded: the
  *      finer nodes beyond a wall hold exactly zero mass, and the active nodes of all levels
  *      hold the particles' mass to 1e-14 (summed in long double; the fold only moves mass).
@@ -151,6 +152,11 @@ static void test_pou(void **state) {
     }
     ew = fmax(ew, fabs(sw - 1.0));
   }
+  /* A point 1.6 level-0 cells past y_lo (an integrator's stage may step past a wall): its
+   * mirrored masks would send it to level 2, whose box stops two nodes past the wall; it stays
+   * on level 1, whose box holds its stencil (the transfers then stay inside the boxes). */
+  const double past[3] = {0.1, -0.08, 0.0};
+  assert_int_equal(mpm_hier_level_of(f.h, past), 1);
   printf("walls: partition of unity to %.1e; points per level %d %d %d\n", ew, per_level[0],
          per_level[1], per_level[2]);
   assert_true(ew <= 1e-14);
