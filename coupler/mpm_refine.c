@@ -116,8 +116,9 @@ static int check_case(const mpm_config *cfg, const mpm_grid *grid, mpm_module **
   return 0;
 }
 
-/* Box NAME from its section, kept REFINE_FACE_CELLS level-0 cells from non-periodic faces
- * (along a periodic axis mpm_hier_new takes it up to a period beyond the faces). */
+/* Box NAME from its section, kept REFINE_FACE_CELLS level-0 cells from non-periodic faces other
+ * than a carried wall (wall[d][side]: touched, not crossed); along a periodic axis mpm_hier_new
+ * takes it up to a period beyond the faces. */
 static int read_box(const mpm_config *cfg, const mpm_grid *g, const char *name,
                     const unsigned char (*wall)[2], mpm_hier_box *b) {
   char key[3][160];
