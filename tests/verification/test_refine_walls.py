@@ -25,7 +25,7 @@ dynamic  The nonlinear pulse of test_refine_gas's dynamic part (along x, over th
          height) regridded by density: the regions now reach the walls (level-1 particles within
          half a cell of both walls at the start and the end), the gas does not press into the
          walls (|v_y| as the uniform twins'), and mass, momentum and energy are conserved across
-         every regrid (~3 s).
+         every regrid; the same on three levels to t = 0.6, level 2 reaching the walls (~9 s).
 Able to fail: with mpm_hier_walls_fold / mpm_hier_walls_apply switched off (fluid/fluid_module.c)
 every part fails (figures in docs/refinement.md). Tolerances are stated at each check.
 """
@@ -246,12 +246,23 @@ def part_dynamic():
               f"of y_lo and y_hi {n} (the regions reach the walls)")
     vy = np.abs(p["v"][:, 1]).max()  # c = 1
     # The pulse runs along the walls, uniform across the strip; the grid pressure's own v_y on
-    # this nonlinear pulse is 1.1e-4 c (coarse twin) and 1.0e-4 c (fine twin), measured 7.7e-5 c
+    # this nonlinear pulse is 1.1e-4 c (coarse twin) and 1.0e-4 c (fine twin), measured 9.1e-5 c
     # here; 2e-4 fails when the gas presses into the walls (the finer levels' wall rule off).
     check(vy <= 2e-4, f"regridded, t = {p['time']:g}: largest |v_y| / c {vy:.2e} <= 2e-4")
     # Energy: as test_refine_gas's dynamic part (bs32 on a steepening pulse, measured 6e-11
     # clear of the walls), 1e-8.
     conservation("regridded", out, "xy", 1e-8)
+    # Three levels to t = 0.6: level 2 reaches both walls too (the nesting beyond a wall is the
+    # mirror of the nesting inside); v_y measured 7.7e-5 c, energy 6.2e-11.
+    out = run("walls_dynamic3", case_text(3, 0.6, PULSE_5, DYNAMIC.replace("levels = 2",
+                                                                           "levels = 3")))
+    p = final(out)
+    n = near_walls(p, 2, [(1, 0.0), (1, 0.6)], h=0.0125)
+    vy = np.abs(p["v"][:, 1]).max()
+    check(min(n) > 0 and vy <= 2e-4, f"regridded on 3 levels, t = {p['time']:g}: level-2 "
+          f"particles within half a level-1 cell of y_lo and y_hi {n}; largest |v_y| / c "
+          f"{vy:.2e} <= 2e-4")
+    conservation("regridded on 3 levels", out, "xy", 1e-8)
 
 
 {"rest": part_rest, "stream": part_stream, "pulse": part_pulse, "dynamic": part_dynamic}[PART]()
