@@ -11,6 +11,10 @@
  *   leave a box (on level 0 the domain check and the grid's pad do the same).
  * - Masks outside a box: on level 0 every span is covered and none refined (the grid's own
  *   pad edges keep the plain rule); on finer levels nothing outside the box is covered.
+ * - Walls (mpm_hier.h): every mask lookup (span_flag) first moves a span beyond a walled face
+ *   onto its mirror, so the stored masks beyond a wall are never read and the regions are
+ *   symmetric about it; a box touching a wall stores the nodes beyond it that its stencils
+ *   reach (2a - 2 >= -2 on level 1, whose level-0 parents lie in the grid's pad of 3).
  * - Periodic axes (mpm_hier.h): masks are marked on every image of a span in the box, and
  *   looked up at the image in [0, period) along the axes where a level has a period, so the
  *   masks of images equal those of their nodes; a level's period is set when its box would
@@ -149,12 +153,13 @@ static void mark(const mpm_hier_level *lv, unsigned char *mask, const int *a, co
       }
 }
 
-/* Mask value of span gi on level l, looked up at its image along the level's periodic axes,
- * with the rule outside the box of the file comment. */
+/* Mask value of span gi on level l, looked up at its mirror beyond a wall and at its image
+ * along the level's periodic axes, with the rule outside the box of the file comment. */
 static inline int span_flag(const mpm_hier *h, int l, const unsigned char *mask, const int *gi,
                             int out) {
   const mpm_grid *g = h->level[l].grid;
   int c[MPM_MAX_DIM] = {gi[0], gi[1], gi[2]};
+  for (int d = 0; d < h->dim; ++d) c[d] = hier_mirror(h, l, d, c[d]);
   hier_canon(&h->level[l], h->dim, c);
   return hier_in_box(g, c) ? mask[mpm_grid_local_index(g, c)] : out;
 }
@@ -305,6 +310,12 @@ static int build_levels(mpm_hier *h, const mpm_hier_box *box, int nbox, char *wh
 
 int mpm_hier_new(mpm_hier **hp, mpm_grid *grid, int nlevels, const mpm_hier_box *box, int nbox,
                  int buffer, char *why, size_t why_len) {
+  return mpm_hier_new_walled(hp, grid, nlevels, box, nbox, buffer, NULL, why, why_len);
+}
+
+int mpm_hier_new_walled(mpm_hier **hp, mpm_grid *grid, int nlevels, const mpm_hier_box *box,
+                        int nbox, int buffer, const unsigned char (*wall)[2], char *why,
+                        size_t why_len) {
   *hp = NULL;
   if (why && why_len) why[0] = '\0';
   int rc = check_setup(grid, nlevels, buffer, why, why_len);
@@ -313,6 +324,9 @@ int mpm_hier_new(mpm_hier **hp, mpm_grid *grid, int nlevels, const mpm_hier_box 
   mpm_hier *h;
   MPM_ALLOC(h, 1);
   h->dim = grid->dim, h->nlevels = nlevels, h->buffer = buffer;
+  for (int d = 0; wall && d < grid->dim; ++d)
+    h->wall[d][0] = grid->periodic[d] ? 0 : wall[d][0],
+    h->wall[d][1] = grid->periodic[d] ? 0 : wall[d][1];
   h->level[0].grid = grid;
   for (int d = 0; d < grid->dim; ++d)
     h->level[0].period[d] = grid->periodic[d] ? grid->ncells[d] : 0;
@@ -344,6 +358,25 @@ void mpm_hier_destroy(mpm_hier **hp) {
 
 /* ---- points ----------------------------------------------------------------------------- */
 
+/* Does h carry a wall (mpm_hier.h, walls)? */
+static int walled(const mpm_hier *h) {
+  int any = 0;
+  for (int d = 0; d < h->dim; ++d) any |= h->wall[d][0] | h->wall[d][1];
+  return any;
+}
+
+/* Does g's box hold the quadratic stencil of x? Only a point beyond a wall can fail it: its
+ * mirrored masks may send it to a finer level whose box stops two nodes past the wall (a point
+ * in an integrator's stage may step past a wall before the walls return it); it then stays on
+ * the coarser level, whose pad holds it. */
+static int stencil_in_box(const mpm_grid *g, const double *x) {
+  for (int d = 0; d < g->dim; ++d) {
+    const int first = hier_span_of(hier_xi(g, d, x[d])) - 1;
+    if (first < g->box_lo[d] || first + 2 > g->box_lo[d] + g->box_n[d] - 1) return 0;
+  }
+  return 1;
+}
+
 int mpm_hier_level_of(const mpm_hier *h, const double *xp) {
   int l = 0, gi[MPM_MAX_DIM] = {0, 0, 0};
   double x[MPM_MAX_DIM];
@@ -357,6 +390,7 @@ int mpm_hier_level_of(const mpm_hier *h, const double *xp) {
       gi[d] = hier_span_of(xi);
     }
     if (!span_flag(h, l, h->level[l].refined, gi, 0)) return l;
+    if (walled(h) && !stencil_in_box(h->level[l + 1].grid, x)) return l;
   }
   return l;
 }

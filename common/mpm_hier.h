@@ -47,6 +47,20 @@
  * Elsewhere period[d] = 0, and nothing changes: a hierarchy that stays clear of the periodic
  * faces computes bit for bit what it did before they were carried.
  *
+ * Walls (slip and no-slip faces, given to mpm_hier_new_walled; the gas alone). The levels'
+ * lattices are symmetric about a wall face: on level 0 the face is a node (node 0, or ncells[d])
+ * and the middle of span 0 (or ncells[d]); on a level l >= 1 it is a knot between two nodes, so
+ * node (and span) j mirrors 2^l - 1 - j at the low face and 2 N_l + 2^l - 1 - j at the high face
+ * (level 0 alike: -j and 2 ncells[d] - j). The masks are looked up at the mirror for every span
+ * beyond a wall, so the regions, masks and composite basis are symmetric about it and a region
+ * may touch it (it then reaches past it by half a level-0 span, span 0 straddling the face):
+ * the composite basis of the constrained velocity is the even (tangential) or odd (normal)
+ * extension across the wall, restricted to the domain. mpm_hier_walls_fold() then adds every
+ * finer level's nodes beyond a wall into their mirrors after the restriction, as level 0's wall
+ * rules fold its pad nodes, and mpm_hier_walls_apply() sets them from their mirrors after the
+ * solve; the prolongation keeps the symmetry (the reflection maps each level's B-splines onto
+ * each other). Without walls nothing changes.
+ *
  * Masks (one byte per box node of a level, indexed like its nodal fields): covered[l][i] is 1
  * when span i of level l lies in Omega_l, refined[l][i] when it lies in Omega_{l+1}, active[l][i]
  * when node i is active. */
@@ -80,6 +94,9 @@ typedef struct mpm_hier_level {
 
 typedef struct mpm_hier {
   int dim, nlevels, buffer;
+  /* Components a wall on face [d][side] constrains (bit e: component e flips in the mirror;
+   * 0: no wall, the face is not mirrored). */
+  unsigned char wall[MPM_MAX_DIM][2];
   int wraps; /* some level >= 1 stores a whole period (mpm_hier_level.period) */
   mpm_hier_level level[MPM_HIER_MAX_LEVELS];
   void *scratch; /* private to mpm_hier.c: per-level particle lists and gathered arrays */
@@ -102,7 +119,20 @@ typedef struct mpm_hier_weight {
  * rank or a shape other than the quadratic B-spline. Logs nothing: the caller names the key. */
 int mpm_hier_new(mpm_hier **h, mpm_grid *grid, int nlevels, const mpm_hier_box *box, int nbox,
                  int buffer, char *why, size_t why_len);
+/* The same with walls: wall[d][side] as mpm_hier.wall (NULL: none). A box may then touch a
+ * walled face. */
+int mpm_hier_new_walled(mpm_hier **h, mpm_grid *grid, int nlevels, const mpm_hier_box *box,
+                        int nbox, int buffer, const unsigned char (*wall)[2], char *why,
+                        size_t why_len);
 void mpm_hier_destroy(mpm_hier **h);
+
+/* The walls on the finer levels (mpm_hier_walls.c): fold adds every node beyond a wall (m, m v
+ * and f of the phase, the components the wall constrains negated) into its mirror and zeroes
+ * it, after the restriction; apply sets every node beyond a wall to its mirror's v and a (so
+ * negated), after the solve. Axis by axis, so a corner node goes through both walls. Level 0's
+ * own rules (mpm_bc.h) do the same there. No-ops without walls. */
+void mpm_hier_walls_fold(mpm_hier *h, int phase);
+void mpm_hier_walls_apply(mpm_hier *h, int phase);
 
 /* Give every finer level the phases the grid has and it lacks (after a module adds one). */
 int mpm_hier_add_phases(mpm_hier *h);

@@ -42,6 +42,16 @@ static inline void hier_canon(const mpm_hier_level *lv, int dim, int *gi) {
   }
 }
 
+/* Index i of level l's lattice along d at its mirror when it lies beyond a walled face
+ * (mpm_hier.h, walls), else i: beyond the low face when 2 i < 2^l - 1, the high face when
+ * 2 i > 2 N_l + 2^l - 1 (N_l = ncells[d] 2^l). */
+static inline int hier_mirror(const mpm_hier *h, int l, int d, int i) {
+  const int twice_lo = (1 << l) - 1, twice_hi = 2 * (h->level[0].grid->ncells[d] << l) + twice_lo;
+  if (h->wall[d][0] && 2 * i < twice_lo) return twice_lo - i;
+  if (h->wall[d][1] && 2 * i > twice_hi) return twice_hi - i;
+  return i;
+}
+
 /* x wrapped into [lo, hi) when it lies at most a period outside, as mpm_grid_wrap does (inline:
  * a hot path). */
 static inline double hier_wrap_coord(double x, double lo, double hi) {

@@ -129,32 +129,59 @@ static int deposit_arrays(mpm_grid_phase *ph, int dim, double **slot[DEPOSIT_MAX
   return n;
 }
 
+/* The grids that hold module k's phase: the shared grid, then its hierarchy's finer levels.
+ * Returns their number. */
+static int phase_grids(const mpm_cycle *c, int k, mpm_grid **g) {
+  const mpm_hier *h = c->mod[k]->hier;
+  int n = 0;
+  g[n++] = c->grid;
+  for (int l = 1; h && l < h->nlevels; ++l) g[n++] = h->level[l].grid;
+  return n;
+}
+
+/* Put copies of phase ph's deposit (on g, dim axes) in its arrays' place, keeping the arrays in
+ * own; returns their number. */
+static int shadow_in(mpm_grid *g, int phase, double *own[DEPOSIT_MAX]) {
+  mpm_grid_phase *ph = &g->phase[phase];
+  const size_t nn = (size_t)g->nnodes;
+  double **slot[DEPOSIT_MAX];
+  const int ns = deposit_arrays(ph, g->dim, slot);
+  if (!ph->shadow) MPM_ALLOC(ph->shadow, DEPOSIT_MAX * nn);
+  for (int j = 0; j < ns; ++j) {
+    own[j] = *slot[j];
+    memcpy(ph->shadow + j * nn, own[j], nn * sizeof(double));
+    *slot[j] = ph->shadow + j * nn;
+  }
+  return 0;
+}
+
+/* Give phase ph on g its own deposit arrays back. */
+static void shadow_out(mpm_grid *g, int phase, double *const own[DEPOSIT_MAX]) {
+  double **slot[DEPOSIT_MAX];
+  const int ns = deposit_arrays(&g->phase[phase], g->dim, slot);
+  for (int j = 0; j < ns; ++j) *slot[j] = own[j];
+}
+
 /* Preview the solve of this deposit at h = 0 and let the modules that read it complete their
  * deposits. The grid pass (as MUSL's remap: nothing is recorded) runs on copies of the
- * deposits in the phases' shadows, so that the deposits themselves are summed and solved once,
- * by the pass that follows; it leaves the velocity of the solve in every phase's v_i. A held
+ * deposits in the phases' shadows, on every level of a hierarchy (the walls fold the finer
+ * levels' deposits in place), so that the deposits themselves are summed and solved once, by
+ * the pass that follows; it leaves the velocity of the solve in every phase's v_i. A held
  * partner's phase is restored from the interface by either pass alike. */
 static int preview(const mpm_cycle *c, double t, double *const *y) {
   int need = 0;
   for (int k = 0; k < c->nmod; ++k) need |= c->mod[k]->ops->p2g_rate != NULL;
   if (!need) return 0;
-  const int dim = c->grid->dim;
-  const size_t nn = (size_t)c->grid->nnodes;
-  double **slot[MPM_MAX_MODULES][DEPOSIT_MAX], *own[MPM_MAX_MODULES][DEPOSIT_MAX];
-  int ns[MPM_MAX_MODULES];
+  double *own[MPM_MAX_MODULES][MPM_HIER_MAX_LEVELS][DEPOSIT_MAX];
+  mpm_grid *g[MPM_MAX_MODULES][MPM_HIER_MAX_LEVELS];
+  int ng[MPM_MAX_MODULES];
   for (int k = 0; k < c->nmod; ++k) {
-    mpm_grid_phase *ph = &c->grid->phase[c->mod[k]->phase];
-    ns[k] = deposit_arrays(ph, dim, slot[k]);
-    if (!ph->shadow) MPM_ALLOC(ph->shadow, DEPOSIT_MAX * nn);
-    for (int j = 0; j < ns[k]; ++j) {
-      own[k][j] = *slot[k][j];
-      memcpy(ph->shadow + j * nn, own[k][j], nn * sizeof(double));
-      *slot[k][j] = ph->shadow + j * nn;
-    }
+    ng[k] = phase_grids(c, k, g[k]);
+    for (int l = 0; l < ng[k]; ++l) MPM_CALL(shadow_in(g[k][l], c->mod[k]->phase, own[k][l]));
   }
   const int rc = grid_pass(c, t, 0.0, MPM_PASS_REMAP);
   for (int k = 0; k < c->nmod; ++k)
-    for (int j = 0; j < ns[k]; ++j) *slot[k][j] = own[k][j];
+    for (int l = 0; l < ng[k]; ++l) shadow_out(g[k][l], c->mod[k]->phase, own[k][l]);
   MPM_CALL(rc);
   for (int k = 0; k < c->nmod; ++k)
     if (c->mod[k]->ops->p2g_rate) MPM_CALL(c->mod[k]->ops->p2g_rate(c->mod[k], t, y[k]));

@@ -2,14 +2,16 @@
  *
  * What the slice refuses here, one line each naming the key: boxes without refine.levels > 1,
  * a solid beside a gas, a solid with dynamic regrids, more than one rank, a shape other than the
- * quadratic B-spline, and a box within three level-0 cells of a non-periodic domain face (walls and
- * open faces act on level 0 alone). Along a periodic axis a box or a dynamic region may touch,
- * cross or span the periodic faces (the levels wrap there, mpm_hier.h). mpm_hier_new's own reasons
- * name the box's key. The gas and the solid refuse their own settings (fluid/fluid_refine.c,
- * solid/solid_refine.c). */
+ * quadratic B-spline, and a box within three level-0 cells of a non-periodic domain face other than
+ * a gas's slip or no-slip wall (open and closed faces, and a solid's walls, act on level 0 alone;
+ * a gas's walls are carried to every level, mpm_hier.h, and a box or region may touch them). Along
+ * a periodic axis a box or a dynamic region may touch, cross or span the periodic faces (the levels
+ * wrap there, mpm_hier.h). mpm_hier_new's own reasons name the box's key. The gas and the solid
+ * refuse their own settings (fluid/fluid_refine.c, solid/solid_refine.c). */
 #include "mpm_refine.h"
 
 #include "fluid_module.h"
+#include "mpm_bc.h"
 #include "mpm_error.h"
 #include "solid_module.h"
 
@@ -79,6 +81,22 @@ static const mpm_module *solid_of(mpm_module **mod, int nmod) {
   return NULL;
 }
 
+/* The walls the finer levels carry (mpm_hier.h, walls): the slip and no-slip faces of a gas-only
+ * case, as the components each constrains; none for a solid (its levels keep off every face). */
+static int carried_walls(const mpm_config *cfg, const mpm_grid *g, mpm_module **mod, int nmod,
+                         unsigned char wall[MPM_MAX_DIM][2]) {
+  memset(wall, 0, sizeof(unsigned char) * MPM_MAX_DIM * 2);
+  if (solid_of(mod, nmod)) return 0;
+  mpm_walls w;
+  MPM_CALL(mpm_walls_from_config(&w, cfg, g->dim));
+  for (int d = 0; d < g->dim; ++d)
+    for (int s = 0; s < 2; ++s)
+      wall[d][s] = w.face[d][s] == MPM_WALL_NO_SLIP ? (unsigned char)((1u << g->dim) - 1)
+                   : w.face[d][s] == MPM_WALL_SLIP  ? (unsigned char)(1u << d)
+                                                    : 0;
+  return 0;
+}
+
 /* The case-wide refusals: a solid beside a gas, several ranks, another shape. */
 static int check_case(const mpm_config *cfg, const mpm_grid *grid, mpm_module **mod, int nmod) {
   if (solid_of(mod, nmod) && nmod > 1)
@@ -98,9 +116,11 @@ static int check_case(const mpm_config *cfg, const mpm_grid *grid, mpm_module **
   return 0;
 }
 
-/* Box NAME from its section, kept REFINE_FACE_CELLS level-0 cells from non-periodic faces
- * (along a periodic axis mpm_hier_new takes it up to a period beyond the faces). */
-static int read_box(const mpm_config *cfg, const mpm_grid *g, const char *name, mpm_hier_box *b) {
+/* Box NAME from its section, kept REFINE_FACE_CELLS level-0 cells from non-periodic faces other
+ * than a carried wall (wall[d][side]: touched, not crossed); along a periodic axis mpm_hier_new
+ * takes it up to a period beyond the faces. */
+static int read_box(const mpm_config *cfg, const mpm_grid *g, const char *name,
+                    const unsigned char (*wall)[2], mpm_hier_box *b) {
   char key[3][160];
   static const char *const part[3] = {"level", "lo", "hi"};
   for (int j = 0; j < 3; ++j) snprintf(key[j], sizeof key[j], "refine.%s.%s", name, part[j]);
@@ -115,14 +135,16 @@ static int read_box(const mpm_config *cfg, const mpm_grid *g, const char *name, 
   const double gap = REFINE_FACE_CELLS * g->dx, tol = 1e-9 * g->dx;
   for (int d = 0; d < g->dim; ++d) {
     if (g->periodic[d]) continue;
-    const int low = b->lo[d] < g->lo[d] + gap - tol;
-    if (low || b->hi[d] > g->hi[d] - gap + tol)
+    const double gap_lo = wall[d][0] ? 0.0 : gap, gap_hi = wall[d][1] ? 0.0 : gap;
+    const int low = b->lo[d] < g->lo[d] + gap_lo - tol;
+    if (low || b->hi[d] > g->hi[d] - gap_hi + tol)
       return mpm_config_fail(cfg, key[low ? 1 : 2],
                              "the box comes within %d level-0 cells (%g) of the domain face %c = "
-                             "%g: walls and open faces act on level 0 only; keep the box inside "
-                             "[%g, %g] along %c (or make the axis periodic)",
+                             "%g, or past a wall: open faces, closed faces (none) and a solid's "
+                             "walls act on level 0 only; keep the box inside [%g, %g] along %c "
+                             "(a slip or no-slip wall of a gas may be touched, not crossed)",
                              REFINE_FACE_CELLS, gap, "xyz"[d], low ? g->lo[d] : g->hi[d],
-                             g->lo[d] + gap, g->hi[d] - gap, "xyz"[d]);
+                             g->lo[d] + gap_lo, g->hi[d] - gap_hi, "xyz"[d]);
   }
   return 0;
 }
@@ -140,16 +162,16 @@ static int fail_why(const mpm_config *cfg, const char *const *names, int nbox, c
 }
 
 static int read_boxes(const mpm_config *cfg, const mpm_grid *g, const char *const *names, int n,
-                      mpm_hier_box *box) {
-  for (int k = 0; k < n; ++k) MPM_CALL(read_box(cfg, g, names[k], &box[k]));
+                      const unsigned char (*wall)[2], mpm_hier_box *box) {
+  for (int k = 0; k < n; ++k) MPM_CALL(read_box(cfg, g, names[k], wall, &box[k]));
   return 0;
 }
 
 /* ---- dynamic refinement: the regions from the criterion's flags --------------------------- */
 
-/* Level-0 cells a dynamic region keeps from every non-periodic domain face (the static boxes'
- * rule, met by construction: span i's lower face is at (i - 1/2) dx); along a periodic axis
- * the region wraps. */
+/* Level-0 cells a dynamic region keeps from every non-periodic domain face other than a carried
+ * wall (the static boxes' rule, met by construction: span i's lower face is at (i - 1/2) dx);
+ * along a periodic axis the region wraps, and at a wall it may take in the face span. */
 #define REFINE_CLIP 4
 
 /* The criteria refine.criterion may list, in fluid_refine_criterion's order; the first
@@ -162,7 +184,8 @@ typedef struct dynamic {
   int levels, buffer, every, dilate;
   int ncrit; /* criteria listed (0: none) */
   fluid_refine_criterion crit[REFINE_NCRIT];
-  double threshold[REFINE_NCRIT]; /* each one's threshold */
+  double threshold[REFINE_NCRIT];     /* each one's threshold */
+  unsigned char wall[MPM_MAX_DIM][2]; /* the walls carried (carried_walls) */
 } dynamic;
 
 /* The criteria of refine.criterion into dy->crit (none: ncrit = 0), each known and listed
@@ -320,6 +343,8 @@ static int mask_boxes(const mpm_grid *g, const int *n, int l, double eps, const 
       for (int d = 0; d < g->dim; ++d) { /* (span 0 of a periodic axis crosses its face) */
         b->lo[d] = g->lo[d] + (first[d] - 0.5) * g->dx + eps;
         b->hi[d] = g->lo[d] + (last[d] + 0.5) * g->dx - eps;
+        if (!g->periodic[d]) /* at a wall: its face span, snapped back to it by mpm_hier_new */
+          b->lo[d] = fmax(b->lo[d], g->lo[d]), b->hi[d] = fmin(b->hi[d], g->hi[d]);
       }
       a = z;
     }
@@ -353,7 +378,8 @@ static int make_dynamic(mpm_hier **h, const dynamic *dy, mpm_grid *grid, mpm_mod
     for (size_t s = 0; s < total; ++s) {
       int in = 1;
       for (int d = 0, r = (int)s; d < grid->dim; r /= n[d], ++d)
-        in &= grid->periodic[d] || (r % n[d] >= clip && r % n[d] <= grid->ncells[d] - clip);
+        in &= grid->periodic[d] || ((dy->wall[d][0] || r % n[d] >= clip) &&
+                                    (dy->wall[d][1] || r % n[d] <= grid->ncells[d] - clip));
       mask[s] &= (unsigned char)in;
       any |= mask[s];
     }
@@ -364,7 +390,9 @@ static int make_dynamic(mpm_hier **h, const dynamic *dy, mpm_grid *grid, mpm_mod
   free(flag);
   char why[512] = "";
   *h = NULL;
-  if (!rc && used > 1) rc = mpm_hier_new(h, grid, used, box, nbox, dy->buffer, why, sizeof why);
+  if (!rc && used > 1)
+    rc = mpm_hier_new_walled(h, grid, used, box, nbox, dy->buffer,
+                             (const unsigned char(*)[2])dy->wall, why, sizeof why);
   free(box);
   if (rc == MPM_ERR_INPUT) MPM_FAIL(MPM_ERR_INTERNAL, "regrid: %s", why);
   return rc;
@@ -401,6 +429,7 @@ int mpm_refine_regrid(mpm_hier **h, const mpm_config *cfg, mpm_grid *grid, mpm_m
   int on;
   MPM_CALL(read_dynamic(cfg, &dy, &on));
   if (!on || nmod < 1 || (!force && step % dy.every != 0)) return 0;
+  MPM_CALL(carried_walls(cfg, grid, mod, nmod, dy.wall));
   mpm_hier *next;
   MPM_CALL(make_dynamic(&next, &dy, grid, mod[0]));
   if (same_regions(next, *h)) { /* keep the hierarchy, and the integrator's state */
@@ -445,6 +474,9 @@ int mpm_refine_build(mpm_hier **h, const mpm_config *cfg, mpm_grid *grid, mpm_mo
                            "is a static box, and refine.criterion refines dynamically: remove "
                            "the [refine.NAME] boxes or set refine.criterion = none");
   }
+  unsigned char wall[MPM_MAX_DIM][2];
+  MPM_CALL(carried_walls(cfg, grid, mod, nmod, wall));
+  memcpy(dy.wall, wall, sizeof wall);
   if (on) { /* from the seeded gas (on a restart the sim regrids once the particles are read) */
     MPM_CALL(make_dynamic(h, &dy, grid, mod[0]));
     for (int k = 0; k < nmod; ++k) MPM_CALL(fluid_module_refine(mod[k], cfg, *h, seed));
@@ -452,9 +484,11 @@ int mpm_refine_build(mpm_hier **h, const mpm_config *cfg, mpm_grid *grid, mpm_mo
   }
   mpm_hier_box *box;
   MPM_ALLOC(box, nbox);
-  int rc = read_boxes(cfg, grid, names, nbox, box);
+  int rc = read_boxes(cfg, grid, names, nbox, (const unsigned char(*)[2])wall, box);
   char why[512] = "";
-  if (!rc) rc = mpm_hier_new(h, grid, levels, box, nbox, buffer, why, sizeof why);
+  if (!rc)
+    rc = mpm_hier_new_walled(h, grid, levels, box, nbox, buffer, (const unsigned char(*)[2])wall,
+                             why, sizeof why);
   free(box);
   if (rc == MPM_ERR_INPUT && why[0]) return fail_why(cfg, names, nbox, why);
   MPM_CALL(rc);

@@ -24,7 +24,9 @@
  * restriction folds what lands on its images.
  *
  * Walls. Level 0's pad nodes take part like any node (their pressure and rate from their own
- * unfolded mass); the walls then fold their forces as they fold the particles' deposits.
+ * unfolded mass); the walls then fold their forces as they fold the particles' deposits. A finer
+ * level reaching a wall (mpm_hier.h, walls) does the same with its nodes beyond the wall, and
+ * integrates only its spans inside it (the wall is a knot of every finer level).
  *
  * Scope (fluid_gridp_read refuses the rest): the method-of-lines ERK pairs with the current
  * strain rate, the quadratic B-spline, a gas alone (no solid, obstacle or open face), no
@@ -47,9 +49,9 @@ struct fluid_gridp {
   double *zero;
   mpm_lidx cap;
   /* Per level: nodal pressure, then rate per unit mass (P), forces (F, dim), rates (D), the
-   * mass they divide by (M: level 0's before the walls fold it), and the spans it skips. */
+   * mass they divide by (M: each level's before the walls fold it), and the spans it skips. */
   double *P[MPM_HIER_MAX_LEVELS], *F[MPM_HIER_MAX_LEVELS][MPM_MAX_DIM], *D[MPM_HIER_MAX_LEVELS];
-  double *M0;
+  double *M[MPM_HIER_MAX_LEVELS];
   unsigned char *skip[MPM_HIER_MAX_LEVELS];
   mpm_span_set set[MPM_HIER_MAX_LEVELS];
 };
@@ -124,11 +126,9 @@ int fluid_gridp_refine(mpm_module *m, const mpm_config *cfg, mpm_hier *h) {
 void fluid_gridp_reset(fluid_content *fc) {
   fluid_gridp *gp = fc->gridp;
   if (!gp) return;
-  free(gp->M0);
-  gp->M0 = NULL;
   for (int l = 0; l < MPM_HIER_MAX_LEVELS; ++l) {
-    free(gp->P[l]), free(gp->D[l]), free(gp->skip[l]);
-    gp->P[l] = gp->D[l] = NULL, gp->skip[l] = NULL;
+    free(gp->P[l]), free(gp->D[l]), free(gp->M[l]), free(gp->skip[l]);
+    gp->P[l] = gp->D[l] = gp->M[l] = NULL, gp->skip[l] = NULL;
     for (int d = 0; d < MPM_MAX_DIM; ++d) free(gp->F[l][d]), gp->F[l][d] = NULL;
   }
 }
@@ -146,6 +146,16 @@ static const mpm_grid *level_grid(const mpm_module *m, int l) {
   return m->hier ? m->hier->level[l].grid : m->grid;
 }
 
+/* Along d, the spans of level l >= 1 inside the walls (mpm_hier.h, walls: a wall is a knot of
+ * the level, between spans 2^(l-1) - 1 and 2^(l-1) at the low face and N_l + 2^(l-1) - 1 and
+ * N_l + 2^(l-1) at the high one), so that the level integrates the domain only, as level 0
+ * does with its halved face spans. */
+static void wall_spans(const mpm_hier *h, int l, int d, mpm_span_set *s) {
+  const int half = 1 << (l - 1), N = h->level[0].grid->ncells[d] << l;
+  if (h->wall[d][0]) s->lo[d] = MPM_MAX(s->lo[d], half);
+  if (h->wall[d][1]) s->hi[d] = MPM_MIN(s->hi[d], N + half - 1);
+}
+
 /* The per-level arrays and span sets, on first use (the hierarchy is static). */
 static int ensure_levels(mpm_module *m, fluid_gridp *gp) {
   if (gp->P[0]) return 0;
@@ -156,9 +166,9 @@ static int ensure_levels(mpm_module *m, fluid_gridp *gp) {
     const size_t nn = (size_t)g->nnodes;
     MPM_ALLOC(gp->P[l], nn);
     MPM_ALLOC(gp->D[l], nn);
+    MPM_ALLOC(gp->M[l], nn);
     for (int d = 0; d < g->dim; ++d) MPM_ALLOC(gp->F[l][d], nn);
     if (l == 0) {
-      MPM_ALLOC(gp->M0, nn);
       if (h) {
         MPM_ALLOC(gp->skip[0], nn);
         memcpy(gp->skip[0], h->level[0].refined, nn);
@@ -174,6 +184,7 @@ static int ensure_levels(mpm_module *m, fluid_gridp *gp) {
     for (int d = 0; d < g->dim; ++d) { /* the spans in [0, N_l) where the level wraps */
       const int N = h->level[l].period[d];
       s->lo[d] = N ? 0 : g->box_lo[d], s->hi[d] = N ? N - 1 : g->box_lo[d] + g->box_n[d] - 1;
+      wall_spans(h, l, d, s);
     }
   }
   return 0;
@@ -239,7 +250,7 @@ static void per_mass(const mpm_module *m, const fluid_gridp *gp, double *const *
                      double *const *out) {
   for (int l = 0; l < gp->nlev; ++l) {
     const mpm_grid *g = level_grid(m, l);
-    const double *mass = l == 0 ? gp->M0 : g->phase[m->phase].m_i;
+    const double *mass = gp->M[l];
     const unsigned char *act = m->hier ? m->hier->level[l].active : NULL;
     for (mpm_lidx k = 0; k < g->nnodes; ++k)
       out[l][k] = (!act || act[k]) && mass[k] > 0.0 ? num[l][k] / mass[k] : 0.0;
@@ -254,8 +265,11 @@ int fluid_gridp_forces(mpm_module *m) {
   if (m->hier) mpm_hier_restrict(m->hier, gp->phase);
   for (int l = 0; l < gp->nlev; ++l) Q[l][0] = level_grid(m, l)->phase[gp->phase].m_i;
   MPM_CALL(mpm_grid_halo_reverse(m->grid, Q[0], 1));
-  /* Level 0's mass as the rates will divide by it (the walls fold the phase's own next). */
-  memcpy(gp->M0, m->grid->phase[m->phase].m_i, sizeof(double) * (size_t)m->grid->nnodes);
+  /* Each level's mass as the rates will divide by it (the walls fold the phase's own next). */
+  for (int l = 0; l < gp->nlev; ++l) {
+    const mpm_grid *g = level_grid(m, l);
+    memcpy(gp->M[l], g->phase[m->phase].m_i, sizeof(double) * (size_t)g->nnodes);
+  }
   double *q[MPM_HIER_MAX_LEVELS];
   for (int l = 0; l < gp->nlev; ++l) q[l] = Q[l][0];
   per_mass(m, gp, q, gp->P);

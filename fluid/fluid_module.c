@@ -423,7 +423,8 @@ static int fluid_p2g_rate(mpm_module *m, double t, const double *y) {
 
 /* Before the nodal solve: the ghost pressure of the obstacles and the virtual particles' forces
  * (first pass only: in MUSL's remap no force acts, and only the first pass's obstacle force is
- * recorded), the mirrored pad nodes folded into the walls, and the open faces' forces. */
+ * recorded), the mirrored pad nodes folded into the walls (on every level of a hierarchy), and
+ * the open faces' forces. */
 static int fluid_forces(mpm_module *m, double t, double h, mpm_pass pass) {
   fluid_content *fc = m->content;
   const int first = pass == MPM_PASS_FIRST;
@@ -434,6 +435,7 @@ static int fluid_forces(mpm_module *m, double t, double h, mpm_pass pass) {
     MPM_CALL(fluid_open_gauge_forces(fc->open, m));
   }
   mpm_constraints_fold(&fc->cons, m->grid, m->phase);
+  if (m->hier) mpm_hier_walls_fold(m->hier, m->phase);
   if (first) MPM_CALL(fluid_open_forces(fc->open, m, t));
   return 0;
 }
@@ -445,6 +447,7 @@ static int fluid_constrain(mpm_module *m, double t, double h, mpm_pass pass) {
   fluid_content *fc = m->content;
   const int first = pass == MPM_PASS_FIRST;
   mpm_constraints_apply(&fc->cons, m->grid, m->phase);
+  if (m->hier) mpm_hier_walls_apply(m->hier, m->phase);
   fluid_open_hold(fc->open, m);
   if (fc->obs.count) {
     MPM_CALL(fluid_obstacles_apply(&fc->obs, m->grid, m->phase, first ? h : 0.0, first));

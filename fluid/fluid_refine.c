@@ -9,8 +9,9 @@
  * (coupler/mpm_cycle.c). The artificial viscosity of a particle takes the spacing of the level
  * it deposits on (its position's) as its length, as on a uniform grid of that spacing, and the
  * stable step is the smallest over the particles of that spacing over their signal speed
- * (fluid_module.c). Walls act on level 0 only: the sim keeps every box three level-0 cells from the
- * non-periodic faces (coupler/mpm_refine.c).
+ * (fluid_module.c). Slip and no-slip walls act on every level (mpm_hier.h, walls: the finer levels
+ * fold and mirror their nodes beyond a wall in fluid_module.c's forces and constrain); the sim
+ * keeps every box three level-0 cells from the other non-periodic faces (coupler/mpm_refine.c).
  *
  * Refused (fluid_refine_check), each naming its key: everything that reads or writes the gas's
  * nodal fields or the grid otherwise: the classic update (its time-centred nodal velocity, heat

@@ -16,3 +16,8 @@ mpm_add_test(test_span SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/unit/test_span.c LABE
 # 3-D): partition of unity, periodicity of the basis, conservation, P2G = eval, reproduction.
 mpm_add_test(test_hier_periodic SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/unit/test_hier_periodic.c
              LABELS unit RANKS 1)
+# Levels touching walls (slip and no-slip, a corner): the masks are symmetric about the walls,
+# partition of unity, the finer levels' fold keeps the mass and empties the nodes beyond the
+# walls, and the apply mirrors the velocity.
+mpm_add_test(test_hier_walls SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/unit/test_hier_walls.c
+             LABELS unit RANKS 1)

@@ -37,3 +37,12 @@ mpm_add_script_test(test_refine_sod SCRIPT verification/test_refine_sod.py LABEL
                     TIMEOUT 300)
 mpm_add_script_test(test_refine_sod_long SCRIPT verification/test_refine_sod.py ARGS long
                     LABELS "verification;long" TIMEOUT 600)
+# Finer levels at slip and no-slip walls (the gas): gas at rest in a closed box refined in its
+# corner (~3 s), a uniform stream along the walls through a band touching them (~4 s), an
+# acoustic pulse reflecting from a slip wall in a band against its uniform twins (~5 s), the
+# regridded pulse whose regions reach the walls, on 2 and 3 levels (~9 s); the stream part also
+# runs in 3-D (~4 s).
+foreach(part rest stream pulse dynamic)
+  mpm_add_script_test(test_refine_walls_${part} SCRIPT verification/test_refine_walls.py
+                      ARGS ${part} LABELS verification TIMEOUT 300)
+endforeach()

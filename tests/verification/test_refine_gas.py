@@ -556,8 +556,13 @@ def part_input():
     cases = [
         ("box with levels = 1", case_text(2, 0.1, gas, box.replace("levels = 2", "levels = 1")),
          "refine.box.level", "level = 1", "refine.levels = 1"),
-        ("box near a wall", case_text(2, 0.1, gas, box.replace("lo = 0.8 0.15", "lo = 0.8 0.1")),
-         "refine.box.lo", "lo = 0.8 0.1", "act on level 0 only"),
+        # A box may touch a slip or no-slip wall of the gas (test_refine_walls.py), not a
+        # closed face (none), nor cross a wall.
+        ("box near a closed face", case_text(2, 0.1, gas, box.replace(
+            "lo = 0.8 0.15", "lo = 0.8 0.1"), y="none"), "refine.box.lo", "lo = 0.8 0.1",
+         "act on level 0 only"),
+        ("box past a wall", case_text(2, 0.1, gas, box.replace("lo = 0.8 0.15", "lo = 0.8 -0.1")),
+         "refine.box.lo", "lo = 0.8 -0.1", "not crossed"),
         # Along a periodic axis a box may cross the faces (the levels wrap), by up to a period.
         ("box more than a period beyond a periodic face", case_text(
             2, 0.1, gas, box.replace("hi = 1.2 0.45", "hi = 4.5 0.45")),

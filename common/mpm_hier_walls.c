@@ -1,0 +1,75 @@
+/* The wall rule on the finer levels of the hierarchy (mpm_hier.h, walls): every node of a level
+ * l >= 1 beyond a walled face is folded into its mirror before the solve (its deposit is the
+ * mirror image's, the constrained components negated) and set from it after the solve.
+ *
+ * Invariants: a wall face is a knot of every finer level, so no finer node lies on it (level 0's
+ * face nodes, held by mpm_bc.c, have no counterpart here) and every node beyond it has a mirror
+ * inside; a node whose mirror lies outside the level's box (the box's outermost layers, whose
+ * supports stay beyond the wall) is skipped. Faces are taken axis by axis in both calls, so a
+ * corner node folds through the first wall onto a node beyond the second, which then folds
+ * inside, and is set back in the same order. Level 0 is left to mpm_bc.c. */
+#include "mpm_hier_impl.h"
+
+/* The mirror of box node n of level l along axis d (its box index), or -1 when n is not beyond
+ * a wall of d or its mirror leaves the box. */
+static mpm_lidx mirror_node(const mpm_hier *h, int l, int d, mpm_lidx n) {
+  const mpm_grid *g = h->level[l].grid;
+  int gi[MPM_MAX_DIM];
+  hier_node_of(g, n, gi);
+  const int m = hier_mirror(h, l, d, gi[d]);
+  if (m == gi[d]) return -1;
+  gi[d] = m;
+  return hier_in_box(g, gi) ? mpm_grid_local_index(g, gi) : -1;
+}
+
+/* The components a wall of axis d constrains at box node n (the wall on n's side). */
+static unsigned char flips(const mpm_hier *h, int l, int d, mpm_lidx n) {
+  int gi[MPM_MAX_DIM];
+  hier_node_of(h->level[l].grid, n, gi);
+  return h->wall[d][2 * gi[d] > (1 << l) - 1];
+}
+
+static int has_walls(const mpm_hier *h, int d) {
+  return h->wall[d][0] || h->wall[d][1];
+}
+
+void mpm_hier_walls_fold(mpm_hier *h, int phase) {
+  for (int l = 1; l < h->nlevels; ++l) {
+    mpm_grid *g = h->level[l].grid;
+    mpm_grid_phase *ph = &g->phase[phase];
+    for (int d = 0; d < h->dim; ++d) {
+      if (!has_walls(h, d)) continue;
+      for (mpm_lidx n = 0; n < g->nnodes; ++n) {
+        const mpm_lidx s = mirror_node(h, l, d, n);
+        if (s < 0) continue;
+        const unsigned char mask = flips(h, l, d, n);
+        ph->m_i[s] += ph->m_i[n], ph->m_i[n] = 0.0;
+        for (int e = 0; e < h->dim; ++e) {
+          const double sign = (mask >> e) & 1 ? -1.0 : 1.0;
+          ph->mv_i[e][s] += sign * ph->mv_i[e][n], ph->mv_i[e][n] = 0.0;
+          ph->f_i[e][s] += sign * ph->f_i[e][n], ph->f_i[e][n] = 0.0;
+        }
+      }
+    }
+  }
+}
+
+void mpm_hier_walls_apply(mpm_hier *h, int phase) {
+  for (int l = 1; l < h->nlevels; ++l) {
+    mpm_grid *g = h->level[l].grid;
+    mpm_grid_phase *ph = &g->phase[phase];
+    for (int d = 0; d < h->dim; ++d) {
+      if (!has_walls(h, d)) continue;
+      for (mpm_lidx n = 0; n < g->nnodes; ++n) {
+        const mpm_lidx s = mirror_node(h, l, d, n);
+        if (s < 0) continue;
+        const unsigned char mask = flips(h, l, d, n);
+        for (int e = 0; e < h->dim; ++e) {
+          const double sign = (mask >> e) & 1 ? -1.0 : 1.0;
+          ph->v_i[e][n] = sign * ph->v_i[e][s];
+          ph->a_i[e][n] = sign * ph->a_i[e][s];
+        }
+      }
+    }
+  }
+}
