@@ -271,6 +271,20 @@ static int read_thresholds(const mpm_config *cfg, dynamic *dy) {
   return 0;
 }
 
+/* With refine.criterion = none nothing regrids: a key only the regrids read is refused rather
+ * than ignored, so that a case that forgot its criterion does not run unrefined unawares. */
+static int refuse_regrid_keys(const mpm_config *cfg) {
+  static const char *const keys[] = {"refine.threshold", "refine.min_particles", "refine.every",
+                                     "refine.dilate"};
+  for (size_t k = 0; k < sizeof keys / sizeof keys[0]; ++k)
+    if (mpm_config_has(cfg, keys[k]))
+      return mpm_config_fail(cfg, keys[k],
+                             "is set, and refine.criterion is none, so nothing regrids and the "
+                             "key has no effect; name a criterion (density, compression, "
+                             "vorticity, starvation) or remove the key");
+  return 0;
+}
+
 /* The dynamic settings, or 0 in *on when refine.criterion = none. */
 static int read_dynamic(const mpm_config *cfg, dynamic *dy, int *on) {
   MPM_CALL(read_criteria(cfg, dy));
@@ -279,7 +293,7 @@ static int read_dynamic(const mpm_config *cfg, dynamic *dy, int *on) {
   MPM_CALL(mpm_config_get_int(cfg, "refine.buffer", &dy->buffer));
   MPM_CALL(mpm_config_get_int(cfg, "refine.every", &dy->every));
   MPM_CALL(mpm_config_get_int(cfg, "refine.dilate", &dy->dilate));
-  if (!*on) return 0;
+  if (!*on) return refuse_regrid_keys(cfg);
   MPM_CALL(read_thresholds(cfg, dy));
   if (2 * dy->dilate < dy->buffer)
     return mpm_config_fail(cfg, "refine.dilate",

@@ -665,6 +665,13 @@ def part_input():
         ("min_particles without starvation", dyn.replace("threshold = 0.004",
                                                          "threshold = 0.004\nmin_particles = 2"),
          "refine.min_particles", "min_particles = 2", "does not list starvation"),
+        # With criterion = none nothing regrids: the regrids' keys are refused, not ignored.
+        ("a threshold without a criterion", case_text(2, 0.1, gas, box.replace(
+            "levels = 2", "levels = 2\nthreshold = 0.01")), "refine.threshold",
+         "threshold = 0.01", "refine.criterion is none"),
+        ("every without a criterion", case_text(2, 0.1, gas, box.replace(
+            "levels = 2", "levels = 2\nevery = 5")), "refine.every", "every = 5",
+         "refine.criterion is none"),
     ]
     for name, text, key, start, words in cases_dyn:
         mt.expect_input_error(check, name, text, key, mt.line_starting(text, start), words)
