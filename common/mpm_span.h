@@ -50,7 +50,6 @@ void mpm_span_divergence(const mpm_grid *g, const mpm_span_set *s, const double 
  * array). The boundary term of an open face: with q the face's pressure, the span force less
  * this term (times the outward normal) is -integral of N_i grad p_h, so a uniform p that equals
  * q gives no force at any node (fluid/fluid_boundary.c). */
-void mpm_span_plane(const mpm_grid *g, const mpm_span_set *s, int axis, const double *q,
-                    double *f);
+void mpm_span_plane(const mpm_grid *g, const mpm_span_set *s, int axis, const double *q, double *f);
 
 #endif

@@ -31,6 +31,12 @@
  *                       reflection and holds the free stream; where the free stream crosses
  *                       the face supersonically, p_b is p_inf (entering) or p (leaving).
  *                     The nodes beyond these faces extrapolate the face node linearly.
+ * With the grid pressure (fluid.pressure = grid, which refinement takes) neither the exterior
+ * lattice nor the copies act: the pressure's force is an exact integral over the domain's spans,
+ * and each open face replaces its boundary term by the same boundary pressure p_b, integrated
+ * exactly over the face (fluid_open_grid_forces, below); the nodal pressure on and beyond the
+ * face is set as the velocity there is held. On a hierarchy the finer levels keep three level-0
+ * cells from the open faces, so everything here acts on level 0.
  * The normal n points out of the domain. Where an obstacle crosses the face, the body
  * continues beyond it (fluid_obstacle.c puts its ghost points there) and the copies stop at
  * its surface.
@@ -94,7 +100,9 @@ const mpm_key_spec fluid_boundary_keys[] = {
      "(the nodes within a stencil of the face feel the particles' pressure less the boundary "
      "pressure, which holds the far field when mixed flow crosses the face, but blew up on "
      "RAE 2822 at 50 cells per chord when a vortex crossed the face; see "
-     "fluid/fluid_boundary.c)",
+     "fluid/fluid_boundary.c); with the grid pressure (fluid.pressure = grid, and refinement) "
+     "the faces take the exterior pressure as an integral over the face instead, and gauge is "
+     "refused",
      0, NULL},
     {"freestream.sponge", MPM_KEY_REAL, "0", 0, HUGE_VAL, 0, 0, NULL,
      "thickness, m, of an absorbing layer inside every farfield face that relaxes the gas's "
@@ -144,7 +152,7 @@ struct fluid_open {
   mpm_lidx *near;     /* their indices */
   mpm_lidx cand_cap;
   struct column_entry *cand; /* near-face particles of the faces, by face and column */
-  double *bp;                /* the grid pressure's face term: per box node (fluid_open_grid_forces) */
+  double *bp; /* the grid pressure's face term: per box node (fluid_open_grid_forces) */
 };
 
 /* ---- exterior force weights ---------------------------------------------------------------- */
