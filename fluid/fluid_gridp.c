@@ -98,8 +98,8 @@ static int check_scope(const fluid_content *fc, const mpm_config *cfg, const mpm
   if (open) MPM_CALL(mpm_config_get_string(cfg, "freestream.exterior", &exterior));
   if (strcmp(exterior, "gauge") == 0)
     return refuse(cfg, "freestream.exterior",
-                  "takes the open faces' exterior pressure on the grid (gauge is the particle "
-                  "pressure's); remove the key or set it to copies");
+                  "integrates the open faces' exterior pressure over the face and does not "
+                  "carry gauge (the particle pressure's gauge points)");
   return 0;
 }
 
