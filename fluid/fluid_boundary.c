@@ -629,8 +629,8 @@ int fluid_open_forces(fluid_open *o, mpm_module *m, double t) {
  * their column's outermost particle: P_j at an outflow face (no boundary force at all), the
  * back pressure, or the characteristic state. The integral is exact (mpm_span_plane), so a
  * uniform state at p_b keeps every node free of force to roundoff, whatever the particles'
- * positions and the lattice's phase (the exterior lattice's quadrature of the particle
- * pressure would not be: its midpoint rule against the exact interior). The finer levels keep
+ * positions and the lattice's phase (the exterior lattice and the copies are a quadrature
+ * made to cancel the particles' own quadrature, not the exact integral). The finer levels keep
  * away from the open faces (coupler/mpm_refine.c), so the term acts on level 0 alone.
  * The nodal pressure on and beyond the faces (fluid_open_grid_pressure) is set as the velocity
  * there is held: the free stream's on and beyond an inflow face, extrapolated linearly beyond

@@ -16,13 +16,13 @@ stream   A uniform Mach 2 stream (rho 1, p 1) entering through the inflow face x
          particle count stays within 2 % of its start (the lag of split and merge at the box's
          faces); the mass stays constant at every step, so the mass that entered (0.95 of the
          strip's) left. Then the same with subsonic_inflow | subsonic_outflow at Mach 0.5 on a
-         strip periodic along y, to t = 1.6 (1.6 flow-throughs of the box) (~12 s).
+         strip periodic along y, to t = 1.6 (1.6 flow-throughs of the box) (~15 s).
 farfield A uniform Mach 0.5 stream through farfield faces x_lo and x_hi with a sponge 0.15 deep
          (freestream.sponge) inside both, y periodic, level-1 and level-2 boxes clear of the
          sponge, to t = 1 (1.9 flow-throughs of the level-1 box): uniform to roundoff, mass
          constant; then in 3-D a Mach 2 stream through inflow | outflow along x with a farfield
          face along the stream (y_hi), a slip wall (y_lo) and z periodic, across a level-1 box
-         (dx = 0.075, to t = 0.3, 2.4 flow-throughs of the box) (~13 s).
+         (dx = 0.075, to t = 0.3, 2.4 flow-throughs of the box) (~15 s).
 shock    A Mach 3 shock driven into gas at rest (rho 1, p 1) through the inflow face x_lo (the
          free stream is the post-shock state, u/c = 1.36: every characteristic enters), on a
          strip 2 x 0.15 periodic along y, regridded by the density criterion (threshold 0.05,
