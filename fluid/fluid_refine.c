@@ -137,7 +137,7 @@ static const refusal g_refused[] = {
 };
 
 /* The first obstacle of the case: refused with its key. */
-static int refuse_boundaries(const mpm_config *cfg, const fluid_content *fc, int dim) {
+static int refuse_obstacles(const mpm_config *cfg) {
   const char *const *names;
   int count;
   MPM_CALL(mpm_config_instances(cfg, "obstacle", &names, &count));
@@ -146,7 +146,6 @@ static int refuse_boundaries(const mpm_config *cfg, const fluid_content *fc, int
     snprintf(key, sizeof key, "obstacle.%s.shape", names[0]);
     return refuse(cfg, key, "obstacles constrain and deposit on level 0's nodes");
   }
-  (void)fc, (void)dim; /* open faces act on level 0, which they alone reach (below) */
   return 0;
 }
 
@@ -158,7 +157,7 @@ int fluid_refine_check(const mpm_module *m, const mpm_config *cfg) {
       return refuse(cfg, r->key, r->why);
   }
   if (fc->reg_every > 0) return refuse(cfg, "fluid.regularise_every", g_refused[6].why);
-  MPM_CALL(refuse_boundaries(cfg, fc, m->grid->dim));
+  MPM_CALL(refuse_obstacles(cfg));
   if (fc->ppc % 2)
     return mpm_config_fail(
         cfg, "fluid.ppc",
