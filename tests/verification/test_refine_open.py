@@ -37,9 +37,11 @@ ranks    The grid pressure without refinement through farfield faces with a spon
          (cases/acoustic_pulse.ini carried by a Mach 0.5 stream, fixed bs32 steps) on 1 and 2
          ranks: the same particles, fields within 1e-12 (the face term on the rank that owns the
          face, its ghosts summed) (~5 s).
-Able to fail: with fluid_open_grid_pressure switched off (fluid/fluid_gridp.c) the stream drifts
-by 5e-4 and the first check of `stream` fails; with the face term (fluid_open_grid_forces) off
-every part fails (figures in docs/refinement.md). Tolerances are stated at each check.
+Able to fail: with fluid_open_grid_pressure switched off (fluid/fluid_gridp.c) the streams of
+`stream` and `farfield` deviate by 5e-6 .. 4e-4 and their uniformity checks fail; with the face
+term (fluid_open_grid_forces) off they deviate by 0.15 .. 3 and lose mass, and the gas ahead of
+the shock is pulled out through the outflow face (1.2): `stream`, `farfield` and `shock` fail
+(`ranks` compares two runs of the same code). Tolerances are stated at each check.
 """
 import os
 import sys
