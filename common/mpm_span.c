@@ -22,7 +22,11 @@
  * products, without a bias repeated span after span: the grid pressure's momentum stays exact
  * to roundoff over long runs (Gauss-rule matrices, correct to 1e-17, drift 70x more on
  * test_refine_gas_pulse_grid). The grid's spacing is the same along every axis, so one set of
- * kinds serves all axes. */
+ * kinds serves all axes.
+ *
+ * A node plane (mpm_span_plane) cuts its spans through their nodes (t = 0), where the three
+ * B-splines of the normal axis are 1/8, 3/4, 1/8: along that axis the matrix is their outer
+ * product, 1/64 [1 6 1; 6 36 6; 1 6 1], and the other axes take M. */
 #include "mpm_span.h"
 
 #include <string.h>
@@ -121,23 +125,28 @@ static inline void span_scales(const axis_mats *const *m, int dim, double *sc) {
   }
 }
 
+/* The box offsets of a span's 3^dim nodes (axis 0 fastest) and the strides of the box. */
+static int span_offsets(const mpm_grid *g, int dim, mpm_lidx *off) {
+  mpm_lidx stride[3] = {1, 0, 0};
+  for (int d = 1; d < dim; ++d) stride[d] = stride[d - 1] * g->box_n[d - 1];
+  const int na = dim == 3 ? 27 : 9;
+  for (int a = 0; a < na; ++a) {
+    off[a] = 0;
+    for (int d = 0, r = a; d < dim; ++d, r /= NA) off[a] += (mpm_lidx)(r % NA - 1) * stride[d];
+  }
+  return na;
+}
+
 /* One walk over the spans of a dim-D grid: the force of p into f when p is set, the divergence
  * of v into D when v is set. dim is a constant at each call, so the axis loops unroll. */
 static inline void integrate_dim(const mpm_grid *g, const mpm_span_set *s, int dim, const double *p,
                                  double *const *f, const double *const *v, double *D) {
   axis_mats kind[SPAN_KINDS];
   kinds_fill(kind, g->dx);
-  mpm_lidx stride[3] = {1, 0, 0};
-  for (int d = 1; d < dim; ++d) stride[d] = stride[d - 1] * g->box_n[d - 1];
   int lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
   for (int d = 0; d < dim; ++d) lo[d] = s->lo[d], hi[d] = s->hi[d];
-  /* The 3^dim node offsets of a span, axis 0 fastest. */
   mpm_lidx off[NMAX];
-  const int na = dim == 3 ? 27 : 9;
-  for (int a = 0; a < na; ++a) {
-    off[a] = 0;
-    for (int d = 0, r = a; d < dim; ++d, r /= NA) off[a] += (mpm_lidx)(r % NA - 1) * stride[d];
-  }
+  const int na = span_offsets(g, dim, off);
   int gi[3];
   for (gi[2] = lo[2]; gi[2] <= hi[2]; ++gi[2])
     for (gi[1] = lo[1]; gi[1] <= hi[1]; ++gi[1])
@@ -163,6 +172,34 @@ static inline void integrate_dim(const mpm_grid *g, const mpm_span_set *s, int d
           span_divergence(m, dim, x, y[0]);
           for (int a = 0; a < na; ++a) D[n + off[a]] += y[0][a];
         }
+      }
+}
+
+void mpm_span_plane(const mpm_grid *g, const mpm_span_set *s, int axis, const double *q,
+                    double *f) {
+  static const double E[NA][NA] = {{1, 6, 1}, {6, 36, 6}, {1, 6, 1}};
+  const int dim = g->dim;
+  axis_mats kind[SPAN_KINDS];
+  kinds_fill(kind, g->dx);
+  mpm_lidx off[NMAX];
+  const int na = span_offsets(g, dim, off);
+  int lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0}, gi[3];
+  for (int d = 0; d < dim; ++d) lo[d] = s->lo[d], hi[d] = s->hi[d];
+  for (gi[2] = lo[2]; gi[2] <= hi[2]; ++gi[2])
+    for (gi[1] = lo[1]; gi[1] <= hi[1]; ++gi[1])
+      for (gi[0] = lo[0]; gi[0] <= hi[0]; ++gi[0]) {
+        const mpm_lidx n = mpm_grid_local_index(g, gi);
+        if (s->skip && s->skip[n]) continue;
+        double x[2][NMAX], scale = 1.0 / 64;
+        for (int a = 0; a < na; ++a) x[0][a] = q[n + off[a]];
+        for (int d = 0; d < dim; ++d) {
+          const axis_mats *m = &kind[s->half_lo[d] && gi[d] == s->lo[d]   ? SPAN_UPPER
+                                     : s->half_hi[d] && gi[d] == s->hi[d] ? SPAN_LOWER
+                                                                          : SPAN_FULL];
+          axis_apply(d == axis ? E : m->M, d, dim, x[d & 1], x[(d + 1) & 1], 0);
+          if (d != axis) scale *= m->sM;
+        }
+        for (int a = 0; a < na; ++a) f[n + off[a]] += scale * x[dim & 1][a];
       }
 }
 

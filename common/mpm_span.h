@@ -45,4 +45,11 @@ void mpm_span_force(const mpm_grid *g, const mpm_span_set *s, const double *p, d
 void mpm_span_divergence(const mpm_grid *g, const mpm_span_set *s, const double *const *v,
                          double *D);
 
+/* f[i] += integral of N_i q_h over the node plane x_axis = x of node s->lo[axis] (s->hi[axis]
+ * must equal it), within the set's spans along the other axes, for every box node i (q: box
+ * array). The boundary term of an open face: with q the face's pressure, the span force less
+ * this term (times the outward normal) is -integral of N_i grad p_h, so a uniform p that equals
+ * q gives no force at any node (fluid/fluid_boundary.c). */
+void mpm_span_plane(const mpm_grid *g, const mpm_span_set *s, int axis, const double *q, double *f);
+
 #endif

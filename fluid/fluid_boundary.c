@@ -31,6 +31,12 @@
  *                       reflection and holds the free stream; where the free stream crosses
  *                       the face supersonically, p_b is p_inf (entering) or p (leaving).
  *                     The nodes beyond these faces extrapolate the face node linearly.
+ * With the grid pressure (fluid.pressure = grid, which refinement takes) neither the exterior
+ * lattice nor the copies act: the pressure's force is an exact integral over the domain's spans,
+ * and each open face replaces its boundary term by the same boundary pressure p_b, integrated
+ * exactly over the face (fluid_open_grid_forces, below); the nodal pressure on and beyond the
+ * face is set as the velocity there is held. On a hierarchy the finer levels keep three level-0
+ * cells from the open faces, so everything here acts on level 0.
  * The normal n points out of the domain. Where an obstacle crosses the face, the body
  * continues beyond it (fluid_obstacle.c puts its ghost points there) and the copies stop at
  * its surface.
@@ -73,6 +79,7 @@
 #include "mpm_error.h"
 #include "mpm_kernels.h"
 #include "mpm_log.h"
+#include "mpm_span.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -93,7 +100,9 @@ const mpm_key_spec fluid_boundary_keys[] = {
      "(the nodes within a stencil of the face feel the particles' pressure less the boundary "
      "pressure, which holds the far field when mixed flow crosses the face, but blew up on "
      "RAE 2822 at 50 cells per chord when a vortex crossed the face; see "
-     "fluid/fluid_boundary.c)",
+     "fluid/fluid_boundary.c); with the grid pressure (fluid.pressure = grid, and refinement) "
+     "the faces take the exterior pressure as an integral over the face instead, and gauge is "
+     "refused",
      0, NULL},
     {"freestream.sponge", MPM_KEY_REAL, "0", 0, HUGE_VAL, 0, 0, NULL,
      "thickness, m, of an absorbing layer inside every farfield face that relaxes the gas's "
@@ -143,6 +152,7 @@ struct fluid_open {
   mpm_lidx *near;     /* their indices */
   mpm_lidx cand_cap;
   struct column_entry *cand; /* near-face particles of the faces, by face and column */
+  double *bp; /* the grid pressure's face term: per box node (fluid_open_grid_forces) */
 };
 
 /* ---- exterior force weights ---------------------------------------------------------------- */
@@ -377,7 +387,7 @@ void fluid_open_destroy(fluid_open **openp) {
   for (int k = 0; k < o->nfaces; ++k)
     free(o->face[k].node), free(o->face[k].r), free(o->face[k].wt), free(o->face[k].out),
         free(o->face[k].beyond), free(o->face[k].dout), free(o->face[k].src);
-  free(o->cand), free(o->near);
+  free(o->cand), free(o->near), free(o->bp);
   fluid_virtual_free(&o->gpts);
   free(o);
   *openp = NULL;
@@ -573,7 +583,7 @@ int fluid_open_gauge_forces(fluid_open *o, mpm_module *m) {
 }
 
 int fluid_open_p2g(fluid_open *o, mpm_module *m, const double *y, fluid_virtual *virt) {
-  if (!o || !o->columns) return 0;
+  if (!o || !o->columns || ((const fluid_content *)m->content)->gridp) return 0;
   const mpm_particles *p = m->particles;
   const mpm_lidx need = o->nfaces * p->n;
   if (need > o->cand_cap || !o->cand) {
@@ -596,7 +606,7 @@ int fluid_open_p2g(fluid_open *o, mpm_module *m, const double *y, fluid_virtual 
 }
 
 int fluid_open_forces(fluid_open *o, mpm_module *m, double t) {
-  if (!o) return 0;
+  if (!o || ((const fluid_content *)m->content)->gridp) return 0; /* fluid_open_grid_forces */
   mpm_grid *g = m->grid;
   mpm_grid_phase *ph = &g->phase[m->phase];
   for (int k = 0; k < o->nfaces; ++k) {
@@ -607,6 +617,56 @@ int fluid_open_forces(fluid_open *o, mpm_module *m, double t) {
       ph->f_i[f->axis][f->node[j]] += o->p * f->wn[f->r[j]] * f->wt[j];
   }
   return 0;
+}
+
+/* The grid pressure (fluid/fluid_gridp.c). Its span force over the domain, f_i = integral of
+ * p_h grad N_i, holds the boundary term p_h N_i n on the faces; an open face replaces it with
+ * the exterior gas's pressure p_b: f_i -= integral over the face of N_i p_b n, so that the
+ * nodes feel -integral of N_i grad p_h inside plus p_h - p_b across the face. p_b is the
+ * B-spline field of the nodal boundary pressures B_j (the B-splines sum to 1 on the face, so
+ * a constant part carries over): the free-stream pressure at an inflow face, boundary_pressure
+ * of each node's pressure and (previewed) velocity at the others, as the copies take it from
+ * their column's outermost particle: P_j at an outflow face (no boundary force at all), the
+ * back pressure, or the characteristic state. The integral is exact (mpm_span_plane), so a
+ * uniform state at p_b keeps every node free of force to roundoff, whatever the particles'
+ * positions and the lattice's phase (the exterior lattice and the copies are a quadrature
+ * made to cancel the particles' own quadrature, not the exact integral). The finer levels keep
+ * away from the open faces (coupler/mpm_refine.c), so the term acts on level 0 alone.
+ * The nodal pressure on and beyond the faces (fluid_open_grid_pressure) is set as the velocity
+ * there is held: the free stream's on and beyond an inflow face, extrapolated linearly beyond
+ * the others. The mass-weighted mean would leave a node beyond the face at 0 whenever the gap
+ * that the entering gas opens at the face during a step (up to delta + U h) leaves it without a
+ * particle, and the face's half span reads that node (a uniform Mach 2 stream through an
+ * inflow face drifted by 5e-4 of p). */
+int fluid_open_grid_forces(fluid_open *o, const mpm_grid *g, const double *P,
+                           const double *const *v, double *const *F) {
+  if (!o) return 0;
+  if (!o->bp) MPM_ALLOC(o->bp, (size_t)g->nnodes);
+  for (int k = 0; k < o->nfaces; ++k) {
+    const open_face *f = &o->face[k];
+    const int a = f->axis, plane = f->side ? g->ncells[a] : 0;
+    mpm_span_set s = mpm_span_owned(g, NULL);
+    if (plane < s.lo[a] || plane > s.hi[a]) continue; /* another rank's face */
+    s.lo[a] = s.hi[a] = plane, s.half_lo[a] = s.half_hi[a] = 0;
+    for (mpm_lidx j = 0; j < g->nnodes; ++j) {
+      double vj[MPM_MAX_DIM] = {0, 0, 0};
+      for (int d = 0; d < g->dim; ++d) vj[d] = v[d][j];
+      const double pb = f->kind == MPM_WALL_INFLOW ? o->p : boundary_pressure(o, f, P[j], vj);
+      o->bp[j] = -f->sign * pb;
+    }
+    mpm_span_plane(g, &s, a, o->bp, F[a]);
+  }
+  return 0;
+}
+
+void fluid_open_grid_pressure(const fluid_open *o, double *P) {
+  for (int k = 0; o && k < o->nfaces; ++k) {
+    const open_face *f = &o->face[k];
+    for (mpm_lidx j = 0; j < f->nout; ++j) {
+      const mpm_lidx l = f->out[3 * j], src = f->out[3 * j + 1], in = f->out[3 * j + 2];
+      P[l] = f->kind == MPM_WALL_INFLOW ? o->p : P[src] + f->beyond[j] * (P[src] - P[in]);
+    }
+  }
 }
 
 void fluid_open_hold(const fluid_open *o, mpm_module *m) {

@@ -33,6 +33,16 @@ int fluid_open_gauge_forces(fluid_open *open, mpm_module *m);
 /* Before the nodal update (first pass only) at time t: add the force of the exterior
  * lattice of the inflow faces to the nodal forces. */
 int fluid_open_forces(fluid_open *open, mpm_module *m, double t);
+/* The grid pressure's boundary term of the open faces (fluid.pressure = grid, in place of the
+ * exterior lattice and the copies): F[d][i] -= integral over each face this rank owns of N_i
+ * p_b n_d, p_b the face's boundary pressure from the nodal pressure P and velocity v (box
+ * arrays of g, level 0's, ghosts filled). The caller sums the ghosts into their owners. */
+int fluid_open_grid_forces(fluid_open *open, const mpm_grid *g, const double *P,
+                           const double *const *v, double *const *F);
+/* The grid pressure's nodal pressure P (level 0's box array) on and beyond the open faces, as
+ * fluid_open_hold sets the velocity there: the free stream's at an inflow face, extrapolated
+ * linearly from the face node beyond the others. */
+void fluid_open_grid_pressure(const fluid_open *open, double *P);
 /* After the nodal update: hold the nodes on and beyond an inflow face at the free-stream
  * velocity; beyond the other open faces, extrapolate the face node linearly. */
 void fluid_open_hold(const fluid_open *open, mpm_module *m);

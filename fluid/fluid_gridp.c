@@ -28,9 +28,14 @@
  * level reaching a wall (mpm_hier.h, walls) does the same with its nodes beyond the wall, and
  * integrates only its spans inside it (the wall is a knot of every finer level).
  *
+ * Open faces (fluid_open_grid_forces): the span force holds the boundary term p_h N_i n on every
+ * face; an open face replaces it by its exterior pressure, integrated exactly over the face, so a
+ * uniform stream through inflow, outflow and far-field faces stays uniform to roundoff. The
+ * volume rate integrates the domain only, as at a wall.
+ *
  * Scope (fluid_gridp_read refuses the rest): the method-of-lines ERK pairs with the current
- * strain rate, the quadratic B-spline, a gas alone (no solid, obstacle or open face), no
- * shifting, the point volume rate. */
+ * strain rate, the quadratic B-spline, a gas alone (no solid or obstacle), no shifting, the
+ * point volume rate, open faces with their default exterior (copies, not gauge). */
 #include "fluid_internal.h"
 
 #include "mpm_error.h"
@@ -86,13 +91,15 @@ static int check_scope(const fluid_content *fc, const mpm_config *cfg, const mpm
     snprintf(key, sizeof key, "obstacle.%s.shape", names[0]);
     return refuse(cfg, key, "integrates over every span of the domain, obstacles included");
   }
+  int open = 0;
   for (int d = 0; d < g->dim; ++d)
-    for (int s = 0; s < 2; ++s)
-      if (mpm_wall_is_open_gas(fc->walls.face[d][s])) {
-        char key[32];
-        snprintf(key, sizeof key, "boundary.%c_%s", "xyz"[d], s ? "hi" : "lo");
-        return refuse(cfg, key, "is not carried with open faces (their particles' pressure)");
-      }
+    for (int s = 0; s < 2; ++s) open |= mpm_wall_is_open_gas(fc->walls.face[d][s]);
+  const char *exterior = "copies";
+  if (open) MPM_CALL(mpm_config_get_string(cfg, "freestream.exterior", &exterior));
+  if (strcmp(exterior, "gauge") == 0)
+    return refuse(cfg, "freestream.exterior",
+                  "integrates the open faces' exterior pressure over the face and does not "
+                  "carry gauge (the particle pressure's gauge points)");
   return 0;
 }
 
@@ -273,12 +280,16 @@ int fluid_gridp_forces(mpm_module *m) {
   double *q[MPM_HIER_MAX_LEVELS];
   for (int l = 0; l < gp->nlev; ++l) q[l] = Q[l][0];
   per_mass(m, gp, q, gp->P);
+  fluid_open_grid_pressure(fc->open, gp->P[0]);
   MPM_CALL(prolong_all(m, gp->P));
   for (int l = 0; l < gp->nlev; ++l) {
     const mpm_grid *g = level_grid(m, l);
     for (int d = 0; d < dim; ++d) memset(gp->F[l][d], 0, sizeof(double) * (size_t)g->nnodes);
     mpm_span_force(g, &gp->set[l], gp->P[l], gp->F[l]);
   }
+  const double *v0[MPM_MAX_DIM] = {NULL};
+  for (int d = 0; d < dim; ++d) v0[d] = m->grid->phase[m->phase].v_i[d];
+  MPM_CALL(fluid_open_grid_forces(fc->open, m->grid, gp->P[0], v0, gp->F[0]));
   MPM_CALL(restrict_all(m, gp->F, dim));
   for (int l = 0; l < gp->nlev; ++l) {
     const mpm_grid *g = level_grid(m, l);

@@ -964,7 +964,7 @@ static int build(mpm_module *m, const mpm_config *cfg, int seed) {
   MPM_CALL(fluid_obstacles_build(&fc->obs, cfg, g, fc->ppc, (const unsigned char(*)[2])m->open));
   MPM_CALL(fluid_wall_ls_init(m, cfg, fc->tr.classic));
   fc->virt.phase = -1;
-  if (fluid_open_uses_virtual(fc->open)) MPM_CALL(fluid_virtual_init(&fc->virt, g));
+  if (!fc->gridp && fluid_open_uses_virtual(fc->open)) MPM_CALL(fluid_virtual_init(&fc->virt, g));
   MPM_ALLOC(fc->node, (size_t)(g->dim + 3) * g->nnodes);
   MPM_CALL(fluid_particles_new(&m->particles, g->dim, &fc->lay, fc->tr.apic, fc->gas.mu > 0,
                                fc->gas.av_riemann, fc->tr.classic));

@@ -12,12 +12,17 @@
  * (fluid_module.c). Slip and no-slip walls act on every level (mpm_hier.h, walls: the finer levels
  * fold and mirror their nodes beyond a wall in fluid_module.c's forces and constrain); the sim
  * keeps every box three level-0 cells from the other non-periodic faces (coupler/mpm_refine.c).
+ * Open faces (inflow, outflow, subsonic, far field with its sponge) therefore act on level 0
+ * alone: their particles are injected and removed within two level-0 cells of the face, on
+ * level 0's lattice and size, and the grid pressure that the hierarchy needs takes their
+ * exterior pressure as an exact face integral on level 0 (fluid_open_grid_forces); the sponge
+ * acts on each particle, of any level.
  *
  * Refused (fluid_refine_check), each naming its key: everything that reads or writes the gas's
  * nodal fields or the grid otherwise: the classic update (its time-centred nodal velocity, heat
  * shares and wall rule), the domain volume rate, the riemann viscosity's limiter, shifting,
  * regularisation and refill (cell counts), the neighbourhood stable step, the light-node threshold,
- * obstacles and open faces. An odd fluid.ppc puts level-0 particles on the span faces that bound
+ * obstacles. An odd fluid.ppc puts level-0 particles on the span faces that bound
  * the finer regions, so it is refused too.
  *
  * Invariant: with m->hier NULL every call here is the plain kernel call (the refined path costs
@@ -131,8 +136,8 @@ static const refusal g_refused[] = {
     {"fluid.light_node_mass", NULL, "the mean nodal mass is level 0's"},
 };
 
-/* The first obstacle, or open face, of the case: refused with its key. */
-static int refuse_boundaries(const mpm_config *cfg, const fluid_content *fc, int dim) {
+/* The first obstacle of the case: refused with its key. */
+static int refuse_obstacles(const mpm_config *cfg) {
   const char *const *names;
   int count;
   MPM_CALL(mpm_config_instances(cfg, "obstacle", &names, &count));
@@ -141,14 +146,6 @@ static int refuse_boundaries(const mpm_config *cfg, const fluid_content *fc, int
     snprintf(key, sizeof key, "obstacle.%s.shape", names[0]);
     return refuse(cfg, key, "obstacles constrain and deposit on level 0's nodes");
   }
-  for (int d = 0; d < dim; ++d)
-    for (int s = 0; s < 2; ++s)
-      if (mpm_wall_is_open_gas(fc->walls.face[d][s])) {
-        char key[32];
-        snprintf(key, sizeof key, "boundary.%c_%s", "xyz"[d], s ? "hi" : "lo");
-        return refuse(cfg, key,
-                      "open faces (inflow, outflow, far field) are not carried in this slice");
-      }
   return 0;
 }
 
@@ -160,7 +157,7 @@ int fluid_refine_check(const mpm_module *m, const mpm_config *cfg) {
       return refuse(cfg, r->key, r->why);
   }
   if (fc->reg_every > 0) return refuse(cfg, "fluid.regularise_every", g_refused[6].why);
-  MPM_CALL(refuse_boundaries(cfg, fc, m->grid->dim));
+  MPM_CALL(refuse_obstacles(cfg));
   if (fc->ppc % 2)
     return mpm_config_fail(
         cfg, "fluid.ppc",

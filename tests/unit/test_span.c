@@ -17,7 +17,14 @@
  *      = c |V| (V the spans integrated), and a constant p = a gives sum_i f_d,i x_d,i = a |V|
  *      (the B-splines reproduce x_d, so that sum is the integral of p d x_d/dx_d), to 1e-13
  *      relative; and sum f.v = sum p D for random fields, as in (1). A wrong half, or a skipped
- *      span still integrated, along any axis misses these by a span's share of |V|. */
+ *      span still integrated, along any axis misses these by a span's share of |V|.
+ *  (6) Node planes (mpm_span_plane, an open face's boundary term): on the set of (5) without
+ *      the skipped spans, for each axis d, the span force of a constant p less the planes
+ *      through the end nodes along d (the face integrals of p N_i n_d) is 0 at every node, to
+ *      1e-14 of p h^(dim-1) (the divergence theorem: what an open face at p cancels); and a
+ *      plane integrates q = c x_t (t another axis, which the B-splines reproduce) to c times
+ *      the face's first moment, to 1e-13 relative. A wrong normal matrix or tangential half
+ *      leaves a node's force off by a share of p h^(dim-1). */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -242,13 +249,64 @@ static void test_halved(void **state) {
   halved(2), halved(3);
 }
 
+/* (6): the planes through the end nodes along d of the set of (5), without its skipped spans. */
+static void planes(int dim) {
+  fixture x;
+  make(&x, dim);
+  const size_t nn = (size_t)x.g->nnodes;
+  const double a = 2.0, c = 1.5;
+  double len[3] = {10 * H, 7 * H, 7 * H};
+  x.set = (mpm_span_set){.lo = {0, 0, 0}, .hi = {10, 7, 7}};
+  for (int d = 0; d < dim; ++d) x.set.half_lo[d] = x.set.half_hi[d] = 1;
+  double *plane = calloc(nn, sizeof(double));
+  for (int d = 0; d < dim; ++d) {
+    for (mpm_lidx k = 0; k < x.g->nnodes; ++k) x.p[k] = a, x.f[d][k] = 0;
+    mpm_span_force(x.g, &x.set, x.p, x.f);
+    for (int side = 0; side < 2; ++side) {
+      mpm_span_set face = x.set;
+      face.lo[d] = face.hi[d] = side ? x.set.hi[d] : 0, face.half_lo[d] = face.half_hi[d] = 0;
+      memset(plane, 0, sizeof(double) * nn);
+      mpm_span_plane(x.g, &face, d, x.p, plane);
+      for (mpm_lidx k = 0; k < x.g->nnodes; ++k) x.f[d][k] += (side ? -1.0 : 1.0) * plane[k];
+    }
+    double worst = 0;
+    for (mpm_lidx k = 0; k < x.g->nnodes; ++k) worst = fmax(worst, fabs(x.f[d][k]));
+    printf("%d-D planes along %d: largest |f - planes| %.2e (of a h^(dim-1) %.1e)\n", dim, d, worst,
+           a * pow(H, dim - 1));
+    assert_true(worst <= 1e-14 * a * pow(H, dim - 1));
+    for (int t = 0; t < dim; ++t) {
+      if (t == d) continue;
+      for (mpm_lidx k = 0; k < x.g->nnodes; ++k) {
+        int gi[3];
+        node_of(x.g, k, gi);
+        x.p[k] = c * gi[t] * H;
+      }
+      mpm_span_set face = x.set;
+      face.lo[d] = face.hi[d] = x.set.hi[d], face.half_lo[d] = face.half_hi[d] = 0;
+      memset(plane, 0, sizeof(double) * nn);
+      mpm_span_plane(x.g, &face, d, x.p, plane);
+      double sum = 0, want = c * len[t] * len[t] / 2;
+      for (mpm_lidx k = 0; k < x.g->nnodes; ++k) sum += plane[k];
+      for (int e = 0; e < dim; ++e) want *= e == d || e == t ? 1.0 : len[e];
+      printf("%d-D plane along %d of c x_%d: %.15e, want %.15e\n", dim, d, t, sum, want);
+      assert_true(fabs(sum - want) <= 1e-13 * want);
+    }
+  }
+  free(plane);
+  done(&x);
+}
+
+static void test_planes(void **state) {
+  (void)state;
+  planes(2), planes(3);
+}
+
 int main(int argc, char **argv) {
   MPI_Init(&argc, &argv);
   const struct CMUnitTest tests[] = {
-      cmocka_unit_test(test_adjoint),
-      cmocka_unit_test(test_pressure),
-      cmocka_unit_test(test_divergence),
-      cmocka_unit_test(test_halved),
+      cmocka_unit_test(test_adjoint),    cmocka_unit_test(test_pressure),
+      cmocka_unit_test(test_divergence), cmocka_unit_test(test_halved),
+      cmocka_unit_test(test_planes),
   };
   const int rc = cmocka_run_group_tests(tests, NULL, NULL);
   MPI_Finalize();

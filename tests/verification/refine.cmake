@@ -46,3 +46,14 @@ foreach(part rest stream pulse dynamic)
   mpm_add_script_test(test_refine_walls_${part} SCRIPT verification/test_refine_walls.py
                       ARGS ${part} LABELS verification TIMEOUT 300)
 endforeach()
+# Open faces with the gas on the hierarchy (level 0 alone reaches them): a uniform stream
+# through inflow | outflow and subsonic faces across static level-1 and level-2 boxes (~15 s),
+# through farfield faces with a sponge in 2-D and 3-D (~15 s), a Mach 3 shock entering through
+# the inflow face across a regridded region against its uniform twins, with a restart (~10 s);
+# the grid pressure through farfield faces on 1 and 2 ranks (~5 s).
+foreach(part stream farfield shock)
+  mpm_add_script_test(test_refine_open_${part} SCRIPT verification/test_refine_open.py
+                      ARGS ${part} LABELS verification TIMEOUT 300)
+endforeach()
+mpm_add_script_test(test_refine_open_ranks SCRIPT verification/test_refine_open.py ARGS ranks
+                    LABELS "verification;mpi" TIMEOUT 300)

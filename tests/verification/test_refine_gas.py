@@ -589,9 +589,15 @@ def part_input():
     obstacle = "[obstacle.post]\nshape = circle\ncenter = 0.3 0.3\nradius = 0.05\n"
     cases.append(("obstacle", case_text(2, 0.1, gas, box, extra=obstacle), "obstacle.post.shape",
                   "shape = circle", "not carried"))
+    # Open faces are carried on level 0 (test_refine_open.py); a box keeps its three cells from
+    # them, and the gauge exterior (the particle pressure's) is refused with the grid pressure.
     openface = refined.replace("y_lo = slip\ny_hi = slip", "y_lo = slip\ny_hi = outflow")
-    openface = openface.replace("[gas.air]", "[freestream]\ndensity = 1\npressure = 1\n\n[gas.air]")
-    cases.append(("open face", openface, "boundary.y_hi", "y_hi = outflow", "not carried"))
+    openface = openface.replace("[gas.air]", "[freestream]\ndensity = 1\npressure = 1\n"
+                                "exterior = gauge\n\n[gas.air]")
+    cases.append(("open face with the gauge exterior", openface, "freestream.exterior",
+                  "exterior = gauge", "gauge"))
+    cases.append(("box near an open face", openface.replace("exterior = gauge\n", "").replace(
+        "hi = 1.2 0.45", "hi = 1.2 0.5"), "refine.box.hi", "hi = 1.2 0.5", "act on level 0 only"))
     solid = ("[geometry.plate]\ntype = box\nlo = 0.2 0.2\nhi = 0.3 0.3\n\n[solid.plate]\n"
              "geometry = plate\nmaterial = linear_elastic\ndensity = 1000\nE = 1e6\nnu = 0.3\n")
     solid += "\n[geometry.air]\ntype = difference\nof = strip plate\n"
@@ -616,8 +622,9 @@ def part_input():
         cases.append((f"grid pressure with {key} = {value}", text, key, f"{k} = {value}", words))
     cases.append(("grid pressure with an obstacle", plain + "\n" + obstacle,
                   "obstacle.post.shape", "shape = circle", "obstacles"))
-    cases.append(("grid pressure with an open face", openface.replace(
-        "[refine]", grid + "\n[refine]"), "boundary.y_hi", "y_hi = outflow", "open faces"))
+    cases.append(("grid pressure with the gauge exterior", openface.replace(
+        "[refine]", grid + "\n[refine]").replace("levels = 2", "levels = 1").split(
+        "\n[refine.box]")[0], "freestream.exterior", "exterior = gauge", "gauge"))
     cases.append(("particle pressure with refinement", case_text(
         2, 0.1, gas, box, extra="[fluid]\npressure = particle\n"), "fluid.pressure",
         "pressure = particle", "corners"))
