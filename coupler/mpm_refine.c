@@ -1,8 +1,9 @@
 /* The [refine] section and the build of the static hierarchy (see mpm_refine.h).
  *
  * What the slice refuses here, one line each naming the key: boxes without refine.levels > 1,
- * a solid beside a gas in a partitioned time scheme (coupling.time other than monolithic) or
- * off the finest level (REFINE_SOLID_CELLS), a solid with dynamic regrids, more than one rank, a
+ * a solid beside a gas in a partitioned time scheme (coupling.time other than monolithic), off
+ * the finest level (REFINE_SOLID_CELLS) or with a box that does not span every periodic axis
+ * (check_bands), a solid with dynamic regrids, more than one rank, a
  * shape other than the quadratic B-spline, and a box within three level-0 cells of a non-periodic
  * domain face other than a gas's slip or no-slip wall (open and closed faces, and a solid's walls,
  * act on level 0 alone; a gas's walls are carried to every level, mpm_hier.h, and a box or region
@@ -29,8 +30,8 @@ const mpm_key_spec mpm_refine_keys[] = {
     {"refine.levels", MPM_KEY_INT, "1", 1, MPM_HIER_MAX_LEVELS, 0, 0, NULL,
      "levels of the refinement hierarchy (static boxes, or regridded with refine.criterion), each "
      "halving the spacing of the one below (1: "
-     "off); gas-only or solid-only cases on one rank with the quadratic shape, see "
-     "docs/refinement.md",
+     "off); on one rank with the quadratic shape: a gas, a solid on static boxes, or both "
+     "(velocity coupling on bands across a periodic axis), see docs/refinement.md",
      0, "-"},
     {"refine.buffer", MPM_KEY_INT, "2", 1, 64, 0, 0, NULL,
      "level-l cells kept between the region of level l + 1 and the edge of level l's region", 0,

@@ -19,8 +19,9 @@
  * scale and lagged rate are level 0's), a rigid body and a clamp (they hold level-0 nodes), an
  * odd ppc (a level-0 particle would sit on a face of the refined region), time.method = musl
  * (the remap deposits on level 0), and a traction whose region reaches a refined region (the
- * tractions load level-0 particles only). A gas beside the solid, dynamic regrids and several
- * ranks are refused by coupler/mpm_refine.c.
+ * tractions load level-0 particles only). Dynamic regrids and several ranks are refused by
+ * coupler/mpm_refine.c, which also asks a solid beside a gas to lie on the finest level
+ * (solid_refine_inside).
  *
  * Invariant: with m->hier NULL every call here is the plain kernel call, so an unrefined run is
  * bit for bit what it was. */
