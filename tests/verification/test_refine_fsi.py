@@ -22,6 +22,8 @@ pulse  A right-going acoustic pulse in the left column (p' = 1e-2 exp(-((x - 0.4
        Z = Z_s / sqrt(F0) (the code's nominal stress M (F - 1) / F at F0 = M / (M + p), reference
        density rho_s F0) and against the twins; the interface momentum balance of coupling.csv
        on every step; mass and total energy drift against the twins'.
+restart The pulse scene refined to t = 0.4 (the pulse on the interface), restarted from its
+       checkpoint at t = 0.2: bit for bit the run straight through, both phases.
 input  Every refusal of a gas beside a solid on a hierarchy: exit 2, one line naming
        case.ini:LINE and the key.
 Able to fail (measured while building it): with the coupling on level 0 only (the code before
@@ -161,6 +163,24 @@ def part_pulse():
           f"twin {drift['coarse']:.2e}, fine {drift['fine']:.2e})")
 
 
+def part_restart():
+    """As mt.restart_difference, both phases from one pair of runs."""
+    out, t_end = mt.outdir("refine_fsi_restart"), 0.4
+    path = os.path.join(out, "case.ini")
+    with open(path, "w") as f:
+        f.write(rs.fsi_case(t_end, rs.FSI_BAND, pulse=rs.FSI_PULSE))
+    full, rest = (os.path.join(out, d) for d in ("full", "restarted"))
+    common = ["run.progress=false"]
+    mt.run(["run", path, f"output.dir={full}", f"output.checkpoint_interval={t_end / 2}"] + common)
+    mt.run(["restart", os.path.join(full, "checkpoint_000001.h5"), f"output.dir={rest}"] + common)
+    for phase in ("solid", "fluid"):
+        a, b = (mt.particles(mt.snapshots(d)[-1][1], phase) for d in (full, rest))
+        same = np.array_equal(a["id"], b["id"])
+        worst = mt.worst_difference(a, b)[0] if same else float("inf")
+        check(same and worst == 0.0, f"{phase}: restarted at t = {t_end / 2:g}: worst difference "
+              f"{worst:.1e} (want 0)")
+
+
 def part_input():
     text = rs.fsi_case(0.1, rs.FSI_BAND)
     band = "lo = 0.9 0\nhi = 2.7 0.06"
@@ -190,6 +210,8 @@ if PART == "rest":
     part_rest()
 elif PART == "pulse":
     part_pulse()
+elif PART == "restart":
+    part_restart()
 elif PART == "input":
     part_input()
 else:
