@@ -187,6 +187,8 @@ def part_input():
     cases = [
         ("staggered", text.replace("scheme = velocity", "scheme = velocity\ntime = staggered"),
          "coupling.time", "time = staggered", "not carried"),
+        ("multirate", text.replace("scheme = velocity", "scheme = velocity\ntime = multirate"),
+         "coupling.time", "time = multirate", "not carried"),
         ("traction", text.replace("scheme = velocity", "scheme = traction"), "coupling.scheme",
          "scheme = traction", "not carried"),
         ("slab off the finest level", text.replace(band, "lo = 0.9 0\nhi = 2.5 0.06"),
