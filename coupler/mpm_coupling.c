@@ -200,7 +200,7 @@ void mpm_coupling_destroy(mpm_coupling **cp) {
   mpm_coupling *c = *cp;
   if (c->type->ops->destroy) c->type->ops->destroy(c);
   free(c->owned), free(c->wall_axes);
-  for (int l = 1; l < c->nlev; ++l) free(c->lev_owned[l]);
+  mpm_coupling_levels_free(c);
   for (int d = 0; d < MPM_MAX_DIM; ++d) free(c->da[d]), free(c->held_v[d]), free(c->held_a[d]);
   free(c);
   *cp = NULL;

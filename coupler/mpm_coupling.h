@@ -105,7 +105,9 @@ struct mpm_coupling {
    * scheme acts on the active nodes of every level (coupler/mpm_coupling_levels.c). */
   int nlev;
   mpm_grid *lev_grid[MPM_HIER_MAX_LEVELS];
-  unsigned char *lev_owned[MPM_HIER_MAX_LEVELS]; /* level 0: owned; finer: active, not images */
+  unsigned char *lev_owned[MPM_HIER_MAX_LEVELS];     /* level 0: owned; finer: active, not images */
+  unsigned char *lev_wall_axes[MPM_HIER_MAX_LEVELS]; /* finer levels: 0 (no walls beside a solid)*/
+  double *lev_held[MPM_HIER_MAX_LEVELS][2][MPM_MAX_DIM]; /* held_v, held_a per level */
 };
 
 /* The registered types, `none` first; count in *n. */
@@ -126,12 +128,15 @@ void mpm_coupling_destroy(mpm_coupling **c);
  * scheme acts on the active nodes of each level in turn, where both phases' composite masses sit
  * (restricted onto them), and the prolongation then hands both phases the same velocity wherever
  * their composite weights meet only shared nodes. The exchanges are per node, so the balance of
- * coupling.csv holds summed over every level's active nodes. Refuses (MPM_ERR_INPUT, naming the
- * key) what is not carried: schemes other than velocity and several bodies reported one by one
- * (coupler/mpm_coupling_levels.c). A no-op for a NULL c. */
+ * coupling.csv holds summed over every level's active nodes; a scheme's per-node state (the
+ * walls' axes, the held velocities) is kept per level too. Refuses (MPM_ERR_INPUT, naming the
+ * key) what is not carried: several bodies reported one by one, and traction's least-squares
+ * wall (coupler/mpm_coupling_levels.c). A no-op for a NULL c. */
 int mpm_coupling_set_hier(mpm_coupling *c, const mpm_config *cfg, const mpm_hier *h);
-/* Run fn once per level (the grid alone without a hierarchy), with c->grid and c->owned set to
- * the level's; stops at the first error. */
+/* Free what mpm_coupling_set_hier allocated (mpm_coupling_destroy). */
+void mpm_coupling_levels_free(mpm_coupling *c);
+/* Run fn once per level (the grid alone without a hierarchy), with c->grid, c->owned and the
+ * per-node state set to the level's; stops at the first error. */
 typedef int (*mpm_coupling_level_fn)(mpm_coupling *c, double t, double h, mpm_pass pass);
 int mpm_coupling_each_level(mpm_coupling *c, mpm_coupling_level_fn fn, double t, double h,
                             mpm_pass pass);

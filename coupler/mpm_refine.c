@@ -31,7 +31,7 @@ const mpm_key_spec mpm_refine_keys[] = {
      "levels of the refinement hierarchy (static boxes, or regridded with refine.criterion), each "
      "halving the spacing of the one below (1: "
      "off); on one rank with the quadratic shape: a gas, a solid on static boxes, or both "
-     "(velocity coupling on bands across a periodic axis), see docs/refinement.md",
+     "(on bands across a periodic axis), see docs/refinement.md",
      0, "-"},
     {"refine.buffer", MPM_KEY_INT, "2", 1, 64, 0, 0, NULL,
      "level-l cells kept between the region of level l + 1 and the edge of level l's region", 0,
