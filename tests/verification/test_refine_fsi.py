@@ -32,8 +32,9 @@ input  Every refusal of a gas beside a solid on a hierarchy: exit 2, one line na
        case.ini:LINE and the key.
 Able to fail (measured while building it): with the coupling on level 0 only (the code before
 this change, the refusal lifted) the rest part's kinetic energy reaches 1.7e-3 J by t = 0.05
-(the gas runs into the slab) and the pulse part sees no interface force and a transmitted
-velocity 24 times the impedance solution's.
+(the gas runs into the slab; 1.7e-2 J by t = 0.2) and the pulse part sees no interface force
+and a transmitted velocity 24 times the impedance solution's; the traction part alike (|v| 2.3 at
+rest, T 31.9).
 """
 import os
 import sys
