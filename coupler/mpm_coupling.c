@@ -200,6 +200,7 @@ void mpm_coupling_destroy(mpm_coupling **cp) {
   mpm_coupling *c = *cp;
   if (c->type->ops->destroy) c->type->ops->destroy(c);
   free(c->owned), free(c->wall_axes);
+  mpm_coupling_levels_free(c);
   for (int d = 0; d < MPM_MAX_DIM; ++d) free(c->da[d]), free(c->held_v[d]), free(c->held_a[d]);
   free(c);
   *cp = NULL;
@@ -222,7 +223,7 @@ static int run_hook(mpm_coupling *c, hook_fn fn, double t, double h, mpm_pass pa
   if (!fn) return 0;
   mpm_timer_start(MPM_T_COUPLING);
   c->recording = pass == MPM_PASS_FIRST;
-  const int rc = fn(c, t, h, pass);
+  const int rc = mpm_coupling_each_level(c, fn, t, h, pass);
   c->recording = 0;
   mpm_timer_stop(MPM_T_COUPLING);
   return rc;
@@ -275,10 +276,9 @@ int mpm_coupling_after_constrain(mpm_coupling *c, double t, double h, mpm_pass p
   return 0;
 }
 
-void mpm_coupling_record_inside(mpm_coupling *c) {
-  /* Interpenetration: gas mass on the owned nodes inside the solid, those with at least 90 %
-   * of the largest solid nodal mass of the grid (full support: the stencil is covered). */
-  mpm_timer_start(MPM_T_COUPLING);
+/* Add the gas mass on this level's owned nodes inside the solid to the latest record. */
+static int add_inside(mpm_coupling *c, double t, double h, mpm_pass pass) {
+  (void)t, (void)h, (void)pass;
   const mpm_grid *g = c->grid;
   const double *ms = g->phase[c->phase[MPM_ROLE_SOLID]].m_i;
   const double *mf = g->phase[c->phase[MPM_ROLE_FLUID]].m_i;
@@ -286,7 +286,18 @@ void mpm_coupling_record_inside(mpm_coupling *c) {
   double inside = 0.0;
   for (mpm_lidx l = 0; l < g->nnodes; ++l)
     if (c->owned[l] && ms[l] >= 0.9 * mmax && mmax > 0) inside += mf[l];
-  c->rec[c->which.latest].gas_inside = inside;
+  c->rec[c->which.latest].gas_inside += inside;
+  return 0;
+}
+
+void mpm_coupling_record_inside(mpm_coupling *c) {
+  /* Interpenetration: gas mass on the owned nodes inside the solid, those with at least 90 %
+   * of the largest solid nodal mass of the grid (full support: the stencil is covered); on a
+   * hierarchy, of every level (the largest over all levels, mpm_hier_phase_update: the finest
+   * level's when the solid lies on it, mpm_refine.h). */
+  mpm_timer_start(MPM_T_COUPLING);
+  c->rec[c->which.latest].gas_inside = 0.0;
+  mpm_coupling_each_level(c, add_inside, 0.0, 0.0, MPM_PASS_FIRST);
   mpm_timer_stop(MPM_T_COUPLING);
 }
 

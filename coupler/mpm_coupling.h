@@ -29,6 +29,7 @@
 #define MPM_COUPLING_H
 
 #include "mpm_config.h"
+#include "mpm_hier.h"
 #include "mpm_impulse.h"
 #include "mpm_interface.h"
 #include "mpm_module.h"
@@ -99,6 +100,14 @@ struct mpm_coupling {
   unsigned char *wall_axes; /* MPM_COUPLING_NORMALS: per box node, bit d set where the node lies
                                on a wall face across axis d (slip, no_slip) */
   mpm_interface *capture;   /* non-NULL: what the solid is given goes there instead (held) */
+  /* On a refinement hierarchy (mpm_coupling_set_hier; 0 levels: the grid alone): every hook and
+   * the interpenetration run on each level in turn, grid and owned set to the level's, so that a
+   * scheme acts on the active nodes of every level (coupler/mpm_coupling_levels.c). */
+  int nlev;
+  mpm_grid *lev_grid[MPM_HIER_MAX_LEVELS];
+  unsigned char *lev_owned[MPM_HIER_MAX_LEVELS];     /* level 0: owned; finer: active, not images */
+  unsigned char *lev_wall_axes[MPM_HIER_MAX_LEVELS]; /* finer levels: 0 (no walls beside a solid)*/
+  double *lev_held[MPM_HIER_MAX_LEVELS][2][MPM_MAX_DIM]; /* held_v, held_a per level */
 };
 
 /* The registered types, `none` first; count in *n. */
@@ -113,6 +122,24 @@ int mpm_coupling_add_schema(mpm_config *cfg);
 int mpm_coupling_new(mpm_coupling **c, const mpm_config *cfg, mpm_grid *grid, mpm_module **modules,
                      int nmodules);
 void mpm_coupling_destroy(mpm_coupling **c);
+
+/* Put the scheme on the levels of hierarchy h (the modules' own, mpm_refine.h; NULL: the grid
+ * alone), between the restriction and the prolongation: after the nodal solve of every level the
+ * scheme acts on the active nodes of each level in turn, where both phases' composite masses sit
+ * (restricted onto them), and the prolongation then hands both phases the same velocity wherever
+ * their composite weights meet only shared nodes. The exchanges are per node, so the balance of
+ * coupling.csv holds summed over every level's active nodes; a scheme's per-node state (the
+ * walls' axes, the held velocities) is kept per level too. Refuses (MPM_ERR_INPUT, naming the
+ * key) what is not carried: several bodies reported one by one, and traction's least-squares
+ * wall (coupler/mpm_coupling_levels.c). A no-op for a NULL c. */
+int mpm_coupling_set_hier(mpm_coupling *c, const mpm_config *cfg, const mpm_hier *h);
+/* Free what mpm_coupling_set_hier allocated (mpm_coupling_destroy). */
+void mpm_coupling_levels_free(mpm_coupling *c);
+/* Run fn once per level (the grid alone without a hierarchy), with c->grid, c->owned and the
+ * per-node state set to the level's; stops at the first error. */
+typedef int (*mpm_coupling_level_fn)(mpm_coupling *c, double t, double h, mpm_pass pass);
+int mpm_coupling_each_level(mpm_coupling *c, mpm_coupling_level_fn fn, double t, double h,
+                            mpm_pass pass);
 
 /* The hooks, each a no-op for NULL or an op the scheme leaves out; timed as coupling. */
 int mpm_coupling_before_solve(mpm_coupling *c, double t, double h, mpm_pass pass);

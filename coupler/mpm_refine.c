@@ -1,13 +1,16 @@
 /* The [refine] section and the build of the static hierarchy (see mpm_refine.h).
  *
  * What the slice refuses here, one line each naming the key: boxes without refine.levels > 1,
- * a solid beside a gas, a solid with dynamic regrids, more than one rank, a shape other than the
- * quadratic B-spline, and a box within three level-0 cells of a non-periodic domain face other than
- * a gas's slip or no-slip wall (open and closed faces, and a solid's walls, act on level 0 alone;
- * a gas's walls are carried to every level, mpm_hier.h, and a box or region may touch them). Along
- * a periodic axis a box or a dynamic region may touch, cross or span the periodic faces (the levels
- * wrap there, mpm_hier.h). mpm_hier_new's own reasons name the box's key. The gas and the solid
- * refuse their own settings (fluid/fluid_refine.c, solid/solid_refine.c). */
+ * a solid beside a gas in a partitioned time scheme (coupling.time other than monolithic), off
+ * the finest level (REFINE_SOLID_CELLS) or with a box that does not span every periodic axis
+ * (check_bands), a solid with dynamic regrids, more than one rank, a
+ * shape other than the quadratic B-spline, and a box within three level-0 cells of a non-periodic
+ * domain face other than a gas's slip or no-slip wall (open and closed faces, and a solid's walls,
+ * act on level 0 alone; a gas's walls are carried to every level, mpm_hier.h, and a box or region
+ * may touch them). Along a periodic axis a box or a dynamic region may touch, cross or span the
+ * periodic faces (the levels wrap there, mpm_hier.h). mpm_hier_new's own reasons name the box's
+ * key. The gas and the solid refuse their own settings (fluid/fluid_refine.c,
+ * solid/solid_refine.c). */
 #include "mpm_refine.h"
 
 #include "fluid_module.h"
@@ -27,8 +30,8 @@ const mpm_key_spec mpm_refine_keys[] = {
     {"refine.levels", MPM_KEY_INT, "1", 1, MPM_HIER_MAX_LEVELS, 0, 0, NULL,
      "levels of the refinement hierarchy (static boxes, or regridded with refine.criterion), each "
      "halving the spacing of the one below (1: "
-     "off); gas-only or solid-only cases on one rank with the quadratic shape, see "
-     "docs/refinement.md",
+     "off); on one rank with the quadratic shape: a gas, a solid on static boxes, or both "
+     "(on bands across a periodic axis), see docs/refinement.md",
      0, "-"},
     {"refine.buffer", MPM_KEY_INT, "2", 1, 64, 0, 0, NULL,
      "level-l cells kept between the region of level l + 1 and the edge of level l's region", 0,
@@ -97,13 +100,30 @@ static int carried_walls(const mpm_config *cfg, const mpm_grid *g, mpm_module **
   return 0;
 }
 
-/* The case-wide refusals: a solid beside a gas, several ranks, another shape. */
+/* Finest cells a solid beside a gas keeps inside the finest level's region (solid_refine_inside):
+ * its particles' stencils (1.5 cells) and their nodes' supports (1.5 more) lie on that level,
+ * so that every node where both phases meet is one of its active nodes, and one cell to move. */
+#define REFINE_SOLID_CELLS 4
+
+/* A solid beside a gas: the coupling runs on every level (mpm_coupling_set_hier) in the
+ * monolithic time scheme alone (the partitioned ones keep interface state on level 0). */
+static int check_coupled(const mpm_config *cfg) {
+  const char *time;
+  MPM_CALL(mpm_config_get_string(cfg, "coupling.time", &time));
+  if (strcmp(time, "monolithic") != 0)
+    return mpm_config_fail(cfg, "coupling.time",
+                           "coupling.time = %s is not carried to the refined levels (refine.levels "
+                           "> 1): its interface state (loads, held velocities) lives on level 0's "
+                           "nodes; use coupling.time = monolithic or set refine.levels = 1 "
+                           "(docs/refinement.md)",
+                           time);
+  return 0;
+}
+
+/* The case-wide refusals: a solid beside a gas in a partitioned time scheme, several ranks,
+ * another shape. */
 static int check_case(const mpm_config *cfg, const mpm_grid *grid, mpm_module **mod, int nmod) {
-  if (solid_of(mod, nmod) && nmod > 1)
-    return mpm_config_fail(cfg, "refine.levels",
-                           "refinement carries a gas alone or a solid alone in this slice, and "
-                           "the case has both; remove the [solid.NAME] or the [gas.NAME] "
-                           "sections, or set levels = 1");
+  if (solid_of(mod, nmod) && nmod > 1) MPM_CALL(check_coupled(cfg));
   if (grid->size > 1)
     return mpm_config_fail(cfg, "refine.levels",
                            "refinement runs on one rank in this slice, and the run has %d; run "
@@ -145,6 +165,40 @@ static int read_box(const mpm_config *cfg, const mpm_grid *g, const char *name,
                              "(a slip or no-slip wall of a gas may be touched, not crossed)",
                              REFINE_FACE_CELLS, gap, "xyz"[d], low ? g->lo[d] : g->hi[d],
                              g->lo[d] + gap_lo, g->hi[d] - gap_hi, "xyz"[d]);
+  }
+  return 0;
+}
+
+/* A solid beside a gas: the gas keeps its particles' pressure (fluid/fluid_gridp.c), whose
+ * quadrature is exact across a level's face only where that face is a plane through the domain
+ * (edges and corners of a box in the gas disturb it, docs/refinement.md): every box spans the
+ * whole period of every periodic axis, and some axis must be periodic. */
+static int check_bands(const mpm_config *cfg, const mpm_grid *g, const char *const *names,
+                       const mpm_hier_box *box, int nbox) {
+  const double tol = 1e-9 * g->dx;
+  for (int k = 0; k < nbox; ++k) {
+    int periodic = 0;
+    for (int d = 0; d < g->dim; ++d) {
+      if (!g->periodic[d]) continue;
+      periodic = 1;
+      if (box[k].lo[d] <= g->lo[d] + tol && box[k].hi[d] >= g->hi[d] - tol) continue;
+      char key[160];
+      snprintf(key, sizeof key, "refine.%s.lo", names[k]);
+      return mpm_config_fail(cfg, key,
+                             "with a solid beside the gas a box must span the periodic axis %c "
+                             "(lo = %g, hi = %g along it): the gas keeps its particles' pressure, "
+                             "which a box's edges in the gas disturb (docs/refinement.md)",
+                             "xyz"[d], g -> lo[d], g -> hi[d]);
+    }
+    if (!periodic) {
+      char key[160];
+      snprintf(key, sizeof key, "refine.%s.lo", names[k]);
+      return mpm_config_fail(cfg, key,
+                             "with a solid beside the gas a box must span a periodic axis, and "
+                             "the domain has none: the gas keeps its particles' pressure, which a "
+                             "box's edges in the gas disturb; make an axis periodic or set "
+                             "refine.levels = 1 (docs/refinement.md)");
+    }
   }
   return 0;
 }
@@ -499,6 +553,7 @@ int mpm_refine_build(mpm_hier **h, const mpm_config *cfg, mpm_grid *grid, mpm_mo
   mpm_hier_box *box;
   MPM_ALLOC(box, nbox);
   int rc = read_boxes(cfg, grid, names, nbox, (const unsigned char(*)[2])wall, box);
+  if (!rc && solid_of(mod, nmod) && nmod > 1) rc = check_bands(cfg, grid, names, box, nbox);
   char why[512] = "";
   if (!rc)
     rc = mpm_hier_new_walled(h, grid, levels, box, nbox, buffer, (const unsigned char(*)[2])wall,
@@ -509,5 +564,7 @@ int mpm_refine_build(mpm_hier **h, const mpm_config *cfg, mpm_grid *grid, mpm_mo
   for (int k = 0; k < nmod; ++k)
     MPM_CALL(mod[k]->role == MPM_ROLE_SOLID ? solid_module_refine(mod[k], cfg, *h, seed)
                                             : fluid_module_refine(mod[k], cfg, *h, seed));
+  const mpm_module *solid = solid_of(mod, nmod);
+  if (solid && nmod > 1) MPM_CALL(solid_refine_inside(solid, cfg, REFINE_SOLID_CELLS));
   return 0;
 }

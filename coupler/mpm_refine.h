@@ -1,14 +1,14 @@
 /* The [refine] section: a refinement hierarchy over the shared grid (mpm_hier.h), given by
  * boxes in the case file or by a criterion, for a gas-only case on one rank, or by boxes for a
- * solid-only case (docs/refinement.md):
+ * solid, alone or beside a gas (docs/refinement.md):
  *   [refine]              levels = 2 (1: off, the default), buffer = 2
  *                         criterion = density, threshold = 0.05, every = 10, dilate = 2
  *                         (or a list: criterion = compression, starvation, threshold = 0.003,
  *                         min_particles = 2: the union of their flags)
  *   [refine.NAME]         level = 1, lo = x y, hi = x y (static boxes, without a criterion)
- * The sim builds it after the modules and hands it to the gas (fluid_module_refine) or the solid
- * (solid_module_refine), which then deposits, solves and gathers on every level
- * (coupler/mpm_cycle.c). */
+ * The sim builds it after the modules and hands it to the gas (fluid_module_refine) and the solid
+ * (solid_module_refine), which then deposit, solve and gather on every level
+ * (coupler/mpm_cycle.c); the coupling scheme then acts on every level (mpm_coupling_set_hier). */
 #ifndef MPM_REFINE_H
 #define MPM_REFINE_H
 

@@ -285,8 +285,10 @@ static int build_modules(mpm_sim *s, int seed) {
     if (s->mod[k]->ops->attach_wall)
       MPM_CALL(s->mod[k]->ops->attach_wall(s->mod[k], s->cfg, NULL, &taken));
   }
-  /* The hierarchy over the built grid and phases; the gas reseeds its finer regions. */
-  return mpm_refine_build(&s->hier, s->cfg, s->grid, s->mod, s->nmod, seed);
+  /* The hierarchy over the built grid and phases; the gas reseeds its finer regions; the
+   * coupling acts on every level. */
+  MPM_CALL(mpm_refine_build(&s->hier, s->cfg, s->grid, s->mod, s->nmod, seed));
+  return mpm_coupling_set_hier(s->coupling, s->cfg, s->hier);
 }
 
 static const char *const g_diag_cols[] = {"t",       "step",     "dt",    "particles",

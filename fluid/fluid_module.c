@@ -94,7 +94,8 @@ static const mpm_key_spec fluid_keys[] = {
      "particles', integrated exactly over the grid's cells, with each particle's volume "
      "following its nodes' volume rate: gas at rest and uniform streams stay exact across "
      "refined regions; ERK pairs, quadratic shape and a gas alone) or auto (grid with "
-     "refine.levels > 1, where particle is refused; else particle); see docs/refinement.md",
+     "refine.levels > 1 and no solid, where particle is refused; else particle); see "
+     "docs/refinement.md",
      0, NULL},
     {"fluid.ppc", MPM_KEY_INT, "2", 1, 8, 0, 0, NULL,
      "gas particles per cell per direction at seeding", 0, "-"},

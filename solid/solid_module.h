@@ -30,4 +30,10 @@ struct mpm_hier;
  * level's region at its own spacing. */
 int solid_module_refine(mpm_module *m, const mpm_config *cfg, struct mpm_hier *h, int seed);
 
+/* Beside a gas (the coupling on the hierarchy, mpm_refine.h): does every particle of the solid
+ * lie inside the finest level's region with `cells` finest cells to spare along every axis
+ * (every point of the cube of half-side cells h_finest around it on the finest level)? If not,
+ * an input error naming the offending body's geometry key. */
+int solid_refine_inside(const mpm_module *m, const mpm_config *cfg, int cells);
+
 #endif

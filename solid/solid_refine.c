@@ -19,8 +19,9 @@
  * scale and lagged rate are level 0's), a rigid body and a clamp (they hold level-0 nodes), an
  * odd ppc (a level-0 particle would sit on a face of the refined region), time.method = musl
  * (the remap deposits on level 0), and a traction whose region reaches a refined region (the
- * tractions load level-0 particles only). A gas beside the solid, dynamic regrids and several
- * ranks are refused by coupler/mpm_refine.c.
+ * tractions load level-0 particles only). Dynamic regrids and several ranks are refused by
+ * coupler/mpm_refine.c, which also asks a solid beside a gas to lie on the finest level
+ * (solid_refine_inside).
  *
  * Invariant: with m->hier NULL every call here is the plain kernel call, so an unrefined run is
  * bit for bit what it was. */
@@ -96,6 +97,44 @@ static int refine_check(const mpm_module *m, const mpm_config *cfg) {
     char key[160];
     snprintf(key, sizeof key, "clamp.%s.geometry", names[0]);
     return refuse(cfg, key, "a clamp holds level-0 nodes");
+  }
+  return 0;
+}
+
+/* ---- beside a gas: the solid on the finest level -------------------------------------------- */
+
+/* Do the points of the cube of half-side cells h around x, a lattice of spacing h (the finest
+ * region is a union of spans of side 2 h, so no gap escapes it), all lie on the finest level? */
+static int cube_on_finest(const mpm_hier *h, int dim, const double *x, int cells) {
+  const int top = h->nlevels - 1, side = 2 * cells + 1;
+  const double dx = h->level[top].grid->dx;
+  int total = 1;
+  for (int d = 0; d < dim; ++d) total *= side;
+  for (int k = 0; k < total; ++k) {
+    double y[3] = {x[0], dim > 1 ? x[1] : 0, dim > 2 ? x[2] : 0};
+    for (int d = 0, r = k; d < dim; r /= side, ++d) y[d] += (r % side - cells) * dx;
+    if (mpm_hier_level_of(h, y) != top) return 0;
+  }
+  return 1;
+}
+
+int solid_refine_inside(const mpm_module *m, const mpm_config *cfg, int cells) {
+  const solid_content *sc = m->content;
+  const mpm_particles *p = m->particles;
+  if (!m->hier) return 0;
+  const double *body = mpm_particles_comp(p, sc->lay.f_body, 0);
+  for (mpm_lidx i = 0; i < p->n; ++i) {
+    double x[3] = {0, 0, 0};
+    for (int d = 0; d < p->dim; ++d) x[d] = mpm_particles_comp(p, F_X, d)[i];
+    if (cube_on_finest(m->hier, p->dim, x, cells)) continue;
+    char key[160];
+    solid_key(key, sizeof key, sc->body[(int)body[i]].section, "geometry");
+    return mpm_config_fail(cfg, key,
+                           "a solid beside a gas must lie on the finest refinement level with %d "
+                           "of its cells to spare (every coupling node on that level), and a "
+                           "particle at (%g, %g%s) does not; enlarge or add a [refine.NAME] box "
+                           "of level %d around the body (docs/refinement.md)",
+                           cells, x[0], x[1], p->dim == 3 ? ", ..." : "", m->hier->nlevels - 1);
   }
   return 0;
 }

@@ -149,3 +149,96 @@ SOD_COARSE = 100
 def sod_refine(levels):
     """Command-line settings of the refined Sod run with `levels` levels over SOD_COARSE cells."""
     return [f"refine.levels={levels}", "refine.criterion=density", "refine.threshold=0.02"]
+
+# A gas beside a solid on the hierarchy (tests/verification/test_refine_fsi.py): a quasi-1-D
+# strip periodic along y (3 level-0 cells high), slip walls at the x ends: gas rho 1, p 1
+# (c_g = Z_g = 1.1832) on [0, 1], a linear_elastic slab on [1, 2.6] prestressed to the gas's
+# pressure (initial_pressure = 1), gas again on [2.6, 3]. The slab: rho_s = 0.25, E = 22.4,
+# nu = 0 (plane strain: M = E), so c_s = 9.466 = 8 c_g and Z_s = 2.366 = 2 Z_g, at a prestrain
+# p / M = 4.3 %. The level-1 band (the gas keeps its particles' pressure beside a solid: a box
+# spans the periodic axis) covers the slab with 0.1 to spare, more than the 4 finest cells the
+# code asks for. {pulse}: extra keys of the left column (a right-going pulse, FSI_PULSE).
+FSI_DX, FSI_X_I, FSI_L_S, FSI_LENGTH = 0.02, 1.0, 1.6, 3.0
+FSI_RHO_S, FSI_E = 0.25, 22.4
+FSI_AMBIENT = "density = 1\npressure = 1\n"
+FSI_BAND = ("[refine]\nlevels = 2\n\n[refine.band]\nlevel = 1\nlo = 0.9 0\n"
+            "hi = 2.7 {height}\n")
+
+
+def fsi_case(t_end, refine, dx=FSI_DX, pulse="", extra="", interval=None):
+    h = 3 * FSI_DX
+    xs = FSI_X_I + FSI_L_S
+    return f"""[run]
+name = refine_fsi
+
+[domain]
+dim = 2
+lo = 0 0
+hi = {FSI_LENGTH} {h}
+
+[grid]
+dx = {dx}
+
+[boundary]
+x_lo = slip
+x_hi = slip
+y_lo = periodic
+y_hi = periodic
+
+[coupling]
+scheme = velocity
+
+[time]
+t_end = {t_end}
+
+[output]
+interval = {interval or t_end}
+
+[fluid]
+gamma = 1.4
+
+[geometry.left]
+type = box
+lo = 0 0
+hi = {FSI_X_I} {h}
+
+[geometry.slab]
+type = box
+lo = {FSI_X_I} 0
+hi = {xs} {h}
+
+[geometry.right]
+type = box
+lo = {xs} 0
+hi = {FSI_LENGTH} {h}
+
+[gas.left]
+geometry = left
+{pulse or FSI_AMBIENT}
+
+[gas.right]
+geometry = right
+density = 1
+pressure = 1
+
+[solid.slab]
+geometry = slab
+material = linear_elastic
+density = {FSI_RHO_S}
+E = {FSI_E}
+nu = 0
+initial_pressure = 1
+{extra}
+{refine.format(height=h) if refine else ""}"""
+
+
+# The pulse: right-going, p' = A f, rho' = p' / c^2, u = p' / Z_g, f = exp(-((x - 0.45) / 0.05)^2 / 2)
+# (A = 1e-2): its front (3 sigma) reaches the slab at t = 0.338, its tail leaves at 0.59.
+FSI_A, FSI_XC, FSI_SIGMA = 1e-2, 0.45, 0.05
+_F = f"exp(-((x-{FSI_XC})/{FSI_SIGMA})^2/2)"
+# The slab's particle nearest the left face's inside, followed by probes.csv (the transmitted
+# wave's velocity).
+FSI_PROBE = "[probe.slab]\npoint = 1.04 0.03\nphase = solid\n"
+FSI_PULSE = (f"density_field = 1 + {FSI_A / 1.4}*{_F}\n"
+             f"pressure_field = 1 + {FSI_A}*{_F}\n"
+             f"velocity_field = {FSI_A / np.sqrt(1.4)}*{_F}; 0\n")

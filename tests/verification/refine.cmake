@@ -57,3 +57,11 @@ foreach(part stream farfield shock)
 endforeach()
 mpm_add_script_test(test_refine_open_ranks SCRIPT verification/test_refine_open.py ARGS ranks
                     LABELS "verification;mpi" TIMEOUT 300)
+# A gas beside a solid on a static hierarchy (the coupling on every level): gas and a
+# prestressed slab at rest across a level-1 band (~5 s), an acoustic pulse striking the slab
+# inside the band against the impedance solution and the uniform twins (~20 s), both refined
+# under coupling.scheme = traction (~12 s), a restart (~10 s), every refusal (~5 s).
+foreach(part rest pulse traction restart input)
+  mpm_add_script_test(test_refine_fsi_${part} SCRIPT verification/test_refine_fsi.py
+                      ARGS ${part} LABELS verification TIMEOUT 300)
+endforeach()

@@ -378,8 +378,9 @@ def part_input():
     ]
     gas = ("\n[geometry.air]\ntype = box\nlo = 110 9\nhi = 140 13\n\n[gas.air]\n"
            "geometry = air\ndensity = 1\npressure = 1\n")
-    cases.append(("a gas beside the solid", refined.replace("[refine]", gas + "\n[refine]"),
-                  "refine.levels", "levels = 2", "both"))
+    cases.append(("a gas beside the solid in a box that spans no periodic axis",
+                  refined.replace("[refine]", gas + "\n[refine]"), "refine.box.lo", "lo = 75 3",
+                  "periodic axis"))
     for name, text, key, start, words in cases:
         mt.expect_input_error(check, name, text, key, mt.line_starting(text, start), words)
 
