@@ -65,9 +65,9 @@ static int refuse(const mpm_config *cfg, const char *key, const char *why) {
 
 /* The refusals of the grid pressure; the first found names its key. */
 static int check_scope(const fluid_content *fc, const mpm_config *cfg, const mpm_grid *g) {
-  if (fc->tr.classic)
-    return refuse(cfg, "time.method", "is carried by the ERK pairs (the method of lines) only");
-  if (!fc->current_rate)
+  if (fc->tr.musl)
+    return refuse(cfg, "time.method", "is carried by the ERK pairs and usl, not by MUSL's remap");
+  if (!fc->tr.classic && !fc->current_rate)
     return refuse(cfg, "fluid.strain_rate", "needs the current strain rate (the default)");
   if (g->shape != MPM_SHAPE_QUADRATIC)
     return refuse(cfg, "grid.shape", "integrates the quadratic B-spline's spans");
@@ -289,14 +289,14 @@ int fluid_gridp_forces(mpm_module *m) {
   return 0;
 }
 
-int fluid_gridp_nodal_rate(mpm_module *m, mpm_hier_scalars *s) {
+int fluid_gridp_nodal_rate(mpm_module *m, const mpm_hier_nodal *vel, mpm_hier_scalars *s) {
   fluid_content *fc = m->content;
   fluid_gridp *gp = fc->gridp;
   double *D[MPM_HIER_MAX_LEVELS][MPM_MAX_DIM] = {{NULL}};
   for (int l = 0; l < gp->nlev; ++l) {
     const mpm_grid *g = level_grid(m, l);
     const double *v[MPM_MAX_DIM];
-    for (int d = 0; d < g->dim; ++d) v[d] = g->phase[m->phase].v_i[d];
+    for (int d = 0; d < g->dim; ++d) v[d] = vel ? vel->v_i[l][d] : g->phase[m->phase].v_i[d];
     memset(gp->D[l], 0, sizeof(double) * (size_t)g->nnodes);
     mpm_span_divergence(g, &gp->set[l], v, gp->D[l]);
     D[l][0] = gp->D[l];

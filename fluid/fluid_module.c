@@ -361,7 +361,7 @@ static int fluid_p2g(mpm_module *m, double t, const double *y) {
   MPM_CALL(ensure_scratch(m));
   fluid_av_lengths(m, y);
   fluid_batch b = batch_of(m, y);
-  if (!fc->current_rate) {
+  if (!fc->current_rate && !fc->gridp) {
     mpm_timer_start(MPM_T_STRESS);
     fluid_stress(&fc->gas, &b);
     mpm_timer_stop(MPM_T_STRESS);
@@ -370,13 +370,16 @@ static int fluid_p2g(mpm_module *m, double t, const double *y) {
     mpm_timer_stop(MPM_T_P2G);
     return 0;
   }
-  /* The current rate (above): the pressure's deposit; p2g_rate adds the viscous one. */
+  /* The current rate (above): the pressure's deposit; p2g_rate adds the viscous one. The grid
+   * pressure (fluid_gridp.c) in the classic update: the pressure's deposit, then the viscous
+   * one of the lagged rate at once. */
   mpm_timer_start(MPM_T_STRESS);
   fluid_stress_pressure(&fc->gas, &b);
   mpm_timer_stop(MPM_T_STRESS);
   mpm_timer_start(MPM_T_P2G);
   if (fc->gridp) MPM_CALL(fluid_gridp_deposit(m, y, &b));
   MPM_CALL(deposit(m, y, fc->vsig, NULL));
+  if (!fc->current_rate) MPM_CALL(deposit_viscous(m, y, &b));
   mpm_timer_stop(MPM_T_P2G);
   return 0;
 }
@@ -478,8 +481,9 @@ static int classic_transfer(mpm_module *m, const double *y, double h, fluid_step
   fluid_content *fc = m->content;
   o->L = fc->scratch + (size_t)2 * m->grid->dim * m->particles->n;
   o->heat = fc->power;
-  fluid_classic_transfer(m, y, h, o);
+  MPM_CALL(fluid_classic_transfer(m, y, h, o));
   energy_rate(m, o->L, o->heat, h);
+  if (fc->gridp) fluid_gridp_work(m, y, fc->power); /* the pressure's work, at vbar */
   return 0;
 }
 
@@ -572,7 +576,7 @@ static int g2p_rates(mpm_module *m, const double *y, double *ydot, double h) {
     mpm_hier_scalars rate;
     double *rate_out = NULL;
     if (fc->gridp) {
-      MPM_CALL(fluid_gridp_nodal_rate(m, &rate));
+      MPM_CALL(fluid_gridp_nodal_rate(m, NULL, &rate));
       rate_out = fluid_gridp_rate_out(fc);
     }
     MPM_CALL(fluid_g2p_phase(m, y, xdot, vdot, L, &rate, rate_out));
@@ -771,6 +775,7 @@ static void fluid_destroy(mpm_module *m) {
     free(fc->av_l), free(fc->lev);
     free(fc->sub), free(fc->zero), free(fc->work);
     free(fc->tscratch), free(fc->node), free(fc->cellsum), free(fc->lim), free(fc->vol);
+    fluid_lnode_free(fc);
     free(fc);
   }
   mpm_particles_destroy(&m->particles);

@@ -118,9 +118,6 @@ typedef struct refusal {
 } refusal;
 
 static const refusal g_refused[] = {
-    {"time.method", "usl",
-     "the classic update's transfer reads a time-centred nodal velocity, heat shares and a wall "
-     "rule on level 0's nodes"},
     {"time.method", "musl", "MUSL's remap deposits on level 0's nodes"},
     {"fluid.volume_rate", "domain", "the domain rate samples the nodal velocity on level 0"},
     {"fluid.av_form", "riemann", "the riemann limiter reads the nodal velocity on level 0"},
@@ -130,6 +127,13 @@ static const refusal g_refused[] = {
     {"fluid.refill_every", NULL, "refilling counts particles in level-0 cells"},
     {"fluid.light_node_mass", NULL, "the mean nodal mass is level 0's"},
 };
+
+/* The reason g_refused gives for key (looked up, so that rows may come and go). */
+static const char *refused_why(const char *key) {
+  for (size_t k = 0; k < sizeof g_refused / sizeof g_refused[0]; ++k)
+    if (strcmp(g_refused[k].key, key) == 0) return g_refused[k].why;
+  return "";
+}
 
 /* The first obstacle, or open face, of the case: refused with its key. */
 static int refuse_boundaries(const mpm_config *cfg, const fluid_content *fc, int dim) {
@@ -159,7 +163,8 @@ int fluid_refine_check(const mpm_module *m, const mpm_config *cfg) {
     if (r->choice ? is_choice(cfg, r->key, r->choice) : is_positive(cfg, r->key))
       return refuse(cfg, r->key, r->why);
   }
-  if (fc->reg_every > 0) return refuse(cfg, "fluid.regularise_every", g_refused[6].why);
+  if (fc->reg_every > 0)
+    return refuse(cfg, "fluid.regularise_every", refused_why("fluid.regularise_every"));
   MPM_CALL(refuse_boundaries(cfg, fc, m->grid->dim));
   if (fc->ppc % 2)
     return mpm_config_fail(
@@ -182,6 +187,11 @@ int fluid_module_refine(mpm_module *m, const mpm_config *cfg, mpm_hier *h, int s
 void fluid_module_rehier(mpm_module *m, mpm_hier *h) {
   m->hier = h;
   fluid_gridp_reset(m->content);
+  fluid_lnode_free(m->content);
+}
+
+void fluid_lnode_free(fluid_content *fc) {
+  for (int l = 0; l < MPM_HIER_MAX_LEVELS; ++l) free(fc->lnode[l]), fc->lnode[l] = NULL;
 }
 
 /* ---- the refinement criteria (mpm_refine.c regrids with them) ---------------------------- */

@@ -2,8 +2,10 @@
 and bench/bench_refine.py: a 2-D strip periodic along x with slip walls along y (level 0 at
 dx = 0.05), its static level-1 box, the 3-D strip and box, the regridded pulse, and a radial
 expansion for the starvation criterion; with y = "periodic" the strip is periodic along y too
-(the levels then wrap across its faces); and the refinement of Sod's shock tube (cases/sod.ini,
-a strip periodic along y)."""
+(the levels then wrap across its faces); the refinement of Sod's shock tube (cases/sod.ini,
+a strip periodic along y), and the walled scenes of tests/verification/test_refine_walls.py (a
+closed box refined in its corner, a band and a box on the walls of the strip), which
+test_refine_usl.py shares."""
 import numpy as np
 
 C0 = np.sqrt(1.4)  # sound speed of rho 1, p 1
@@ -149,3 +151,60 @@ SOD_COARSE = 100
 def sod_refine(levels):
     """Command-line settings of the refined Sod run with `levels` levels over SOD_COARSE cells."""
     return [f"refine.levels={levels}", "refine.criterion=density", "refine.threshold=0.02"]
+
+# A closed box (walls {wall} on all four faces) refined on three levels in its corner (x_lo,
+# y_lo) and against y_hi; {gas} fills it.
+CLOSED = """[run]
+name = refine_walls
+
+[domain]
+dim = 2
+lo = 0 0
+hi = 1.2 0.6
+
+[grid]
+dx = 0.05
+
+[boundary]
+x_lo = {wall}
+x_hi = {wall}
+y_lo = {wall}
+y_hi = {wall}
+
+[time]
+t_end = 1
+
+[output]
+interval = 0.5
+
+[geometry.all]
+type = box
+lo = 0 0
+hi = 1.2 0.6
+
+[gas.air]
+geometry = all
+{gas}
+
+[refine]
+levels = 3
+
+[refine.corner]
+level = 1
+lo = 0 0
+hi = 0.5 0.35
+
+[refine.inner]
+level = 2
+lo = 0 0
+hi = 0.3 0.2
+
+[refine.top]
+level = 1
+lo = 0.7 0.3
+hi = 1.0 0.6
+"""
+
+# On the strip: a level-1 band over its whole height and a level-2 box on y_lo inside it.
+STREAM = ("[refine]\nlevels = 3\n\n[refine.band]\nlevel = 1\nlo = 0.8 0\nhi = 1.2 0.6\n\n"
+          "[refine.floor]\nlevel = 2\nlo = 0.9 0\nhi = 1.1 0.15\n")

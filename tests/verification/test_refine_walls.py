@@ -36,7 +36,8 @@ import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "tools"))
 import mpmtest as mt  # noqa: E402
-from refine_scenes import BOX_3D, C0, CASE_3D, DYNAMIC, PULSE_5, case_text  # noqa: E402
+from refine_scenes import (BOX_3D, C0, CASE_3D, CLOSED, DYNAMIC, PULSE_5, STREAM,  # noqa: E402
+                           case_text)
 
 PART = sys.argv[1] if len(sys.argv) > 1 else "rest"
 check = mt.Checks(f"test_refine_walls_{PART}")
@@ -81,58 +82,6 @@ def near_walls(p, level, faces, h=0.025):
     return [int(np.sum((lev == level) & (np.abs(p["x"][:, a] - v) < h))) for a, v in faces]
 
 
-CLOSED = """[run]
-name = refine_walls
-
-[domain]
-dim = 2
-lo = 0 0
-hi = 1.2 0.6
-
-[grid]
-dx = 0.05
-
-[boundary]
-x_lo = {wall}
-x_hi = {wall}
-y_lo = {wall}
-y_hi = {wall}
-
-[time]
-t_end = 1
-
-[output]
-interval = 0.5
-
-[geometry.all]
-type = box
-lo = 0 0
-hi = 1.2 0.6
-
-[gas.air]
-geometry = all
-{gas}
-
-[refine]
-levels = 3
-
-[refine.corner]
-level = 1
-lo = 0 0
-hi = 0.5 0.35
-
-[refine.inner]
-level = 2
-lo = 0 0
-hi = 0.3 0.2
-
-[refine.top]
-level = 1
-lo = 0.7 0.3
-hi = 1.0 0.6
-"""
-
-
 def part_rest():
     for wall in ("slip", "no_slip"):
         out = run(f"walls_rest_{wall}", CLOSED.format(wall=wall, gas=REST))
@@ -147,10 +96,6 @@ def part_rest():
         check(min(n1 + n2) > 0, f"{wall}: level-1 particles within half a cell of x_lo, y_lo, "
               f"y_hi {n1}, level-2 of x_lo, y_lo {n2} (the levels reach the walls)")
         conservation(f"{wall}, at rest", out, "x", 1e-12)
-
-
-STREAM = ("[refine]\nlevels = 3\n\n[refine.band]\nlevel = 1\nlo = 0.8 0\nhi = 1.2 0.6\n\n"
-          "[refine.floor]\nlevel = 2\nlo = 0.9 0\nhi = 1.1 0.15\n")
 
 
 def part_stream():
