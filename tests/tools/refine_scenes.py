@@ -208,3 +208,28 @@ hi = 1.0 0.6
 # On the strip: a level-1 band over its whole height and a level-2 box on y_lo inside it.
 STREAM = ("[refine]\nlevels = 3\n\n[refine.band]\nlevel = 1\nlo = 0.8 0\nhi = 1.2 0.6\n\n"
           "[refine.floor]\nlevel = 2\nlo = 0.9 0\nhi = 1.1 0.15\n")
+
+
+def wall_pulse_case(refine, dx, extra=""):
+    """An acoustic pulse (amplitude 1e-3, gaussian of width 0.2) running down (-y) onto the slip
+    wall y_lo of a strip 0.3 wide (periodic along x) and 2 high, to t = 1.2."""
+    a, y0 = 1e-3, 0.6
+    g = f"exp(-(y-{y0})^2/0.04)"
+    gas = (f"density_field = 1 + {a}*{g}\npressure_field = 0.714285714285714 + {a}*{g}\n"
+           f"velocity_field = 0; -{a}*{g}")
+    text = case_text(0.3, 1.2, gas, refine, dx=dx, extra=extra, height=2.0)
+    return text.replace("interval = 0.6", "interval = 0.3")
+
+
+# A level-1 band touching the wall y_lo of wall_pulse_case and spanning its x period.
+WALL_BAND = "[refine]\nlevels = 2\n\n[refine.band]\nlevel = 1\nlo = 0 0\nhi = 0.3 1.2\n"
+
+
+def wall_pulse_profile(p):
+    """Mass-weighted p' and v_y binned along y (0.025) at the end: the strip is 1-D."""
+    y = p["x"][:, 1]
+    k = np.minimum((y / 0.025).astype(int), 79)
+    w = np.bincount(k, p["m"].ravel(), 80)
+    pp = np.bincount(k, p["m"].ravel() * (p["p"].ravel() - 1 / 1.4), 80) / w
+    vv = np.bincount(k, p["m"].ravel() * p["v"][:, 1], 80) / w
+    return 0.5 * (pp + vv), 0.5 * (pp - vv)  # up-running, down-running (Z = 1)

@@ -50,7 +50,7 @@ endforeach()
 # stream across static level-1 and level-2 boxes at the walls, FLIP, a PIC share and APIC
 # (~10 s); the acoustic pulse crossing a box against its coarse twin (~5 s); Sod with a regridded
 # fine region against its uniform usl twin (~5 s); conservation through regrids (~8 s).
-foreach(part uniform pulse sod regrid)
+foreach(part uniform pulse sod wall regrid)
   mpm_add_script_test(test_refine_usl_${part} SCRIPT verification/test_refine_usl.py ARGS ${part}
                       LABELS verification TIMEOUT 300)
 endforeach()

@@ -37,7 +37,7 @@ import numpy as np
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "tools"))
 import mpmtest as mt  # noqa: E402
 from refine_scenes import (BOX_3D, C0, CASE_3D, CLOSED, DYNAMIC, PULSE_5, STREAM,  # noqa: E402
-                           case_text)
+                           WALL_BAND, case_text, wall_pulse_case, wall_pulse_profile)
 
 PART = sys.argv[1] if len(sys.argv) > 1 else "rest"
 check = mt.Checks(f"test_refine_walls_{PART}")
@@ -125,37 +125,16 @@ def part_stream():
     conservation("3-D stream", out, "x", 1e-12)
 
 
-def pulse_case(refine, dx, extra=""):
-    a, y0 = 1e-3, 0.6
-    g = f"exp(-(y-{y0})^2/0.04)"
-    gas = (f"density_field = 1 + {a}*{g}\npressure_field = 0.714285714285714 + {a}*{g}\n"
-           f"velocity_field = 0; -{a}*{g}")
-    text = case_text(0.3, 1.2, gas, refine, dx=dx, extra=extra, height=2.0)
-    return text.replace("interval = 0.6", "interval = 0.3")
-
-
 GRIDP = "[fluid]\npressure = grid\n"
-BAND = "[refine]\nlevels = 2\n\n[refine.band]\nlevel = 1\nlo = 0 0\nhi = 0.3 1.2\n"
-
-
-def profile(out):
-    """Mass-weighted p' and v_y binned along y (0.025) at the end: the strip is 1-D."""
-    p = final(out)
-    y = p["x"][:, 1]
-    k = np.minimum((y / 0.025).astype(int), 79)
-    w = np.bincount(k, p["m"].ravel(), 80)
-    pp = np.bincount(k, p["m"].ravel() * (p["p"].ravel() - 1 / 1.4), 80) / w
-    vv = np.bincount(k, p["m"].ravel() * p["v"][:, 1], 80) / w
-    return 0.5 * (pp + vv), 0.5 * (pp - vv)  # up-running, down-running (Z = 1)
 
 
 def part_pulse():
-    runs = {"refined": run("walls_pulse", pulse_case(BAND, 0.05)),
-            "coarse": run("walls_pulse_coarse", pulse_case("", 0.05, GRIDP)),
-            "fine": run("walls_pulse_fine", pulse_case("", 0.025, GRIDP))}
+    runs = {"refined": run("walls_pulse", wall_pulse_case(WALL_BAND, 0.05)),
+            "coarse": run("walls_pulse_coarse", wall_pulse_case("", 0.05, GRIDP)),
+            "fine": run("walls_pulse_fine", wall_pulse_case("", 0.025, GRIDP))}
     up, down, energy, peak = {}, {}, {}, {}
     for label, out in runs.items():
-        up[label], down[label] = profile(out)
+        up[label], down[label] = wall_pulse_profile(final(out))
         energy[label] = float((up[label] ** 2).sum())
         peak[label] = float(up[label].max())
         print(f"info {label}: reflected (up-running) energy {energy[label]:.4e}, peak "
