@@ -28,9 +28,16 @@
  * level reaching a wall (mpm_hier.h, walls) does the same with its nodes beyond the wall, and
  * integrates only its spans inside it (the wall is a knot of every finer level).
  *
- * Scope (fluid_gridp_read refuses the rest): the method-of-lines ERK pairs with the current
- * strain rate, the quadratic B-spline, a gas alone (no solid, obstacle or open face), no
- * shifting, the point volume rate. */
+ * The classic update (usl). The particles deposit m p and, beside it, the viscous and artificial
+ * stresses of the lagged strain rate; the force acts in the solve as above; the volume rate is
+ * integrated at the time-centred nodal velocity vbar (fluid_transfer.c), whose gradient heats the
+ * viscous stresses too. The pressure's work over the step, -h sum_j p_j D_j(vbar), is then
+ * -h sum_i f_i . vbar_i, exactly the grid's kinetic energy gain from these forces, so usl keeps
+ * total energy to roundoff as with the particles' quadrature.
+ *
+ * Scope (check_scope refuses the rest): the method-of-lines ERK pairs with the current strain
+ * rate or usl (not MUSL's remap), the quadratic B-spline, a gas alone (no solid, obstacle or open
+ * face), no shifting, the point volume rate. */
 #include "fluid_internal.h"
 
 #include "mpm_error.h"

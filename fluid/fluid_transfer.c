@@ -77,7 +77,17 @@
  * test_pic_rate checks the rate itself, at a quarter of the gas's step and at another time.cfl.
  * A gas that sets its own step at time.cfl = 0.4 is blended exactly as before. The heat shares
  * above hold for any blend, so the energy balance is unchanged. (Particle shifting is a rate
- * already: fluid_shift.c.) */
+ * already: fluid_shift.c.)
+ *
+ * On a refinement hierarchy (mpm_hier.h) every nodal field above lives on every level: vbar on
+ * each level's nodes (composite, since v and a are after the prolongation), the scalars formed
+ * on each level's nodes and then prolonged into the inactive ones (a particle must read
+ * sum_i w_ip s_i over the composite weights w it deposited with, or the shares' sums break;
+ * |v|^2 of a prolonged v is not the prolongation of |v|^2), and the G2P reads the particle's
+ * level (mpm_hier_g2p_from). The wall rule weighs a particle of level l at spacing h_l: no
+ * level-l node lies on the wall (a knot there), so w is the weight a node on the wall would have
+ * on a uniform grid of spacing h_l (the fine twin's rule; WALL_NODE below). The method of lines'
+ * rate (fluid_wall_rate_mol) still weighs every particle on level 0. */
 #include "fluid_internal.h"
 
 #include "mpm_error.h"
