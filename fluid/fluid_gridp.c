@@ -28,15 +28,17 @@
  * level reaching a wall (mpm_hier.h, walls) does the same with its nodes beyond the wall, and
  * integrates only its spans inside it (the wall is a knot of every finer level).
  *
- * The classic update (usl). The particles deposit m p and, beside it, the viscous and artificial
- * stresses of the lagged strain rate; the force acts in the solve as above; the volume rate is
- * integrated at the time-centred nodal velocity vbar (fluid_transfer.c), whose gradient heats the
- * viscous stresses too. The pressure's work over the step, -h sum_j p_j D_j(vbar), is then
- * -h sum_i f_i . vbar_i, exactly the grid's kinetic energy gain from these forces, so usl keeps
- * total energy to roundoff as with the particles' quadrature.
+ * The classic update (usl, musl). The particles deposit m p and, beside it, the viscous and
+ * artificial stresses of the lagged strain rate; the force acts in the solve as above; the volume
+ * rate is integrated at the time-centred nodal velocity vbar (fluid_transfer.c), whose gradient
+ * heats the viscous stresses too. The pressure's work over the step, -h sum_j p_j D_j(vbar), is
+ * then -h sum_i f_i . vbar_i, exactly the grid's kinetic energy gain from these forces, so usl
+ * keeps total energy to roundoff as with the particles' quadrature. MUSL books the same work from
+ * its first pass (fluid_module.c, fluid_remap) and moves the volume with the same rate; only the
+ * positions follow its remapped velocity.
  *
  * Scope (check_scope refuses the rest): the method-of-lines ERK pairs with the current strain
- * rate or usl (not MUSL's remap), the quadratic B-spline, a gas alone (no solid, obstacle or open
+ * rate or the classic update, the quadratic B-spline, a gas alone (no solid, obstacle or open
  * face), no shifting, the point volume rate. */
 #include "fluid_internal.h"
 
@@ -72,8 +74,6 @@ static int refuse(const mpm_config *cfg, const char *key, const char *why) {
 
 /* The refusals of the grid pressure; the first found names its key. */
 static int check_scope(const fluid_content *fc, const mpm_config *cfg, const mpm_grid *g) {
-  if (fc->tr.musl)
-    return refuse(cfg, "time.method", "is carried by the ERK pairs and usl, not by MUSL's remap");
   if (!fc->tr.classic && !fc->current_rate)
     return refuse(cfg, "fluid.strain_rate", "needs the current strain rate (the default)");
   if (g->shape != MPM_SHAPE_QUADRATIC)

@@ -93,7 +93,7 @@ static const mpm_key_spec fluid_keys[] = {
      "the classic MPM quadrature), grid (the nodal pressure, a mass-weighted mean of the "
      "particles', integrated exactly over the grid's cells, with each particle's volume "
      "following its nodes' volume rate: gas at rest and uniform streams stay exact across "
-     "refined regions; ERK pairs or usl, quadratic shape and a gas alone) or auto (grid with "
+     "refined regions; ERK pairs, usl or musl, quadratic shape and a gas alone) or auto (grid with "
      "refine.levels > 1, where particle is refused; else particle); see docs/refinement.md",
      0, NULL},
     {"fluid.ppc", MPM_KEY_INT, "2", 1, 8, 0, 0, NULL,
@@ -501,15 +501,19 @@ static int fluid_remap(mpm_module *m, double t, const double *y, double h) {
   for (int d = 0; d < dim; ++d)
     o.vhat[d] = fc->scratch + (size_t)d * n, o.vnew[d] = fc->vnew + (size_t)d * n;
   MPM_CALL(classic_transfer(m, y, h, &o));
-  mpm_grid_phase_zero(m->grid, m->phase);
+  if (m->hier)
+    mpm_hier_phase_zero(m->hier, m->phase);
+  else
+    mpm_grid_phase_zero(m->grid, m->phase);
   mpm_p2g_args a = {
       .n = n, .m = mpm_particles_comp(p, fc->lay.f_m, 0), .C = fc->Cnew, .lp = fc->lp};
   for (int d = 0; d < dim; ++d) {
     a.x[d] = state(p, y, FLUID_X) + (size_t)d * n;
     a.v[d] = o.vnew[d];
   }
-  mpm_kernels_get(dim)->p2g(m->grid, m->phase, &a);
-  return 0;
+  int rc = 0;
+  fluid_p2g_any(m, m->phase, &a, &rc); /* the coupler restricts it on a hierarchy */
+  return rc;
 }
 
 /* A replaced state field as a rate over the step: out = (out - y) / h, or (src - y) / h. */
@@ -591,7 +595,7 @@ static int g2p_rates(mpm_module *m, const double *y, double *ydot, double h) {
     as_rate(vdot[0], NULL, v, nv, h);
     if (Cdot) as_rate(Cdot, NULL, C, nC, h);
   } else {
-    mpm_transfer_g2p(m->grid, m->phase, p, y, fc->lp, xdot, a_p, L, NULL);
+    MPM_CALL(fluid_g2p_phase(m, y, xdot, a_p, L, NULL, NULL)); /* the remapped velocities */
     as_rate(vdot[0], fc->vnew, v, nv, h);
     if (Cdot) as_rate(Cdot, fc->Cnew, C, nC, h);
   }

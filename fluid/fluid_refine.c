@@ -12,16 +12,16 @@
  * (fluid_module.c). Slip and no-slip walls act on every level (mpm_hier.h, walls: the finer levels
  * fold and mirror their nodes beyond a wall in fluid_module.c's forces and constrain); the sim
  * keeps every box three level-0 cells from the other non-periodic faces (coupler/mpm_refine.c).
- * The classic update usl: its transfer forms the time-centred nodal velocity and the heat shares'
- * scalars on every level and gathers through the hierarchy, and weighs its wall rule at the
- * particle's level spacing (fluid_transfer.c); the grid pressure runs with it (fluid_gridp.c).
+ * The classic update (usl, musl): its transfer forms the time-centred nodal velocity and the heat
+ * shares' scalars on every level and gathers through the hierarchy, and weighs its wall rule at
+ * the particle's level spacing (fluid_transfer.c); MUSL's remap deposits through the hierarchy
+ * (fluid_module.c) and the coupler restricts it; the grid pressure runs with both (fluid_gridp.c).
  *
  * Refused (fluid_refine_check), each naming its key: everything that reads or writes the gas's
- * nodal fields or the grid otherwise: MUSL's remap (its deposit of the new velocities on level
- * 0's nodes), the domain volume rate, the riemann viscosity's limiter, shifting,
- * regularisation and refill (cell counts), the neighbourhood stable step, the light-node threshold,
- * obstacles and open faces. An odd fluid.ppc puts level-0 particles on the span faces that bound
- * the finer regions, so it is refused too.
+ * nodal fields or the grid otherwise: the domain volume rate, the riemann viscosity's limiter,
+ * shifting, regularisation and refill (cell counts), the neighbourhood stable step, the light-node
+ * threshold, obstacles and open faces. An odd fluid.ppc puts level-0 particles on the span faces
+ * that bound the finer regions, so it is refused too.
  *
  * Invariant: with m->hier NULL every call here is the plain kernel call (the refined path costs
  * one pointer test per transfer). */
@@ -121,7 +121,6 @@ typedef struct refusal {
 } refusal;
 
 static const refusal g_refused[] = {
-    {"time.method", "musl", "MUSL's remap deposits on level 0's nodes"},
     {"fluid.volume_rate", "domain", "the domain rate samples the nodal velocity on level 0"},
     {"fluid.av_form", "riemann", "the riemann limiter reads the nodal velocity on level 0"},
     {"fluid.stable_step", "neighbourhood", "the neighbourhood step sums level-0 cells"},

@@ -1,9 +1,9 @@
-"""The classic update (time.method = usl) for the gas on a refinement hierarchy
+"""The classic update (time.method = usl, or musl) for the gas on a refinement hierarchy
 (docs/refinement.md, "The classic update on the hierarchy").
 
-Every run takes time.method = usl at time.cfl = 0.4 (as the cases that use it) and, refined,
-fluid.pressure = auto (the grid pressure, integrated at the time-centred nodal velocity). The
-argument picks the part (one ctest each):
+Every run takes time.method = usl (or the second argument, musl) at time.cfl = 0.4 (as the cases
+that use it) and, refined, fluid.pressure = auto (the grid pressure, integrated at the
+time-centred nodal velocity). The first argument picks the part (one ctest each per method):
 
 uniform  Gas at rest (rho 1, p 1/1.4) in refine_scenes.CLOSED (walls on all four faces, a level-1
          and a level-2 box in a corner, a level-1 box on y_hi) to t = 1 with slip walls and FLIP,
@@ -15,7 +15,9 @@ uniform  Gas at rest (rho 1, p 1/1.4) in refine_scenes.CLOSED (walls on all four
 pulse    The acoustic pulse of test_refine_gas's pulse part (amplitude 1e-3 crossing a level-1
          box clear of the walls) under usl: the reflected energy fraction of the refined run
          against its coarse twin's (both from the particles' p' and u' binned along x, the
-         refined run's less its own run at rest), the fine twin printed; conservation (~12 s).
+         refined run's less its own run at rest) against the coarse twin's with the grid
+         pressure (the same discretisation), the particle-pressure and fine twins printed;
+         conservation (~12 s).
 sod      Sod with a fine region regridded every 10 steps (test_refine_sod's scene: 100 level-0
          cells, refine_scenes.sod_refine, 2 levels) under usl against the uniform usl twin at the
          finest spacing (200 cells, grid pressure; the default particle pressure printed): the
@@ -40,7 +42,9 @@ Able to fail (measured with each piece switched back to level 0, fluid/fluid_tra
 - the heat shares' scalars not prolonged into the inactive nodes (|v|^2 of the prolonged v):
   pulse: energy drift 3.3e-12; regrid: 6.6e-10 (FLIP), 2.7e-8 (pic_fraction 0.3);
 - the wall rule weighed on level 0's nodes for every particle: wall: reflected energy 0.942 of
-  the fine twin's (FLIP), 0.965 (pic_fraction 0.3).
+  the fine twin's (FLIP), 0.965 (pic_fraction 0.3);
+- musl: its remap deposited on level 0 alone (fluid/fluid_module.c, fluid_remap): uniform: the
+  FLIP stream blows up at t = 0.37.
 Tolerances are stated at each check.
 """
 import os
@@ -57,8 +61,9 @@ from refine_scenes import (BOX, C0, CLOSED, DYNAMIC, PULSE_5, SOD_COARSE, STREAM
 from riemann import Riemann  # noqa: E402
 
 PART = sys.argv[1] if len(sys.argv) > 1 else "uniform"
-check = mt.Checks(f"test_refine_usl_{PART}")
-USL = ["time.method=usl", "time.cfl=0.4"]
+METHOD = sys.argv[2] if len(sys.argv) > 2 else "usl"  # or musl
+check = mt.Checks(f"test_refine_{METHOD}_{PART}")
+USL = [f"time.method={METHOD}", "time.cfl=0.4"]
 REST = "density = 1\npressure = 0.714285714285714"
 PIC = "fluid.pic_fraction=0.3"
 
@@ -157,6 +162,8 @@ def part_pulse():
     box = BOX.format(x0=1.6, x1=2.4)
     runs = {"refined": run("usl_pulse", case_text(3, 2.4, gas, box)),
             "coarse": run("usl_pulse_coarse", case_text(3, 2.4, gas, "")),
+            "coarse, grid pressure": run("usl_pulse_coarse_gridp", case_text(3, 2.4, gas, ""),
+                                         "fluid.pressure=grid"),
             "fine": run("usl_pulse_fine", case_text(3, 2.4, gas, "", 0.025))}
     rest, _ = run("usl_pulse_rest", case_text(3, 2.4, REST, box))
     r = final(rest)
@@ -180,7 +187,7 @@ def part_sod():
                              ["fluid.pressure=grid"]),
                             (f"uniform at {fine} cells, particle pressure", fine, [])):
         t0 = time.time()
-        out = shocktube.run("sod.ini", N, "usl", 0.2, 1, ["output.interval=0.2"] + extra,
+        out = shocktube.run("sod.ini", N, METHOD, 0.2, 1, ["output.interval=0.2"] + extra,
                             height=3.0 / SOD_COARSE)
         wall = time.time() - t0
         l1[label], xs, P = shocktube.measure(out, fine, EXACT, 0.2)
@@ -243,20 +250,21 @@ if PART == "uniform":
     part_uniform()
 elif PART == "pulse":
     runs, frac = part_pulse()
-    # The bound: at most twice the coarse twin's own dispersion, and the issue's 1 % (stated
-    # after measuring: docs/refinement.md).
-    got, coarse = frac["refined"], frac["coarse"]
-    check(got <= 1e-2 and got <= 2 * coarse, f"pulse under usl: reflected energy fraction "
-          f"{got:.2e} <= 1e-2 and <= 2 x the coarse twin's {coarse:.2e} (fine twin "
-          f"{frac['fine']:.2e})")
+    # The bound: the issue's 1 %, and at most twice the reflection of the coarse twin with the
+    # same discretisation (the grid pressure), its own dispersion (measured 1.43 x, usl and
+    # musl alike; the particle-pressure twin printed: docs/refinement.md).
+    got, coarse = frac["refined"], frac["coarse, grid pressure"]
+    check(got <= 1e-2 and got <= 2 * coarse, f"pulse under {METHOD}: reflected energy fraction "
+          f"{got:.2e} <= 1e-2 and <= 2 x the grid-pressure coarse twin's {coarse:.2e} (fine "
+          f"twin {frac['fine']:.2e})")
     for label in ("refined", "coarse"):
         conservation(f"pulse, {label}", runs[label][0], 1e-12)
 elif PART == "sod":
     refined, uniform, particle = part_sod()
     ratio = refined / uniform
     print(f"info refined / uniform with the particle pressure: {refined / particle:.3f}")
-    check(ratio <= 1.10, f"Sod under usl, 2 levels: L1 {refined:.3e} is {ratio:.3f} x the "
-          f"uniform usl twin's {uniform:.3e} at the finest spacing (<= 1.10)")
+    check(ratio <= 1.10, f"Sod under {METHOD}, 2 levels: L1 {refined:.3e} is {ratio:.3f} x the "
+          f"uniform {METHOD} twin's {uniform:.3e} at the finest spacing (<= 1.10)")
 elif PART == "wall":
     part_wall()
 elif PART == "regrid":
