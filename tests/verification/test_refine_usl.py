@@ -34,7 +34,8 @@ regrid   The nonlinear pulse of test_refine_gas's dynamic part (refine_scenes.PU
          fluid.pic_fraction = 0.3: mass, momentum and total energy through every regrid (usl
          conserves total energy to roundoff: the heat shares close the transfer's budget, the
          grid pressure's work matches its forces', split and merge keep it); the region follows
-         the pulse (~15 s).
+         the pulse; a restart at t = 0.2 ends bit for bit as the run through, to t = 0.4
+         (~8 s).
 Able to fail (measured with each piece switched back to level 0, fluid/fluid_transfer.c):
 - the level-0 kernel's G2P in place of mpm_hier_g2p_from (the transfer reading level 0 alone):
   uniform: the FLIP stream blows up at t = 0.54; pulse: reflected fraction 1.4, energy drift
@@ -244,6 +245,14 @@ def part_regrid():
         # Energy: usl conserves it to roundoff step by step, and so do the regrids (split and
         # merge move the merged kinetic energy into e); 1e-12 as mass and momentum.
         conservation(f"{label}, regridded", out, 1e-12)
+    # A restart at t = 0.2 (between regrids) of the run to 0.4 (PIC share on: its rate reads the
+    # stable step, which the restart must rebuild).
+    case = os.path.join(mt.outdir("usl_restart_case"), "case.ini")
+    with open(case, "w") as f:
+        f.write(case_text(3, 0.4, PULSE_5, DYNAMIC))
+    ids, worst, _ = mt.restart_difference(case, USL + [PIC], 0.4, "usl_restart", "fluid")
+    check(ids and worst == 0.0, f"regridded run restarted at t = 0.2: the same particles, fields "
+          f"{worst:.1e} from the run straight through (bit for bit: 0)")
 
 
 if PART == "uniform":
