@@ -30,8 +30,8 @@ wall     The acoustic pulse of test_refine_walls's pulse part (amplitude 1e-3) r
          wall rule (fluid/fluid_transfer.c) on level 1, weighed at its spacing; mass, momentum
          along the wall and energy (~10 s).
 regrid   The nonlinear pulse of test_refine_gas's dynamic part (refine_scenes.PULSE_5, DYNAMIC:
-         density criterion, a regrid every 10 steps) to t = 1.2 under usl, with FLIP and with
-         fluid.pic_fraction = 0.3: mass, momentum and total energy through every regrid (usl
+         density criterion, a regrid every 10 steps) to t = 1.2 under usl, with FLIP,
+         fluid.pic_fraction = 0.3 and APIC (a split copies C, a merge mass-weights it): mass, momentum and total energy through every regrid (usl
          conserves total energy to roundoff: the heat shares close the transfer's budget, the
          grid pressure's work matches its forces', split and merge keep it); the region follows
          the pulse; a restart at t = 0.2 ends bit for bit as the run through, to t = 0.4
@@ -227,7 +227,8 @@ def part_wall():
 
 
 def part_regrid():
-    for label, over in (("FLIP", ()), ("pic_fraction 0.3", (PIC,))):
+    for label, over in (("FLIP", ()), ("pic_fraction 0.3", (PIC,)),
+                        ("APIC", ("transfer.velocity=apic",))):
         out, _ = run("usl_regrid", case_text(3, 1.2, PULSE_5, DYNAMIC), *over)
         d = np.genfromtxt(os.path.join(out, "diagnostics.csv"), delimiter=",", names=True)
         counts = set(d["particles"].astype(int))
