@@ -175,6 +175,18 @@ typedef struct mpm_hier_scalars {
  * mpm_hier_prolong. */
 int mpm_hier_g2p(mpm_hier *h, int phase, const mpm_g2p_args *a, const mpm_hier_scalars *s);
 
+/* A nodal velocity of the caller's on every level: v_i[l][d] on level l (level 0's too). */
+typedef struct mpm_hier_nodal {
+  const double *v_i[MPM_HIER_MAX_LEVELS][MPM_MAX_DIM];
+} mpm_hier_nodal;
+
+/* mpm_hier_g2p reading v (v and L_out interpolate it) in place of the phase's v_i on every
+ * level (v NULL: mpm_hier_g2p); a_i stays as there. The caller's v must be a composite field:
+ * every inactive node the prolongation of its parents (as the phase's v_i after
+ * mpm_hier_prolong), so that the particles read the composite basis. */
+int mpm_hier_g2p_from(mpm_hier *h, int phase, const mpm_g2p_args *a, const mpm_hier_nodal *v,
+                      const mpm_hier_scalars *s);
+
 /* Restrict the deposit of a phase (m, m v, f and the mass gradient where deposited), finest
  * level first; every inactive node ends at zero. */
 void mpm_hier_restrict(mpm_hier *h, int phase);

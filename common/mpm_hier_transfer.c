@@ -186,11 +186,11 @@ int mpm_hier_p2g(mpm_hier *h, int phase, const mpm_p2g_args *a) {
 /* The G2P arguments of level l: its own nodal fields, and the caller's outputs (a level-0 run
  * on the caller's arrays). */
 static mpm_g2p_args level_args(const mpm_hier *h, int l, int phase, const mpm_g2p_args *a,
-                               const mpm_hier_scalars *s) {
+                               const mpm_hier_nodal *v, const mpm_hier_scalars *s) {
   const mpm_grid_phase *ph = &h->level[l].grid->phase[phase];
   mpm_g2p_args b = *a;
   for (int d = 0; d < h->dim; ++d) {
-    b.v_i[d] = l == 0 && a->v_i[d] ? a->v_i[d] : ph->v_i[d];
+    b.v_i[d] = v ? v->v_i[l][d] : l == 0 && a->v_i[d] ? a->v_i[d] : ph->v_i[d];
     b.a_i[d] = l == 0 && a->a_i[d] ? a->a_i[d] : ph->a_i[d];
   }
   for (int j = 0; j < a->nscalar && l > 0; ++j) b.s_i[j] = s->s_i[l][j];
@@ -229,17 +229,22 @@ static int check_scalars(const mpm_hier *h, const mpm_g2p_args *a, const mpm_hie
 }
 
 int mpm_hier_g2p(mpm_hier *h, int phase, const mpm_g2p_args *a, const mpm_hier_scalars *s) {
+  return mpm_hier_g2p_from(h, phase, a, NULL, s);
+}
+
+int mpm_hier_g2p_from(mpm_hier *h, int phase, const mpm_g2p_args *a, const mpm_hier_nodal *v,
+                      const mpm_hier_scalars *s) {
   MPM_CALL(check_scalars(h, a, s));
   mpm_lidx first[MPM_HIER_MAX_LEVELS + 1];
   if (h->nlevels > 1) MPM_CALL(reserve(h, a->n));
   if (h->nlevels == 1 || classify(h, a->n, a->x, first)) {
-    const mpm_g2p_args b = level_args(h, 0, phase, a, s);
+    const mpm_g2p_args b = level_args(h, 0, phase, a, v, s);
     mpm_kernels_get(h->dim)->g2p(h->level[0].grid, &b);
     return 0;
   }
   const hier_scratch *sc = h->scratch;
   for (int l = 0; l < h->nlevels; ++l) {
-    const mpm_g2p_args lv = level_args(h, l, phase, a, s);
+    const mpm_g2p_args lv = level_args(h, l, phase, a, v, s);
     for (mpm_lidx i = first[l]; i < first[l + 1]; i += CHUNK) {
       chunk c = {sc->order + i, MPM_MIN(CHUNK, first[l + 1] - i), a->n, sc->buf};
       g2p_chunk(h, l, &lv, a, &c);

@@ -222,6 +222,7 @@ int mpm_cycle_rhs(const mpm_cycle *c, double t, double *const *y, double *const 
     for (int k = 0; k < c->nmod; ++k)
       if (c->mod[k]->ops->remap) MPM_CALL(c->mod[k]->ops->remap(c->mod[k], t, y[k], h));
     mpm_timer_stop(MPM_T_P2G);
+    restrict_deposits(c, 0); /* a refined module's remap deposited on its levels */
     MPM_CALL(grid_pass(c, t, h, MPM_PASS_REMAP));
   }
   /* The gas first: a wall a coupling scheme gave it (mpm_wall.h) hands what the gas's G2P

@@ -33,10 +33,19 @@
  * uniform stream through inflow, outflow and far-field faces stays uniform to roundoff. The
  * volume rate integrates the domain only, as at a wall.
  *
- * Scope (fluid_gridp_read refuses the rest): the method-of-lines ERK pairs with the current
- * strain rate, the quadratic B-spline, a gas alone (no solid or obstacle), no shifting, the
- * point volume rate, open faces with their default exterior (copies, not gauge). On a hierarchy
- * beside a solid, auto keeps the particles' pressure (fluid_gridp_refine). */
+ * The classic update (usl, musl). The particles deposit m p and, beside it, the viscous and
+ * artificial stresses of the lagged strain rate; the force acts in the solve as above; the volume
+ * rate is integrated at the time-centred nodal velocity vbar (fluid_transfer.c), whose gradient
+ * heats the viscous stresses too. The pressure's work over the step, -h sum_j p_j D_j(vbar), is
+ * then -h sum_i f_i . vbar_i, exactly the grid's kinetic energy gain from these forces, so usl
+ * keeps total energy to roundoff as with the particles' quadrature. MUSL books the same work from
+ * its first pass (fluid_module.c, fluid_remap) and moves the volume with the same rate; only the
+ * positions follow its remapped velocity.
+ *
+ * Scope (check_scope refuses the rest): the method-of-lines ERK pairs with the current strain
+ * rate or the classic update, the quadratic B-spline, a gas alone (no solid or obstacle), no
+ * shifting, the point volume rate, open faces with their default exterior (copies, not gauge).
+ * On a hierarchy beside a solid, auto keeps the particles' pressure (fluid_gridp_refine). */
 #include "fluid_internal.h"
 
 #include "mpm_error.h"
@@ -71,9 +80,7 @@ static int refuse(const mpm_config *cfg, const char *key, const char *why) {
 
 /* The refusals of the grid pressure; the first found names its key. */
 static int check_scope(const fluid_content *fc, const mpm_config *cfg, const mpm_grid *g) {
-  if (fc->tr.classic)
-    return refuse(cfg, "time.method", "is carried by the ERK pairs (the method of lines) only");
-  if (!fc->current_rate)
+  if (!fc->tr.classic && !fc->current_rate)
     return refuse(cfg, "fluid.strain_rate", "needs the current strain rate (the default)");
   if (g->shape != MPM_SHAPE_QUADRATIC)
     return refuse(cfg, "grid.shape", "integrates the quadratic B-spline's spans");
@@ -308,14 +315,14 @@ int fluid_gridp_forces(mpm_module *m) {
   return 0;
 }
 
-int fluid_gridp_nodal_rate(mpm_module *m, mpm_hier_scalars *s) {
+int fluid_gridp_nodal_rate(mpm_module *m, const mpm_hier_nodal *vel, mpm_hier_scalars *s) {
   fluid_content *fc = m->content;
   fluid_gridp *gp = fc->gridp;
   double *D[MPM_HIER_MAX_LEVELS][MPM_MAX_DIM] = {{NULL}};
   for (int l = 0; l < gp->nlev; ++l) {
     const mpm_grid *g = level_grid(m, l);
     const double *v[MPM_MAX_DIM];
-    for (int d = 0; d < g->dim; ++d) v[d] = g->phase[m->phase].v_i[d];
+    for (int d = 0; d < g->dim; ++d) v[d] = vel ? vel->v_i[l][d] : g->phase[m->phase].v_i[d];
     memset(gp->D[l], 0, sizeof(double) * (size_t)g->nnodes);
     mpm_span_divergence(g, &gp->set[l], v, gp->D[l]);
     D[l][0] = gp->D[l];

@@ -76,6 +76,8 @@ typedef struct fluid_content {
   int refined;        /* on a refinement (its particles follow the levels: fluid_relevel.c) */
   double *av_l;       /* refined: each particle's artificial viscosity length (cap) */
   unsigned char *lev; /* refined: the level of each particle's position in this RHS (cap) */
+  /* refined, usl: the classic transfer's nodal scratch (as node) on the finer levels, l >= 1 */
+  double *lnode[MPM_HIER_MAX_LEVELS];
 } fluid_content;
 
 /* What the classic step's transfer gives each particle (component-major, stride n). */
@@ -87,8 +89,9 @@ typedef struct fluid_step_out {
   double *heat; /* its share of the transfer's energy defect, J/kg (fluid_transfer.c) */
 } fluid_step_out;
 
-/* G2P of the classic step h after the grid update (fluid_transfer.c). */
-void fluid_classic_transfer(mpm_module *m, const double *y, double h, const fluid_step_out *o);
+/* G2P of the classic step h after the grid update, on every level of a hierarchy
+ * (fluid_transfer.c). */
+int fluid_classic_transfer(mpm_module *m, const double *y, double h, const fluid_step_out *o);
 /* The wall rule for the method of lines (fluid_transfer.c), in the right-hand side of state y:
  * relaxes the particles' velocity into a wall face at (1 - keep) 2 c / dx, subtracting from
  * vdot, and adds the kinetic energy removed to power (de/dt). */
@@ -117,8 +120,9 @@ int fluid_volume_rate(mpm_module *m, const double *y, const double *const *v_i, 
  * refused, sets it up if init did not and gives the hierarchy its phase; deposit: in the RHS's
  * P2G after fluid_stress_pressure, keeps m p and zeroes the pressure's stress in b; forces:
  * before the walls fold the deposit (first pass), adds the nodal pressure's force; nodal_rate:
- * after the solve, the nodal volume rate per unit mass on every level, into s for the G2P that
- * fills the particles' rate (fluid_gridp_rate_out); work: adds the pressure's de/dt to power,
+ * after the solve, the nodal volume rate per unit mass on every level of the nodal velocity v
+ * (NULL: the phase's v_i; usl: its time-centred one), into s for the G2P that fills the
+ * particles' rate (fluid_gridp_rate_out); work: adds the pressure's de/dt to power,
  * then turns that rate into dJ/dt / J in place. */
 int fluid_gridp_init(mpm_module *m, const mpm_config *cfg);
 int fluid_gridp_refine(mpm_module *m, const mpm_config *cfg, mpm_hier *h); /* h may be NULL */
@@ -127,7 +131,7 @@ void fluid_gridp_destroy(fluid_content *fc);
 void fluid_gridp_reset(fluid_content *fc);
 int fluid_gridp_deposit(mpm_module *m, const double *y, const fluid_batch *b);
 int fluid_gridp_forces(mpm_module *m);
-int fluid_gridp_nodal_rate(mpm_module *m, mpm_hier_scalars *s);
+int fluid_gridp_nodal_rate(mpm_module *m, const mpm_hier_nodal *v, mpm_hier_scalars *s);
 double *fluid_gridp_rate_out(const fluid_content *fc);
 void fluid_gridp_work(const mpm_module *m, const double *y, double *power);
 
@@ -186,6 +190,8 @@ double fluid_level_spacing(const mpm_module *m, const double *y, mpm_lidx i);
  * RHS's last phase forgets them), and each particle's artificial viscosity length, its level's
  * spacing, into fc->av_l (capacity fc->cap); a no-op unrefined. */
 void fluid_av_lengths(mpm_module *m, const double *y);
+/* Free the classic transfer's nodal scratch of the finer levels (a regrid, or the end). */
+void fluid_lnode_free(fluid_content *fc);
 /* Refuse, naming the key, every gas setting the refined levels do not carry (fluid_refine.c). */
 int fluid_refine_check(const mpm_module *m, const mpm_config *cfg);
 

@@ -93,8 +93,8 @@ static const mpm_key_spec fluid_keys[] = {
      "the classic MPM quadrature), grid (the nodal pressure, a mass-weighted mean of the "
      "particles', integrated exactly over the grid's cells, with each particle's volume "
      "following its nodes' volume rate: gas at rest and uniform streams stay exact across "
-     "refined regions; ERK pairs, quadratic shape and a gas alone) or auto (grid with "
-     "refine.levels > 1 and no solid, where particle is refused; else particle); see "
+     "refined regions; ERK pairs, usl or musl, quadratic shape and a gas alone) or auto (grid "
+     "with refine.levels > 1 and no solid, where particle is refused; else particle); see "
      "docs/refinement.md",
      0, NULL},
     {"fluid.ppc", MPM_KEY_INT, "2", 1, 8, 0, 0, NULL,
@@ -362,7 +362,7 @@ static int fluid_p2g(mpm_module *m, double t, const double *y) {
   MPM_CALL(ensure_scratch(m));
   fluid_av_lengths(m, y);
   fluid_batch b = batch_of(m, y);
-  if (!fc->current_rate) {
+  if (!fc->current_rate && !fc->gridp) {
     mpm_timer_start(MPM_T_STRESS);
     fluid_stress(&fc->gas, &b);
     mpm_timer_stop(MPM_T_STRESS);
@@ -371,13 +371,16 @@ static int fluid_p2g(mpm_module *m, double t, const double *y) {
     mpm_timer_stop(MPM_T_P2G);
     return 0;
   }
-  /* The current rate (above): the pressure's deposit; p2g_rate adds the viscous one. */
+  /* The current rate (above): the pressure's deposit; p2g_rate adds the viscous one. The grid
+   * pressure (fluid_gridp.c) in the classic update: the pressure's deposit, then the viscous
+   * one of the lagged rate at once. */
   mpm_timer_start(MPM_T_STRESS);
   fluid_stress_pressure(&fc->gas, &b);
   mpm_timer_stop(MPM_T_STRESS);
   mpm_timer_start(MPM_T_P2G);
   if (fc->gridp) MPM_CALL(fluid_gridp_deposit(m, y, &b));
   MPM_CALL(deposit(m, y, fc->vsig, NULL));
+  if (!fc->current_rate) MPM_CALL(deposit_viscous(m, y, &b));
   mpm_timer_stop(MPM_T_P2G);
   return 0;
 }
@@ -479,8 +482,9 @@ static int classic_transfer(mpm_module *m, const double *y, double h, fluid_step
   fluid_content *fc = m->content;
   o->L = fc->scratch + (size_t)2 * m->grid->dim * m->particles->n;
   o->heat = fc->power;
-  fluid_classic_transfer(m, y, h, o);
+  MPM_CALL(fluid_classic_transfer(m, y, h, o));
   energy_rate(m, o->L, o->heat, h);
+  if (fc->gridp) fluid_gridp_work(m, y, fc->power); /* the pressure's work, at vbar */
   return 0;
 }
 
@@ -498,15 +502,19 @@ static int fluid_remap(mpm_module *m, double t, const double *y, double h) {
   for (int d = 0; d < dim; ++d)
     o.vhat[d] = fc->scratch + (size_t)d * n, o.vnew[d] = fc->vnew + (size_t)d * n;
   MPM_CALL(classic_transfer(m, y, h, &o));
-  mpm_grid_phase_zero(m->grid, m->phase);
+  if (m->hier)
+    mpm_hier_phase_zero(m->hier, m->phase);
+  else
+    mpm_grid_phase_zero(m->grid, m->phase);
   mpm_p2g_args a = {
       .n = n, .m = mpm_particles_comp(p, fc->lay.f_m, 0), .C = fc->Cnew, .lp = fc->lp};
   for (int d = 0; d < dim; ++d) {
     a.x[d] = state(p, y, FLUID_X) + (size_t)d * n;
     a.v[d] = o.vnew[d];
   }
-  mpm_kernels_get(dim)->p2g(m->grid, m->phase, &a);
-  return 0;
+  int rc = 0;
+  fluid_p2g_any(m, m->phase, &a, &rc); /* the coupler restricts it on a hierarchy */
+  return rc;
 }
 
 /* A replaced state field as a rate over the step: out = (out - y) / h, or (src - y) / h. */
@@ -573,7 +581,7 @@ static int g2p_rates(mpm_module *m, const double *y, double *ydot, double h) {
     mpm_hier_scalars rate;
     double *rate_out = NULL;
     if (fc->gridp) {
-      MPM_CALL(fluid_gridp_nodal_rate(m, &rate));
+      MPM_CALL(fluid_gridp_nodal_rate(m, NULL, &rate));
       rate_out = fluid_gridp_rate_out(fc);
     }
     MPM_CALL(fluid_g2p_phase(m, y, xdot, vdot, L, &rate, rate_out));
@@ -588,7 +596,7 @@ static int g2p_rates(mpm_module *m, const double *y, double *ydot, double h) {
     as_rate(vdot[0], NULL, v, nv, h);
     if (Cdot) as_rate(Cdot, NULL, C, nC, h);
   } else {
-    mpm_transfer_g2p(m->grid, m->phase, p, y, fc->lp, xdot, a_p, L, NULL);
+    MPM_CALL(fluid_g2p_phase(m, y, xdot, a_p, L, NULL, NULL)); /* the remapped velocities */
     as_rate(vdot[0], fc->vnew, v, nv, h);
     if (Cdot) as_rate(Cdot, fc->Cnew, C, nC, h);
   }
@@ -772,6 +780,7 @@ static void fluid_destroy(mpm_module *m) {
     free(fc->av_l), free(fc->lev);
     free(fc->sub), free(fc->zero), free(fc->work);
     free(fc->tscratch), free(fc->node), free(fc->cellsum), free(fc->lim), free(fc->vol);
+    fluid_lnode_free(fc);
     free(fc);
   }
   mpm_particles_destroy(&m->particles);

@@ -16,14 +16,17 @@
  * alone: their particles are injected and removed within two level-0 cells of the face, on
  * level 0's lattice and size, and the grid pressure that the hierarchy needs takes their
  * exterior pressure as an exact face integral on level 0 (fluid_open_grid_forces); the sponge
- * acts on each particle, of any level.
+ * acts on each particle, of any level. The classic update (usl, musl): its transfer forms the
+ * time-centred nodal velocity and the heat shares' scalars on every level and gathers through
+ * the hierarchy, and weighs its wall rule at the particle's level spacing (fluid_transfer.c);
+ * MUSL's remap deposits through the hierarchy (fluid_module.c) and the coupler restricts it; the
+ * grid pressure runs with both (fluid_gridp.c).
  *
  * Refused (fluid_refine_check), each naming its key: everything that reads or writes the gas's
- * nodal fields or the grid otherwise: the classic update (its time-centred nodal velocity, heat
- * shares and wall rule), the domain volume rate, the riemann viscosity's limiter, shifting,
- * regularisation and refill (cell counts), the neighbourhood stable step, the light-node threshold,
- * obstacles. An odd fluid.ppc puts level-0 particles on the span faces that bound
- * the finer regions, so it is refused too.
+ * nodal fields or the grid otherwise: the domain volume rate, the riemann viscosity's limiter,
+ * shifting, regularisation and refill (cell counts), the neighbourhood stable step, the light-node
+ * threshold, obstacles. An odd fluid.ppc puts level-0 particles on the span faces that bound the
+ * finer regions, so it is refused too.
  *
  * Invariant: with m->hier NULL every call here is the plain kernel call (the refined path costs
  * one pointer test per transfer). */
@@ -123,10 +126,6 @@ typedef struct refusal {
 } refusal;
 
 static const refusal g_refused[] = {
-    {"time.method", "usl",
-     "the classic update's transfer reads a time-centred nodal velocity, heat shares and a wall "
-     "rule on level 0's nodes"},
-    {"time.method", "musl", "MUSL's remap deposits on level 0's nodes"},
     {"fluid.volume_rate", "domain", "the domain rate samples the nodal velocity on level 0"},
     {"fluid.av_form", "riemann", "the riemann limiter reads the nodal velocity on level 0"},
     {"fluid.stable_step", "neighbourhood", "the neighbourhood step sums level-0 cells"},
@@ -135,6 +134,13 @@ static const refusal g_refused[] = {
     {"fluid.refill_every", NULL, "refilling counts particles in level-0 cells"},
     {"fluid.light_node_mass", NULL, "the mean nodal mass is level 0's"},
 };
+
+/* The reason g_refused gives for key (looked up, so that rows may come and go). */
+static const char *refused_why(const char *key) {
+  for (size_t k = 0; k < sizeof g_refused / sizeof g_refused[0]; ++k)
+    if (strcmp(g_refused[k].key, key) == 0) return g_refused[k].why;
+  return "";
+}
 
 /* The first obstacle of the case: refused with its key. */
 static int refuse_obstacles(const mpm_config *cfg) {
@@ -156,7 +162,8 @@ int fluid_refine_check(const mpm_module *m, const mpm_config *cfg) {
     if (r->choice ? is_choice(cfg, r->key, r->choice) : is_positive(cfg, r->key))
       return refuse(cfg, r->key, r->why);
   }
-  if (fc->reg_every > 0) return refuse(cfg, "fluid.regularise_every", g_refused[6].why);
+  if (fc->reg_every > 0)
+    return refuse(cfg, "fluid.regularise_every", refused_why("fluid.regularise_every"));
   MPM_CALL(refuse_obstacles(cfg));
   if (fc->ppc % 2)
     return mpm_config_fail(
@@ -179,6 +186,11 @@ int fluid_module_refine(mpm_module *m, const mpm_config *cfg, mpm_hier *h, int s
 void fluid_module_rehier(mpm_module *m, mpm_hier *h) {
   m->hier = h;
   fluid_gridp_reset(m->content);
+  fluid_lnode_free(m->content);
+}
+
+void fluid_lnode_free(fluid_content *fc) {
+  for (int l = 0; l < MPM_HIER_MAX_LEVELS; ++l) free(fc->lnode[l]), fc->lnode[l] = NULL;
 }
 
 /* ---- the refinement criteria (mpm_refine.c regrids with them) ---------------------------- */

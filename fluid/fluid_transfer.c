@@ -77,7 +77,17 @@
  * test_pic_rate checks the rate itself, at a quarter of the gas's step and at another time.cfl.
  * A gas that sets its own step at time.cfl = 0.4 is blended exactly as before. The heat shares
  * above hold for any blend, so the energy balance is unchanged. (Particle shifting is a rate
- * already: fluid_shift.c.) */
+ * already: fluid_shift.c.)
+ *
+ * On a refinement hierarchy (mpm_hier.h) every nodal field above lives on every level: vbar on
+ * each level's nodes (composite, since v and a are after the prolongation), the scalars formed
+ * on each level's nodes and then prolonged into the inactive ones (a particle must read
+ * sum_i w_ip s_i over the composite weights w it deposited with, or the shares' sums break;
+ * |v|^2 of a prolonged v is not the prolongation of |v|^2), and the G2P reads the particle's
+ * level (mpm_hier_g2p_from). The wall rule weighs a particle of level l at spacing h_l: no
+ * level-l node lies on the wall (a knot there), so w is the weight a node on the wall would have
+ * on a uniform grid of spacing h_l (the fine twin's rule; WALL_NODE below). The method of lines'
+ * rate (fluid_wall_rate_mol) still weighs every particle on level 0. */
 #include "fluid_internal.h"
 
 #include "mpm_error.h"
@@ -85,6 +95,7 @@
 #include "mpm_kernels.h"
 
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 /* The time.cfl at whose step fluid.pic_fraction is stated (see the file comment). */
@@ -97,8 +108,45 @@ static double pic_share(const mpm_module *m, double pic, double h) {
   return -expm1(r * log1p(-pic));
 }
 
+/* The classic transfer's nodal fields on every level of the gas (level 0 alone without a
+ * hierarchy): the time-centred velocity vbar and the scalars the G2P interpolates, each a
+ * composite field (an inactive node holds the prolongation of its parents), in level 0's
+ * fc->node and a finer level's fc->lnode[l], (dim + 3) nnodes each. */
+typedef struct classic_nodal {
+  int nlev;
+  double *node[MPM_HIER_MAX_LEVELS];
+  mpm_hier_nodal vbar;
+  mpm_hier_scalars s; /* scalar k of level l; level 0's are also in the G2P's arguments */
+} classic_nodal;
+
+static const mpm_grid *level_grid(const mpm_module *m, int l) {
+  return l ? m->hier->level[l].grid : m->grid;
+}
+
+/* vbar = v^{n+1} - h a / 2 on every node of every level, into c (its arrays set up here). On a
+ * hierarchy v and a are composite after the prolongation, and so is vbar, node by node (the
+ * prolongation is linear). */
+static int centred_velocity(mpm_module *m, double h, classic_nodal *c) {
+  fluid_content *fc = m->content;
+  memset(c, 0, sizeof *c);
+  c->nlev = m->hier ? m->hier->nlevels : 1;
+  for (int l = 0; l < c->nlev; ++l) {
+    const mpm_grid *g = level_grid(m, l);
+    const mpm_grid_phase *ph = &g->phase[m->phase];
+    const size_t nn = (size_t)g->nnodes;
+    if (l && !fc->lnode[l]) MPM_ALLOC(fc->lnode[l], (size_t)(g->dim + 3) * nn);
+    c->node[l] = l ? fc->lnode[l] : fc->node;
+    for (int d = 0; d < g->dim; ++d) {
+      double *vb = c->node[l] + (size_t)d * nn;
+      for (mpm_lidx k = 0; k < g->nnodes; ++k) vb[k] = ph->v_i[d][k] - 0.5 * h * ph->a_i[d][k];
+      c->vbar.v_i[l][d] = vb;
+    }
+  }
+  return 0;
+}
+
 /* APIC's new affine velocity is that of v^{n+1} = vbar + h a / 2: add h/2 C(a). */
-static void apic_half_step(mpm_module *m, const double *y, double h, double *C) {
+static int apic_half_step(mpm_module *m, const double *y, double h, double *C) {
   fluid_content *fc = m->content;
   const mpm_particles *p = m->particles;
   const mpm_grid_phase *ph = &m->grid->phase[m->phase];
@@ -106,41 +154,77 @@ static void apic_half_step(mpm_module *m, const double *y, double h, double *C) 
   const mpm_lidx n = p->n;
   double *Ca = fc->tscratch + (size_t)(dim + 3) * n, *dummy = Ca + (size_t)dim * dim * n;
   mpm_g2p_args a = {.n = n, .lp = fc->lp, .C_out = Ca};
+  mpm_hier_nodal acc = {{{NULL}}};
   for (int d = 0; d < dim; ++d) {
     a.x[d] = y + (size_t)(p->offset[FLUID_X] + d) * n;
     a.v_i[d] = ph->a_i[d];
     a.a_i[d] = ph->a_i[d];
     a.v_out[d] = dummy + (size_t)d * n;
     a.a_out[d] = dummy + (size_t)(dim + d) * n;
+    for (int l = 0; m->hier && l < m->hier->nlevels; ++l)
+      acc.v_i[l][d] = level_grid(m, l)->phase[m->phase].a_i[d];
   }
-  mpm_kernels_get(dim)->g2p(m->grid, &a);
+  if (m->hier)
+    MPM_CALL(mpm_hier_g2p_from(m->hier, m->phase, &a, &acc, NULL));
+  else
+    mpm_kernels_get(dim)->g2p(m->grid, &a);
   for (size_t k = 0; k < (size_t)dim * dim * (size_t)n; ++k) C[k] += 0.5 * h * Ca[k];
+  return 0;
+}
+
+/* Scalar j of the heat shares on the nodes of level l into s: |a|^2, |v^{n+1}|^2 or |v^n|^2. */
+static void level_scalar(const mpm_module *m, const classic_nodal *c, int l, int j, double h,
+                         double *s) {
+  const mpm_grid *g = level_grid(m, l);
+  const mpm_grid_phase *ph = &g->phase[m->phase];
+  const double *const *vbar = c->vbar.v_i[l];
+  const double half = j == 1 ? 0.5 * h : -0.5 * h; /* v^{n+1} or v^n from vbar */
+  for (mpm_lidx k = 0; k < g->nnodes; ++k) {
+    double sum = 0.0;
+    for (int d = 0; d < g->dim; ++d) {
+      const double q = j == 0 ? ph->a_i[d][k] : vbar[d][k] + half * ph->a_i[d][k];
+      sum += q * q;
+    }
+    s[k] = sum;
+  }
 }
 
 /* The nodal scalars the heat shares need, |a|^2, |v^{n+1}|^2 and |v^n|^2 (FLIP needs the first,
  * a PIC share or APIC the other two), set up for interpolation in the G2P pass a: out[j]
- * receives scalar j at the particles. */
-static void nodal_scalars(mpm_module *m, const double *const *vbar, double h, double **out,
+ * receives scalar j at the particles. On a hierarchy each is computed on every node of a level
+ * and then its inactive nodes take the prolongation of their parents, level 1 first: the
+ * particles then read sum_i w_ip s_i over the composite weights they deposited with, on which
+ * the heat shares' identities rest (a node's |v|^2 is not the prolongation of its parents'). */
+static void nodal_scalars(mpm_module *m, classic_nodal *c, double h, double **out,
                           mpm_g2p_args *a) {
-  fluid_content *fc = m->content;
-  const mpm_grid *g = m->grid;
-  const mpm_grid_phase *ph = &g->phase[m->phase];
-  const int dim = g->dim, flip = !fc->tr.apic, pic = fc->tr.apic || fc->tr.pic > 0;
+  const fluid_content *fc = m->content;
+  const int dim = m->grid->dim, flip = !fc->tr.apic, pic = fc->tr.apic || fc->tr.pic > 0;
   for (int j = 0; j < 3; ++j) {
     if ((j == 0 && !flip) || (j > 0 && !pic)) continue;
-    double *s = fc->node + (size_t)(dim + a->nscalar) * g->nnodes;
-    const double half = j == 1 ? 0.5 * h : -0.5 * h; /* v^{n+1} or v^n from vbar */
-    for (mpm_lidx l = 0; l < g->nnodes; ++l) {
-      double sum = 0.0;
-      for (int d = 0; d < dim; ++d) {
-        const double q = j == 0 ? ph->a_i[d][l] : vbar[d][l] + half * ph->a_i[d][l];
-        sum += q * q;
-      }
-      s[l] = sum;
+    const int k = a->nscalar;
+    for (int l = 0; l < c->nlev; ++l) {
+      double *s = c->node[l] + (size_t)(dim + k) * level_grid(m, l)->nnodes;
+      level_scalar(m, c, l, j, h, s);
+      if (l) mpm_hier_prolong_level(m->hier, l, &c->s.s_i[l - 1][k], &s, 1);
+      c->s.s_i[l][k] = s;
     }
-    a->s_i[a->nscalar] = s;
+    a->s_i[k] = c->s.s_i[0][k];
     a->s_out[a->nscalar++] = out[j];
   }
+}
+
+/* fluid.pressure = grid: the nodal volume rate of vbar on every level, one more scalar of a,
+ * into fluid_gridp_rate_out (fluid_gridp_work reads it). */
+static int gridp_scalar(mpm_module *m, classic_nodal *c, mpm_g2p_args *a) {
+  fluid_content *fc = m->content;
+  if (!fc->gridp) return 0;
+  mpm_hier_scalars r;
+  MPM_CALL(fluid_gridp_nodal_rate(m, &c->vbar, &r));
+  const int k = a->nscalar;
+  for (int l = 0; l < c->nlev; ++l) c->s.s_i[l][k] = r.s_i[l][0];
+  a->s_i[k] = r.s_i[0][0];
+  a->s_out[a->nscalar++] = fluid_gridp_rate_out(fc);
+  return 0;
 }
 
 /* The new velocity and the heat share of particle i (see the file comment). */
@@ -192,9 +276,15 @@ static void wall_faces_of(const fluid_content *fc, const mpm_grid *g, wall_faces
     }
 }
 
+/* On a level l >= 1 no node lies on a wall face (it is a knot between two nodes: mpm_hier.h,
+ * walls); the rule then weighs a particle as a uniform grid of the level's spacing would, on a
+ * node at the face: the B-spline at (x - x_face) / h_l, evaluated about this node index. */
+#define WALL_NODE 4
+
 /* The wall rule of the file comment: into keep[d], the factor on the FLIP share of velocity
- * component d of a particle at xp (1 away from the walls). Returns whether any is below 1. */
-static int wall_keep(const fluid_content *fc, const mpm_grid *g, const wall_faces *w,
+ * component d of a particle at xp (1 away from the walls), on level `level` (0 unrefined).
+ * Returns whether any is below 1. */
+static int wall_keep(const fluid_content *fc, const mpm_grid *g, const wall_faces *w, int level,
                      const double *xp, const double *vF, double *keep) {
   const int dim = g->dim;
   const double reach = 0.5 * mpm_shape_support(g->shape) + fc->lp;
@@ -204,10 +294,13 @@ static int wall_keep(const fluid_content *fc, const mpm_grid *g, const wall_face
     const wall_face *f = &w->f[q];
     const int ax = f->ax;
     if (!(xp[ax] > f->lo && xp[ax] < f->hi)) continue;
-    const double xi = (xp[ax] - g->lo[ax]) / g->dx;
-    if (fabs(xi - f->F) >= reach) continue;
+    double xi = (xp[ax] - g->lo[ax]) / g->dx;
+    int F = f->F;
+    if (level > 0) /* (the band above is level 0's, wider than level l's: it only prefilters) */
+      xi = (xp[ax] - (g->lo[ax] + f->F * g->dx)) / ldexp(g->dx, -level) + WALL_NODE, F = WALL_NODE;
+    if (fabs(xi - F) >= reach) continue;
     double wt[MPM_SHAPE_MAX_SUPPORT], dw[MPM_SHAPE_MAX_SUPPORT];
-    const int s = f->F - mpm_shape_1d(g->shape, xi, fc->lp, wt, dw);
+    const int s = F - mpm_shape_1d(g->shape, xi, fc->lp, wt, dw);
     if (s < 0 || s >= MPM_SHAPE_MAX_SUPPORT || wt[s] <= 0.0) continue;
     for (int d = 0; d < dim; ++d) {
       const int into = f->side ? vF[d] > 0.0 : vF[d] < 0.0; /* the normal: only into the wall */
@@ -217,36 +310,48 @@ static int wall_keep(const fluid_content *fc, const mpm_grid *g, const wall_face
   return any;
 }
 
-void fluid_classic_transfer(mpm_module *m, const double *y, double h, const fluid_step_out *o) {
+/* The G2P of the classic step: vhat, a_p, L, C and the scalars at the particles of state y. */
+static int classic_g2p(mpm_module *m, const double *y, double h, const fluid_step_out *o,
+                       double *const *ap, double **sc) {
   fluid_content *fc = m->content;
   const mpm_particles *p = m->particles;
-  const mpm_grid *g = m->grid;
-  const mpm_grid_phase *ph = &g->phase[m->phase];
   const int dim = p->dim;
   const mpm_lidx n = p->n;
-  double *vbar[MPM_MAX_DIM] = {NULL}, *ap[MPM_MAX_DIM] = {NULL}, *sc[3];
-  for (int d = 0; d < dim; ++d) {
-    vbar[d] = fc->node + (size_t)d * g->nnodes;
-    for (mpm_lidx l = 0; l < g->nnodes; ++l) vbar[d][l] = ph->v_i[d][l] - 0.5 * h * ph->a_i[d][l];
-    ap[d] = fc->tscratch + (size_t)d * n;
-  }
-  for (int j = 0; j < 3; ++j) sc[j] = fc->tscratch + (size_t)(dim + j) * n;
+  classic_nodal c;
+  MPM_CALL(centred_velocity(m, h, &c));
   mpm_g2p_args a = {.n = n, .lp = fc->lp, .L_out = o->L, .C_out = o->C};
-  wall_faces w;
-  wall_faces_of(fc, g, &w);
-  const double pic = pic_share(m, fc->tr.pic, h);
   for (int d = 0; d < dim; ++d) {
     a.x[d] = y + (size_t)(p->offset[FLUID_X] + d) * n;
-    a.v_i[d] = vbar[d];
-    a.a_i[d] = ph->a_i[d];
+    a.v_i[d] = c.vbar.v_i[0][d];
+    a.a_i[d] = m->grid->phase[m->phase].a_i[d];
     a.v_out[d] = o->vhat[d];
     a.a_out[d] = ap[d];
   }
-  nodal_scalars(m, (const double *const *)vbar, h, sc, &a);
-  mpm_kernels_get(dim)->g2p(g, &a);
+  nodal_scalars(m, &c, h, sc, &a);
+  MPM_CALL(gridp_scalar(m, &c, &a));
+  if (m->hier)
+    MPM_CALL(mpm_hier_g2p_from(m->hier, m->phase, &a, &c.vbar, &c.s));
+  else
+    mpm_kernels_get(dim)->g2p(m->grid, &a);
   for (int d = 0; d < dim; ++d)
     for (mpm_lidx i = 0; i < n; ++i) o->vhat[d][i] += 0.5 * h * ap[d][i];
-  if (o->C) apic_half_step(m, y, h, o->C);
+  if (o->C) MPM_CALL(apic_half_step(m, y, h, o->C));
+  return 0;
+}
+
+int fluid_classic_transfer(mpm_module *m, const double *y, double h, const fluid_step_out *o) {
+  fluid_content *fc = m->content;
+  const mpm_particles *p = m->particles;
+  const mpm_grid *g = m->grid;
+  const int dim = p->dim;
+  const mpm_lidx n = p->n;
+  double *ap[MPM_MAX_DIM] = {NULL}, *sc[3];
+  for (int d = 0; d < dim; ++d) ap[d] = fc->tscratch + (size_t)d * n;
+  for (int j = 0; j < 3; ++j) sc[j] = fc->tscratch + (size_t)(dim + j) * n;
+  wall_faces w;
+  wall_faces_of(fc, g, &w);
+  const double pic = pic_share(m, fc->tr.pic, h);
+  MPM_CALL(classic_g2p(m, y, h, o, ap, sc));
   for (mpm_lidx i = 0; i < n; ++i) {
     double v[MPM_MAX_DIM], acc[MPM_MAX_DIM], vh[MPM_MAX_DIM], vn[MPM_MAX_DIM];
     for (int d = 0; d < dim; ++d) {
@@ -257,7 +362,8 @@ void fluid_classic_transfer(mpm_module *m, const double *y, double h, const flui
     double xp[MPM_MAX_DIM], vF[MPM_MAX_DIM], keep[MPM_MAX_DIM];
     for (int d = 0; d < dim; ++d)
       xp[d] = y[(size_t)(p->offset[FLUID_X] + d) * n + i], vF[d] = v[d] + h * acc[d];
-    if (!fc->tr.apic && wall_keep(fc, g, &w, xp, vF, keep))
+    const int level = m->hier ? fc->lev[i] : 0;
+    if (!fc->tr.apic && wall_keep(fc, g, &w, level, xp, vF, keep))
       for (int d = 0; d < dim; ++d) {
         double damped = vn[d] - (1.0 - keep[d]) * (1.0 - pic) * vF[d];
         /* With a PIC share the blend may already point elsewhere: never push it further or
@@ -269,6 +375,7 @@ void fluid_classic_transfer(mpm_module *m, const double *y, double h, const flui
       }
     for (int d = 0; d < dim; ++d) o->vnew[d][i] = vn[d];
   }
+  return 0;
 }
 
 void fluid_wall_rate_mol(const mpm_module *m, const double *y, double *const *vdot, double *power) {
@@ -286,7 +393,7 @@ void fluid_wall_rate_mol(const mpm_module *m, const double *y, double *const *vd
     for (int d = 0; d < dim; ++d)
       xp[d] = y[(size_t)(p->offset[FLUID_X] + d) * n + i],
       v[d] = y[(size_t)(p->offset[FLUID_V] + d) * n + i];
-    if (!wall_keep(fc, g, &w, xp, v, keep)) continue;
+    if (!wall_keep(fc, g, &w, 0, xp, v, keep)) continue;
     const double rate = 2.0 * sqrt(gamma * (gamma - 1.0) * fabs(e[i])) / g->dx; /* 2 c / dx */
     for (int d = 0; d < dim; ++d) {
       const double k = rate * (1.0 - keep[d]);

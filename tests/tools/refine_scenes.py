@@ -2,8 +2,10 @@
 and bench/bench_refine.py: a 2-D strip periodic along x with slip walls along y (level 0 at
 dx = 0.05), its static level-1 box, the 3-D strip and box, the regridded pulse, and a radial
 expansion for the starvation criterion; with y = "periodic" the strip is periodic along y too
-(the levels then wrap across its faces); and the refinement of Sod's shock tube (cases/sod.ini,
-a strip periodic along y)."""
+(the levels then wrap across its faces); the refinement of Sod's shock tube (cases/sod.ini,
+a strip periodic along y); the gas beside a prestressed slab of test_refine_fsi.py; and the
+walled scenes of tests/verification/test_refine_walls.py (a closed box refined in its corner, a
+band and a box on the walls of the strip), which test_refine_usl.py shares."""
 import numpy as np
 
 C0 = np.sqrt(1.4)  # sound speed of rho 1, p 1
@@ -242,3 +244,85 @@ FSI_PROBE = "[probe.slab]\npoint = 1.04 0.03\nphase = solid\n"
 FSI_PULSE = (f"density_field = 1 + {FSI_A / 1.4}*{_F}\n"
              f"pressure_field = 1 + {FSI_A}*{_F}\n"
              f"velocity_field = {FSI_A / np.sqrt(1.4)}*{_F}; 0\n")
+
+# A closed box (walls {wall} on all four faces) refined on three levels in its corner (x_lo,
+# y_lo) and against y_hi; {gas} fills it.
+CLOSED = """[run]
+name = refine_walls
+
+[domain]
+dim = 2
+lo = 0 0
+hi = 1.2 0.6
+
+[grid]
+dx = 0.05
+
+[boundary]
+x_lo = {wall}
+x_hi = {wall}
+y_lo = {wall}
+y_hi = {wall}
+
+[time]
+t_end = 1
+
+[output]
+interval = 0.5
+
+[geometry.all]
+type = box
+lo = 0 0
+hi = 1.2 0.6
+
+[gas.air]
+geometry = all
+{gas}
+
+[refine]
+levels = 3
+
+[refine.corner]
+level = 1
+lo = 0 0
+hi = 0.5 0.35
+
+[refine.inner]
+level = 2
+lo = 0 0
+hi = 0.3 0.2
+
+[refine.top]
+level = 1
+lo = 0.7 0.3
+hi = 1.0 0.6
+"""
+
+# On the strip: a level-1 band over its whole height and a level-2 box on y_lo inside it.
+STREAM = ("[refine]\nlevels = 3\n\n[refine.band]\nlevel = 1\nlo = 0.8 0\nhi = 1.2 0.6\n\n"
+          "[refine.floor]\nlevel = 2\nlo = 0.9 0\nhi = 1.1 0.15\n")
+
+
+def wall_pulse_case(refine, dx, extra=""):
+    """An acoustic pulse (amplitude 1e-3, gaussian of width 0.2) running down (-y) onto the slip
+    wall y_lo of a strip 0.3 wide (periodic along x) and 2 high, to t = 1.2."""
+    a, y0 = 1e-3, 0.6
+    g = f"exp(-(y-{y0})^2/0.04)"
+    gas = (f"density_field = 1 + {a}*{g}\npressure_field = 0.714285714285714 + {a}*{g}\n"
+           f"velocity_field = 0; -{a}*{g}")
+    text = case_text(0.3, 1.2, gas, refine, dx=dx, extra=extra, height=2.0)
+    return text.replace("interval = 0.6", "interval = 0.3")
+
+
+# A level-1 band touching the wall y_lo of wall_pulse_case and spanning its x period.
+WALL_BAND = "[refine]\nlevels = 2\n\n[refine.band]\nlevel = 1\nlo = 0 0\nhi = 0.3 1.2\n"
+
+
+def wall_pulse_profile(p):
+    """Mass-weighted p' and v_y binned along y (0.025) at the end: the strip is 1-D."""
+    y = p["x"][:, 1]
+    k = np.minimum((y / 0.025).astype(int), 79)
+    w = np.bincount(k, p["m"].ravel(), 80)
+    pp = np.bincount(k, p["m"].ravel() * (p["p"].ravel() - 1 / 1.4), 80) / w
+    vv = np.bincount(k, p["m"].ravel() * p["v"][:, 1], 80) / w
+    return 0.5 * (pp + vv), 0.5 * (pp - vv)  # up-running, down-running (Z = 1)

@@ -334,6 +334,29 @@ static void check_affine(hier_case c) {
   assert_true(e[0] <= 1e-12 * scale);
   assert_true(e[1] <= 1e-12 * scale);
   assert_int_equal(mpm_hier_g2p(f.h, f.phase, &a, NULL), MPM_ERR_INTERNAL);
+  /* mpm_hier_g2p_from reads the caller's velocity on every level: the affine one, moved out of
+   * the phase, whose v_i then holds garbage. */
+  mpm_hier_nodal vel = {{{NULL}}};
+  double *moved[MPM_HIER_MAX_LEVELS][3] = {{NULL}};
+  for (int l = 0; l < f.h->nlevels; ++l) {
+    mpm_grid *g = f.h->level[l].grid;
+    for (int d = 0; d < dim; ++d) {
+      moved[l][d] = alloc0((size_t)g->nnodes);
+      memcpy(moved[l][d], g->phase[f.phase].v_i[d], sizeof(double) * (size_t)g->nnodes);
+      for (mpm_lidx i = 0; i < g->nnodes; ++i) g->phase[f.phase].v_i[d][i] = 1e30;
+      vel.v_i[l][d] = moved[l][d];
+    }
+  }
+  for (int d = 0; d < dim; ++d) a.v_i[d] = NULL;
+  assert_int_equal(mpm_hier_g2p_from(f.h, f.phase, &a, &vel, &hs), 0);
+  double ef[2] = {0, 0};
+  g2p_errors(&f, &p, &o, ef);
+  printf("affine %-13s G2P from the caller's velocity: v/a/s %.2e, L and C (times h) %.2e\n",
+         hier_case_name[c], ef[0], ef[1]);
+  assert_true(ef[0] <= 1e-12 * scale);
+  assert_true(ef[1] <= 1e-12 * scale);
+  for (int l = 0; l < f.h->nlevels; ++l)
+    for (int d = 0; d < dim; ++d) free(moved[l][d]);
   for (int d = 0; d < dim; ++d) free(o.v[d]), free(o.a[d]);
   free(o.L), free(o.C), free(o.s);
   for (int l = 0; l < f.h->nlevels; ++l) free(s[l]);

@@ -65,3 +65,14 @@ foreach(part rest pulse traction restart input)
   mpm_add_script_test(test_refine_fsi_${part} SCRIPT verification/test_refine_fsi.py
                       ARGS ${part} LABELS verification TIMEOUT 300)
 endforeach()
+# The classic update (time.method = usl, then musl) on the hierarchy (the gas): gas at rest and
+# a uniform stream across static level-1 and level-2 boxes at the walls, FLIP, a PIC share and
+# APIC (~10 s); the acoustic pulse crossing a box against its coarse twin (~8 s); Sod with a
+# regridded fine region against its uniform twin (~5 s); a pulse reflected from a wall in a
+# level-1 band against its fine twin (~8 s); conservation through regrids and a restart (~8 s).
+foreach(method usl musl)
+  foreach(part uniform pulse sod wall regrid)
+    mpm_add_script_test(test_refine_${method}_${part} SCRIPT verification/test_refine_usl.py
+                        ARGS ${part} ${method} LABELS verification TIMEOUT 300)
+  endforeach()
+endforeach()

@@ -575,8 +575,7 @@ def part_input():
         ("odd ppc", case_text(2, 0.1, gas, box, extra="[fluid]\nppc = 3\n"), "fluid.ppc",
          "ppc = 3", "even"),
     ]
-    for key, value in [("time.method", "usl"), ("time.method", "musl"),
-                       ("fluid.volume_rate", "domain"), ("fluid.av_form", "riemann"),
+    for key, value in [("fluid.volume_rate", "domain"), ("fluid.av_form", "riemann"),
                        ("fluid.stable_step", "neighbourhood"),
                        ("fluid.shift", "0.375"), ("fluid.regularise_every", "30"),
                        ("fluid.refill_every", "10"), ("fluid.light_node_mass", "0.01")]:
@@ -609,8 +608,7 @@ def part_input():
     # fluid.pressure = grid's own refusals (fluid/fluid_gridp.c), on the strip without [refine].
     grid = "[fluid]\npressure = grid\n"
     plain = case_text(2, 0.1, gas, "", extra=grid)
-    for key, value, words in [("time.method", "usl", "ERK pairs"),
-                              ("fluid.strain_rate", "lagged", "current strain rate"),
+    for key, value, words in [("fluid.strain_rate", "lagged", "current strain rate"),
                               ("grid.shape", "linear", "quadratic"),
                               ("fluid.shift", "0.375", "shifting"),
                               ("fluid.volume_rate", "domain", "volume rate")]:

@@ -36,7 +36,8 @@ import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "tools"))
 import mpmtest as mt  # noqa: E402
-from refine_scenes import BOX_3D, C0, CASE_3D, DYNAMIC, PULSE_5, case_text  # noqa: E402
+from refine_scenes import (BOX_3D, C0, CASE_3D, CLOSED, DYNAMIC, PULSE_5, STREAM,  # noqa: E402
+                           WALL_BAND, case_text, wall_pulse_case, wall_pulse_profile)
 
 PART = sys.argv[1] if len(sys.argv) > 1 else "rest"
 check = mt.Checks(f"test_refine_walls_{PART}")
@@ -81,58 +82,6 @@ def near_walls(p, level, faces, h=0.025):
     return [int(np.sum((lev == level) & (np.abs(p["x"][:, a] - v) < h))) for a, v in faces]
 
 
-CLOSED = """[run]
-name = refine_walls
-
-[domain]
-dim = 2
-lo = 0 0
-hi = 1.2 0.6
-
-[grid]
-dx = 0.05
-
-[boundary]
-x_lo = {wall}
-x_hi = {wall}
-y_lo = {wall}
-y_hi = {wall}
-
-[time]
-t_end = 1
-
-[output]
-interval = 0.5
-
-[geometry.all]
-type = box
-lo = 0 0
-hi = 1.2 0.6
-
-[gas.air]
-geometry = all
-{gas}
-
-[refine]
-levels = 3
-
-[refine.corner]
-level = 1
-lo = 0 0
-hi = 0.5 0.35
-
-[refine.inner]
-level = 2
-lo = 0 0
-hi = 0.3 0.2
-
-[refine.top]
-level = 1
-lo = 0.7 0.3
-hi = 1.0 0.6
-"""
-
-
 def part_rest():
     for wall in ("slip", "no_slip"):
         out = run(f"walls_rest_{wall}", CLOSED.format(wall=wall, gas=REST))
@@ -147,10 +96,6 @@ def part_rest():
         check(min(n1 + n2) > 0, f"{wall}: level-1 particles within half a cell of x_lo, y_lo, "
               f"y_hi {n1}, level-2 of x_lo, y_lo {n2} (the levels reach the walls)")
         conservation(f"{wall}, at rest", out, "x", 1e-12)
-
-
-STREAM = ("[refine]\nlevels = 3\n\n[refine.band]\nlevel = 1\nlo = 0.8 0\nhi = 1.2 0.6\n\n"
-          "[refine.floor]\nlevel = 2\nlo = 0.9 0\nhi = 1.1 0.15\n")
 
 
 def part_stream():
@@ -180,37 +125,16 @@ def part_stream():
     conservation("3-D stream", out, "x", 1e-12)
 
 
-def pulse_case(refine, dx, extra=""):
-    a, y0 = 1e-3, 0.6
-    g = f"exp(-(y-{y0})^2/0.04)"
-    gas = (f"density_field = 1 + {a}*{g}\npressure_field = 0.714285714285714 + {a}*{g}\n"
-           f"velocity_field = 0; -{a}*{g}")
-    text = case_text(0.3, 1.2, gas, refine, dx=dx, extra=extra, height=2.0)
-    return text.replace("interval = 0.6", "interval = 0.3")
-
-
 GRIDP = "[fluid]\npressure = grid\n"
-BAND = "[refine]\nlevels = 2\n\n[refine.band]\nlevel = 1\nlo = 0 0\nhi = 0.3 1.2\n"
-
-
-def profile(out):
-    """Mass-weighted p' and v_y binned along y (0.025) at the end: the strip is 1-D."""
-    p = final(out)
-    y = p["x"][:, 1]
-    k = np.minimum((y / 0.025).astype(int), 79)
-    w = np.bincount(k, p["m"].ravel(), 80)
-    pp = np.bincount(k, p["m"].ravel() * (p["p"].ravel() - 1 / 1.4), 80) / w
-    vv = np.bincount(k, p["m"].ravel() * p["v"][:, 1], 80) / w
-    return 0.5 * (pp + vv), 0.5 * (pp - vv)  # up-running, down-running (Z = 1)
 
 
 def part_pulse():
-    runs = {"refined": run("walls_pulse", pulse_case(BAND, 0.05)),
-            "coarse": run("walls_pulse_coarse", pulse_case("", 0.05, GRIDP)),
-            "fine": run("walls_pulse_fine", pulse_case("", 0.025, GRIDP))}
+    runs = {"refined": run("walls_pulse", wall_pulse_case(WALL_BAND, 0.05)),
+            "coarse": run("walls_pulse_coarse", wall_pulse_case("", 0.05, GRIDP)),
+            "fine": run("walls_pulse_fine", wall_pulse_case("", 0.025, GRIDP))}
     up, down, energy, peak = {}, {}, {}, {}
     for label, out in runs.items():
-        up[label], down[label] = profile(out)
+        up[label], down[label] = wall_pulse_profile(final(out))
         energy[label] = float((up[label] ** 2).sum())
         peak[label] = float(up[label].max())
         print(f"info {label}: reflected (up-running) energy {energy[label]:.4e}, peak "
