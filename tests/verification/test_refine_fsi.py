@@ -220,6 +220,8 @@ def part_input():
          "fluid.pressure", "pressure = grid", "solid"),
         ("classic update", text.replace("t_end = 0.1", "t_end = 0.1\nmethod = usl"),
          "time.method", "method = usl", "not carried"),
+        ("MUSL", text.replace("t_end = 0.1", "t_end = 0.1\nmethod = musl"),
+         "time.method", "method = musl", "not carried"),
         ("two bodies", text.replace("hi = 2.6 0.06", "hi = 1.8 0.06") +
          "\n[geometry.slab2]\ntype = box\nlo = 1.8 0\nhi = 2.6 0.06\n\n"
          "[solid.slab2]\ngeometry = slab2\nmaterial = linear_elastic\ndensity = 0.25\nE = 22.4\n"
