@@ -81,10 +81,13 @@ static int check_scope(const fluid_content *fc, const mpm_config *cfg, const mpm
     return refuse(cfg, "fluid.pressure",
                   "integrates over every span of the domain, and the case has a solid");
   MPM_CALL(mpm_config_instances(cfg, "obstacle", &names, &count));
-  if (count > 0) {
+  for (int k = 0; k < count; ++k) {
     char key[160];
-    snprintf(key, sizeof key, "obstacle.%s.shape", names[0]);
-    return refuse(cfg, key, "integrates over every span of the domain, obstacles included");
+    snprintf(key, sizeof key, "obstacle.%s.surface_interval", names[k]);
+    if (mpm_config_has(cfg, key))
+      return refuse(cfg, key,
+                    "does not carry the surface output (it samples the particles' pressure "
+                    "beside the ghost lattice)");
   }
   for (int d = 0; d < g->dim; ++d)
     for (int s = 0; s < 2; ++s)
@@ -161,6 +164,7 @@ static int ensure_levels(mpm_module *m, fluid_gridp *gp) {
   if (gp->P[0]) return 0;
   const mpm_hier *h = m->hier;
   gp->nlev = h ? h->nlevels : 1;
+  MPM_CALL(fluid_obstacles_levels(&((fluid_content *)m->content)->obs, m->grid, h, 1));
   for (int l = 0; l < gp->nlev; ++l) {
     const mpm_grid *g = level_grid(m, l);
     const size_t nn = (size_t)g->nnodes;
@@ -257,6 +261,30 @@ static void per_mass(const mpm_module *m, const fluid_gridp *gp, double *const *
   }
 }
 
+/* The obstacles' span ghost (fluid_obstacle_levels.c): the mask of the massless nodes inside a
+ * body, prolonged, integrated against grad N_i over each level's spans and restricted, into the
+ * force p_i GH_i of every node with mass. D and F are scratch here. */
+static int ghost_forces(mpm_module *m, fluid_gridp *gp) {
+  fluid_obstacles *o = &((fluid_content *)m->content)->obs;
+  const int dim = m->grid->dim;
+  if (o->count == 0) return 0;
+  for (int l = 0; l < gp->nlev; ++l)
+    fluid_obstacles_span_mask(o, l, level_grid(m, l), gp->M[l],
+                              m->hier ? m->hier->level[l].active : NULL, gp->D[l]);
+  MPM_CALL(prolong_all(m, gp->D));
+  for (int l = 0; l < gp->nlev; ++l) {
+    const mpm_grid *g = level_grid(m, l);
+    for (int d = 0; d < dim; ++d) memset(gp->F[l][d], 0, sizeof(double) * (size_t)g->nnodes);
+    mpm_span_force(g, &gp->set[l], gp->D[l], gp->F[l]);
+  }
+  MPM_CALL(restrict_all(m, gp->F, dim));
+  for (int l = 0; l < gp->nlev; ++l)
+    fluid_obstacles_span_force(o, l, m->hier ? m->hier->level[l].grid : m->grid, m->phase,
+                               gp->P[l], gp->M[l], m->hier ? m->hier->level[l].active : NULL,
+                               (const double *const *)gp->F[l]);
+  return 0;
+}
+
 int fluid_gridp_forces(mpm_module *m) {
   fluid_content *fc = m->content;
   fluid_gridp *gp = fc->gridp;
@@ -286,7 +314,7 @@ int fluid_gridp_forces(mpm_module *m) {
     for (int d = 0; d < dim; ++d)
       for (mpm_lidx k = 0; k < g->nnodes; ++k) ph->f_i[d][k] += gp->F[l][d][k];
   }
-  return 0;
+  return ghost_forces(m, gp);
 }
 
 int fluid_gridp_nodal_rate(mpm_module *m, mpm_hier_scalars *s) {

@@ -12,12 +12,14 @@
  * (fluid_module.c). Slip and no-slip walls act on every level (mpm_hier.h, walls: the finer levels
  * fold and mirror their nodes beyond a wall in fluid_module.c's forces and constrain); the sim
  * keeps every box three level-0 cells from the other non-periodic faces (coupler/mpm_refine.c).
+ * Obstacles (ghost treatment) act on every level: the constraint on each level's active nodes and
+ * the ghosts through the grid pressure's spans (fluid_obstacle_levels.c).
  *
  * Refused (fluid_refine_check), each naming its key: everything that reads or writes the gas's
  * nodal fields or the grid otherwise: the classic update (its time-centred nodal velocity, heat
  * shares and wall rule), the domain volume rate, the riemann viscosity's limiter, shifting,
  * regularisation and refill (cell counts), the neighbourhood stable step, the light-node threshold,
- * obstacles and open faces. An odd fluid.ppc puts level-0 particles on the span faces that bound
+ * the least-squares wall treatment, an obstacle's surface output (fluid_gridp.c) and open faces. An odd fluid.ppc puts level-0 particles on the span faces that bound
  * the finer regions, so it is refused too.
  *
  * Invariant: with m->hier NULL every call here is the plain kernel call (the refined path costs
@@ -129,18 +131,13 @@ static const refusal g_refused[] = {
     {"fluid.regularise_every", NULL, "merging and splitting count particles in level-0 cells"},
     {"fluid.refill_every", NULL, "refilling counts particles in level-0 cells"},
     {"fluid.light_node_mass", NULL, "the mean nodal mass is level 0's"},
+    {"fluid.wall_treatment", "least_squares",
+     "the least-squares wall fits the particles in level-0 cells and books heat on level 0's "
+     "nodes"},
 };
 
-/* The first obstacle, or open face, of the case: refused with its key. */
+/* The first open face of the case: refused with its key. */
 static int refuse_boundaries(const mpm_config *cfg, const fluid_content *fc, int dim) {
-  const char *const *names;
-  int count;
-  MPM_CALL(mpm_config_instances(cfg, "obstacle", &names, &count));
-  if (count > 0) {
-    char key[160];
-    snprintf(key, sizeof key, "obstacle.%s.shape", names[0]);
-    return refuse(cfg, key, "obstacles constrain and deposit on level 0's nodes");
-  }
   for (int d = 0; d < dim; ++d)
     for (int s = 0; s < 2; ++s)
       if (mpm_wall_is_open_gas(fc->walls.face[d][s])) {
