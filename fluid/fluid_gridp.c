@@ -52,6 +52,7 @@ struct fluid_gridp {
    * mass they divide by (M: each level's before the walls fold it), and the spans it skips. */
   double *P[MPM_HIER_MAX_LEVELS], *F[MPM_HIER_MAX_LEVELS][MPM_MAX_DIM], *D[MPM_HIER_MAX_LEVELS];
   double *M[MPM_HIER_MAX_LEVELS];
+  double *G[MPM_HIER_MAX_LEVELS][MPM_MAX_DIM]; /* the obstacles' span ghost GH (with obstacles) */
   unsigned char *skip[MPM_HIER_MAX_LEVELS];
   mpm_span_set set[MPM_HIER_MAX_LEVELS];
 };
@@ -133,6 +134,7 @@ void fluid_gridp_reset(fluid_content *fc) {
     free(gp->P[l]), free(gp->D[l]), free(gp->M[l]), free(gp->skip[l]);
     gp->P[l] = gp->D[l] = gp->M[l] = NULL, gp->skip[l] = NULL;
     for (int d = 0; d < MPM_MAX_DIM; ++d) free(gp->F[l][d]), gp->F[l][d] = NULL;
+    for (int d = 0; d < MPM_MAX_DIM; ++d) free(gp->G[l][d]), gp->G[l][d] = NULL;
   }
 }
 
@@ -172,6 +174,8 @@ static int ensure_levels(mpm_module *m, fluid_gridp *gp) {
     MPM_ALLOC(gp->D[l], nn);
     MPM_ALLOC(gp->M[l], nn);
     for (int d = 0; d < g->dim; ++d) MPM_ALLOC(gp->F[l][d], nn);
+    for (int d = 0; ((fluid_content *)m->content)->obs.count && d < g->dim; ++d)
+      MPM_ALLOC(gp->G[l][d], nn);
     if (l == 0) {
       if (h) {
         MPM_ALLOC(gp->skip[0], nn);
@@ -262,8 +266,8 @@ static void per_mass(const mpm_module *m, const fluid_gridp *gp, double *const *
 }
 
 /* The obstacles' span ghost (fluid_obstacle_levels.c): the mask of the massless nodes inside a
- * body, prolonged, integrated against grad N_i over each level's spans and restricted, into the
- * force p_i GH_i of every node with mass. D and F are scratch here. */
+ * body, prolonged, integrated against grad N_i over each level's spans and restricted (GH, kept
+ * for the rate), into the force p_i GH_i of every node with mass. D is scratch here. */
 static int ghost_forces(mpm_module *m, fluid_gridp *gp) {
   fluid_obstacles *o = &((fluid_content *)m->content)->obs;
   const int dim = m->grid->dim;
@@ -274,14 +278,14 @@ static int ghost_forces(mpm_module *m, fluid_gridp *gp) {
   MPM_CALL(prolong_all(m, gp->D));
   for (int l = 0; l < gp->nlev; ++l) {
     const mpm_grid *g = level_grid(m, l);
-    for (int d = 0; d < dim; ++d) memset(gp->F[l][d], 0, sizeof(double) * (size_t)g->nnodes);
-    mpm_span_force(g, &gp->set[l], gp->D[l], gp->F[l]);
+    for (int d = 0; d < dim; ++d) memset(gp->G[l][d], 0, sizeof(double) * (size_t)g->nnodes);
+    mpm_span_force(g, &gp->set[l], gp->D[l], gp->G[l]);
   }
-  MPM_CALL(restrict_all(m, gp->F, dim));
+  MPM_CALL(restrict_all(m, gp->G, dim));
   for (int l = 0; l < gp->nlev; ++l)
-    fluid_obstacles_span_force(o, l, m->hier ? m->hier->level[l].grid : m->grid, m->phase,
-                               gp->P[l], gp->M[l], m->hier ? m->hier->level[l].active : NULL,
-                               (const double *const *)gp->F[l]);
+    fluid_obstacles_span_force(o, l, m->hier ? m->hier->level[l].grid : m->grid, m->phase, gp->P[l],
+                               gp->M[l], m->hier ? m->hier->level[l].active : NULL,
+                               (const double *const *)gp->G[l]);
   return 0;
 }
 
@@ -330,6 +334,10 @@ int fluid_gridp_nodal_rate(mpm_module *m, mpm_hier_scalars *s) {
     D[l][0] = gp->D[l];
   }
   MPM_CALL(restrict_all(m, D, 1));
+  for (int l = 0; fc->obs.count && l < gp->nlev; ++l)
+    fluid_obstacles_span_rate(level_grid(m, l), m->phase, gp->M[l],
+                              m->hier ? m->hier->level[l].active : NULL,
+                              (const double *const *)gp->G[l], gp->D[l]);
   per_mass(m, gp, gp->D, gp->P); /* P now holds the rate per unit mass */
   MPM_CALL(prolong_all(m, gp->P));
   memset(s, 0, sizeof *s);

@@ -144,7 +144,7 @@ typedef struct fluid_obstacles {
   int *nob[MPM_HIER_MAX_LEVELS];
   mpm_lidx rcount[MPM_HIER_MAX_LEVELS], *rnode[MPM_HIER_MAX_LEVELS];
   int *rob[MPM_HIER_MAX_LEVELS];
-  char path[4096];          /* obstacles.csv */
+  char path[4096]; /* obstacles.csv */
   mpm_diag *csv;
 } fluid_obstacles;
 
@@ -223,14 +223,17 @@ int fluid_obstacles_levels(fluid_obstacles *o, const mpm_grid *grid, const mpm_h
 void fluid_obstacles_levels_free(fluid_obstacles *o);
 /* Span ghost, level l (grid g, active mask act or NULL, the nodal mass M after the deposit):
  * U = 1 on the active massless nodes inside a body, else 0. */
-void fluid_obstacles_span_mask(const fluid_obstacles *o, int l, const mpm_grid *g,
-                               const double *M, const unsigned char *act, double *U);
+void fluid_obstacles_span_mask(const fluid_obstacles *o, int l, const mpm_grid *g, const double *M,
+                               const unsigned char *act, double *U);
 /* Span ghost, level l: add P_i GH_i (GH: the integral of the prolonged mask times grad N_i,
  * restricted) to phase's f_i on the active nodes with mass, and minus it to the nearest
  * obstacle's recorded force (owned nodes). */
 void fluid_obstacles_span_force(fluid_obstacles *o, int l, mpm_grid *g, int phase, const double *P,
-                                const double *M, const unsigned char *act,
-                                const double *const *GH);
+                                const double *M, const unsigned char *act, const double *const *GH);
+/* Span ghost, level l: D_i -= v_i . GH_i on the active nodes with mass (the ghosts move with the
+ * node they act on: the adjoint of the ghost force, and a uniform stream keeps D = 0). */
+void fluid_obstacles_span_rate(const mpm_grid *g, int phase, const double *M,
+                               const unsigned char *act, const double *const *GH, double *D);
 /* Constrain the finer levels' nodes after the solve (see fluid_obstacles_apply). Collective. */
 int fluid_obstacles_apply_levels(fluid_obstacles *o, int phase, double h, int record);
 

@@ -150,8 +150,8 @@ int fluid_obstacles_levels(fluid_obstacles *o, const mpm_grid *grid, const mpm_h
   return 0;
 }
 
-void fluid_obstacles_span_mask(const fluid_obstacles *o, int l, const mpm_grid *g,
-                               const double *M, const unsigned char *act, double *U) {
+void fluid_obstacles_span_mask(const fluid_obstacles *o, int l, const mpm_grid *g, const double *M,
+                               const unsigned char *act, double *U) {
   const unsigned char *in = o->inside[l];
   for (mpm_lidx n = 0; n < g->nnodes; ++n)
     U[n] = in && in[n] && (!act || act[n]) && !(M[n] > 0.0) ? 1.0 : 0.0;
@@ -191,6 +191,15 @@ void fluid_obstacles_span_force(fluid_obstacles *o, int l, mpm_grid *g, int phas
   }
 }
 
+void fluid_obstacles_span_rate(const mpm_grid *g, int phase, const double *M,
+                               const unsigned char *act, const double *const *GH, double *D) {
+  const mpm_grid_phase *ph = &g->phase[phase];
+  for (mpm_lidx n = 0; n < g->nnodes; ++n) {
+    if ((act && !act[n]) || !(M[n] > 0.0)) continue;
+    for (int d = 0; d < g->dim; ++d) D[n] -= ph->v_i[d][n] * GH[d][n];
+  }
+}
+
 /* Level l >= 1: the empty or light nodes of the reach hand their force to the body, then every
  * obstacle's nodes are constrained (fluid_obstacles_apply does level 0). */
 static void apply_level(fluid_obstacles *o, int l, int phase, double h, int record) {
@@ -198,8 +207,7 @@ static void apply_level(fluid_obstacles *o, int l, int phase, double h, int reco
   mpm_grid_phase *ph = &g->phase[phase];
   const int dim = g->dim;
   double mmax = 0.0, scratch[3];
-  for (mpm_lidx k = 0; k < o->rcount[l]; ++k)
-    mmax = fmax(mmax, ph->m_i[o->rnode[l][k]]);
+  for (mpm_lidx k = 0; k < o->rcount[l]; ++k) mmax = fmax(mmax, ph->m_i[o->rnode[l][k]]);
   for (mpm_lidx k = 0; record && k < o->rcount[l]; ++k) {
     const mpm_lidx n = o->rnode[l][k];
     if ((!o->span && !(ph->m_i[n] > 0.0)) || ph->m_i[n] > ph->m_empty) continue;
@@ -210,7 +218,7 @@ static void apply_level(fluid_obstacles *o, int l, int phase, double h, int reco
     const fluid_obstacle *ob = &o->ob[k];
     double *f = record ? o->f[o->rec.latest] + (size_t)dim * k : scratch;
     fluid_obstacle_constrain(ob->fine[l].node, ob->fine[l].normal, NULL, ob->fine[l].count,
-                             ob->no_slip, ph, dim, h, getenv("NOHOLD") ? 0.0 : o->hold * mmax, o->coast, f, NULL);
+                             ob->no_slip, ph, dim, h, o->hold * mmax, o->coast, f, NULL);
   }
 }
 

@@ -19,8 +19,9 @@
  * nodal fields or the grid otherwise: the classic update (its time-centred nodal velocity, heat
  * shares and wall rule), the domain volume rate, the riemann viscosity's limiter, shifting,
  * regularisation and refill (cell counts), the neighbourhood stable step, the light-node threshold,
- * the least-squares wall treatment, an obstacle's surface output (fluid_gridp.c) and open faces. An odd fluid.ppc puts level-0 particles on the span faces that bound
- * the finer regions, so it is refused too.
+ * the least-squares wall treatment, an obstacle's surface output (fluid_gridp.c) and open faces. An
+ * odd fluid.ppc puts level-0 particles on the span faces that bound the finer regions, so it is
+ * refused too.
  *
  * Invariant: with m->hier NULL every call here is the plain kernel call (the refined path costs
  * one pointer test per transfer). */
