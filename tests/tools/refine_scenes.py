@@ -149,3 +149,20 @@ SOD_COARSE = 100
 def sod_refine(levels):
     """Command-line settings of the refined Sod run with `levels` levels over SOD_COARSE cells."""
     return [f"refine.levels={levels}", "refine.criterion=density", "refine.threshold=0.02"]
+
+# Static obstacles on the hierarchy (tests/verification/test_refine_obstacles.py), in the strip
+# of case_text (1.6 x 0.8, periodic along x, slip walls along y, dx = 0.05). OBSTACLES: a circle
+# wholly inside the level-1 box (and cut by the level-2 box of OBST_BOX3) and a no-slip box
+# whose corner lies in the level-1 box (the box's edge x = 1.3 crosses it). FLOOR: a slab under
+# y = 0.225 (mid-cell of level 0 and of level 1) over the whole period, its face along the
+# stream; FLOOR_BAND refines a band over it (the levels' faces cross the slab inside it),
+# FLOOR_BOX a box whose edges cross its face.
+OBSTACLES = ("[obstacle.disc]\nshape = circle\ncenter = 0.5 0.4\nradius = 0.12\n\n"
+             "[obstacle.block]\nshape = box\ncondition = no_slip\nlo = 1.15 0.2\nhi = 1.45 0.5\n")
+OBST_BOX = "[refine]\nlevels = 2\n\n[refine.box]\nlevel = 1\nlo = 0.3 0.2\nhi = 1.3 0.6\n"
+OBST_BOX3 = OBST_BOX.replace("levels = 2", "levels = 3") + (
+    "\n[refine.inner]\nlevel = 2\nlo = 0.4 0.3\nhi = 0.6 0.5\n")
+FLOOR = "[obstacle.floor]\nshape = box\nlo = -0.1 -0.1\nhi = 1.7 0.225\n"
+FLOOR_BAND = ("[refine]\nlevels = 3\n\n[refine.band]\nlevel = 1\nlo = 0 0.05\nhi = 1.6 0.5\n\n"
+              "[refine.band2]\nlevel = 2\nlo = 0 0.15\nhi = 1.6 0.3\n")
+FLOOR_BOX = "[refine]\nlevels = 2\n\n[refine.box]\nlevel = 1\nlo = 0.5 0.1\nhi = 1.1 0.45\n"
