@@ -28,9 +28,13 @@
  * level reaching a wall (mpm_hier.h, walls) does the same with its nodes beyond the wall, and
  * integrates only its spans inside it (the wall is a knot of every finer level).
  *
+ * Obstacles. The massless nodes inside a body are its ghosts: each node with mass takes its own
+ * pressure times the integral of their prolonged mask against grad N_i, and the adjoint rate
+ * (ghost_forces here, fluid_obstacle_levels.c).
+ *
  * Scope (fluid_gridp_read refuses the rest): the method-of-lines ERK pairs with the current
- * strain rate, the quadratic B-spline, a gas alone (no solid, obstacle or open face), no
- * shifting, the point volume rate. */
+ * strain rate, the quadratic B-spline, a gas alone (no solid or open face; obstacles without
+ * their surface output), no shifting, the point volume rate. */
 #include "fluid_internal.h"
 
 #include "mpm_error.h"

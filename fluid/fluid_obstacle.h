@@ -14,6 +14,10 @@
  * evaluated once, at build. Nodes deep inside carry no mass (no particle is seeded inside, and
  * the stencil of a particle outside reaches at most two cells in), so they cost one comparison.
  *
+ * Levels and the grid pressure. On a refinement hierarchy every level constrains its active
+ * nodes, and with the grid pressure (any hierarchy, or fluid.pressure = grid) the ghosts are the
+ * massless nodes inside a body instead of the lattice below (fluid_obstacle_levels.c).
+ *
  * Ghost pressure. Held nodes alone leave the nodes next to the surface with an incomplete
  * stencil: the gas pressure pushes them towards the body (a force of order p / dx per unit
  * volume), so gas at rest does not stay at rest and slips into the body at corners. Like the
