@@ -166,3 +166,10 @@ FLOOR = "[obstacle.floor]\nshape = box\nlo = -0.1 -0.1\nhi = 1.7 0.225\n"
 FLOOR_BAND = ("[refine]\nlevels = 3\n\n[refine.band]\nlevel = 1\nlo = 0 0.05\nhi = 1.6 0.5\n\n"
               "[refine.band2]\nlevel = 2\nlo = 0 0.15\nhi = 1.6 0.3\n")
 FLOOR_BOX = "[refine]\nlevels = 2\n\n[refine.box]\nlevel = 1\nlo = 0.5 0.1\nhi = 1.1 0.45\n"
+# DISC: a slip circle in a uniform stream (u = 0.5 c) along the strip, started impulsively;
+# DISC_BAND refines a level-1 band over it. Level 1's nodes sit half a level-1 cell off a
+# uniform fine grid's (o_1 = lo - h_1 / 2), so the fine twin that level 1 reproduces is the one
+# with the disc moved by (h_1 / 2, h_1 / 2): DISC_ALIGNED.
+DISC = "[obstacle.disc]\nshape = circle\ncenter = 0.6 0.4\nradius = 0.1\n"
+DISC_ALIGNED = DISC.replace("center = 0.6 0.4", "center = 0.6125 0.4125")
+DISC_BAND = "[refine]\nlevels = 2\n\n[refine.band]\nlevel = 1\nlo = 0 0.2\nhi = 1.6 0.6\n"
