@@ -870,6 +870,7 @@ int fluid_obstacles_report(fluid_obstacles *o, const mpm_grid *grid, double t, d
 }
 
 void fluid_obstacles_free(fluid_obstacles *o) {
+  fluid_obstacles_levels_free(o); /* reads o->ob */
   for (int k = 0; k < o->count; ++k) {
     mpm_sdf_free(&o->ob[k].sdf);
     fluid_surface_free(&o->ob[k].surf);
@@ -881,6 +882,5 @@ void fluid_obstacles_free(fluid_obstacles *o) {
       free(o->near), free(o->listed), free(o->list), free(o->list_cell), free(o->sm), free(o->q),
       free(o->own);
   mpm_diag_close(&o->csv);
-  fluid_obstacles_levels_free(o);
   memset(o, 0, sizeof *o);
 }
