@@ -33,8 +33,8 @@
  * (ghost_forces here, fluid_obstacle_levels.c).
  *
  * Scope (fluid_gridp_read refuses the rest): the method-of-lines ERK pairs with the current
- * strain rate, the quadratic B-spline, a gas alone (no solid or open face; obstacles without
- * their surface output), no shifting, the point volume rate. */
+ * strain rate, the quadratic B-spline, a gas alone (no solid or open face), no shifting, the point
+ * volume rate. */
 #include "fluid_internal.h"
 
 #include "mpm_error.h"
@@ -85,15 +85,6 @@ static int check_scope(const fluid_content *fc, const mpm_config *cfg, const mpm
   if (count > 0)
     return refuse(cfg, "fluid.pressure",
                   "integrates over every span of the domain, and the case has a solid");
-  MPM_CALL(mpm_config_instances(cfg, "obstacle", &names, &count));
-  for (int k = 0; k < count; ++k) {
-    char key[160];
-    snprintf(key, sizeof key, "obstacle.%s.surface_interval", names[k]);
-    if (mpm_config_has(cfg, key))
-      return refuse(cfg, key,
-                    "does not carry the surface output (it samples the particles' pressure "
-                    "beside the ghost lattice)");
-  }
   for (int d = 0; d < g->dim; ++d)
     for (int s = 0; s < 2; ++s)
       if (mpm_wall_is_open_gas(fc->walls.face[d][s])) {
@@ -276,6 +267,13 @@ static int ghost_forces(mpm_module *m, fluid_gridp *gp) {
   fluid_obstacles *o = &((fluid_content *)m->content)->obs;
   const int dim = m->grid->dim;
   if (o->count == 0) return 0;
+  const mpm_grid *grids[MPM_HIER_MAX_LEVELS];
+  for (int l = 0; l < gp->nlev; ++l) { /* m p of the active nodes for the surface output */
+    const mpm_grid *g = grids[l] = level_grid(m, l);
+    for (mpm_lidx k = 0; k < g->nnodes; ++k) gp->D[l][k] = gp->M[l][k] * gp->P[l][k];
+  }
+  fluid_obstacles_span_surface(o, grids, (const double *const *)gp->M,
+                               (const double *const *)gp->D);
   for (int l = 0; l < gp->nlev; ++l)
     fluid_obstacles_span_mask(o, l, level_grid(m, l), gp->M[l],
                               m->hier ? m->hier->level[l].active : NULL, gp->D[l]);

@@ -234,6 +234,11 @@ void fluid_obstacles_span_mask(const fluid_obstacles *o, int l, const mpm_grid *
  * obstacle's recorded force (owned nodes). */
 void fluid_obstacles_span_force(fluid_obstacles *o, int l, mpm_grid *g, int phase, const double *P,
                                 const double *M, const unsigned char *act, const double *const *GH);
+/* With the grid pressure: the surface output's sums of this RHS, each point from the nodes
+ * around it of the finest level whose region holds it (M: nodal mass, MP: m p, per level;
+ * grids: the levels' grids). */
+void fluid_obstacles_span_surface(fluid_obstacles *o, const mpm_grid *const *grids,
+                                  const double *const *M, const double *const *MP);
 /* Span ghost, level l: D_i -= v_i . GH_i on the active nodes with mass (the ghosts move with the
  * node they act on: the adjoint of the ghost force, and a uniform stream keeps D = 0). */
 void fluid_obstacles_span_rate(const mpm_grid *g, int phase, const double *M,

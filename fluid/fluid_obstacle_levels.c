@@ -191,6 +191,20 @@ void fluid_obstacles_span_force(fluid_obstacles *o, int l, mpm_grid *g, int phas
   }
 }
 
+void fluid_obstacles_span_surface(fluid_obstacles *o, const mpm_grid *const *grids,
+                                  const double *const *M, const double *const *MP) {
+  for (int k = 0; k < o->count; ++k) {
+    fluid_surface *s = &o->ob[k].surf;
+    if (s->n == 0) continue;
+    memset(s->sum, 0, sizeof *s->sum * 2 * (size_t)s->n);
+    for (int i = 0; i < s->n; ++i) {
+      const double x[3] = {s->x[2 * i], s->x[2 * i + 1], 0.0};
+      const int l = o->hier ? mpm_hier_level_of(o->hier, x) : 0;
+      fluid_surface_sample_point(s, i, grids[l], M[l], MP[l], l ? NULL : o->own);
+    }
+  }
+}
+
 void fluid_obstacles_span_rate(const mpm_grid *g, int phase, const double *M,
                                const unsigned char *act, const double *const *GH, double *D) {
   const mpm_grid_phase *ph = &g->phase[phase];

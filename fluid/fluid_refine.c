@@ -19,7 +19,7 @@
  * nodal fields or the grid otherwise: the classic update (its time-centred nodal velocity, heat
  * shares and wall rule), the domain volume rate, the riemann viscosity's limiter, shifting,
  * regularisation and refill (cell counts), the neighbourhood stable step, the light-node threshold,
- * the least-squares wall treatment, an obstacle's surface output (fluid_gridp.c) and open faces. An
+ * the least-squares wall treatment and open faces. An
  * odd fluid.ppc puts level-0 particles on the span faces that bound the finer regions, so it is
  * refused too.
  *

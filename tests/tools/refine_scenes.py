@@ -153,7 +153,8 @@ def sod_refine(levels):
 # Static obstacles on the hierarchy (tests/verification/test_refine_obstacles.py), in the strip
 # of case_text (1.6 x 0.8, periodic along x, slip walls along y, dx = 0.05). OBSTACLES: a circle
 # wholly inside the level-1 box (and cut by the level-2 box of OBST_BOX3) and a no-slip box
-# whose corner lies in the level-1 box (the box's edge x = 1.3 crosses it). FLOOR: a slab under
+# whose corner lies in the level-1 box (the box's edge x = 1.3 crosses it); SURFACE: a triangle
+# in the level-1 box that writes its surface pressure. FLOOR: a slab under
 # y = 0.225 (mid-cell of level 0 and of level 1) over the whole period, its face along the
 # stream; FLOOR_BAND refines a band over it (the levels' faces cross the slab inside it),
 # FLOOR_BOX a box whose edges cross its face.
@@ -162,6 +163,8 @@ OBSTACLES = ("[obstacle.disc]\nshape = circle\ncenter = 0.5 0.4\nradius = 0.12\n
 OBST_BOX = "[refine]\nlevels = 2\n\n[refine.box]\nlevel = 1\nlo = 0.3 0.2\nhi = 1.3 0.6\n"
 OBST_BOX3 = OBST_BOX.replace("levels = 2", "levels = 3") + (
     "\n[refine.inner]\nlevel = 2\nlo = 0.4 0.3\nhi = 0.6 0.5\n")
+SURFACE = ("[obstacle.tri]\nshape = polygon\nvertices = 0.8 0.3 1.0 0.3 0.9 0.45\n"
+           "surface_interval = 0.1\n")
 FLOOR = "[obstacle.floor]\nshape = box\nlo = -0.1 -0.1\nhi = 1.7 0.225\n"
 FLOOR_BAND = ("[refine]\nlevels = 3\n\n[refine.band]\nlevel = 1\nlo = 0 0.05\nhi = 1.6 0.5\n\n"
               "[refine.band2]\nlevel = 2\nlo = 0 0.15\nhi = 1.6 0.3\n")

@@ -586,11 +586,8 @@ def part_input():
         else:
             text = case_text(2, 0.1, gas, box, extra=f"[fluid]\n{k} = {value}\n")
         cases.append((f"{key} = {value}", text, key, f"{k} = {value}", "not carried"))
-    # Obstacles act on every level (test_refine_obstacles); their surface output does not.
-    obstacle = ("[obstacle.post]\nshape = polygon\nvertices = 0.25 0.25 0.35 0.25 0.3 0.35\n"
-                "surface_interval = 0.05\n")
-    cases.append(("obstacle's surface output", case_text(2, 0.1, gas, box, extra=obstacle),
-                  "obstacle.post.surface_interval", "surface_interval = 0.05", "surface output"))
+    # Obstacles act on every level (test_refine_obstacles); least_squares, refused with them,
+    # needs the classic update, which its own check and the list above refuse first.
     openface = refined.replace("y_lo = slip\ny_hi = slip", "y_lo = slip\ny_hi = outflow")
     openface = openface.replace("[gas.air]", "[freestream]\ndensity = 1\npressure = 1\n\n[gas.air]")
     cases.append(("open face", openface, "boundary.y_hi", "y_hi = outflow", "not carried"))
@@ -616,8 +613,6 @@ def part_input():
         else:
             text = plain.replace("dx = 0.05", f"dx = 0.05\n{k} = {value}")
         cases.append((f"grid pressure with {key} = {value}", text, key, f"{k} = {value}", words))
-    cases.append(("grid pressure with an obstacle's surface output", plain + "\n" + obstacle,
-                  "obstacle.post.surface_interval", "surface_interval = 0.05", "surface output"))
     cases.append(("grid pressure with an open face", openface.replace(
         "[refine]", grid + "\n[refine]"), "boundary.y_hi", "y_hi = outflow", "open faces"))
     cases.append(("particle pressure with refinement", case_text(

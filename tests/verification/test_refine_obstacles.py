@@ -8,7 +8,8 @@ rest    Gas at rest (rho 1, p 1/1.4, c = 1) around a slip circle and a no-slip b
         (tests/tools/refine_scenes.py, OBSTACLES): the circle inside a level-1 box, the box's
         corner in it (the region's face crosses the body); on 2 levels and on 3 (a level-2 box
         cutting the circle), to t = 0.5: at rest to roundoff, no force on either body, no
-        particle inside a body, particles of every level next to the bodies (~4 s).
+        particle inside a body, particles of every level next to the bodies; a triangle in the
+        level-1 box writes p0 as its surface pressure (~4 s).
 stream  A uniform stream (u = 0.5 c) along the flat face of a slab over the whole period
         (FLOOR), through a level-1 band and a level-2 band over the face whose faces cross the
         slab, to t = 0.5: uniform to roundoff, the force on the slab p L along -y and none along
@@ -32,7 +33,7 @@ import numpy as np
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "tools"))
 import mpmtest as mt  # noqa: E402
 from refine_scenes import (DISC, DISC_ALIGNED, DISC_BAND, FLOOR, FLOOR_BAND, FLOOR_BOX,  # noqa
-                           OBST_BOX, OBST_BOX3, OBSTACLES, case_text)
+                           OBST_BOX, OBST_BOX3, OBSTACLES, SURFACE, case_text)
 
 PART = sys.argv[1] if len(sys.argv) > 1 else "rest"
 check = mt.Checks(f"test_refine_obstacles_{PART}")
@@ -68,8 +69,8 @@ def drifts(out):
 
 def part_rest():
     for levels, refine in ((2, OBST_BOX), (3, OBST_BOX3)):
-        out = run(f"obstacles_rest{levels}", case_text(1.6, 0.5, REST, refine, extra=OBSTACLES,
-                                                       height=0.8))
+        out = run(f"obstacles_rest{levels}", case_text(1.6, 0.5, REST, refine,
+                                                       extra=OBSTACLES + SURFACE, height=0.8))
         p = final(out)
         x, lev = p["x"], p["level"].ravel()
         got = np.hypot(p["v"][:, 0], p["v"][:, 1]).max()
@@ -95,6 +96,12 @@ def part_rest():
         check(min(near) > 0 and near_box > 0,
               f"{levels} levels: particles of levels 1.. within a cell of the circle {near}, of "
               f"level 1 against the box's face x = 1.15: {near_box}")
+        s = np.genfromtxt(os.path.join(out, "surface_tri.csv"), delimiter=",", names=True,
+                          dtype=None, encoding=None)
+        ds = np.abs(s["p"] / P0 - 1).max()
+        # Roundoff: the mass-weighted mean of equal pressures (measured 6.7e-16).
+        check(len(s) > 0 and ds <= 1e-12, f"{levels} levels: the triangle's surface pressure "
+              f"is p0 within {ds:.2e} <= 1e-12 at {len(s)} samples (surface_tri.csv)")
         dm, de = drifts(out)
         # Sums of ~1e4 particle values (n eps); the gas does not move.
         check(dm <= 1e-12 and de <= 1e-12, f"{levels} levels: mass drift {dm:.2e}, energy drift "
