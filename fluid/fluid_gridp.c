@@ -42,8 +42,12 @@
  * its first pass (fluid_module.c, fluid_remap) and moves the volume with the same rate; only the
  * positions follow its remapped velocity.
  *
+ * Obstacles. The massless nodes inside a body are its ghosts: each node with mass takes its own
+ * pressure times the integral of their prolonged mask against grad N_i, and the adjoint rate
+ * (ghost_forces here, fluid_obstacle_levels.c).
+ *
  * Scope (check_scope refuses the rest): the method-of-lines ERK pairs with the current strain
- * rate or the classic update, the quadratic B-spline, a gas alone (no solid or obstacle), no
+ * rate or the classic update, the quadratic B-spline, a gas alone (no solid), no
  * shifting, the point volume rate, open faces with their default exterior (copies, not gauge).
  * On a hierarchy beside a solid, auto keeps the particles' pressure (fluid_gridp_refine). */
 #include "fluid_internal.h"
@@ -67,6 +71,7 @@ struct fluid_gridp {
    * mass they divide by (M: each level's before the walls fold it), and the spans it skips. */
   double *P[MPM_HIER_MAX_LEVELS], *F[MPM_HIER_MAX_LEVELS][MPM_MAX_DIM], *D[MPM_HIER_MAX_LEVELS];
   double *M[MPM_HIER_MAX_LEVELS];
+  double *G[MPM_HIER_MAX_LEVELS][MPM_MAX_DIM]; /* the obstacles' span ghost GH (with obstacles) */
   unsigned char *skip[MPM_HIER_MAX_LEVELS];
   mpm_span_set set[MPM_HIER_MAX_LEVELS];
 };
@@ -93,12 +98,6 @@ static int check_scope(const fluid_content *fc, const mpm_config *cfg, const mpm
   if (count > 0)
     return refuse(cfg, "fluid.pressure",
                   "integrates over every span of the domain, and the case has a solid");
-  MPM_CALL(mpm_config_instances(cfg, "obstacle", &names, &count));
-  if (count > 0) {
-    char key[160];
-    snprintf(key, sizeof key, "obstacle.%s.shape", names[0]);
-    return refuse(cfg, key, "integrates over every span of the domain, obstacles included");
-  }
   int open = 0;
   for (int d = 0; d < g->dim; ++d)
     for (int s = 0; s < 2; ++s) open |= mpm_wall_is_open_gas(fc->walls.face[d][s]);
@@ -152,6 +151,7 @@ void fluid_gridp_reset(fluid_content *fc) {
     free(gp->P[l]), free(gp->D[l]), free(gp->M[l]), free(gp->skip[l]);
     gp->P[l] = gp->D[l] = gp->M[l] = NULL, gp->skip[l] = NULL;
     for (int d = 0; d < MPM_MAX_DIM; ++d) free(gp->F[l][d]), gp->F[l][d] = NULL;
+    for (int d = 0; d < MPM_MAX_DIM; ++d) free(gp->G[l][d]), gp->G[l][d] = NULL;
   }
 }
 
@@ -183,6 +183,7 @@ static int ensure_levels(mpm_module *m, fluid_gridp *gp) {
   if (gp->P[0]) return 0;
   const mpm_hier *h = m->hier;
   gp->nlev = h ? h->nlevels : 1;
+  MPM_CALL(fluid_obstacles_levels(&((fluid_content *)m->content)->obs, m->grid, h, 1));
   for (int l = 0; l < gp->nlev; ++l) {
     const mpm_grid *g = level_grid(m, l);
     const size_t nn = (size_t)g->nnodes;
@@ -190,6 +191,8 @@ static int ensure_levels(mpm_module *m, fluid_gridp *gp) {
     MPM_ALLOC(gp->D[l], nn);
     MPM_ALLOC(gp->M[l], nn);
     for (int d = 0; d < g->dim; ++d) MPM_ALLOC(gp->F[l][d], nn);
+    for (int d = 0; ((fluid_content *)m->content)->obs.count && d < g->dim; ++d)
+      MPM_ALLOC(gp->G[l][d], nn);
     if (l == 0) {
       if (h) {
         MPM_ALLOC(gp->skip[0], nn);
@@ -279,6 +282,37 @@ static void per_mass(const mpm_module *m, const fluid_gridp *gp, double *const *
   }
 }
 
+/* The obstacles' span ghost (fluid_obstacle_levels.c): the mask of the massless nodes inside a
+ * body, prolonged, integrated against grad N_i over each level's spans and restricted (GH, kept
+ * for the rate), into the force p_i GH_i of every node with mass. D is scratch here. */
+static int ghost_forces(mpm_module *m, fluid_gridp *gp) {
+  fluid_obstacles *o = &((fluid_content *)m->content)->obs;
+  const int dim = m->grid->dim;
+  if (o->count == 0) return 0;
+  const mpm_grid *grids[MPM_HIER_MAX_LEVELS];
+  for (int l = 0; l < gp->nlev; ++l) { /* m p of the active nodes for the surface output */
+    const mpm_grid *g = grids[l] = level_grid(m, l);
+    for (mpm_lidx k = 0; k < g->nnodes; ++k) gp->D[l][k] = gp->M[l][k] * gp->P[l][k];
+  }
+  fluid_obstacles_span_surface(o, grids, (const double *const *)gp->M,
+                               (const double *const *)gp->D);
+  for (int l = 0; l < gp->nlev; ++l)
+    fluid_obstacles_span_mask(o, l, level_grid(m, l), gp->M[l],
+                              m->hier ? m->hier->level[l].active : NULL, gp->D[l]);
+  MPM_CALL(prolong_all(m, gp->D));
+  for (int l = 0; l < gp->nlev; ++l) {
+    const mpm_grid *g = level_grid(m, l);
+    for (int d = 0; d < dim; ++d) memset(gp->G[l][d], 0, sizeof(double) * (size_t)g->nnodes);
+    mpm_span_force(g, &gp->set[l], gp->D[l], gp->G[l]);
+  }
+  MPM_CALL(restrict_all(m, gp->G, dim));
+  for (int l = 0; l < gp->nlev; ++l)
+    fluid_obstacles_span_force(o, l, m->hier ? m->hier->level[l].grid : m->grid, m->phase, gp->P[l],
+                               gp->M[l], m->hier ? m->hier->level[l].active : NULL,
+                               (const double *const *)gp->G[l]);
+  return 0;
+}
+
 int fluid_gridp_forces(mpm_module *m) {
   fluid_content *fc = m->content;
   fluid_gridp *gp = fc->gridp;
@@ -312,7 +346,7 @@ int fluid_gridp_forces(mpm_module *m) {
     for (int d = 0; d < dim; ++d)
       for (mpm_lidx k = 0; k < g->nnodes; ++k) ph->f_i[d][k] += gp->F[l][d][k];
   }
-  return 0;
+  return ghost_forces(m, gp);
 }
 
 int fluid_gridp_nodal_rate(mpm_module *m, const mpm_hier_nodal *vel, mpm_hier_scalars *s) {
@@ -328,6 +362,10 @@ int fluid_gridp_nodal_rate(mpm_module *m, const mpm_hier_nodal *vel, mpm_hier_sc
     D[l][0] = gp->D[l];
   }
   MPM_CALL(restrict_all(m, D, 1));
+  for (int l = 0; fc->obs.count && l < gp->nlev; ++l)
+    fluid_obstacles_span_rate(level_grid(m, l), m->phase, gp->M[l],
+                              m->hier ? m->hier->level[l].active : NULL,
+                              (const double *const *)gp->G[l], gp->D[l]);
   per_mass(m, gp, gp->D, gp->P); /* P now holds the rate per unit mass */
   MPM_CALL(prolong_all(m, gp->P));
   memset(s, 0, sizeof *s);

@@ -432,9 +432,9 @@ static int fluid_p2g_rate(mpm_module *m, double t, const double *y) {
 static int fluid_forces(mpm_module *m, double t, double h, mpm_pass pass) {
   fluid_content *fc = m->content;
   const int first = pass == MPM_PASS_FIRST;
-  if (first && fc->gridp) MPM_CALL(fluid_gridp_forces(m));
+  if (first) MPM_CALL(fluid_obstacles_begin(&fc->obs, m->grid, m->phase, t, h, 1));
+  if (first && fc->gridp) MPM_CALL(fluid_gridp_forces(m)); /* after begin: the span ghost */
   if (first) {
-    MPM_CALL(fluid_obstacles_begin(&fc->obs, m->grid, m->phase, t, h, 1));
     MPM_CALL(fluid_virtual_forces(&fc->virt, m->grid, m->phase, NULL, 0));
     MPM_CALL(fluid_open_gauge_forces(fc->open, m));
   }
@@ -456,6 +456,7 @@ static int fluid_constrain(mpm_module *m, double t, double h, mpm_pass pass) {
   if (fc->obs.count) {
     MPM_CALL(fluid_obstacles_apply(&fc->obs, m->grid, m->phase, first ? h : 0.0, first));
     mpm_constraints_apply(&fc->cons, m->grid, m->phase);
+    if (m->hier) mpm_hier_walls_apply(m->hier, m->phase);
     if (first) MPM_CALL(fluid_obstacles_work(&fc->obs, m->grid, m->phase, h));
   }
   return 0;

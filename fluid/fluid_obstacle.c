@@ -348,7 +348,7 @@ static int check_overlap(const fluid_obstacle *ob, const reader *r, const mpm_gr
 
 /* phi (and the normal) at x, nearest over the periodic images of x: a body near a periodic face
  * is also near the nodes beyond the opposite face. */
-static double phi_images(const mpm_sdf *sdf, const mpm_grid *g, const double *x, double *normal) {
+double fluid_obstacle_phi(const mpm_sdf *sdf, const mpm_grid *g, const double *x, double *normal) {
   double best = HUGE_VAL;
   const int nimg = g->dim == 2 ? 9 : 27;
   for (int k = 0; k < nimg; ++k) {
@@ -380,7 +380,7 @@ static int find_nodes(fluid_obstacle *ob, const mpm_grid *g, double band) {
       double x[3] = {0, 0, 0}, nrm[3];
       mpm_grid_node_global(g, l, gi);
       for (int d = 0; d < dim; ++d) x[d] = g->lo[d] + gi[d] * g->dx;
-      if (!(phi_images(&ob->sdf, g, x, nrm) < band)) continue;
+      if (!(fluid_obstacle_phi(&ob->sdf, g, x, nrm) < band)) continue;
       if (pass) {
         ob->node[n] = l;
         memcpy(ob->normal + (size_t)dim * n, nrm, sizeof *nrm * (size_t)dim);
@@ -506,7 +506,7 @@ static int nearest(const fluid_obstacles *o, const mpm_grid *g, const int *gi) {
   int k_best = 0;
   for (int d = 0; d < g->dim; ++d) x[d] = g->lo[d] + gi[d] * g->dx;
   for (int k = 0; k < o->count; ++k) {
-    const double phi = phi_images(&o->ob[k].sdf, g, x, NULL);
+    const double phi = fluid_obstacle_phi(&o->ob[k].sdf, g, x, NULL);
     if (phi < best) best = phi, k_best = k;
   }
   return k_best;
@@ -591,8 +591,10 @@ int fluid_obstacles_build(fluid_obstacles *o, const mpm_config *cfg, const mpm_g
   double band;
   memset(o, 0, sizeof *o);
   o->ppc = ppc, o->lp = 0.5 / ppc, o->hold = FLUID_OBSTACLE_HOLD;
+  o->nlev = 1;
   memcpy(o->open, open, sizeof o->open);
   MPM_CALL(mpm_config_get_real(cfg, "fluid.obstacle_band", &band));
+  o->band = band;
   MPM_CALL(mpm_config_get_string(cfg, "output.dir", &dir));
   snprintf(o->path, sizeof o->path, "%s/obstacles.csv", dir);
   MPM_CALL(mpm_config_instances(cfg, "obstacle", &names, &count));
@@ -663,7 +665,7 @@ static int list_reserve(fluid_obstacles *o, mpm_lidx n) {
 void fluid_obstacles_deposit(fluid_obstacles *o, const mpm_grid *grid, mpm_lidx n,
                              const double *const *x, const double *m, const double *V0,
                              const double *J, const double *vsig, const double *e, double gamma) {
-  if (o->count == 0) return;
+  if (o->count == 0 || o->span) return; /* the span ghost reads the grid pressure's nodes */
   const int dim = grid->dim;
   double *sm = o->sm, *smp = o->sm + grid->nnodes, *smt = o->sm + 2 * (size_t)grid->nnodes;
   memset(sm, 0, sizeof *sm * (size_t)o->nsm * grid->nnodes);
@@ -698,14 +700,14 @@ int fluid_obstacles_begin(fluid_obstacles *o, mpm_grid *grid, int phase, double 
   const int dim = grid->dim;
   double *sm = o->sm, *smp = o->sm + grid->nnodes, *smt = o->sm + 2 * (size_t)grid->nnodes;
   double *fields[3] = {sm, smp, smt};
-  MPM_CALL(mpm_grid_halo_reverse(grid, fields, o->nsm));
+  if (!o->span) MPM_CALL(mpm_grid_halo_reverse(grid, fields, o->nsm)); /* else not deposited */
   double *rec = o->f[record ? mpm_rhs_records_begin(&o->rec, t, h) : o->rec.latest];
   if (record) memset(rec, 0, sizeof *rec * (size_t)dim * o->count);
   if (record && o->heat) memset(o->q, 0, sizeof *o->q * (size_t)grid->nnodes);
-  for (int k = 0; record && k < o->count; ++k)
+  for (int k = 0; record && !o->span && k < o->count; ++k)
     if (o->ob[k].surf.n) fluid_surface_sample(&o->ob[k].surf, grid, sm, smt, o->own);
   mpm_grid_phase *ph = &grid->phase[phase];
-  for (mpm_lidx k = 0; k < o->gcount; ++k) {
+  for (mpm_lidx k = 0; !o->span && k < o->gcount; ++k) {
     const mpm_lidx l = o->gnode[k];
     if (!(sm[l] > 0.0)) continue;
     const double p = smp[l] / sm[l];
@@ -721,21 +723,23 @@ int fluid_obstacles_begin(fluid_obstacles *o, mpm_grid *grid, int phase, double 
 /* Constrain one obstacle's nodes; adds this rank's owned share of the force to f. Nodes with
  * less mass than hold_below are held entirely (see the header). In the classic update the
  * velocity change is an impulse over the step (mpm_impulse.h). */
-static void apply_one(const fluid_obstacle *ob, mpm_grid_phase *ph, int dim, double h,
-                      double hold_below, int coast, double *f, double *q) {
-  for (mpm_lidx k = 0; k < ob->count; ++k) {
-    const mpm_lidx l = ob->node[k];
+void fluid_obstacle_constrain(const mpm_lidx *node, const double *normal,
+                              const unsigned char *owned, mpm_lidx count, int no_slip,
+                              mpm_grid_phase *ph, int dim, double h, double hold_below, int coast,
+                              double *f, double *q) {
+  for (mpm_lidx k = 0; k < count; ++k) {
+    const mpm_lidx l = node[k];
     const double m = ph->m_i[l];
     if (!(m > 0.0)) continue; /* empty: the nodal update left v = a = 0 */
-    const double *n = ob->normal + (size_t)dim * k;
-    const int hold = ob->no_slip || m < hold_below;
+    const double *n = normal + (size_t)dim * k;
+    const int hold = no_slip || m < hold_below;
     double vn = 0.0, an = 0.0, v[MPM_MAX_DIM], a[MPM_MAX_DIM], force[MPM_MAX_DIM];
     for (int d = 0; d < dim; ++d) vn += ph->v_i[d][l] * n[d], an += ph->a_i[d][l] * n[d];
     for (int d = 0; d < dim; ++d) {
       v[d] = hold ? 0.0 : ph->v_i[d][l] - vn * n[d];
       a[d] = hold ? 0.0 : ph->a_i[d][l] - an * n[d];
     }
-    if (hold && coast && h > 0 && !ob->no_slip) { /* v^n = v - h a, slip-projected */
+    if (hold && coast && h > 0 && !no_slip) { /* v^n = v - h a, slip-projected */
       double v0n = 0.0;
       for (int d = 0; d < dim; ++d) v0n += (ph->v_i[d][l] - h * ph->a_i[d][l]) * n[d];
       for (int d = 0; d < dim; ++d) v[d] = ph->v_i[d][l] - h * ph->a_i[d][l] - v0n * n[d];
@@ -743,7 +747,7 @@ static void apply_one(const fluid_obstacle *ob, mpm_grid_phase *ph, int dim, dou
     const double power = mpm_impulse_apply(ph, dim, l, v, a, h, force);
     if (q) q[l] += power;
     /* the force the gas exerts on the obstacle: minus the rate the obstacle gives the gas */
-    for (int d = 0; ob->owned[k] && d < dim; ++d) f[d] -= force[d];
+    for (int d = 0; (!owned || owned[k]) && d < dim; ++d) f[d] -= force[d];
   }
 }
 
@@ -758,16 +762,18 @@ int fluid_obstacles_apply(fluid_obstacles *o, mpm_grid *grid, int phase, double 
   MPM_CALL_MPI(MPI_Allreduce(MPI_IN_PLACE, &mmax, 1, MPI_DOUBLE, MPI_MAX, grid->comm));
   for (mpm_lidx k = 0; record && k < o->lcount; ++k) { /* empty or light: the body took f_i */
     const mpm_lidx l = o->lnode[k];
-    if (!(ph->m_i[l] > 0.0) || ph->m_i[l] > ph->m_empty) continue;
+    if ((!o->span && !(ph->m_i[l] > 0.0)) || ph->m_i[l] > ph->m_empty) continue;
     double *f = o->f[o->rec.latest] + (size_t)dim * o->lob[k];
     for (int d = 0; d < dim; ++d) f[d] += ph->f_i[d][l];
   }
   for (int k = 0; k < o->count; ++k) {
     double *f = record ? o->f[o->rec.latest] + (size_t)dim * k : scratch;
-    apply_one(&o->ob[k], &grid->phase[phase], dim, h, o->hold * mmax, o->coast, f,
-              record && o->heat ? o->q : NULL);
+    const fluid_obstacle *ob = &o->ob[k];
+    fluid_obstacle_constrain(ob->node, ob->normal, ob->owned, ob->count, ob->no_slip,
+                             &grid->phase[phase], dim, h, o->hold * mmax, o->coast, f,
+                             record && o->heat ? o->q : NULL);
   }
-  return 0;
+  return o->hier ? fluid_obstacles_apply_levels(o, phase, h, record) : 0;
 }
 
 void fluid_obstacles_book_heat(fluid_obstacles *o, const mpm_grid *g) {
@@ -864,6 +870,7 @@ int fluid_obstacles_report(fluid_obstacles *o, const mpm_grid *grid, double t, d
 }
 
 void fluid_obstacles_free(fluid_obstacles *o) {
+  fluid_obstacles_levels_free(o); /* reads o->ob */
   for (int k = 0; k < o->count; ++k) {
     mpm_sdf_free(&o->ob[k].sdf);
     fluid_surface_free(&o->ob[k].surf);

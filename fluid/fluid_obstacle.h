@@ -14,6 +14,10 @@
  * evaluated once, at build. Nodes deep inside carry no mass (no particle is seeded inside, and
  * the stencil of a particle outside reaches at most two cells in), so they cost one comparison.
  *
+ * Levels and the grid pressure. On a refinement hierarchy every level constrains its active
+ * nodes, and with the grid pressure (any hierarchy, or fluid.pressure = grid) the ghosts are the
+ * massless nodes inside a body instead of the lattice below (fluid_obstacle_levels.c).
+ *
  * Ghost pressure. Held nodes alone leave the nodes next to the surface with an incomplete
  * stencil: the gas pressure pushes them towards the body (a force of order p / dx per unit
  * volume), so gas at rest does not stay at rest and slips into the body at corners. Like the
@@ -63,6 +67,7 @@
 #include "mpm_config.h"
 #include "mpm_diag.h"
 #include "mpm_grid.h"
+#include "mpm_hier.h"
 #include "mpm_impulse.h"
 #include "mpm_sdf.h"
 #include "mpm_shape.h"
@@ -88,6 +93,12 @@ typedef struct fluid_obstacle {
   mpm_lidx *node;          /* box index */
   double *normal;          /* dim per node */
   unsigned char *owned;    /* counted in the force */
+  /* Levels >= 1 of a hierarchy (fluid_obstacle_levels.c): the active nodes with
+   * phi < band h_l and their normals (index 0 unused; the level-0 nodes are the above). */
+  struct {
+    mpm_lidx count, *node;
+    double *normal;
+  } fine[MPM_HIER_MAX_LEVELS];
 } fluid_obstacle;
 
 typedef struct fluid_obstacles {
@@ -125,7 +136,19 @@ typedef struct fluid_obstacles {
   double *q;                /* per box node: the rate at which the obstacles put energy into the gas
                                in the latest recorded RHS (ghost work and constraint power), W, then
                                per unit nodal mass, W/kg (fluid_obstacles_work) */
-  char path[4096];          /* obstacles.csv */
+  /* The span ghost (fluid_obstacle_levels.c): with the grid pressure (fluid.pressure = grid,
+   * and any refinement) the ghosts are the massless nodes inside a body; per level l of
+   * nlev: inside[l] marks the box nodes inside a body (phi < 0, mirrored into the domain across
+   * a wall), nob[l] the nearest obstacle of a node (-1: not yet found); the reach of the finer
+   * levels (rcount, rnode, rob: the constrained active nodes, each once). */
+  int span, nlev;
+  const mpm_hier *hier; /* NULL: level 0 alone */
+  double band;          /* fluid.obstacle_band, cells */
+  unsigned char *inside[MPM_HIER_MAX_LEVELS];
+  int *nob[MPM_HIER_MAX_LEVELS];
+  mpm_lidx rcount[MPM_HIER_MAX_LEVELS], *rnode[MPM_HIER_MAX_LEVELS];
+  int *rob[MPM_HIER_MAX_LEVELS];
+  char path[4096]; /* obstacles.csv */
   mpm_diag *csv;
 } fluid_obstacles;
 
@@ -186,5 +209,41 @@ void fluid_obstacles_heat(const fluid_obstacles *o, const mpm_grid *grid, mpm_li
  * obstacle to obstacles.csv (opened at the first call; appended after a restart). Collective. */
 int fluid_obstacles_report(fluid_obstacles *o, const mpm_grid *grid, double t, double h);
 void fluid_obstacles_free(fluid_obstacles *o);
+
+/* ---- on every level, and with the grid pressure (fluid_obstacle_levels.c) ---------------- */
+
+/* phi at x (and the outward normal), nearest over the periodic images of x along g's periodic
+ * axes. */
+double fluid_obstacle_phi(const mpm_sdf *sdf, const mpm_grid *g, const double *x, double *normal);
+/* Constrain count nodes (box indices node, normals normal, owned NULL: all owned) of phase ph
+ * as fluid_obstacles_apply does; adds the owned share of the force to f and the power to q. */
+void fluid_obstacle_constrain(const mpm_lidx *node, const double *normal,
+                              const unsigned char *owned, mpm_lidx count, int no_slip,
+                              mpm_grid_phase *ph, int dim, double h, double hold_below, int coast,
+                              double *f, double *q);
+/* Set the obstacles up on the levels of h (NULL: level 0 alone) for the span ghost, span 1
+ * with the grid pressure; drops what an earlier hierarchy left. grid: level 0. */
+int fluid_obstacles_levels(fluid_obstacles *o, const mpm_grid *grid, const mpm_hier *h, int span);
+void fluid_obstacles_levels_free(fluid_obstacles *o);
+/* Span ghost, level l (grid g, active mask act or NULL, the nodal mass M after the deposit):
+ * U = 1 on the active massless nodes inside a body, else 0. */
+void fluid_obstacles_span_mask(const fluid_obstacles *o, int l, const mpm_grid *g, const double *M,
+                               const unsigned char *act, double *U);
+/* Span ghost, level l: add P_i GH_i (GH: the integral of the prolonged mask times grad N_i,
+ * restricted) to phase's f_i on the active nodes with mass, and minus it to the nearest
+ * obstacle's recorded force (owned nodes). */
+void fluid_obstacles_span_force(fluid_obstacles *o, int l, mpm_grid *g, int phase, const double *P,
+                                const double *M, const unsigned char *act, const double *const *GH);
+/* With the grid pressure: the surface output's sums of this RHS, each point from the nodes
+ * around it of the finest level whose region holds it (M: nodal mass, MP: m p, per level;
+ * grids: the levels' grids). */
+void fluid_obstacles_span_surface(fluid_obstacles *o, const mpm_grid *const *grids,
+                                  const double *const *M, const double *const *MP);
+/* Span ghost, level l: D_i -= v_i . GH_i on the active nodes with mass (the ghosts move with the
+ * node they act on: the adjoint of the ghost force, and a uniform stream keeps D = 0). */
+void fluid_obstacles_span_rate(const mpm_grid *g, int phase, const double *M,
+                               const unsigned char *act, const double *const *GH, double *D);
+/* Constrain the finer levels' nodes after the solve (see fluid_obstacles_apply). Collective. */
+int fluid_obstacles_apply_levels(fluid_obstacles *o, int phase, double h, int record);
 
 #endif

@@ -20,13 +20,15 @@
  * time-centred nodal velocity and the heat shares' scalars on every level and gathers through
  * the hierarchy, and weighs its wall rule at the particle's level spacing (fluid_transfer.c);
  * MUSL's remap deposits through the hierarchy (fluid_module.c) and the coupler restricts it; the
- * grid pressure runs with both (fluid_gridp.c).
+ * grid pressure runs with both (fluid_gridp.c). Obstacles (ghost treatment) act on every level:
+ * the constraint on each level's active nodes and the ghosts through the grid pressure's spans
+ * (fluid_obstacle_levels.c).
  *
  * Refused (fluid_refine_check), each naming its key: everything that reads or writes the gas's
  * nodal fields or the grid otherwise: the domain volume rate, the riemann viscosity's limiter,
  * shifting, regularisation and refill (cell counts), the neighbourhood stable step, the light-node
- * threshold, obstacles. An odd fluid.ppc puts level-0 particles on the span faces that bound the
- * finer regions, so it is refused too.
+ * threshold, the least-squares wall treatment. An odd fluid.ppc puts level-0 particles on the span
+ * faces that bound the finer regions, so it is refused too.
  *
  * Invariant: with m->hier NULL every call here is the plain kernel call (the refined path costs
  * one pointer test per transfer). */
@@ -133,6 +135,9 @@ static const refusal g_refused[] = {
     {"fluid.regularise_every", NULL, "merging and splitting count particles in level-0 cells"},
     {"fluid.refill_every", NULL, "refilling counts particles in level-0 cells"},
     {"fluid.light_node_mass", NULL, "the mean nodal mass is level 0's"},
+    {"fluid.wall_treatment", "least_squares",
+     "the least-squares wall fits the particles in level-0 cells and books heat on level 0's "
+     "nodes"},
 };
 
 /* The reason g_refused gives for key (looked up, so that rows may come and go). */
@@ -140,19 +145,6 @@ static const char *refused_why(const char *key) {
   for (size_t k = 0; k < sizeof g_refused / sizeof g_refused[0]; ++k)
     if (strcmp(g_refused[k].key, key) == 0) return g_refused[k].why;
   return "";
-}
-
-/* The first obstacle of the case: refused with its key. */
-static int refuse_obstacles(const mpm_config *cfg) {
-  const char *const *names;
-  int count;
-  MPM_CALL(mpm_config_instances(cfg, "obstacle", &names, &count));
-  if (count > 0) {
-    char key[160];
-    snprintf(key, sizeof key, "obstacle.%s.shape", names[0]);
-    return refuse(cfg, key, "obstacles constrain and deposit on level 0's nodes");
-  }
-  return 0;
 }
 
 int fluid_refine_check(const mpm_module *m, const mpm_config *cfg) {
@@ -164,7 +156,6 @@ int fluid_refine_check(const mpm_module *m, const mpm_config *cfg) {
   }
   if (fc->reg_every > 0)
     return refuse(cfg, "fluid.regularise_every", refused_why("fluid.regularise_every"));
-  MPM_CALL(refuse_obstacles(cfg));
   if (fc->ppc % 2)
     return mpm_config_fail(
         cfg, "fluid.ppc",

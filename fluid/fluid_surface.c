@@ -49,7 +49,12 @@ int fluid_surface_build(fluid_surface *s, const char *path, double interval, con
 void fluid_surface_sample(fluid_surface *s, const mpm_grid *g, const double *sm, const double *smp,
                           const unsigned char *own) {
   memset(s->sum, 0, sizeof *s->sum * 2 * (size_t)s->n);
-  for (int i = 0; i < s->n; ++i) {
+  for (int i = 0; i < s->n; ++i) fluid_surface_sample_point(s, i, g, sm, smp, own);
+}
+
+void fluid_surface_sample_point(fluid_surface *s, int i, const mpm_grid *g, const double *sm,
+                                const double *smp, const unsigned char *own) {
+  {
     double xi[2];
     int base[2];
     for (int d = 0; d < 2; ++d) {
@@ -63,7 +68,7 @@ void fluid_surface_sample(fluid_surface *s, const mpm_grid *g, const double *sm,
       for (int d = 0; d < 2; ++d) in &= gi[d] >= g->box_lo[d] && gi[d] < g->box_lo[d] + g->box_n[d];
       if (!in) continue;
       const mpm_lidx l = mpm_grid_local_index(g, gi);
-      if (!own[l] || !(sm[l] > 0.0)) continue;
+      if ((own && !own[l]) || !(sm[l] > 0.0)) continue;
       const double w = (off[0] ? xi[0] : 1.0 - xi[0]) * (off[1] ? xi[1] : 1.0 - xi[1]);
       s->sum[2 * i] += w * sm[l], s->sum[2 * i + 1] += w * smp[l];
     }

@@ -53,6 +53,9 @@ int fluid_surface_build(fluid_surface *s, const char *path, double interval, con
  * owned nodes (own). */
 void fluid_surface_sample(fluid_surface *s, const mpm_grid *g, const double *sm, const double *smp,
                           const unsigned char *own);
+/* Add point i's share of g's nodes to its sums (own NULL: all owned), without zeroing them. */
+void fluid_surface_sample_point(fluid_surface *s, int i, const mpm_grid *g, const double *sm,
+                                const double *smp, const unsigned char *own);
 /* After an accepted step from t - h to t: reduce the sums, add them to the window and write the
  * window when t reaches its end. Collective. */
 int fluid_surface_step(fluid_surface *s, const mpm_grid *g, double t, double h);

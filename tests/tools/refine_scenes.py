@@ -326,3 +326,30 @@ def wall_pulse_profile(p):
     pp = np.bincount(k, p["m"].ravel() * (p["p"].ravel() - 1 / 1.4), 80) / w
     vv = np.bincount(k, p["m"].ravel() * p["v"][:, 1], 80) / w
     return 0.5 * (pp + vv), 0.5 * (pp - vv)  # up-running, down-running (Z = 1)
+
+# Static obstacles on the hierarchy (tests/verification/test_refine_obstacles.py), in the strip
+# of case_text (1.6 x 0.8, periodic along x, slip walls along y, dx = 0.05). OBSTACLES: a circle
+# wholly inside the level-1 box (and cut by the level-2 box of OBST_BOX3) and a no-slip box
+# whose corner lies in the level-1 box (the box's edge x = 1.3 crosses it); SURFACE: a triangle
+# in the level-1 box that writes its surface pressure. FLOOR: a slab under
+# y = 0.225 (mid-cell of level 0 and of level 1) over the whole period, its face along the
+# stream; FLOOR_BAND refines a band over it (the levels' faces cross the slab inside it),
+# FLOOR_BOX a box whose edges cross its face.
+OBSTACLES = ("[obstacle.disc]\nshape = circle\ncenter = 0.5 0.4\nradius = 0.12\n\n"
+             "[obstacle.block]\nshape = box\ncondition = no_slip\nlo = 1.15 0.2\nhi = 1.45 0.5\n")
+OBST_BOX = "[refine]\nlevels = 2\n\n[refine.box]\nlevel = 1\nlo = 0.3 0.2\nhi = 1.3 0.6\n"
+OBST_BOX3 = OBST_BOX.replace("levels = 2", "levels = 3") + (
+    "\n[refine.inner]\nlevel = 2\nlo = 0.4 0.3\nhi = 0.6 0.5\n")
+SURFACE = ("[obstacle.tri]\nshape = polygon\nvertices = 0.8 0.3 1.0 0.3 0.9 0.45\n"
+           "surface_interval = 0.1\n")
+FLOOR = "[obstacle.floor]\nshape = box\nlo = -0.1 -0.1\nhi = 1.7 0.225\n"
+FLOOR_BAND = ("[refine]\nlevels = 3\n\n[refine.band]\nlevel = 1\nlo = 0 0.05\nhi = 1.6 0.5\n\n"
+              "[refine.band2]\nlevel = 2\nlo = 0 0.15\nhi = 1.6 0.3\n")
+FLOOR_BOX = "[refine]\nlevels = 2\n\n[refine.box]\nlevel = 1\nlo = 0.5 0.1\nhi = 1.1 0.45\n"
+# DISC: a slip circle in a uniform stream (u = 0.5 c) along the strip, started impulsively;
+# DISC_BAND refines a level-1 band over it. Level 1's nodes sit half a level-1 cell off a
+# uniform fine grid's (o_1 = lo - h_1 / 2), so the fine twin that level 1 reproduces is the one
+# with the disc moved by (h_1 / 2, h_1 / 2): DISC_ALIGNED.
+DISC = "[obstacle.disc]\nshape = circle\ncenter = 0.6 0.4\nradius = 0.1\n"
+DISC_ALIGNED = DISC.replace("center = 0.6 0.4", "center = 0.6125 0.4125")
+DISC_BAND = "[refine]\nlevels = 2\n\n[refine.band]\nlevel = 1\nlo = 0 0.2\nhi = 1.6 0.6\n"

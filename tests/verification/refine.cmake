@@ -76,3 +76,11 @@ foreach(method usl musl)
                         ARGS ${part} ${method} LABELS verification TIMEOUT 300)
   endforeach()
 endforeach()
+# Static obstacles on every level (the gas): gas at rest around a circle and a box's corner in
+# refined boxes, on 2 and 3 levels (~4 s); a uniform stream along a slab's face through bands
+# over it and its uniform twin (~6 s); a stream past a circle in a band against its aligned fine
+# twin (~8 s).
+foreach(part rest stream disc)
+  mpm_add_script_test(test_refine_obstacles_${part} SCRIPT verification/test_refine_obstacles.py
+                      ARGS ${part} LABELS verification TIMEOUT 300)
+endforeach()

@@ -585,9 +585,12 @@ def part_input():
         else:
             text = case_text(2, 0.1, gas, box, extra=f"[fluid]\n{k} = {value}\n")
         cases.append((f"{key} = {value}", text, key, f"{k} = {value}", "not carried"))
+    # Obstacles act on every level (test_refine_obstacles); the least-squares wall does not.
     obstacle = "[obstacle.post]\nshape = circle\ncenter = 0.3 0.3\nradius = 0.05\n"
-    cases.append(("obstacle", case_text(2, 0.1, gas, box, extra=obstacle), "obstacle.post.shape",
-                  "shape = circle", "not carried"))
+    lsq = case_text(2, 0.1, gas, box, extra="[fluid]\nwall_treatment = least_squares\n\n" +
+                    obstacle).replace("t_end = 0.1", "t_end = 0.1\nmethod = usl")
+    cases.append(("least-squares wall", lsq, "fluid.wall_treatment",
+                  "wall_treatment = least_squares", "not carried"))
     # Open faces are carried on level 0 (test_refine_open.py); a box keeps its three cells from
     # them, and the gauge exterior (the particle pressure's) is refused with the grid pressure.
     openface = refined.replace("y_lo = slip\ny_hi = slip", "y_lo = slip\ny_hi = outflow")
@@ -620,8 +623,6 @@ def part_input():
         else:
             text = plain.replace("dx = 0.05", f"dx = 0.05\n{k} = {value}")
         cases.append((f"grid pressure with {key} = {value}", text, key, f"{k} = {value}", words))
-    cases.append(("grid pressure with an obstacle", plain + "\n" + obstacle,
-                  "obstacle.post.shape", "shape = circle", "obstacles"))
     cases.append(("grid pressure with the gauge exterior", openface.replace(
         "[refine]", grid + "\n[refine]").replace("levels = 2", "levels = 1").split(
         "\n[refine.box]")[0], "freestream.exterior", "exterior = gauge", "gauge"))
