@@ -99,7 +99,9 @@ static int check_scope(const fluid_content *fc, const mpm_config *cfg, const mpm
     return refuse(cfg, "fluid.pressure",
                   "integrates over every span of the domain, and the case has a solid");
   /* Measured (test_refine_obstacles stream, usl): on a uniform grid a stream along an obstacle's
-   * face left its uniform state by 1.09 under the classic update; the ERK pairs keep it. */
+   * face left its uniform state by 1.09 under the classic update; the ERK pairs keep it. The
+   * cause is the obstacles' hold of barely covered nodes, an impulse in the classic update
+   * (fluid_obstacle.c), which the particle pressure shares (docs/refinement.md). */
   MPM_CALL(mpm_config_instances(cfg, "obstacle", &names, &count));
   if (count > 0 && fc->tr.classic)
     return refuse(cfg, "time.method",
