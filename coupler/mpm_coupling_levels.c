@@ -13,9 +13,9 @@
  * so a scheme skips them as it skips any empty node. A scheme's per-node state (traction's held
  * velocities, the walls' axes of its normals) is kept per level and swapped in with the grid.
  *
- * Carried: velocity and traction (contact needs the classic update, which the gas refuses on a
- * hierarchy). Not carried: traction's least-squares wall (mpm_solid_wall.h gathers the solid on
- * level 0's cells; it needs the classic update too) and the per-body forces of several bodies.
+ * Carried: velocity and traction, under the ERK pairs and usl. Not carried: contact (not
+ * measured on the levels; refused), traction's least-squares wall (mpm_solid_wall.h gathers the
+ * solid on level 0's cells) and the per-body forces of several bodies.
  *
  * Invariants: without a hierarchy nlev = 0 and every hook runs once on the grid, as before, bit
  * for bit; c->grid, c->owned and the per-node state are level 0's between hooks. */
@@ -42,6 +42,11 @@ static int level_state(mpm_coupling *c, int l, mpm_lidx nn) {
 
 int mpm_coupling_set_hier(mpm_coupling *c, const mpm_config *cfg, const mpm_hier *h) {
   if (!c || !h || h->nlevels < 2) return 0;
+  if (strcmp(c->type->name, "contact") == 0)
+    return mpm_config_fail(cfg, "coupling.scheme",
+                           "coupling.scheme = contact is not carried to the refined levels "
+                           "(refine.levels > 1); use velocity or traction, or set refine.levels "
+                           "= 1 (docs/refinement.md)");
   if (strcmp(c->type->name, "traction") == 0 && c->content) /* its least-squares wall */
     return mpm_config_fail(cfg, "fluid.wall_treatment",
                            "the solid's surface as the gas's least-squares wall is not carried "

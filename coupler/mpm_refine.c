@@ -107,7 +107,7 @@ static int carried_walls(const mpm_config *cfg, const mpm_grid *g, mpm_module **
 
 /* A solid beside a gas: the coupling runs on every level (mpm_coupling_set_hier) in the
  * monolithic time scheme alone (the partitioned ones keep interface state on level 0), with the
- * ERK pairs (usl below). */
+ * ERK pairs or usl (musl: the solid refuses it). */
 static int check_coupled(const mpm_config *cfg) {
   const char *time;
   MPM_CALL(mpm_config_get_string(cfg, "coupling.time", &time));
@@ -118,17 +118,6 @@ static int check_coupled(const mpm_config *cfg) {
                            "nodes; use coupling.time = monolithic or set refine.levels = 1 "
                            "(docs/refinement.md)",
                            time);
-  /* Measured (test_refine_fsi.py pulse, usl): the refined run transmits +7.0 % where its coarse
-   * twin gives +2.3 % and its fine twin -0.8 %, not between them as under bs32; not understood
-   * yet, so refused rather than run. */
-  const char *method;
-  MPM_CALL(mpm_config_get_string(cfg, "time.method", &method));
-  if (strcmp(method, "usl") == 0)
-    return mpm_config_fail(cfg, "time.method",
-                           "usl beside a solid is not carried to the refined levels yet (a pulse "
-                           "through the refined interface transmits 7 %% too much, worse than "
-                           "the coarse grid); use an ERK pair (bs32) or set refine.levels = 1 "
-                           "(docs/refinement.md)");
   return 0;
 }
 

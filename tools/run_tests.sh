@@ -52,7 +52,7 @@
 #   test_hier_*), the classic update's studies test_refine_usl_{pulse,sod,wall} and
 #   test_refine_musl_{pulse,sod,wall,regrid} (its transfer, remap and regrids run there in
 #   test_refine_usl_uniform, _regrid and test_refine_musl_uniform), the gas beside a solid's
-#   pulse studies test_refine_fsi_pulse and _traction (its coupling on every level in
+#   pulse studies test_refine_fsi_pulse, _pulse_usl and _traction (its coupling on every level in
 #   test_refine_fsi_rest and _restart), the open faces' test_refine_open_stream and _shock (in
 #   test_refine_open_farfield and _ranks) and the obstacles' test_refine_obstacles_disc (in
 #   test_refine_obstacles_rest and _stream);
@@ -72,7 +72,8 @@ PLAIN_ONLY+="|csm1|csm3_fast|axial_bar|cantilever3d|model_swap|ranks_solid|perio
 PLAIN_ONLY+="|decomposition|restart_cases|run_safety|euler_reference"
 PLAIN_ONLY+="|refine_gas_pulse|refine_gas_uniform3d|refine_gas_dynamic"
 PLAIN_ONLY+="|refine_usl_pulse|refine_usl_sod|refine_usl_wall|refine_musl_pulse|refine_musl_sod"
-PLAIN_ONLY+="|refine_musl_wall|refine_musl_regrid|refine_fsi_pulse|refine_fsi_traction"
+PLAIN_ONLY+="|refine_musl_wall|refine_musl_regrid|refine_fsi_pulse|refine_fsi_pulse_usl"
+PLAIN_ONLY+="|refine_fsi_traction"
 PLAIN_ONLY+="|refine_open_stream|refine_open_shock|refine_obstacles_disc"
 BOTH="checkpoint_integrity"
 

@@ -164,19 +164,25 @@ FSI_DX, FSI_X_I, FSI_L_S, FSI_LENGTH = 0.02, 1.0, 1.6, 3.0
 FSI_RHO_S, FSI_E = 0.25, 22.4
 FSI_AMBIENT = "density = 1\npressure = 1\n"
 FSI_BAND = ("[refine]\nlevels = 2\n\n[refine.band]\nlevel = 1\nlo = 0.9 0\n"
-            "hi = 2.7 {height}\n")
+            "hi = {band_hi} {height}\n")
+# The pulse's slab (FSI_PULSE_L_S long): its far face's echo reaches the probe after the
+# incident pulse's tail, dispersed on level 0, has passed (tests/verification/test_refine_fsi.py).
+FSI_PULSE_L_S = 2.8
 
 
-def fsi_case(t_end, refine, dx=FSI_DX, pulse="", extra="", interval=None):
+def fsi_case(t_end, refine, dx=FSI_DX, pulse="", extra="", interval=None, slab=FSI_L_S):
+    """The scene with a slab `slab` long (the right gas column and the band's margin as for
+    FSI_L_S's)."""
     h = 3 * FSI_DX
-    xs = FSI_X_I + FSI_L_S
+    xs = FSI_X_I + slab
+    length = round(FSI_LENGTH + slab - FSI_L_S, 9)
     return f"""[run]
 name = refine_fsi
 
 [domain]
 dim = 2
 lo = 0 0
-hi = {FSI_LENGTH} {h}
+hi = {length} {h}
 
 [grid]
 dx = {dx}
@@ -212,7 +218,7 @@ hi = {xs} {h}
 [geometry.right]
 type = box
 lo = {xs} 0
-hi = {FSI_LENGTH} {h}
+hi = {length} {h}
 
 [gas.left]
 geometry = left
@@ -231,7 +237,7 @@ E = {FSI_E}
 nu = 0
 initial_pressure = 1
 {extra}
-{refine.format(height=h) if refine else ""}"""
+{refine.format(height=h, band_hi=round(xs + 0.1, 9)) if refine else ""}"""
 
 
 # The pulse: right-going, p' = A f, rho' = p' / c^2, u = p' / Z_g, f = exp(-((x - 0.45) / 0.05)^2 / 2)

@@ -59,9 +59,10 @@ mpm_add_script_test(test_refine_open_ranks SCRIPT verification/test_refine_open.
                     LABELS "verification;mpi" TIMEOUT 300)
 # A gas beside a solid on a static hierarchy (the coupling on every level): gas and a
 # prestressed slab at rest across a level-1 band (~5 s), an acoustic pulse striking the slab
-# inside the band against the impedance solution and the uniform twins (~20 s), both refined
-# under coupling.scheme = traction (~12 s), a restart (~10 s), every refusal (~5 s).
-foreach(part rest pulse traction restart input)
+# inside the band against the impedance solution and the uniform twins (~30 s), both again
+# under usl (~3 s, ~12 s) and refined under coupling.scheme = traction (~20 s), a restart
+# (~10 s), every refusal (~5 s).
+foreach(part rest pulse rest_usl pulse_usl traction restart input)
   mpm_add_script_test(test_refine_fsi_${part} SCRIPT verification/test_refine_fsi.py
                       ARGS ${part} LABELS verification TIMEOUT 300)
 endforeach()

@@ -1,5 +1,5 @@
 """A gas beside a solid on a static refinement hierarchy (docs/refinement.md, "A gas beside a
-solid"): the coupling scheme (velocity, monolithic, bs32) on every level's active nodes.
+solid"): the coupling scheme (velocity, monolithic, bs32 or usl) on every level's active nodes.
 
 The scene (tests/tools/refine_scenes.py, fsi_case): a quasi-1-D strip periodic along y, slip
 walls at the x ends; gas rho 1, p 1 (Z_g = c_g = 1.1832) on [0, 1] and [2.6, 3]; between them
@@ -13,15 +13,18 @@ rest   Nothing but the scene (gas and slab at rest, the slab's stress balancing 
        pressure), refined, to t = 0.2: every particle stays at rest to roundoff, as on the
        uniform grid; and coupling.csv's interface force balances.
 pulse  A right-going acoustic pulse in the left column (p' = 1e-2 exp(-((x - 0.45) / 0.05)^2
-       / 2)) strikes the slab inside the band. Reflected amplitude: the integral of the gas's
-       p - 1 over x in [0.2, 0.82] at t = 0.8 (the reflected pulse alone, on level 0 again) over
-       the incident's; transmitted: Z_eff times the integral of the velocity of a slab particle
-       next to the interface (probes.csv) over t in [0.25, 0.62] (before the far face's echo)
-       over the incident pressure's time integral. Against the acoustic impedance solution
+       / 2)) strikes the slab inside the band; the slab is 2.8 long here (FSI_PULSE_L_S) so
+       that its far face's echo comes back after the incident pulse's tail. Reflected
+       amplitude: the integral of the gas's p - 1 over x in [0.2, 0.82] at t = 0.85 (the
+       reflected pulse alone, on level 0 again) over the incident's; transmitted: Z_eff times
+       the displacement of a slab particle next to the interface (probes.csv) from t = 0.25 to
+       0.85 (the time integral of its grid velocity, before the echo) over the incident
+       pressure's time integral. Against the acoustic impedance solution
        R = (Z - Z_g) / (Z + Z_g), T = 2 Z / (Z + Z_g) with the prestressed slab's impedance
        Z = Z_s / sqrt(F0) (the code's nominal stress M (F - 1) / F at F0 = M / (M + p), reference
        density rho_s F0) and against the twins; the interface momentum balance of coupling.csv
        on every step; mass and total energy drift against the twins'.
+rest_usl, pulse_usl The rest and pulse parts under time.method = usl (FLIP), with their bounds.
 traction The rest and pulse parts' refined runs under coupling.scheme = traction (the gas
        held to the solid's normal velocity, slip): in the quasi-1-D strip the normal is the whole
        velocity, so they give velocity's figures (at rest to roundoff; T, R within the same bounds;
@@ -35,6 +38,12 @@ this change, the refusal lifted) the rest part's kinetic energy reaches 1.7e-3 J
 (the gas runs into the slab; 1.7e-2 J by t = 0.2) and the pulse part sees no interface force
 and a transmitted velocity 24 times the impedance solution's; the traction part alike (|v| 2.3 at
 rest, T 31.9).
+The transmitted measure before 2026-12-03 (the velocity's integral over [0.25, 0.62], a slab 1.6
+long) cut off the trailing lobe that the pulse (sigma = 2.5 level-0 cells) grows while it crosses
+level 0, and read one particle's FLIP velocity: T +7.0 % refined, +9.3 % coarse under bs32, and
+under usl a coarse +2.3 % that its neighbours' velocities (+9.6 % .. +13.6 %) and its own
+displacement (+7.9 %) contradict. A band that holds the pulse from the start (lo = 0.1) gave
+-0.9 % then, the fine twin's -0.8 %.
 """
 import os
 import sys
@@ -83,6 +92,14 @@ def traction(text):
     return text.replace("scheme = velocity", "scheme = traction")
 
 
+def usl(text):
+    return text.replace("[time]\n", "[time]\nmethod = usl\n")
+
+
+def plain(text):
+    return text
+
+
 def part_rest(scheme=lambda text: text):
     out = run("refine_fsi_rest", scheme(rs.fsi_case(0.2, rs.FSI_BAND, interval=0.05)))
     vmax = 0.0
@@ -104,12 +121,20 @@ def part_rest(scheme=lambda text: text):
           f"force {fmax:.1e} N (roundoff)")
 
 
+# The transmitted wave's window at the probe: from before the pulse's front (t = 0.338) to
+# before the echo of the slab's far face (its front, 3 sigma ahead, reaches the probe at
+# 0.338 + (2 FSI_PULSE_L_S - 0.04) / c_s = 0.925); the trailing lobe the pulse grows on level 0
+# has passed by 0.8 (window ends 0.8 and 0.85 agree to 0.4 %, measured).
+WINDOW = (0.25, 0.85)
+
+
 def transmitted(out):
-    """Z_eff times the time integral of the probe's velocity over [0.25, 0.62], over the
-    incident pressure's time integral at a point, I / c_g."""
+    """Z_eff times the probe's displacement over WINDOW (its velocity's time integral, the
+    grid's velocity under usl, where a particle's FLIP velocity carries noise the grid does not
+    see), over the incident pressure's time integral at a point, I / c_g."""
     q = csv(out, "probes.csv")
-    w = (q["t"] >= 0.25) & (q["t"] <= 0.62)
-    return Z_EFF * np.trapz(q["slab_vx"][w], q["t"][w]) / (INCIDENT / C_G)
+    u = np.interp(WINDOW, q["t"], q["slab_ux"])
+    return Z_EFF * (u[1] - u[0]) / (INCIDENT / C_G)
 
 
 def reflected(out):
@@ -124,14 +149,15 @@ def reflected(out):
     return mean.sum() * (b - a) / nb / INCIDENT
 
 
-def part_pulse():
-    t_end = 0.8
-    runs = {"refined": run("refine_fsi_pulse", rs.fsi_case(t_end, rs.FSI_BAND, pulse=rs.FSI_PULSE,
-                                                             extra=rs.FSI_PROBE)),
-            "coarse": run("refine_fsi_coarse", rs.fsi_case(t_end, "", pulse=rs.FSI_PULSE,
-                                                           extra=rs.FSI_PROBE)),
-            "fine": run("refine_fsi_fine", rs.fsi_case(t_end, "", dx=rs.FSI_DX / 2,
-                                                       pulse=rs.FSI_PULSE, extra=rs.FSI_PROBE))}
+def pulse_case(refine, dx=rs.FSI_DX):
+    return rs.fsi_case(WINDOW[1], refine, dx=dx, pulse=rs.FSI_PULSE, extra=rs.FSI_PROBE,
+                       slab=rs.FSI_PULSE_L_S)
+
+
+def part_pulse(method=plain):
+    runs = {"refined": run("refine_fsi_pulse", method(pulse_case(rs.FSI_BAND))),
+            "coarse": run("refine_fsi_coarse", method(pulse_case(""))),
+            "fine": run("refine_fsi_fine", method(pulse_case("", dx=rs.FSI_DX / 2)))}
     T, R, drift, mass = {}, {}, {}, {}
     for label, out in runs.items():
         T[label], R[label] = transmitted(out), reflected(out)
@@ -144,13 +170,16 @@ def part_pulse():
     print(f"info impedance solution: Z_s {Z_S:.4f}, prestressed {Z_EFF:.4f}, Z_g {Z_G:.4f}: "
           f"T {T_AC:.4f}, R {R_AC:.4f}")
     t, r = T["refined"], R["refined"]
-    # Measured: T +7.0 % refined, +9.3 % coarse, -0.7 % fine; R +0.009, +0.019, +0.003. The
-    # incident pulse crosses level 0 (the coarse twin's spacing) before it meets the band, and
-    # the interface spreads its coupling over the shared nodes (3 cells), a third of the pulse's
-    # width on level 0: the refined run lies between its twins. Bounds: 10 % and 0.02 (what the
-    # coarse twin reaches), and within the twins' range with 1 % of T to spare.
-    check(abs(t / T_AC - 1) <= 0.10, f"transmitted {t:.4f} against the impedance solution "
-          f"{T_AC:.4f}: {100 * (t / T_AC - 1):+.2f} % (<= 10 %)")
+    # Measured (bs32; usl): T -0.43 %, -0.44 % refined, -0.37 %, -0.39 % coarse, -0.63 %,
+    # -0.65 % fine; R -0.001, +0.000 refined, +0.005, +0.006 coarse, +0.007, +0.007 fine. The
+    # incident pulse crosses level 0 before the band, where it grows a trailing lobe that the
+    # window holds; the interface spreads its coupling over the shared nodes (3 cells). The
+    # refined T lies between its twins, its R 0.006 below both (the reflected pulse leaves the
+    # band for level 0 as the coarse twin's does; not explained). Bounds:
+    # T within 2 % (three times the fine twin's error; the old window's +7 % fails it), R within
+    # 0.02, and within the twins' range with 1 % of T and 0.01 of R to spare.
+    check(abs(t / T_AC - 1) <= 0.02, f"transmitted {t:.4f} against the impedance solution "
+          f"{T_AC:.4f}: {100 * (t / T_AC - 1):+.2f} % (<= 2 %)")
     check(abs(r - R_AC) <= 0.02, f"reflected {r:.4f} against the impedance solution {R_AC:.4f}:"
           f" {r - R_AC:+.4f} (<= 0.02)")
     lo_t, hi_t = sorted((T["coarse"], T["fine"]))
@@ -164,9 +193,9 @@ def part_pulse():
     check(rel <= 1e-12, f"interface momentum balance of coupling.csv: |F_solid + F_fluid| "
           f"{rel:.1e} of the largest force {fmax:.1e} N (<= 1e-12)")
     # Mass: constant particle masses (measured 3e-15). Energy: bs32 at its default tolerance
-    # and the velocity scheme's inelastic exchange lose 5.5e-6 refined, 5.4e-6 coarse, 6.1e-6
-    # fine; 2e-5 fails on an interface that creates or loses a tenth of the pulse's energy
-    # (its energy is 2e-5 of the total).
+    # (or usl) and the velocity scheme's inelastic exchange lose 7.2e-6 refined, 7.2e-6 coarse,
+    # 6.9e-6 fine (usl 7.2e-6, 7.2e-6, 7.1e-6); 2e-5 fails on an interface that creates or
+    # loses a tenth of the pulse's energy (its energy is 2e-5 of the total).
     check(mass["refined"] <= 1e-12, f"mass drift {mass['refined']:.1e} <= 1e-12")
     check(drift["refined"] <= 2e-5, f"total energy drift {drift['refined']:.2e} <= 2e-5 (coarse "
           f"twin {drift['coarse']:.2e}, fine {drift['fine']:.2e})")
@@ -174,15 +203,14 @@ def part_pulse():
 
 def part_traction():
     part_rest(traction)
-    out = run("refine_fsi_traction", traction(rs.fsi_case(0.8, rs.FSI_BAND, pulse=rs.FSI_PULSE,
-                                                            extra=rs.FSI_PROBE)))
+    out = run("refine_fsi_traction", traction(pulse_case(rs.FSI_BAND)))
     t, r = transmitted(out), reflected(out)
     rel, fmax = balance(out)
     print(f"info traction: {mt.cost(out)}; T {t:.4f}, R {r:.4f}, balance {rel:.1e}")
-    # Measured T 1.4378, R 0.3520 (velocity's to 4 digits), balance 2.9e-14; the bounds of the
+    # Measured T 1.3372, R 0.3420 (velocity's to 4 digits), balance 2.9e-14; the bounds of the
     # pulse part.
-    check(abs(t / T_AC - 1) <= 0.10 and abs(r - R_AC) <= 0.02, f"traction: transmitted {t:.4f} "
-          f"({100 * (t / T_AC - 1):+.2f} %, <= 10 %), reflected {r:.4f} ({r - R_AC:+.4f}, <= 0.02)")
+    check(abs(t / T_AC - 1) <= 0.02 and abs(r - R_AC) <= 0.02, f"traction: transmitted {t:.4f} "
+          f"({100 * (t / T_AC - 1):+.2f} %, <= 2 %), reflected {r:.4f} ({r - R_AC:+.4f}, <= 0.02)")
     check(rel <= 1e-12, f"traction: interface momentum balance {rel:.1e} (<= 1e-12)")
 
 
@@ -218,8 +246,8 @@ def part_input():
          "refine.band.lo", "lo = 0.9 0.01", "periodic axis y"),
         ("grid pressure", text.replace("gamma = 1.4", "gamma = 1.4\npressure = grid"),
          "fluid.pressure", "pressure = grid", "solid"),
-        ("classic update", text.replace("t_end = 0.1", "t_end = 0.1\nmethod = usl"),
-         "time.method", "method = usl", "not carried"),
+        ("contact", usl(text.replace("scheme = velocity", "scheme = contact")),
+         "coupling.scheme", "scheme = contact", "not carried"),
         ("MUSL", text.replace("t_end = 0.1", "t_end = 0.1\nmethod = musl"),
          "time.method", "method = musl", "not carried"),
         ("two bodies", text.replace("hi = 2.6 0.06", "hi = 1.8 0.06") +
@@ -235,6 +263,10 @@ if PART == "rest":
     part_rest()
 elif PART == "pulse":
     part_pulse()
+elif PART == "rest_usl":
+    part_rest(usl)
+elif PART == "pulse_usl":
+    part_pulse(usl)
 elif PART == "traction":
     part_traction()
 elif PART == "restart":
