@@ -359,3 +359,37 @@ FLOOR_BOX = "[refine]\nlevels = 2\n\n[refine.box]\nlevel = 1\nlo = 0.5 0.1\nhi =
 DISC = "[obstacle.disc]\nshape = circle\ncenter = 0.6 0.4\nradius = 0.1\n"
 DISC_ALIGNED = DISC.replace("center = 0.6 0.4", "center = 0.6125 0.4125")
 DISC_BAND = "[refine]\nlevels = 2\n\n[refine.band]\nlevel = 1\nlo = 0 0.2\nhi = 1.6 0.6\n"
+
+
+# The acoustic pulse of the _pulse parts (test_refine_gas.py, test_refine_usl.py): amplitude a,
+# a gaussian of width 0.2 about x0, right-running (Z = 1 at rho 1, p 1 / 1.4).
+def pulse_gas(a=1e-3, x0=0.6):
+    g = f"exp(-(x-{x0})^2/0.04)"
+    return (f"density_field = 1 + {a}*{g}\npressure_field = 0.714285714285714 + {a}*{g}\n"
+            f"velocity_field = {a}*{g}; 0")
+
+
+def pulse_binned(p, rest, length, nbins):
+    """Means of p' and u' over nbins bins along x, the particles' p and u less those of the same
+    particle (by id) in the run at rest: what the pulse adds, without the disturbance the box's
+    corners raise in gas at rest (docs/refinement.md). The strip is quasi-1-D away from the box.
+    p, rest: particle dicts (mpmtest.particles); rest None for a uniform twin, whose gas at rest
+    stays at rest to roundoff."""
+    if rest is None:
+        rest = {"id": p["id"], "p": np.full_like(p["p"], 1 / 1.4), "v": np.zeros_like(p["v"])}
+    assert np.array_equal(p["id"], rest["id"])
+    x = p["x"][:, 0] % length
+    k = np.minimum((x / length * nbins).astype(int), nbins - 1)
+    vol = (p["m"] / p["rho"]).ravel()
+    w = np.bincount(k, vol, nbins)
+    pp = np.bincount(k, vol * (p["p"] - rest["p"]).ravel(), nbins) / w
+    uu = np.bincount(k, vol * (p["v"][:, 0] - rest["v"][:, 0]), nbins) / w
+    return pp, uu
+
+
+def reflected_energy(p, rest, length):
+    """Energy of the left-running component over that of the right-running one (Z = 1), from
+    120 bins of pulse_binned."""
+    pp, uu = pulse_binned(p, rest, length, 120)
+    left, right = 0.5 * (pp - uu), 0.5 * (pp + uu)
+    return float((left ** 2).sum() / (right ** 2).sum())

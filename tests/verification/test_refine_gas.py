@@ -122,6 +122,7 @@ import numpy as np  # noqa: E402
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "tools"))
 import mpmtest as mt  # noqa: E402
+import refine_scenes as rs  # noqa: E402
 from refine_scenes import (BOX, BOX_3D, C0, CASE_3D, DYNAMIC, EXPAND_V, EXPANSION,  # noqa: E402
                            PULSE_5, STARVE, case_text)
 
@@ -217,34 +218,13 @@ def part_uniform():
     return runs, dev
 
 
-def binned(p, rest, length, nbins):
-    """Means of p' and u' over nbins bins along x, the particles' p and u less those of the same
-    particle (by id) in the run at rest: what the pulse adds, without the disturbance the box's
-    corners raise in gas at rest (docs/refinement.md). The strip is quasi-1-D away from the box."""
-    if rest is None:  # a uniform twin: its gas at rest stays at rest to roundoff
-        rest = {"id": p["id"], "p": np.full_like(p["p"], 1 / 1.4), "v": np.zeros_like(p["v"])}
-    assert np.array_equal(p["id"], rest["id"])
-    x = p["x"][:, 0] % length
-    k = np.minimum((x / length * nbins).astype(int), nbins - 1)
-    vol = (p["m"] / p["rho"]).ravel()
-    w = np.bincount(k, vol, nbins)
-    pp = np.bincount(k, vol * (p["p"] - rest["p"]).ravel(), nbins) / w
-    uu = np.bincount(k, vol * (p["v"][:, 0] - rest["v"][:, 0]), nbins) / w
-    return pp, uu
-
-
 def reflected_fraction(out, rest, length):
-    """Energy of the left-running component over that of the right-running one (Z = 1)."""
-    pp, uu = binned(final(out), final(rest) if rest else None, length, 120)
-    left, right = 0.5 * (pp - uu), 0.5 * (pp + uu)
-    return float((left ** 2).sum() / (right ** 2).sum())
+    """refine_scenes.reflected_energy of the run out's last snapshot (rest: the run at rest)."""
+    return rs.reflected_energy(final(out), final(rest) if rest else None, length)
 
 
 def part_pulse():
-    a, x0 = 1e-3, 0.6
-    g = f"exp(-(x-{x0})^2/0.04)"
-    gas = (f"density_field = 1 + {a}*{g}\npressure_field = 0.714285714285714 + {a}*{g}\n"
-           f"velocity_field = {a}*{g}; 0")
+    gas = rs.pulse_gas()
     runs = twins("refine_pulse", 3, 2.4, gas, 1.6, 2.4)
     rest, _ = run("refine_rest", case_text(3, 2.4, "density = 1\npressure = 0.714285714285714",
                                            BOX.format(x0=1.6, x1=2.4),
