@@ -54,7 +54,7 @@
 #   test_refine_usl_uniform, _regrid and test_refine_musl_uniform), the gas beside a solid's
 #   pulse studies test_refine_fsi_pulse, _pulse_usl and _traction (its coupling on every level in
 #   test_refine_fsi_rest and _restart), the open faces' test_refine_open_stream and _shock (in
-#   test_refine_open_farfield and _ranks) and the obstacles' test_refine_obstacles_disc (in
+#   test_refine_open_farfield and _ranks) and the obstacles' test_refine_obstacles_disc and _rest3d (in
 #   test_refine_obstacles_rest and _stream);
 # - test_euler_reference: the inviscid aerofoil reference in numpy, which runs no mpmfsi at all.
 # The input refusal drivers (test_input_safety, test_bad_input, test_cases) run under the
@@ -74,7 +74,7 @@ PLAIN_ONLY+="|refine_gas_pulse|refine_gas_uniform3d|refine_gas_dynamic"
 PLAIN_ONLY+="|refine_usl_pulse|refine_usl_sod|refine_usl_wall|refine_musl_pulse|refine_musl_sod"
 PLAIN_ONLY+="|refine_musl_wall|refine_musl_regrid|refine_fsi_pulse|refine_fsi_pulse_usl"
 PLAIN_ONLY+="|refine_fsi_traction"
-PLAIN_ONLY+="|refine_open_stream|refine_open_shock|refine_obstacles_disc"
+PLAIN_ONLY+="|refine_open_stream|refine_open_shock|refine_obstacles_disc|refine_obstacles_rest3d"
 BOTH="checkpoint_integrity"
 
 # The tests also need clang-format (test_format) and ParaView under Xvfb (test_paraview), and

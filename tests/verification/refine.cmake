@@ -81,7 +81,7 @@ endforeach()
 # refined boxes, on 2 and 3 levels (~4 s); a uniform stream along a slab's face through bands
 # over it and its uniform twin (~6 s); a stream past a circle in a band against its aligned fine
 # twin (~8 s).
-foreach(part rest stream disc)
+foreach(part rest stream disc rest3d)
   mpm_add_script_test(test_refine_obstacles_${part} SCRIPT verification/test_refine_obstacles.py
                       ARGS ${part} LABELS verification TIMEOUT 300)
 endforeach()
