@@ -52,10 +52,10 @@
 #   test_hier_*), the classic update's studies test_refine_usl_{pulse,sod,wall} and
 #   test_refine_musl_{pulse,sod,wall,regrid} (its transfer, remap and regrids run there in
 #   test_refine_usl_uniform, _regrid and test_refine_musl_uniform), the gas beside a solid's
-#   pulse studies test_refine_fsi_pulse, _pulse_usl and _traction (its coupling on every level in
-#   test_refine_fsi_rest and _restart), the open faces' test_refine_open_stream and _shock (in
-#   test_refine_open_farfield and _ranks) and the obstacles' test_refine_obstacles_disc and _rest3d (in
-#   test_refine_obstacles_rest and _stream);
+#   pulse studies test_refine_fsi_pulse, _pulse_usl and _traction (its coupling on every level
+#   in test_refine_fsi_rest and _restart), the open faces' test_refine_open_stream and _shock
+#   (in test_refine_open_farfield and _ranks) and the obstacles' test_refine_obstacles_disc and
+#   _rest3d (in test_refine_obstacles_rest and _stream);
 # - test_euler_reference: the inviscid aerofoil reference in numpy, which runs no mpmfsi at all.
 # The input refusal drivers (test_input_safety, test_bad_input, test_cases) run under the
 # sanitizers without the leak check at exit (NO_LEAK_CHECK in tests/CMakeLists.txt).
