@@ -33,7 +33,11 @@ static int has_walls(const mpm_hier *h, int d) {
   return h->wall[d][0] || h->wall[d][1];
 }
 
-void mpm_hier_walls_fold(mpm_hier *h, int phase) {
+/* Call fn on every node n of a finer level beyond a wall of axis d, with its mirror s and the
+ * components the wall flips there: both passes walk the same nodes, axis by axis. */
+typedef void (*mirror_fn)(mpm_grid_phase *ph, int dim, mpm_lidx n, mpm_lidx s, unsigned char mask);
+
+static void each_mirror(mpm_hier *h, int phase, mirror_fn fn) {
   for (int l = 1; l < h->nlevels; ++l) {
     mpm_grid *g = h->level[l].grid;
     mpm_grid_phase *ph = &g->phase[phase];
@@ -41,35 +45,35 @@ void mpm_hier_walls_fold(mpm_hier *h, int phase) {
       if (!has_walls(h, d)) continue;
       for (mpm_lidx n = 0; n < g->nnodes; ++n) {
         const mpm_lidx s = mirror_node(h, l, d, n);
-        if (s < 0) continue;
-        const unsigned char mask = flips(h, l, d, n);
-        ph->m_i[s] += ph->m_i[n], ph->m_i[n] = 0.0;
-        for (int e = 0; e < h->dim; ++e) {
-          const double sign = (mask >> e) & 1 ? -1.0 : 1.0;
-          ph->mv_i[e][s] += sign * ph->mv_i[e][n], ph->mv_i[e][n] = 0.0;
-          ph->f_i[e][s] += sign * ph->f_i[e][n], ph->f_i[e][n] = 0.0;
-        }
+        if (s >= 0) fn(ph, h->dim, n, s, flips(h, l, d, n));
       }
     }
   }
 }
 
-void mpm_hier_walls_apply(mpm_hier *h, int phase) {
-  for (int l = 1; l < h->nlevels; ++l) {
-    mpm_grid *g = h->level[l].grid;
-    mpm_grid_phase *ph = &g->phase[phase];
-    for (int d = 0; d < h->dim; ++d) {
-      if (!has_walls(h, d)) continue;
-      for (mpm_lidx n = 0; n < g->nnodes; ++n) {
-        const mpm_lidx s = mirror_node(h, l, d, n);
-        if (s < 0) continue;
-        const unsigned char mask = flips(h, l, d, n);
-        for (int e = 0; e < h->dim; ++e) {
-          const double sign = (mask >> e) & 1 ? -1.0 : 1.0;
-          ph->v_i[e][n] = sign * ph->v_i[e][s];
-          ph->a_i[e][n] = sign * ph->a_i[e][s];
-        }
-      }
-    }
+/* Add node n's m, m v and f into its mirror s (the flipped components negated), zero n. */
+static void fold_node(mpm_grid_phase *ph, int dim, mpm_lidx n, mpm_lidx s, unsigned char mask) {
+  ph->m_i[s] += ph->m_i[n], ph->m_i[n] = 0.0;
+  for (int e = 0; e < dim; ++e) {
+    const double sign = (mask >> e) & 1 ? -1.0 : 1.0;
+    ph->mv_i[e][s] += sign * ph->mv_i[e][n], ph->mv_i[e][n] = 0.0;
+    ph->f_i[e][s] += sign * ph->f_i[e][n], ph->f_i[e][n] = 0.0;
   }
+}
+
+/* Set node n's v and a to its mirror s's (the flipped components negated). */
+static void apply_node(mpm_grid_phase *ph, int dim, mpm_lidx n, mpm_lidx s, unsigned char mask) {
+  for (int e = 0; e < dim; ++e) {
+    const double sign = (mask >> e) & 1 ? -1.0 : 1.0;
+    ph->v_i[e][n] = sign * ph->v_i[e][s];
+    ph->a_i[e][n] = sign * ph->a_i[e][s];
+  }
+}
+
+void mpm_hier_walls_fold(mpm_hier *h, int phase) {
+  each_mirror(h, phase, fold_node);
+}
+
+void mpm_hier_walls_apply(mpm_hier *h, int phase) {
+  each_mirror(h, phase, apply_node);
 }
