@@ -43,7 +43,8 @@ const mpm_key_spec mpm_refine_keys[] = {
      "refine.threshold times the smaller), compression (where the velocity normal to their "
      "face falls by more than refine.threshold times the sound speed: shocks), vorticity "
      "(where a velocity along their face jumps by that much: shear layers), starvation (a "
-     "level-0 cell inside the gas holding fewer than refine.min_particles level-0 particles)",
+     "level-0 cell inside the gas holding fewer than refine.min_particles level-0 particles), "
+     "proximity (a level-0 cell within refine.distance of an [obstacle.NAME])",
      0, NULL},
     {"refine.threshold", MPM_KEY_REALS, "0", 0, HUGE_VAL, 0, 3, NULL,
      "one threshold per listed density, compression or vorticity criterion, in the list's "
@@ -57,6 +58,11 @@ const mpm_key_spec mpm_refine_keys[] = {
      "is refined when it holds fewer particles than this, a level-l particle counting 2^-(dim l) "
      "(fluid.ppc^dim fill a cell at the start; e.g. half that; required with starvation)",
      0, "-"},
+    {"refine.distance", MPM_KEY_REAL, "0", 0, HUGE_VAL, 0, 0, NULL,
+     "the proximity criterion's reach: every level-0 cell that comes within this distance of an "
+     "obstacle's surface (or lies inside it) is refined, m (0: the cells the surface cuts; the "
+     "obstacles are static, so nothing pads it for their motion)",
+     0, "m"},
     {"refine.every", MPM_KEY_INT, "10", 1, 1000000, 0, 0, NULL,
      "steps between regrids of a dynamic refinement (a regrid also runs before every checkpoint)",
      0, "-"},
@@ -230,8 +236,10 @@ static int read_boxes(const mpm_config *cfg, const mpm_grid *g, const char *cons
 #define REFINE_CLIP 4
 
 /* The criteria refine.criterion may list, in fluid_refine_criterion's order; the first
- * REFINE_NGAS read refine.threshold, starvation reads refine.min_particles. */
-static const char *const g_criteria[] = {"density", "compression", "vorticity", "starvation"};
+ * REFINE_NGAS read refine.threshold, starvation reads refine.min_particles, proximity
+ * refine.distance. */
+static const char *const g_criteria[] = {"density", "compression", "vorticity", "starvation",
+                                         "proximity"};
 #define REFINE_NCRIT ((int)(sizeof g_criteria / sizeof g_criteria[0]))
 #define REFINE_NGAS  3
 
@@ -261,7 +269,8 @@ static int read_criteria(const mpm_config *cfg, dynamic *dy) {
     else if (k == REFINE_NCRIT)
       return mpm_config_fail(cfg, "refine.criterion",
                              "'%.*s' is not a criterion; list none, or one or more of density, "
-                             "compression, vorticity and starvation, separated by commas",
+                             "compression, vorticity, starvation and proximity, separated by "
+                             "commas",
                              len, s);
     else if (seen[k]++)
       return mpm_config_fail(cfg, "refine.criterion", "lists %s twice; list each criterion once",
@@ -277,6 +286,42 @@ static int read_criteria(const mpm_config *cfg, dynamic *dy) {
   return 0;
 }
 
+/* Is proximity listed? */
+static int near_listed(const dynamic *dy) {
+  for (int k = 0; k < dy->ncrit; ++k)
+    if (dy->crit[k] == FLUID_REFINE_PROXIMITY) return 1;
+  return 0;
+}
+
+/* The first listed criterion that reads refine.threshold (the caller knows there is one). */
+static fluid_refine_criterion first_gas(const dynamic *dy) {
+  int k = 0;
+  while (k + 1 < dy->ncrit && dy->crit[k] >= FLUID_REFINE_STARVATION) ++k;
+  return dy->crit[k];
+}
+
+/* Proximity's reach, refine.distance (>= 0 by its key), into its slot of dy->threshold; the key
+ * is refused without proximity, and proximity without an [obstacle.NAME] to be near. */
+static int read_distance(const mpm_config *cfg, dynamic *dy) {
+  double distance;
+  MPM_CALL(mpm_config_get_real(cfg, "refine.distance", &distance));
+  const int listed = near_listed(dy);
+  if (!listed && mpm_config_has(cfg, "refine.distance"))
+    return mpm_config_fail(cfg, "refine.distance",
+                           "is set, and refine.criterion does not list proximity, its only "
+                           "reader; add proximity to the list or remove the key");
+  const char *const *names;
+  int nobstacle;
+  MPM_CALL(mpm_config_instances(cfg, "obstacle", &names, &nobstacle));
+  if (listed && nobstacle == 0)
+    return mpm_config_fail(cfg, "refine.criterion",
+                           "lists proximity, which refines around the case's [obstacle.NAME] "
+                           "bodies, and the case has none; add an obstacle or remove proximity");
+  for (int k = 0; k < dy->ncrit; ++k)
+    if (dy->crit[k] == FLUID_REFINE_PROXIMITY) dy->threshold[k] = distance;
+  return 0;
+}
+
 /* The thresholds of the listed criteria: refine.threshold's values, one per gas-state
  * criterion in the list's order, and refine.min_particles for starvation; each required and
  * > 0, and neither key set without a criterion reading it. */
@@ -286,14 +331,14 @@ static int read_thresholds(const mpm_config *cfg, dynamic *dy) {
   MPM_CALL(mpm_config_get_reals(cfg, "refine.threshold", value, REFINE_NGAS, &count));
   MPM_CALL(mpm_config_get_real(cfg, "refine.min_particles", &min_particles));
   for (int k = 0; k < dy->ncrit; ++k) starve += dy->crit[k] == FLUID_REFINE_STARVATION;
-  ngas = dy->ncrit - starve;
+  ngas = dy->ncrit - starve - near_listed(dy);
   const int has_threshold = mpm_config_has(cfg, "refine.threshold");
   if (ngas > 0 && !has_threshold) /* named: the first gas-state criterion (starvation is once) */
     return mpm_config_fail(cfg, "refine.criterion",
                            "%s needs a threshold: set refine.threshold > 0 (the jump between "
                            "neighbouring cells that refines them, e.g. 0.05; one value per "
                            "density, compression or vorticity criterion; see the key reference)",
-                           g_criteria[dy->crit[dy->crit[0] == FLUID_REFINE_STARVATION]]);
+                           g_criteria[first_gas(dy)]);
   if (has_threshold && ngas == 0)
     return mpm_config_fail(cfg, "refine.threshold",
                            "is set, and refine.criterion lists none of its readers (density, "
@@ -315,7 +360,9 @@ static int read_thresholds(const mpm_config *cfg, dynamic *dy) {
     return mpm_config_fail(cfg, "refine.min_particles",
                            "is set, and refine.criterion does not list starvation, its only "
                            "reader; add starvation to the list or remove the key");
+  MPM_CALL(read_distance(cfg, dy));
   for (int k = 0, j = 0; k < dy->ncrit; ++k) {
+    if (dy->crit[k] == FLUID_REFINE_PROXIMITY) continue; /* read_distance */
     const int gas = dy->crit[k] != FLUID_REFINE_STARVATION;
     dy->threshold[k] = gas ? value[j++] : min_particles;
     if (!(dy->threshold[k] > 0))
@@ -329,14 +376,14 @@ static int read_thresholds(const mpm_config *cfg, dynamic *dy) {
 /* With refine.criterion = none nothing regrids: a key only the regrids read is refused rather
  * than ignored, so that a case that forgot its criterion does not run unrefined unawares. */
 static int refuse_regrid_keys(const mpm_config *cfg) {
-  static const char *const keys[] = {"refine.threshold", "refine.min_particles", "refine.every",
-                                     "refine.dilate"};
+  static const char *const keys[] = {"refine.threshold", "refine.min_particles", "refine.distance",
+                                     "refine.every", "refine.dilate"};
   for (size_t k = 0; k < sizeof keys / sizeof keys[0]; ++k)
     if (mpm_config_has(cfg, keys[k]))
       return mpm_config_fail(cfg, keys[k],
                              "is set, and refine.criterion is none, so nothing regrids and the "
                              "key has no effect; name a criterion (density, compression, "
-                             "vorticity, starvation) or remove the key");
+                             "vorticity, starvation, proximity) or remove the key");
   return 0;
 }
 

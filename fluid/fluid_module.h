@@ -38,7 +38,8 @@ typedef enum {
   FLUID_REFINE_DENSITY,
   FLUID_REFINE_COMPRESSION,
   FLUID_REFINE_VORTICITY,
-  FLUID_REFINE_STARVATION
+  FLUID_REFINE_STARVATION,
+  FLUID_REFINE_PROXIMITY
 } fluid_refine_criterion;
 
 /* The refinement flags over the level-0 spans (node-centred cells) of the global lattice, x
@@ -49,7 +50,10 @@ typedef enum {
  * (compression: shocks and steepening waves), or a tangential velocity jumps by more than that
  * (vorticity: shear layers, h |omega| > threshold c); or a span holding fewer than threshold
  * level-0 particles (starvation: a particle of size level l counts 2^(-dim l)) whose 2 dim axis
- * neighbours all hold gas (not the gas's edge). flag has prod n[d] bytes. One rank. */
+ * neighbours all hold gas (not the gas's edge); or a span that comes within threshold (a length,
+ * >= 0) of an obstacle (proximity: its centre's signed distance to the nearest obstacle, over the
+ * periodic images, below threshold plus the span's half-diagonal; the obstacles are static, so
+ * no padding for their motion). flag has prod n[d] bytes. One rank. */
 int fluid_refine_flags(const mpm_module *m, fluid_refine_criterion criterion, double threshold,
                        const int *n, unsigned char *flag);
 

@@ -259,6 +259,21 @@ static int starved_flags(const mpm_module *m, double threshold, const int *n, co
   return 0;
 }
 
+/* Proximity: the spans that come within `distance` of an obstacle (fluid_module.h). */
+static void near_flags(const mpm_module *m, double distance, const int *n, const size_t *stride,
+                       size_t total, unsigned char *flag) {
+  const fluid_obstacles *o = &((const fluid_content *)m->content)->obs;
+  const mpm_grid *g = m->grid;
+  const double reach = distance + 0.5 * sqrt((double)g->dim) * g->dx;
+  for (size_t s = 0; s < total; ++s) {
+    double x[MPM_MAX_DIM] = {0, 0, 0};
+    for (int d = 0; d < g->dim; ++d)
+      x[d] = g->lo[d] + (double)(s / stride[d] % (size_t)n[d]) * g->dx;
+    for (int k = 0; k < o->count && !flag[s]; ++k)
+      flag[s] = fluid_obstacle_phi(&o->ob[k].sdf, g, x, NULL) < reach;
+  }
+}
+
 int fluid_refine_flags(const mpm_module *m, fluid_refine_criterion criterion, double threshold,
                        const int *n, unsigned char *flag) {
   const fluid_content *fc = m->content;
@@ -270,6 +285,10 @@ int fluid_refine_flags(const mpm_module *m, fluid_refine_criterion criterion, do
   memset(flag, 0, total);
   if (criterion == FLUID_REFINE_STARVATION)
     return starved_flags(m, threshold, n, stride, total, flag);
+  if (criterion == FLUID_REFINE_PROXIMITY) {
+    near_flags(m, threshold, n, stride, total, flag);
+    return 0;
+  }
   const size_t nsums = 3 + (size_t)dim; /* mass, volume, m e, m v */
   double *sums = calloc(nsums * total, sizeof(double));
   if (!sums) MPM_FAIL_OOM(nsums * total * sizeof(double));

@@ -80,8 +80,8 @@ endforeach()
 # Static obstacles on every level (the gas): gas at rest around a circle and a box's corner in
 # refined boxes, on 2 and 3 levels (~4 s); a uniform stream along a slab's face through bands
 # over it and its uniform twin (~6 s); a stream past a circle in a band against its aligned fine
-# twin (~8 s).
-foreach(part rest stream disc rest3d)
+# twin (~8 s); the bodies regridded by the proximity criterion (~4 s).
+foreach(part rest stream disc rest3d proximity)
   mpm_add_script_test(test_refine_obstacles_${part} SCRIPT verification/test_refine_obstacles.py
                       ARGS ${part} LABELS verification TIMEOUT 300)
 endforeach()

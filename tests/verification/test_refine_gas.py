@@ -656,10 +656,22 @@ def part_input():
         ("min_particles without starvation", dyn.replace("threshold = 0.004",
                                                          "threshold = 0.004\nmin_particles = 2"),
          "refine.min_particles", "min_particles = 2", "does not list starvation"),
+        ("proximity without an obstacle", dyn.replace("criterion = density",
+                                                      "criterion = density, proximity"),
+         "refine.criterion", "criterion = density, proximity", "the case has none"),
+        ("distance without proximity", dyn.replace("threshold = 0.004",
+                                                   "threshold = 0.004\ndistance = 0.1"),
+         "refine.distance", "distance = 0.1", "does not list proximity"),
+        ("a negative distance", dyn.replace("threshold = 0.004",
+                                            "threshold = 0.004\ndistance = -0.1"),
+         "refine.distance", "distance = -0.1", ""),
         # With criterion = none nothing regrids: the regrids' keys are refused, not ignored.
         ("a threshold without a criterion", case_text(2, 0.1, gas, box.replace(
             "levels = 2", "levels = 2\nthreshold = 0.01")), "refine.threshold",
          "threshold = 0.01", "refine.criterion is none"),
+        ("distance without a criterion", case_text(2, 0.1, gas, box.replace(
+            "levels = 2", "levels = 2\ndistance = 0.1")), "refine.distance", "distance = 0.1",
+         "refine.criterion is none"),
         ("every without a criterion", case_text(2, 0.1, gas, box.replace(
             "levels = 2", "levels = 2\nevery = 5")), "refine.every", "every = 5",
          "refine.criterion is none"),
