@@ -42,13 +42,13 @@ typedef struct mpm_module mpm_module;
 struct mpm_hier;
 
 /* A module's particles as another module's integrals read them (the gas's grid pressure beside
- * a solid, fluid/fluid_gridp_solid.c): n positions (component d at x[d]), current volumes V and
- * mean pressures p = -tr(sigma) / dim, as the module's last p2g left them. The arrays belong to
- * the module and may move at its next p2g; the view's address does not. */
+ * a solid, fluid/fluid_gridp_solid.c): n positions (component d at x[d]) and current volumes V,
+ * as the module's last p2g left them. The arrays belong to the module and may move at its next
+ * p2g; the view's address does not. */
 typedef struct mpm_points {
   mpm_lidx n;
   const double *x[MPM_MAX_DIM];
-  const double *V, *p;
+  const double *V;
 } mpm_points;
 
 /* Which transfer a grid pass follows: the first (particles with their stress, gravity and

@@ -3,13 +3,13 @@
  * What the slice refuses here, one line each naming the key: boxes without refine.levels > 1,
  * a solid beside a gas in a partitioned time scheme (coupling.time other than monolithic), off
  * the finest level (REFINE_SOLID_CELLS) or, with the gas's particle pressure (auto), with a box
- * that does not span every periodic axis (check_bands), a solid with dynamic regrids, more than one rank, a
- * shape other than the quadratic B-spline, and a box within three level-0 cells of a non-periodic
- * domain face other than a gas's slip or no-slip wall (open and closed faces, and a solid's walls,
- * act on level 0 alone; a gas's walls are carried to every level, mpm_hier.h, and a box or region
- * may touch them). Along a periodic axis a box or a dynamic region may touch, cross or span the
- * periodic faces (the levels wrap there, mpm_hier.h). mpm_hier_new's own reasons name the box's
- * key. The gas and the solid refuse their own settings (fluid/fluid_refine.c,
+ * that does not span every periodic axis (check_bands), a solid with dynamic regrids, more than one
+ * rank, a shape other than the quadratic B-spline, and a box within three level-0 cells of a
+ * non-periodic domain face other than a gas's slip or no-slip wall (open and closed faces, and a
+ * solid's walls, act on level 0 alone; a gas's walls are carried to every level, mpm_hier.h, and a
+ * box or region may touch them). Along a periodic axis a box or a dynamic region may touch, cross
+ * or span the periodic faces (the levels wrap there, mpm_hier.h). mpm_hier_new's own reasons name
+ * the box's key. The gas and the solid refuse their own settings (fluid/fluid_refine.c,
  * solid/solid_refine.c). */
 #include "mpm_refine.h"
 

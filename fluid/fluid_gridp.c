@@ -46,10 +46,14 @@
  * pressure times the integral of their prolonged mask against grad N_i, and the adjoint rate
  * (ghost_forces here, fluid_obstacle_levels.c).
  *
+ * A solid. Its region is taken out of both span integrals by its own quadrature, the nodal
+ * pressure continued into it from the gas's nodes (fluid_gridp_solid.c).
+ *
  * Scope (check_scope refuses the rest): the method-of-lines ERK pairs with the current strain
- * rate or the classic update, the quadratic B-spline, a gas alone (no solid), no
- * shifting, the point volume rate, open faces with their default exterior (copies, not gauge).
- * On a hierarchy beside a solid, auto keeps the particles' pressure (fluid_gridp_refine). */
+ * rate or the classic update, the quadratic B-spline, beside a solid the monolithic time scheme
+ * and a scheme that shares nodes (not contact), no shifting, the point volume rate, open faces
+ * with their default exterior (copies, not gauge). On a hierarchy beside a solid, auto keeps the
+ * particles' pressure (fluid_gridp_refine). */
 #include "fluid_internal.h"
 
 #include "mpm_error.h"
@@ -74,7 +78,7 @@ struct fluid_gridp {
   double *G[MPM_HIER_MAX_LEVELS][MPM_MAX_DIM]; /* the obstacles' span ghost GH (with obstacles) */
   unsigned char *skip[MPM_HIER_MAX_LEVELS];
   mpm_span_set set[MPM_HIER_MAX_LEVELS];
-  int beside_solid;       /* the case has a solid: its region is taken out (sol) */
+  int beside_solid;      /* the case has a solid: its region is taken out (sol) */
   fluid_gridp_solid sol; /* fluid_gridp_solid.c */
 };
 
@@ -289,7 +293,7 @@ static int restrict_all(mpm_module *m, double *a[][MPM_MAX_DIM], int nf) {
 
 /* Fill level 0's ghosts from their owners and prolong the scalar a[l] into the inactive
  * nodes. */
-static int prolong_all(mpm_module *m, double **a) {
+int fluid_gridp_prolong(mpm_module *m, double **a) {
   MPM_CALL(mpm_grid_halo_forward(m->grid, &a[0], 1));
   for (int l = 1; m->hier && l < m->hier->nlevels; ++l)
     mpm_hier_prolong_level(m->hier, l, (const double *const *)&a[l - 1], &a[l], 1);
@@ -325,7 +329,7 @@ static int ghost_forces(mpm_module *m, fluid_gridp *gp) {
   for (int l = 0; l < gp->nlev; ++l)
     fluid_obstacles_span_mask(o, l, level_grid(m, l), gp->M[l],
                               m->hier ? m->hier->level[l].active : NULL, gp->D[l]);
-  MPM_CALL(prolong_all(m, gp->D));
+  MPM_CALL(fluid_gridp_prolong(m, gp->D));
   for (int l = 0; l < gp->nlev; ++l) {
     const mpm_grid *g = level_grid(m, l);
     for (int d = 0; d < dim; ++d) memset(gp->G[l][d], 0, sizeof(double) * (size_t)g->nnodes);
@@ -358,7 +362,7 @@ int fluid_gridp_forces(mpm_module *m) {
   fluid_open_grid_pressure(fc->open, gp->P[0]);
   if (gp->beside_solid)
     MPM_CALL(fluid_gridp_solid_pressure(m, &gp->sol, gp->P, (const double *const *)gp->M));
-  MPM_CALL(prolong_all(m, gp->P));
+  MPM_CALL(fluid_gridp_prolong(m, gp->P));
   for (int l = 0; l < gp->nlev; ++l) {
     const mpm_grid *g = level_grid(m, l);
     for (int d = 0; d < dim; ++d) memset(gp->F[l][d], 0, sizeof(double) * (size_t)g->nnodes);
@@ -391,13 +395,14 @@ int fluid_gridp_nodal_rate(mpm_module *m, const mpm_hier_nodal *vel, mpm_hier_sc
     D[l][0] = gp->D[l];
   }
   MPM_CALL(restrict_all(m, D, 1));
-  if (gp->beside_solid) MPM_CALL(fluid_gridp_solid_rate(m, &gp->sol, vel, gp->D));
+  if (gp->beside_solid)
+    MPM_CALL(fluid_gridp_solid_rate(m, &gp->sol, vel, gp->D, (const double *const *)gp->M));
   for (int l = 0; fc->obs.count && l < gp->nlev; ++l)
     fluid_obstacles_span_rate(level_grid(m, l), m->phase, gp->M[l],
                               m->hier ? m->hier->level[l].active : NULL,
                               (const double *const *)gp->G[l], gp->D[l]);
   per_mass(m, gp, gp->D, gp->P); /* P now holds the rate per unit mass */
-  MPM_CALL(prolong_all(m, gp->P));
+  MPM_CALL(fluid_gridp_prolong(m, gp->P));
   memset(s, 0, sizeof *s);
   for (int l = 0; l < gp->nlev; ++l) s->s_i[l][0] = gp->P[l];
   return 0;

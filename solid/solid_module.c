@@ -303,28 +303,25 @@ static int ensure_scratch(mpm_module *m) {
   if (sc->tr.musl) MPM_ALLOC(sc->vnew, (size_t)dim * sc->cap);
   free(sc->pts_buf);
   sc->pts_buf = NULL;
-  if (sc->pts_on) MPM_ALLOC(sc->pts_buf, (size_t)2 * sc->cap);
+  if (sc->pts_on) MPM_ALLOC(sc->pts_buf, (size_t)sc->cap);
   return 0;
 }
 
-/* The points view (mpm_points) at state y, from the stress V sigma this p2g put in vsig: the
- * volume V0 det F and the mean pressure -tr(V sigma) / (dim V). */
+/* The points view (mpm_points) at state y: the positions and the volumes V0 det F. */
 static void fill_points(solid_content *sc, const mpm_particles *p, const double *y) {
   const int dim = p->dim;
   const mpm_lidx n = p->n;
   const double *F = y + (size_t)p->offset[F_F] * n, *V0 = mpm_particles_comp(p, sc->lay.f_V0, 0);
-  double *V = sc->pts_buf, *pr = sc->pts_buf + sc->cap;
+  double *V = sc->pts_buf;
   for (mpm_lidx i = 0; i < n; ++i) {
-    double f[9], tr = 0.0;
+    double f[9];
     for (int k = 0; k < dim * dim; ++k) f[k] = F[(size_t)k * n + i];
-    for (int d = 0; d < dim; ++d) tr += sc->vsig[(size_t)(d * dim + d) * n + i];
-    V[i] = V0[i] * (dim == 2 ? f[0] * f[3] - f[1] * f[2]
-                             : f[0] * (f[4] * f[8] - f[5] * f[7]) -
-                                   f[1] * (f[3] * f[8] - f[5] * f[6]) +
-                                   f[2] * (f[3] * f[7] - f[4] * f[6]));
-    pr[i] = -tr / (dim * V[i]);
+    V[i] = V0[i] * (dim == 2
+                        ? f[0] * f[3] - f[1] * f[2]
+                        : f[0] * (f[4] * f[8] - f[5] * f[7]) - f[1] * (f[3] * f[8] - f[5] * f[6]) +
+                              f[2] * (f[3] * f[7] - f[4] * f[6]));
   }
-  sc->pts.n = n, sc->pts.V = V, sc->pts.p = pr;
+  sc->pts.n = n, sc->pts.V = V;
   for (int d = 0; d < dim; ++d) sc->pts.x[d] = y + (size_t)(p->offset[F_X] + d) * n;
 }
 
@@ -370,8 +367,8 @@ static int solid_p2g(mpm_module *m, double t, const double *y) {
                       y + (size_t)p->offset[sc->lay.f_divv] * n, sc->vsig);
     idx += sc->count[b];
   }
-  if (sc->pts_on) fill_points(sc, p, y);
   mpm_timer_stop(MPM_T_STRESS);
+  if (sc->pts_on) fill_points(sc, p, y);
 
   mpm_timer_start(MPM_T_P2G);
   mpm_p2g_args a = {.n = n,
