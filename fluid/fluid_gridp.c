@@ -55,6 +55,7 @@
  * with their default exterior (copies, not gauge). On a hierarchy beside a solid, auto keeps the
  * particles' pressure (fluid_gridp_refine). */
 #include "fluid_internal.h"
+#include "fluid_module.h"
 
 #include "mpm_error.h"
 #include "mpm_hier.h"
@@ -171,6 +172,11 @@ int fluid_gridp_refine(mpm_module *m, const mpm_config *cfg, mpm_hier *h) {
                            "key or set fluid.pressure = grid");
   if (!((fluid_content *)m->content)->gridp) MPM_CALL(enable(m, cfg));
   return h ? mpm_hier_add_phases(h) : 0;
+}
+
+int fluid_module_reads_beside(const mpm_module *m) {
+  const fluid_gridp *gp = ((const fluid_content *)m->content)->gridp;
+  return gp && gp->beside_solid;
 }
 
 void fluid_gridp_reset(fluid_content *fc) {
