@@ -65,9 +65,10 @@ static int ensure(mpm_module *m, fluid_gridp_solid *s, mpm_lidx n) {
     MPM_ALLOC(s->A[l], (size_t)nn);
     MPM_ALLOC(s->B[l], (size_t)nn);
     const mpm_grid_phase *ph = &level_grid(m, l)->phase[s->phase];
-    for (int d = 0; d < dim; ++d) /* never solved: the scalar gathers read zeros */
-      memset(ph->v_i[d], 0, sizeof(double) * (size_t)nn),
-          memset(ph->a_i[d], 0, sizeof(double) * (size_t)nn);
+    for (int d = 0; d < dim; ++d) { /* never solved: the scalar gathers read zeros */
+      memset(ph->v_i[d], 0, sizeof(double) * (size_t)nn);
+      memset(ph->a_i[d], 0, sizeof(double) * (size_t)nn);
+    }
   }
   if (s->cap >= n && s->buf) return 0;
   free(s->buf);
