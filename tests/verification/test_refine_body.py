@@ -8,9 +8,9 @@ The scene (tests/tools/refine_scenes.py, body_case): a prestressed linear_elasti
 rho 1, p 1 around it, level 0 at dx = 0.05, a level-1 box [0.3, 0.7]^2 around the disk.
 
 Parts (one ctest each):
-rest    The disk at rest in gas at rest, refined, to t = 1; and the quasi-1-D slab of
-        test_refine_fsi.py (rs.fsi_case) on the uniform grid with fluid.pressure = grid, to
-        t = 0.2: every particle stays at rest to roundoff.
+rest    The disk at rest in gas at rest, refined and on the uniform grid, to t = 1; and the
+        quasi-1-D slab of test_refine_fsi.py (rs.fsi_case) on the uniform grid, to t = 0.2:
+        every particle stays at rest to roundoff.
 sphere  The same in 3-D (a sphere, the box [0.3, 0.7]^3), to t = 0.02.
 pulse   A planar pulse strikes a neo-Hookean disk (its stress derives from its energy, so that
         the total is a conserved quantity) inside the box, to t = 0.3: total energy and mass
@@ -69,7 +69,8 @@ def at_rest(label, out, what):
     v = largest_speed(out)
     d = csv(out, "diagnostics.csv")
     print(f"info {label}: {mt.cost(out)}; largest |v| {v:.1e}, kinetic {d['kinetic'].max():.1e}")
-    # Measured 2e-14 (disk to t = 1), 2e-14 (slab), 4e-15 (sphere): roundoff. The particle
+    # Measured 1.6e-14 (disk in the box to t = 1), 4.3e-15 (disk, uniform), 1.7e-14 (slab),
+    # 3.8e-15 (sphere): roundoff. The particle
     # pressure moves the disk in the box to 3.2e-2 (2.7 % of c).
     check(v <= 1e-12, f"{what}: largest |v| {v:.1e} <= 1e-12 (c_g = 1.18)")
 
@@ -77,6 +78,8 @@ def at_rest(label, out, what):
 def part_rest():
     at_rest("disk in the box", run("refine_body_rest", rs.body_case(1.0, interval=0.25)),
             "disk in gas at rest, level-1 box around it, to t = 1")
+    at_rest("disk, uniform grid", run("refine_body_rest_uniform", rs.body_case(1.0, "", interval=0.25)),
+            "disk in gas at rest on the uniform grid, to t = 1")
     text = rs.fsi_case(0.2, "", interval=0.05).replace("gamma = 1.4", "gamma = 1.4\npressure = grid")
     at_rest("slab, uniform grid", run("refine_body_slab", text),
             "slab in gas at rest on the uniform grid, fluid.pressure = grid, to t = 0.2")
