@@ -68,8 +68,7 @@ foreach(part rest pulse rest_usl pulse_usl traction restart input)
 endforeach()
 # A body inside a refined gas (fluid.pressure = grid beside a solid): a disk at rest in a level-1
 # box to t = 1, on the uniform grid, and the slab at rest on it (~15 s), a sphere at rest in 3-D
-# (~15 s),
-# a pulse striking the disk, refined and its uniform twins (~15 s), the refusals (~3 s).
+# (~15 s), a pulse striking the disk, refined and its uniform twins (~6 s), the refusals (~3 s).
 foreach(part rest sphere pulse input)
   mpm_add_script_test(test_refine_body_${part} SCRIPT verification/test_refine_body.py
                       ARGS ${part} LABELS verification TIMEOUT 300)
