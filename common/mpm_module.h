@@ -41,6 +41,16 @@ typedef struct mpm_module_sums {
 typedef struct mpm_module mpm_module;
 struct mpm_hier;
 
+/* A module's particles as another module's integrals read them (the gas's grid pressure beside
+ * a solid, fluid/fluid_gridp_solid.c): n positions (component d at x[d]) and current volumes V,
+ * as the module's last p2g left them. The arrays belong to the module and may move at its next
+ * p2g; the view's address does not. */
+typedef struct mpm_points {
+  mpm_lidx n;
+  const double *x[MPM_MAX_DIM];
+  const double *V;
+} mpm_points;
+
 /* Which transfer a grid pass follows: the first (particles with their stress, gravity and
  * external forces) or MUSL's remap (mass and momentum only, after the first solve: no force
  * acts, the solve just turns momenta into velocities). */
@@ -103,6 +113,9 @@ typedef struct mpm_module_ops {
    * coupling is built the sim calls it once more with src = NULL: a module that needs a wall
    * and was given none fails there with an input error. Optional. */
   int (*attach_wall)(mpm_module *m, const mpm_config *cfg, const mpm_wall_source *src, int *taken);
+  /* The view of this module's particles that its p2g refreshes (mpm_points), for the sim to
+   * hand to another module (beside, below). Optional. */
+  const mpm_points *(*points)(mpm_module *m);
 } mpm_module_ops;
 
 struct mpm_module {
@@ -141,6 +154,9 @@ struct mpm_module {
    * by the sim after the modules are built; NULL without refinement. The coupler then zeroes,
    * restricts, solves and prolongs the phase on every level (coupler/mpm_cycle.c). */
   struct mpm_hier *hier;
+  /* Another module's particles, set by the sim when both are built (the solid's points beside a
+   * gas; their p2g runs before this module's forces in every cycle); NULL if none. */
+  const mpm_points *beside;
 };
 
 /* Call ops->destroy and free the module; accepts NULL. */

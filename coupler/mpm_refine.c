@@ -2,14 +2,14 @@
  *
  * What the slice refuses here, one line each naming the key: boxes without refine.levels > 1,
  * a solid beside a gas in a partitioned time scheme (coupling.time other than monolithic), off
- * the finest level (REFINE_SOLID_CELLS) or with a box that does not span every periodic axis
- * (check_bands), a solid with dynamic regrids, more than one rank, a
- * shape other than the quadratic B-spline, and a box within three level-0 cells of a non-periodic
- * domain face other than a gas's slip or no-slip wall (open and closed faces, and a solid's walls,
- * act on level 0 alone; a gas's walls are carried to every level, mpm_hier.h, and a box or region
- * may touch them). Along a periodic axis a box or a dynamic region may touch, cross or span the
- * periodic faces (the levels wrap there, mpm_hier.h). mpm_hier_new's own reasons name the box's
- * key. The gas and the solid refuse their own settings (fluid/fluid_refine.c,
+ * the finest level (REFINE_SOLID_CELLS) or, with the gas's particle pressure (auto), with a box
+ * that does not span every periodic axis (check_bands), a solid with dynamic regrids, more than one
+ * rank, a shape other than the quadratic B-spline, and a box within three level-0 cells of a
+ * non-periodic domain face other than a gas's slip or no-slip wall (open and closed faces, and a
+ * solid's walls, act on level 0 alone; a gas's walls are carried to every level, mpm_hier.h, and a
+ * box or region may touch them). Along a periodic axis a box or a dynamic region may touch, cross
+ * or span the periodic faces (the levels wrap there, mpm_hier.h). mpm_hier_new's own reasons name
+ * the box's key. The gas and the solid refuse their own settings (fluid/fluid_refine.c,
  * solid/solid_refine.c). */
 #include "mpm_refine.h"
 
@@ -176,7 +176,9 @@ static int read_box(const mpm_config *cfg, const mpm_grid *g, const char *name,
   return 0;
 }
 
-/* A solid beside a gas: the gas keeps its particles' pressure (fluid/fluid_gridp.c), whose
+/* A solid beside a gas with fluid.pressure = auto: the gas keeps its particles' pressure
+ * (fluid/fluid_gridp.c; grid takes the solid's region out of its span integrals and needs no
+ * bands, fluid/fluid_gridp_solid.c), whose
  * quadrature is exact across a level's face only where that face is a plane through the domain
  * (edges and corners of a box in the gas disturb it, docs/refinement.md): every box spans the
  * whole period of every periodic axis, and some axis must be periodic. */
@@ -601,7 +603,11 @@ int mpm_refine_build(mpm_hier **h, const mpm_config *cfg, mpm_grid *grid, mpm_mo
   mpm_hier_box *box;
   MPM_ALLOC(box, nbox);
   int rc = read_boxes(cfg, grid, names, nbox, (const unsigned char(*)[2])wall, box);
-  if (!rc && solid_of(mod, nmod) && nmod > 1) rc = check_bands(cfg, grid, names, box, nbox);
+  const char *pressure = "auto";
+  if (!rc && solid_of(mod, nmod) && nmod > 1)
+    rc = mpm_config_get_string(cfg, "fluid.pressure", &pressure);
+  if (!rc && solid_of(mod, nmod) && nmod > 1 && strcmp(pressure, "grid") != 0)
+    rc = check_bands(cfg, grid, names, box, nbox);
   char why[512] = "";
   if (!rc)
     rc = mpm_hier_new_walled(h, grid, levels, box, nbox, buffer, (const unsigned char(*)[2])wall,

@@ -272,6 +272,7 @@ static int build_modules(mpm_sim *s, int seed) {
   if (solid) s->mod[s->nmod++] = solid;
   MPM_CALL(fluid_module_create(&fluid, s->cfg, s->grid, seed));
   if (fluid) s->mod[s->nmod++] = fluid;
+  if (solid && fluid && fluid_module_reads_beside(fluid)) fluid->beside = solid->ops->points(solid);
   if (s->nmod == 0)
     return mpm_config_fail(s->cfg, "solid",
                            "the case defines neither bodies nor gas: add a [solid.NAME] or a "

@@ -46,11 +46,16 @@
  * pressure times the integral of their prolonged mask against grad N_i, and the adjoint rate
  * (ghost_forces here, fluid_obstacle_levels.c).
  *
+ * A solid. Its region is taken out of both span integrals by its own quadrature, the nodal
+ * pressure continued into it from the gas's nodes (fluid_gridp_solid.c).
+ *
  * Scope (check_scope refuses the rest): the method-of-lines ERK pairs with the current strain
- * rate or the classic update, the quadratic B-spline, a gas alone (no solid), no
- * shifting, the point volume rate, open faces with their default exterior (copies, not gauge).
- * On a hierarchy beside a solid, auto keeps the particles' pressure (fluid_gridp_refine). */
+ * rate or the classic update, the quadratic B-spline, beside a solid the monolithic time scheme
+ * and a scheme that shares nodes (not contact), no shifting, the point volume rate, open faces
+ * with their default exterior (copies, not gauge). On a hierarchy beside a solid, auto keeps the
+ * particles' pressure (fluid_gridp_refine). */
 #include "fluid_internal.h"
+#include "fluid_module.h"
 
 #include "mpm_error.h"
 #include "mpm_hier.h"
@@ -74,6 +79,8 @@ struct fluid_gridp {
   double *G[MPM_HIER_MAX_LEVELS][MPM_MAX_DIM]; /* the obstacles' span ghost GH (with obstacles) */
   unsigned char *skip[MPM_HIER_MAX_LEVELS];
   mpm_span_set set[MPM_HIER_MAX_LEVELS];
+  int beside_solid;      /* the case has a solid: its region is taken out (sol) */
+  fluid_gridp_solid sol; /* fluid_gridp_solid.c */
 };
 
 static int refuse(const mpm_config *cfg, const char *key, const char *why) {
@@ -95,9 +102,19 @@ static int check_scope(const fluid_content *fc, const mpm_config *cfg, const mpm
   const char *const *names;
   int count;
   MPM_CALL(mpm_config_instances(cfg, "solid", &names, &count));
-  if (count > 0)
-    return refuse(cfg, "fluid.pressure",
-                  "integrates over every span of the domain, and the case has a solid");
+  const char *time = "monolithic", *scheme = "velocity";
+  if (count > 0) MPM_CALL(mpm_config_get_string(cfg, "coupling.time", &time));
+  if (count > 0) MPM_CALL(mpm_config_get_string(cfg, "coupling.scheme", &scheme));
+  /* Beside a solid the gas reads the solid's particles in its forces (fluid_gridp_solid.c), as
+   * the solid's deposit of the same state left them: the monolithic cycle alone deposits both. */
+  if (strcmp(time, "monolithic") != 0)
+    return refuse(cfg, "coupling.time",
+                  "reads the solid's particles of the same stage beside a solid: use "
+                  "coupling.time = monolithic");
+  if (strcmp(scheme, "contact") == 0)
+    return refuse(cfg, "coupling.scheme",
+                  "beside a solid shares the nodes of both phases: use coupling.scheme = "
+                  "velocity or traction");
   /* Measured (test_refine_obstacles stream, usl): on a uniform grid a stream along an obstacle's
    * face left its uniform state by 1.09 under the classic update; the ERK pairs keep it. The
    * cause is the obstacles' hold of barely covered nodes, an impulse in the classic update
@@ -125,6 +142,11 @@ static int enable(mpm_module *m, const mpm_config *cfg) {
   MPM_CALL(check_scope(fc, cfg, m->grid));
   MPM_ALLOC(fc->gridp, 1);
   memset(fc->gridp, 0, sizeof *fc->gridp);
+  const char *const *names;
+  int count;
+  MPM_CALL(mpm_config_instances(cfg, "solid", &names, &count));
+  fc->gridp->beside_solid = count > 0;
+  if (count > 0) MPM_CALL(fluid_gridp_solid_init(&fc->gridp->sol, m->grid));
   return mpm_grid_add_phase(m->grid, "fluid_pressure", &fc->gridp->phase);
 }
 
@@ -139,10 +161,9 @@ int fluid_gridp_refine(mpm_module *m, const mpm_config *cfg, mpm_hier *h) {
   int nsolid;
   MPM_CALL(mpm_config_get_string(cfg, "fluid.pressure", &form));
   MPM_CALL(mpm_config_instances(cfg, "solid", &solids, &nsolid));
-  /* Beside a solid the gas keeps its particles' pressure (auto; grid is refused by
-   * check_scope): the grid pressure's span integral does not meet the solid's particle stress
-   * at the interface (a gas at rest beside a prestressed slab reached 0.1 c); the sim keeps the
-   * levels' faces off corners in the gas instead (coupler/mpm_refine.c, bands). */
+  /* Beside a solid auto keeps the particles' pressure (the sim then keeps the levels' faces off
+   * corners in the gas, coupler/mpm_refine.c, bands); grid takes the solid's region out of its
+   * span integrals (fluid_gridp_solid.c) and runs in any box. */
   if (nsolid > 0 && strcmp(form, "grid") != 0) return h ? mpm_hier_add_phases(h) : 0;
   if (strcmp(form, "particle") == 0)
     return mpm_config_fail(cfg, "fluid.pressure",
@@ -151,6 +172,11 @@ int fluid_gridp_refine(mpm_module *m, const mpm_config *cfg, mpm_hier *h) {
                            "key or set fluid.pressure = grid");
   if (!((fluid_content *)m->content)->gridp) MPM_CALL(enable(m, cfg));
   return h ? mpm_hier_add_phases(h) : 0;
+}
+
+int fluid_module_reads_beside(const mpm_module *m) {
+  const fluid_gridp *gp = ((const fluid_content *)m->content)->gridp;
+  return gp && gp->beside_solid;
 }
 
 void fluid_gridp_reset(fluid_content *fc) {
@@ -168,6 +194,7 @@ void fluid_gridp_destroy(fluid_content *fc) {
   fluid_gridp *gp = fc->gridp;
   if (!gp) return;
   fluid_gridp_reset(fc);
+  fluid_gridp_solid_free(&gp->sol);
   free(gp->mp), free(gp->s), free(gp->zero);
   free(gp);
   fc->gridp = NULL;
@@ -272,7 +299,7 @@ static int restrict_all(mpm_module *m, double *a[][MPM_MAX_DIM], int nf) {
 
 /* Fill level 0's ghosts from their owners and prolong the scalar a[l] into the inactive
  * nodes. */
-static int prolong_all(mpm_module *m, double **a) {
+int fluid_gridp_prolong(mpm_module *m, double **a) {
   MPM_CALL(mpm_grid_halo_forward(m->grid, &a[0], 1));
   for (int l = 1; m->hier && l < m->hier->nlevels; ++l)
     mpm_hier_prolong_level(m->hier, l, (const double *const *)&a[l - 1], &a[l], 1);
@@ -308,7 +335,7 @@ static int ghost_forces(mpm_module *m, fluid_gridp *gp) {
   for (int l = 0; l < gp->nlev; ++l)
     fluid_obstacles_span_mask(o, l, level_grid(m, l), gp->M[l],
                               m->hier ? m->hier->level[l].active : NULL, gp->D[l]);
-  MPM_CALL(prolong_all(m, gp->D));
+  MPM_CALL(fluid_gridp_prolong(m, gp->D));
   for (int l = 0; l < gp->nlev; ++l) {
     const mpm_grid *g = level_grid(m, l);
     for (int d = 0; d < dim; ++d) memset(gp->G[l][d], 0, sizeof(double) * (size_t)g->nnodes);
@@ -339,7 +366,9 @@ int fluid_gridp_forces(mpm_module *m) {
   for (int l = 0; l < gp->nlev; ++l) q[l] = Q[l][0];
   per_mass(m, gp, q, gp->P);
   fluid_open_grid_pressure(fc->open, gp->P[0]);
-  MPM_CALL(prolong_all(m, gp->P));
+  if (gp->beside_solid)
+    MPM_CALL(fluid_gridp_solid_pressure(m, &gp->sol, gp->P, (const double *const *)gp->M));
+  MPM_CALL(fluid_gridp_prolong(m, gp->P));
   for (int l = 0; l < gp->nlev; ++l) {
     const mpm_grid *g = level_grid(m, l);
     for (int d = 0; d < dim; ++d) memset(gp->F[l][d], 0, sizeof(double) * (size_t)g->nnodes);
@@ -355,6 +384,7 @@ int fluid_gridp_forces(mpm_module *m) {
     for (int d = 0; d < dim; ++d)
       for (mpm_lidx k = 0; k < g->nnodes; ++k) ph->f_i[d][k] += gp->F[l][d][k];
   }
+  if (gp->beside_solid) MPM_CALL(fluid_gridp_solid_force(m, &gp->sol, gp->P));
   return ghost_forces(m, gp);
 }
 
@@ -371,12 +401,14 @@ int fluid_gridp_nodal_rate(mpm_module *m, const mpm_hier_nodal *vel, mpm_hier_sc
     D[l][0] = gp->D[l];
   }
   MPM_CALL(restrict_all(m, D, 1));
+  if (gp->beside_solid)
+    MPM_CALL(fluid_gridp_solid_rate(m, &gp->sol, vel, gp->D, (const double *const *)gp->M));
   for (int l = 0; fc->obs.count && l < gp->nlev; ++l)
     fluid_obstacles_span_rate(level_grid(m, l), m->phase, gp->M[l],
                               m->hier ? m->hier->level[l].active : NULL,
                               (const double *const *)gp->G[l], gp->D[l]);
   per_mass(m, gp, gp->D, gp->P); /* P now holds the rate per unit mass */
-  MPM_CALL(prolong_all(m, gp->P));
+  MPM_CALL(fluid_gridp_prolong(m, gp->P));
   memset(s, 0, sizeof *s);
   for (int l = 0; l < gp->nlev; ++l) s->s_i[l][0] = gp->P[l];
   return 0;

@@ -135,6 +135,30 @@ int fluid_gridp_nodal_rate(mpm_module *m, const mpm_hier_nodal *v, mpm_hier_scal
 double *fluid_gridp_rate_out(const fluid_content *fc);
 void fluid_gridp_work(const mpm_module *m, const double *y, double *power);
 
+/* The grid pressure beside a solid (fluid_gridp_solid.c): the solid's region, its points
+ * (m->beside), taken out of the span integrals. phase: a grid phase of the fluid's for the
+ * solid's deposits; A, B: scalars per level; buf: scratch per solid point. init adds the phase
+ * (before the hierarchy's phases are added); pressure continues P (every level, before the
+ * prolongation) into the active nodes without gas mass M from the gas nodes' pressures; force
+ * adds the solid quadrature's correction to the gas phase's f_i (P prolonged); rate subtracts its
+ * adjoint from the restricted rates D and hands the continued nodes' rates to the gas nodes
+ * (the continuation's transpose; vel: the velocity read, NULL the gas phase's). Each does
+ * nothing while m->beside is NULL. fluid_gridp_prolong (fluid_gridp.c) fills level 0's ghosts
+ * of the level scalars a[l] and prolongs them into the inactive nodes. */
+typedef struct fluid_gridp_solid {
+  int phase;
+  mpm_lidx cap;
+  double *buf, *A[MPM_HIER_MAX_LEVELS], *B[MPM_HIER_MAX_LEVELS];
+} fluid_gridp_solid;
+int fluid_gridp_prolong(mpm_module *m, double **a);
+int fluid_gridp_solid_init(fluid_gridp_solid *s, mpm_grid *g);
+void fluid_gridp_solid_free(fluid_gridp_solid *s);
+int fluid_gridp_solid_pressure(mpm_module *m, fluid_gridp_solid *s, double *const *P,
+                               const double *const *M);
+int fluid_gridp_solid_force(mpm_module *m, fluid_gridp_solid *s, double *const *P);
+int fluid_gridp_solid_rate(mpm_module *m, fluid_gridp_solid *s, const mpm_hier_nodal *vel,
+                           double *const *D, const double *const *M);
+
 /* The gas's empty particle set and its layout: C with apic, D with viscous, psi with limiter,
  * and the lagged strain rate in the state (lag_in_state, the classic update) or after a
  * pending copy (the method of lines) (fluid_module.c). */

@@ -93,8 +93,9 @@ static const mpm_key_spec fluid_keys[] = {
      "the classic MPM quadrature), grid (the nodal pressure, a mass-weighted mean of the "
      "particles', integrated exactly over the grid's cells, with each particle's volume "
      "following its nodes' volume rate: gas at rest and uniform streams stay exact across "
-     "refined regions; ERK pairs, usl or musl, quadratic shape and a gas alone) or auto (grid "
-     "with refine.levels > 1 and no solid, where particle is refused; else particle); see "
+     "refined regions, and beside a solid its region is taken out by the solid's quadrature; "
+     "ERK pairs, usl or musl, quadratic shape; beside a solid monolithic, not contact) or auto "
+     "(grid with refine.levels > 1 and no solid, where particle is refused; else particle); see "
      "docs/refinement.md",
      0, NULL},
     {"fluid.ppc", MPM_KEY_INT, "2", 1, 8, 0, 0, NULL,

@@ -29,6 +29,10 @@ struct mpm_hier;
  * Collective. */
 int fluid_module_refine(mpm_module *m, const mpm_config *cfg, struct mpm_hier *h, int seed);
 
+/* 1 if the gas reads a solid's particles (mpm_module.h, beside): its grid pressure beside a
+ * solid (fluid/fluid_gridp_solid.c); else 0. */
+int fluid_module_reads_beside(const mpm_module *m);
+
 /* A regrid: move the module onto the new hierarchy h (may be NULL); the particles follow it
  * after the next step. */
 void fluid_module_rehier(mpm_module *m, struct mpm_hier *h);

@@ -75,6 +75,11 @@ typedef struct {
   mpm_lidx cap;           /* capacity of the scratch arrays */
   double *vsig, *scratch; /* V sigma (dim^2 n); G2P output v, a, L ((2 dim + dim^2) n) */
   mpm_lidx *idx, *count;  /* particle indices grouped by body; counts per body */
+  /* The particles' view for the gas's grid pressure (mpm_points), refreshed by each p2g once
+   * the points op has handed it out (pts_on); pts_buf holds its volumes (cap). */
+  mpm_points pts;
+  int pts_on;
+  double *pts_buf;
 } solid_content;
 
 /* "SECTION.NAME" into key. */

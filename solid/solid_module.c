@@ -290,7 +290,7 @@ static int ensure_scratch(mpm_module *m) {
   solid_content *sc = m->content;
   const mpm_lidx n = m->particles->n;
   const int dim = m->grid->dim;
-  if (n <= sc->cap && sc->vsig) return 0;
+  if (n <= sc->cap && sc->vsig && (!sc->pts_on || sc->pts_buf)) return 0;
   free(sc->vsig);
   free(sc->scratch);
   free(sc->idx);
@@ -301,7 +301,34 @@ static int ensure_scratch(mpm_module *m) {
   MPM_ALLOC(sc->scratch, (size_t)(2 * dim + dim * dim) * sc->cap);
   MPM_ALLOC(sc->idx, sc->cap);
   if (sc->tr.musl) MPM_ALLOC(sc->vnew, (size_t)dim * sc->cap);
+  free(sc->pts_buf);
+  sc->pts_buf = NULL;
+  if (sc->pts_on) MPM_ALLOC(sc->pts_buf, (size_t)sc->cap);
   return 0;
+}
+
+/* The points view (mpm_points) at state y: the positions and the volumes V0 det F. */
+static void fill_points(solid_content *sc, const mpm_particles *p, const double *y) {
+  const int dim = p->dim;
+  const mpm_lidx n = p->n;
+  const double *F = y + (size_t)p->offset[F_F] * n, *V0 = mpm_particles_comp(p, sc->lay.f_V0, 0);
+  double *V = sc->pts_buf;
+  for (mpm_lidx i = 0; i < n; ++i) {
+    double f[9];
+    for (int k = 0; k < dim * dim; ++k) f[k] = F[(size_t)k * n + i];
+    V[i] = V0[i] * (dim == 2
+                        ? f[0] * f[3] - f[1] * f[2]
+                        : f[0] * (f[4] * f[8] - f[5] * f[7]) - f[1] * (f[3] * f[8] - f[5] * f[6]) +
+                              f[2] * (f[3] * f[7] - f[4] * f[6]));
+  }
+  sc->pts.n = n, sc->pts.V = V;
+  for (int d = 0; d < dim; ++d) sc->pts.x[d] = y + (size_t)(p->offset[F_X] + d) * n;
+}
+
+static const mpm_points *solid_points(mpm_module *m) {
+  solid_content *sc = m->content;
+  sc->pts_on = 1; /* the next p2g's ensure_scratch allocates pts_buf */
+  return &sc->pts;
 }
 
 /* Group particle indices by body (a counting sort of the body field). */
@@ -341,6 +368,7 @@ static int solid_p2g(mpm_module *m, double t, const double *y) {
     idx += sc->count[b];
   }
   mpm_timer_stop(MPM_T_STRESS);
+  if (sc->pts_on) fill_points(sc, p, y);
 
   mpm_timer_start(MPM_T_P2G);
   mpm_p2g_args a = {.n = n,
@@ -647,6 +675,7 @@ static void solid_destroy(mpm_module *m) {
     free(sc->body);
     free(sc->vsig);
     free(sc->scratch);
+    free(sc->pts_buf);
     free(sc->idx);
     free(sc->vnew);
     free(sc->count);
@@ -668,6 +697,7 @@ static const mpm_module_ops solid_ops = {
     .post_step = solid_post_step,
     .destroy = solid_destroy,
     .remap = solid_remap,
+    .points = solid_points,
 };
 
 /* A body's bulk viscosity (solid_bulk_viscosity.h); the schema refuses negative values. */

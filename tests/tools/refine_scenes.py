@@ -393,3 +393,78 @@ def reflected_energy(p, rest, length):
     pp, uu = pulse_binned(p, rest, length, 120)
     left, right = 0.5 * (pp - uu), 0.5 * (pp + uu)
     return float((left ** 2).sum() / (right ** 2).sum())
+
+
+# A body inside a refined gas (tests/verification/test_refine_body.py): a prestressed disk
+# (sphere in 3-D) of radius 0.1 at the centre of the periodic unit square (cube), gas rho 1, p 1
+# around it, level 0 at dx = 0.05 and a level-1 box [0.3, 0.7]^dim around the body (4 finest
+# cells to spare). The gas takes fluid.pressure = grid, which takes the body's region out of its
+# span integrals (fluid/fluid_gridp_solid.c). {pulse}: a right-going planar pulse at x = 0.25
+# (p' = 1e-2 exp(-((x - 0.25) / 0.05)^2 / 2)), which strikes the body inside the box at t = 0.1.
+BODY_BOX = "[refine]\nlevels = 2\n\n[refine.box]\nlevel = 1\nlo = {lo}\nhi = {hi}\n"
+
+
+def body_case(t_end, refine=BODY_BOX, dim=2, pulse=False, material="linear_elastic",
+              pressure="grid", interval=None):
+    """The body scene; refine "" for the uniform twin, pressure "auto" for the particles'."""
+    lo, hi, c = (" ".join([v] * dim) for v in ("0", "1", "0.5"))
+    faces = "".join(f"{a}_lo = periodic\n{a}_hi = periodic\n" for a in "xyz"[:dim])
+    gas = "density = 1\npressure = 1\n"
+    if pulse:
+        f = "exp(-((x-0.25)/0.05)^2/2)"
+        zero = "; 0" * (dim - 1)
+        gas = (f"density_field = 1 + {1e-2 / 1.4}*{f}\npressure_field = 1 + 1e-2*{f}\n"
+               f"velocity_field = {1e-2 / np.sqrt(1.4)}*{f}{zero}\n")
+    box = refine.format(lo=" ".join(["0.3"] * dim), hi=" ".join(["0.7"] * dim)) if refine else ""
+    return f"""[run]
+name = refine_body
+
+[domain]
+dim = {dim}
+lo = {lo}
+hi = {hi}
+
+[grid]
+dx = 0.05
+
+[boundary]
+{faces}
+[coupling]
+scheme = velocity
+
+[time]
+t_end = {t_end}
+
+[output]
+interval = {interval or t_end}
+
+[fluid]
+gamma = 1.4
+pressure = {pressure}
+
+[geometry.all]
+type = box
+lo = {lo}
+hi = {hi}
+
+[geometry.body]
+type = {"sphere" if dim == 3 else "disk"}
+center = {c}
+radius = 0.1
+
+[geometry.gas]
+type = difference
+of = all body
+
+[gas.air]
+geometry = gas
+{gas}
+[solid.body]
+geometry = body
+material = {material}
+density = 0.25
+E = 22.4
+nu = 0
+initial_pressure = 1
+
+{box}"""

@@ -66,6 +66,13 @@ foreach(part rest pulse rest_usl pulse_usl traction restart input)
   mpm_add_script_test(test_refine_fsi_${part} SCRIPT verification/test_refine_fsi.py
                       ARGS ${part} LABELS verification TIMEOUT 300)
 endforeach()
+# A body inside a refined gas (fluid.pressure = grid beside a solid): a disk at rest in a level-1
+# box to t = 1, on the uniform grid, and the slab at rest on it (~15 s), a sphere at rest in 3-D
+# (~15 s), a pulse striking the disk, refined and its uniform twins (~6 s), the refusals (~3 s).
+foreach(part rest sphere pulse input)
+  mpm_add_script_test(test_refine_body_${part} SCRIPT verification/test_refine_body.py
+                      ARGS ${part} LABELS verification TIMEOUT 300)
+endforeach()
 # The classic update (time.method = usl, then musl) on the hierarchy (the gas): gas at rest and
 # a uniform stream across static level-1 and level-2 boxes at the walls, FLIP, a PIC share and
 # APIC (~10 s); the acoustic pulse crossing a box against its coarse twin (~8 s); Sod with a

@@ -244,8 +244,6 @@ def part_input():
          "solid.slab.geometry", "geometry = slab", "finest"),
         ("box not across the periodic axis", text.replace(band, "lo = 0.9 0.01\nhi = 2.7 0.05"),
          "refine.band.lo", "lo = 0.9 0.01", "periodic axis y"),
-        ("grid pressure", text.replace("gamma = 1.4", "gamma = 1.4\npressure = grid"),
-         "fluid.pressure", "pressure = grid", "solid"),
         ("contact", usl(text.replace("scheme = velocity", "scheme = contact")),
          "coupling.scheme", "scheme = contact", "not carried"),
         ("MUSL", text.replace("t_end = 0.1", "t_end = 0.1\nmethod = musl"),
