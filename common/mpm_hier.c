@@ -352,6 +352,7 @@ void mpm_hier_destroy(mpm_hier **hp) {
     free(lv->image), free(lv->canon), free(lv->is_image);
   }
   mpm_hier_scratch_free(h->scratch);
+  mpm_hier_census_free(h->census);
   free(h);
   *hp = NULL;
 }

@@ -112,5 +112,7 @@ int mpm_hier_parents(const mpm_grid *c, const int *gi, mpm_lidx *idx, double *w)
 
 /* Release the transfer scratch (mpm_hier_transfer.c). */
 void mpm_hier_scratch_free(void *scratch);
+/* Release the remembered levels (mpm_hier_census.c). */
+void mpm_hier_census_free(void *census);
 
 #endif
