@@ -4,8 +4,10 @@
 Runs CASE with binary A, then with binary B, PAIRS times (A B A B ...), on RANKS ranks, each to
 the same end time, and takes each run's wall time from its summary.json (the step loop's own
 clock, set-up excluded). Prints every pair and the median ratio A/B, checks that the two builds
-took the same number of steps (a change meant to be bit-identical must), and writes the rows
-to OUT.json and OUT.csv. Pairing keeps the ratio meaningful when the shared machine's speed
+took the same number of steps and wrote the same diagnostics.csv byte for byte (a change meant
+to be bit-identical must), and writes the rows to OUT.json and OUT.csv. Each run's user CPU time
+(of mpiexec and the ranks it waited for) is recorded too: unlike the wall time, another job on
+the machine barely changes it. Pairing keeps the ratio meaningful when the shared machine's speed
 drifts; compare ratios, not absolute times, across sessions.
 
   /usr/bin/python3 bench/bench_build_ab.py --a build/app/mpmfsi --b /path/to/old/mpmfsi \\
@@ -15,6 +17,7 @@ import argparse
 import csv
 import json
 import os
+import resource
 import statistics
 import subprocess
 import sys
@@ -31,12 +34,17 @@ def run(binary, case, ranks, t_end, extra):
     cmd = ["mpiexec", "-n", str(ranks), binary, "run", case, f"time.t_end={t_end}",
            f"output.dir={out}", "output.overwrite=true", "output.interval=1",
            "run.progress=false"] + extra
+    before = resource.getrusage(resource.RUSAGE_CHILDREN).ru_utime
     p = subprocess.run(cmd, env=env, capture_output=True, text=True)
+    user_s = resource.getrusage(resource.RUSAGE_CHILDREN).ru_utime - before
     if p.returncode != 0:
         sys.exit(f"{binary} failed ({p.returncode}):\n{p.stderr[-2000:]}")
     with open(os.path.join(out, "summary.json")) as f:
         s = json.load(f)
-    return {"wall_s": s["wall_s"], "steps": s["steps"], "particle_steps": s["particle_steps"]}
+    with open(os.path.join(out, "diagnostics.csv"), "rb") as f:
+        diag = f.read()
+    return {"wall_s": s["wall_s"], "user_s": user_s, "steps": s["steps"],
+            "particle_steps": s["particle_steps"], "diag": diag}
 
 
 def main():
@@ -55,25 +63,35 @@ def main():
         ra = run(a.a, a.case, a.ranks, a.t_end, a.extra)
         rb = run(a.b, a.case, a.ranks, a.t_end, a.extra)
         rows.append({"pair": k, "a_wall_s": ra["wall_s"], "b_wall_s": rb["wall_s"],
+                     "a_user_s": ra["user_s"], "b_user_s": rb["user_s"],
                      "a_steps": ra["steps"], "b_steps": rb["steps"],
-                     "ratio": ra["wall_s"] / rb["wall_s"]})
-        print(f"pair {k}: A {ra['wall_s']:.2f} s, B {rb['wall_s']:.2f} s, A/B "
-              f"{rows[-1]['ratio']:.3f} ({ra['steps']} / {rb['steps']} steps)", flush=True)
+                     "a_particle_steps": ra["particle_steps"],
+                     "b_particle_steps": rb["particle_steps"],
+                     "same_diagnostics": ra["diag"] == rb["diag"],
+                     "ratio": ra["wall_s"] / rb["wall_s"], "user_ratio": ra["user_s"] / rb["user_s"]})
+        print(f"pair {k}: A {ra['wall_s']:.2f} s ({ra['user_s']:.2f} s user), B "
+              f"{rb['wall_s']:.2f} s ({rb['user_s']:.2f} s user), A/B {rows[-1]['ratio']:.3f} "
+              f"(user {rows[-1]['user_ratio']:.3f}; {ra['steps']} / {rb['steps']} steps, "
+              f"{ra['particle_steps']} / {rb['particle_steps']} particle-steps, diagnostics "
+              f"{'identical' if rows[-1]['same_diagnostics'] else 'DIFFER'})", flush=True)
     ratios = [r["ratio"] for r in rows]
+    user = [r["user_ratio"] for r in rows]
     summary = {"case": os.path.relpath(a.case, os.path.join(HERE, "..")), "t_end": a.t_end,
                "ranks": a.ranks, "extra": a.extra, "pairs": rows,
                "median_ratio": statistics.median(ratios), "min_ratio": min(ratios),
-               "max_ratio": max(ratios),
-               "same_steps": all(r["a_steps"] == r["b_steps"] for r in rows)}
+               "max_ratio": max(ratios), "median_user_ratio": statistics.median(user),
+               "same_steps": all(r["a_steps"] == r["b_steps"] for r in rows),
+               "same_diagnostics": all(r["same_diagnostics"] for r in rows)}
     print(f"A/B wall: median {summary['median_ratio']:.3f} (range {min(ratios):.3f}-"
-          f"{max(ratios):.3f}); same step counts: {summary['same_steps']}")
+          f"{max(ratios):.3f}); user CPU: median {summary['median_user_ratio']:.3f}; same step "
+          f"counts: {summary['same_steps']}; same diagnostics: {summary['same_diagnostics']}")
     with open(a.out + ".json", "w") as f:
         json.dump(summary, f, indent=1)
     with open(a.out + ".csv", "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=list(rows[0].keys()))
         w.writeheader()
         w.writerows(rows)
-    return 0 if summary["same_steps"] else 1
+    return 0 if summary["same_steps"] and summary["same_diagnostics"] else 1
 
 
 if __name__ == "__main__":

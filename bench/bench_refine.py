@@ -1,6 +1,7 @@
 """Cost of the refined gas against its uniform twins (issue 51's benchmarks): for each case the
 refined run, the same scene without refinement at level 0's spacing (coarse) and at the finest
-level's (fine): particles, steps, RHS evaluations, wall time, peak memory, the error the case
+level's (fine): particles, steps, RHS evaluations, wall time, user CPU time (which another job on
+the shared machine changes far less than the wall time), peak memory, the error the case
 measures, and the refinement's overhead (timers restrict, prolong, relevel, regrid) as a share
 of the wall time.
 
@@ -50,12 +51,13 @@ DEFAULT_CASES = "stream,pulse,stream3d,sod,sod3"
 def run(binary, out, case, overrides):
     """One run: its summary, timers, peak memory (MB) and output folder."""
     os.makedirs(out, exist_ok=True)
-    cmd = ["/usr/bin/time", "-f", "%M", binary, "run", case, f"output.dir={out}/run",
+    cmd = ["/usr/bin/time", "-f", "%M %U", binary, "run", case, f"output.dir={out}/run",
            "output.overwrite=true", "run.progress=false"] + overrides
     p = subprocess.run(cmd, capture_output=True, text=True)
     if p.returncode != 0:
         raise SystemExit(f"{' '.join(cmd)} failed:\n{p.stderr[-2000:]}")
-    rss_mb = int(p.stderr.strip().splitlines()[-1]) / 1024.0
+    rss_kb, user_s = p.stderr.strip().splitlines()[-1].split()
+    rss_mb = int(rss_kb) / 1024.0
     run_dir = os.path.join(out, "run")
     with open(os.path.join(run_dir, "summary.json")) as f:
         summary = json.load(f)
@@ -67,7 +69,7 @@ def run(binary, out, case, overrides):
     return {"steps": int(d["step"][-1]), "rhs": int(d["rhs_evals"][-1]),
             "particles_start": int(d["particles"][0]), "particles_end": int(d["particles"][-1]),
             "particle_steps": summary["particle_steps"], "wall_s": summary["wall_s"],
-            "rss_mb": rss_mb, "timers": timers, "dir": run_dir}
+            "user_s": float(user_s), "rss_mb": rss_mb, "timers": timers, "dir": run_dir}
 
 
 def final(run_dir):
@@ -149,29 +151,30 @@ def page(results, commit, command):
     lines = ["# Cost of the refined gas against its uniform twins", "",
              f"Made by `{command}` at commit {commit}, {now}, on a shared 2-core machine "
              "(compare within a case: its runs went one after another). One rank. Wall time "
-             "from each run's summary, peak memory from /usr/bin/time. The overhead columns are "
+             "from each run's summary (the step loop), user CPU time (the whole process, set-up "
+             "included) and peak memory from /usr/bin/time. The overhead columns are "
              "the refinement's timers as a share of the run's wall time (restrict and prolong "
              "run inside the grid and transfer phases, relevel, the particles' splits and merges, "
              "inside post_step, regrid between steps).", ""]
     for name, rows in results.items():
         lines += [f"## {name}", "", f"Error: {ERRORS[name]}.", "",
-                  "| run | particles (start / end) | steps | RHS | wall s | peak MB | error | "
-                  "restrict | prolong | relevel | regrid |",
-                  "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
+                  "| run | particles (start / end) | steps | RHS | wall s | user s | peak MB | "
+                  "error | restrict | prolong | relevel | regrid |",
+                  "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
         for label, r in rows.items():
             t = r["timers"]
             share = [f"{100 * t.get(k, 0.0) / r['wall_s']:.1f} %" for k in TIMERS]
             lines.append(f"| {label} | {r['particles_start']} / {r['particles_end']} | "
-                         f"{r['steps']} | {r['rhs']} | {r['wall_s']:.2f} | {r['rss_mb']:.0f} | "
+                         f"{r['steps']} | {r['rhs']} | {r['wall_s']:.2f} | {r['user_s']:.2f} | "
+                         f"{r['rss_mb']:.0f} | "
                          f"{r['error']:.2e} | " + " | ".join(share) + " |")
         ref, fine = rows["refined"], rows["fine"]
         lines += ["", f"Refined against fine: {ref['wall_s'] / fine['wall_s']:.2f}× the wall "
-                  f"time, {ref['particle_steps'] / fine['particle_steps']:.2f}× the "
-                  f"particle-steps, {ref['rss_mb'] / fine['rss_mb']:.2f}× the peak memory, "
-                  f"{ref['error'] / fine['error']:.2f}× the error" if name.startswith("sod") else
-                  f"Refined against fine: {ref['wall_s'] / fine['wall_s']:.2f}× the wall "
-                  f"time, {ref['particle_steps'] / fine['particle_steps']:.2f}× the "
+                  f"time, {ref['user_s'] / fine['user_s']:.2f}× the user CPU time, "
+                  f"{ref['particle_steps'] / fine['particle_steps']:.2f}× the "
                   f"particle-steps, {ref['rss_mb'] / fine['rss_mb']:.2f}× the peak memory", ""]
+        if name.startswith("sod"):
+            lines[-2] += f", {ref['error'] / fine['error']:.2f}× the error"
         lines[-2] += "."
     return "\n".join(lines)
 
@@ -197,7 +200,7 @@ def main():
         else:
             raise SystemExit(f"unknown case {name}: choose among {DEFAULT_CASES}")
         for label, r in results[name].items():
-            print(f"{name} {label}: {r['steps']} steps, {r['wall_s']:.2f} s, {r['rss_mb']:.0f} MB,"
+            print(f"{name} {label}: {r['steps']} steps, {r['wall_s']:.2f} s ({r['user_s']:.2f} s user), {r['rss_mb']:.0f} MB,"
                   f" error {r['error']:.2e}", flush=True)
     os.makedirs(a.out, exist_ok=True)
     flat = [dict(case=n, run=label, **{k: v for k, v in r.items() if k not in ("timers", "dir")},

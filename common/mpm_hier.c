@@ -154,14 +154,19 @@ static void mark(const mpm_hier_level *lv, unsigned char *mask, const int *a, co
 }
 
 /* Mask value of span gi on level l, looked up at its mirror beyond a wall and at its image
- * along the level's periodic axes, with the rule outside the box of the file comment. */
+ * along the level's periodic axes, with the rule outside the box of the file comment. Axis by
+ * axis (each axis's mirror and image are its own), building the box index as
+ * mpm_grid_local_index does: a hot path (mpm_hier_level_of). */
 static inline int span_flag(const mpm_hier *h, int l, const unsigned char *mask, const int *gi,
                             int out) {
   const mpm_grid *g = h->level[l].grid;
-  int c[MPM_MAX_DIM] = {gi[0], gi[1], gi[2]};
-  for (int d = 0; d < h->dim; ++d) c[d] = hier_mirror(h, l, d, c[d]);
-  hier_canon(&h->level[l], h->dim, c);
-  return hier_in_box(g, c) ? mask[mpm_grid_local_index(g, c)] : out;
+  mpm_lidx k = 0;
+  for (int d = h->dim - 1; d >= 0; --d) {
+    const int c = hier_canon_1d(&h->level[l], d, hier_mirror(h, l, d, gi[d]));
+    if (c < g->box_lo[d] || c >= g->box_lo[d] + g->box_n[d]) return out;
+    k = k * g->box_n[d] + (c - g->box_lo[d]);
+  }
+  return mask[k];
 }
 
 /* Is every span in [a, z] covered on level l (periodically)? */
@@ -352,6 +357,7 @@ void mpm_hier_destroy(mpm_hier **hp) {
     free(lv->image), free(lv->canon), free(lv->is_image);
   }
   mpm_hier_scratch_free(h->scratch);
+  mpm_hier_census_free(h->census);
   free(h);
   *hp = NULL;
 }
@@ -380,6 +386,7 @@ static int stencil_in_box(const mpm_grid *g, const double *x) {
 int mpm_hier_level_of(const mpm_hier *h, const double *xp) {
   int l = 0, gi[MPM_MAX_DIM] = {0, 0, 0};
   double x[MPM_MAX_DIM];
+  const int walls = walled(h);
   hier_wrap_point(h, xp, x);
   for (; l + 1 < h->nlevels; ++l) {
     const mpm_grid *g = h->level[l].grid;
@@ -390,7 +397,7 @@ int mpm_hier_level_of(const mpm_hier *h, const double *xp) {
       gi[d] = hier_span_of(xi);
     }
     if (!span_flag(h, l, h->level[l].refined, gi, 0)) return l;
-    if (walled(h) && !stencil_in_box(h->level[l + 1].grid, x)) return l;
+    if (walls && !stencil_in_box(h->level[l + 1].grid, x)) return l;
   }
   return l;
 }

@@ -100,6 +100,7 @@ typedef struct mpm_hier {
   int wraps; /* some level >= 1 stores a whole period (mpm_hier_level.period) */
   mpm_hier_level level[MPM_HIER_MAX_LEVELS];
   void *scratch; /* private to mpm_hier.c: per-level particle lists and gathered arrays */
+  void *census;  /* private to mpm_hier_census.c: the points mpm_hier_levels saw last */
 } mpm_hier;
 
 /* One composite weight of a point: node `node` (box index) of level `level`, its weight and
@@ -141,11 +142,17 @@ int mpm_hier_add_phases(mpm_hier *h);
  * when the hierarchy wraps). */
 int mpm_hier_level_of(const mpm_hier *h, const double *x);
 
+/* The level (mpm_hier_level_of) of each of n points x[d][i], in an array of h's that holds
+ * them until the next call (NULL when out of memory). h remembers the points: a point equal bit
+ * for bit to the one the last call had at its index takes the level found then, so a caller
+ * asking again at positions that did not move pays a comparison per point (mpm_hier_census.c). */
+const unsigned char *mpm_hier_levels(mpm_hier *h, const double *const *x, mpm_lidx n);
 /* The level of every particle of p (mpm_hier_level_of at its field "x") into level[p->n]
  * (mpm_hier_census.c). */
 void mpm_hier_particle_levels(const mpm_hier *h, const mpm_particles *p, double *level);
-/* Add the number of p's particles on level l to count[l], l = 0 .. nlevels - 1. */
-void mpm_hier_count_levels(const mpm_hier *h, const mpm_particles *p, double *count);
+/* Add the number of p's particles on level l to count[l], l = 0 .. nlevels - 1 (through
+ * mpm_hier_levels). */
+void mpm_hier_count_levels(mpm_hier *h, const mpm_particles *p, double *count);
 
 /* The composite basis at x: writes the nonzero weights (each active node once) into w[max]
  * and returns their number (at most 3^dim times the number of levels); -1 if max is too small

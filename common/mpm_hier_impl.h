@@ -35,11 +35,13 @@ static inline int hier_mod(int i, int n) {
 
 /* Move gi (global indices of level lv's lattice, first dim entries) onto its image in
  * [0, period[d]) along every axis where the level has a period (mpm_hier.h, periodic axes). */
+static inline int hier_canon_1d(const mpm_hier_level *lv, int d, int i) {
+  const int P = lv->period[d]; /* (the division only for an image: this is a hot path) */
+  return P && (i < 0 || i >= P) ? hier_mod(i, P) : i;
+}
+
 static inline void hier_canon(const mpm_hier_level *lv, int dim, int *gi) {
-  for (int d = 0; d < dim; ++d) {
-    const int P = lv->period[d]; /* (the division only for an image: this is a hot path) */
-    if (P && (gi[d] < 0 || gi[d] >= P)) gi[d] = hier_mod(gi[d], P);
-  }
+  for (int d = 0; d < dim; ++d) gi[d] = hier_canon_1d(lv, d, gi[d]);
 }
 
 /* Index i of level l's lattice along d at its mirror when it lies beyond a walled face
@@ -112,5 +114,7 @@ int mpm_hier_parents(const mpm_grid *c, const int *gi, mpm_lidx *idx, double *w)
 
 /* Release the transfer scratch (mpm_hier_transfer.c). */
 void mpm_hier_scratch_free(void *scratch);
+/* Release the remembered levels (mpm_hier_census.c). */
+void mpm_hier_census_free(void *census);
 
 #endif

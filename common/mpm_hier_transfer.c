@@ -7,7 +7,8 @@
  * nothing per step; a chunk holds at most CHUNK particles, so the gathered columns stay in
  * cache and their memory is bounded whatever the particle count; when every particle lies on
  * level 0 the kernel runs on the caller's arrays directly (the plain kernel call); levels a
- * caller vouches for (mpm_hier_levels_known) are taken as given for its positions alone. On a level
+ * caller vouches for (mpm_hier_levels_known) are taken as given for its positions alone, and
+ * their grouping by level is made once for all the transfers of those positions. On a level
  * that stores a whole period along an axis (mpm_hier.h) the gathered positions are wrapped
  * into the domain along it, so every stencil lies in the level's box. */
 #include "mpm_hier_impl.h"
@@ -31,6 +32,8 @@ typedef struct hier_scratch {
   const double *known_x; /* mpm_hier_levels_known: positions, count and their levels */
   mpm_lidx known_n;
   const unsigned char *known;
+  int sorted; /* lev, order and first hold the known levels' grouping (classify) */
+  mpm_lidx first[MPM_HIER_MAX_LEVELS + 1];
 } hier_scratch;
 
 void mpm_hier_scratch_free(void *scratch) {
@@ -54,6 +57,7 @@ void mpm_hier_levels_known(mpm_hier *h, const double *x0, mpm_lidx n, const unsi
   hier_scratch *s = NULL;
   if (scratch_of(h, &s)) return; /* (out of memory: the transfers find the levels) */
   s->known_x = x0, s->known_n = x0 ? n : 0, s->known = x0 ? level : NULL;
+  s->sorted = 0;
 }
 
 /* Room for n particles (and a chunk of columns for them). */
@@ -78,11 +82,18 @@ static int reserve(mpm_hier *h, mpm_lidx n) {
 }
 
 /* Level of every particle and the particles grouped by level: level l's are
- * order[first[l] .. first[l + 1]). Returns 1 when all lie on level 0. */
+ * order[first[l] .. first[l + 1]). Returns 1 when all lie on level 0. The grouping of known
+ * levels is kept for the next transfer of the same positions (a transfer of other positions
+ * overwrites lev and order, so it drops it, as a new mpm_hier_levels_known does). */
 static int classify(mpm_hier *h, mpm_lidx n, const double *const *x, mpm_lidx *first) {
   hier_scratch *s = h->scratch;
   mpm_lidx count[MPM_HIER_MAX_LEVELS + 1] = {0};
   const int known = s->known && s->known_x == x[0] && s->known_n == n;
+  if (known && s->sorted) {
+    for (int l = 0; l <= h->nlevels; ++l) first[l] = s->first[l];
+    return first[1] == n;
+  }
+  s->sorted = known;
   for (mpm_lidx p = 0; p < n; ++p) {
     double xp[MPM_MAX_DIM] = {0, 0, 0};
     for (int d = 0; d < h->dim && !known; ++d) xp[d] = x[d][p];
@@ -91,6 +102,7 @@ static int classify(mpm_hier *h, mpm_lidx n, const double *const *x, mpm_lidx *f
   }
   first[0] = 0;
   for (int l = 0; l < h->nlevels; ++l) first[l + 1] = first[l] + count[l + 1];
+  for (int l = 0; known && l <= h->nlevels; ++l) s->first[l] = first[l];
   if (first[1] == n) return 1;
   mpm_lidx next[MPM_HIER_MAX_LEVELS];
   for (int l = 0; l < h->nlevels; ++l) next[l] = first[l];

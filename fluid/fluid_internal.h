@@ -55,6 +55,7 @@ typedef struct fluid_content {
   int filter_phase;          /* its scratch grid phase (-1: none) */
   double *work;              /* its particle scratch (4 dim cap) */
   double *sub, *zero;        /* its viscous deposit: positions and stresses, zeros (cap each) */
+  unsigned char *sub_lev;    /* and, refined, their levels (cap) */
   int stable_local;          /* fluid.stable_step = neighbourhood (fluid_stable.c) */
   double s_local;            /* its fastest signal for this step, m/s; < 0: not yet known */
   double *cellsum;           /* its per-cell sums and their block sums (6 nnodes) */
@@ -206,9 +207,13 @@ int fluid_g2p_phase(mpm_module *m, const double *y, double *const *v_out, double
                     double *L_out, const mpm_hier_scalars *s, double *s_out);
 /* The grid spacing of the finest level (the grid's without refinement). */
 double fluid_finest_dx(const mpm_module *m);
-/* The spacing of the level particle i of state y deposits on (its position's; the grid's
- * without a hierarchy). */
-double fluid_level_spacing(const mpm_module *m, const double *y, mpm_lidx i);
+/* The levels of the positions of state y (mpm_hier_levels: remembered while they do not move),
+ * NULL without a hierarchy or out of memory. */
+const unsigned char *fluid_position_levels(const mpm_module *m, const double *y);
+/* The level particle i of state y deposits on (its position's): lev[i] from
+ * fluid_position_levels, found afresh when lev is NULL; 0 without a hierarchy. */
+int fluid_position_level(const mpm_module *m, const unsigned char *lev, const double *y,
+                         mpm_lidx i);
 /* On a refinement, at the start of an RHS: the level of each particle's position in state y
  * into fc->lev, handed to the hierarchy for this RHS's transfers (mpm_hier_levels_known; the
  * RHS's last phase forgets them), and each particle's artificial viscosity length, its level's

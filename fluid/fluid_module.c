@@ -218,8 +218,9 @@ static int ensure_scratch(mpm_module *m) {
   if (n <= fc->cap && fc->vsig && (!fc->refined || fc->av_l)) return 0;
   free(fc->vsig), free(fc->scratch), free(fc->vnew), free(fc->Cnew), free(fc->power);
   free(fc->tscratch), free(fc->sub), free(fc->zero), free(fc->work), free(fc->av_l), free(fc->lev);
+  free(fc->sub_lev);
   fc->vnew = fc->Cnew = fc->tscratch = fc->sub = fc->zero = fc->work = fc->av_l = NULL;
-  fc->lev = NULL;
+  fc->lev = fc->sub_lev = NULL;
   fc->cap = n + n / 4 + 16;
   MPM_ALLOC(fc->vsig, (size_t)dim * dim * fc->cap);
   MPM_ALLOC(fc->scratch, (size_t)(2 * dim + dim * dim) * fc->cap);
@@ -306,7 +307,9 @@ static void rate_parts(int dim, mpm_lidx n, const double *L, double *divv, doubl
 }
 
 /* Deposit the viscous part of V sigma (fluid_stress_viscous) of the particles that have one, as
- * massless particles (forces only), and add it to b->vsig, which held the pressure's part. */
+ * massless particles (forces only), and add it to b->vsig, which held the pressure's part. On a
+ * hierarchy they deposit on the levels of this RHS (fc->lev, fluid_av_lengths), handed to it
+ * for their positions and then again for the whole set's. */
 static int deposit_viscous(mpm_module *m, const double *y, const fluid_batch *b) {
   fluid_content *fc = m->content;
   const int dim = b->dim, nk = dim * dim;
@@ -317,6 +320,8 @@ static int deposit_viscous(mpm_module *m, const double *y, const fluid_batch *b)
     fc->zero = calloc(cap, sizeof(double));
     if (!fc->zero) MPM_FAIL(MPM_ERR_MEMORY, "out of memory for %zu particles", cap);
   }
+  const int leveled = m->hier && fc->refined; /* fc->lev holds this RHS's levels */
+  if (leveled && !fc->sub_lev) MPM_ALLOC(fc->sub_lev, cap);
   double *xs = fc->sub, *sig = xs + (size_t)dim * cap;
   const double *x = state(m->particles, y, FLUID_X);
   mpm_lidx k = 0;
@@ -327,6 +332,7 @@ static int deposit_viscous(mpm_module *m, const double *y, const fluid_batch *b)
   for (mpm_lidx i = 0; i < n; ++i) {
     if (!fluid_stress_viscous(&fc->gas, b, i, one)) continue;
     for (int d = 0; d < dim; ++d) xs[(size_t)d * cap + j] = x[(size_t)d * n + i];
+    if (leveled) fc->sub_lev[j] = fc->lev[i];
     for (int q = 0; q < nk; ++q) {
       sig[(size_t)q * k + j] = one[q]; /* stride k: the kernel's n */
       b->vsig[(size_t)q * n + i] += one[q];
@@ -336,7 +342,9 @@ static int deposit_viscous(mpm_module *m, const double *y, const fluid_batch *b)
   mpm_p2g_args a = {.n = k, .m = fc->zero, .vsig = sig, .lp = fc->lp};
   for (int d = 0; d < dim; ++d) a.x[d] = xs + (size_t)d * cap, a.v[d] = fc->zero;
   int rc = 0;
+  if (leveled) mpm_hier_levels_known(m->hier, xs, k, fc->sub_lev);
   fluid_p2g_any(m, m->phase, &a, &rc);
+  if (leveled) mpm_hier_levels_known(m->hier, x, n, fc->lev);
   return rc;
 }
 
@@ -667,8 +675,9 @@ static int fluid_output(mpm_module *m) {
 }
 
 /* The stable step of a refined gas: the smallest over the particles of their level's spacing h
- * (fluid_level_spacing) over their signal speed, each computed as on a uniform grid of spacing h
- * (the artificial viscosity's length h too), returned as dx_finest / smax. */
+ * (their position's level, fluid_position_level) over their signal speed, each computed as on a
+ * uniform grid of spacing h (the artificial viscosity's length h too), returned as dx_finest /
+ * smax. */
 static double refined_stable_dt(const mpm_module *m, const double *y, double dx) {
   const fluid_content *fc = m->content;
   const mpm_particles *p = m->particles;
@@ -679,6 +688,7 @@ static double refined_stable_dt(const mpm_module *m, const double *y, double dx)
   const double *divv = field(p, y, fc->lay.f_divv);
   const double *psi = fc->lay.f_psi >= 0 ? field(p, y, fc->lay.f_psi) : NULL;
   const double *J = state(p, y, FLUID_J), *e = state(p, y, FLUID_E);
+  const unsigned char *lev = fluid_position_levels(m, y);
   double smax = 0.0;
   for (mpm_lidx i = 0; i < n; ++i) {
     double v2 = 0.0;
@@ -686,7 +696,8 @@ static double refined_stable_dt(const mpm_module *m, const double *y, double dx)
       const double v = state(p, y, FLUID_V)[(size_t)d * n + i];
       v2 += v * v;
     }
-    const double h = fluid_level_spacing(m, y, i);
+    const double h =
+        m->hier ? m->hier->level[fluid_position_level(m, lev, y, i)].grid->dx : m->grid->dx;
     const fluid_gas g = fluid_gas_at(&fc->gas, &h, 0);
     const double rho = mass[i] / (V0[i] * J[i]);
     const double c = sqrt(gamma * (gamma - 1.0) * fabs(e[i]));
@@ -780,7 +791,7 @@ static void fluid_destroy(mpm_module *m) {
     fluid_virtual_free(&fc->virt);
     free(fc->vsig), free(fc->scratch), free(fc->vnew), free(fc->Cnew), free(fc->power);
     free(fc->av_l), free(fc->lev);
-    free(fc->sub), free(fc->zero), free(fc->work);
+    free(fc->sub), free(fc->zero), free(fc->work), free(fc->sub_lev);
     free(fc->tscratch), free(fc->node), free(fc->cellsum), free(fc->lim), free(fc->vol);
     fluid_lnode_free(fc);
     free(fc);

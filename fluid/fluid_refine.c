@@ -76,12 +76,22 @@ double fluid_finest_dx(const mpm_module *m) {
   return h ? h->level[h->nlevels - 1].grid->dx : m->grid->dx;
 }
 
-double fluid_level_spacing(const mpm_module *m, const double *y, mpm_lidx i) {
+const unsigned char *fluid_position_levels(const mpm_module *m, const double *y) {
   const mpm_particles *p = m->particles;
-  if (!m->hier) return m->grid->dx;
+  if (!m->hier) return NULL;
+  const double *x[MPM_MAX_DIM];
+  for (int d = 0; d < p->dim; ++d) x[d] = y + (size_t)(p->offset[FLUID_X] + d) * p->n;
+  return mpm_hier_levels(m->hier, x, p->n);
+}
+
+int fluid_position_level(const mpm_module *m, const unsigned char *lev, const double *y,
+                         mpm_lidx i) {
+  const mpm_particles *p = m->particles;
+  if (!m->hier) return 0;
+  if (lev) return lev[i];
   double x[MPM_MAX_DIM] = {0, 0, 0};
   for (int d = 0; d < p->dim; ++d) x[d] = y[(size_t)(p->offset[FLUID_X] + d) * p->n + i];
-  return m->hier->level[mpm_hier_level_of(m->hier, x)].grid->dx;
+  return mpm_hier_level_of(m->hier, x);
 }
 
 void fluid_av_lengths(mpm_module *m, const double *y) {
@@ -92,14 +102,12 @@ void fluid_av_lengths(mpm_module *m, const double *y) {
     for (mpm_lidx i = 0; i < p->n; ++i) fc->av_l[i] = m->grid->dx;
     return;
   }
-  const double *x = y + (size_t)p->offset[FLUID_X] * p->n;
+  const unsigned char *lev = fluid_position_levels(m, y);
   for (mpm_lidx i = 0; i < p->n; ++i) {
-    double xp[MPM_MAX_DIM] = {0, 0, 0};
-    for (int d = 0; d < p->dim; ++d) xp[d] = x[(size_t)d * p->n + i];
-    fc->lev[i] = (unsigned char)mpm_hier_level_of(m->hier, xp);
+    fc->lev[i] = (unsigned char)fluid_position_level(m, lev, y, i);
     fc->av_l[i] = m->hier->level[fc->lev[i]].grid->dx;
   }
-  mpm_hier_levels_known(m->hier, x, p->n, fc->lev);
+  mpm_hier_levels_known(m->hier, y + (size_t)p->offset[FLUID_X] * p->n, p->n, fc->lev);
 }
 
 /* ---- what the slice refuses ------------------------------------------------------------------ */

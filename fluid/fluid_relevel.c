@@ -52,15 +52,6 @@ int fluid_size_level(const mpm_module *m, double V0_0, mpm_lidx i) {
   return (int)(l < 0 ? 0 : l >= MPM_HIER_MAX_LEVELS ? MPM_HIER_MAX_LEVELS - 1 : l);
 }
 
-/* The level of the position of particle i (0 without a hierarchy). */
-static int position_level(const mpm_module *m, mpm_lidx i) {
-  const mpm_particles *p = m->particles;
-  if (!m->hier) return 0;
-  double x[MPM_MAX_DIM];
-  for (int d = 0; d < p->dim; ++d) x[d] = mpm_particles_comp(p, FLUID_X, d)[i];
-  return mpm_hier_level_of(m->hier, x);
-}
-
 /* The size and position levels of every particle: lev[2 i] and lev[2 i + 1] (room for the set,
  * grown as it grows). */
 static int classify(const mpm_module *m, unsigned char **lev) {
@@ -70,9 +61,10 @@ static int classify(const mpm_module *m, unsigned char **lev) {
   if (!grown) MPM_FAIL_OOM(2 * (size_t)MPM_MAX(n, 1));
   *lev = grown;
   const double V0_0 = pow(m->grid->dx / fc->ppc, m->grid->dim);
+  const unsigned char *at = fluid_position_levels(m, m->particles->data);
   for (mpm_lidx i = 0; i < n; ++i) {
     grown[2 * i] = (unsigned char)fluid_size_level(m, V0_0, i);
-    grown[2 * i + 1] = (unsigned char)position_level(m, i);
+    grown[2 * i + 1] = (unsigned char)fluid_position_level(m, at, m->particles->data, i);
   }
   return 0;
 }

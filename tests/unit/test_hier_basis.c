@@ -21,7 +21,11 @@
  *  (7) Bad input: every refusal of mpm_hier_new returns MPM_ERR_INPUT, creates nothing and
  *      names the box (by its index) or the level at fault; the buffer check is exact (a box
  *      that fits with buffer 2 fails with 3). A grid split over ranks is test_hier_ranks's (it
- *      needs two). A box grid refuses the halo exchanges. */
+ *      needs two). A box grid refuses the halo exchanges.
+ *  (8) Remembered levels (mpm_hier_levels): over 10,000 random points, then again with every
+ *      third point moved to a fresh random point, the set shortened and then grown past its
+ *      first size, every level equals mpm_hier_level_of's exactly (levels are integers); the
+ *      moves must change some levels (else the check could not see a stale one). */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -334,12 +338,56 @@ static void test_box_grid(void **state) {
   assert_null(g);
 }
 
+/* ---- (8) remembered levels ------------------------------------------------------------- */
+
+/* mpm_hier_levels over the first n points of x (component-major, stride NPOINTS) against
+ * mpm_hier_level_of at each. */
+static void check_levels(const fixture *f, double *const *x, mpm_lidx n) {
+  const double *xs[3] = {x[0], x[1], x[2]};
+  const unsigned char *lev = mpm_hier_levels(f->h, xs, n);
+  assert_non_null(lev);
+  for (mpm_lidx i = 0; i < n; ++i) {
+    const double p[3] = {x[0][i], x[1][i], x[2][i]};
+    assert_int_equal(lev[i], mpm_hier_level_of(f->h, p));
+  }
+}
+
+static void test_levels(void **state) {
+  (void)state;
+  for (int c = 0; c < HIER_NCASES; ++c) {
+    fixture f;
+    assert_int_equal(fixture_make(&f, (hier_case)c), 0);
+    uint64_t rng = 8000 + (uint64_t)c;
+    double *x[3];
+    for (int d = 0; d < 3; ++d) x[d] = calloc(2 * NPOINTS, sizeof(double));
+    for (int k = 0; k < 2 * NPOINTS; ++k) {
+      double p[3];
+      fixture_point(&f, &rng, k, p);
+      for (int d = 0; d < 3; ++d) x[d][k] = p[d];
+    }
+    check_levels(&f, x, NPOINTS);
+    int moved_level = 0;
+    for (int k = 0; k < NPOINTS; k += 3) { /* a fresh point at index k */
+      double p[3], q[3] = {x[0][k], x[1][k], x[2][k]};
+      fixture_point(&f, &rng, k + 1, p);
+      moved_level += mpm_hier_level_of(f.h, p) != mpm_hier_level_of(f.h, q);
+      for (int d = 0; d < 3; ++d) x[d][k] = p[d];
+    }
+    assert_true(moved_level > NPOINTS / 30);
+    check_levels(&f, x, NPOINTS);
+    check_levels(&f, x, NPOINTS / 2);
+    check_levels(&f, x, 2 * NPOINTS);
+    for (int d = 0; d < 3; ++d) free(x[d]);
+    fixture_free(&f);
+  }
+}
+
 int main(int argc, char **argv) {
   MPI_Init(&argc, &argv);
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_pou),      cmocka_unit_test(test_c1),
       cmocka_unit_test(test_adjoint),  cmocka_unit_test(test_bad_input),
-      cmocka_unit_test(test_box_grid),
+      cmocka_unit_test(test_box_grid), cmocka_unit_test(test_levels),
   };
   const int rc = cmocka_run_group_tests(tests, NULL, NULL);
   MPI_Finalize();

@@ -3,7 +3,8 @@
 
 cases/sod.ini on a strip of 100 level-0 cells along x and 3 across (periodic in y: every level
 wraps there), regridded every 10 steps by the density criterion (threshold 0.02: the shock, the
-contact and the rarefaction's edges; refine_scenes.sod_refine), against its uniform twin at the
+contact and the rarefaction's edges; the flags dilated by one level-0 cell per level;
+refine_scenes.sod_refine), against its uniform twin at the
 finest spacing on the same strip (so 3 x 2^(levels - 1) cells across: the same ppc per fine
 cell, bs32 at the same fixed cfl). The density's L1 is measured as tests/verification/test_sod.py
 does (tests/tools/shocktube.py), on the finest level's cells.
@@ -15,9 +16,10 @@ cells). Particles, steps and wall times are printed; the cost is bench/bench_ref
 (bench/results/refine_cost.md), never asserted.
 
 Argument:
-  (none)  2 levels (finest 200 cells): L1 <= 1.10 x the twin's (measured 1.01; ~3 s).
-  long    3 levels (finest 400 cells): the same bar, measured 1.010 (3.811e-3 against
-          3.773e-3; ~15 s). (It was 1.44, an expected failure, until the regrid stopped
+  (none)  2 levels (finest 200 cells): L1 <= 1.10 x the twin's (measured 1.000; 1.009 with
+          the default refine.dilate = 2; ~3 s).
+  long    3 levels (finest 400 cells): the same bar, measured 1.015 (3.830e-3 against
+          3.773e-3; 1.010 with refine.dilate = 2; ~15 s). (It was 1.44, an expected failure, until the regrid stopped
           cutting the level-2 region short at the periodic face: test_refine_gas_wrap.)
 Able to fail: the default variant refined by the compression criterion (the shock alone)
 measures 1.80 (L1 1.345e-2, worse than the 100-cell run alone, 1.117e-2); the long variant
