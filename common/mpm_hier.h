@@ -92,8 +92,23 @@ typedef struct mpm_hier_level {
   unsigned char *is_image;
 } mpm_hier_level;
 
+/* On more than one rank (mpm_hier.h, ranks): level 0's nodes that level 1's nodes have as
+ * parents, a box [lo, lo + n) of level 0's lattice, with, for each of its nodes, the level-0
+ * box index of the node (or its periodic image) this rank owns, or -1. */
+typedef struct mpm_hier_parents_box {
+  mpm_grid *grid;  /* the box, as a box grid of level 0's lattice (mpm_grid_box_new) */
+  mpm_lidx *owned; /* level-0 box index of the owned node, -1: another rank's */
+  double *buf;     /* room for 1 + 3 MPM_MAX_DIM fields over the box */
+} mpm_hier_parents_box;
+
 typedef struct mpm_hier {
   int dim, nlevels, buffer;
+  /* The ranks of level 0's grid (1: the one-rank code paths, unchanged) and this one's. */
+  int nranks, rank;
+  mpm_hier_parents_box pbox; /* nranks > 1 only */
+  /* nranks > 1: a phase's finer levels hold this rank's own deposit, not yet summed over the
+   * ranks (set by mpm_hier_p2g, cleared by mpm_hier_restrict's sum), or hold the sum. */
+  unsigned char pending[MPM_GRID_MAX_PHASES], summed[MPM_GRID_MAX_PHASES];
   /* Components a wall on face [d][side] constrains (bit e: component e flips in the mirror;
    * 0: no wall, the face is not mirrored). */
   unsigned char wall[MPM_MAX_DIM][2];
@@ -190,9 +205,19 @@ int mpm_hier_g2p_from(mpm_hier *h, int phase, const mpm_g2p_args *a, const mpm_h
 /* Restrict the deposit of a phase (m, m v, f and the mass gradient where deposited), finest
  * level first; every inactive node ends at zero. */
 void mpm_hier_restrict(mpm_hier *h, int phase);
+/* Before a deposit of a phase onto the finer levels (mpm_hier_p2g calls it; a caller adding its
+ * own per-particle shares calls it too): on more than one rank the finer levels must hold this
+ * rank's share alone, for the next mpm_hier_restrict to sum them; a rank other than 0 zeroes a
+ * sum they already hold (rank 0 keeps it, so the sum adds it once). No-op on one rank. */
+void mpm_hier_own_share(mpm_hier *h, int phase);
 /* Prolong a phase's v and a into every inactive node, level 1 first. */
 void mpm_hier_prolong(mpm_hier *h, int phase);
-/* The same for nf arrays of the caller: fine[k] on level l (>= 1), coarse[k] on level l - 1. */
+/* The same for nf arrays of the caller: fine[k] on level l (>= 1), coarse[k] on level l - 1.
+ * On more than one rank the fine arrays hold this rank's share (the restriction sums them over
+ * the ranks; a caller computing a finer level's values alike on every rank gives them on rank 0
+ * alone, zeros elsewhere), the restriction onto level 0 lands on the nodes this rank owns (call
+ * level 0's halo_reverse after it), and the prolongation onto level 1 reads level 0's owned
+ * nodes (collective over the grid's communicator). */
 void mpm_hier_restrict_level(mpm_hier *h, int l, double *const *fine, double *const *coarse,
                              int nf);
 void mpm_hier_prolong_level(mpm_hier *h, int l, const double *const *coarse, double *const *fine,
