@@ -29,8 +29,23 @@
  *
  * Storage. Level l >= 1 is one box of nodes per rank, an mpm_grid made by mpm_grid_box_new()
  * (no communicator), so the P2G/G2P kernels run on it unchanged. Its box holds every node
- * whose support meets Omega_l plus one layer. This version runs on one rank, with the
- * quadratic B-spline only: mpm_hier_new() refuses anything else with a reason.
+ * whose support meets Omega_l plus one layer. The quadratic B-spline only: mpm_hier_new()
+ * refuses anything else with a reason.
+ *
+ * Ranks. Level 0 is split over the ranks (mpm_grid.h); every rank stores each finer level's
+ * whole box, and a rank's particles are those owning their position, as without refinement.
+ * The finer levels are kept alike on every rank: after a deposit they hold the rank's own share
+ * (mpm_hier_own_share), and the restriction first sums each finer level over the ranks (one
+ * MPI_Allreduce per level and field over its box), then restricts; onto a finer level l - 1
+ * only rank 0 adds (the level's own sum follows), onto level 0 it goes through the parents box
+ * (the level-0 nodes that are parents of level 1's box, alike on every rank) and lands on the
+ * level-0 nodes the rank owns (a node's image in [0, ncells) along a periodic axis), so every
+ * contribution is added once over the ranks, before level 0's halo sums its ghosts. The
+ * prolongation onto level 1 reads the parents box filled by the owners and summed over the
+ * ranks, so level 1's inactive nodes are whole on every rank (never read outside level 0's
+ * box); the finer prolongations and the nodal solve then run alike on every rank. A rank's
+ * level-0 masks cover its box; beyond it, level 0's refined spans are read from level 1's
+ * covered mask, so every rank finds the level of any point. On one rank none of this runs.
  *
  * Periodic axes. Along a periodic axis d of the grid, level l's lattice wraps with a period of
  * N_l = ncells[d] 2^l nodes (and spans), and a region may touch, cross or span the periodic
@@ -130,8 +145,9 @@ typedef struct mpm_hier_weight {
  * Omega_l. Mirrors the grid's phases (mpm_hier_add_phases). On bad input returns MPM_ERR_INPUT
  * and writes one sentence into why[why_len] naming the box (by its index in `box`) and what is
  * wrong: a level outside 1 .. nlevels - 1, a box empty or outside the domain, a level without a
- * box, a box not inside the coarser level's region by `buffer` spans, a grid on more than one
- * rank or a shape other than the quadratic B-spline. Logs nothing: the caller names the key. */
+ * box, a box not inside the coarser level's region by `buffer` spans or a shape other than the
+ * quadratic B-spline. Logs nothing: the caller names the key. On several ranks every rank
+ * calls it with the same boxes, and so builds the same finer levels. */
 int mpm_hier_new(mpm_hier **h, mpm_grid *grid, int nlevels, const mpm_hier_box *box, int nbox,
                  int buffer, char *why, size_t why_len);
 /* The same with walls: wall[d][side] as mpm_hier.wall (NULL: none). A box may then touch a

@@ -23,8 +23,8 @@ dynamic  The nonlinear pulse (5e-2) regridded by the density criterion every 10 
 Bounds: 1e-12 relative. Roundoff: the ranks add the same terms in another order (the finer
 levels' sums over the ranks, level 0's halo sums, the diagnostics' and the regrid's sums);
 measured 2e-13 (pulse), 2e-16 (stream), 5e-15 (dynamic). Able to fail: without the sum over
-the ranks (common/mpm_hier_basis.c, sum_ranks) the pulse's 2-rank run stops at its first step
-(a particle moves more than a cell); with the regrid's flags left per rank the regions differ.
+the ranks (common/mpm_hier_basis.c, sum_ranks) every check of `static` fails (other particles;
+momentum drifts by 1.5e-2 and 7.4e-2 of sum m |v| on 2 ranks).
 rhs_evals is not compared: a particle crossing the ranks' boundary restarts the integrator's
 first stage (as without refinement), so 2 ranks evaluate a few more right-hand sides.
 """
