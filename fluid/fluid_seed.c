@@ -12,7 +12,8 @@
  * inside the finer regions go, and each level l >= 1 seeds its own region less the finer ones
  * on its lattice: ppc points per axis in each level-l span, of volume (h_l / ppc)^dim, with the
  * same first-section-wins rule. A level-0 span is whole for an even ppc, so the region's
- * level-0 particles leave no part behind. */
+ * level-0 particles leave no part behind. On more than one rank every rank walks the level's
+ * whole lattice (the ids follow its order, whatever the ranks) and keeps the points it owns. */
 #include "fluid_eos.h"
 #include "fluid_internal.h"
 
