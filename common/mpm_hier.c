@@ -388,7 +388,7 @@ void mpm_hier_destroy(mpm_hier **hp) {
     free(lv->image), free(lv->canon), free(lv->is_image);
   }
   mpm_grid_destroy(&h->pbox.grid);
-  free(h->pbox.owned), free(h->pbox.buf);
+  free(h->pbox.owned), free(h->pbox.buf), free(h->sum_buf);
   mpm_hier_scratch_free(h->scratch);
   free(h);
   *hp = NULL;

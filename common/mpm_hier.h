@@ -124,6 +124,8 @@ typedef struct mpm_hier {
   /* nranks > 1: a phase's finer levels hold this rank's own deposit, not yet summed over the
    * ranks (set by mpm_hier_p2g, cleared by mpm_hier_restrict's sum), or hold the sum. */
   unsigned char pending[MPM_GRID_MAX_PHASES], summed[MPM_GRID_MAX_PHASES];
+  double *sum_buf; /* nranks > 1: room for the fields a restriction sums (grown, kept) */
+  size_t sum_cap;
   /* Components a wall on face [d][side] constrains (bit e: component e flips in the mirror;
    * 0: no wall, the face is not mirrored). */
   unsigned char wall[MPM_MAX_DIM][2];

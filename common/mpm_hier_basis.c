@@ -15,6 +15,8 @@
 #include "mpm_hier_impl.h"
 #include "mpm_timer.h"
 
+#include <limits.h>
+#include <stdlib.h>
 #include <string.h>
 
 int mpm_hier_parents(const mpm_grid *c, const int *gi, mpm_lidx *idx, double *w) {
@@ -48,11 +50,25 @@ static int skips(const mpm_hier_level *lv, mpm_lidx n) {
   return lv->active[n] || (lv->is_image && lv->is_image[n]);
 }
 
-/* Sum nf arrays of level l >= 1 over the ranks (mpm_hier.h, ranks). */
-static void sum_ranks(const mpm_hier *h, int l, double *const *a, int nf) {
-  const mpm_grid *g = h->level[l].grid;
-  for (int k = 0; k < nf; ++k) /* (MPI's errors abort: the default handler) */
-    MPI_Allreduce(MPI_IN_PLACE, a[k], (int)g->nnodes, MPI_DOUBLE, MPI_SUM, h->level[0].grid->comm);
+/* Sum nf arrays of level l >= 1 over the ranks (mpm_hier.h, ranks): one MPI_Allreduce of them
+ * packed together (per array when the room cannot be had). MPI's errors abort (the default
+ * handler). */
+static void sum_ranks(mpm_hier *h, int l, double *const *a, int nf) {
+  const size_t nn = (size_t)h->level[l].grid->nnodes, need = nn * (size_t)nf;
+  const MPI_Comm comm = h->level[0].grid->comm;
+  if (need > h->sum_cap) {
+    free(h->sum_buf);
+    h->sum_buf = malloc(sizeof(double) * need);
+    h->sum_cap = h->sum_buf ? need : 0;
+  }
+  if (!h->sum_buf || need > (size_t)INT_MAX) {
+    for (int k = 0; k < nf; ++k)
+      MPI_Allreduce(MPI_IN_PLACE, a[k], (int)nn, MPI_DOUBLE, MPI_SUM, comm);
+    return;
+  }
+  for (int k = 0; k < nf; ++k) memcpy(h->sum_buf + (size_t)k * nn, a[k], sizeof(double) * nn);
+  MPI_Allreduce(MPI_IN_PLACE, h->sum_buf, (int)need, MPI_DOUBLE, MPI_SUM, comm);
+  for (int k = 0; k < nf; ++k) memcpy(a[k], h->sum_buf + (size_t)k * nn, sizeof(double) * nn);
 }
 
 /* Restrict the inactive nodes of level l (fine) onto their parents' arrays `to` on the lattice
