@@ -15,8 +15,8 @@ endforeach()
 mpm_add_script_test(test_refine_gas_ranks SCRIPT verification/test_refine_gas.py ARGS ranks
                     LABELS "verification;mpi" TIMEOUT 300)
 # The gas's hierarchy on 2 ranks against 1 (fixed steps): a pulse through a static box and a
-# stream through a band and a box on the floor (~15 s); the regridded pulse, the particles per
-# rank, and a restart on 2 ranks across a regrid (~15 s).
+# stream through a band and a box on the floor (~15 s); the regridded pulse under bs32 and usl,
+# its levels' output, the particles per rank, and a restart on 2 ranks across a regrid (~15 s).
 foreach(part static dynamic)
   mpm_add_script_test(test_refine_ranks_${part} SCRIPT verification/test_refine_ranks.py
                       ARGS ${part} LABELS "verification;mpi" TIMEOUT 300)
