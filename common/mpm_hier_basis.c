@@ -10,6 +10,8 @@
  * folds every image into its node and the prolongation ends by copying every node into its
  * images; both skip the images otherwise (their parents may lie outside the coarser box), and
  * mpm_hier_eval moves every node onto its image before it looks it up.
+ * On more than one rank (mpm_hier.h, ranks) level 1's parents are read and written through the
+ * parents box, and a restriction first sums the finer level over the ranks.
  * Every call of the per-level restriction and prolongation is timed (MPM_T_RESTRICT and
  * MPM_T_PROLONG, mpm_timer.h), whoever calls it. */
 #include "mpm_hier_impl.h"
@@ -71,9 +73,9 @@ static void sum_ranks(mpm_hier *h, int l, double *const *a, int nf) {
   for (int k = 0; k < nf; ++k) memcpy(a[k], h->sum_buf + (size_t)k * nn, sizeof(double) * nn);
 }
 
-/* Restrict the inactive nodes of level l (fine) onto their parents' arrays `to` on the lattice
- * c (level l - 1, or the parents box), nf arrays of stride `stride` (0: to[k] apart), zeroing
- * them; add: 0 only zeroes. */
+/* Restrict the inactive nodes of level l (fine, nf arrays) onto their parents in the arrays
+ * `to` over the lattice c (level l - 1, or the parents box), zeroing them; add 0: only zero
+ * them (a rank other than 0 whose sum rank 0 adds). */
 static void restrict_into(const mpm_hier *h, int l, double *const *fine, const mpm_grid *c,
                           double *const *to, int nf, int add) {
   const mpm_hier_level *lv = &h->level[l];

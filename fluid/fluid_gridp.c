@@ -222,7 +222,7 @@ static int ensure_levels(mpm_module *m, fluid_gridp *gp) {
       s->lo[d] = N ? 0 : g->box_lo[d], s->hi[d] = N ? N - 1 : g->box_lo[d] + g->box_n[d] - 1;
       wall_spans(h, l, d, s);
     }
-    /* On more than one rank rank 0 integrates the finer levels, the others give zeros: the
+    /* With more than one rank, rank 0 integrates the finer levels and the others give zeros: the
      * restriction sums the ranks' shares (mpm_hier.h). */
     if (m->grid->rank != 0) s->hi[0] = s->lo[0] - 1;
   }
