@@ -55,11 +55,6 @@ static int check_setup(const mpm_grid *grid, int nlevels, int buffer, char *why,
   if (nlevels < 1 || nlevels > MPM_HIER_MAX_LEVELS)
     return refuse(why, len, "%d levels: give 1 to %d (level 0 is the grid)", nlevels,
                   MPM_HIER_MAX_LEVELS);
-  if (grid->size != 1)
-    return refuse(why, len,
-                  "refinement runs on one rank for now (its levels are not split over ranks), "
-                  "and the grid is split over %d: run on one rank",
-                  grid->size);
   if (grid->shape != MPM_SHAPE_QUADRATIC)
     return refuse(why, len,
                   "refinement needs the quadratic B-spline shape (its nested levels use that "
@@ -161,12 +156,26 @@ static inline int span_flag(const mpm_hier *h, int l, const unsigned char *mask,
                             int out) {
   const mpm_grid *g = h->level[l].grid;
   mpm_lidx k = 0;
-  for (int d = h->dim - 1; d >= 0; --d) {
+  int d = h->dim - 1;
+  for (; d >= 0; --d) {
     const int c = hier_canon_1d(&h->level[l], d, hier_mirror(h, l, d, gi[d]));
-    if (c < g->box_lo[d] || c >= g->box_lo[d] + g->box_n[d]) return out;
+    if (c < g->box_lo[d] || c >= g->box_lo[d] + g->box_n[d]) break;
     k = k * g->box_n[d] + (c - g->box_lo[d]);
   }
-  return mask[k];
+  if (d < 0) return mask[k];
+  /* A rank's part of level 0 may hold the span's image but not its image in [0, period). */
+  int m[MPM_MAX_DIM] = {gi[0], gi[1], gi[2]};
+  for (int e = 0; e < h->dim; ++e) m[e] = hier_mirror(h, l, e, m[e]);
+  if (hier_in_box(g, m)) return mask[mpm_grid_local_index(g, m)];
+  /* On more than one rank, level 0's refined spans beyond the rank's box: span i is refined
+   * when level 1 covers its span 2 i (its level-1 spans are 2 i and 2 i + 1), so every rank
+   * finds every point's level. */
+  if (l == 0 && h->nranks > 1 && h->nlevels > 1 && mask == h->level[0].refined) {
+    int f[MPM_MAX_DIM] = {0, 0, 0};
+    for (int e = 0; e < h->dim; ++e) f[e] = 2 * gi[e];
+    return span_flag(h, 1, h->level[1].covered, f, 0);
+  }
+  return out;
 }
 
 /* Is every span in [a, z] covered on level l (periodically)? */
@@ -296,6 +305,33 @@ static int check_nesting(const mpm_hier *h, int l, const box_spans *sp, const mp
   return 0;
 }
 
+/* On more than one rank: the box of level 0's nodes that are parents of level 1's box nodes,
+ * [floor(lo / 2) - 1, floor(hi / 2) + 1] per axis (mpm_hier_impl.h, hier_parents_1d), and for
+ * each the level-0 box index of the node this rank owns there (its image in [0, ncells) along
+ * a periodic axis), or -1. */
+static int make_parents_box(mpm_hier *h) {
+  const mpm_grid *g0 = h->level[0].grid, *g1 = h->level[1].grid;
+  int lo[MPM_MAX_DIM] = {0, 0, 0}, n[MPM_MAX_DIM] = {1, 1, 1}, gi[MPM_MAX_DIM];
+  for (int d = 0; d < h->dim; ++d) {
+    lo[d] = hier_half(g1->box_lo[d]) - 1;
+    n[d] = hier_half(g1->box_lo[d] + g1->box_n[d] - 1) + 1 - lo[d] + 1;
+  }
+  mpm_hier_parents_box *pb = &h->pbox;
+  MPM_CALL(mpm_grid_box_new(&pb->grid, h->dim, g0->lo, g0->dx, g0->shape, lo, n));
+  MPM_ALLOC(pb->owned, pb->grid->nnodes);
+  MPM_ALLOC(pb->buf, (size_t)pb->grid->nnodes * (1 + 3 * MPM_MAX_DIM));
+  for (mpm_lidx k = 0; k < pb->grid->nnodes; ++k) {
+    hier_node_of(pb->grid, k, gi);
+    int own = 1;
+    for (int d = 0; d < h->dim; ++d) {
+      if (g0->periodic[d]) gi[d] = hier_mod(gi[d], g0->ncells[d]);
+      own &= gi[d] >= g0->own_lo[d] && gi[d] < g0->own_hi[d];
+    }
+    pb->owned[k] = own ? mpm_grid_local_index(g0, gi) : -1;
+  }
+  return 0;
+}
+
 /* Levels 1 .. nlevels - 1 in turn (each snaps its boxes to the level before); why is set on an
  * input error. */
 static int build_levels(mpm_hier *h, const mpm_hier_box *box, int nbox, char *why, size_t len) {
@@ -310,6 +346,7 @@ static int build_levels(mpm_hier *h, const mpm_hier_box *box, int nbox, char *wh
   }
   free(sp);
   for (int l = 0; l < h->nlevels && !rc; ++l) set_active(h, l);
+  if (!rc && h->nranks > 1 && h->nlevels > 1) rc = make_parents_box(h);
   return rc;
 }
 
@@ -329,6 +366,7 @@ int mpm_hier_new_walled(mpm_hier **hp, mpm_grid *grid, int nlevels, const mpm_hi
   mpm_hier *h;
   MPM_ALLOC(h, 1);
   h->dim = grid->dim, h->nlevels = nlevels, h->buffer = buffer;
+  h->nranks = grid->size, h->rank = grid->rank;
   for (int d = 0; wall && d < grid->dim; ++d)
     h->wall[d][0] = grid->periodic[d] ? 0 : wall[d][0],
     h->wall[d][1] = grid->periodic[d] ? 0 : wall[d][1];
@@ -356,6 +394,8 @@ void mpm_hier_destroy(mpm_hier **hp) {
     free(lv->covered), free(lv->refined), free(lv->active);
     free(lv->image), free(lv->canon), free(lv->is_image);
   }
+  mpm_grid_destroy(&h->pbox.grid);
+  free(h->pbox.owned), free(h->pbox.buf), free(h->sum_buf);
   mpm_hier_scratch_free(h->scratch);
   mpm_hier_census_free(h->census);
   free(h);
@@ -392,8 +432,11 @@ int mpm_hier_level_of(const mpm_hier *h, const double *xp) {
     const mpm_grid *g = h->level[l].grid;
     for (int d = 0; d < h->dim; ++d) {
       const double xi = hier_xi(g, d, x[d]);
-      /* Also false for NaN: such a point stays where it is. */
-      if (!(xi > g->box_lo[d] - 1.0 && xi < g->box_lo[d] + g->box_n[d])) return l;
+      /* Also false for NaN: such a point stays where it is. On more than one rank level 0's
+       * box is the rank's: span_flag finds the spans beyond it on level 1. */
+      if (!(xi > g->box_lo[d] - 1.0 && xi < g->box_lo[d] + g->box_n[d]) &&
+          (l > 0 || h->nranks == 1 || xi != xi))
+        return l;
       gi[d] = hier_span_of(xi);
     }
     if (!span_flag(h, l, h->level[l].refined, gi, 0)) return l;
@@ -423,6 +466,7 @@ void mpm_hier_phase_zero(mpm_hier *h, int phase) {
     h->level[l].grid->phase[phase].normals = normals;
     mpm_grid_phase_zero(h->level[l].grid, phase);
   }
+  h->pending[phase] = h->summed[phase] = 0;
 }
 
 int mpm_hier_phase_update(mpm_hier *h, int phase, double hstep) {

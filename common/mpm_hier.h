@@ -29,8 +29,23 @@
  *
  * Storage. Level l >= 1 is one box of nodes per rank, an mpm_grid made by mpm_grid_box_new()
  * (no communicator), so the P2G/G2P kernels run on it unchanged. Its box holds every node
- * whose support meets Omega_l plus one layer. This version runs on one rank, with the
- * quadratic B-spline only: mpm_hier_new() refuses anything else with a reason.
+ * whose support meets Omega_l plus one layer. The quadratic B-spline only: mpm_hier_new()
+ * refuses anything else with a reason.
+ *
+ * Ranks. Level 0 is split over the ranks (mpm_grid.h); every rank stores each finer level's
+ * whole box, and a rank's particles are those owning their position, as without refinement.
+ * The finer levels are kept alike on every rank: after a deposit they hold the rank's own share
+ * (mpm_hier_own_share), and the restriction first sums each finer level over the ranks (one
+ * MPI_Allreduce per level and field over its box), then restricts; onto a finer level l - 1
+ * only rank 0 adds (the level's own sum follows), onto level 0 it goes through the parents box
+ * (the level-0 nodes that are parents of level 1's box, alike on every rank) and lands on the
+ * level-0 nodes the rank owns (a node's image in [0, ncells) along a periodic axis), so every
+ * contribution is added once over the ranks, before level 0's halo sums its ghosts. The
+ * prolongation onto level 1 reads the parents box filled by the owners and summed over the
+ * ranks, so level 1's inactive nodes are whole on every rank (never read outside level 0's
+ * box); the finer prolongations and the nodal solve then run alike on every rank. A rank's
+ * level-0 masks cover its box; beyond it, level 0's refined spans are read from level 1's
+ * covered mask, so every rank finds the level of any point. On one rank none of this runs.
  *
  * Periodic axes. Along a periodic axis d of the grid, level l's lattice wraps with a period of
  * N_l = ncells[d] 2^l nodes (and spans), and a region may touch, cross or span the periodic
@@ -92,8 +107,25 @@ typedef struct mpm_hier_level {
   unsigned char *is_image;
 } mpm_hier_level;
 
+/* On more than one rank (mpm_hier.h, ranks): level 0's nodes that level 1's nodes have as
+ * parents, a box [lo, lo + n) of level 0's lattice, with, for each of its nodes, the level-0
+ * box index of the node (or its periodic image) this rank owns, or -1. */
+typedef struct mpm_hier_parents_box {
+  mpm_grid *grid;  /* the box, as a box grid of level 0's lattice (mpm_grid_box_new) */
+  mpm_lidx *owned; /* level-0 box index of the owned node, -1: another rank's */
+  double *buf;     /* room for 1 + 3 MPM_MAX_DIM fields over the box */
+} mpm_hier_parents_box;
+
 typedef struct mpm_hier {
   int dim, nlevels, buffer;
+  /* The ranks of level 0's grid (1: the one-rank code paths, unchanged) and this one's. */
+  int nranks, rank;
+  mpm_hier_parents_box pbox; /* nranks > 1 only */
+  /* nranks > 1: a phase's finer levels hold this rank's own deposit, not yet summed over the
+   * ranks (set by mpm_hier_p2g, cleared by mpm_hier_restrict's sum), or hold the sum. */
+  unsigned char pending[MPM_GRID_MAX_PHASES], summed[MPM_GRID_MAX_PHASES];
+  double *sum_buf; /* nranks > 1: room for the fields a restriction sums (grown, kept) */
+  size_t sum_cap;
   /* Components a wall on face [d][side] constrains (bit e: component e flips in the mirror;
    * 0: no wall, the face is not mirrored). */
   unsigned char wall[MPM_MAX_DIM][2];
@@ -116,8 +148,9 @@ typedef struct mpm_hier_weight {
  * Omega_l. Mirrors the grid's phases (mpm_hier_add_phases). On bad input returns MPM_ERR_INPUT
  * and writes one sentence into why[why_len] naming the box (by its index in `box`) and what is
  * wrong: a level outside 1 .. nlevels - 1, a box empty or outside the domain, a level without a
- * box, a box not inside the coarser level's region by `buffer` spans, a grid on more than one
- * rank or a shape other than the quadratic B-spline. Logs nothing: the caller names the key. */
+ * box, a box not inside the coarser level's region by `buffer` spans or a shape other than the
+ * quadratic B-spline. Logs nothing: the caller names the key. On several ranks every rank
+ * calls it with the same boxes, and so builds the same finer levels. */
 int mpm_hier_new(mpm_hier **h, mpm_grid *grid, int nlevels, const mpm_hier_box *box, int nbox,
                  int buffer, char *why, size_t why_len);
 /* The same with walls: wall[d][side] as mpm_hier.wall (NULL: none). A box may then touch a
@@ -197,9 +230,19 @@ int mpm_hier_g2p_from(mpm_hier *h, int phase, const mpm_g2p_args *a, const mpm_h
 /* Restrict the deposit of a phase (m, m v, f and the mass gradient where deposited), finest
  * level first; every inactive node ends at zero. */
 void mpm_hier_restrict(mpm_hier *h, int phase);
+/* Before a deposit of a phase onto the finer levels (mpm_hier_p2g calls it; a caller adding its
+ * own per-particle shares calls it too): on more than one rank the finer levels must hold this
+ * rank's share alone, for the next mpm_hier_restrict to sum them; a rank other than 0 zeroes a
+ * sum they already hold (rank 0 keeps it, so the sum adds it once). No-op on one rank. */
+void mpm_hier_own_share(mpm_hier *h, int phase);
 /* Prolong a phase's v and a into every inactive node, level 1 first. */
 void mpm_hier_prolong(mpm_hier *h, int phase);
-/* The same for nf arrays of the caller: fine[k] on level l (>= 1), coarse[k] on level l - 1. */
+/* The same for nf arrays of the caller: fine[k] on level l (>= 1), coarse[k] on level l - 1.
+ * On more than one rank the fine arrays hold this rank's share (the restriction sums them over
+ * the ranks; a caller computing a finer level's values alike on every rank gives them on rank 0
+ * alone, zeros elsewhere), the restriction onto level 0 lands on the nodes this rank owns (call
+ * level 0's halo_reverse after it), and the prolongation onto level 1 reads level 0's owned
+ * nodes (collective over the grid's communicator). */
 void mpm_hier_restrict_level(mpm_hier *h, int l, double *const *fine, double *const *coarse,
                              int nf);
 void mpm_hier_prolong_level(mpm_hier *h, int l, const double *const *coarse, double *const *fine,

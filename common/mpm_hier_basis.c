@@ -10,11 +10,15 @@
  * folds every image into its node and the prolongation ends by copying every node into its
  * images; both skip the images otherwise (their parents may lie outside the coarser box), and
  * mpm_hier_eval moves every node onto its image before it looks it up.
+ * On more than one rank (mpm_hier.h, ranks) level 1's parents are read and written through the
+ * parents box, and a restriction first sums the finer level over the ranks.
  * Every call of the per-level restriction and prolongation is timed (MPM_T_RESTRICT and
  * MPM_T_PROLONG, mpm_timer.h), whoever calls it. */
 #include "mpm_hier_impl.h"
 #include "mpm_timer.h"
 
+#include <limits.h>
+#include <stdlib.h>
 #include <string.h>
 
 int mpm_hier_parents(const mpm_grid *c, const int *gi, mpm_lidx *idx, double *w) {
@@ -48,26 +52,97 @@ static int skips(const mpm_hier_level *lv, mpm_lidx n) {
   return lv->active[n] || (lv->is_image && lv->is_image[n]);
 }
 
-void mpm_hier_restrict_level(mpm_hier *h, int l, double *const *fine, double *const *coarse,
-                             int nf) {
+/* Sum nf arrays of level l >= 1 over the ranks (mpm_hier.h, ranks): one MPI_Allreduce of them
+ * packed together (per array when the room cannot be had). MPI's errors abort (the default
+ * handler). */
+static void sum_ranks(mpm_hier *h, int l, double *const *a, int nf) {
+  const size_t nn = (size_t)h->level[l].grid->nnodes, need = nn * (size_t)nf;
+  const MPI_Comm comm = h->level[0].grid->comm;
+  if (need > h->sum_cap) {
+    free(h->sum_buf);
+    h->sum_buf = malloc(sizeof(double) * need);
+    h->sum_cap = h->sum_buf ? need : 0;
+  }
+  if (!h->sum_buf || need > (size_t)INT_MAX) {
+    for (int k = 0; k < nf; ++k)
+      MPI_Allreduce(MPI_IN_PLACE, a[k], (int)nn, MPI_DOUBLE, MPI_SUM, comm);
+    return;
+  }
+  for (int k = 0; k < nf; ++k) memcpy(h->sum_buf + (size_t)k * nn, a[k], sizeof(double) * nn);
+  MPI_Allreduce(MPI_IN_PLACE, h->sum_buf, (int)need, MPI_DOUBLE, MPI_SUM, comm);
+  for (int k = 0; k < nf; ++k) memcpy(a[k], h->sum_buf + (size_t)k * nn, sizeof(double) * nn);
+}
+
+/* Restrict the inactive nodes of level l (fine, nf arrays) onto their parents in the arrays
+ * `to` over the lattice c (level l - 1, or the parents box), zeroing them; add 0: only zero
+ * them (a rank other than 0 whose sum rank 0 adds). */
+static void restrict_into(const mpm_hier *h, int l, double *const *fine, const mpm_grid *c,
+                          double *const *to, int nf, int add) {
   const mpm_hier_level *lv = &h->level[l];
-  const mpm_grid *f = lv->grid, *c = h->level[l - 1].grid;
+  const mpm_grid *f = lv->grid;
   int gi[MPM_MAX_DIM];
   mpm_lidx idx[8];
   double w[8];
-  mpm_timer_start(MPM_T_RESTRICT);
-  fold_images(lv, fine, nf);
   for (mpm_lidx n = 0; n < f->nnodes; ++n) {
     if (skips(lv, n)) continue;
     hier_node_of(f, n, gi);
-    const int np = mpm_hier_parents(c, gi, idx, w);
+    const int np = add ? mpm_hier_parents(c, gi, idx, w) : 0;
     for (int k = 0; k < nf; ++k) {
       const double v = fine[k][n];
-      for (int q = 0; q < np; ++q) coarse[k][idx[q]] += w[q] * v;
+      for (int q = 0; q < np; ++q) to[k][idx[q]] += w[q] * v;
       fine[k][n] = 0.0;
     }
   }
+}
+
+/* Level 1 onto level 0 on more than one rank: onto the parents box (the same on every rank),
+ * then each of its nodes into the level-0 node this rank owns there, so that every
+ * contribution lands once over the ranks (level 0's ghosts get none). */
+static void restrict_ranks(mpm_hier *h, double *const *fine, double *const *coarse, int nf) {
+  const mpm_hier_parents_box *pb = &h->pbox;
+  const mpm_lidx nn = pb->grid->nnodes;
+  double *to[1 + 3 * MPM_MAX_DIM] = {NULL};
+  for (int k = 0; k < nf; ++k) to[k] = pb->buf + (size_t)k * nn;
+  memset(pb->buf, 0, sizeof(double) * (size_t)nf * (size_t)nn);
+  restrict_into(h, 1, fine, pb->grid, to, nf, 1);
+  for (int k = 0; k < nf; ++k)
+    for (mpm_lidx q = 0; q < nn; ++q)
+      if (pb->owned[q] >= 0) coarse[k][pb->owned[q]] += to[k][q];
+}
+
+/* The restriction of level l; sum: the fine arrays hold each rank's share, summed here first
+ * (more than one rank; then only rank 0 adds the sum onto a finer level l - 1 >= 1, whose own
+ * restriction sums it in turn). */
+static void restrict_level(mpm_hier *h, int l, double *const *fine, double *const *coarse, int nf,
+                           int sum) {
+  const mpm_hier_level *lv = &h->level[l];
+  mpm_timer_start(MPM_T_RESTRICT);
+  if (sum) sum_ranks(h, l, fine, nf);
+  fold_images(lv, fine, nf);
+  if (h->nranks > 1 && l == 1)
+    restrict_ranks(h, fine, coarse, nf);
+  else
+    restrict_into(h, l, fine, h->level[l - 1].grid, coarse, nf, !sum || h->rank == 0);
   mpm_timer_stop(MPM_T_RESTRICT);
+}
+
+void mpm_hier_restrict_level(mpm_hier *h, int l, double *const *fine, double *const *coarse,
+                             int nf) {
+  restrict_level(h, l, fine, coarse, nf, h->nranks > 1);
+}
+
+/* Level 0's values of nf arrays on the parents box, from the rank owning each node (the same
+ * on every rank), into the box's buffer; returns the arrays there. */
+static void parents_ranks(mpm_hier *h, const double *const *coarse, const double **out, int nf) {
+  const mpm_hier_parents_box *pb = &h->pbox;
+  const mpm_lidx nn = pb->grid->nnodes;
+  for (int k = 0; k < nf; ++k) {
+    double *b = pb->buf + (size_t)k * nn;
+    for (mpm_lidx q = 0; q < nn; ++q) b[q] = pb->owned[q] >= 0 ? coarse[k][pb->owned[q]] : 0.0;
+    out[k] = b;
+  }
+  MPI_Allreduce(MPI_IN_PLACE, pb->buf, (int)((size_t)nf * (size_t)nn), MPI_DOUBLE, MPI_SUM,
+                h->level[0].grid->comm);
 }
 
 void mpm_hier_prolong_level(mpm_hier *h, int l, const double *const *coarse, double *const *fine,
@@ -77,7 +152,12 @@ void mpm_hier_prolong_level(mpm_hier *h, int l, const double *const *coarse, dou
   int gi[MPM_MAX_DIM];
   mpm_lidx idx[8];
   double w[8];
+  const double *from[1 + 3 * MPM_MAX_DIM];
   mpm_timer_start(MPM_T_PROLONG);
+  if (h->nranks > 1 && l == 1) {
+    parents_ranks(h, coarse, from, nf);
+    coarse = from, c = h->pbox.grid;
+  }
   for (mpm_lidx n = 0; n < f->nnodes; ++n) {
     if (skips(lv, n)) continue;
     hier_node_of(f, n, gi);
@@ -106,11 +186,27 @@ static int deposit_fields(mpm_grid *g, int phase, int normals, double **out) {
 void mpm_hier_restrict(mpm_hier *h, int phase) {
   const int normals = h->level[0].grid->phase[phase].normals;
   double *fine[1 + 3 * MPM_MAX_DIM], *coarse[1 + 3 * MPM_MAX_DIM];
+  const int sum = h->nranks > 1 && h->pending[phase];
   for (int l = h->nlevels - 1; l >= 1; --l) {
     const int nf = deposit_fields(h->level[l].grid, phase, normals, fine);
     deposit_fields(h->level[l - 1].grid, phase, normals, coarse);
-    mpm_hier_restrict_level(h, l, fine, coarse, nf);
+    restrict_level(h, l, fine, coarse, nf, sum);
   }
+  if (sum) h->pending[phase] = 0, h->summed[phase] = 1;
+}
+
+void mpm_hier_own_share(mpm_hier *h, int phase) {
+  if (h->nranks == 1) return;
+  if (h->summed[phase] && h->rank != 0) {
+    const int normals = h->level[0].grid->phase[phase].normals;
+    double *a[1 + 3 * MPM_MAX_DIM];
+    for (int l = 1; l < h->nlevels; ++l) {
+      const mpm_grid *g = h->level[l].grid;
+      const int nf = deposit_fields(h->level[l].grid, phase, normals, a);
+      for (int k = 0; k < nf; ++k) memset(a[k], 0, sizeof(double) * (size_t)g->nnodes);
+    }
+  }
+  h->summed[phase] = 0, h->pending[phase] = 1;
 }
 
 void mpm_hier_prolong(mpm_hier *h, int phase) {

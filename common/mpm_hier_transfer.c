@@ -178,6 +178,7 @@ static void p2g_chunk(mpm_hier *h, int l, int phase, const mpm_p2g_args *a, chun
 int mpm_hier_p2g(mpm_hier *h, int phase, const mpm_p2g_args *a) {
   const int normals = h->level[0].grid->phase[phase].normals;
   for (int l = 1; l < h->nlevels; ++l) h->level[l].grid->phase[phase].normals = normals;
+  if (h->nlevels > 1) mpm_hier_own_share(h, phase);
   mpm_lidx first[MPM_HIER_MAX_LEVELS + 1];
   if (h->nlevels > 1) MPM_CALL(reserve(h, a->n));
   if (h->nlevels == 1 || classify(h, a->n, a->x, first)) {

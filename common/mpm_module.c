@@ -61,7 +61,10 @@ static int largest_mass(mpm_grid *const *grids, int ngrids, int phase, double *m
 /* Mean mass of the owned nodes heavier than mmin over ngrids grids (0 if none). */
 static int mean_mass(mpm_grid *const *grids, int ngrids, int phase, double mmin, double *mean) {
   double sum[2] = {0.0, 0.0}, all[2]; /* mass and count over the owned nodes with mass */
-  for (int k = 0; k < ngrids; ++k) owned_mass(grids[k], grids[k]->phase[phase].m_i, mmin, sum);
+  /* The finer levels of a hierarchy (box grids, no communicator) are alike on every rank:
+   * counted on rank 0 alone. */
+  for (int k = 0; k < ngrids; ++k)
+    if (k == 0 || grids[0]->rank == 0) owned_mass(grids[k], grids[k]->phase[phase].m_i, mmin, sum);
   MPM_CALL_MPI(MPI_Allreduce(sum, all, 2, MPI_DOUBLE, MPI_SUM, grids[0]->comm));
   *mean = all[1] > 0.0 ? all[0] / all[1] : 0.0;
   return 0;

@@ -25,7 +25,8 @@
  *   default XDMF reader (Xdmf3ReaderS) draws all phases as one dataset that keeps only the
  *   fields every phase has, so without it the gas's colour field rho is dropped and the whole
  *   picture is drawn white (mpm_xdmf.h). It is output only: never read back.
- * - A refinement hierarchy (mpm_output_set_hier, one rank) adds to a snapshot and nothing
+ * - A refinement hierarchy (mpm_output_set_hier; its finer levels, alike on every rank, are
+ *   written by rank 0, the others selecting nothing) adds to a snapshot and nothing
  *   else: the particle field level, and with the grid fields /levels/<l> after /grid, each
  *   level over its own lattice (level 0's is /grid's, whose phases it does not repeat). A run
  *   without one writes the same objects in the same order as before the hierarchy existed.
@@ -249,6 +250,9 @@ static int write_nodes(const mpm_h5 *h, hid_t loc, const char *name, hid_t ftype
                        const lattice *L, const node_source *src, double *buf) {
   hsize_t fdims[4], start[4], count[4];
   const int rank = node_block(g, L, src->ncomp, fdims, start, count);
+  /* A finer level of a hierarchy is alike on every rank: rank 0 writes it. */
+  if (g->comm == MPI_COMM_NULL && h->rank != 0)
+    for (int d = 0; d < rank; ++d) count[d] = 0;
   pack_owned(g, src, buf);
   MPM_CALL(
       mpm_h5_write_block(h, loc, name, ftype, H5T_NATIVE_DOUBLE, rank, fdims, start, count, buf));
@@ -628,9 +632,6 @@ int mpm_output_count(const mpm_output *out) {
 }
 
 int mpm_output_set_hier(mpm_output *out, const mpm_hier *h) {
-  if (h && out->size > 1)
-    MPM_FAIL(MPM_ERR_INTERNAL, "output: a refinement hierarchy on %d ranks (it runs on one)",
-             out->size);
   if (h && h->dim != out->dim)
     MPM_FAIL(MPM_ERR_INTERNAL, "output: the hierarchy is %d-D but the output %d-D", h->dim,
              out->dim);

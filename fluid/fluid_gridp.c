@@ -21,7 +21,9 @@
  * and the level forces and rates are restricted onto the active nodes, the transposes of the
  * prolongations: the composite basis is integrated exactly. A level that stores a whole period
  * (mpm_hier.h, periodic axes) integrates each span once, over [0, N_l) along that axis; the
- * restriction folds what lands on its images.
+ * restriction folds what lands on its images. On more than one rank level 0 integrates each
+ * rank's owned spans and rank 0 alone the finer levels (alike on every rank), so that the
+ * restriction's sum over the ranks (mpm_hier.h, ranks) counts every span once.
  *
  * Walls. Level 0's pad nodes take part like any node (their pressure and rate from their own
  * unfolded mass); the walls then fold their forces as they fold the particles' deposits. A finer
@@ -247,6 +249,9 @@ static int ensure_levels(mpm_module *m, fluid_gridp *gp) {
       s->lo[d] = N ? 0 : g->box_lo[d], s->hi[d] = N ? N - 1 : g->box_lo[d] + g->box_n[d] - 1;
       wall_spans(h, l, d, s);
     }
+    /* With more than one rank, rank 0 integrates the finer levels and the others give zeros: the
+     * restriction sums the ranks' shares (mpm_hier.h). */
+    if (m->grid->rank != 0) s->hi[0] = s->lo[0] - 1;
   }
   return 0;
 }

@@ -40,6 +40,7 @@
 #include "mpm_hier.h"
 #include "mpm_kernels.h"
 
+#include <limits.h>
 #include <math.h>
 #include <stdlib.h>
 #include <stdio.h>
@@ -201,6 +202,15 @@ static int span_of(const mpm_grid *g, int d, double x, int n) {
   return (int)(i < 0 ? 0 : i >= n ? n - 1 : i);
 }
 
+/* Sum a binning of the particles over the ranks, so that every rank flags the same cells (one
+ * rank: nothing to do). */
+static int sum_ranks(const mpm_grid *g, double *a, size_t n) {
+  if (g->size == 1) return 0;
+  if (n > (size_t)INT_MAX) MPM_FAIL(MPM_ERR_INTERNAL, "regrid: %zu level-0 cells to sum", n);
+  MPM_CALL_MPI(MPI_Allreduce(MPI_IN_PLACE, a, (int)n, MPI_DOUBLE, MPI_SUM, g->comm));
+  return 0;
+}
+
 /* Does the face between spans s and t (t above s along d) ask for refinement? sums: mass,
  * volume, internal energy m e, then momentum per axis, each of total entries. */
 static int face_flag(const fluid_gas *gas, fluid_refine_criterion criterion, double threshold,
@@ -261,10 +271,11 @@ static int starved_flags(const mpm_module *m, double threshold, const int *n, co
   if (!count) MPM_FAIL_OOM(total * sizeof(double));
   for (mpm_lidx i = 0; i < m->particles->n; ++i)
     count[span_index(m, n, stride, i)] += ldexp(1.0, -dim * fluid_size_level(m, V0_0, i));
-  for (size_t s = 0; s < total; ++s)
+  const int rc = sum_ranks(m->grid, count, total);
+  for (size_t s = 0; s < total && !rc; ++s)
     flag[s] = count[s] < threshold && neighbours_hold_gas(m->grid, n, stride, count, s);
   free(count);
-  return 0;
+  return rc;
 }
 
 /* Proximity: the spans that come within `distance` of an obstacle (fluid_module.h). */
@@ -310,8 +321,9 @@ int fluid_refine_flags(const mpm_module *m, fluid_refine_criterion criterion, do
     for (int d = 0; d < dim; ++d)
       sums[(3 + (size_t)d) * total + s] += pm[i] * mpm_particles_comp(p, FLUID_V, d)[i];
   }
+  const int rc = sum_ranks(g, sums, nsums * total);
   const double *vol = sums + total;
-  for (size_t s = 0; s < total; ++s) {
+  for (size_t s = 0; s < total && !rc; ++s) {
     if (!(vol[s] > 0)) continue;
     for (int d = 0; d < dim; ++d) {
       const int i = (int)(s / stride[d] % (size_t)n[d]);
@@ -324,5 +336,5 @@ int fluid_refine_flags(const mpm_module *m, fluid_refine_criterion criterion, do
     }
   }
   free(sums);
-  return 0;
+  return rc;
 }

@@ -89,6 +89,14 @@ static int merge_level(mpm_module *m, int L, const unsigned char *lev, mpm_lidx 
   return rc;
 }
 
+/* Did no rank split (k: this rank's parents)? One rank answers alone; several agree. */
+static int none_left(const mpm_grid *g, mpm_lidx k) {
+  if (g->size == 1) return k == 0;
+  int any = k > 0; /* (MPI's errors abort: the default handler) */
+  MPI_Allreduce(MPI_IN_PLACE, &any, 1, MPI_INT, MPI_LOR, g->comm);
+  return !any;
+}
+
 static int relevel(mpm_module *m, int *changed) {
   mpm_lidx *idx;
   MPM_ALLOC(idx, m->particles->n > 0 ? m->particles->n : 1);
@@ -111,7 +119,7 @@ static int relevel(mpm_module *m, int *changed) {
     fluid_split_report rep = {0};
     rc = fluid_split(m, idx, k, &rep); /* collective: every rank calls, k = 0 too */
     split += rep.parents;
-    if (!rc && k == 0) break;
+    if (!rc && none_left(m->grid, k)) break; /* (on every rank alike) */
     if (!rc && pass + 1 < MPM_HIER_MAX_LEVELS) {
       mpm_lidx *grown = realloc(idx, sizeof *idx * (size_t)MPM_MAX(m->particles->n, 1));
       if (!grown)

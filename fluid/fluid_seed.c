@@ -12,7 +12,8 @@
  * inside the finer regions go, and each level l >= 1 seeds its own region less the finer ones
  * on its lattice: ppc points per axis in each level-l span, of volume (h_l / ppc)^dim, with the
  * same first-section-wins rule. A level-0 span is whole for an even ppc, so the region's
- * level-0 particles leave no part behind. */
+ * level-0 particles leave no part behind. On more than one rank every rank walks the level's
+ * whole lattice (the ids follow its order, whatever the ranks) and keeps the points it owns. */
 #include "fluid_eos.h"
 #include "fluid_internal.h"
 
@@ -95,13 +96,14 @@ static int check_inside(const gas_state *s, const mpm_config *cfg, const mpm_gri
 }
 
 /* A density or pressure expression must be positive and finite at every particle: the
- * smallest value over all ranks is reported with its place. Collective. */
+ * smallest value over all ranks is reported with its place (HUGE_VAL: this rank seeded no
+ * point, as a finer level's on a rank that holds none of it). Collective. */
 static int check_positive(const mpm_config *cfg, const mpm_grid *g, const char *section,
                           const char *name, double value, const double *x) {
   struct {
     double v;
     int rank;
-  } mine = {isfinite(value) ? value : -HUGE_VAL, g->rank}, worst;
+  } mine = {isfinite(value) || value == HUGE_VAL ? value : -HUGE_VAL, g->rank}, worst;
   MPM_CALL_MPI(MPI_Allreduce(&mine, &worst, 1, MPI_DOUBLE_INT, MPI_MINLOC, g->comm));
   if (worst.v > 0) return 0;
   double at[3] = {x[0], x[1], x[2]};
@@ -268,6 +270,22 @@ int fluid_seed(mpm_module *m, const mpm_config *cfg) {
 
 /* ---- the finer levels of a refinement hierarchy ---------------------------------------------- */
 
+/* Keep the points of x (n, component-major) and their ids that this rank owns, in order;
+ * returns their number. Every rank generates a finer level's whole lattice, so that a point's
+ * id does not depend on the ranks. */
+static mpm_lidx keep_owned(const mpm_grid *g, double *x, mpm_gidx *id, mpm_lidx n) {
+  mpm_lidx k = 0;
+  for (mpm_lidx i = 0; i < n; ++i) {
+    double xq[MPM_MAX_DIM] = {0, 0, 0};
+    for (int d = 0; d < g->dim; ++d) xq[d] = x[(size_t)d * n + i];
+    if (mpm_grid_owner_of(g, xq) != g->rank) continue;
+    for (int d = 0; d < g->dim; ++d) x[(size_t)d * n + k] = xq[d];
+    id[k++] = id[i];
+  }
+  for (int d = 1; d < g->dim; ++d) memmove(x + (size_t)d * k, x + (size_t)d * n, sizeof *x * k);
+  return k;
+}
+
 /* Seed section k on level l. */
 static int seed_level(mpm_module *m, const mpm_config *cfg, gas_state *s, int k, int l) {
   const fluid_content *fc = m->content;
@@ -280,6 +298,7 @@ static int seed_level(mpm_module *m, const mpm_config *cfg, gas_state *s, int k,
   int rc = 0;
   if (!(id = malloc(sizeof *id * (size_t)(n ? n : 1)))) rc = MPM_ERR_MEMORY;
   for (mpm_lidx i = 0; !rc && i < n; ++i) id[i] = p->id_next + i;
+  if (!rc && m->grid->size > 1) n = keep_owned(m->grid, x, id, n);
   if (!rc) rc = add_points(m, cfg, s, k, n, x, id, pow(lg->dx / fc->ppc, lg->dim), &total);
   free(x), free(id);
   MPM_CALL(rc);

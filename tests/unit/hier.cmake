@@ -6,7 +6,8 @@ mpm_add_test(test_hier_basis SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/unit/test_hier_
              LABELS unit RANKS 1)
 mpm_add_test(test_hier_transfer SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/unit/test_hier_transfer.c
              LABELS unit RANKS 1)
-# The refusal of a grid split over ranks (the hierarchy runs on one rank for now).
+# The hierarchy on a grid split over 2 ranks against one rank: the level of points, a deposit
+# restricted, a field prolonged (a periodic level across the ranks' boundary, three levels).
 mpm_add_test(test_hier_ranks SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/unit/test_hier_ranks.c
              LABELS mpi RANKS 2)
 # The exact span integrals the grid pressure uses (common/mpm_span.h): adjointness, constant and

@@ -14,6 +14,13 @@ endforeach()
 # The grid pressure on 1 and 2 ranks (~5 s).
 mpm_add_script_test(test_refine_gas_ranks SCRIPT verification/test_refine_gas.py ARGS ranks
                     LABELS "verification;mpi" TIMEOUT 300)
+# The gas's hierarchy on 2 ranks against 1 (fixed steps): a pulse through a static box and a
+# stream through a band and a box on the floor (~15 s); the regridded pulse under bs32 and usl,
+# its levels' output, the particles per rank, and a restart on 2 ranks across a regrid (~15 s).
+foreach(part static dynamic)
+  mpm_add_script_test(test_refine_ranks_${part} SCRIPT verification/test_refine_ranks.py
+                      ARGS ${part} LABELS "verification;mpi" TIMEOUT 300)
+endforeach()
 # The refined output (issue 51 item 6): levels in the snapshots and the XDMF index, the
 # particle level, the per-level counts, the timers, ParaView opening it when pvpython is there
 # (~8 s).

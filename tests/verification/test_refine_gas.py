@@ -678,17 +678,29 @@ def part_input():
     ]
     for name, text, key, start, words in cases_dyn:
         mt.expect_input_error(check, name, text, key, mt.line_starting(text, start), words)
-    # Two ranks: one line from rank 0, exit 2.
+    # Two ranks with an obstacle (the gas alone runs there): one line from rank 0, exit 2.
     out = mt.outdir("refine_ranks")
     path = os.path.join(out, "case.ini")
+    obstacle = refined + "\n" + rs.DISC
     with open(path, "w") as f:
-        f.write(refined)
+        f.write(obstacle)
     p = mt.run(["run", path, f"output.dir={out}/run", "run.progress=false"], ranks=2,
                check=False)
     errors = [ln for ln in p.stderr.splitlines() if ln.startswith("error:")]
-    want = f"case.ini:{mt.line_starting(refined, 'levels = 2')}:"
+    want = f"case.ini:{mt.line_starting(obstacle, 'shape = circle')}:"
+    check(p.returncode == 2 and len(errors) == 1 and "obstacle.disc.shape" in errors[0]
+          and want in errors[0], f"2 ranks with an obstacle: exit {p.returncode}: "
+          f"{errors[0] if errors else p.stderr[-300:]}")
+    # A gas beside a solid on 2 ranks: the same, naming refine.levels.
+    fsi = rs.fsi_case(0.1, rs.FSI_BAND)
+    with open(path, "w") as f:
+        f.write(fsi)
+    p = mt.run(["run", path, f"output.dir={out}/run_fsi", "run.progress=false"], ranks=2,
+               check=False)
+    errors = [ln for ln in p.stderr.splitlines() if ln.startswith("error:")]
+    want = f"case.ini:{mt.line_starting(fsi, 'levels = 2')}:"
     check(p.returncode == 2 and len(errors) == 1 and "refine.levels" in errors[0]
-          and want in errors[0], f"2 ranks: exit {p.returncode}: "
+          and want in errors[0], f"2 ranks beside a solid: exit {p.returncode}: "
           f"{errors[0] if errors else p.stderr[-300:]}")
 
 
