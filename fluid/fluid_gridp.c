@@ -190,13 +190,13 @@ void fluid_gridp_reset(fluid_content *fc) {
     for (int d = 0; d < MPM_MAX_DIM; ++d) free(gp->F[l][d]), gp->F[l][d] = NULL;
     for (int d = 0; d < MPM_MAX_DIM; ++d) free(gp->G[l][d]), gp->G[l][d] = NULL;
   }
+  fluid_gridp_solid_free(&gp->sol); /* its level scalars are sized by the hierarchy's levels */
 }
 
 void fluid_gridp_destroy(fluid_content *fc) {
   fluid_gridp *gp = fc->gridp;
   if (!gp) return;
   fluid_gridp_reset(fc);
-  fluid_gridp_solid_free(&gp->sol);
   free(gp->mp), free(gp->s), free(gp->zero);
   free(gp);
   fc->gridp = NULL;

@@ -73,8 +73,9 @@ static int ensure(mpm_module *m, fluid_gridp_solid *s, mpm_lidx n) {
   if (s->cap >= n && s->buf) return 0;
   free(s->buf);
   s->cap = n + n / 4 + 16;
-  s->buf = calloc((size_t)(4 + 2 * dim + dim * dim) * s->cap, sizeof(double));
-  if (!s->buf) MPM_FAIL_OOM((size_t)s->cap);
+  const size_t count = (size_t)(4 + 2 * dim + dim * dim) * (size_t)s->cap;
+  s->buf = calloc(count, sizeof(double));
+  if (!s->buf) MPM_FAIL_OOM(count * sizeof(double));
   return 0;
 }
 

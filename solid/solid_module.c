@@ -313,14 +313,7 @@ static void fill_points(solid_content *sc, const mpm_particles *p, const double 
   const mpm_lidx n = p->n;
   const double *F = y + (size_t)p->offset[F_F] * n, *V0 = mpm_particles_comp(p, sc->lay.f_V0, 0);
   double *V = sc->pts_buf;
-  for (mpm_lidx i = 0; i < n; ++i) {
-    double f[9];
-    for (int k = 0; k < dim * dim; ++k) f[k] = F[(size_t)k * n + i];
-    V[i] = V0[i] * (dim == 2
-                        ? f[0] * f[3] - f[1] * f[2]
-                        : f[0] * (f[4] * f[8] - f[5] * f[7]) - f[1] * (f[3] * f[8] - f[5] * f[6]) +
-                              f[2] * (f[3] * f[7] - f[4] * f[6]));
-  }
+  for (mpm_lidx i = 0; i < n; ++i) V[i] = V0[i] * solid_det(dim, F, n, i);
   sc->pts.n = n, sc->pts.V = V;
   for (int d = 0; d < dim; ++d) sc->pts.x[d] = y + (size_t)(p->offset[F_X] + d) * n;
 }
