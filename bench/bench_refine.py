@@ -48,14 +48,15 @@ DEFAULT_CASES = "stream,pulse,stream3d,sod,sod3"
 
 
 def run(binary, out, case, overrides):
-    """One run: its summary, timers, peak memory (MB) and output folder."""
+    """One run: its summary, timers, peak memory (MB), user CPU (s) and output folder."""
     os.makedirs(out, exist_ok=True)
-    cmd = ["/usr/bin/time", "-f", "%M", binary, "run", case, f"output.dir={out}/run",
+    cmd = ["/usr/bin/time", "-f", "%M %U", binary, "run", case, f"output.dir={out}/run",
            "output.overwrite=true", "run.progress=false"] + overrides
     p = subprocess.run(cmd, capture_output=True, text=True)
     if p.returncode != 0:
         raise SystemExit(f"{' '.join(cmd)} failed:\n{p.stderr[-2000:]}")
-    rss_mb = int(p.stderr.strip().splitlines()[-1]) / 1024.0
+    rss_kb, user_s = p.stderr.strip().splitlines()[-1].split()
+    rss_mb = int(rss_kb) / 1024.0
     run_dir = os.path.join(out, "run")
     with open(os.path.join(run_dir, "summary.json")) as f:
         summary = json.load(f)
@@ -67,7 +68,7 @@ def run(binary, out, case, overrides):
     return {"steps": int(d["step"][-1]), "rhs": int(d["rhs_evals"][-1]),
             "particles_start": int(d["particles"][0]), "particles_end": int(d["particles"][-1]),
             "particle_steps": summary["particle_steps"], "wall_s": summary["wall_s"],
-            "rss_mb": rss_mb, "timers": timers, "dir": run_dir}
+            "rss_mb": rss_mb, "user_s": float(user_s), "timers": timers, "dir": run_dir}
 
 
 def final(run_dir):
