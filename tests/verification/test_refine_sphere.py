@@ -4,7 +4,8 @@ its static boxes, about 115,000 particles) for 3 steps from the impulsive start 
 that the case is accepted and seeds every level, that it runs, that the mass is constant (no
 layer has entered or left through the far-field faces yet, and split and merge conserve it),
 that the flow keeps the scene's symmetry about the stream's axis (no momentum across it), and
-that the sphere feels the stream (a drag coefficient, finite and positive, in obstacles.csv).
+that the force on the sphere is booked and stays near d'Alembert's zero drag of the potential
+flow the case starts from (obstacles.csv).
 The scene's cost and stability are bench/bench_sphere.py's (docs/refinement.md, "The 3-D
 sphere"); no test runs it at full size.
 Able to fail: with the sphere off the axis (obstacle.sphere.center = 4 5.1 5, a second
@@ -43,6 +44,8 @@ check(across <= 1e-12, f"momentum across the stream's axis {across:.1e} of px (b
 ob = np.genfromtxt(os.path.join(out, "obstacles.csv"), delimiter=",", names=True, dtype=None,
                    encoding=None)
 cd = np.atleast_1d(ob["Cd"])
-check(np.all(np.isfinite(cd)) and cd[-1] > 0, f"the sphere feels the stream: Cd = {cd[-1]:.3f} "
-      "at the last step (finite and positive; the start's transient, not the steady value)")
+# The potential flow has no drag; the seeded lattice's and the grid's departures from it give a
+# little (measured 0.012 after 3 steps); the impulsive start gave 0.8-0.9 over the same steps.
+check(len(cd) == STEPS and np.all(np.abs(cd) <= 0.1), f"drag coefficient of the sphere at each "
+      f"step {', '.join(f'{c:.3f}' for c in cd)} (|Cd| <= 0.1: the potential start's zero drag)")
 sys.exit(check.finish())
