@@ -4,7 +4,7 @@ of the uniform grid's).
 
 Runs, each a separate mpmfsi process on one rank, one after another, all at the same fixed
 step (time.dt_max = --dt, below every run's stable step, bs32 at a fixed step as the case runs),
-for 2 + --steps steps from the case's impulsive start, and again for 2 steps, without
+for 2 + --steps steps from the case's start, and again for 2 steps, without
 snapshots:
   refined         the case: 40^3 level-0 cells of 0.25 and levels 1 and 2 in its static boxes
   uniform         the same domain without refinement at level 0's spacing, with the grid
@@ -129,7 +129,7 @@ def page(rows, commit, command, dx, dt):
              "runs one after another; other jobs ran beside them, so the wall times carry the "
              "machine's load: compare the user CPU column first). One rank, "
              f"`cases/sphere_m08.ini` with level 0 at dx = {dx:g}, every run at the fixed step "
-             f"{dt:g} from the impulsive start, no snapshots. Wall: the stepping loop "
+             f"{dt:g} from the case's start, no snapshots. Wall: the stepping loop "
              "(summary.json), per particle-step: over the sum over steps of the particle count. "
              "User CPU (from /usr/bin/time): the whole process; per particle-step: the run's "
              "less that of a run of its first 2 steps, over the difference of their "
@@ -151,8 +151,8 @@ def page(rows, commit, command, dx, dt):
     ref = rows.get("refined")
     for label, r in rows.items():
         if ref is not None and label != "refined":
-            lines.append(f"- refined against {label}: {ref['wall_per_ps_us'] / r['wall_per_ps_us']:.2f}× "
-                         f"the wall per particle-step, "
+            wall = ref["wall_per_ps_us"] / r["wall_per_ps_us"]
+            lines.append(f"- refined against {label}: {wall:.2f}× the wall per particle-step, "
                          f"{ref['user_per_ps_us'] / r['user_per_ps_us']:.2f}× the user CPU per "
                          f"particle-step, {ref['rss_mb'] / r['rss_mb']:.2f}× the peak memory.")
     return "\n".join(lines)
@@ -163,8 +163,9 @@ def watch(out):
     d = np.genfromtxt(os.path.join(out, "diagnostics.csv"), delimiter=",", names=True)
     ob = np.genfromtxt(os.path.join(out, "obstacles.csv"), delimiter=",", names=True,
                        dtype=None, encoding=None)
-    print(f"steps {int(d['step'][-1])}, t = {d['t'][-1]:.4f}; mass {d['mass'][-1] / d['mass'][0] - 1:+.2e} "
-          f"of the start, kinetic energy {d['kinetic'][-1] / d['kinetic'][0]:.4f} of the start "
+    print(f"steps {int(d['step'][-1])}, t = {d['t'][-1]:.4f}; mass "
+          f"{d['mass'][-1] / d['mass'][0] - 1:+.2e} of the start, kinetic energy "
+          f"{d['kinetic'][-1] / d['kinetic'][0]:.4f} of the start "
           f"(largest {d['kinetic'].max() / d['kinetic'][0]:.4f}), total energy "
           f"{d['total'][-1] / d['total'][0] - 1:+.2e}")
     print("t | particles (per level) | inside the sphere | max |v| | rho min..max | p min..max"
