@@ -49,7 +49,7 @@ DEFAULT_CASES = "stream,pulse,stream3d,sod,sod3"
 
 
 def run(binary, out, case, overrides):
-    """One run: its summary, timers, peak memory (MB) and output folder."""
+    """One run: its summary, timers, peak memory (MB), user CPU (s) and output folder."""
     os.makedirs(out, exist_ok=True)
     cmd = ["/usr/bin/time", "-f", "%M %U", binary, "run", case, f"output.dir={out}/run",
            "output.overwrite=true", "run.progress=false"] + overrides

@@ -101,3 +101,8 @@ foreach(part rest stream disc rest3d proximity)
   mpm_add_script_test(test_refine_obstacles_${part} SCRIPT verification/test_refine_obstacles.py
                       ARGS ${part} LABELS verification TIMEOUT 300)
 endforeach()
+# The 3-D sphere at Mach 0.8 (cases/sphere_m08.ini) at 20^3 level-0 cells for 3 steps: the case
+# runs on its three levels, keeps its mass and its symmetry, and the sphere feels the stream
+# (~5 s). Its cost and stability at full size: bench/bench_sphere.py.
+mpm_add_script_test(test_refine_sphere_smoke SCRIPT verification/test_refine_sphere.py
+                    LABELS verification TIMEOUT 300)
