@@ -37,7 +37,9 @@ measured 2e-13 (pulse), 2e-16 (stream), 5e-15 (dynamic). Able to fail: without t
 the ranks (common/mpm_hier_basis.c, sum_ranks) every check of `static` fails (other particles;
 momentum drifts by 1.5e-2 and 7.4e-2 of sum m |v| on 2 ranks); with every rank booking the
 finer levels' forces (fluid/fluid_obstacle_levels.c, books_level returning 1) `obstacles`
-fails (the disc's force).
+fails (the forces: 0.17 of p times the perimeter at rest, 1.0 of the disc's); without a rank's
+zero share of the velocity preview's second deposit (fluid/fluid_module.c, deposit_viscous)
+the disc on 2 ranks hangs (ctest's timeout).
 rhs_evals is not compared: a particle crossing the ranks' boundary restarts the integrator's
 first stage (as without refinement), so 2 ranks evaluate a few more right-hand sides.
 """
