@@ -57,6 +57,22 @@ def run(args, ranks=1, check=True, timeout=1200):
     return p
 
 
+def run_text(name, text, args=(), ranks=1):
+    """Write text as case.ini in a fresh folder named after name, run it there (output in its
+    run/, no progress line) with the overrides args on `ranks` ranks; returns the run folder."""
+    out = outdir(name)
+    path = os.path.join(out, "case.ini")
+    with open(path, "w") as f:
+        f.write(text)
+    run(["run", path, f"output.dir={out}/run", "run.progress=false"] + list(args), ranks=ranks)
+    return os.path.join(out, "run")
+
+
+def csv_rows(out, name):
+    """A CSV file of a run folder as a numpy structured array (names from its header)."""
+    return np.genfromtxt(os.path.join(out, name), delimiter=",", names=True)
+
+
 def cost(outdir):
     """The cost of a run, from its summary.json, as one line: steps, wall time, particle-steps."""
     import json

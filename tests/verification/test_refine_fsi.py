@@ -69,16 +69,10 @@ INCIDENT = rs.FSI_A * rs.FSI_SIGMA * np.sqrt(2 * np.pi)  # integral of p' dx
 
 
 def run(name, text):
-    out = mt.outdir(name)
-    path = os.path.join(out, "case.ini")
-    with open(path, "w") as f:
-        f.write(text)
-    mt.run(["run", path, f"output.dir={out}/run", "run.progress=false"])
-    return os.path.join(out, "run")
+    return mt.run_text(name, text)
 
 
-def csv(out, name):
-    return np.genfromtxt(os.path.join(out, name), delimiter=",", names=True)
+csv = mt.csv_rows
 
 
 def balance(out):

@@ -52,12 +52,7 @@ REST = f"density = 1\npressure = {P0}"
 
 
 def run(name, text, *extra):
-    out = mt.outdir(name)
-    path = os.path.join(out, "case.ini")
-    with open(path, "w") as f:
-        f.write(text)
-    mt.run(["run", path, f"output.dir={out}/run", "run.progress=false"] + list(extra))
-    return os.path.join(out, "run")
+    return mt.run_text(name, text, extra)
 
 
 def final(out):

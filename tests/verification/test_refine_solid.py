@@ -105,12 +105,7 @@ velocity_field = {AMP}*exp(-((x-{X0})/{WIDTH})^2); 0
 
 
 def run(name, text):
-    out = mt.outdir(name)
-    path = os.path.join(out, "case.ini")
-    with open(path, "w") as f:
-        f.write(text)
-    mt.run(["run", path, f"output.dir={out}/run", "run.progress=false"])
-    return os.path.join(out, "run")
+    return mt.run_text(name, text)
 
 
 def diagnostics(out):

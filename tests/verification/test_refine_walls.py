@@ -46,12 +46,7 @@ REST = "density = 1\npressure = 0.714285714285714"
 
 
 def run(name, text):
-    out = mt.outdir(name)
-    path = os.path.join(out, "case.ini")
-    with open(path, "w") as f:
-        f.write(text)
-    mt.run(["run", path, f"output.dir={out}/run", "run.progress=false"])
-    return os.path.join(out, "run")
+    return mt.run_text(name, text)
 
 
 def final(out):
