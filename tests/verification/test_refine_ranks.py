@@ -220,7 +220,8 @@ def part_dynamic():
           f"same particles, fields {worst:.1e} from the run through (bit for bit: 0)")
 
 
-def csv_rows(out, name):
+def labelled_rows(out, name):
+    """A CSV of a run folder with its text columns kept (mt.csv_rows reads numbers only)."""
     return np.genfromtxt(os.path.join(out, name), delimiter=",", names=True, dtype=None,
                          encoding=None)
 
@@ -228,7 +229,7 @@ def csv_rows(out, name):
 def force_difference(a, b, floor=0.0):
     """The largest difference of obstacles.csv's forces over every row, against the largest
     force or floor; the rows (times and bodies) must agree."""
-    ra, rb = csv_rows(a, "obstacles.csv"), csv_rows(b, "obstacles.csv")
+    ra, rb = labelled_rows(a, "obstacles.csv"), labelled_rows(b, "obstacles.csv")
     # The times within roundoff: the fixed step comes from a minimum over the ranks.
     if ra.shape != rb.shape or not (np.allclose(ra["t"], rb["t"], rtol=BOUND, atol=0) and
                                     np.array_equal(ra["name"], rb["name"])):
@@ -249,7 +250,7 @@ def compare_obstacles(name, text, floor=0.0, surface=False, at_rest=False):
     check(df <= BOUND, f"{name}: obstacles.csv on 2 ranks against 1: the forces within {df:.1e} "
           f"of max(largest force {big:.2e}, {floor:g}) (bound {BOUND:g})")
     if surface:
-        sa, sb = csv_rows(a, "surface_tri.csv"), csv_rows(b, "surface_tri.csv")
+        sa, sb = labelled_rows(a, "surface_tri.csv"), labelled_rows(b, "surface_tri.csv")
         ds = (float(np.abs(sa["p"] - sb["p"]).max() / P0)
               if len(sa) and sa.shape == sb.shape else float("inf"))
         check(ds <= BOUND, f"{name}: the triangle's surface pressures on 2 ranks within {ds:.1e}"
