@@ -3,11 +3,12 @@
  * What the slice refuses here, one line each naming the key: boxes without refine.levels > 1,
  * a solid beside a gas in a partitioned time scheme (coupling.time other than monolithic), off
  * the finest level (REFINE_SOLID_CELLS) or, with the gas's particle pressure (auto), with a box
- * that does not span every periodic axis (check_bands), a solid with dynamic regrids, a solid or
- * an obstacle on more than one rank, a shape other than the quadratic B-spline, and a box within
- * three level-0 cells of a non-periodic domain face other than a gas's slip or no-slip wall (open
- * and closed faces, and a solid's walls, act on level 0 alone; a gas's walls are carried to every
- * level, mpm_hier.h, and a box or region may touch them). Along a periodic axis a box or a dynamic
+ * that does not span every periodic axis (check_bands), a solid with dynamic regrids, a solid
+ * on more than one rank (a gas and its obstacles run on any number), a shape other than the
+ * quadratic B-spline, and a box within three level-0 cells of a non-periodic domain face other
+ * than a gas's slip or no-slip wall (open and closed faces, and a solid's walls, act on level 0
+ * alone; a gas's walls are carried to every level, mpm_hier.h, and a box or region may touch
+ * them). Along a periodic axis a box or a dynamic
  * region may touch, cross or span the periodic faces (the levels wrap there, mpm_hier.h).
  * mpm_hier_new's own reasons name the box's key. The gas and the solid refuse their own settings
  * (fluid/fluid_refine.c,
@@ -128,8 +129,8 @@ static int check_coupled(const mpm_config *cfg) {
   return 0;
 }
 
-/* The case-wide refusals: a solid beside a gas in a partitioned time scheme, a solid or an
- * obstacle on several ranks, another shape. */
+/* The case-wide refusals: a solid beside a gas in a partitioned time scheme, a solid on several
+ * ranks, another shape. */
 static int check_case(const mpm_config *cfg, const mpm_grid *grid, mpm_module **mod, int nmod) {
   if (solid_of(mod, nmod) && nmod > 1) MPM_CALL(check_coupled(cfg));
   if (grid->size > 1 && solid_of(mod, nmod))
@@ -137,17 +138,6 @@ static int check_case(const mpm_config *cfg, const mpm_grid *grid, mpm_module **
                            "a solid runs on the refined levels on one rank in this slice, and the "
                            "run has %d; run without mpirun or set refine.levels = 1",
                            grid->size);
-  const char *const *obstacle;
-  int nobstacle = 0;
-  MPM_CALL(mpm_config_instances(cfg, "obstacle", &obstacle, &nobstacle));
-  if (grid->size > 1 && nobstacle > 0) {
-    char key[160];
-    snprintf(key, sizeof key, "obstacle.%s.shape", obstacle[0]);
-    return mpm_config_fail(cfg, key,
-                           "obstacles run on the refined levels on one rank in this slice, and "
-                           "the run has %d; run without mpirun or set refine.levels = 1",
-                           grid->size);
-  }
   if (grid->shape != MPM_SHAPE_QUADRATIC)
     return mpm_config_fail(cfg, "grid.shape",
                            "refinement needs the quadratic B-spline (its knot spans nest); set "

@@ -326,7 +326,10 @@ static int deposit_viscous(mpm_module *m, const double *y, const fluid_batch *b)
   const double *x = state(m->particles, y, FLUID_X);
   mpm_lidx k = 0;
   for (mpm_lidx i = 0; i < n; ++i) k += fluid_stress_viscous(&fc->gas, b, i, NULL);
-  if (k == 0) return 0;
+  if (k == 0) { /* a share of zero: the next restriction still sums the ranks (mpm_hier.h) */
+    if (m->hier) mpm_hier_own_share(m->hier, m->phase);
+    return 0;
+  }
   double one[MPM_MAX_DIM * MPM_MAX_DIM];
   mpm_lidx j = 0;
   for (mpm_lidx i = 0; i < n; ++i) {

@@ -22,6 +22,13 @@
  * one, whose partners the gas took) or light nodes of its reach, on every level; level 0's reach
  * is fluid_obstacle.c's, a finer level's its constrained nodes.
  *
+ * Ranks (mpm_hier.h, ranks). The finer levels are alike on every rank (their deposits summed
+ * over the ranks): every rank constrains them and takes their ghost forces alike, and rank 0
+ * alone books what they give to the bodies (forces, surface samples), so that the sums over the
+ * ranks (fluid_obstacles_report, fluid_surface_step) count each once; level 0 books its owned
+ * nodes. The ghost span integrals on the finer levels are the grid pressure's split
+ * (fluid_gridp.c: rank 0 integrates them, the restriction sums the ranks).
+ *
  * Invariant: without a hierarchy and without the grid pressure nothing here runs. */
 #include "fluid_obstacle.h"
 
@@ -31,6 +38,12 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+
+/* Does this rank book what level l >= 1 gives to the bodies (rank 0 alone: the level is alike on
+ * every rank)? */
+static int books_level(const fluid_obstacles *o) {
+  return o->hier->rank == 0;
+}
 
 /* x reflected into the domain of g across every non-periodic face it lies beyond (the walls: a
  * node beyond one mirrors a node inside). */
@@ -182,7 +195,7 @@ void fluid_obstacles_span_force(fluid_obstacles *o, int l, mpm_grid *g, int phas
     int any = 0;
     for (int d = 0; d < dim; ++d) any |= GH[d][n] != 0.0;
     if (!any) continue;
-    const int owned = l > 0 || o->own[n];
+    const int owned = l > 0 ? books_level(o) : o->own[n];
     double *f = rec + (size_t)dim * (owned ? nearest_of(o, l, g, n) : 0);
     for (int d = 0; d < dim; ++d) {
       ph->f_i[d][n] += P[n] * GH[d][n];
@@ -200,6 +213,7 @@ void fluid_obstacles_span_surface(fluid_obstacles *o, const mpm_grid *const *gri
     for (int i = 0; i < s->n; ++i) {
       const double x[3] = {s->x[2 * i], s->x[2 * i + 1], 0.0};
       const int l = o->hier ? mpm_hier_level_of(o->hier, x) : 0;
+      if (l > 0 && !books_level(o)) continue;
       fluid_surface_sample_point(s, i, grids[l], M[l], MP[l], l ? NULL : o->own);
     }
   }
@@ -217,6 +231,7 @@ void fluid_obstacles_span_rate(const mpm_grid *g, int phase, const double *M,
 /* Level l >= 1: the empty or light nodes of the reach hand their force to the body, then every
  * obstacle's nodes are constrained (fluid_obstacles_apply does level 0). */
 static void apply_level(fluid_obstacles *o, int l, int phase, double h, int record) {
+  record = record && books_level(o);
   mpm_grid *g = o->hier->level[l].grid;
   mpm_grid_phase *ph = &g->phase[phase];
   const int dim = g->dim;

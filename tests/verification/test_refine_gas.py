@@ -677,20 +677,10 @@ def part_input():
     ]
     for name, text, key, start, words in cases_dyn:
         mt.expect_input_error(check, name, text, key, mt.line_starting(text, start), words)
-    # Two ranks with an obstacle (the gas alone runs there): one line from rank 0, exit 2.
+    # A gas beside a solid on 2 ranks (a gas and its obstacles run there,
+    # test_refine_ranks_obstacles): one line from rank 0, exit 2, naming refine.levels.
     out = mt.outdir("refine_ranks")
     path = os.path.join(out, "case.ini")
-    obstacle = refined + "\n" + rs.DISC
-    with open(path, "w") as f:
-        f.write(obstacle)
-    p = mt.run(["run", path, f"output.dir={out}/run", "run.progress=false"], ranks=2,
-               check=False)
-    errors = [ln for ln in p.stderr.splitlines() if ln.startswith("error:")]
-    want = f"case.ini:{mt.line_starting(obstacle, 'shape = circle')}:"
-    check(p.returncode == 2 and len(errors) == 1 and "obstacle.disc.shape" in errors[0]
-          and want in errors[0], f"2 ranks with an obstacle: exit {p.returncode}: "
-          f"{errors[0] if errors else p.stderr[-300:]}")
-    # A gas beside a solid on 2 ranks: the same, naming refine.levels.
     fsi = rs.fsi_case(0.1, rs.FSI_BAND)
     with open(path, "w") as f:
         f.write(fsi)
