@@ -7,7 +7,8 @@
 # test_refine_solid_wave and _prestress, added on 2026-12-03, from one sanitizer run on a shared
 # machine; the refinement tests added later that day (usl, open faces, a gas beside a solid,
 # obstacles), estimated as three times their plain time on a loaded machine under the
-# sanitizers (not yet measured there). Only their order matters.
+# sanitizers (not yet measured there); the ranks' and bodies' tests of the next session from
+# one loaded plain run (2026-12-03). Only their order matters.
 if(MPMFSI_SANITIZE)
   set(costs test_input_safety 68 test_bad_input 49 test_output_links 43 test_input_limits 42
       test_timeschemes_quick 39 test_volume_rate 39 test_traction_ls 38 test_refine_solid_wave 38
@@ -20,7 +21,8 @@ if(MPMFSI_SANITIZE)
       test_coupling_rigid 14 test_messages_run 14 test_obstacles_3d 14 test_mol_damping_shift 13
       test_refine_musl_uniform 50 test_refine_usl_uniform 50 test_refine_usl_regrid 40
       test_refine_open_ranks 40 test_refine_obstacles_stream 40 test_refine_open_farfield 30
-      test_refine_fsi_input 27 test_refine_fsi_restart 20)
+      test_refine_fsi_input 27 test_refine_fsi_restart 20 test_refine_ranks_obstacles 60
+      test_refine_body_pulse 30)
 else()
   set(costs test_restart_cases 80 test_checkpoint_integrity 71 test_euler_reference 63
       test_timeschemes 53 test_fsi_reflection 48 test_decomposition 47 test_wedge 43
@@ -28,7 +30,9 @@ else()
       test_farfield_gauge 29 test_multirate_face 29 test_multirate_step 29 test_mol_damping 20
       test_supersonic_bar 18 test_forward_step 17 test_prestress 16 test_fsi_waves 15
       test_periodic 14 test_gas_time_order 13 test_refine_gas_pulse 12 test_refine_fsi_pulse 20
-      test_refine_open_stream 16 test_refine_open_shock 16 test_refine_usl_pulse 12)
+      test_refine_open_stream 16 test_refine_open_shock 16 test_refine_usl_pulse 12
+      test_refine_ranks_static 40 test_refine_ranks_dynamic 30 test_refine_body_rest 24
+      test_refine_body_sphere 14)
 endif()
 while(costs)
   list(POP_FRONT costs name cost)

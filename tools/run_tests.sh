@@ -55,7 +55,10 @@
 #   pulse studies test_refine_fsi_pulse, _pulse_usl and _traction (its coupling on every level
 #   in test_refine_fsi_rest and _restart), the open faces' test_refine_open_stream and _shock
 #   (in test_refine_open_farfield and _ranks) and the obstacles' test_refine_obstacles_disc and
-#   _rest3d (in test_refine_obstacles_rest and _stream);
+#   _rest3d (in test_refine_obstacles_rest and _stream), the ranks' comparisons
+#   test_refine_ranks_static and _dynamic (the levels over ranks in test_hier_ranks,
+#   test_refine_ranks_obstacles and test_refine_gas_ranks), the bodies in a box
+#   test_refine_body_rest and _sphere (in _pulse and _input);
 # - test_euler_reference: the inviscid aerofoil reference in numpy, which runs no mpmfsi at all.
 # The input refusal drivers (test_input_safety, test_bad_input, test_cases) run under the
 # sanitizers without the leak check at exit (NO_LEAK_CHECK in tests/CMakeLists.txt).
@@ -75,6 +78,7 @@ PLAIN_ONLY+="|refine_usl_pulse|refine_usl_sod|refine_usl_wall|refine_musl_pulse|
 PLAIN_ONLY+="|refine_musl_wall|refine_musl_regrid|refine_fsi_pulse|refine_fsi_pulse_usl"
 PLAIN_ONLY+="|refine_fsi_traction"
 PLAIN_ONLY+="|refine_open_stream|refine_open_shock|refine_obstacles_disc|refine_obstacles_rest3d"
+PLAIN_ONLY+="|refine_ranks_static|refine_ranks_dynamic|refine_body_rest|refine_body_sphere"
 BOTH="checkpoint_integrity"
 
 # The tests also need clang-format (test_format) and ParaView under Xvfb (test_paraview), and
