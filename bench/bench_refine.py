@@ -146,6 +146,22 @@ ERRORS = {"stream": "largest deviation of rho, p, v (relative)",
           "sod3": "L1 of the density on the finest cells (fine: grid pressure, as refined)"}
 
 
+def write_rows(out, stem, rows):
+    """rows (a list of flat dicts with the same keys) as out/stem.json and out/stem.csv."""
+    with open(os.path.join(out, stem + ".json"), "w") as f:
+        json.dump(rows, f, indent=1)
+    with open(os.path.join(out, stem + ".csv"), "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=list(rows[0].keys()))
+        w.writeheader()
+        w.writerows(rows)
+
+
+def head_commit():
+    """The short hash of the checkout's HEAD (for the results page)."""
+    return subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"],
+                          capture_output=True, text=True).stdout.strip()
+
+
 def page(results, commit, command):
     now = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
     lines = ["# Cost of the refined gas against its uniform twins", "",
@@ -206,14 +222,8 @@ def main():
     flat = [dict(case=n, run=label, **{k: v for k, v in r.items() if k not in ("timers", "dir")},
                  **{f"t_{k}": r["timers"].get(k, 0.0) for k in TIMERS})
             for n, rows in results.items() for label, r in rows.items()]
-    with open(os.path.join(a.out, "refine_cost.json"), "w") as f:
-        json.dump(flat, f, indent=1)
-    with open(os.path.join(a.out, "refine_cost.csv"), "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=list(flat[0].keys()))
-        w.writeheader()
-        w.writerows(flat)
-    commit = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"],
-                            capture_output=True, text=True).stdout.strip()
+    write_rows(a.out, "refine_cost", flat)
+    commit = head_commit()
     command = "/usr/bin/python3 bench/bench_refine.py" + (
         f" --cases {a.cases}" if a.cases != DEFAULT_CASES else "")
     with open(a.md, "w") as f:

@@ -36,12 +36,9 @@ lines in run.log.
 """
 import argparse
 import configparser
-import csv
 import datetime
 import glob
-import json
 import os
-import subprocess
 import sys
 
 import numpy as np
@@ -49,7 +46,7 @@ import numpy as np
 CWD = os.getcwd()  # mpmtest (imported by bench_refine) moves to a scratch folder
 ROOT = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, ROOT)
-from bench_refine import TIMERS, run  # noqa: E402
+from bench_refine import TIMERS, head_commit, run, write_rows  # noqa: E402
 
 sys.path.insert(0, os.path.join(os.path.dirname(ROOT), "tests", "tools"))
 import mpmtest as mt  # noqa: E402
@@ -221,14 +218,8 @@ def main():
                  levels=" ".join(map(str, r["levels"])),
                  **{f"t_{k}": r["timers"].get(k, 0.0) for k in TIMERS})
             for label, r in rows.items()]
-    with open(os.path.join(a.out, "sphere_cost.json"), "w") as f:
-        json.dump(flat, f, indent=1)
-    with open(os.path.join(a.out, "sphere_cost.csv"), "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=list(flat[0].keys()))
-        w.writeheader()
-        w.writerows(flat)
-    commit = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"],
-                            capture_output=True, text=True).stdout.strip()
+    write_rows(a.out, "sphere_cost", flat)
+    commit = head_commit()
     defaults = {"runs": DEFAULT_RUNS, "steps": 6, "dt": 0.004, "dx": 0.25, "fine_side": 2.5}
     extra = "".join(f" --{k.replace('_', '-')} {getattr(a, k)}" for k, v in defaults.items()
                     if getattr(a, k) != v)
