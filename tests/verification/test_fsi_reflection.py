@@ -91,8 +91,8 @@ Known failures, marked EXPECTED-FAIL (printed with the reason; not counted as fa
   mid-cell as well kept the soft layer near p* to t = 0.30 but heated it and emptied the columns
   behind it (-38 %).
   A third experiment, the multi-material MPM literature's position-based contact detection (Nairn;
-  Lemiale et al.), is on the branch `layer` as coupling.contact_detection = gap (off by default;
-  docs/coupling.md): a shared node takes part in the exchange only where the phases' nodal
+  Lemiale et al.), was built as an opt-in key (2026-12-03; not merged, as it met no target): a
+  shared node takes part in the exchange only where the phases' nodal
   centres of mass, x_k = x_i + sum m_p S_i (x_p - x_i) / m_k,i, lie within a cutoff of each other
   along the solid's normal (a flat face under the quadratic B-spline: 0.81-0.90 dx on the node
   nearest the face, 1.27 dx on the tail nodes a cell either side). Measured (cutoff 1 dx unless
