@@ -110,7 +110,7 @@ Known failures, marked EXPECTED-FAIL (printed with the reason; not counted as fa
     (the gas's tail node inside the slab moves with the face particle's own FLIP velocity, so
     the particle keeps creeping into the wall).
   * the node beyond the face left out alone (the gas's tail inside the solid stays coupled),
-    with the hand-off (what the branch keeps): rest state and the other checks hold, but rigid
+    with the hand-off (the form measured in full): rest state and the other checks hold, but rigid
     usl p -17.5 %, rho -13.1 % (second column +4.7 %, the first at 0.0011 from the face against the
     exact 0.0014; steady, 0.84-0.82 p* from t = 0.20 to 0.50); bs32 +14 % and growing (0.93 to
     1.14 p* from 0.20 to 0.50; second column +77 %); least squares -3.2 % (fails, main passes);
