@@ -75,7 +75,7 @@ with the step and with the grid (monolithic at dx = 0.005, time.cfl 0.2, the str
 creates energy (+4.1e-5 J at 0.4) that falls fast with the step (a run instrumented by hand, not
 kept, puts it on the substeps in which a face node holds gas but no solid mass, the node the face
 leaves or reaches within the coupling step: +4.1e-5 J there after t = 0.1 at 0.4, 2.2e-5 at 0.2,
-1.5e-5 at 0.1, offset from 0.2 on by the substeps with solid mass, -1.7e-5 and -1.5e-5). At 0.4 the
+1.5e-5 at 0.1, offset from 0.2 on by the substeps with solid mass, -2.0e-5 at both). At 0.4 the
 creation outweighs the merge, W > 0; from 0.2 on it does not, so |W| grows towards the merge's loss
 before it falls with it: the raw |W| is not a measure that falls, its parts are. What the scheme
 adds to the run's energy, dE - dE_monolithic, falls at order 1.4-1.5 to 0.05 and to 5e-7 J at
