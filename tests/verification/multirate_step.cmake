@@ -10,3 +10,7 @@ mpm_add_script_test(test_multirate_step SCRIPT verification/test_multirate_step.
 # clamped under shared and held (the gas stays out, W within 2x of monolithic's) (~60 s).
 mpm_add_script_test(test_multirate_face SCRIPT verification/test_multirate_face.py
                     LABELS verification TIMEOUT 300)
+# The same face and energy at time.cfl 0.4 to 0.025 (shared): the total energy's excess over
+# monolithic's falls at every halving; the booked W's own part to 0.05 only (~8 min).
+mpm_add_script_test(test_multirate_face_long SCRIPT verification/test_multirate_face.py ARGS long
+                    LABELS "verification;long" TIMEOUT 1800)

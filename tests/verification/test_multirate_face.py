@@ -28,7 +28,11 @@ Checks, at time.cfl = 0.4 and 0.2, multirate with coupling.exchange = shared:
 - the coupling's own energy error, W - W_monolithic at the same time.cfl, falls from 0.4 to 0.2
   (the issue's "falls with the coupling step": W itself is dominated by the velocity scheme's
   inelastic merge, which monolithic shares: -5.4e-5 and -4.6e-5 J, so W is compared through
-  its difference from it);
+  its difference from it), and so does the total energy's change beyond monolithic's,
+  dE - dE_monolithic (diagnostics.csv: what the scheme really adds, whoever books it);
+- `long` as the argument (test_multirate_face_long) runs these checks alone at time.cfl 0.4,
+  0.2, 0.1, 0.05 and 0.025: dE - dE_monolithic falls at every halving; W - W_monolithic to 0.05,
+  and is expected to fail from 0.05 to 0.025 (below);
 - the interface balances momentum to 1e-9 of the interface force;
 - shared with what it cannot serve (the traction scheme, the linear predictor, slow substeps)
   is one error line naming the file, the line and the key, exit 2;
@@ -52,14 +56,48 @@ Checks, at time.cfl = 0.4 and 0.2, multirate with coupling.exchange = shared:
   layer, stretched 13 % by t = 0.05, pulled the gas in (solid_constraints.c); the clamp itself
   held the gas on its nodes. With the particles at rest and the old booking held gives +0.059
   dx and W +2.7e-2 J.
+
+Why raw |W| does not fall with the step under shared (measured 2026-12-03, 1 rank):
+| time.cfl | 0.4 | 0.2 | 0.1 | 0.05 | 0.025 |
+|---|---|---|---|---|---|
+| monolithic W, 1e-5 J | -5.41 | -4.64 | -3.62 | -2.43 | -1.53 |
+| shared W | +1.81 | -2.30 | -2.98 | -2.77 | -2.20 |
+| shared, to t = 0.1 / after | -2.33 / +4.14 | -2.47 / +0.18 | -2.39 / -0.59 | -2.13 / -0.64 |
+|  | | | | | -1.75 / -0.45 |
+| monolithic, to 0.1 / after | -4.16 / -1.24 | -3.62 / -1.01 | -3.13 / -0.50 | -2.52 / +0.08 |
+|  | | | | | -1.84 / +0.31 |
+| W - W_monolithic | +7.21 | +2.34 | +0.65 | -0.33 | -0.67 |
+| dE - dE_monolithic | +8.26 | +2.92 | +1.10 | +0.39 | +0.05 |
+W is two parts of opposite sign. By t = 0.1 (the start-up and the shock's arrival at 0.085) the
+velocity scheme's inelastic merge destroys 1.8e-5 ... 4.2e-5 J under both schemes, falling slowly
+with the step and with the grid (monolithic at dx = 0.005, time.cfl 0.2, the strip half as high: W
+5.0e-4 of the energy that crossed, against 1.05e-3 at dx = 0.01). After it, shared's coupling step
+creates energy (+4.1e-5 J at 0.4) that falls fast with the step (a run instrumented by hand, not
+kept, puts it on the substeps in which a face node holds gas but no solid mass, the node the face
+leaves or reaches within the coupling step: +4.1e-5 J there after t = 0.1 at 0.4, 2.2e-5 at 0.2,
+1.5e-5 at 0.1, offset from 0.2 on by the substeps with solid mass, -2.0e-5 at both). At 0.4 the
+creation outweighs the merge, W > 0; from 0.2 on it does not, so |W| grows towards the merge's loss
+before it falls with it: the raw |W| is not a measure that falls, its parts are. What the scheme
+adds to the run's energy, dE - dE_monolithic, falls at order 1.4-1.5 to 0.05 and to 5e-7 J at
+0.025. W - W_monolithic follows it to 0.1 and then levels off at 3e-6 ... 7e-6 J of either sign:
+the booking differs from monolithic's by that much (dE - W, shared less monolithic: +1.0, +0.5,
++0.5, +0.8, +0.7e-5 J), an attribution between the coupling's W and the modules' own energy, not
+energy created (EXPECTED-FAIL in `long`). |W| stays within twice monolithic's at every step (0.33,
+0.50, 0.82, 1.14, 1.44 times), the face within +0.58 ... +0.83 % of u*, its rattle 0.31 ... 0.73 %.
+At 0.0125 (run once, not in the test): W -1.65e-5 J against monolithic's -1.12e-5 (1.47 times), W -
+W_monolithic -5.3e-6 J, dE - dE_monolithic -1.0e-6 J (its floor: the sign flips, so the sweep stops
+at 0.025).
+
 Measured (2026-12-02, 1 rank, time.cfl 0.4 / 0.2): monolithic W -5.41e-5 / -4.64e-5 J, face
 +0.70 % / +0.60 %, rattle 0.39 % / 0.34 %; shared W +1.81e-5 / -2.30e-5 J (its own part
 7.2e-5 -> 2.3e-5 J), face +0.58 % / +0.83 %, rattle 0.73 % / 0.44 %, 388 / 776 coupling steps.
 The held exchange, the default and the only one before (`held` as the argument runs the same
 checks on it; 5 of them fail, 8 before the clamped slab passed): W -2.53e-4 / -4.19e-4 J (its
 own part 2.0e-4 -> 3.7e-4, growing), face -1.10 % / -0.33 %, rattle 5.3 % / 3.1 %; with
-coupling.predictor = linear it blows up at every time.cfl from 0.4 to 0.05 (t = 0.10 ... 0.18),
-printed as info.
+coupling.predictor = linear it blew up at every time.cfl from 0.4 to 0.05 (t = 0.10 ... 0.18)
+on 2026-12-02; on 004fc08 it runs to the end at 0.2 (which change cured it was not
+looked for), printed as info. Held
+at 0.1 / 0.05: W -4.16e-4 / -3.06e-4 J (its own part 3.8e-4 / 2.8e-4).
 """
 import json
 import os
@@ -70,14 +108,17 @@ import numpy as np
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "tools"))
 import mpmtest as mt  # noqa: E402
 
-EXCHANGE = "held" if sys.argv[1:] == ["held"] else "shared"
-check = mt.Checks("test_multirate_face" + ("_held" if EXCHANGE == "held" else ""))
+EXCHANGE = "held" if "held" in sys.argv[1:] else "shared"
+LONG = "long" in sys.argv[1:]  # the coupling-step sweep only (test_multirate_face_long)
+check = mt.Checks("test_multirate_face" + ("_held" if EXCHANGE == "held" else "")
+                  + ("_long" if LONG else ""))
 U_STAR = 1.254242511527340  # the exact interface speed (docstring)
 T_HIT = 0.2 / 2.366431913239846  # ambient gap / incident shock speed 2 c0
 T_END = 0.3
 WINDOW = (T_HIT + 0.05, T_END)
-CFLS = (0.4, 0.2)
+CFLS = (0.4, 0.2, 0.1, 0.05, 0.025) if LONG else (0.4, 0.2)
 TOL_MEAN, TOL_RATTLE, TOL_W = 0.03, 0.015, 2.0
+T_SPLIT = 0.1  # W to here: the start-up and the shock's arrival (info only)
 FACE, DX, T_CLAMPED = 1.5, 0.01, 0.15  # the slab's gas-side face, grid.dx (the case's)
 CLAMPED = ["clamp.wall.geometry=slab", f"time.t_end={T_CLAMPED}"]
 
@@ -103,6 +144,18 @@ def summary(out):
         return json.load(f)
 
 
+def energy_change(out):
+    """The total energy's change over the run (diagnostics.csv), J."""
+    total = np.genfromtxt(os.path.join(out, "diagnostics.csv"), delimiter=",", names=True)["total"]
+    return float(total[-1] - total[0])
+
+
+def work_until(out, t):
+    """The coupling's booked energy W from the start to time t (coupling.csv), J."""
+    c = np.genfromtxt(os.path.join(out, "coupling.csv"), delimiter=",", names=True)
+    return float(np.interp(t, c["t"], c["W_net"]))
+
+
 result = {}
 for cfl in CFLS:
     for label, extra in (("monolithic", ["coupling.time=monolithic"]),
@@ -110,11 +163,14 @@ for cfl in CFLS:
         out, _ = run(f"mrf_{label}_{cfl}", [f"time.cfl={cfl}"] + extra)
         s = summary(out)
         mean, rattle, n = face(out)
-        result[label, cfl] = (s["coupling_work"], mean, rattle)
+        result[label, cfl] = (s["coupling_work"], mean, rattle, energy_change(out))
         tag = f"{label} at time.cfl {cfl}"
         share = 100 * s["coupling_work_of_crossed"]
+        w_hit = work_until(out, T_SPLIT)
         print(f"info {tag}: W {s['coupling_work']:+.3e} J ({share:+.3f} % of the "
-              f"{s['coupling_crossed']:.4f} J that crossed); face {mean:.5f} "
+              f"{s['coupling_crossed']:.4f} J that crossed; {w_hit:+.2e} to t = {T_SPLIT}, "
+              f"{s['coupling_work'] - w_hit:+.2e} after), total energy "
+              f"{result[label, cfl][3]:+.4e} J; face {mean:.5f} "
               f"({100 * (mean / U_STAR - 1):+.2f} % of u* {U_STAR:.5f}), rattle {rattle:.5f} "
               f"({100 * rattle / U_STAR:.2f} %) over {n} steps; {mt.cost(out)}")
         if label == "monolithic":
@@ -136,9 +192,18 @@ for cfl in CFLS:
         check(abs(s["coupling_work"]) <= TOL_W * abs(w_mono),
               f"{tag}: |W| {abs(s['coupling_work']):.2e} J, monolithic's {abs(w_mono):.2e} "
               f"(at most {TOL_W:g} times)")
-own = [abs(result[EXCHANGE, c][0] - result["monolithic", c][0]) for c in CFLS]
-check(own[1] < own[0], f"{EXCHANGE}: the coupling's own energy error |W - W_monolithic| "
-      f"{own[0]:.2e} J at time.cfl {CFLS[0]}, {own[1]:.2e} at {CFLS[1]} (falls with the step)")
+for k in (0, 3):  # W, then the total energy's change
+    what = ("the coupling's own energy error |W - W_monolithic|" if k == 0 else
+            "the total energy's change beyond monolithic's |dE - dE_monolithic|")
+    own = [abs(result[EXCHANGE, c][k] - result["monolithic", c][k]) for c in CFLS]
+    for c0, c1, e0, e1 in zip(CFLS, CFLS[1:], own, own[1:]):
+        msg = f"{EXCHANGE}: {what} {e0:.2e} J at time.cfl {c0}, {e1:.2e} at {c1} (falls)"
+        if k == 0 and c1 < 0.05:  # the booked W's own part levels off (docstring)
+            check.expect_fail(e1 < e0, msg, "W levels off 5e-6 J from monolithic's, dE not")
+        else:
+            check(e1 < e0, msg)
+if LONG:
+    sys.exit(check.finish())
 
 # Bad input: shared with what it cannot serve is one error line naming the file, the line and
 # the key (exit 2).
@@ -167,10 +232,9 @@ CLAMPED_RUNS = (("monolithic", ["coupling.time=monolithic"]),
 for label, extra in CLAMPED_RUNS:
     out, _ = run(f"mrf_clamped_{label}", CLAMPED + extra)
     gas = mt.particles(mt.snapshots(out)[-1][1], "fluid")
-    diag = np.genfromtxt(os.path.join(out, "diagnostics.csv"), delimiter=",", names=True)
     inside = np.genfromtxt(os.path.join(out, "coupling.csv"), delimiter=",", names=True)
     clamped[label] = (float(np.max(gas["x"][:, 0])), float(np.max(inside["gas_inside"])),
-                      float(diag["total"][-1] - diag["total"][0]), summary(out)["coupling_work"])
+                      energy_change(out), summary(out)["coupling_work"])
     print(f"info clamped slab, {label}: the gas's rightmost particle at x = "
           f"{clamped[label][0]:.7f} ({(clamped[label][0] - FACE) / DX:+.2e} dx), gas_inside at "
           f"most {clamped[label][1]:.2e} kg, total energy {clamped[label][2]:+.2e} J, coupling W "
