@@ -8,7 +8,7 @@ void solid_bulkq_add(const solid_bulkq *q, int dim, mpm_lidx n, mpm_lidx count, 
   for (mpm_lidx k = 0; k < count; ++k) {
     const mpm_lidx i = idx[k];
     if (!(divv[i] < 0.0)) continue;
-    const double vq = -m[i] * solid_bulkq_nu(q, divv[i]) * divv[i]; /* V rho nu |tr D| */
+    const double vq = solid_bulkq_vq(q, m[i], divv[i]);
     for (int d = 0; d < dim; ++d) vsig[(size_t)(d * dim + d) * (size_t)n + (size_t)i] -= vq;
   }
 }

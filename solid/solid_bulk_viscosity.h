@@ -5,11 +5,13 @@
  *   q = rho l (c1 c |tr D| + c2 l (tr D)^2),   sigma -= q I,
  *
  * with l the cell size and c the body's elastic wave speed; q = 0 in expansion. It damps the
- * ringing behind a shock the solid's model steepens. tr D is lagged: the classic update
- * (usl, musl) keeps the previous step's tr L in the state field divv (its rate over the step is
- * (new - old) / h), as the gas's lagged artificial viscosity does; the ERK pairs are refused
- * (their RHS must be a function of y alone). q does work only through the grid forces: the
- * kinetic energy it takes is not stored anywhere, so it shows as a drop of the total energy. */
+ * ringing behind a shock the solid's model steepens. The classic update (usl, musl) lags tr D:
+ * it keeps the previous step's tr L in the state field divv (its rate over the step is
+ * (new - old) / h), as the gas's lagged artificial viscosity does. The method of lines (the ERK
+ * pairs, ssprk2) takes the current rate of the state itself, as the gas's current strain rate
+ * does, so that the RHS is a function of y alone (solid_bulkq_rate.c). q does work only through
+ * the grid forces: the kinetic energy it takes is not stored anywhere, so it shows as a drop of
+ * the total energy, under either update. */
 #ifndef SOLID_BULK_VISCOSITY_H
 #define SOLID_BULK_VISCOSITY_H
 
@@ -28,6 +30,11 @@ static inline int solid_bulkq_on(const solid_bulkq *q) {
 /* The kinematic viscosity q / (rho l |tr D|) times l, in compression; else 0. */
 static inline double solid_bulkq_nu(const solid_bulkq *q, double divv) {
   return divv < 0.0 ? q->l * (q->c1 * q->c - q->c2 * q->l * divv) : 0.0;
+}
+
+/* V q = m nu |tr D| of a particle of mass m (V rho = m), >= 0; 0 unless compressed. */
+static inline double solid_bulkq_vq(const solid_bulkq *q, double m, double divv) {
+  return -m * solid_bulkq_nu(q, divv) * divv;
 }
 
 /* V q = m nu |tr D| added to V sigma as -V q I, for the batch's particles idx (arrays of

@@ -18,9 +18,15 @@
 #include <stdio.h>
 
 /* Field indices: x, v, F are always fields 0-2; sigma (rate-form stress) and hist (material
- * history) exist only when some body's model needs them, divv (the lagged tr D) only when some
- * body has a bulk viscosity (see solid_layout). */
+ * history) exist only when some body's model needs them, divv (tr D) only when some body has a
+ * bulk viscosity (see solid_layout). */
 enum { F_X, F_V, F_F };
+
+/* Where a bulk viscosity keeps tr D (solid_bulk_viscosity.h): nowhere (no body has one); in the
+ * state (usl, musl: the lagged rate, advanced as (new - old) / h); or, under the method of
+ * lines, in the fields pending_divv (each RHS's current rate) and divv (committed after an
+ * accepted step, for the stable step), both outside the state. */
+enum { SOLID_BULKQ_NONE, SOLID_BULKQ_STATE, SOLID_BULKQ_PENDING };
 
 typedef struct {
   char section[96];
@@ -34,14 +40,15 @@ typedef struct {
 } solid_body;
 
 typedef struct {
-  int f_sigma, f_C, f_divv, f_m, f_V0, f_body, f_hist, f_fixed,
-      f_fext; /* field indices (-1 if absent) */
-  int nhist;  /* history components per particle */
+  int f_sigma, f_C, f_divv, f_m, f_V0, f_body, f_hist, f_fixed, f_fext,
+      f_pending; /* field indices (-1 if absent) */
+  int nhist;     /* history components per particle */
 } solid_layout;
 
 /* The solid's empty particle set and its layout (solid_module.c): sigma if any model is in
- * rate form, C with APIC, divv with a bulk viscosity, hist of nhist components (the model
- * with the most history; 0: none), fixed with clamps, fext with tractions. */
+ * rate form, C with APIC, divv (and pending_divv) as bulkq says (SOLID_BULKQ_*), hist of nhist
+ * components (the model with the most history; 0: none), fixed with clamps, fext with
+ * tractions. */
 int solid_particles_new(mpm_particles **p, int dim, solid_layout *lay, int has_rate, int apic,
                         int bulkq, int nhist, int fixed, int fext);
 
@@ -71,6 +78,7 @@ typedef struct {
   double damping;         /* mass-proportional damping rate alpha, 1/s: f_i -= alpha (m v)_i */
   mpm_transfer tr;        /* [transfer] settings and the time method's kind */
   double *vnew;           /* MUSL: the particles' new velocities (dim n) */
+  double *zero;           /* the bulk viscosity's current rate: zeros (cap), its deposit's m, v */
   double lp;              /* GIMP half-width in cells */
   mpm_lidx cap;           /* capacity of the scratch arrays */
   double *vsig, *scratch; /* V sigma (dim^2 n); G2P output v, a, L ((2 dim + dim^2) n) */
@@ -80,6 +88,7 @@ typedef struct {
   mpm_points pts;
   int pts_on;
   double *pts_buf;
+  mpm_module_ops ops; /* the module's table: solid_ops, with p2g_rate for the current rate */
 } solid_content;
 
 /* "SECTION.NAME" into key. */
@@ -114,6 +123,14 @@ int solid_deposit(mpm_module *m, const mpm_p2g_args *a);
 int solid_gather(mpm_module *m, const mpm_g2p_args *a);
 /* The spacing of the finest level (the grid's without a hierarchy). */
 double solid_finest_dx(const mpm_module *m);
+
+/* ---- solid_bulkq_rate.c: the bulk viscosity under the method of lines ------------------------ */
+
+/* p2g_rate (mpm_module.h): tr L of the previewed nodal velocity into pending_divv, and the bulk
+ * viscosity of the compressed particles deposited as forces only. */
+int solid_bulkq_p2g_rate(mpm_module *m, double t, const double *y);
+/* After an accepted step: the pending rate becomes divv, which the stable step reads. */
+void solid_bulkq_commit(const mpm_module *m);
 
 /* ---- solid_constraints.c ------------------------------------------------------------------ */
 

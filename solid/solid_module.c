@@ -2,16 +2,17 @@
  * constraints (walls, clamps, rigid bodies) and surface tractions are in solid_constraints.c.
  *
  * Invariants: particle field order is x, v, F, [sigma], [C], [divv] | m, V0, body, [hist],
- * [fixed], [fext] (see solid_particles_new; bracketed fields exist only when a body's model, the
- * APIC transfer, a bulk viscosity, a clamp or a traction needs them). body holds a small integer
- * stored as a double. The per-body index lists used for batched stress evaluation are rebuilt at
- * each P2G, so they never go stale after migration, sorting or injection. A rigid body's particles
- * keep F = I, C = 0 and their seeded velocity, and its region moves rigidly with that velocity: at
- * time t it is the seeded region translated by v t (wrapped through periodic faces). A body with an
- * initial stress is seeded at its state of solid_prestress.h: F = F0 (and sigma = sigma0 for a
- * rate-form model), V0 = seeded volume / det F0. On a refinement hierarchy (m->hier) the P2G and
- * G2P go through it and the finer levels are seeded by solid_refine.c; without one they are the
- * plain kernel calls. */
+ * [fixed], [fext], [pending_divv, divv] (see solid_particles_new; bracketed fields exist only
+ * when a body's model, the APIC transfer, a bulk viscosity, a clamp or a traction needs them;
+ * divv is in the state under usl and musl, after fext under the method of lines). body holds a
+ * small integer stored as a double. The per-body index lists used for batched stress evaluation are
+ * rebuilt at each P2G, so they never go stale after migration, sorting or injection. A rigid body's
+ * particles keep F = I, C = 0 and their seeded velocity, and its region moves rigidly with that
+ * velocity: at time t it is the seeded region translated by v t (wrapped through periodic faces). A
+ * body with an initial stress is seeded at its state of solid_prestress.h: F = F0 (and sigma =
+ * sigma0 for a rate-form model), V0 = seeded volume / det F0. On a refinement hierarchy (m->hier)
+ * the P2G and G2P go through it and the finer levels are seeded by solid_refine.c; without one they
+ * are the plain kernel calls. */
 #include "solid_internal.h"
 #include "solid_module.h"
 #include "solid_tensor.h"
@@ -65,7 +66,8 @@ static mpm_key_spec solid_keys[] = {
     {"solid.*.bulk_viscosity_linear", MPM_KEY_REAL, "0", 0, HUGE_VAL, 0, 0, NULL,
      "linear coefficient c1 of the bulk (shock) viscosity q = rho l (c1 c |tr D| + c2 l "
      "(tr D)^2) in compression (l the cell size, c the elastic wave speed), sigma -= q I; "
-     "LS-DYNA's default is 0.06; needs time.method = usl or musl (docs/solid.md)",
+     "LS-DYNA's default is 0.06; usl and musl lag tr D by a step, the other methods take the "
+     "current rate (docs/solid.md)",
      0, "-"},
     {"solid.*.bulk_viscosity_quadratic", MPM_KEY_REAL, "0", 0, HUGE_VAL, 0, 0, NULL,
      "quadratic coefficient c2 of the bulk viscosity (see bulk_viscosity_linear); LS-DYNA's "
@@ -96,8 +98,8 @@ int solid_particles_new(mpm_particles **p, int dim, solid_layout *lay, int has_r
   if (has_rate) fields[nf++] = (mpm_field_desc){"sigma", dim * dim};
   lay->f_C = apic ? nf : -1;
   if (apic) fields[nf++] = (mpm_field_desc){"C", dim * dim};
-  lay->f_divv = bulkq ? nf : -1;
-  if (bulkq) fields[nf++] = (mpm_field_desc){"divv", 1};
+  lay->f_divv = lay->f_pending = -1;
+  if (bulkq == SOLID_BULKQ_STATE) lay->f_divv = nf, fields[nf++] = (mpm_field_desc){"divv", 1};
   const int nstate = nf;
   lay->f_m = nf, fields[nf++] = (mpm_field_desc){"m", 1};
   lay->f_V0 = nf, fields[nf++] = (mpm_field_desc){"V0", 1};
@@ -109,7 +111,14 @@ int solid_particles_new(mpm_particles **p, int dim, solid_layout *lay, int has_r
   if (fixed) fields[nf++] = (mpm_field_desc){"fixed", 1};
   lay->f_fext = fext ? nf : -1;
   if (fext) fields[nf++] = (mpm_field_desc){"fext", dim};
-  return mpm_particles_new(p, dim, fields, nf, nstate);
+  if (bulkq == SOLID_BULKQ_PENDING) {
+    lay->f_pending = nf, fields[nf++] = (mpm_field_desc){"pending_divv", 1};
+    lay->f_divv = nf, fields[nf++] = (mpm_field_desc){"divv", 1};
+  }
+  MPM_CALL(mpm_particles_new(p, dim, fields, nf, nstate));
+  /* Every RHS writes the pending rate before the step commits it (as the gas's). */
+  if (lay->f_pending >= 0) mpm_particles_set_scratch(*p, lay->f_pending);
+  return 0;
 }
 
 /* What a checkpoint may hold in the fields that are not plain reals: positive masses and
@@ -216,6 +225,7 @@ int solid_seed_append(mpm_module *m, const mpm_config *cfg, const solid_seed *s,
         data[(size_t)(p->offset[sc->lay.f_sigma] + rc) * n + i] = pre->sigma0[rc];
     }
     if (sc->lay.f_divv >= 0) data[(size_t)p->offset[sc->lay.f_divv] * n + i] = 0.0;
+    if (sc->lay.f_pending >= 0) data[(size_t)p->offset[sc->lay.f_pending] * n + i] = 0.0;
     /* Seeded where it is: the current volume V0 det F0 is the seeding volume. */
     data[(size_t)p->offset[sc->lay.f_m] * n + i] = sc->body[b].rho * vol;
     data[(size_t)p->offset[sc->lay.f_V0] * n + i] = vol / pre->J0;
@@ -296,11 +306,17 @@ static int ensure_scratch(mpm_module *m) {
   free(sc->idx);
   free(sc->vnew);
   sc->vnew = NULL;
+  free(sc->zero);
+  sc->zero = NULL;
   sc->cap = n + n / 4 + 16;
   MPM_ALLOC(sc->vsig, (size_t)dim * dim * sc->cap);
   MPM_ALLOC(sc->scratch, (size_t)(2 * dim + dim * dim) * sc->cap);
   MPM_ALLOC(sc->idx, sc->cap);
   if (sc->tr.musl) MPM_ALLOC(sc->vnew, (size_t)dim * sc->cap);
+  if (sc->lay.f_pending >= 0) {
+    sc->zero = calloc((size_t)sc->cap, sizeof(double));
+    if (!sc->zero) MPM_FAIL(MPM_ERR_MEMORY, "out of memory for %lld particles", (long long)sc->cap);
+  }
   free(sc->pts_buf);
   sc->pts_buf = NULL;
   if (sc->pts_on) MPM_ALLOC(sc->pts_buf, (size_t)sc->cap);
@@ -355,7 +371,7 @@ static int solid_p2g(mpm_module *m, double t, const double *y) {
   for (int b = 0; b < sc->nbodies; ++b) {
     const solid_batch batch = batch_of(sc, p, y, sc->count[b], idx, sc->vsig);
     sc->body[b].mat->ops->stress(sc->body[b].mat, &batch);
-    if (solid_bulkq_on(&sc->body[b].q))
+    if (solid_bulkq_on(&sc->body[b].q) && sc->lay.f_pending < 0) /* lagged: from the state */
       solid_bulkq_add(&sc->body[b].q, dim, n, sc->count[b], idx, mass,
                       y + (size_t)p->offset[sc->lay.f_divv] * n, sc->vsig);
     idx += sc->count[b];
@@ -500,8 +516,8 @@ static int solid_g2p(mpm_module *m, double t, const double *y, double *ydot, dou
   const mpm_lidx n = p->n;
   /* dF/dt = L F comes out of the kernel directly; L itself is kept only for rate-form
    * models and the bulk viscosity's lagged tr L. */
-  double *L =
-      sc->lay.f_sigma >= 0 || sc->lay.f_divv >= 0 ? sc->scratch + (size_t)2 * dim * n : NULL;
+  const int lagged = sc->lay.f_divv >= 0 && sc->lay.f_pending < 0;
+  double *L = sc->lay.f_sigma >= 0 || lagged ? sc->scratch + (size_t)2 * dim * n : NULL;
   double *xdot[MPM_MAX_DIM] = {NULL}, *vdot[MPM_MAX_DIM] = {NULL};
   for (int d = 0; d < dim; ++d) {
     xdot[d] = ydot + (size_t)(p->offset[F_X] + d) * n;
@@ -521,7 +537,7 @@ static int solid_g2p(mpm_module *m, double t, const double *y, double *ydot, dou
     for (size_t k = 0; k < (size_t)dim * dim * (size_t)n; ++k) Cdot[k] = (Cdot[k] - C[k]) / h;
   }
   if (sc->lay.f_sigma >= 0) solid_stress_rates(m, y, ydot, L);
-  if (sc->lay.f_divv >= 0) lag_divv(p, sc->lay.f_divv, y, ydot, L, h);
+  if (lagged) lag_divv(p, sc->lay.f_divv, y, ydot, L, h);
   if (sc->lay.f_fixed >= 0) solid_hold_fixed(p, sc->lay.f_fixed, ydot);
   if (sc->nrigid) solid_move_rigid(sc, p, ydot);
   return 0;
@@ -579,11 +595,13 @@ static int solid_body_loads(mpm_module *m, const double *y, const double *const 
   return 0;
 }
 
-/* After an accepted step (and migration): models with history store the returned state. */
+/* After an accepted step (and migration): the ERK pairs' pending bulk-viscosity rate becomes the
+ * stable step's, and models with history store the returned state. */
 static int solid_post_step(mpm_module *m, double t, double h, int *changed) {
   (void)t, (void)h, (void)changed;
   solid_content *sc = m->content;
   const mpm_particles *p = m->particles;
+  if (sc->lay.f_pending >= 0) solid_bulkq_commit(m);
   if (sc->lay.f_hist < 0) return 0;
   MPM_CALL(ensure_scratch(m));
   group_by_body(m);
@@ -603,7 +621,9 @@ static double solid_stable_dt(const mpm_module *m, const double *y) {
   const solid_content *sc = m->content;
   const mpm_particles *p = m->particles;
   const double *body = mpm_particles_comp(p, sc->lay.f_body, 0);
-  const double *divv = sc->lay.f_divv >= 0 ? y + (size_t)p->offset[sc->lay.f_divv] * p->n : NULL;
+  const double *divv = sc->lay.f_pending >= 0 ? mpm_particles_comp(p, sc->lay.f_divv, 0)
+                       : sc->lay.f_divv >= 0  ? y + (size_t)p->offset[sc->lay.f_divv] * p->n
+                                              : NULL;
   const double dx = solid_finest_dx(m);
   double dt = HUGE_VAL;
   for (mpm_lidx i = 0; i < p->n; ++i) {
@@ -671,6 +691,7 @@ static void solid_destroy(mpm_module *m) {
     free(sc->pts_buf);
     free(sc->idx);
     free(sc->vnew);
+    free(sc->zero);
     free(sc->count);
     free(sc);
   }
@@ -695,7 +716,6 @@ static const mpm_module_ops solid_ops = {
 
 /* A body's bulk viscosity (solid_bulk_viscosity.h); the schema refuses negative values. */
 static int read_bulkq(const mpm_module *m, const mpm_config *cfg, solid_body *body) {
-  const solid_content *sc = m->content;
   char key[160];
   solid_key(key, sizeof key, body->section, "bulk_viscosity_linear");
   MPM_CALL(mpm_config_get_real(cfg, key, &body->q.c1));
@@ -708,10 +728,6 @@ static int read_bulkq(const mpm_module *m, const mpm_config *cfg, solid_body *bo
     solid_key(key, sizeof key, body->section, "bulk_viscosity_linear");
   if (body->mat->ops->rigid)
     return mpm_config_fail(cfg, key, "a rigid body has no stress to damp; remove the key");
-  if (!sc->tr.classic)
-    return mpm_config_fail(cfg, key,
-                           "the bulk viscosity reads the previous step's strain rate, which "
-                           "only time.method = usl or musl keep; set one or remove the key");
   return 0;
 }
 
@@ -773,11 +789,12 @@ int solid_module_create(mpm_module **mp, const mpm_config *cfg, mpm_grid *grid, 
   int rc = mpm_grid_add_phase(grid, "solid", &m->phase);
   if (!rc) rc = read_bodies(m, cfg);
   if (!rc) {
-    int has_rate = 0, nhist = 0, bulkq = 0;
+    int has_rate = 0, nhist = 0, bulkq = SOLID_BULKQ_NONE;
     for (int b = 0; b < sc->nbodies; ++b) {
       const solid_material_ops *ops = sc->body[b].mat->ops;
       has_rate |= ops->rate != NULL;
-      bulkq |= solid_bulkq_on(&sc->body[b].q);
+      if (solid_bulkq_on(&sc->body[b].q))
+        bulkq = sc->tr.classic ? SOLID_BULKQ_STATE : SOLID_BULKQ_PENDING;
       if (ops->nhistory) nhist = MPM_MAX(nhist, ops->nhistory(grid->dim));
     }
     if (!rc) rc = solid_read_constraints(m, cfg);
@@ -806,5 +823,8 @@ int solid_module_create(mpm_module **mp, const mpm_config *cfg, mpm_grid *grid, 
     return mpm_trace(__FILE__, __LINE__, __func__, rc);
   }
   m->commits_history = sc->lay.f_hist >= 0; /* the materials' commit (solid_post_step) */
+  sc->ops = solid_ops;
+  if (sc->lay.f_pending >= 0) sc->ops.p2g_rate = solid_bulkq_p2g_rate; /* the current rate */
+  m->ops = &sc->ops;
   return 0;
 }

@@ -6,13 +6,13 @@
  *    by the case keys today (APIC needs the classic update), but a layout the store cannot
  *    hold must not be what keeps them refused;
  *  - the solid (solid_particles_new): every combination of a rate-form model, APIC, a bulk
- *    viscosity, clamps and tractions, with no history or with the largest history of any
- *    registered model, 64 in all;
+ *    viscosity (none, its rate in the state, or pending: the method of lines), clamps and
+ *    tractions, with no history or with the largest history of any registered model, 96 in all;
  *  - the coupler's interface state (mpm_interface_particles_new), with and without predictor.
  * Each built set must hold its fields under their names, with the sizes the layout gives, and
- * every field that holds the gas's pending strain rate must be scratch (a checkpoint need not
- * hold it). Every failing combination is printed before the test fails, so one run lists them
- * all. Exact: no tolerance (counts and names).
+ * every field that holds the gas's or the solid's pending strain rate must be scratch (a checkpoint
+ * need not hold it). Every failing combination is printed before the test fails, so one run lists
+ * them all. Exact: no tolerance (counts and names).
  *
  * Shown to fail on the old store (16 fields, a single "pending" field of 1 + dim^2 + 1
  * components): the six 3-D gas layouts with viscosity and a pending copy. */
@@ -91,7 +91,8 @@ static int max_history(int dim) {
   return nh;
 }
 
-/* The solid layout {rate, apic, bulkq, history, fixed, fext}: as gas_layout_check. */
+/* The solid layout {rate, apic, bulkq (SOLID_BULKQ_*), history, fixed, fext}: as
+ * gas_layout_check. */
 static int solid_layout_check(int dim, const int *o) {
   mpm_particles *p = NULL;
   solid_layout lay;
@@ -103,6 +104,10 @@ static int solid_layout_check(int dim, const int *o) {
   ok = ok && (o[0] ? has(p, lay.f_sigma, "sigma", d2) : lay.f_sigma < 0);
   ok = ok && (o[1] ? has(p, lay.f_C, "C", d2) : lay.f_C < 0);
   ok = ok && (o[2] ? has(p, lay.f_divv, "divv", 1) : lay.f_divv < 0);
+  ok = ok && (o[2] == SOLID_BULKQ_STATE) == (lay.f_divv >= 0 && lay.f_divv < p->nstate_fields);
+  ok = ok && (o[2] == SOLID_BULKQ_PENDING
+                  ? has(p, lay.f_pending, "pending_divv", 1) && (p->scratch >> lay.f_pending & 1u)
+                  : lay.f_pending < 0);
   ok = ok && (nh ? has(p, lay.f_hist, "hist", nh) : lay.f_hist < 0);
   ok = ok && (o[4] ? has(p, lay.f_fixed, "fixed", 1) : lay.f_fixed < 0);
   ok = ok && (o[5] ? has(p, lay.f_fext, "fext", dim) : lay.f_fext < 0);
@@ -115,9 +120,10 @@ static void test_solid(void **state) {
   int bad = 0;
   assert_true(max_history(3) > 0); /* J2 has history: the "with history" layouts are real */
   for (int dim = 2; dim <= 3; ++dim)
-    for (int k = 0; k < 64; ++k) {
+    for (int k = 0; k < 96; ++k) {
       int o[6];
-      for (int b = 0; b < 6; ++b) o[b] = k >> b & 1;
+      for (int b = 0; b < 5; ++b) o[b < 2 ? b : b + 1] = k >> b & 1;
+      o[2] = k >> 5; /* 0, 1, 2 */
       const int why = solid_layout_check(dim, o);
       if (!why) continue;
       ++bad;

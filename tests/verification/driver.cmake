@@ -22,6 +22,11 @@ mpm_add_script_test(test_csm3_fast SCRIPT verification/test_csm3.py ARGS fast
                     LABELS verification TIMEOUT 300)
 mpm_add_script_test(test_damping SCRIPT verification/test_damping.py LABELS verification
                     TIMEOUT 300)
+# The solid bulk viscosity under the method of lines (bs32, dp54, ssprk2) against usl: the
+# ringing behind a bar's shock, the stable step, the energy it removes, 2 ranks against 1,
+# bitwise restart (~35 s).
+mpm_add_script_test(test_solid_bulkq SCRIPT verification/test_solid_bulkq.py
+                    LABELS "verification;mpi" TIMEOUT 300)
 mpm_add_script_test(test_model_swap SCRIPT verification/test_model_swap.py
                     LABELS verification TIMEOUT 600)
 mpm_add_script_test(test_disks SCRIPT verification/test_disks.py LABELS verification

@@ -6,12 +6,13 @@ linear_elastic slabs with nu = 0 (M = E) from the gas's face to a slip wall, dx 
   rigid: Mach 1.21 into (rho, p) = (1, 1); rho_s = 4000, E = 1e5: c_s = 5, Z_s / Z_g = 1.69e4.
   soft:  Mach 2 into (1, 1);             rho_s = 0.1,  E = 160: c_s = 40, Z_s / Z_g = 3.38.
 Each slab starts at rest, pre-stressed at the ambient p0 = 1 (solid.slab.initial_pressure), so
-gas and slab start in equilibrium. Under usl and musl the soft slab runs with a bulk viscosity
-(solid.slab.bulk_viscosity_linear = 0.5, _quadratic = 1.5; docs/solid.md), which damps the wave
-train behind its transmitted shock; bs32 refuses it and runs the slab undamped. Why 0.5: it is
-the linear coefficient of the gas's own default viscosity (fluid.av_form = vnr), and the linear
-term is the one that acts on a weak shock (strain 2.9 %); the RMS bound below is met narrowly
-with it (2.91 % against 3 %), and not with LS-DYNA's 0.06 (5.6 %): see Known failures.
+gas and slab start in equilibrium. Both slabs run with a bulk viscosity under every time method
+(solid.slab.bulk_viscosity_linear = 0.5, _quadratic = 1.5; docs/solid.md: usl and musl lag tr D
+by a step, the method of lines takes the stage's current rate), which damps the wave train
+behind the transmitted shock. Why 0.5: it is the linear coefficient of the gas's own default
+viscosity (fluid.av_form = vnr), and the linear term is the one that acts on a weak shock (strain
+2.9 %); the soft slab's RMS bound below is met narrowly with it (2.91 % usl, 2.99 % bs32, against
+3 %), and not with LS-DYNA's 0.06 (5.6 %): see Known failures.
 
 Exact answer: the code's small-strain model puts V0 sigma into the nodal forces, so in uniaxial
 strain its nominal stress is P(F) = M (F - 1) / F (the slab's ambient F, 160/161, measured to
@@ -48,13 +49,16 @@ Tolerances and why:
   plateau       2 % in p and in rho: the slip-wall reflection of the same shock in gas alone
                 (what the interface should reach) scatters by 1-2 % over such a region under
                 usl (FLIP noise behind a shock).
-  force         1 %: the interface force carries the state * in momentum; measured -0.06 %
-                (rigid) and -0.36 % (soft; the slab's residual nonlinearity, see above).
-  transmitted   2 % of the jump (issue 55's acceptance), median; measured -0.04 % (bs32
-                +0.53 %) and -1.6 %.
+  force         1 %: the interface force carries the state * in momentum; measured (velocity
+                usl, bs32) -0.002 %, -0.23 % (rigid) and -0.19 %, -0.11 % (soft; the slab's
+                residual nonlinearity, see above); without the viscosity -0.06 % and -0.36 %.
+  transmitted   2 % of the jump (issue 55's acceptance), median; measured (velocity usl,
+                bs32) -0.10 %, -0.11 % (rigid) and -1.02 %, -0.89 % (soft); without the
+                viscosity -0.04 % (bs32 +0.53 %) and -1.6 %.
   ringing       RMS 3 %, largest 10 % of the jump (cell averages): a clean acoustic plateau
-                (the rigid slab under usl: 0.28 %, 1.1 %) with room for the smeared start of the
-                wave; the issue's moving-slab start measured a median -10 %, beyond both.
+                (the rigid slab under usl: 0.28 %, 1.1 % without the viscosity, 0.26 %, 1.27 %
+                with it) with room for the smeared start of the wave; the issue's moving-slab
+                start measured a median -10 %, beyond both.
                 The pre-stressed start brings the issue's -10 % median to -1.6 %.
 
 Known failures, marked EXPECTED-FAIL (printed with the reason; not counted as failures):
@@ -125,30 +129,65 @@ Known failures, marked EXPECTED-FAIL (printed with the reason; not counted as fa
   B-spline wall needs what lies beyond the face (the mirror above) or a boundary-fitted basis.
 - the least-squares layer next to the soft slab: -3.0 % in p, -3.4 % in rho, the second column
   alike (not diagnosed; -3.9 %, -4.0 % with the moving-slab start).
-- the ringing behind the soft slab's shock without the bulk viscosity (bs32; under usl it
-  measured RMS 7.4 %, largest 21 %) and under bs32 behind the rigid one (3.8 %, 15 %): the
-  slab's own, not the interface's. It grows from 3.6 % RMS a metre behind the
-  face to 8.6 % near the front (the wave train of a shock with no dissipation in the solid), and
-  the pre-stressed start left it as large as the moving-slab start (5.0 %).
-  With the bulk viscosity (soft, usl; c1 = 0.5, c2 = 1.5) the RMS is 2.91 % (velocity) and
-  2.80 % (traction, least squares), an ordinary check for these two (the long list's soft
-  contact:usl, traction:usl and velocity:musl were not measured: expected to fail, XPASS tells);
-  the linear coefficient does the work (RMS velocity:usl: 0.06 -> 5.62 %, 0.3 -> 3.48 %,
-  1.0 -> 2.55 %; c2 1.2 or 1.5 alike: the strain jump is only 2.9 %), at the price of the
-  stable step (4042 steps -> 7141 at 0.5). LS-DYNA's defaults (0.06, 1.5) leave the RMS at
-  5.6 %. The largest deviation stays an expected failure: 17.2 % and 14.9 %, a cell 5 cells
-  behind the face (the impact's start, kept in the material there: velocity:usl RMS 6.4 % in
-  the first 0.5 m, 1.9-2.2 % and largest 3.8 % in each 0.5 m beyond, 5.2 % and 9.6 % in the last
-  0.3 m before the smeared front); 20.4 % there without the viscosity. The median moves from -1.61 %
-  to -1.02 % (velocity) and -1.09 % (traction, least squares), the force from -0.36 % to -0.19 %.
+- the ringing's largest cell average behind the soft slab's shock (the RMS is an ordinary check).
+  History: without a solid viscosity the soft slab rang at RMS 7.4 %, largest 21 % (usl), 7.85 %,
+  18.7 % (bs32: median -1.10 %, force -0.20 %, 10064 steps), and under bs32, which refused the
+  viscosity until issue 55's item 3, the rigid one at 3.8 %, 15 %: the slab's own wave train
+  (3.6 % RMS a metre behind the face, 8.6 % near the front), as large from the pre-stressed start
+  as from the moving-slab start (5.0 %). With the bulk viscosity (c1 = 0.5, c2 = 1.5) under every
+  method: rigid RMS 0.26 %, largest 1.27 % (usl), 0.29 %, 0.98 % (musl), 1.95 %, 7.21 % (bs32);
+  soft RMS 2.91 % (velocity, traction: usl), 2.94 % (contact:usl), 2.80 % (traction:usl:ls),
+  2.99 % (velocity, traction: bs32), met narrowly, and 3.06 % (velocity:musl), not met: an
+  expected failure (SOFT_RMS_FAILS; not diagnosed). The linear coefficient does the work (RMS
+  velocity:usl: 0.06 -> 5.62 %, 0.3 -> 3.48 %, 1.0 -> 2.55 %; c2 1.2 or 1.5 alike: the strain jump
+  is only 2.9 %), at the price of the stable step (soft usl 4042 steps -> 7141; rigid usl 630 ->
+  1259; bs32 takes the current rate: rigid 1537 -> 1673, soft 9700 steps). LS-DYNA's defaults
+  (0.06, 1.5) leave the RMS at 5.6 %. The median moves from -1.61 % to -1.02 % (velocity:usl; bs32
+  -0.89 %), the force from -0.36 % to -0.19 % (bs32 -0.11 %). The largest deviation stays an
+  expected failure next to the soft slab: 17.2 % (velocity:usl), 14.9 % (traction:usl:ls), 15.7 %
+  (velocity:bs32); 20.4 % without the viscosity. Diagnosis (velocity:usl, snapshots every 0.005 s,
+  P per particle column): within 15 cells of the face the cell averages hold +-20 % of the jump
+  from t = 0.2 to t_end, nearly fixed in the material (at t_end +22, +21, -8, -22, +4, +16, -7,
+  -18 % in the cells 1-8 behind the face), with a +-5 % part that alternates between snapshots;
+  beyond the first 0.5 m the RMS is 1.9-2.2 % (largest 3.8 %) in each 0.5 m. Split into each
+  material cell's mean and the half-difference of its two particle columns, the half-difference
+  dominates: 50 % of the jump in the face cell at t = 0.080 (the gas's smeared shock arriving),
+  159 % at 0.090, 98-171 % to t_end; it reaches the next cell (30-80 %) from 0.105, the 8th
+  (13-31 %) from 0.11, the 30th (5-12 %) from 0.19, and stays under 0.5 % at the 100th. A
+  particle-scale alternation of F lies in the kernel of the quadratic B-spline's nodal forces at 2
+  particles per cell: the grid does not see it, so the elastic response does not carry it off as a
+  wave and the bulk viscosity, which reads the grid's rate, does not damp it; it spreads only as
+  the slab crosses the grid, and the +-20 % is its residue in the cell averages. Its source is the
+  first layer's node: the face column's rate reads the node a cell outside the face, which holds
+  the solid's spline tail and, under the shared velocity, the gas's velocity (the gas's mass there
+  is 500 times the tail's). While the incoming gas leads the slab (u1 = 1.48 against a slab at
+  rest) that node adds up to |S'(1.25 dx)| (v_gas - v_solid) = 0.25 x 1.48 / dx = 37 /s to the
+  first column's rate and nothing to the second's; over a few ms of the smeared shock's rise
+  (DELAY = 4.2 ms) that is a strain difference of order 10 %, the size measured (a half-difference
+  of 159 % of the jump is a difference of 9 % in strain, three times the 2.9 % jump). Next to the
+  rigid slab the tail node's velocity is mostly the solid's (its mass there is 63 times the
+  gas's), but the jump is tiny (strain 1.3e-5): the same alternation holds half-differences of
+  545, 89, 30 and 3 % of the jump in the first, second, third and fifth cells from t = 0.2 to
+  t_end, and none by the 9th; it stays there because that slab does not move across the grid (u* =
+  7e-5), and the measured region starts 5 cells behind the face. The soft slab moves 32 cells
+  across the grid by t_end, and its alternation has spread over some 30. A bar driven into a slip
+  wall (test_solid_bulkq's scene) leaves 1-2 % there: the coupling face makes it, not the slab's
+  own impact. It is therefore a defect, the solid side of the first layer's; its cure is the wall
+  condition at the face that the first layer needs (above). An experiment that left the solid out
+  of the velocity exchange at nodes holding little of its mass (not kept) broke the coupling: a
+  momentum imbalance up to 1.2 times the interface force with one threshold, a failed run
+  (t = 0.105) with another.
 
-Arguments: [long] [slab:scheme:method[:ls] ...]. Default (~80 s): the rigid slab under
+Arguments: [long] [slab:scheme:method[:ls] ...]. Default (~80 s idle before the rigid slab took
+the viscosity, whose usl runs now take twice the steps, a few seconds more; 149-209 s measured
+with the machine's load at 10-12): the rigid slab under
 velocity:usl, contact:usl, traction:usl, traction:usl:ls (fluid.wall_treatment =
 least_squares) and velocity:bs32 (the default time method); the soft slab under velocity:usl
 and traction:usl:ls. `long` runs the rest: rigid traction:bs32, velocity:musl,
 traction:musl; soft contact:usl, traction:usl, velocity:bs32 (3-4 minutes alone),
 traction:bs32, velocity:musl (about 8 minutes in all; measured 467 s with another run
-sharing the core). Rigid under musl: ringing RMS 1.4 %, largest 6.0 %.
+sharing the core, before the viscosity under bs32). Rigid under musl: ringing RMS 0.29 %,
+largest 0.98 % (1.4 %, 6.0 % without the viscosity).
 """
 import math
 import os
@@ -177,20 +216,21 @@ LAYER_REASON = ("the node a cell outside the solid's face carries its spline tai
 
 LS_REASON = ("next to the soft slab the least-squares layer sits 3 % low in p and rho (the first "
              "and second columns alike); not diagnosed")
-PEAK_REASON = ("the largest cell average lies 5 cells behind the soft slab's face (-17 %, -15 % "
-               "with the bulk viscosity; -20 % without): the impact's start, kept in the material "
-               "near the face; beyond it the cells stay within 10 %; see the docstring")
-# The soft combinations whose ringing RMS was measured with the bulk viscosity (docstring).
-DAMPED_MEASURED = {("velocity", "usl", False), ("traction", "usl", True)}
-RING_REASON = ("behind the soft slab's transmitted shock, and under bs32 behind either, the "
-               "slab's cell averages ring beyond the bound: the wave train of a shock the solid "
-               "does not damp, growing towards its front; see the docstring")
+PEAK_REASON = ("within 15 cells of the soft slab's face the cell averages hold +-20 % of the jump "
+               "(the largest 5-8 cells behind it): the residue of a particle-scale strain "
+               "alternation the impact leaves in the face cells (the solid's spline-tail node "
+               "carries the gas's velocity into the first column's rate), which the grid does not "
+               "see, so neither elasticity nor the bulk viscosity removes it; see the docstring")
+# The soft combinations whose ringing RMS misses the bound (measured; docstring).
+SOFT_RMS_FAILS = {("velocity", "musl", False)}
+MUSL_REASON = ("under musl the soft slab's ringing RMS measured 3.06 %: the bound is met narrowly "
+               "by the other combinations (2.80-2.99 %); see the docstring")
 
 SLABS = {
     "rigid": dict(case="fsi_reflect_rigid.ini", mach=1.21, rho_s=4000.0, E=1e5, x_s=1.5,
                   x_i=1.7, L=3.0, t_end=0.5),
     "soft": dict(case="fsi_reflect_soft.ini", mach=2.0, rho_s=0.1, E=160.0, x_s=2.0, x_i=2.2,
-                 L=9.0, t_end=0.35, q=(0.5, 1.5)),
+                 L=9.0, t_end=0.35),
 }
 
 
@@ -215,10 +255,8 @@ def exact(sl):
                 t_hit=(sl["x_i"] - sl["x_s"]) / S)
 
 
-def damped(sl, method):
-    """Does the slab run with its bulk viscosity (the classic update only: the ERK pairs refuse
-    it)?"""
-    return "q" in sl and method in ("usl", "musl")
+# The slabs' bulk viscosity (c1, c2), under every time method (docstring).
+Q = (0.5, 1.5)
 
 
 def run(name, sl, ex, scheme, method, ls):
@@ -232,9 +270,8 @@ def run(name, sl, ex, scheme, method, ls):
              f"time.t_end={sl['t_end']}"]
     if ls:
         extra.append("fluid.wall_treatment=least_squares")
-    if damped(sl, method):
-        extra += [f"solid.slab.bulk_viscosity_linear={sl['q'][0]!r}",
-                  f"solid.slab.bulk_viscosity_quadratic={sl['q'][1]!r}"]
+    extra += [f"solid.slab.bulk_viscosity_linear={Q[0]!r}",
+              f"solid.slab.bulk_viscosity_quadratic={Q[1]!r}"]
     mt.run(["run", mt.case(sl["case"]), f"output.dir={out}", f"grid.dx={DX}",
             f"coupling.scheme={scheme}", f"time.method={method}", "run.progress=false"] + extra)
     print(f"cost {tag}: {mt.cost(out)}")
@@ -332,14 +369,10 @@ def measure(name, sl, ex, scheme, method, ls):
           f"p* - p0 = {jump:.5f}: {100 * (T - 1):+.2f} % (<= {100 * TOL_T:g} %)")
     ring = (f"{tag}: ringing of the transmitted stress (cell averages): RMS {100 * rms:.2f} %, "
             f"largest {100 * dev:.2f} % of the jump (<= {100 * TOL_RMS:g} %, {100 * TOL_MAX:g} %)")
-    if not damped(sl, method):
-        verdict(rms <= TOL_RMS and dev <= TOL_MAX,
-                None if name == "rigid" and method in ("usl", "musl") else RING_REASON, ring)
-        return
-    measured = (scheme, method, ls) in DAMPED_MEASURED
-    verdict(rms <= TOL_RMS, None if measured else "not measured with the bulk viscosity",
-            ring + " [RMS, with the bulk viscosity]")
-    verdict(dev <= TOL_MAX, PEAK_REASON, ring + " [largest, with the bulk viscosity]")
+    soft = name == "soft"
+    fails = soft and (scheme, method, ls) in SOFT_RMS_FAILS
+    verdict(rms <= TOL_RMS, MUSL_REASON if fails else None, ring + " [RMS]")
+    verdict(dev <= TOL_MAX, PEAK_REASON if soft else None, ring + " [largest]")
 
 
 def variants():
