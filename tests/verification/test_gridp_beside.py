@@ -2,8 +2,8 @@
 coupling.time = multirate and coupling.scheme = contact, which main refused (exit 2).
 
 Why it matters: on the resonator (cases/fsi_resonator.ini) at 800 cells per metre the particle
-pressure's quadrature grows a transverse gas mode (|v_y| / c_g 0.39 by t = 1.8 under usl); the
-grid pressure integrates the nodal pressure exactly and keeps it at roundoff.
+pressure's quadrature grows a transverse gas mode (issue 55: |v_y| / c_g 0.39 by t = 1.8 under
+usl); the grid pressure integrates the nodal pressure exactly and keeps it at roundoff.
 
 Parts (one ctest each):
 multirate  The resonator strip at 200 cells per metre to t = 2 under multirate, usl (the held
