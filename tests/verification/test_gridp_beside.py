@@ -21,9 +21,12 @@ long       The resonator at 800 cells per metre to t = 3 under multirate (usl): 
 Tolerances (measured while building it, on a loaded machine):
 - |v_y| / c_g <= 1e-12 (roundoff: measured 1.8e-15 usl at 200, 3.3e-15 MRIStep at 100; the
   particle pressure's unstable mode at 800 reached 0.39 by t = 1.8).
-- Interface balance max |F_solid + F_fluid| / max |F_solid| over coupling.csv <= 1e-12 (measured
-  5.8e-16 and 3.5e-16 on the strip, 2.4e-13 on the pulse: roundoff of the nodal sums; on the
-  strip multirate's held impulse is paid within each coupling step).
+- Interface balance: on the strip the run's own imbalance (summary.json, the owed momentum
+  counted; measured 5.5e-16 usl at 200, 3.5e-16 MRIStep at 100, 7.6e-16 over t = 36 at 400),
+  on the pulse max |F_solid + F_fluid| / max |F_solid| over coupling.csv (monolithic: measured
+  2.4e-13); both <= 1e-12, roundoff of the nodal sums. coupling.csv's rows alone do not balance
+  under multirate's held exchange to better than 4e-12 over long runs (what is owed crosses a
+  step).
 - The gas's energy: |dE_fluid - int P_fluid dt| <= 1e-12 of E_fluid (usl; measured 7.0e-14 on
   the strip, 1.3e-14 on the pulse): a share of the pressure's work that the gas's p dV misses is
   far above it (the continuation's transposed rate dropped: 2.8e-8 on the pulse, measured).
@@ -31,6 +34,7 @@ Tolerances (measured while building it, on a loaded machine):
 - Rest: max |v| <= 1e-12 (measured 7.5e-15 disk, 1.1e-14 square).
 Able to fail: on main every run here but the input part exits 2 (refused).
 """
+import json
 import os
 import sys
 
@@ -79,8 +83,11 @@ def resonator(name, cells, t_end, extra):
 def check_strip(label, out, energy=True):
     vy = largest(out, ["fluid"], 1) / rz.C_G
     check(vy <= TOL_VY, f"{label}: max |v_y| / c_g {vy:.1e} <= {TOL_VY:g}")
-    b = balance(out)
-    check(b <= TOL_BAL, f"{label}: interface balance {b:.1e} <= {TOL_BAL:g}")
+    # multirate books a step's exchange as the gas captured it and the solid received it, the
+    # rest owed to the next step: the run's own imbalance counts what is owed (summary.json)
+    with open(os.path.join(out, "summary.json")) as f:
+        b = json.load(f)["coupling_imbalance"]
+    check(b <= TOL_BAL, f"{label}: interface imbalance {b:.1e} <= {TOL_BAL:g}")
     if energy:
         e = gas_energy(out)
         check(e <= TOL_E, f"{label}: gas energy against its booked power {e:.1e} <= {TOL_E:g}")
