@@ -94,7 +94,8 @@ static const mpm_key_spec fluid_keys[] = {
      "particles', integrated exactly over the grid's cells, with each particle's volume "
      "following its nodes' volume rate: gas at rest and uniform streams stay exact across "
      "refined regions, and beside a solid its region is taken out by the solid's quadrature; "
-     "ERK pairs, usl or musl, quadratic shape; beside a solid monolithic, not contact) or auto "
+     "ERK pairs, usl or musl, quadratic shape; beside a solid coupling.time monolithic or "
+     "multirate with the held exchange, any coupling.scheme) or auto "
      "(grid with refine.levels > 1 and no solid, where particle is refused; else particle); see "
      "docs/refinement.md",
      0, NULL},

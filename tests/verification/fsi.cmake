@@ -57,3 +57,14 @@ mpm_add_script_test(test_fsi_resonator SCRIPT verification/test_fsi_resonator.py
                     LABELS verification TIMEOUT 600)
 mpm_add_script_test(test_fsi_resonator_long SCRIPT verification/test_fsi_resonator.py ARGS long
                     LABELS "verification;long" TIMEOUT 7200)
+# The grid pressure beside a solid under multirate and contact (test_gridp_beside.py): the
+# resonator strip stays 1-D and balances under multirate (usl, MRIStep), a body in gas at rest
+# stays at rest and a pulse on it keeps the gas's energy booked under contact (23, 5 and 3 s);
+# the refusals that remain (staggered, the shared exchange); `long` the strip at 800 cells/m
+# to t = 3 (357 s under load).
+foreach(part multirate contact input)
+  mpm_add_script_test(test_gridp_beside_${part} SCRIPT verification/test_gridp_beside.py
+                      ARGS ${part} LABELS verification TIMEOUT 600)
+endforeach()
+mpm_add_script_test(test_gridp_beside_long SCRIPT verification/test_gridp_beside.py ARGS long
+                    LABELS "verification;long" TIMEOUT 3600)

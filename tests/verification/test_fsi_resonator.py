@@ -54,6 +54,7 @@ from scipy.optimize import brentq, least_squares
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "tools"))
 import mpmtest as mt  # noqa: E402
+import resonator as rz  # noqa: E402
 
 check = mt.Checks("test_fsi_resonator")
 ARGS = sys.argv[1:]
@@ -137,8 +138,6 @@ def fit_modes(t, y, guesses):
 
 
 def run(cells, scheme, method, time_scheme, t_end):
-    dx = 1.0 / cells
-    h = 3 * dx
     name = f"resonator_{scheme}_{method}_{time_scheme}_{cells}" + ("_standin" if STANDIN else "")
     out = mt.outdir(name)
     case = mt.case("fsi_resonator.ini")
@@ -148,9 +147,7 @@ def run(cells, scheme, method, time_scheme, t_end):
         case = os.path.join(out, "standin.ini")
         with open(case, "w") as f:
             f.writelines(text)
-    args = ["run", case, f"output.dir={out}", "output.overwrite=true", f"grid.dx={dx!r}",
-            f"domain.hi=1.4 {h!r}", f"geometry.gas.hi=1.0 {h!r}", f"geometry.slab.hi=1.4 {h!r}",
-            f"geometry.face.hi={1 + dx / 2!r} {h!r}", f"probe.face.point={1 + dx / 4!r} {dx / 4!r}",
+    args = ["run", case, f"output.dir={out}", "output.overwrite=true"] + rz.strip_args(cells) + [
             f"coupling.scheme={scheme}", f"time.method={method}", f"coupling.time={time_scheme}",
             f"time.t_end={t_end}", "run.progress=false"]
     if STANDIN:

@@ -120,10 +120,7 @@ def part_input():
     uniform = rs.body_case(0.1, "")
     cases = [
         ("staggered", uniform.replace("scheme = velocity", "scheme = velocity\ntime = staggered"),
-         "coupling.time", "time = staggered", "monolithic"),
-        ("contact", uniform.replace("scheme = velocity", "scheme = contact").replace(
-            "[time]\n", "[time]\nmethod = usl\n"), "coupling.scheme", "scheme = contact",
-         "velocity or traction"),
+         "coupling.time", "time = staggered", "monolithic or multirate"),
         ("particle pressure in a box", text.replace("pressure = grid", "pressure = auto"),
          "refine.box.lo", "lo = 0.3 0.3", "periodic axis"),
     ]
