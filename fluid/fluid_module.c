@@ -97,7 +97,7 @@ static const mpm_key_spec fluid_keys[] = {
      "ERK pairs, usl or musl, quadratic shape; beside a solid monolithic, not contact), hybrid "
      "(the particles' pressure with the grid's as a defect correction: the particles integrate "
      "p - p_h, the grid p_h exactly, so a uniform pressure exerts no force whatever the "
-     "particles' positions; the grid's scope without refinement, obstacles or open faces; "
+     "particles' positions; the grid's scope without refinement or obstacles; "
      "docs/gas.md) or auto (grid with refine.levels > 1 and no solid, where particle is "
      "refused; else particle); see docs/refinement.md",
      0, NULL},
