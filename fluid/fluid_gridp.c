@@ -81,7 +81,7 @@
  * Beside a solid the continuation is the grid pressure's, D^Q taken out before its transpose.
  * Open faces are the grid pressure's: the exterior pressure integrated over the face, the pad
  * nodes' pressure set from it; a uniform stream gives p_p = p_h(x_p), so the particles' share
- * vanishes there too (measured: inflow to outflow, |v - v0| 2e-16 at t = 2, the particle
+ * vanishes there too (measured: inflow to outflow, |v - v0| 3e-15 at t = 2, the particle
  * pressure 1e-13). Scope: the grid pressure's, without refinement or obstacles (check_hybrid). */
 #include "fluid_internal.h"
 #include "fluid_module.h"
