@@ -59,7 +59,35 @@
  * rate or the classic update, the quadratic B-spline, beside a solid the monolithic or multirate
  * time scheme (multirate's held exchange, not shared) and any coupling scheme, no shifting, the
  * point volume rate, open faces with their default exterior (copies, not gauge). On a hierarchy
- * beside a solid, auto keeps the particles' pressure (fluid_gridp_refine). */
+ * beside a solid, auto keeps the particles' pressure (fluid_gridp_refine).
+ *
+ * fluid.pressure = hybrid: the particles' pressure, defect-corrected by the grid's. The
+ * particles' quadrature of the pressure's force is exact for a linear pressure only on a uniform
+ * lattice; once the particles leave their seeding lattice a uniform pressure p0 gives
+ * sum_p V_p p0 grad N_i(x_p) != 0, an indefinite stiffness proportional to p0 that the acoustic
+ * motion pumps (a grid-scale transverse mode, docs/gas.md). The hybrid takes the particles'
+ * quadrature of the defect p_p - p_h(x_p) and the exact span integral of p_h:
+ *   f_i = sum_p V_p (p_p - p_h(x_p)) grad N_i(x_p) + F_i,   F_i = integral of p_h grad N_i,
+ *   dV_p/dt = V_p div v_h(x_p) + m_p sum_j N_j(x_p) (D_j - D^Q_j) / m_j,
+ * with p_h and p_j as above, D_j = integral of N_j div v_h and D^Q_j = sum_q V_q N_j(x_q)
+ * div v_h(x_q), the particles' quadrature of D_j. Energy: with de_p/dt = -p_p dV_p/dt / m_p,
+ *   sum_p p_p dV_p/dt = sum_p V_p p_p div v_h(x_p) + sum_j p_j (D_j - D^Q_j)
+ * (sum_p m_p N_j(x_p) p_p / m_j = p_j), and the forces' power is
+ *   sum_i v_i . f_i = sum_p V_p p_p div v_h(x_p) - sum_j p_j D^Q_j + sum_j p_j D_j
+ * (sum_i v_i . grad N_i(x) = div v_h(x), p_h(x_p) = sum_j N_j(x_p) p_j, and the span integrals
+ * are adjoint): the two are equal term by term, so total energy stays exact as with either
+ * pressure alone. A uniform pressure p_p = p0 gives p_j = p0 and p_h = p0 at every particle
+ * whose nodes all have mass, so the particles' share vanishes whatever their positions and only
+ * the exact span force remains (no shuffling stiffness); on a uniform lattice, where the
+ * particles' quadrature of p_h is nearly the span integral, the force is nearly the particles'.
+ * The corrections are those of a solid's region (fluid_gridp_solid.c) with the gas's own
+ * particles as the points; the particles keep -V p in their stress (viscous stresses as ever).
+ * Beside a solid the continuation is the grid pressure's, D^Q taken out before its transpose.
+ * Open faces are the grid pressure's: the exterior pressure integrated over the face, the pad
+ * nodes' pressure set from it; a uniform stream gives p_p = p_h(x_p), so the particles' share
+ * vanishes there too (measured: inflow to outflow, |v - v0| 3e-15 at t = 2, the particle
+ * pressure 1e-13). Scope: the grid pressure's, without refinement or obstacles, and beside a solid
+ * the monolithic time scheme only (multirate and contact not measured with it; check_hybrid). */
 #include "fluid_internal.h"
 #include "fluid_module.h"
 
@@ -87,24 +115,61 @@ struct fluid_gridp {
   mpm_span_set set[MPM_HIER_MAX_LEVELS];
   int beside_solid;      /* the case has a solid: its region is taken out (sol) */
   fluid_gridp_solid sol; /* fluid_gridp_solid.c */
+  int hybrid;            /* fluid.pressure = hybrid: the gas's own correction (own, pts) */
+  fluid_gridp_solid own;
+  mpm_points pts; /* the gas's particles of the deposit's state: positions, V (cap) */
+  double *V;
 };
 
-static int refuse(const mpm_config *cfg, const char *key, const char *why) {
+static int refuse(const mpm_config *cfg, const char *key, const char *why, int hybrid) {
+  if (hybrid)
+    return mpm_config_fail(cfg, key,
+                           "the hybrid pressure (fluid.pressure = hybrid, on the grid pressure's "
+                           "scope) %s; change this key, or set fluid.pressure = particle",
+                           why);
   return mpm_config_fail(cfg, key,
                          "the grid pressure (fluid.pressure = grid, or auto with refinement) %s; "
                          "change this key, or set fluid.pressure = particle without refinement",
                          why);
 }
 
+static int refuse_hybrid(const mpm_config *cfg, const char *why) {
+  return mpm_config_fail(cfg, "fluid.pressure",
+                         "hybrid does not carry %s; use fluid.pressure = grid or particle", why);
+}
+
+/* What the hybrid refuses beyond the grid pressure's scope. */
+static int check_hybrid(const mpm_config *cfg) {
+  const char *const *names;
+  int count;
+  MPM_CALL(mpm_config_instances(cfg, "obstacle", &names, &count));
+  if (count > 0) return refuse_hybrid(cfg, "obstacles (remove the [obstacle.*] sections)");
+  MPM_CALL(mpm_config_instances(cfg, "solid", &names, &count));
+  if (count == 0) return 0;
+  const char *time = "monolithic", *scheme = "velocity";
+  MPM_CALL(mpm_config_get_string(cfg, "coupling.time", &time));
+  MPM_CALL(mpm_config_get_string(cfg, "coupling.scheme", &scheme));
+  /* The grid pressure's multirate and contact (test_gridp_beside) were not measured with the
+   * particles' share beside them. */
+  if (strcmp(time, "monolithic") != 0)
+    return refuse_hybrid(cfg, "a solid under coupling.time = multirate or staggered (not "
+                              "measured): use coupling.time = monolithic");
+  if (strcmp(scheme, "contact") == 0)
+    return refuse_hybrid(cfg, "a solid under coupling.scheme = contact (not measured): use "
+                              "velocity or traction");
+  return 0;
+}
+
 /* The refusals of the grid pressure; the first found names its key. */
-static int check_scope(const fluid_content *fc, const mpm_config *cfg, const mpm_grid *g) {
+static int check_scope(const fluid_content *fc, const mpm_config *cfg, const mpm_grid *g,
+                       int hybrid) {
   if (!fc->tr.classic && !fc->current_rate)
-    return refuse(cfg, "fluid.strain_rate", "needs the current strain rate (the default)");
+    return refuse(cfg, "fluid.strain_rate", "needs the current strain rate (the default)", hybrid);
   if (g->shape != MPM_SHAPE_QUADRATIC)
-    return refuse(cfg, "grid.shape", "integrates the quadratic B-spline's spans");
+    return refuse(cfg, "grid.shape", "integrates the quadratic B-spline's spans", hybrid);
   if (fc->volume_domain)
-    return refuse(cfg, "fluid.volume_rate", "sets the volume rate itself (from the nodes)");
-  if (fc->shift > 0.0) return refuse(cfg, "fluid.shift", "is not carried with shifting");
+    return refuse(cfg, "fluid.volume_rate", "sets the volume rate itself (from the nodes)", hybrid);
+  if (fc->shift > 0.0) return refuse(cfg, "fluid.shift", "is not carried with shifting", hybrid);
   const char *const *names;
   int count;
   MPM_CALL(mpm_config_instances(cfg, "solid", &names, &count));
@@ -118,7 +183,8 @@ static int check_scope(const fluid_content *fc, const mpm_config *cfg, const mpm
   if (strcmp(time, "monolithic") != 0 && strcmp(time, "multirate") != 0)
     return refuse(cfg, "coupling.time",
                   "beside a solid is carried by the monolithic and multirate time schemes only "
-                  "(not staggered): use coupling.time = monolithic or multirate");
+                  "(not staggered): use coupling.time = monolithic or multirate",
+                  hybrid);
   const char *exchange = "held";
   if (strcmp(time, "multirate") == 0)
     MPM_CALL(mpm_config_get_string(cfg, "coupling.exchange", &exchange));
@@ -127,7 +193,8 @@ static int check_scope(const fluid_content *fc, const mpm_config *cfg, const mpm
   if (strcmp(exchange, "shared") == 0)
     return refuse(cfg, "coupling.exchange",
                   "reads the solid's particles of the gas's own state, and with shared nodes the "
-                  "solid has moved on when the gas steps: use coupling.exchange = held");
+                  "solid has moved on when the gas steps: use coupling.exchange = held",
+                  hybrid);
   /* Measured (test_refine_obstacles stream, usl): on a uniform grid a stream along an obstacle's
    * face left its uniform state by 1.09 under the classic update; the ERK pairs keep it. The
    * cause is the obstacles' hold of barely covered nodes, an impulse in the classic update
@@ -136,7 +203,8 @@ static int check_scope(const fluid_content *fc, const mpm_config *cfg, const mpm
   if (count > 0 && fc->tr.classic)
     return refuse(cfg, "time.method",
                   "carries obstacles with the ERK pairs only (under the classic update a "
-                  "stream along a body's face does not stay uniform); use time.method = bs32");
+                  "stream along a body's face does not stay uniform); use time.method = bs32",
+                  hybrid);
   int open = 0;
   for (int d = 0; d < g->dim; ++d)
     for (int s = 0; s < 2; ++s) open |= mpm_wall_is_open_gas(fc->walls.face[d][s]);
@@ -145,28 +213,37 @@ static int check_scope(const fluid_content *fc, const mpm_config *cfg, const mpm
   if (strcmp(exterior, "gauge") == 0)
     return refuse(cfg, "freestream.exterior",
                   "integrates the open faces' exterior pressure over the face and does not "
-                  "carry gauge (the particle pressure's gauge points)");
+                  "carry gauge (the particle pressure's gauge points)",
+                  hybrid);
   return 0;
 }
 
 /* Check the scope, then set the grid pressure up with its grid phase. */
-static int enable(mpm_module *m, const mpm_config *cfg) {
+static int enable(mpm_module *m, const mpm_config *cfg, int hybrid) {
   fluid_content *fc = m->content;
-  MPM_CALL(check_scope(fc, cfg, m->grid));
+  MPM_CALL(check_scope(fc, cfg, m->grid, hybrid));
+  if (hybrid) MPM_CALL(check_hybrid(cfg));
   MPM_ALLOC(fc->gridp, 1);
   memset(fc->gridp, 0, sizeof *fc->gridp);
+  fc->gridp->hybrid = hybrid;
   const char *const *names;
   int count;
   MPM_CALL(mpm_config_instances(cfg, "solid", &names, &count));
   fc->gridp->beside_solid = count > 0;
   if (count > 0) MPM_CALL(fluid_gridp_solid_init(&fc->gridp->sol, m->grid));
+  /* The hybrid's corrections deposit into a phase of their own, or share the solid region's
+   * (the grid holds at most four phases): the two instances never interleave their deposits. */
+  if (hybrid && count > 0) fc->gridp->own.phase = fc->gridp->sol.phase;
+  if (hybrid && count == 0) MPM_CALL(fluid_gridp_solid_init(&fc->gridp->own, m->grid));
+  fc->gridp->own.pts = &fc->gridp->pts;
   return mpm_grid_add_phase(m->grid, "fluid_pressure", &fc->gridp->phase);
 }
 
 int fluid_gridp_init(mpm_module *m, const mpm_config *cfg) {
   const char *form;
   MPM_CALL(mpm_config_get_string(cfg, "fluid.pressure", &form));
-  return strcmp(form, "grid") == 0 ? enable(m, cfg) : 0;
+  const int hybrid = strcmp(form, "hybrid") == 0;
+  return strcmp(form, "grid") == 0 || hybrid ? enable(m, cfg, hybrid) : 0;
 }
 
 int fluid_gridp_refine(mpm_module *m, const mpm_config *cfg, mpm_hier *h) {
@@ -174,6 +251,8 @@ int fluid_gridp_refine(mpm_module *m, const mpm_config *cfg, mpm_hier *h) {
   int nsolid;
   MPM_CALL(mpm_config_get_string(cfg, "fluid.pressure", &form));
   MPM_CALL(mpm_config_instances(cfg, "solid", &solids, &nsolid));
+  if (strcmp(form, "hybrid") == 0)
+    return h ? refuse_hybrid(cfg, "refinement (set refine.levels = 1)") : 0;
   /* Beside a solid auto keeps the particles' pressure (the sim then keeps the levels' faces off
    * corners in the gas, coupler/mpm_refine.c, bands); grid takes the solid's region out of its
    * span integrals (fluid_gridp_solid.c) and runs in any box. */
@@ -183,7 +262,7 @@ int fluid_gridp_refine(mpm_module *m, const mpm_config *cfg, mpm_hier *h) {
                            "the particles' quadrature is not exact at the corners of a refined "
                            "region and disturbs the gas there (docs/refinement.md); remove the "
                            "key or set fluid.pressure = grid");
-  if (!((fluid_content *)m->content)->gridp) MPM_CALL(enable(m, cfg));
+  if (!((fluid_content *)m->content)->gridp) MPM_CALL(enable(m, cfg, 0));
   return h ? mpm_hier_add_phases(h) : 0;
 }
 
@@ -202,13 +281,14 @@ void fluid_gridp_reset(fluid_content *fc) {
     for (int d = 0; d < MPM_MAX_DIM; ++d) free(gp->G[l][d]), gp->G[l][d] = NULL;
   }
   fluid_gridp_solid_free(&gp->sol); /* its level scalars are sized by the hierarchy's levels */
+  fluid_gridp_solid_free(&gp->own);
 }
 
 void fluid_gridp_destroy(fluid_content *fc) {
   fluid_gridp *gp = fc->gridp;
   if (!gp) return;
   fluid_gridp_reset(fc);
-  free(gp->mp), free(gp->s), free(gp->zero);
+  free(gp->mp), free(gp->s), free(gp->zero), free(gp->V);
   free(gp);
   fc->gridp = NULL;
 }
@@ -269,10 +349,11 @@ static int ensure_levels(mpm_module *m, fluid_gridp *gp) {
 
 static int ensure_particles(fluid_gridp *gp, mpm_lidx cap) {
   if (gp->cap >= cap && gp->mp) return 0;
-  free(gp->mp), free(gp->s), free(gp->zero);
-  gp->mp = gp->s = gp->zero = NULL;
+  free(gp->mp), free(gp->s), free(gp->zero), free(gp->V);
+  gp->mp = gp->s = gp->zero = gp->V = NULL;
   MPM_ALLOC(gp->mp, (size_t)cap);
   MPM_ALLOC(gp->s, (size_t)cap);
+  if (gp->hybrid) MPM_ALLOC(gp->V, (size_t)cap);
   gp->zero = calloc((size_t)cap, sizeof(double));
   if (!gp->zero) MPM_FAIL(MPM_ERR_MEMORY, "out of memory for %ld particles", (long)cap);
   gp->cap = cap;
@@ -287,12 +368,19 @@ int fluid_gridp_deposit(mpm_module *m, const double *y, const fluid_batch *b) {
   const mpm_lidx n = p->n;
   MPM_CALL(ensure_levels(m, gp));
   MPM_CALL(ensure_particles(gp, fc->cap));
-  /* vsig holds -V p on its diagonal (fluid_stress_pressure): keep m p, deposit no stress. */
+  /* vsig holds -V p on its diagonal (fluid_stress_pressure): keep m p, deposit no stress (the
+   * hybrid keeps it, and the particles' positions and volumes for its correction). */
   for (mpm_lidx i = 0; i < n; ++i) {
     const double V = b->V0[i] * b->J[i];
     gp->mp[i] = -b->m[i] * b->vsig[i] / V;
+    if (gp->hybrid) gp->V[i] = V;
   }
-  memset(b->vsig, 0, sizeof(double) * (size_t)dim * dim * n);
+  if (gp->hybrid) {
+    gp->pts = (mpm_points){.n = n, .V = gp->V};
+    for (int d = 0; d < dim; ++d) gp->pts.x[d] = y + (size_t)(p->offset[FLUID_X] + d) * n;
+  } else {
+    memset(b->vsig, 0, sizeof(double) * (size_t)dim * dim * n);
+  }
   if (m->hier)
     mpm_hier_phase_zero(m->hier, gp->phase);
   else
@@ -401,6 +489,7 @@ int fluid_gridp_forces(mpm_module *m) {
       for (mpm_lidx k = 0; k < g->nnodes; ++k) ph->f_i[d][k] += gp->F[l][d][k];
   }
   if (gp->beside_solid) MPM_CALL(fluid_gridp_solid_force(m, &gp->sol, gp->P));
+  if (gp->hybrid) MPM_CALL(fluid_gridp_points_force(m, &gp->own, gp->P));
   return ghost_forces(m, gp);
 }
 
@@ -417,6 +506,7 @@ int fluid_gridp_nodal_rate(mpm_module *m, const mpm_hier_nodal *vel, mpm_hier_sc
     D[l][0] = gp->D[l];
   }
   MPM_CALL(restrict_all(m, D, 1));
+  if (gp->hybrid) MPM_CALL(fluid_gridp_points_rate(m, &gp->own, vel, gp->D)); /* before sol's */
   if (gp->beside_solid)
     MPM_CALL(fluid_gridp_solid_rate(m, &gp->sol, vel, gp->D, (const double *const *)gp->M));
   for (int l = 0; fc->obs.count && l < gp->nlev; ++l)
@@ -430,7 +520,7 @@ int fluid_gridp_nodal_rate(mpm_module *m, const mpm_hier_nodal *vel, mpm_hier_sc
   return 0;
 }
 
-void fluid_gridp_work(const mpm_module *m, const double *y, double *power) {
+void fluid_gridp_work(const mpm_module *m, const double *y, const double *L, double *power) {
   const fluid_content *fc = m->content;
   const fluid_gridp *gp = fc->gridp;
   const mpm_particles *p = m->particles;
@@ -442,6 +532,9 @@ void fluid_gridp_work(const mpm_module *m, const double *y, double *power) {
     power[i] -= gp->mp[i] / mass[i] * gp->s[i];
     gp->s[i] *= mass[i] / (V0[i] * J[i]);
   }
+  if (!gp->hybrid) return;
+  for (int d = 0; d < p->dim; ++d) /* the point rate, whose work energy_rate has booked */
+    for (mpm_lidx i = 0; i < n; ++i) gp->s[i] += L[(size_t)(d * p->dim + d) * n + i];
 }
 
 double *fluid_gridp_rate_out(const fluid_content *fc) {

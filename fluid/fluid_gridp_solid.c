@@ -29,7 +29,11 @@
  * solid lies on the finest level) and the deposits are restricted onto the active nodes as the
  * gas's are.
  *
- * Invariant: without a solid (m->beside NULL) nothing here runs. */
+ * The same two corrections serve fluid.pressure = hybrid (fluid_gridp.c) with the gas's own
+ * particles as the points (fluid_gridp_points_force, fluid_gridp_points_rate): s->pts names the
+ * points each instance reads.
+ *
+ * Invariant: without a solid (m->beside NULL) the solid's instance does nothing. */
 #include "fluid_internal.h"
 
 #include "mpm_error.h"
@@ -92,7 +96,7 @@ static double *zeros(const mpm_module *m, const fluid_gridp_solid *s) {
  * restrict it and sum level 0's ghosts. */
 static int deposit(mpm_module *m, const fluid_gridp_solid *s, const double *mass, const double *v0,
                    const double *vsig) {
-  const mpm_points *pts = m->beside;
+  const mpm_points *pts = s->pts;
   const int dim = m->grid->dim;
   mpm_p2g_args a = {.n = pts->n, .m = mass, .vsig = vsig, .lp = ((fluid_content *)m->content)->lp};
   for (int d = 0; d < dim; ++d) a.x[d] = pts->x[d], a.v[d] = d == 0 && v0 ? v0 : zeros(m, s);
@@ -124,7 +128,7 @@ static int active(const mpm_module *m, int l, mpm_lidx k) {
  * and the ns (<= 2) prolonged level scalars sc[j] into slots out[j]. */
 static int gather(mpm_module *m, const fluid_gridp_solid *s, int phase, const mpm_hier_nodal *vel,
                   int ns, double *const *const *sc, const int *out, int want_L) {
-  const mpm_points *pts = m->beside;
+  const mpm_points *pts = s->pts;
   const int dim = m->grid->dim;
   const mpm_grid_phase *ph = &m->grid->phase[phase];
   mpm_g2p_args a = {.n = pts->n, .lp = ((fluid_content *)m->content)->lp, .nscalar = ns};
@@ -151,7 +155,7 @@ static int gather(mpm_module *m, const fluid_gridp_solid *s, int phase, const mp
  * region phase's m_i then holds S_c, and with P its mv_i[0] sum_s V_s N_c q_s. */
 static int weights(mpm_module *m, fluid_gridp_solid *s, const double *const *M,
                    const double *const *P) {
-  const mpm_points *pts = m->beside;
+  const mpm_points *pts = s->pts;
   for (int l = 0; l < nlevels(m); ++l)
     for (mpm_lidx k = 0; k < level_grid(m, l)->nnodes; ++k) {
       const int gas = active(m, l, k) && M[l][k] > 0.0;
@@ -180,6 +184,7 @@ static int continued(const mpm_module *m, const fluid_gridp_solid *s, int l, mpm
 int fluid_gridp_solid_pressure(mpm_module *m, fluid_gridp_solid *s, double *const *P,
                                const double *const *M) {
   if (!m->beside) return 0;
+  s->pts = m->beside;
   MPM_CALL(ensure(m, s, m->beside->n));
   MPM_CALL(weights(m, s, M, (const double *const *)P));
   for (int l = 0; l < nlevels(m); ++l) {
@@ -190,11 +195,11 @@ int fluid_gridp_solid_pressure(mpm_module *m, fluid_gridp_solid *s, double *cons
   return 0;
 }
 
-int fluid_gridp_solid_force(mpm_module *m, fluid_gridp_solid *s, double *const *P) {
-  const mpm_points *pts = m->beside;
-  if (!pts) return 0;
+int fluid_gridp_points_force(mpm_module *m, fluid_gridp_solid *s, double *const *P) {
+  const mpm_points *pts = s->pts;
   const int dim = m->grid->dim;
   const mpm_lidx n = pts->n;
+  MPM_CALL(ensure(m, s, n));
   double *const *sc[1] = {P};
   const int out[1] = {S_Q};
   MPM_CALL(gather(m, s, s->phase, NULL, 1, sc, out, 0));
@@ -213,12 +218,19 @@ int fluid_gridp_solid_force(mpm_module *m, fluid_gridp_solid *s, double *const *
   return 0;
 }
 
+int fluid_gridp_solid_force(mpm_module *m, fluid_gridp_solid *s, double *const *P) {
+  if (!m->beside) return 0;
+  s->pts = m->beside;
+  return fluid_gridp_points_force(m, s, P);
+}
+
 /* D_j -= sum_s V_s N_j(x_s) div v_h(x_s) on every node. */
-static int rate_correction(mpm_module *m, fluid_gridp_solid *s, const mpm_hier_nodal *vel,
-                           double *const *D) {
-  const mpm_points *pts = m->beside;
+int fluid_gridp_points_rate(mpm_module *m, fluid_gridp_solid *s, const mpm_hier_nodal *vel,
+                            double *const *D) {
+  const mpm_points *pts = s->pts;
   const int dim = m->grid->dim;
   const mpm_lidx n = pts->n;
+  MPM_CALL(ensure(m, s, n));
   MPM_CALL(gather(m, s, m->phase, vel, 0, NULL, NULL, 1));
   const double *L = slot(s, S_V + 2 * dim);
   double *q = slot(s, S_Q);
@@ -239,7 +251,8 @@ int fluid_gridp_solid_rate(mpm_module *m, fluid_gridp_solid *s, const mpm_hier_n
                            double *const *D, const double *const *M) {
   const mpm_points *pts = m->beside;
   if (!pts) return 0;
-  MPM_CALL(rate_correction(m, s, vel, D));
+  s->pts = pts;
+  MPM_CALL(fluid_gridp_points_rate(m, s, vel, D));
   /* The continuation's transpose: R_c = D_c / S_c, u_s = V_s / W_s sum_c N_c R_c, and the gas
    * nodes take D_j += sum_s N_j u_s. */
   MPM_CALL(weights(m, s, M, NULL));

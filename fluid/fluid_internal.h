@@ -124,7 +124,9 @@ int fluid_volume_rate(mpm_module *m, const double *y, const double *const *v_i, 
  * after the solve, the nodal volume rate per unit mass on every level of the nodal velocity v
  * (NULL: the phase's v_i; usl: its time-centred one), into s for the G2P that fills the
  * particles' rate (fluid_gridp_rate_out); work: adds the pressure's de/dt to power,
- * then turns that rate into dJ/dt / J in place. */
+ * then turns that rate into dJ/dt / J in place (hybrid: adding tr L, the particles' velocity
+ * gradient whose work energy_rate booked). hybrid: the same with the particles' quadrature of
+ * p - p_h kept in their stress (fluid_gridp.c). */
 int fluid_gridp_init(mpm_module *m, const mpm_config *cfg);
 int fluid_gridp_refine(mpm_module *m, const mpm_config *cfg, mpm_hier *h); /* h may be NULL */
 void fluid_gridp_destroy(fluid_content *fc);
@@ -134,7 +136,7 @@ int fluid_gridp_deposit(mpm_module *m, const double *y, const fluid_batch *b);
 int fluid_gridp_forces(mpm_module *m);
 int fluid_gridp_nodal_rate(mpm_module *m, const mpm_hier_nodal *v, mpm_hier_scalars *s);
 double *fluid_gridp_rate_out(const fluid_content *fc);
-void fluid_gridp_work(const mpm_module *m, const double *y, double *power);
+void fluid_gridp_work(const mpm_module *m, const double *y, const double *L, double *power);
 
 /* The grid pressure beside a solid (fluid_gridp_solid.c): the solid's region, its points
  * (m->beside), taken out of the span integrals. phase: a grid phase of the fluid's for the
@@ -148,6 +150,7 @@ void fluid_gridp_work(const mpm_module *m, const double *y, double *power);
  * of the level scalars a[l] and prolongs them into the inactive nodes. */
 typedef struct fluid_gridp_solid {
   int phase;
+  const mpm_points *pts; /* the points read: m->beside, or the gas's own (hybrid) */
   mpm_lidx cap;
   double *buf, *A[MPM_HIER_MAX_LEVELS], *B[MPM_HIER_MAX_LEVELS];
 } fluid_gridp_solid;
@@ -159,6 +162,12 @@ int fluid_gridp_solid_pressure(mpm_module *m, fluid_gridp_solid *s, double *cons
 int fluid_gridp_solid_force(mpm_module *m, fluid_gridp_solid *s, double *const *P);
 int fluid_gridp_solid_rate(mpm_module *m, fluid_gridp_solid *s, const mpm_hier_nodal *vel,
                            double *const *D, const double *const *M);
+/* The two quadrature corrections of the points s->pts (any points, not only a solid's): force
+ * adds -sum_s V_s p_h(x_s) grad N_i(x_s) to the gas phase's f_i (P prolonged), rate subtracts
+ * sum_s V_s N_j(x_s) div v_h(x_s) from D (vel: the velocity read, NULL the gas phase's). */
+int fluid_gridp_points_force(mpm_module *m, fluid_gridp_solid *s, double *const *P);
+int fluid_gridp_points_rate(mpm_module *m, fluid_gridp_solid *s, const mpm_hier_nodal *vel,
+                            double *const *D);
 
 /* The gas's empty particle set and its layout: C with apic, D with viscous, psi with limiter,
  * and the lagged strain rate in the state (lag_in_state, the classic update) or after a

@@ -88,16 +88,19 @@ static const mpm_key_spec fluid_keys[] = {
      "the velocity ripples at the grid scale, as in hot gas at rest on the grid; only J, and so "
      "the density and pressure, reads it; see docs/gas.md)",
      0, NULL},
-    {"fluid.pressure", MPM_KEY_ENUM, "auto", 0, 0, 0, 0, "auto|particle|grid",
+    {"fluid.pressure", MPM_KEY_ENUM, "auto", 0, 0, 0, 0, "auto|particle|grid|hybrid",
      "where the pressure's force is integrated: particle (each particle's V p at its point, "
      "the classic MPM quadrature), grid (the nodal pressure, a mass-weighted mean of the "
      "particles', integrated exactly over the grid's cells, with each particle's volume "
      "following its nodes' volume rate: gas at rest and uniform streams stay exact across "
      "refined regions, and beside a solid its region is taken out by the solid's quadrature; "
      "ERK pairs, usl or musl, quadratic shape; beside a solid coupling.time monolithic or "
-     "multirate with the held exchange, any coupling.scheme) or auto "
-     "(grid with refine.levels > 1 and no solid, where particle is refused; else particle); see "
-     "docs/refinement.md",
+     "multirate with the held exchange, any coupling.scheme), hybrid (the particles' pressure "
+     "with the grid's as a defect correction: the particles integrate p - p_h, the grid p_h "
+     "exactly, so a uniform pressure exerts no force whatever the particles' positions; the "
+     "grid's scope without refinement or obstacles, beside a solid monolithic and not contact; "
+     "docs/gas.md) or auto (grid with refine.levels > 1 and no solid, where particle is "
+     "refused; else particle); see docs/refinement.md",
      0, NULL},
     {"fluid.ppc", MPM_KEY_INT, "2", 1, 8, 0, 0, NULL,
      "gas particles per cell per direction at seeding", 0, "-"},
@@ -498,7 +501,7 @@ static int classic_transfer(mpm_module *m, const double *y, double h, fluid_step
   o->heat = fc->power;
   MPM_CALL(fluid_classic_transfer(m, y, h, o));
   energy_rate(m, o->L, o->heat, h);
-  if (fc->gridp) fluid_gridp_work(m, y, fc->power); /* the pressure's work, at vbar */
+  if (fc->gridp) fluid_gridp_work(m, y, o->L, fc->power); /* the pressure's work, at vbar */
   return 0;
 }
 
@@ -600,7 +603,7 @@ static int g2p_rates(mpm_module *m, const double *y, double *ydot, double h) {
     }
     MPM_CALL(fluid_g2p_phase(m, y, xdot, vdot, L, &rate, rate_out));
     energy_rate(m, L, NULL, h);
-    if (fc->gridp) fluid_gridp_work(m, y, fc->power);
+    if (fc->gridp) fluid_gridp_work(m, y, L, fc->power);
     if (!fc->tr.apic) fluid_wall_rate_mol(m, y, vdot, fc->power);
     MPM_CALL(fluid_mol_damping(m, y, vdot, fc->power, fc->work));
   } else if (!fc->tr.musl) {

@@ -1,0 +1,133 @@
+"""The defect-corrected particle pressure (fluid.pressure = hybrid, fluid/fluid_gridp.c).
+
+The scene: a gas column alone (gamma 1.4, rho 1, p 1) on [0, 1] x [0, 3 dx] at 800 cells per
+metre, slip walls at x = 0 and 1, periodic in y, carrying a 0.08 % acoustic standing wave of
+its first two modes (v_x = 0.0008 (sin(pi x) + sin(2 pi x)), v_y = 0), under usl to t = 0.5.
+Every field is uniform along y, so the exact v_y is zero for all time.
+
+1. With the particles' pressure (fluid.pressure = particle) a grid-scale transverse mode grows
+   out of roundoff: the uniform part of the pressure acts through the particles' inexact
+   quadrature once they leave their seeding lattice (docs/gas.md). Measured: max |v_y| / c
+   7.9e-9 by t = 0.5 (3e-12 at 0.25; 0.6 and the blow-up guard at t = 2.5). Checked >= 1e-10,
+   so that this scene does show the mode.
+2. With the hybrid the particles integrate only p - p_h, which vanishes for a uniform pressure
+   whatever their positions: max |v_y| / c stays at roundoff (measured 1.9e-15 to t = 0.5 and
+   4.6e-15 to t = 2). Checked <= 1e-13 over every snapshot (50x the measured roundoff; the mode
+   at the particle pressure's rate would pass 1e-13 before t = 0.3).
+3. Its total energy stays exact under usl (the derivation in fluid_gridp.c): relative drift
+   <= 1e-12, test_sod's bound for the classic updates (measured ~2e-14).
+4. A uniform stream (Mach 0.42) from an inflow to an outflow face at 100 cells stays uniform:
+   max |v - v0| and |rho - 1| <= 1e-12 at t = 2 (measured 3e-15 and 2e-16; the particles' pressure
+   1e-13, its quadrature at the faces' exterior lattice).
+5. What it does not carry is refused with one line naming fluid.pressure, exit 2: refinement,
+   obstacles, and beside a solid multirate and contact (not measured with the hybrid).
+
+Argument `particle` runs checks 2 and 3 with the particles' pressure instead: check 2 fails
+(measured 7.9e-9 against 1e-13), the demonstration that the test can fail. (The particles'
+pressure keeps energy exact too: check 3 guards the hybrid's volume rate, whose omission of
+D^Q or of the point rate breaks it.)
+"""
+import os
+import sys
+
+import numpy as np
+
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "tools"))
+import mpmtest as mt  # noqa: E402
+
+check = mt.Checks("test_hybrid_pressure")
+UNDER_TEST = sys.argv[1] if len(sys.argv) > 1 else "hybrid"
+CELLS = 800
+C = 1.4 ** 0.5
+
+
+def column(cells=CELLS, extra=""):
+    dx = 1.0 / cells
+    return f"""[domain]
+dim = 2
+lo = 0 0
+hi = 1.0 {3 * dx!r}
+[grid]
+dx = {dx!r}
+shape = quadratic
+[boundary]
+x_lo = slip
+x_hi = slip
+y_lo = periodic
+y_hi = periodic
+[time]
+t_end = 0.5
+method = usl
+[output]
+interval = 0.1
+[fluid]
+gamma = 1.4
+pressure = hybrid
+[geometry.gas]
+type = box
+lo = 0 0
+hi = 1.0 {3 * dx!r}
+[gas.column]
+geometry = gas
+density = 1
+pressure = 1
+velocity_field = 0.0008*sin(3.14159265358979*x) + 0.0008*sin(6.28318530717959*x); 0
+{extra}"""
+
+
+def max_vy(out):
+    """The largest |v_y| / c over every snapshot."""
+    return max(float(np.abs(mt.particles(p, "fluid")["v"][:, 1]).max()) / C
+               for _, p in mt.snapshots(out))
+
+
+def energy_drift(out):
+    d = mt.csv_rows(out, "diagnostics.csv")
+    return float(np.abs(d["total"] - d["total"][0]).max() / d["total"][0])
+
+
+ref = mt.run_text("hybrid_particle", column(), ["fluid.pressure=particle"])
+vy = max_vy(ref)
+check(vy >= 1e-10, f"particle pressure: max |v_y| / c = {vy:.2e} by t = 0.5 (>= 1e-10: the "
+      "grid-scale mode grows out of roundoff in this scene)")
+
+out = mt.run_text("hybrid_" + UNDER_TEST, column(), [f"fluid.pressure={UNDER_TEST}"])
+vy = max_vy(out)
+check(vy <= 1e-13, f"{UNDER_TEST} pressure: max |v_y| / c = {vy:.2e} to t = 0.5 (<= 1e-13, "
+      "roundoff)")
+dE = energy_drift(out)
+check(dE <= 1e-12, f"{UNDER_TEST} pressure, usl: total energy drift {dE:.1e} (<= 1e-12)")
+print(f"info the {UNDER_TEST} run: {mt.cost(out)}")
+
+# A uniform stream through open faces.
+stream = column(100).replace("x_lo = slip", "x_lo = inflow").replace("x_hi = slip", "x_hi = outflow")
+stream = stream.replace("velocity_field = 0.0008*sin(3.14159265358979*x) + 0.0008*sin(6.28318530717959*x); 0",
+                        "velocity = 0.5 0") + "[freestream]\ndensity = 1\npressure = 1\nvelocity = 0.5 0\n"
+out = mt.run_text("hybrid_stream", stream, [f"fluid.pressure={UNDER_TEST}", "time.t_end=2",
+                                            "output.interval=2"])
+last = mt.particles(mt.snapshots(out)[-1][1], "fluid")
+dv = float(np.abs(last["v"] - np.array([0.5, 0.0])).max())
+drho = float(np.abs(last["rho"] - 1.0).max())
+check(max(dv, drho) <= 1e-12, f"{UNDER_TEST} pressure, uniform stream inflow to outflow: max |v - v0| "
+      f"{dv:.1e}, |rho - 1| {drho:.1e} at t = {last['time']:.3g} (<= 1e-12)")
+
+# The refusals: one line naming fluid.pressure (line of `pressure = hybrid`), exit 2.
+base = column(100)
+line = mt.line_starting(base, "pressure = hybrid")
+mt.expect_input_error(check, "refinement", base + "[refine]\nlevels = 2\n[refine.mid]\nlevel = 1\n"
+                      "lo = 0.4 0\nhi = 0.6 0.03\n", "fluid.pressure",
+                      line, "refinement")
+bs32 = base.replace("method = usl", "method = bs32")  # the grid pressure's own refusal is usl's
+mt.expect_input_error(check, "obstacle", bs32 + "[obstacle.block]\nshape = box\nlo = 0.5 0\n"
+                      "hi = 0.55 0.01\n", "fluid.pressure", line, "obstacles")
+
+# Beside a solid the hybrid keeps to what was measured with it: monolithic, not contact (the
+# grid pressure alone carries multirate and contact, test_gridp_beside).
+for key in ("coupling.time=multirate", "coupling.scheme=contact"):
+    p = mt.run(["check", mt.case("fsi_resonator.ini"), "fluid.pressure=hybrid", key], check=False)
+    lines = [ln for ln in p.stderr.splitlines() if ln.startswith("error")]
+    check(p.returncode == 2 and len(lines) == 1 and "fluid.pressure" in lines[0],
+          f"hybrid beside a solid with {key}: exit {p.returncode}, one line naming fluid.pressure "
+          f"({lines[:1]})")
+
+sys.exit(check.finish())
