@@ -41,7 +41,13 @@ Checks and tolerances:
   unstable from t ~ 1 (|v_y| / c_g ~ 1.8 by t = 3) in the middle of the column, 300 cells from
   the slab, and the gas column alone between slip walls (no slab) does the same (|v_y| / c_g
   1.2 at t = 3): the gas's own grid-scale transverse mode under usl with its particles off the
-  seeding lattice (docs/gas.md), not the interface.
+  seeding lattice (docs/gas.md), not the interface. Its cause: the particles' quadrature of the
+  uniform part of the pressure, sum_p V_p p0 grad N_i(x_p), is not zero once the particles leave
+  their lattice (subtracting p0 from the particles' pressure by hand keeps the column alone at
+  8e-16). `long` also runs 800 with fluid.pressure = grid, which integrates the nodal pressure
+  exactly, as an ordinary check: measured 5.2e-14 over 20 periods (2026-12-03). The hybrid
+  pressure (fluid.pressure = hybrid) holds 5.8e-15 to t = 3 (test_hybrid_pressure holds the
+  column).
 """
 import glob
 import math
@@ -137,8 +143,9 @@ def fit_modes(t, y, guesses):
     return [r.x[2 * k] for k in range(len(guesses))], float(np.sqrt(np.mean(res(r.x) ** 2)))
 
 
-def run(cells, scheme, method, time_scheme, t_end):
-    name = f"resonator_{scheme}_{method}_{time_scheme}_{cells}" + ("_standin" if STANDIN else "")
+def run(cells, scheme, method, time_scheme, t_end, extra=()):
+    name = (f"resonator_{scheme}_{method}_{time_scheme}_{cells}" + ("_standin" if STANDIN else "")
+            + "".join("_" + e.split("=")[-1] for e in extra))
     out = mt.outdir(name)
     case = mt.case("fsi_resonator.ini")
     if STANDIN:  # the case as main can run it: no initial stress key, a traction instead
@@ -152,6 +159,7 @@ def run(cells, scheme, method, time_scheme, t_end):
             f"time.t_end={t_end}", "run.progress=false"]
     if STANDIN:
         args += ["traction.balance.geometry=face", "traction.balance.value=-1 0"]
+    args += list(extra)
     mt.run(args)
     print(f"cost {name}: {mt.cost(out)}")
     return out
@@ -201,12 +209,12 @@ def study(scheme, method, time_scheme):
         print(f"XFAIL {msg}: below the issue's target; the B-spline interface's own order")
 
 
-def stability(cells):
-    out = run(cells, "velocity", "usl", "monolithic", T_STABLE)
+def stability(cells, pressure="particle"):
+    out = run(cells, "velocity", "usl", "monolithic", T_STABLE, [f"fluid.pressure={pressure}"])
     vy, first = max_vy(out)
-    msg = (f"stability velocity usl {cells} cells/m, 20 periods: max |v_y| / c_g {vy / C_G:.1e} "
-           f"(<= {TOL_VY:g}; first above at t = {first})")
-    if vy <= TOL_VY * C_G or cells < XFAIL_STABLE_CELLS:
+    msg = (f"stability velocity usl {pressure} pressure {cells} cells/m, 20 periods: max |v_y| / "
+           f"c_g {vy / C_G:.1e} (<= {TOL_VY:g}; first above at t = {first})")
+    if vy <= TOL_VY * C_G or cells < XFAIL_STABLE_CELLS or pressure != "particle":
         check(vy <= TOL_VY * C_G, msg)
     else:  # expected to fail (see the docstring): reported, not counted
         print(f"XFAIL {msg}: the gas's own transverse mode under usl at this resolution")
@@ -218,4 +226,6 @@ for cfg in CONFIGS:
     study(*cfg)
 for cells in STABLE_CELLS:
     stability(cells)
+if LONG and not ARGS:  # the cure (docs/gas.md): the grid pressure integrates p0 exactly
+    stability(800, "grid")
 sys.exit(check.finish())
