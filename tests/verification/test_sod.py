@@ -9,28 +9,35 @@ gives six significant digits).
 Density measure and shock position: see tests/tools/shocktube.py (particle densities joined
 by linear interpolation, averaged per cell, against the exact cell averages).
 
-Acceptance (issue 4), checked for the default method bs32:
-  - L1 <= 8e-3 at 400 cells, observed order >= 0.8 from 100 to 800 cells (log2 of the L1
-    ratio over the three doublings, divided by 3), shock within 2 cells of x = 0.8504.
-The default run (fast) checks bs32 at 100 and 200 cells: the shock within 2 cells; L1 at 200
-cells <= 1.6e-2 (the 400-cell bound under the first-order convergence shocks allow, since
-shocks and contacts limit any method to first order in L1); order 100 -> 200 >= 0.8. It checks
-the classic updates usl and musl at 200 cells the same way, that mass is constant (to the
-1e-14 of summing in another order after particle sorts) and, with the
-walls at rest, that usl and musl conserve total energy to 1e-12 (relative; their transfer is
-exactly energy-conserving, roundoff over ~400 steps stays near 1e-14). 2 ranks (split along x,
-so the shock and the contact cross the rank boundary) vs 1: usl and musl take the same fixed
-steps, so every particle field must agree to 1e-12 relative (sums in another order). So does
-bs32 as cases/sod.ini sets it (fixed steps at time.cfl = 0.8; measured 3.7e-13). Adaptive
-steps followed the global error norm, whose sum in another order moves a step by roundoff
-(measured 9.3e-13 then, under a tolerance of 1e-10); its RHS is a function of the state alone
-(the artificial viscosity takes the current strain rate, fluid.strain_rate = current), so that
-moves the solution by roundoff too. (With the strain rate of the previous step, the default
-before, the particles differed by 6e-4: the step sequence changed the solution at first order.)
-`long` adds 400 and 800 cells for every method and checks the acceptance for bs32; for usl
-and musl it checks L1 at 400 and the shock position, and prints their orders (see docs/verification.md:
-below 0.8, from particle noise that their exact-energy transfer turns into heat).
+Acceptance, checked for the case's own method and step (cases/sod.ini: usl at time.cfl 0.8,
+with the hybrid pressure that fluid.pressure = auto picks for it):
+  - issue 4: L1 <= 8e-3 at 400 cells, observed order >= 0.8 from 100 to 800 cells (log2 of the
+    L1 ratio over the doublings, divided by their count), shock within 2 cells of x = 0.8504;
+  - issue 50: the order stays >= 0.8 up to 1600 cells, over 800 -> 1600 alone too (measured
+    1.03 / 1.03 / 1.07 per doubling from 200 cells, L1 2.12e-3 at 400 and 4.96e-4 at 1600; bs32
+    with the particles' pressure, the default before, gave order 0.35 over 800 -> 1600 and
+    fails it: its L1 1.79e-3 -> 1.40e-3).
+The default run (fast) checks the case's method at 100 and 200 cells: the shock within 2 cells;
+L1 at 200 cells <= 1.6e-2 (the 400-cell bound under the first-order convergence shocks allow,
+since shocks and contacts limit any method to first order in L1); order 100 -> 200 >= 0.8. It
+checks usl and musl at their documented 0.4 and bs32 at the case's step, at 200 cells, the same
+way, that mass is constant (to the 1e-14 of summing in another order after particle sorts) and,
+with the walls at rest, that usl and musl conserve total energy to 1e-12 (relative; their
+transfer, with the hybrid's pressure too, is exactly energy-conserving: roundoff over ~400
+steps stays near 1e-14). It prints the particles' pressure at 200 cells beside it (info).
+2 ranks (split along x, so the shock and the contact cross the rank boundary) vs 1: usl and
+musl take the same fixed steps, so every particle field must agree to 1e-12 relative (sums in
+another order). So does bs32 at its fixed step. Adaptive steps followed the global error
+norm, whose sum in another order moves a step by roundoff (measured 9.3e-13 then, under a
+tolerance of 1e-10); its RHS is a function of the state alone (the artificial viscosity takes
+the current strain rate, fluid.strain_rate = current), so that moves the solution by roundoff
+too. (With the strain rate of the previous step, the default before, the particles differed
+by 6e-4: the step sequence changed the solution at first order.)
+`long` adds 400, 800 and 1600 cells for the case's method and checks both acceptances; it runs
+usl and musl at 0.4 and bs32 at 400 and 800 cells, checks L1 at 400 and the shock position,
+and prints their orders (docs/verification.md).
 """
+import configparser
 import os
 import sys
 
@@ -78,10 +85,10 @@ def conservation(out, method):
         print(f"info {method}: total energy drift {dE:.1e} (time-integration error)")
 
 
-def study(method, Ns, acceptance):
+def study(method, Ns, acceptance, extra=()):
     res = {}
     for N in Ns:
-        out = run(N, method)
+        out = run(N, method, extra=extra)
         l1, xs, _ = measure(out, N)
         res[N] = (l1, xs)
         off = (xs - EXACT.shock_position(T)) * N
@@ -105,10 +112,22 @@ def study(method, Ns, acceptance):
     return res
 
 
-Ns = (100, 200, 400, 800) if LONG else (100, 200)
-study("bs32", Ns, True)
-for method in ("usl", "musl"):
-    study(method, Ns if LONG else (200,), False)
+# The case's own method at its own step (shocktube.run gives usl and musl their documented
+# 0.4 unless told otherwise).
+CASE = configparser.ConfigParser()
+CASE.read(mt.case("sod.ini"))
+DEFAULT, DEFAULT_CFL = CASE["time"]["method"], CASE["time"]["cfl"]
+res = study(DEFAULT, (100, 200, 400, 800, 1600) if LONG else (100, 200), True,
+            [f"time.cfl={DEFAULT_CFL}"])
+if LONG:
+    o = np.log2(res[800][0] / res[1600][0])
+    check(o >= 0.8, f"{DEFAULT} (the case's): order {o:.2f} from 800 to 1600 cells (>= 0.8)")
+for method in ("usl", "musl", "bs32"):
+    study(method, (200, 400, 800) if LONG else (200,), False)
+l1p, _, _ = measure(run(200, DEFAULT, extra=[f"time.cfl={DEFAULT_CFL}",
+                                              "fluid.pressure=particle"]), 200)
+print(f"info {DEFAULT} at time.cfl {DEFAULT_CFL} with the particles' pressure: L1 {l1p:.3e} at "
+      "200 cells")
 
 # 2 ranks (split along x at 0.5: the contact and the shock cross the boundary) vs 1.
 for method in ("usl", "musl", "bs32"):
