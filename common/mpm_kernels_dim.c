@@ -175,44 +175,71 @@ MPM_INLINE void DIMFN(p2g_loop)(const DIMFN(lattice) * L, mpm_grid_phase *ph, co
   }
 }
 
-/* The scalar deposit (mpm_kernels.h): S m into m_i when mass, -viso grad S into f_i when iso
- * (both literals). Each product is the full loop's for zero velocity and vsig = viso I (there
- * P = -viso dwx, Q = viso wx and the zero terms add nothing), so the sums agree bitwise. */
-MPM_INLINE void DIMFN(p2g_scalar_loop)(const DIMFN(lattice) * L, mpm_grid_phase *ph,
-                                       const mpm_p2g_args *a, mpm_shape_kind kind, int mass,
-                                       int iso) {
+/* The lean deposit (mpm_kernels.h): S m into m_i when mass, and with stress (a literal: 0 none,
+ * 1 the isotropic viso, 2 the full vsig) the force -V sigma grad S into f_i. Each product is the
+ * full loop's for zero velocity (there P_d = -sig_d0 dwx, Q_d = sig_d1 wx and the zero body force
+ * adds nothing; a - b = -(b - a) exactly), so the sums agree bitwise. The force factors:
+ * f_d -= wy X_d + dwy Y_d [wz (...) + dwz wy Z_d in 3-D], X_d = sig_d0 dwx, Y_d = sig_d1 wx,
+ * Z_d = sig_d2 wx; the isotropic stress keeps only the diagonal terms. */
+MPM_INLINE void DIMFN(p2g_lean_loop)(const DIMFN(lattice) * L, mpm_grid_phase *ph,
+                                     const mpm_p2g_args *a, mpm_shape_kind kind, int mass,
+                                     int stress) {
   enum { D = MPM_DIM };
   const int S = SUPPORT(kind);
   const size_t n = (size_t)a->n;
   double *restrict mi = ph->m_i, *restrict fi[D];
   const double *restrict xp[D], *restrict mp = a->m, *restrict viso = a->viso;
+  const double *restrict vsig = a->vsig;
   for (int d = 0; d < D; ++d) fi[d] = ph->f_i[d], xp[d] = a->x[d];
   for (size_t p = 0; p < n; ++p) {
-    double x[D];
+    double x[D], sig[D][D];
     for (int d = 0; d < D; ++d) x[d] = xp[d][p];
-    const double m = mass ? mp[p] : 0.0, q = iso ? viso[p] : 0.0;
+    const double m = mass ? mp[p] : 0.0, q = stress == 1 ? viso[p] : 0.0;
+    for (int r = 0; stress == 2 && r < D; ++r)
+      for (int c = 0; c < D; ++c) sig[r][c] = vsig[(size_t)(r * D + c) * n + p];
     DIMFN(weights) s;
     DIMFN(weights_eval)(L, kind, x, 0, &s);
     const double *wx = s.w[0], *dwx = s.dw[0], *wy = s.w[1], *dwy = s.dw[1];
-    double mwx[SMAX], qdx[SMAX], qwx[SMAX];
-    for (int i = 0; i < S; ++i) mwx[i] = m * wx[i], qdx[i] = q * dwx[i], qwx[i] = q * wx[i];
+    double mwx[SMAX], X[D][SMAX], Y[D][SMAX];
+#if MPM_DIM == 3
+    double Z[D][SMAX];
+#endif
+    for (int i = 0; i < S; ++i) {
+      mwx[i] = m * wx[i];
+      for (int d = 0; d < D; ++d) {
+        X[d][i] = stress == 2 ? sig[d][0] * dwx[i] : q * dwx[i];
+        Y[d][i] = stress == 2 ? sig[d][1] * wx[i] : q * wx[i];
+#if MPM_DIM == 3
+        Z[d][i] = stress == 2 ? sig[d][2] * wx[i] : q * wx[i];
+#endif
+      }
+    }
 #if MPM_DIM == 2
     for (int j = 0; j < S; ++j) {
       const mpm_lidx row = s.first + j * L->sy;
       for (int i = 0; i < S; ++i) {
         if (mass) mi[row + i] += wy[j] * mwx[i];
-        if (iso) {
-          fi[0][row + i] -= wy[j] * qdx[i];
-          fi[1][row + i] -= dwy[j] * qwx[i];
+        if (stress == 1) {
+          fi[0][row + i] -= wy[j] * X[0][i];
+          fi[1][row + i] -= dwy[j] * Y[1][i];
         }
+        for (int d = 0; stress == 2 && d < D; ++d)
+          fi[d][row + i] -= wy[j] * X[d][i] + dwy[j] * Y[d][i];
       }
     }
 #else
-    double lm[SMAX][SMAX], lx[SMAX][SMAX], ly[SMAX][SMAX], lz[SMAX][SMAX];
+    double lm[SMAX][SMAX], lf[D][SMAX][SMAX], lz[D][SMAX][SMAX];
     for (int j = 0; j < S; ++j)
       for (int i = 0; i < S; ++i) {
         lm[j][i] = wy[j] * mwx[i];
-        lx[j][i] = wy[j] * qdx[i], ly[j][i] = dwy[j] * qwx[i], lz[j][i] = wy[j] * qwx[i];
+        if (stress == 1) {
+          lf[0][j][i] = wy[j] * X[0][i], lf[1][j][i] = dwy[j] * Y[1][i];
+          lz[2][j][i] = wy[j] * Z[2][i];
+        }
+        for (int d = 0; stress == 2 && d < D; ++d) {
+          lf[d][j][i] = wy[j] * X[d][i] + dwy[j] * Y[d][i];
+          lz[d][j][i] = wy[j] * Z[d][i];
+        }
       }
     for (int k = 0; k < S; ++k) {
       const double wz = s.w[2][k], dwz = s.dw[2][k];
@@ -220,11 +247,13 @@ MPM_INLINE void DIMFN(p2g_scalar_loop)(const DIMFN(lattice) * L, mpm_grid_phase 
         const mpm_lidx row = s.first + j * L->sy + k * L->sz;
         for (int i = 0; i < S; ++i) {
           if (mass) mi[row + i] += wz * lm[j][i];
-          if (iso) {
-            fi[0][row + i] -= wz * lx[j][i];
-            fi[1][row + i] -= wz * ly[j][i];
-            fi[2][row + i] -= dwz * lz[j][i];
+          if (stress == 1) {
+            fi[0][row + i] -= wz * lf[0][j][i];
+            fi[1][row + i] -= wz * lf[1][j][i];
+            fi[2][row + i] -= dwz * lz[2][j][i];
           }
+          for (int d = 0; stress == 2 && d < D; ++d)
+            fi[d][row + i] -= wz * lf[d][j][i] + dwz * lz[d][j][i];
         }
       }
     }
@@ -232,34 +261,39 @@ MPM_INLINE void DIMFN(p2g_scalar_loop)(const DIMFN(lattice) * L, mpm_grid_phase 
   }
 }
 
-/* The scalar deposit of one shape kind, its terms as literals. */
-MPM_INLINE void DIMFN(p2g_scalar)(const DIMFN(lattice) * L, mpm_grid_phase *ph,
-                                  const mpm_p2g_args *a, mpm_shape_kind kind) {
-  if (a->m && a->viso)
-    DIMFN(p2g_scalar_loop)(L, ph, a, kind, 1, 1);
+/* The lean deposit of one shape kind, its terms as literals. */
+MPM_INLINE void DIMFN(p2g_lean)(const DIMFN(lattice) * L, mpm_grid_phase *ph, const mpm_p2g_args *a,
+                                mpm_shape_kind kind) {
+  const int stress = a->vsig ? 2 : a->viso ? 1 : 0;
+  if (a->m && stress == 1)
+    DIMFN(p2g_lean_loop)(L, ph, a, kind, 1, 1);
+  else if (a->m && stress == 0)
+    DIMFN(p2g_lean_loop)(L, ph, a, kind, 1, 0);
   else if (a->m)
-    DIMFN(p2g_scalar_loop)(L, ph, a, kind, 1, 0);
-  else if (a->viso)
-    DIMFN(p2g_scalar_loop)(L, ph, a, kind, 0, 1);
+    DIMFN(p2g_lean_loop)(L, ph, a, kind, 1, 2);
+  else if (stress == 1)
+    DIMFN(p2g_lean_loop)(L, ph, a, kind, 0, 1);
+  else if (stress == 2)
+    DIMFN(p2g_lean_loop)(L, ph, a, kind, 0, 2);
 }
 
 static void DIMFN(p2g)(mpm_grid *g, int phase, const mpm_p2g_args *a) {
   mpm_grid_phase *ph = &g->phase[phase];
   const DIMFN(lattice) L = DIMFN(lattice_of)(g, a->lp);
   if (!a->v[0]) {
-    assert(!a->vsig && !a->C && !a->fext[0] && !ph->normals);
+    assert(!(a->vsig && a->viso) && !a->C && !a->fext[0] && !(a->m && ph->normals));
     switch (g->shape) {
     case MPM_SHAPE_LINEAR:
-      DIMFN(p2g_scalar)(&L, ph, a, MPM_SHAPE_LINEAR);
+      DIMFN(p2g_lean)(&L, ph, a, MPM_SHAPE_LINEAR);
       break;
     case MPM_SHAPE_GIMP:
-      DIMFN(p2g_scalar)(&L, ph, a, MPM_SHAPE_GIMP);
+      DIMFN(p2g_lean)(&L, ph, a, MPM_SHAPE_GIMP);
       break;
     case MPM_SHAPE_QUADRATIC:
-      DIMFN(p2g_scalar)(&L, ph, a, MPM_SHAPE_QUADRATIC);
+      DIMFN(p2g_lean)(&L, ph, a, MPM_SHAPE_QUADRATIC);
       break;
     default:
-      DIMFN(p2g_scalar)(&L, ph, a, MPM_SHAPE_CUBIC);
+      DIMFN(p2g_lean)(&L, ph, a, MPM_SHAPE_CUBIC);
     }
     return;
   }
@@ -305,7 +339,7 @@ MPM_INLINE void DIMFN(g2p_loop)(const DIMFN(lattice) * L, const mpm_g2p_args *a,
   for (int q = 0; q < nscalar; ++q) s_i[q] = a->s_i[q];
   const double Dinv = (kind == MPM_SHAPE_CUBIC ? 3.0 : 4.0) * L->inv_dx * L->inv_dx;
   const double *restrict xp[D], *restrict vi[D], *restrict ai[D];
-  double *restrict vout[D], *restrict aout[D], *restrict divout = a->div_out;
+  double *restrict vout[D], *restrict aout[D], *restrict divout = div ? a->div_out : NULL;
   const double *restrict F = a->LF_out ? a->F : NULL;
   double *restrict Lout = a->L_out, *restrict Cout = a->C_out, *restrict LF = a->LF_out;
   for (int d = 0; d < D; ++d) {
@@ -370,14 +404,17 @@ MPM_INLINE void DIMFN(g2p_loop)(const DIMFN(lattice) * L, const mpm_g2p_args *a,
         }
       }
     }
-    for (int q = 0; q < nscalar; ++q) a->s_out[q][p] = sc[q];
-    if (grad && divout) {
+    if (div) {
       double tr = Lg[0][0];
       for (int d = 1; d < D; ++d) tr += Lg[d][d];
       divout[p] = tr;
     }
-    if (!vel) continue;
+    if (!vel) {
+      for (int q = 0; q < nscalar; ++q) a->s_out[q][p] = sc[q];
+      continue;
+    }
     for (int d = 0; d < D; ++d) vout[d][p] = v[d], aout[d][p] = acc[d];
+    for (int q = 0; q < nscalar; ++q) a->s_out[q][p] = sc[q];
     if (Lout)
       for (int r = 0; r < D; ++r)
         for (int c = 0; c < D; ++c) Lout[(size_t)(r * D + c) * n + p] = Lg[r][c];
@@ -435,6 +472,7 @@ static void DIMFN(g2p)(const mpm_grid *g, const mpm_g2p_args *a) {
     }
     return;
   }
+  assert(!a->div_out);
   const int apic_b = a->C_out != NULL;
   switch (g->shape) {
   case MPM_SHAPE_LINEAR:

@@ -382,7 +382,7 @@ int fluid_gridp_deposit(mpm_module *m, const double *y, const fluid_batch *b) {
     mpm_hier_phase_zero(m->hier, gp->phase);
   else
     mpm_grid_phase_zero(m->grid, gp->phase);
-  mpm_p2g_args a = {.n = n, .m = gp->mp, .lp = fc->lp}; /* the scalar deposit (v NULL) */
+  mpm_p2g_args a = {.n = n, .m = gp->mp, .lp = fc->lp}; /* the lean deposit (v NULL) */
   for (int d = 0; d < dim; ++d) a.x[d] = y + (size_t)(p->offset[FLUID_X] + d) * n;
   int rc = 0;
   fluid_p2g_any(m, gp->phase, &a, &rc);

@@ -81,7 +81,7 @@ static double *slot(const fluid_gridp_solid *s, int k) {
   return s->buf + (size_t)k * s->cap;
 }
 
-/* Zero the region phase, deposit (m, v[0]) or the scalar deposit (m, viso) (mpm_kernels.h) of the
+/* Zero the region phase, deposit (m, v[0]) or the lean deposit (m, viso) (mpm_kernels.h) of the
  * points through the hierarchy, restrict it and sum level 0's ghosts. */
 static int deposit(mpm_module *m, const fluid_gridp_solid *s, const double *mass, const double *v0,
                    const double *viso) {

@@ -1,8 +1,8 @@
 /* The kernels' scalar paths (mpm_kernels.h), for every shape in 2-D and 3-D on a one-rank grid,
  * against the full kernels on random particles and random nodal fields:
- *  (i) the scalar deposit (v[0] NULL) of masses m and an isotropic stress viso gives the nodal
- *      mass and force of the full deposit with zero velocity and vsig = viso I, and leaves the
- *      momentum alone; with m or viso alone, that part alone;
+ *  (i) the lean deposit (v[0] NULL) of masses m and a stress, isotropic (viso) or full (vsig),
+ *      gives the nodal mass and force of the full deposit with zero velocity (and vsig = viso I),
+ *      and leaves the momentum alone; with m or the stress alone, that part alone;
  *  (ii) the scalar gather (v_out[0] NULL) gives the full gather's scalars, and div_out its
  *      trace of L, L_00 + L_11 (+ L_22), for one to three scalars with and without div_out.
  *
@@ -55,14 +55,15 @@ static void positions(int dim, uint64_t *seed, double **x) {
   for (int d = 0; d < dim; ++d) x[d] = random_array(NP, g_lo[d] + 0.1, g_hi[d] - 0.1, seed);
 }
 
-/* Nodes of phase 0 (the scalar deposit) and 1 (the full one) that differ in field f. */
+/* Nodes where the arrays a (the lean deposit's) and b (the full one's) differ. */
 static long differ(const double *a, const double *b, mpm_lidx nn) {
   long count = 0;
   for (mpm_lidx l = 0; l < nn; ++l) count += a[l] != b[l];
   return count;
 }
 
-/* (i) with the mass (with_m) and the stress (with_s) terms on or off. */
+/* (i) with the mass (with_m) on or off and the stress (with_s) off (0), isotropic (1) or full
+ * (2, an asymmetric random tensor). */
 static void check_deposit(int dim, mpm_shape_kind shape, int with_m, int with_s) {
   mpm_grid *g = grid_make(dim, shape);
   uint64_t seed = 5u + (uint64_t)(100 * dim + 10 * shape + 2 * with_m + with_s);
@@ -72,13 +73,19 @@ static void check_deposit(int dim, mpm_shape_kind shape, int with_m, int with_s)
   double *zero = calloc(NP, sizeof(double)),
          *vsig = calloc((size_t)(dim * dim) * NP, sizeof(double));
   for (int d = 0; d < dim; ++d) memcpy(vsig + (size_t)(d * dim + d) * NP, q, sizeof(double) * NP);
-  mpm_p2g_args s = {.n = NP, .m = with_m ? m : NULL, .viso = with_s ? q : NULL, .lp = 0.25};
+  for (size_t k = 0; with_s == 2 && k < (size_t)(dim * dim) * NP; ++k)
+    vsig[k] = -2.0 + 4.0 * uniform(&seed);
+  mpm_p2g_args s = {.n = NP,
+                    .m = with_m ? m : NULL,
+                    .viso = with_s == 1 ? q : NULL,
+                    .vsig = with_s == 2 ? vsig : NULL,
+                    .lp = 0.25};
   mpm_p2g_args f = {.n = NP, .m = with_m ? m : zero, .vsig = with_s ? vsig : NULL, .lp = 0.25};
   for (int d = 0; d < dim; ++d) s.x[d] = f.x[d] = x[d], f.v[d] = zero;
   mpm_grid_phase_zero(g, 0);
   mpm_grid_phase_zero(g, 1);
   const mpm_lidx nn = g->nnodes;
-  for (int d = 0; d < dim; ++d) /* a momentum the scalar deposit must not touch */
+  for (int d = 0; d < dim; ++d) /* a momentum the lean deposit must not touch */
     for (mpm_lidx l = 0; l < nn; ++l) g->phase[0].mv_i[d][l] = 7.0;
   mpm_kernels_get(dim)->p2g(g, 0, &s);
   mpm_kernels_get(dim)->p2g(g, 1, &f);
@@ -90,10 +97,10 @@ static void check_deposit(int dim, mpm_shape_kind shape, int with_m, int with_s)
   }
   long touched = 0; /* the deposit reached nodes (the comparison is not of zeros alone) */
   for (mpm_lidx l = 0; l < nn; ++l) touched += b->m_i[l] != 0.0 || b->f_i[0][l] != 0.0;
-  printf("  %d-D %-9s scalar deposit (m %s, viso %s): %ld nodes reached; differing m_i %ld, "
+  static const char *const stress[3] = {"off", "isotropic", "full"};
+  printf("  %d-D %-9s lean deposit (m %s, stress %s): %ld nodes reached; differing m_i %ld, "
          "f_i %ld, momentum touched %ld\n",
-         dim, mpm_shape_name(shape), with_m ? "on" : "off", with_s ? "on" : "off", touched, dm, df,
-         dmv);
+         dim, mpm_shape_name(shape), with_m ? "on" : "off", stress[with_s], touched, dm, df, dmv);
   assert_true(touched > 100);
   assert_int_equal(dm + df + dmv, 0);
   for (int d = 0; d < dim; ++d) free(x[d]);
@@ -146,14 +153,13 @@ static void check_gather(int dim, mpm_shape_kind shape, int nscalar, int with_di
   mpm_grid_destroy(&g);
 }
 
-static void test_scalar_deposit(void **state) {
+static void test_lean_deposit(void **state) {
   (void)state;
   for (int dim = 2; dim <= 3; ++dim)
-    for (int s = 0; s < MPM_SHAPE_COUNT; ++s) {
-      check_deposit(dim, (mpm_shape_kind)s, 1, 1);
-      check_deposit(dim, (mpm_shape_kind)s, 1, 0);
-      check_deposit(dim, (mpm_shape_kind)s, 0, 1);
-    }
+    for (int s = 0; s < MPM_SHAPE_COUNT; ++s)
+      for (int with_m = 0; with_m <= 1; ++with_m)
+        for (int with_s = 0; with_s <= 2; ++with_s)
+          if (with_m || with_s) check_deposit(dim, (mpm_shape_kind)s, with_m, with_s);
 }
 
 static void test_scalar_gather(void **state) {
@@ -167,7 +173,7 @@ static void test_scalar_gather(void **state) {
 
 int main(int argc, char **argv) {
   MPI_Init(&argc, &argv);
-  const struct CMUnitTest tests[] = {cmocka_unit_test(test_scalar_deposit),
+  const struct CMUnitTest tests[] = {cmocka_unit_test(test_lean_deposit),
                                      cmocka_unit_test(test_scalar_gather)};
   const int rc = cmocka_run_group_tests(tests, NULL, NULL);
   MPI_Finalize();
