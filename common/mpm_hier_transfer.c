@@ -19,8 +19,8 @@
 
 enum {
   CHUNK = 4096,
-  /* Most columns a chunk needs: G2P's x, F, v, a, L, C, LF and scalars in 3-D. */
-  MAX_COLS = 3 + 9 + 3 + 3 + 9 + 9 + 9 + MPM_KERNELS_MAX_SCALARS
+  /* Most columns a chunk needs: G2P's x, F, v, a, L, C, LF, div and scalars in 3-D. */
+  MAX_COLS = 3 + 9 + 3 + 3 + 9 + 9 + 9 + 1 + MPM_KERNELS_MAX_SCALARS
 };
 
 typedef struct hier_scratch {
@@ -143,7 +143,7 @@ static void gather_x(const mpm_hier *h, int l, chunk *c, const double *const *x,
   }
 }
 
-/* Fresh output columns for ncomp components (always: the kernel writes v and a). */
+/* Fresh output columns for ncomp components. */
 static double *column(chunk *c, int ncomp) {
   double *dst = c->next;
   c->next += (size_t)ncomp * c->nc;
@@ -170,6 +170,7 @@ static void p2g_chunk(mpm_hier *h, int l, int phase, const mpm_p2g_args *a, chun
   for (int d = 0; d < D; ++d) b.v[d] = gather(c, a->v[d], 1);
   b.m = gather(c, a->m, 1);
   b.vsig = gather(c, a->vsig, D * D);
+  b.viso = gather(c, a->viso, 1);
   b.C = gather(c, a->C, D * D);
   for (int d = 0; d < D && a->fext[0]; ++d) b.fext[d] = gather(c, a->fext[d], 1);
   mpm_kernels_get(D)->p2g(h->level[l].grid, phase, &b);
@@ -215,7 +216,8 @@ static void g2p_chunk(mpm_hier *h, int l, const mpm_g2p_args *lv, const mpm_g2p_
   mpm_g2p_args b = *lv;
   b.n = c->nc;
   gather_x(h, l, c, a->x, b.x);
-  for (int d = 0; d < D; ++d) b.v_out[d] = column(c, 1), b.a_out[d] = column(c, 1);
+  for (int d = 0; d < D && a->v_out[0]; ++d) b.v_out[d] = column(c, 1), b.a_out[d] = column(c, 1);
+  b.div_out = a->div_out ? column(c, 1) : NULL;
   b.F = a->LF_out ? gather(c, a->F, DD) : NULL;
   b.L_out = a->L_out ? column(c, DD) : NULL;
   b.C_out = a->C_out ? column(c, DD) : NULL;
@@ -229,6 +231,7 @@ static void g2p_chunk(mpm_hier *h, int l, const mpm_g2p_args *lv, const mpm_g2p_
   if (a->L_out) scatter(c, b.L_out, a->L_out, DD);
   if (a->C_out) scatter(c, b.C_out, a->C_out, DD);
   if (a->LF_out) scatter(c, b.LF_out, a->LF_out, DD);
+  if (a->div_out) scatter(c, b.div_out, a->div_out, 1);
   for (int j = 0; j < a->nscalar; ++j) scatter(c, b.s_out[j], a->s_out[j], 1);
 }
 

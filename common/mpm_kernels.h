@@ -12,12 +12,19 @@
 
 #include "mpm_grid.h"
 
-/* Optional fields are NULL when unused and then cost nothing. */
+/* Optional fields are NULL when unused and then cost nothing.
+ *
+ * A lean deposit: with v[0] NULL the kernel deposits S m into m_i (m may be NULL too) and the
+ * force -V sigma grad S of a stress given in full (vsig) or isotropic (viso: V sigma = viso I)
+ * into f_i, and nothing else: C and fext must then be unset, and m too when the phase deposits
+ * its normals (gravity is not read). It visits only the arrays it fills, a fraction of the full
+ * deposit's work; its sums are the full deposit's of zero velocity, operation for operation. */
 typedef struct mpm_p2g_args {
   mpm_lidx n;
   const double *x[MPM_MAX_DIM]; /* positions */
-  const double *v[MPM_MAX_DIM]; /* velocities */
+  const double *v[MPM_MAX_DIM]; /* velocities, or v[0] NULL: the lean deposit */
   const double *m;              /* masses */
+  const double *viso;           /* the lean deposit's isotropic V sigma, or NULL */
   const double *vsig;           /* V_p sigma_p, dim*dim components of n, or NULL */
   /* APIC affine velocity C_p, dim*dim components of n (entry (r, c) at C[(r*dim + c)*n + p]),
    * or NULL. When set the momentum deposited at node i is S m (v_p + C_p (x_i - x_p)). */
@@ -31,14 +38,18 @@ typedef struct mpm_p2g_args {
 
 #define MPM_KERNELS_MAX_SCALARS 4
 
+/* A scalar gather: with v_out[0] NULL the kernel computes only the scalars below and div_out,
+ * reading only the arrays they need; a_out, L_out, C_out and LF_out must then be NULL. Its sums
+ * are the full gather's, operation for operation. */
 typedef struct mpm_g2p_args {
   mpm_lidx n;
   const double *x[MPM_MAX_DIM];
   const double *v_i[MPM_MAX_DIM]; /* nodal velocity to interpolate (and differentiate) */
   const double *a_i[MPM_MAX_DIM]; /* nodal acceleration to interpolate */
   double lp;
-  double *v_out[MPM_MAX_DIM]; /* sum_i S_ip v_i */
+  double *v_out[MPM_MAX_DIM]; /* sum_i S_ip v_i, or v_out[0] NULL: the scalar gather */
   double *a_out[MPM_MAX_DIM]; /* sum_i S_ip a_i */
+  double *div_out;            /* the scalar gather's sum_i v_i . grad S_ip (trace of L), or NULL */
   double *L_out;              /* sum_i v_i (x) grad S_ip, dim*dim components, or NULL */
   /* APIC affine velocity (layout of L_out), or NULL. Quadratic and cubic B-splines:
    * C_p = D^-1 sum_i S_ip v_i (x_i - x_p)^T with D = dx^2/4 and dx^2/3 (Jiang et al. 2015);

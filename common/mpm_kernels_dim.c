@@ -14,6 +14,7 @@
  * loops are fully unrolled and an option that is off costs nothing. The lattice constants
  * are copied to locals first: the compiler must otherwise assume that every store into a
  * nodal array could change them and load them again. */
+#include <assert.h>
 #include <math.h>
 
 #if MPM_DIM == 2
@@ -174,9 +175,129 @@ MPM_INLINE void DIMFN(p2g_loop)(const DIMFN(lattice) * L, mpm_grid_phase *ph, co
   }
 }
 
+/* The lean deposit (mpm_kernels.h): S m into m_i when mass, and with stress (a literal: 0 none,
+ * 1 the isotropic viso, 2 the full vsig) the force -V sigma grad S into f_i. Each product is the
+ * full loop's for zero velocity (there P_d = -sig_d0 dwx, Q_d = sig_d1 wx and the zero body force
+ * adds nothing; a - b = -(b - a) exactly), so the sums agree bitwise. The force factors:
+ * f_d -= wy X_d + dwy Y_d [wz (...) + dwz wy Z_d in 3-D], X_d = sig_d0 dwx, Y_d = sig_d1 wx,
+ * Z_d = sig_d2 wx; the isotropic stress keeps only the diagonal terms. */
+MPM_INLINE void DIMFN(p2g_lean_loop)(const DIMFN(lattice) * L, mpm_grid_phase *ph,
+                                     const mpm_p2g_args *a, mpm_shape_kind kind, int mass,
+                                     int stress) {
+  enum { D = MPM_DIM };
+  const int S = SUPPORT(kind);
+  const size_t n = (size_t)a->n;
+  double *restrict mi = ph->m_i, *restrict fi[D];
+  const double *restrict xp[D], *restrict mp = a->m, *restrict viso = a->viso;
+  const double *restrict vsig = a->vsig;
+  for (int d = 0; d < D; ++d) fi[d] = ph->f_i[d], xp[d] = a->x[d];
+  for (size_t p = 0; p < n; ++p) {
+    double x[D], sig[D][D];
+    for (int d = 0; d < D; ++d) x[d] = xp[d][p];
+    const double m = mass ? mp[p] : 0.0, q = stress == 1 ? viso[p] : 0.0;
+    for (int r = 0; stress == 2 && r < D; ++r)
+      for (int c = 0; c < D; ++c) sig[r][c] = vsig[(size_t)(r * D + c) * n + p];
+    DIMFN(weights) s;
+    DIMFN(weights_eval)(L, kind, x, 0, &s);
+    const double *wx = s.w[0], *dwx = s.dw[0], *wy = s.w[1], *dwy = s.dw[1];
+    double mwx[SMAX], X[D][SMAX], Y[D][SMAX];
+#if MPM_DIM == 3
+    double Z[D][SMAX];
+#endif
+    for (int i = 0; i < S; ++i) {
+      mwx[i] = m * wx[i];
+      for (int d = 0; d < D; ++d) {
+        X[d][i] = stress == 2 ? sig[d][0] * dwx[i] : q * dwx[i];
+        Y[d][i] = stress == 2 ? sig[d][1] * wx[i] : q * wx[i];
+#if MPM_DIM == 3
+        Z[d][i] = stress == 2 ? sig[d][2] * wx[i] : q * wx[i];
+#endif
+      }
+    }
+#if MPM_DIM == 2
+    for (int j = 0; j < S; ++j) {
+      const mpm_lidx row = s.first + j * L->sy;
+      for (int i = 0; i < S; ++i) {
+        if (mass) mi[row + i] += wy[j] * mwx[i];
+        if (stress == 1) {
+          fi[0][row + i] -= wy[j] * X[0][i];
+          fi[1][row + i] -= dwy[j] * Y[1][i];
+        }
+        for (int d = 0; stress == 2 && d < D; ++d)
+          fi[d][row + i] -= wy[j] * X[d][i] + dwy[j] * Y[d][i];
+      }
+    }
+#else
+    double lm[SMAX][SMAX], lf[D][SMAX][SMAX], lz[D][SMAX][SMAX];
+    for (int j = 0; j < S; ++j)
+      for (int i = 0; i < S; ++i) {
+        lm[j][i] = wy[j] * mwx[i];
+        if (stress == 1) {
+          lf[0][j][i] = wy[j] * X[0][i], lf[1][j][i] = dwy[j] * Y[1][i];
+          lz[2][j][i] = wy[j] * Z[2][i];
+        }
+        for (int d = 0; stress == 2 && d < D; ++d) {
+          lf[d][j][i] = wy[j] * X[d][i] + dwy[j] * Y[d][i];
+          lz[d][j][i] = wy[j] * Z[d][i];
+        }
+      }
+    for (int k = 0; k < S; ++k) {
+      const double wz = s.w[2][k], dwz = s.dw[2][k];
+      for (int j = 0; j < S; ++j) {
+        const mpm_lidx row = s.first + j * L->sy + k * L->sz;
+        for (int i = 0; i < S; ++i) {
+          if (mass) mi[row + i] += wz * lm[j][i];
+          if (stress == 1) {
+            fi[0][row + i] -= wz * lf[0][j][i];
+            fi[1][row + i] -= wz * lf[1][j][i];
+            fi[2][row + i] -= dwz * lz[2][j][i];
+          }
+          for (int d = 0; stress == 2 && d < D; ++d)
+            fi[d][row + i] -= wz * lf[d][j][i] + dwz * lz[d][j][i];
+        }
+      }
+    }
+#endif
+  }
+}
+
+/* The lean deposit of one shape kind, its terms as literals. */
+MPM_INLINE void DIMFN(p2g_lean)(const DIMFN(lattice) * L, mpm_grid_phase *ph, const mpm_p2g_args *a,
+                                mpm_shape_kind kind) {
+  const int stress = a->vsig ? 2 : a->viso ? 1 : 0;
+  if (a->m && stress == 1)
+    DIMFN(p2g_lean_loop)(L, ph, a, kind, 1, 1);
+  else if (a->m && stress == 0)
+    DIMFN(p2g_lean_loop)(L, ph, a, kind, 1, 0);
+  else if (a->m)
+    DIMFN(p2g_lean_loop)(L, ph, a, kind, 1, 2);
+  else if (stress == 1)
+    DIMFN(p2g_lean_loop)(L, ph, a, kind, 0, 1);
+  else if (stress == 2)
+    DIMFN(p2g_lean_loop)(L, ph, a, kind, 0, 2);
+}
+
 static void DIMFN(p2g)(mpm_grid *g, int phase, const mpm_p2g_args *a) {
   mpm_grid_phase *ph = &g->phase[phase];
   const DIMFN(lattice) L = DIMFN(lattice_of)(g, a->lp);
+  if (!a->v[0]) {
+    assert(!(a->vsig && a->viso) && !a->C && !a->fext[0] && !(a->m && ph->normals));
+    switch (g->shape) {
+    case MPM_SHAPE_LINEAR:
+      DIMFN(p2g_lean)(&L, ph, a, MPM_SHAPE_LINEAR);
+      break;
+    case MPM_SHAPE_GIMP:
+      DIMFN(p2g_lean)(&L, ph, a, MPM_SHAPE_GIMP);
+      break;
+    case MPM_SHAPE_QUADRATIC:
+      DIMFN(p2g_lean)(&L, ph, a, MPM_SHAPE_QUADRATIC);
+      break;
+    default:
+      DIMFN(p2g_lean)(&L, ph, a, MPM_SHAPE_CUBIC);
+    }
+    return;
+  }
+  assert(!a->viso);
   const int apic = a->C != NULL, grad = ph->normals;
 #define P2G_CASE(kind)                                                                             \
   case kind:                                                                                       \
@@ -203,19 +324,22 @@ static void DIMFN(p2g)(mpm_grid *g, int phase, const mpm_p2g_args *a) {
 
 /* With apic_b (a literal) the loop also sums S v_i (x_i - x_p)^T, the B-spline APIC moment:
  * C_p = D^-1 times that sum, from sum_i S (x_i - x_p)(x_i - x_p)^T = D I. nsc is the number
- * of extra scalars when it is a literal (0 or 1, the common cases: the sums then stay in
- * registers), or -1 to read it from a. */
+ * of extra scalars when it is a literal (0, 1 or 2, the common cases: the sums then stay in
+ * registers), or -1 to read it from a. vel (a literal) is 0 in the scalar gather, which then
+ * forms only the diagonal of L, and that only when div (a literal) asks for its trace; the
+ * diagonal's sums are the full gather's. */
 MPM_INLINE void DIMFN(g2p_loop)(const DIMFN(lattice) * L, const mpm_g2p_args *a,
-                                mpm_shape_kind kind, int apic_b, int nsc) {
+                                mpm_shape_kind kind, int apic_b, int nsc, int vel, int div) {
   enum { D = MPM_DIM };
   const int S = SUPPORT(kind);
   const size_t n = (size_t)a->n;
   const int nscalar = nsc >= 0 ? nsc : a->nscalar;
+  const int grad = vel || div; /* L, or its diagonal, is formed */
   const double *restrict s_i[MPM_KERNELS_MAX_SCALARS] = {NULL};
   for (int q = 0; q < nscalar; ++q) s_i[q] = a->s_i[q];
   const double Dinv = (kind == MPM_SHAPE_CUBIC ? 3.0 : 4.0) * L->inv_dx * L->inv_dx;
   const double *restrict xp[D], *restrict vi[D], *restrict ai[D];
-  double *restrict vout[D], *restrict aout[D];
+  double *restrict vout[D], *restrict aout[D], *restrict divout = div ? a->div_out : NULL;
   const double *restrict F = a->LF_out ? a->F : NULL;
   double *restrict Lout = a->L_out, *restrict Cout = a->C_out, *restrict LF = a->LF_out;
   for (int d = 0; d < D; ++d) {
@@ -245,14 +369,15 @@ MPM_INLINE void DIMFN(g2p_loop)(const DIMFN(lattice) * L, const mpm_g2p_args *a,
 #else
         const mpm_lidx row = s.first + j * L->sy;
 #endif
-        /* Row sums with the x weights: S wx v, S dwx v, S wx a (and S wx rx v). */
+        /* Row sums with the x weights: S wx v, S dwx v, S wx a (and S wx rx v); the diagonal
+         * of L needs S dwx v_0 and S wx v_d for d > 0. */
         double sv[D] = {0}, sd[D] = {0}, sa[D] = {0}, sr[D] = {0};
-        for (int i = 0; i < S; ++i)
+        for (int i = 0; grad && i < S; ++i)
           for (int d = 0; d < D; ++d) {
             const double vn = vi[d][row + i];
-            sv[d] += wx[i] * vn;
-            sd[d] += dwx[i] * vn;
-            sa[d] += wx[i] * ai[d][row + i];
+            if (vel || d > 0) sv[d] += wx[i] * vn;
+            if (vel || d == 0) sd[d] += dwx[i] * vn;
+            if (vel) sa[d] += wx[i] * ai[d][row + i];
             if (apic_b) sr[d] += wrx[i] * vn;
           }
         const double wyz = wy[j] * wz, dwyz = dwy[j] * wz;
@@ -261,13 +386,13 @@ MPM_INLINE void DIMFN(g2p_loop)(const DIMFN(lattice) * L, const mpm_g2p_args *a,
           for (int i = 0; i < S; ++i) ss += wx[i] * s_i[q][row + i];
           sc[q] += wyz * ss;
         }
-        for (int d = 0; d < D; ++d) {
-          v[d] += wyz * sv[d];
-          acc[d] += wyz * sa[d];
-          Lg[d][0] += wyz * sd[d];
-          Lg[d][1] += dwyz * sv[d];
+        for (int d = 0; grad && d < D; ++d) {
+          if (vel) v[d] += wyz * sv[d];
+          if (vel) acc[d] += wyz * sa[d];
+          if (vel || d == 0) Lg[d][0] += wyz * sd[d];
+          if (vel || d == 1) Lg[d][1] += dwyz * sv[d];
 #if MPM_DIM == 3
-          Lg[d][2] += wy[j] * dwz * sv[d];
+          if (vel || d == 2) Lg[d][2] += wy[j] * dwz * sv[d];
 #endif
           if (apic_b) {
             B[d][0] += wyz * sr[d];
@@ -278,6 +403,15 @@ MPM_INLINE void DIMFN(g2p_loop)(const DIMFN(lattice) * L, const mpm_g2p_args *a,
           }
         }
       }
+    }
+    if (div) {
+      double tr = Lg[0][0];
+      for (int d = 1; d < D; ++d) tr += Lg[d][d];
+      divout[p] = tr;
+    }
+    if (!vel) {
+      for (int q = 0; q < nscalar; ++q) a->s_out[q][p] = sc[q];
+      continue;
     }
     for (int d = 0; d < D; ++d) vout[d][p] = v[d], aout[d][p] = acc[d];
     for (int q = 0; q < nscalar; ++q) a->s_out[q][p] = sc[q];
@@ -302,31 +436,69 @@ MPM_INLINE void DIMFN(g2p_loop)(const DIMFN(lattice) * L, const mpm_g2p_args *a,
   }
 }
 
+/* The scalar gather of one shape kind: the quadratic B-spline's common cases as literals (the
+ * grid pressure's corrections read one or two scalars, or the divergence alone). */
+MPM_INLINE void DIMFN(g2p_scalar)(const DIMFN(lattice) * L, const mpm_g2p_args *a,
+                                  mpm_shape_kind kind) {
+  const int div = a->div_out != NULL;
+  if (kind == MPM_SHAPE_QUADRATIC && div && a->nscalar == 0)
+    DIMFN(g2p_loop)(L, a, kind, 0, 0, 0, 1);
+  else if (kind == MPM_SHAPE_QUADRATIC && !div && a->nscalar == 1)
+    DIMFN(g2p_loop)(L, a, kind, 0, 1, 0, 0);
+  else if (kind == MPM_SHAPE_QUADRATIC && !div && a->nscalar == 2)
+    DIMFN(g2p_loop)(L, a, kind, 0, 2, 0, 0);
+  else if (div)
+    DIMFN(g2p_loop)(L, a, kind, 0, -1, 0, 1);
+  else
+    DIMFN(g2p_loop)(L, a, kind, 0, -1, 0, 0);
+}
+
 static void DIMFN(g2p)(const mpm_grid *g, const mpm_g2p_args *a) {
   const DIMFN(lattice) L = DIMFN(lattice_of)(g, a->lp);
+  if (!a->v_out[0]) {
+    assert(!a->a_out[0] && !a->L_out && !a->C_out && !a->LF_out);
+    switch (g->shape) {
+    case MPM_SHAPE_LINEAR:
+      DIMFN(g2p_scalar)(&L, a, MPM_SHAPE_LINEAR);
+      break;
+    case MPM_SHAPE_GIMP:
+      DIMFN(g2p_scalar)(&L, a, MPM_SHAPE_GIMP);
+      break;
+    case MPM_SHAPE_QUADRATIC:
+      DIMFN(g2p_scalar)(&L, a, MPM_SHAPE_QUADRATIC);
+      break;
+    default:
+      DIMFN(g2p_scalar)(&L, a, MPM_SHAPE_CUBIC);
+    }
+    return;
+  }
+  assert(!a->div_out);
   const int apic_b = a->C_out != NULL;
   switch (g->shape) {
   case MPM_SHAPE_LINEAR:
-    DIMFN(g2p_loop)(&L, a, MPM_SHAPE_LINEAR, 0, -1);
+    DIMFN(g2p_loop)(&L, a, MPM_SHAPE_LINEAR, 0, -1, 1, 0);
     break;
   case MPM_SHAPE_GIMP:
-    DIMFN(g2p_loop)(&L, a, MPM_SHAPE_GIMP, 0, -1);
+    DIMFN(g2p_loop)(&L, a, MPM_SHAPE_GIMP, 0, -1, 1, 0);
     break;
-  case MPM_SHAPE_QUADRATIC: /* the gas's FLIP update reads one scalar (fluid_transfer.c) */
+  case MPM_SHAPE_QUADRATIC: /* the gas's FLIP update reads one scalar, two with the grid
+                               pressure (fluid_transfer.c) */
     if (apic_b)
-      DIMFN(g2p_loop)(&L, a, MPM_SHAPE_QUADRATIC, 1, -1);
+      DIMFN(g2p_loop)(&L, a, MPM_SHAPE_QUADRATIC, 1, -1, 1, 0);
+    else if (a->nscalar == 2)
+      DIMFN(g2p_loop)(&L, a, MPM_SHAPE_QUADRATIC, 0, 2, 1, 0);
     else if (a->nscalar == 1)
-      DIMFN(g2p_loop)(&L, a, MPM_SHAPE_QUADRATIC, 0, 1);
+      DIMFN(g2p_loop)(&L, a, MPM_SHAPE_QUADRATIC, 0, 1, 1, 0);
     else if (a->nscalar == 0)
-      DIMFN(g2p_loop)(&L, a, MPM_SHAPE_QUADRATIC, 0, 0);
+      DIMFN(g2p_loop)(&L, a, MPM_SHAPE_QUADRATIC, 0, 0, 1, 0);
     else
-      DIMFN(g2p_loop)(&L, a, MPM_SHAPE_QUADRATIC, 0, -1);
+      DIMFN(g2p_loop)(&L, a, MPM_SHAPE_QUADRATIC, 0, -1, 1, 0);
     break;
   default:
     if (apic_b)
-      DIMFN(g2p_loop)(&L, a, MPM_SHAPE_CUBIC, 1, -1);
+      DIMFN(g2p_loop)(&L, a, MPM_SHAPE_CUBIC, 1, -1, 1, 0);
     else
-      DIMFN(g2p_loop)(&L, a, MPM_SHAPE_CUBIC, 0, -1);
+      DIMFN(g2p_loop)(&L, a, MPM_SHAPE_CUBIC, 0, -1, 1, 0);
     break;
   }
 }

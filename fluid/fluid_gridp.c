@@ -104,7 +104,6 @@ struct fluid_gridp {
   int nlev;   /* levels (1 without a hierarchy) */
   double *mp; /* m p of each particle (cap) */
   double *s;  /* sum_j N_j D_j / m_j at each particle (cap) */
-  double *zero;
   mpm_lidx cap;
   /* Per level: nodal pressure, then rate per unit mass (P), forces (F, dim), rates (D), the
    * mass they divide by (M: each level's before the walls fold it), and the spans it skips. */
@@ -288,7 +287,7 @@ void fluid_gridp_destroy(fluid_content *fc) {
   fluid_gridp *gp = fc->gridp;
   if (!gp) return;
   fluid_gridp_reset(fc);
-  free(gp->mp), free(gp->s), free(gp->zero), free(gp->V);
+  free(gp->mp), free(gp->s), free(gp->V);
   free(gp);
   fc->gridp = NULL;
 }
@@ -349,13 +348,11 @@ static int ensure_levels(mpm_module *m, fluid_gridp *gp) {
 
 static int ensure_particles(fluid_gridp *gp, mpm_lidx cap) {
   if (gp->cap >= cap && gp->mp) return 0;
-  free(gp->mp), free(gp->s), free(gp->zero), free(gp->V);
-  gp->mp = gp->s = gp->zero = gp->V = NULL;
+  free(gp->mp), free(gp->s), free(gp->V);
+  gp->mp = gp->s = gp->V = NULL;
   MPM_ALLOC(gp->mp, (size_t)cap);
   MPM_ALLOC(gp->s, (size_t)cap);
   if (gp->hybrid) MPM_ALLOC(gp->V, (size_t)cap);
-  gp->zero = calloc((size_t)cap, sizeof(double));
-  if (!gp->zero) MPM_FAIL(MPM_ERR_MEMORY, "out of memory for %ld particles", (long)cap);
   gp->cap = cap;
   return 0;
 }
@@ -385,9 +382,8 @@ int fluid_gridp_deposit(mpm_module *m, const double *y, const fluid_batch *b) {
     mpm_hier_phase_zero(m->hier, gp->phase);
   else
     mpm_grid_phase_zero(m->grid, gp->phase);
-  mpm_p2g_args a = {.n = n, .m = gp->mp, .lp = fc->lp};
-  for (int d = 0; d < dim; ++d)
-    a.x[d] = y + (size_t)(p->offset[FLUID_X] + d) * n, a.v[d] = gp->zero;
+  mpm_p2g_args a = {.n = n, .m = gp->mp, .lp = fc->lp}; /* the lean deposit (v NULL) */
+  for (int d = 0; d < dim; ++d) a.x[d] = y + (size_t)(p->offset[FLUID_X] + d) * n;
   int rc = 0;
   fluid_p2g_any(m, gp->phase, &a, &rc);
   return rc;

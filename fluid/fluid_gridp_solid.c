@@ -59,25 +59,19 @@ static const mpm_grid *level_grid(const mpm_module *m, int l) {
   return m->hier ? m->hier->level[l].grid : m->grid;
 }
 
-/* Scratch per solid point: q, W and u (3), v and a (2 dim), L (dim^2), zeros (1). */
-enum { S_Q, S_W, S_U, S_V };
+/* Scratch per solid point: q, W, u, and zeros (the velocities of the continuation's deposit). */
+enum { S_Q, S_W, S_U, S_ZERO, S_COUNT };
 static int ensure(mpm_module *m, fluid_gridp_solid *s, mpm_lidx n) {
-  const int dim = m->grid->dim;
   const int fresh = !s->A[0];
   for (int l = 0; fresh && l < (m->hier ? m->hier->nlevels : 1); ++l) {
     const mpm_lidx nn = m->hier ? m->hier->level[l].grid->nnodes : m->grid->nnodes;
     MPM_ALLOC(s->A[l], (size_t)nn);
     MPM_ALLOC(s->B[l], (size_t)nn);
-    const mpm_grid_phase *ph = &level_grid(m, l)->phase[s->phase];
-    for (int d = 0; d < dim; ++d) { /* never solved: the scalar gathers read zeros */
-      memset(ph->v_i[d], 0, sizeof(double) * (size_t)nn);
-      memset(ph->a_i[d], 0, sizeof(double) * (size_t)nn);
-    }
   }
   if (s->cap >= n && s->buf) return 0;
   free(s->buf);
   s->cap = n + n / 4 + 16;
-  const size_t count = (size_t)(4 + 2 * dim + dim * dim) * (size_t)s->cap;
+  const size_t count = (size_t)S_COUNT * (size_t)s->cap;
   s->buf = calloc(count, sizeof(double));
   if (!s->buf) MPM_FAIL_OOM(count * sizeof(double));
   return 0;
@@ -87,19 +81,14 @@ static double *slot(const fluid_gridp_solid *s, int k) {
   return s->buf + (size_t)k * s->cap;
 }
 
-static double *zeros(const mpm_module *m, const fluid_gridp_solid *s) {
-  const int dim = m->grid->dim;
-  return slot(s, S_V + 2 * dim + dim * dim);
-}
-
-/* Zero the region phase, deposit (m, v[0], vsig) of the solid's points through the hierarchy,
- * restrict it and sum level 0's ghosts. */
+/* Zero the region phase, deposit (m, v[0]) or the lean deposit (m, viso) (mpm_kernels.h) of the
+ * points through the hierarchy, restrict it and sum level 0's ghosts. */
 static int deposit(mpm_module *m, const fluid_gridp_solid *s, const double *mass, const double *v0,
-                   const double *vsig) {
+                   const double *viso) {
   const mpm_points *pts = s->pts;
   const int dim = m->grid->dim;
-  mpm_p2g_args a = {.n = pts->n, .m = mass, .vsig = vsig, .lp = ((fluid_content *)m->content)->lp};
-  for (int d = 0; d < dim; ++d) a.x[d] = pts->x[d], a.v[d] = d == 0 && v0 ? v0 : zeros(m, s);
+  mpm_p2g_args a = {.n = pts->n, .m = mass, .viso = viso, .lp = ((fluid_content *)m->content)->lp};
+  for (int d = 0; d < dim; ++d) a.x[d] = pts->x[d], a.v[d] = v0 ? (d ? slot(s, S_ZERO) : v0) : NULL;
   int rc = 0;
   if (m->hier) {
     mpm_hier_phase_zero(m->hier, s->phase);
@@ -124,20 +113,19 @@ static int active(const mpm_module *m, int l, mpm_lidx k) {
   return !m->hier || m->hier->level[l].active[k];
 }
 
-/* Gather at the solid's points: v_h and L of velocity vel (NULL: the phase's) into the scratch,
- * and the ns (<= 2) prolonged level scalars sc[j] into slots out[j]. */
+/* The scalar gather (mpm_kernels.h) at the points: the ns (<= 2) prolonged level scalars sc[j]
+ * into slots out[j], or with div, div v_h of velocity vel (NULL: the phase's) into div. */
 static int gather(mpm_module *m, const fluid_gridp_solid *s, int phase, const mpm_hier_nodal *vel,
-                  int ns, double *const *const *sc, const int *out, int want_L) {
+                  int ns, double *const *const *sc, const int *out, double *div) {
   const mpm_points *pts = s->pts;
   const int dim = m->grid->dim;
   const mpm_grid_phase *ph = &m->grid->phase[phase];
-  mpm_g2p_args a = {.n = pts->n, .lp = ((fluid_content *)m->content)->lp, .nscalar = ns};
+  mpm_g2p_args a = {
+      .n = pts->n, .lp = ((fluid_content *)m->content)->lp, .nscalar = ns, .div_out = div};
   for (int d = 0; d < dim; ++d) {
     a.x[d] = pts->x[d];
     a.v_i[d] = vel ? vel->v_i[0][d] : ph->v_i[d], a.a_i[d] = ph->a_i[d];
-    a.v_out[d] = slot(s, S_V + d), a.a_out[d] = slot(s, S_V + dim + d);
   }
-  a.L_out = want_L ? slot(s, S_V + 2 * dim) : NULL;
   mpm_hier_scalars hs;
   for (int j = 0; j < ns; ++j) {
     a.s_i[j] = sc[j][0], a.s_out[j] = slot(s, out[j]);
@@ -166,7 +154,7 @@ static int weights(mpm_module *m, fluid_gridp_solid *s, const double *const *M,
   if (P) MPM_CALL(fluid_gridp_prolong(m, s->B));
   double *const *sc[2] = {s->A, s->B};
   const int out[2] = {S_W, S_Q};
-  MPM_CALL(gather(m, s, s->phase, NULL, P ? 2 : 1, sc, out, 0));
+  MPM_CALL(gather(m, s, s->phase, NULL, P ? 2 : 1, sc, out, NULL));
   double *W = slot(s, S_W), *q = slot(s, S_Q), *w = slot(s, S_U);
   for (mpm_lidx i = 0; i < pts->n; ++i) {
     w[i] = W[i] > 0.0 ? pts->V[i] : 0.0;
@@ -202,13 +190,11 @@ int fluid_gridp_points_force(mpm_module *m, fluid_gridp_solid *s, double *const 
   MPM_CALL(ensure(m, s, n));
   double *const *sc[1] = {P};
   const int out[1] = {S_Q};
-  MPM_CALL(gather(m, s, s->phase, NULL, 1, sc, out, 0));
-  /* vsig = +V_s p_h(x_s) I: the kernel's f_i -= vsig grad N_i is the correction. */
-  double *vsig = slot(s, S_V), *q = slot(s, S_Q);
-  memset(vsig, 0, sizeof(double) * (size_t)dim * dim * n);
-  for (int d = 0; d < dim; ++d)
-    for (mpm_lidx i = 0; i < n; ++i) vsig[(size_t)(d * dim + d) * n + i] = pts->V[i] * q[i];
-  MPM_CALL(deposit(m, s, zeros(m, s), NULL, vsig));
+  MPM_CALL(gather(m, s, s->phase, NULL, 1, sc, out, NULL));
+  /* viso = +V_s p_h(x_s): the kernel's f_i -= viso grad N_i is the correction. */
+  double *q = slot(s, S_Q);
+  for (mpm_lidx i = 0; i < n; ++i) q[i] *= pts->V[i];
+  MPM_CALL(deposit(m, s, NULL, NULL, q));
   for (int l = 0; l < nlevels(m); ++l) {
     const mpm_grid *g = level_grid(m, l);
     const mpm_grid_phase *src = &g->phase[s->phase], *dst = &g->phase[m->phase];
@@ -228,17 +214,11 @@ int fluid_gridp_solid_force(mpm_module *m, fluid_gridp_solid *s, double *const *
 int fluid_gridp_points_rate(mpm_module *m, fluid_gridp_solid *s, const mpm_hier_nodal *vel,
                             double *const *D) {
   const mpm_points *pts = s->pts;
-  const int dim = m->grid->dim;
   const mpm_lidx n = pts->n;
   MPM_CALL(ensure(m, s, n));
-  MPM_CALL(gather(m, s, m->phase, vel, 0, NULL, NULL, 1));
-  const double *L = slot(s, S_V + 2 * dim);
   double *q = slot(s, S_Q);
-  for (mpm_lidx i = 0; i < n; ++i) {
-    double div = 0.0;
-    for (int d = 0; d < dim; ++d) div += L[(size_t)(d * dim + d) * n + i];
-    q[i] = pts->V[i] * div;
-  }
+  MPM_CALL(gather(m, s, m->phase, vel, 0, NULL, NULL, q));
+  for (mpm_lidx i = 0; i < n; ++i) q[i] *= pts->V[i];
   MPM_CALL(deposit(m, s, q, NULL, NULL)); /* m_i: sum N V div v_h */
   for (int l = 0; l < nlevels(m); ++l) {
     const double *r = level_grid(m, l)->phase[s->phase].m_i;
@@ -264,7 +244,7 @@ int fluid_gridp_solid_rate(mpm_module *m, fluid_gridp_solid *s, const mpm_hier_n
   MPM_CALL(fluid_gridp_prolong(m, s->B));
   double *const *sc[1] = {s->B};
   const int out[1] = {S_Q};
-  MPM_CALL(gather(m, s, s->phase, NULL, 1, sc, out, 0));
+  MPM_CALL(gather(m, s, s->phase, NULL, 1, sc, out, NULL));
   const double *W = slot(s, S_W), *R = slot(s, S_Q);
   double *u = slot(s, S_U);
   for (mpm_lidx i = 0; i < pts->n; ++i) u[i] = W[i] > 0.0 ? pts->V[i] * R[i] / W[i] : 0.0;

@@ -54,7 +54,7 @@ typedef struct fluid_content {
   double mol_damping;        /* fluid.mol_damping (fluid_transfer.c); 0: off */
   int filter_phase;          /* its scratch grid phase (-1: none) */
   double *work;              /* its particle scratch (4 dim cap) */
-  double *sub, *zero;        /* its viscous deposit: positions and stresses, zeros (cap each) */
+  double *sub;               /* its viscous deposit: positions and stresses (cap each) */
   unsigned char *sub_lev;    /* and, refined, their levels (cap) */
   int stable_local;          /* fluid.stable_step = neighbourhood (fluid_stable.c) */
   double s_local;            /* its fastest signal for this step, m/s; < 0: not yet known */

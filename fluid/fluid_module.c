@@ -221,9 +221,9 @@ static int ensure_scratch(mpm_module *m) {
   const int dim = m->grid->dim;
   if (n <= fc->cap && fc->vsig && (!fc->refined || fc->av_l)) return 0;
   free(fc->vsig), free(fc->scratch), free(fc->vnew), free(fc->Cnew), free(fc->power);
-  free(fc->tscratch), free(fc->sub), free(fc->zero), free(fc->work), free(fc->av_l), free(fc->lev);
+  free(fc->tscratch), free(fc->sub), free(fc->work), free(fc->av_l), free(fc->lev);
   free(fc->sub_lev);
-  fc->vnew = fc->Cnew = fc->tscratch = fc->sub = fc->zero = fc->work = fc->av_l = NULL;
+  fc->vnew = fc->Cnew = fc->tscratch = fc->sub = fc->work = fc->av_l = NULL;
   fc->lev = fc->sub_lev = NULL;
   fc->cap = n + n / 4 + 16;
   MPM_ALLOC(fc->vsig, (size_t)dim * dim * fc->cap);
@@ -319,11 +319,7 @@ static int deposit_viscous(mpm_module *m, const double *y, const fluid_batch *b)
   const int dim = b->dim, nk = dim * dim;
   const mpm_lidx n = b->n;
   const size_t cap = (size_t)fc->cap;
-  if (!fc->sub) {
-    MPM_ALLOC(fc->sub, (size_t)(dim + nk) * cap);
-    fc->zero = calloc(cap, sizeof(double));
-    if (!fc->zero) MPM_FAIL(MPM_ERR_MEMORY, "out of memory for %zu particles", cap);
-  }
+  if (!fc->sub) MPM_ALLOC(fc->sub, (size_t)(dim + nk) * cap);
   const int leveled = m->hier && fc->refined; /* fc->lev holds this RHS's levels */
   if (leveled && !fc->sub_lev) MPM_ALLOC(fc->sub_lev, cap);
   double *xs = fc->sub, *sig = xs + (size_t)dim * cap;
@@ -346,8 +342,8 @@ static int deposit_viscous(mpm_module *m, const double *y, const fluid_batch *b)
     }
     ++j;
   }
-  mpm_p2g_args a = {.n = k, .m = fc->zero, .vsig = sig, .lp = fc->lp};
-  for (int d = 0; d < dim; ++d) a.x[d] = xs + (size_t)d * cap, a.v[d] = fc->zero;
+  mpm_p2g_args a = {.n = k, .vsig = sig, .lp = fc->lp}; /* the lean deposit (v NULL) */
+  for (int d = 0; d < dim; ++d) a.x[d] = xs + (size_t)d * cap;
   int rc = 0;
   if (leveled) mpm_hier_levels_known(m->hier, xs, k, fc->sub_lev);
   fluid_p2g_any(m, m->phase, &a, &rc);
@@ -798,7 +794,7 @@ static void fluid_destroy(mpm_module *m) {
     fluid_virtual_free(&fc->virt);
     free(fc->vsig), free(fc->scratch), free(fc->vnew), free(fc->Cnew), free(fc->power);
     free(fc->av_l), free(fc->lev);
-    free(fc->sub), free(fc->zero), free(fc->work), free(fc->sub_lev);
+    free(fc->sub), free(fc->work), free(fc->sub_lev);
     free(fc->tscratch), free(fc->node), free(fc->cellsum), free(fc->lim), free(fc->vol);
     fluid_lnode_free(fc);
     free(fc);
