@@ -1,12 +1,19 @@
 /* fluid.pressure = grid: the gas's pressure acts through the nodes, integrated exactly over the
  * grid's spans, in place of the particles' one-point quadrature.
  *
- * The method. Each particle deposits m_p p_p as it deposits its mass; the nodal pressure is
- * p_j = sum_p m_p N_j(x_p) p_p / m_j, a mass-weighted mean, and p_h = sum_j N_j p_j the field it
- * spans. The nodal force is f_i = integral of p_h grad N_i (-grad p in weak form), and the nodal
- * volume rate D_j = integral of N_j div v_h, both exact (common/mpm_span.h). A particle's volume
- * grows by its share of its nodes' rates, dV_p/dt = m_p sum_j N_j(x_p) D_j / m_j, and its internal
- * energy by the pressure's work on that volume, de_p/dt = -p_p dV_p/dt / m_p. Summed over the
+ * The method. Each particle deposits its volume V_p and V_p p_p; the nodal pressure is
+ * p_j = sum_p V_p N_j(x_p) p_p / V_j, V_j = sum_p V_p N_j(x_p), a volume-weighted mean, and
+ * p_h = sum_j N_j p_j the field it spans. The nodal force is f_i = integral of p_h grad N_i (-grad
+ * p in weak form), and the nodal volume rate D_j = integral of N_j div v_h, both exact
+ * (common/mpm_span.h). A particle's volume grows by its share of its nodes' rates, in proportion
+ * to its volume, dV_p/dt = V_p sum_j N_j(x_p) D_j / V_j, and its internal energy by the pressure's
+ * work on that volume, de_p/dt = -p_p dV_p/dt / m_p. Why volume, not mass: particles of one mass
+ * but very different volumes share a node where refill and merges have worked (near vacuum, the
+ * main job's wake), and a share by mass hands the small one the large one's volume change. With
+ * the weights by mass (before 2026-12-03) a double rarefaction refilled every step crushed such
+ * a particle to J = 1.5e-3 beside neighbours at J = 2e3 (its energy went negative at t = 0.04),
+ * and the main job stopped at 0.59 ms with J <= 0 in the wake; by volume both run (Sod's L1 moved
+ * by under 0.2 %). Summed over the
  * particles that work is -sum_j p_j D_j, minus the nodal forces' power sum_i f_i . v_i (the two
  * span integrals are adjoint), so total energy stays exact as with the particles' quadrature; so
  * does momentum (sum_i grad N_i = 0), and mass is untouched. The viscous stresses (physical and
@@ -15,7 +22,7 @@
  * particles' positions; the particles' quadrature is exact there only by the symmetry of a
  * uniform lattice, which the corners of a refined region break (docs/refinement.md).
  *
- * On a refinement hierarchy (mpm_hier.h) the deposit of m p is restricted with the mass, the
+ * On a refinement hierarchy (mpm_hier.h) the deposit of V p is restricted with the volume, the
  * nodal pressure is formed on the active nodes and prolonged, each level integrates over its own
  * spans (those of its region not refined further; level 0 over the domain, halved at the walls),
  * and the level forces and rates are restricted onto the active nodes, the transposes of the
@@ -26,7 +33,7 @@
  * restriction's sum over the ranks (mpm_hier.h, ranks) counts every span once.
  *
  * Walls. Level 0's pad nodes take part like any node (their pressure and rate from their own
- * unfolded mass); the walls then fold their forces as they fold the particles' deposits. A finer
+ * unfolded volume); the walls then fold their forces as they fold the particles' deposits. A finer
  * level reaching a wall (mpm_hier.h, walls) does the same with its nodes beyond the wall, and
  * integrates only its spans inside it (the wall is a knot of every finer level).
  *
@@ -35,7 +42,7 @@
  * uniform stream through inflow, outflow and far-field faces stays uniform to roundoff. The
  * volume rate integrates the domain only, as at a wall.
  *
- * The classic update (usl, musl). The particles deposit m p and, beside it, the viscous and
+ * The classic update (usl, musl). The particles deposit V and V p and, beside it, the viscous and
  * artificial stresses of the lagged strain rate; the force acts in the solve as above; the volume
  * rate is integrated at the time-centred nodal velocity vbar (fluid_transfer.c), whose gradient
  * heats the viscous stresses too. The pressure's work over the step, -h sum_j p_j D_j(vbar), is
@@ -68,11 +75,11 @@
  * motion pumps (a grid-scale transverse mode, docs/gas.md). The hybrid takes the particles'
  * quadrature of the defect p_p - p_h(x_p) and the exact span integral of p_h:
  *   f_i = sum_p V_p (p_p - p_h(x_p)) grad N_i(x_p) + F_i,   F_i = integral of p_h grad N_i,
- *   dV_p/dt = V_p div v_h(x_p) + m_p sum_j N_j(x_p) (D_j - D^Q_j) / m_j,
+ *   dV_p/dt = V_p div v_h(x_p) + V_p sum_j N_j(x_p) (D_j - D^Q_j) / V_j,
  * with p_h and p_j as above, D_j = integral of N_j div v_h and D^Q_j = sum_q V_q N_j(x_q)
  * div v_h(x_q), the particles' quadrature of D_j. Energy: with de_p/dt = -p_p dV_p/dt / m_p,
  *   sum_p p_p dV_p/dt = sum_p V_p p_p div v_h(x_p) + sum_j p_j (D_j - D^Q_j)
- * (sum_p m_p N_j(x_p) p_p / m_j = p_j), and the forces' power is
+ * (sum_p V_p N_j(x_p) p_p / V_j = p_j), and the forces' power is
  *   sum_i v_i . f_i = sum_p V_p p_p div v_h(x_p) - sum_j p_j D^Q_j + sum_j p_j D_j
  * (sum_i v_i . grad N_i(x) = div v_h(x), p_h(x_p) = sum_j N_j(x_p) p_j, and the span integrals
  * are adjoint): the two are equal term by term, so total energy stays exact as with either
@@ -100,13 +107,14 @@
 #include <string.h>
 
 struct fluid_gridp {
-  int phase;  /* grid phase whose m_i takes the deposit of m p */
+  int phase;  /* grid phase whose m_i and mv_i[0] take the deposits of V and V p */
   int nlev;   /* levels (1 without a hierarchy) */
-  double *mp; /* m p of each particle (cap) */
-  double *s;  /* sum_j N_j D_j / m_j at each particle (cap) */
+  double *mp; /* the pressure p of each particle (cap) */
+  double *s;  /* sum_j N_j D_j / V_j at each particle (cap) */
+  double *zero;
   mpm_lidx cap;
-  /* Per level: nodal pressure, then rate per unit mass (P), forces (F, dim), rates (D), the
-   * mass they divide by (M: each level's before the walls fold it), and the spans it skips. */
+  /* Per level: nodal pressure, then rate per unit volume (P), forces (F, dim), rates (D), the
+   * nodal volume V_j they divide by (M; no wall folds it), and the spans it skips. */
   double *P[MPM_HIER_MAX_LEVELS], *F[MPM_HIER_MAX_LEVELS][MPM_MAX_DIM], *D[MPM_HIER_MAX_LEVELS];
   double *M[MPM_HIER_MAX_LEVELS];
   double *G[MPM_HIER_MAX_LEVELS][MPM_MAX_DIM]; /* the obstacles' span ghost GH (with obstacles) */
@@ -117,7 +125,7 @@ struct fluid_gridp {
   int hybrid;            /* fluid.pressure = hybrid: the gas's own correction (own, pts) */
   fluid_gridp_solid own;
   mpm_points pts; /* the gas's particles of the deposit's state: positions, V (cap) */
-  double *V;
+  double *V;      /* each particle's volume V0 J, the weight of its deposit (cap) */
 };
 
 static int refuse(const mpm_config *cfg, const char *key, const char *why, int hybrid) {
@@ -287,7 +295,7 @@ void fluid_gridp_destroy(fluid_content *fc) {
   fluid_gridp *gp = fc->gridp;
   if (!gp) return;
   fluid_gridp_reset(fc);
-  free(gp->mp), free(gp->s), free(gp->V);
+  free(gp->mp), free(gp->s), free(gp->V), free(gp->zero);
   free(gp);
   fc->gridp = NULL;
 }
@@ -348,11 +356,13 @@ static int ensure_levels(mpm_module *m, fluid_gridp *gp) {
 
 static int ensure_particles(fluid_gridp *gp, mpm_lidx cap) {
   if (gp->cap >= cap && gp->mp) return 0;
-  free(gp->mp), free(gp->s), free(gp->V);
-  gp->mp = gp->s = gp->V = NULL;
+  free(gp->mp), free(gp->s), free(gp->V), free(gp->zero);
+  gp->mp = gp->s = gp->V = gp->zero = NULL;
   MPM_ALLOC(gp->mp, (size_t)cap);
   MPM_ALLOC(gp->s, (size_t)cap);
-  if (gp->hybrid) MPM_ALLOC(gp->V, (size_t)cap);
+  MPM_ALLOC(gp->V, (size_t)cap);
+  gp->zero = calloc((size_t)cap, sizeof(double));
+  if (!gp->zero) MPM_FAIL(MPM_ERR_MEMORY, "out of memory for %ld particles", (long)cap);
   gp->cap = cap;
   return 0;
 }
@@ -365,12 +375,11 @@ int fluid_gridp_deposit(mpm_module *m, const double *y, const fluid_batch *b) {
   const mpm_lidx n = p->n;
   MPM_CALL(ensure_levels(m, gp));
   MPM_CALL(ensure_particles(gp, fc->cap));
-  /* vsig holds -V p on its diagonal (fluid_stress_pressure): keep m p, deposit no stress (the
+  /* vsig holds -V p on its diagonal (fluid_stress_pressure): keep p, deposit no stress (the
    * hybrid keeps it, and the particles' positions and volumes for its correction). */
   for (mpm_lidx i = 0; i < n; ++i) {
-    const double V = b->V0[i] * b->J[i];
-    gp->mp[i] = -b->m[i] * b->vsig[i] / V;
-    if (gp->hybrid) gp->V[i] = V;
+    gp->V[i] = b->V0[i] * b->J[i];
+    gp->mp[i] = -b->vsig[i] / gp->V[i];
   }
   if (gp->hybrid) {
     gp->pts = (mpm_points){.n = n, .V = gp->V};
@@ -382,8 +391,9 @@ int fluid_gridp_deposit(mpm_module *m, const double *y, const fluid_batch *b) {
     mpm_hier_phase_zero(m->hier, gp->phase);
   else
     mpm_grid_phase_zero(m->grid, gp->phase);
-  mpm_p2g_args a = {.n = n, .m = gp->mp, .lp = fc->lp}; /* the lean deposit (v NULL) */
-  for (int d = 0; d < dim; ++d) a.x[d] = y + (size_t)(p->offset[FLUID_X] + d) * n;
+  mpm_p2g_args a = {.n = n, .m = gp->V, .lp = fc->lp};
+  for (int d = 0; d < dim; ++d)
+    a.x[d] = y + (size_t)(p->offset[FLUID_X] + d) * n, a.v[d] = d ? gp->zero : gp->mp;
   int rc = 0;
   fluid_p2g_any(m, gp->phase, &a, &rc);
   return rc;
@@ -406,15 +416,15 @@ int fluid_gridp_prolong(mpm_module *m, double **a) {
   return 0;
 }
 
-/* out[l] = num[l] / mass on the active nodes with mass, 0 elsewhere. */
-static void per_mass(const mpm_module *m, const fluid_gridp *gp, double *const *num,
-                     double *const *out) {
+/* out[l] = num[l] / V_j on the active nodes with gas, 0 elsewhere. */
+static void per_volume(const mpm_module *m, const fluid_gridp *gp, double *const *num,
+                       double *const *out) {
   for (int l = 0; l < gp->nlev; ++l) {
     const mpm_grid *g = level_grid(m, l);
-    const double *mass = gp->M[l];
+    const double *vol = gp->M[l];
     const unsigned char *act = m->hier ? m->hier->level[l].active : NULL;
     for (mpm_lidx k = 0; k < g->nnodes; ++k)
-      out[l][k] = (!act || act[k]) && mass[k] > 0.0 ? num[l][k] / mass[k] : 0.0;
+      out[l][k] = (!act || act[k]) && vol[k] > 0.0 ? num[l][k] / vol[k] : 0.0;
   }
 }
 
@@ -426,7 +436,7 @@ static int ghost_forces(mpm_module *m, fluid_gridp *gp) {
   const int dim = m->grid->dim;
   if (o->count == 0) return 0;
   const mpm_grid *grids[MPM_HIER_MAX_LEVELS];
-  for (int l = 0; l < gp->nlev; ++l) { /* m p of the active nodes for the surface output */
+  for (int l = 0; l < gp->nlev; ++l) { /* V p of the active nodes for the surface output */
     const mpm_grid *g = grids[l] = level_grid(m, l);
     for (mpm_lidx k = 0; k < g->nnodes; ++k) gp->D[l][k] = gp->M[l][k] * gp->P[l][k];
   }
@@ -455,16 +465,17 @@ int fluid_gridp_forces(mpm_module *m) {
   const int dim = m->grid->dim;
   double *Q[MPM_HIER_MAX_LEVELS][MPM_MAX_DIM] = {{NULL}};
   if (m->hier) mpm_hier_restrict(m->hier, gp->phase);
-  for (int l = 0; l < gp->nlev; ++l) Q[l][0] = level_grid(m, l)->phase[gp->phase].m_i;
-  MPM_CALL(mpm_grid_halo_reverse(m->grid, Q[0], 1));
-  /* Each level's mass as the rates will divide by it (the walls fold the phase's own next). */
   for (int l = 0; l < gp->nlev; ++l) {
-    const mpm_grid *g = level_grid(m, l);
-    memcpy(gp->M[l], g->phase[m->phase].m_i, sizeof(double) * (size_t)g->nnodes);
+    const mpm_grid_phase *ph = &level_grid(m, l)->phase[gp->phase];
+    Q[l][0] = ph->m_i, Q[l][1] = ph->mv_i[0];
   }
+  MPM_CALL(mpm_grid_halo_reverse(m->grid, Q[0], 2));
+  /* Each level's volume sum_p V_p N_j, as the pressure and the rates divide by it. */
+  for (int l = 0; l < gp->nlev; ++l)
+    memcpy(gp->M[l], Q[l][0], sizeof(double) * (size_t)level_grid(m, l)->nnodes);
   double *q[MPM_HIER_MAX_LEVELS];
-  for (int l = 0; l < gp->nlev; ++l) q[l] = Q[l][0];
-  per_mass(m, gp, q, gp->P);
+  for (int l = 0; l < gp->nlev; ++l) q[l] = Q[l][1];
+  per_volume(m, gp, q, gp->P);
   fluid_open_grid_pressure(fc->open, gp->P[0]);
   if (gp->beside_solid)
     MPM_CALL(fluid_gridp_solid_pressure(m, &gp->sol, gp->P, (const double *const *)gp->M));
@@ -509,7 +520,7 @@ int fluid_gridp_nodal_rate(mpm_module *m, const mpm_hier_nodal *vel, mpm_hier_sc
     fluid_obstacles_span_rate(level_grid(m, l), m->phase, gp->M[l],
                               m->hier ? m->hier->level[l].active : NULL,
                               (const double *const *)gp->G[l], gp->D[l]);
-  per_mass(m, gp, gp->D, gp->P); /* P now holds the rate per unit mass */
+  per_volume(m, gp, gp->D, gp->P); /* P now holds the rate per unit volume */
   MPM_CALL(fluid_gridp_prolong(m, gp->P));
   memset(s, 0, sizeof *s);
   for (int l = 0; l < gp->nlev; ++l) s->s_i[l][0] = gp->P[l];
@@ -524,10 +535,7 @@ void fluid_gridp_work(const mpm_module *m, const double *y, const double *L, dou
   const double *mass = mpm_particles_comp(p, fc->lay.f_m, 0);
   const double *V0 = mpm_particles_comp(p, fc->lay.f_V0, 0);
   const double *J = y + (size_t)p->offset[FLUID_J] * n;
-  for (mpm_lidx i = 0; i < n; ++i) {
-    power[i] -= gp->mp[i] / mass[i] * gp->s[i];
-    gp->s[i] *= mass[i] / (V0[i] * J[i]);
-  }
+  for (mpm_lidx i = 0; i < n; ++i) power[i] -= gp->mp[i] * V0[i] * J[i] / mass[i] * gp->s[i];
   if (!gp->hybrid) return;
   for (int d = 0; d < p->dim; ++d) /* the point rate, whose work energy_rate has booked */
     for (mpm_lidx i = 0; i < n; ++i) gp->s[i] += L[(size_t)(d * p->dim + d) * n + i];

@@ -90,7 +90,7 @@ static const mpm_key_spec fluid_keys[] = {
      0, NULL},
     {"fluid.pressure", MPM_KEY_ENUM, "auto", 0, 0, 0, 0, "auto|particle|grid|hybrid",
      "where the pressure's force is integrated: particle (each particle's V p at its point, "
-     "the classic MPM quadrature), grid (the nodal pressure, a mass-weighted mean of the "
+     "the classic MPM quadrature), grid (the nodal pressure, a volume-weighted mean of the "
      "particles', integrated exactly over the grid's cells, with each particle's volume "
      "following its nodes' volume rate: gas at rest and uniform streams stay exact across "
      "refined regions, and beside a solid its region is taken out by the solid's quadrature; "

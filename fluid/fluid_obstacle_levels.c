@@ -7,7 +7,7 @@
  * constrained node: the masses of a level scale with h_l^dim). The active nodes are the composite
  * basis's unknowns; the prolongation then fills the inactive nodes from the constrained ones.
  *
- * Span ghost. With the grid pressure the nodal pressure p_j (the mass-weighted mean) is zero on
+ * Span ghost. With the grid pressure the nodal pressure p_j (the volume-weighted mean) is zero on
  * the massless nodes inside a body, so the nodes near its surface miss the pressure of their
  * neighbours inside, as with the particles' quadrature (fluid_obstacle.h, ghost pressure). The
  * ghosts are those massless nodes: with U_j = 1 on them (0 elsewhere) and u_h = sum_j N_j U_j,
