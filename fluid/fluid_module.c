@@ -99,8 +99,10 @@ static const mpm_key_spec fluid_keys[] = {
      "with the grid's as a defect correction: the particles integrate p - p_h, the grid p_h "
      "exactly, so a uniform pressure exerts no force whatever the particles' positions; the "
      "grid's scope without refinement or obstacles, beside a solid monolithic and not contact; "
-     "docs/gas.md) or auto (grid with refine.levels > 1 and no solid, where particle is "
-     "refused; else particle); see docs/refinement.md",
+     "docs/gas.md) or auto (without a solid: grid with refine.levels > 1, where particle is "
+     "refused, else hybrid where its scope holds (and no fluid.regularise_every; under usl "
+     "and musl no farfield or subsonic_inflow face) and particle outside it, silently; beside "
+     "a solid particle; the log says which); see docs/refinement.md",
      0, NULL},
     {"fluid.ppc", MPM_KEY_INT, "2", 1, 8, 0, 0, NULL,
      "gas particles per cell per direction at seeding", 0, "-"},

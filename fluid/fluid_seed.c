@@ -186,6 +186,9 @@ static int add_points(mpm_module *m, const mpm_config *cfg, gas_state *s, int k,
   mpm_gidx *kid = malloc(sizeof *kid * (size_t)(n ? n : 1));
   double *data = calloc((size_t)p->ncomp * (size_t)(n ? n : 1), sizeof *data);
   int rc = keep && kid && data ? 0 : MPM_ERR_MEMORY;
+  if (rc) /* the one line that says what to change (test_run_safety) */
+    mpm_log_all(MPM_LOG_ERROR, MPM_OOM_MESSAGE,
+                (double)n * (1.0 + sizeof *kid + (double)p->ncomp * sizeof *data) / 1e6);
   double minv[2] = {HUGE_VAL, HUGE_VAL}, where[2][3] = {{0}};
   mpm_lidx nk = 0;
   if (!rc) {

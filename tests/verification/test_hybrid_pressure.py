@@ -21,6 +21,10 @@ Every field is uniform along y, so the exact v_y is zero for all time.
    1e-13, its quadrature at the faces' exterior lattice).
 5. What it does not carry is refused with one line naming fluid.pressure, exit 2: refinement,
    obstacles, and beside a solid multirate and contact (not measured with the hybrid).
+6. fluid.pressure = auto, the default, takes the hybrid for this column and for farfield faces
+   under bs32, and the particles' pressure, without an error, with shifting, merges and
+   splits, an obstacle, farfield faces under usl, and beside a solid (fsi_resonator.ini); each
+   run logs one line "pressure: <choice> (...)".
 
 Argument `particle` runs checks 2 and 3 with the particles' pressure instead: check 2 fails
 (measured 7.9e-9 against 1e-13), the demonstration that the test can fail. (The particles'
@@ -129,5 +133,37 @@ for key in ("coupling.time=multirate", "coupling.scheme=contact"):
     check(p.returncode == 2 and len(lines) == 1 and "fluid.pressure" in lines[0],
           f"hybrid beside a solid with {key}: exit {p.returncode}, one line naming fluid.pressure "
           f"({lines[:1]})")
+
+# 6. fluid.pressure = auto (the default): the hybrid for a gas alone where its scope holds, the
+# particles' pressure elsewhere without a refusal, one log line naming the choice.
+def auto_choice(name, text, args=()):
+    d = mt.outdir("auto_" + name)
+    path = os.path.join(d, "case.ini")
+    with open(path, "w") as f:
+        f.write(text)
+    p = mt.run(["check", path] + list(args), check=False)
+    said = [ln for ln in p.stderr.splitlines() if ln.startswith("pressure: ")]
+    errors = [ln for ln in p.stderr.splitlines() if ln.startswith("error")]
+    return p.returncode, said, errors
+
+
+auto = base.replace("pressure = hybrid", "pressure = auto")
+farfield = auto.replace("x_lo = slip", "x_lo = farfield").replace("x_hi = slip", "x_hi = farfield") \
+    + "[freestream]\ndensity = 1\npressure = 1\nvelocity = 0 0\n"
+for name, text, args, want in (
+        ("alone", auto, [], "hybrid"),
+        ("shift", auto, ["fluid.shift=0.375"], "particle"),
+        ("regularise", auto, ["fluid.regularise_every=5"], "particle"),
+        ("obstacle", bs32.replace("pressure = hybrid", "pressure = auto")
+         + "[obstacle.block]\nshape = box\nlo = 0.5 0\nhi = 0.55 0.01\n", [], "particle"),
+        ("farfield_usl", farfield, [], "particle"),
+        ("farfield_bs32", farfield, ["time.method=bs32"], "hybrid")):
+    rc, said, errors = auto_choice(name, text, args)
+    check(rc == 0 and not errors and len(said) == 1 and said[0].startswith(f"pressure: {want} ("),
+          f"auto, {name}: exit {rc}, {len(errors)} errors, logs {said} (one line, {want})")
+p = mt.run(["check", mt.case("fsi_resonator.ini")], check=False)
+said = [ln for ln in p.stderr.splitlines() if ln.startswith("pressure: ")]
+check(p.returncode == 0 and said == ["pressure: particle (fluid.pressure = auto, beside a solid)"],
+      f"auto beside a solid: exit {p.returncode}, logs {said}")
 
 sys.exit(check.finish())

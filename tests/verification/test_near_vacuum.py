@@ -47,8 +47,9 @@ default:
 5. The issue's acceptance with the default settings (no regularisation, refill, shifting or
    light merges: the case's keys set back to their defaults): no empty node inside the gas at
    200, 400 and 800 cells and an observed order >= 0.5 from 200 to 800. Not met, an expected
-   failure: the default gas tears (measured 51 / 99 / 161 empty nodes, L1 0.0447 / 0.0461 /
-   0.0385, order 0.11). Making refill every step the default was measured to break Sod (L1 at 400 cells
+   failure: the default gas tears (measured 59 / 117 / 237 empty nodes, L1 0.0484 / 0.0492 /
+   0.0509, order -0.04, with the hybrid pressure that fluid.pressure = auto takes here since
+   2026-12-03; the particles' pressure: 51 / 99 / 161, L1 0.0447 / 0.0461 / 0.0385, order 0.11). Making refill every step the default was measured to break Sod (L1 at 400 cells
    3.17e-3 -> 1.14e-2: Sod's expanded gas, 1.7 particles per cell, leaves cells empty by
    chance, and their refills misplace density); docs/gas.md "Expansion" has the rest.
 """
