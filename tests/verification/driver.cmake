@@ -75,14 +75,10 @@ mpm_add_script_test(test_gas_shear SCRIPT verification/test_gas_shear.py LABELS 
 # The viscous wave in 3-D under bs32 (a gas layout the particle store could not hold before).
 mpm_add_script_test(test_gas_shear_3d SCRIPT verification/test_gas_shear.py ARGS 3d
                     LABELS verification TIMEOUT 600)
-# The inviscid shear wave at 64 cells goes unstable under FLIP (usl, musl, bs32: kinetic energy
-# x1e6 by t = 1, onset t = 0.43; Brackbill's ringing instability once the particle columns have
-# slid a quarter cell past each other). APIC is stable; particle regularisation does not fix FLIP
-# (measured: same onset with regularise_every = 30 and min 2, 3, 4).
-# Kept honest as an expected failure; see the test's header for the figures.
+# The inviscid shear wave at 64 cells keeps its energy with the hybrid pressure (auto's choice);
+# with the particles' pressure FLIP went unstable from t = 0.43 (the test's header).
 mpm_add_script_test(test_gas_shear_long SCRIPT verification/test_gas_shear.py ARGS long
                     LABELS "verification;long" TIMEOUT 1800)
-set_tests_properties(test_gas_shear_long PROPERTIES WILL_FAIL TRUE)
 # Particle regularisation of the gas: conservation per event, thresholds, ranks, restart.
 mpm_add_script_test(test_regularise SCRIPT verification/test_regularise.py
                     LABELS "verification;mpi" TIMEOUT 600)
