@@ -65,6 +65,7 @@ static long differ(const double *a, const double *b, mpm_lidx nn) {
 /* (i) with the mass (with_m) on or off and the stress (with_s) off (0), isotropic (1) or full
  * (2, an asymmetric random tensor). */
 static void check_deposit(int dim, mpm_shape_kind shape, int with_m, int with_s) {
+  if (dim < 1 || dim > 3) fail_msg("dim %d", dim); /* bounds the loops over x[3] for gcc */
   mpm_grid *g = grid_make(dim, shape);
   uint64_t seed = 5u + (uint64_t)(100 * dim + 10 * shape + 2 * with_m + with_s);
   double *x[3] = {NULL};
@@ -110,6 +111,7 @@ static void check_deposit(int dim, mpm_shape_kind shape, int with_m, int with_s)
 
 /* (ii) with nscalar scalars, with and without div_out. */
 static void check_gather(int dim, mpm_shape_kind shape, int nscalar, int with_div) {
+  if (dim < 1 || dim > 3) fail_msg("dim %d", dim); /* bounds the loops over x[3] for gcc */
   mpm_grid *g = grid_make(dim, shape);
   uint64_t seed = 11u + (uint64_t)(100 * dim + 10 * shape + 2 * nscalar + with_div);
   const size_t nn = (size_t)g->nnodes;
