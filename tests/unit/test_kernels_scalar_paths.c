@@ -52,7 +52,8 @@ static mpm_grid *grid_make(int dim, mpm_shape_kind shape) {
 
 /* Positions 0.1 inside the domain: every stencil lies in the box. */
 static void positions(int dim, uint64_t *seed, double **x) {
-  for (int d = 0; d < dim; ++d) x[d] = random_array(NP, g_lo[d] + 0.1, g_hi[d] - 0.1, seed);
+  for (int d = 0; d < dim && d < MPM_MAX_DIM; ++d)
+    x[d] = random_array(NP, g_lo[d] + 0.1, g_hi[d] - 0.1, seed);
 }
 
 /* Nodes where the arrays a (the lean deposit's) and b (the full one's) differ. */
@@ -73,7 +74,8 @@ static void check_deposit(int dim, mpm_shape_kind shape, int with_m, int with_s)
   double *m = random_array(NP, 0.5, 2.0, &seed), *q = random_array(NP, -3.0, 3.0, &seed);
   double *zero = calloc(NP, sizeof(double)),
          *vsig = calloc((size_t)(dim * dim) * NP, sizeof(double));
-  for (int d = 0; d < dim; ++d) memcpy(vsig + (size_t)(d * dim + d) * NP, q, sizeof(double) * NP);
+  for (int d = 0; d < dim && d < MPM_MAX_DIM; ++d)
+    memcpy(vsig + (size_t)(d * dim + d) * NP, q, sizeof(double) * NP);
   for (size_t k = 0; with_s == 2 && k < (size_t)(dim * dim) * NP; ++k)
     vsig[k] = -2.0 + 4.0 * uniform(&seed);
   mpm_p2g_args s = {.n = NP,
@@ -82,17 +84,17 @@ static void check_deposit(int dim, mpm_shape_kind shape, int with_m, int with_s)
                     .vsig = with_s == 2 ? vsig : NULL,
                     .lp = 0.25};
   mpm_p2g_args f = {.n = NP, .m = with_m ? m : zero, .vsig = with_s ? vsig : NULL, .lp = 0.25};
-  for (int d = 0; d < dim; ++d) s.x[d] = f.x[d] = x[d], f.v[d] = zero;
+  for (int d = 0; d < dim && d < MPM_MAX_DIM; ++d) s.x[d] = f.x[d] = x[d], f.v[d] = zero;
   mpm_grid_phase_zero(g, 0);
   mpm_grid_phase_zero(g, 1);
   const mpm_lidx nn = g->nnodes;
-  for (int d = 0; d < dim; ++d) /* a momentum the lean deposit must not touch */
+  for (int d = 0; d < dim && d < MPM_MAX_DIM; ++d) /* a momentum the lean deposit must not touch */
     for (mpm_lidx l = 0; l < nn; ++l) g->phase[0].mv_i[d][l] = 7.0;
   mpm_kernels_get(dim)->p2g(g, 0, &s);
   mpm_kernels_get(dim)->p2g(g, 1, &f);
   const mpm_grid_phase *a = &g->phase[0], *b = &g->phase[1];
   long dm = differ(a->m_i, b->m_i, nn), df = 0, dmv = 0;
-  for (int d = 0; d < dim; ++d) {
+  for (int d = 0; d < dim && d < MPM_MAX_DIM; ++d) {
     df += differ(a->f_i[d], b->f_i[d], nn);
     for (mpm_lidx l = 0; l < nn; ++l) dmv += a->mv_i[d][l] != 7.0;
   }
@@ -104,7 +106,7 @@ static void check_deposit(int dim, mpm_shape_kind shape, int with_m, int with_s)
          dim, mpm_shape_name(shape), with_m ? "on" : "off", stress[with_s], touched, dm, df, dmv);
   assert_true(touched > 100);
   assert_int_equal(dm + df + dmv, 0);
-  for (int d = 0; d < dim; ++d) free(x[d]);
+  for (int d = 0; d < dim && d < MPM_MAX_DIM; ++d) free(x[d]);
   free(m), free(q), free(zero), free(vsig);
   mpm_grid_destroy(&g);
 }
@@ -116,7 +118,7 @@ static void check_gather(int dim, mpm_shape_kind shape, int nscalar, int with_di
   uint64_t seed = 11u + (uint64_t)(100 * dim + 10 * shape + 2 * nscalar + with_div);
   const size_t nn = (size_t)g->nnodes;
   const mpm_grid_phase *ph = &g->phase[0];
-  for (int d = 0; d < dim; ++d)
+  for (int d = 0; d < dim && d < MPM_MAX_DIM; ++d)
     for (size_t l = 0; l < nn; ++l)
       ph->v_i[d][l] = -1.0 + 2.0 * uniform(&seed), ph->a_i[d][l] = uniform(&seed);
   double *x[3] = {NULL}, *s_i[3], *ref[3], *out[3], *v[3], *acc[3];
@@ -128,7 +130,7 @@ static void check_gather(int dim, mpm_shape_kind shape, int nscalar, int with_di
   double *L = malloc(sizeof(double) * (size_t)(dim * dim) * NP), *div = malloc(sizeof(double) * NP);
   mpm_g2p_args f = {.n = NP, .lp = 0.25, .L_out = L, .nscalar = nscalar};
   mpm_g2p_args s = {.n = NP, .lp = 0.25, .nscalar = nscalar, .div_out = with_div ? div : NULL};
-  for (int d = 0; d < dim; ++d) {
+  for (int d = 0; d < dim && d < MPM_MAX_DIM; ++d) {
     v[d] = malloc(sizeof(double) * NP), acc[d] = malloc(sizeof(double) * NP);
     f.x[d] = s.x[d] = x[d];
     f.v_i[d] = s.v_i[d] = ph->v_i[d], f.a_i[d] = s.a_i[d] = ph->a_i[d];
@@ -150,7 +152,7 @@ static void check_gather(int dim, mpm_shape_kind shape, int nscalar, int with_di
          mpm_shape_name(shape), nscalar, with_div ? "on" : "off", ds, dd);
   assert_int_equal(ds + dd, 0);
   for (int j = 0; j < 3; ++j) free(s_i[j]), free(ref[j]), free(out[j]);
-  for (int d = 0; d < dim; ++d) free(x[d]), free(v[d]), free(acc[d]);
+  for (int d = 0; d < dim && d < MPM_MAX_DIM; ++d) free(x[d]), free(v[d]), free(acc[d]);
   free(L), free(div);
   mpm_grid_destroy(&g);
 }
