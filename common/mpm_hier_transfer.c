@@ -171,6 +171,7 @@ static void p2g_chunk(mpm_hier *h, int l, int phase, const mpm_p2g_args *a, chun
   b.m = gather(c, a->m, 1);
   b.vsig = gather(c, a->vsig, D * D);
   b.viso = gather(c, a->viso, 1);
+  b.s = gather(c, a->s, 1);
   b.C = gather(c, a->C, D * D);
   for (int d = 0; d < D && a->fext[0]; ++d) b.fext[d] = gather(c, a->fext[d], 1);
   mpm_kernels_get(D)->p2g(h->level[l].grid, phase, &b);

@@ -18,14 +18,19 @@
  * force -V sigma grad S of a stress given in full (vsig) or isotropic (viso: V sigma = viso I)
  * into f_i, and nothing else: C and fext must then be unset, and m too when the phase deposits
  * its normals (gravity is not read). It visits only the arrays it fills, a fraction of the full
- * deposit's work; its sums are the full deposit's of zero velocity, operation for operation. */
+ * deposit's work; its sums are the full deposit's of zero velocity, operation for operation.
+ * With s (a scalar per unit mass; needs m, and no stress) it deposits S m s into mv_i[0] beside
+ * S m into m_i: the full deposit's sums for v = (s, 0, ...) in those two arrays, operation for
+ * operation, and nothing into mv_i[1..] or f_i (a two-scalar deposit, such as the grid
+ * pressure's V and V p). */
 typedef struct mpm_p2g_args {
   mpm_lidx n;
   const double *x[MPM_MAX_DIM]; /* positions */
   const double *v[MPM_MAX_DIM]; /* velocities, or v[0] NULL: the lean deposit */
   const double *m;              /* masses */
   const double *viso;           /* the lean deposit's isotropic V sigma, or NULL */
-  const double *vsig;           /* V_p sigma_p, dim*dim components of n, or NULL */
+  const double *s;    /* the lean deposit's scalar per unit mass (into mv_i[0]), or NULL */
+  const double *vsig; /* V_p sigma_p, dim*dim components of n, or NULL */
   /* APIC affine velocity C_p, dim*dim components of n (entry (r, c) at C[(r*dim + c)*n + p]),
    * or NULL. When set the momentum deposited at node i is S m (v_p + C_p (x_i - x_p)). */
   const double *C;

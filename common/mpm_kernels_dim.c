@@ -175,37 +175,40 @@ MPM_INLINE void DIMFN(p2g_loop)(const DIMFN(lattice) * L, mpm_grid_phase *ph, co
   }
 }
 
-/* The lean deposit (mpm_kernels.h): S m into m_i when mass, and with stress (a literal: 0 none,
- * 1 the isotropic viso, 2 the full vsig) the force -V sigma grad S into f_i. Each product is the
- * full loop's for zero velocity (there P_d = -sig_d0 dwx, Q_d = sig_d1 wx and the zero body force
- * adds nothing; a - b = -(b - a) exactly), so the sums agree bitwise. The force factors:
- * f_d -= wy X_d + dwy Y_d [wz (...) + dwz wy Z_d in 3-D], X_d = sig_d0 dwx, Y_d = sig_d1 wx,
- * Z_d = sig_d2 wx; the isotropic stress keeps only the diagonal terms. */
+/* The lean deposit (mpm_kernels.h): S m into m_i when mass, with scalar (a literal; mass and
+ * no stress) S m s into mv_i[0] as the full loop forms m v_0 and its x factors, and with stress
+ * (a literal: 0 none, 1 the isotropic viso, 2 the full vsig) the force -V sigma grad S into f_i.
+ * Each product is the full loop's for zero velocity (there P_d = -sig_d0 dwx, Q_d = sig_d1 wx and
+ * the zero body force adds nothing; a - b = -(b - a) exactly), so the sums agree bitwise. The force
+ * factors: f_d -= wy X_d + dwy Y_d [wz (...) + dwz wy Z_d in 3-D], X_d = sig_d0 dwx, Y_d = sig_d1
+ * wx, Z_d = sig_d2 wx; the isotropic stress keeps only the diagonal terms. */
 MPM_INLINE void DIMFN(p2g_lean_loop)(const DIMFN(lattice) * L, mpm_grid_phase *ph,
                                      const mpm_p2g_args *a, mpm_shape_kind kind, int mass,
-                                     int stress) {
+                                     int scalar, int stress) {
   enum { D = MPM_DIM };
   const int S = SUPPORT(kind);
   const size_t n = (size_t)a->n;
-  double *restrict mi = ph->m_i, *restrict fi[D];
+  double *restrict mi = ph->m_i, *restrict si = ph->mv_i[0], *restrict fi[D];
   const double *restrict xp[D], *restrict mp = a->m, *restrict viso = a->viso;
-  const double *restrict vsig = a->vsig;
+  const double *restrict vsig = a->vsig, *restrict sp = a->s;
   for (int d = 0; d < D; ++d) fi[d] = ph->f_i[d], xp[d] = a->x[d];
   for (size_t p = 0; p < n; ++p) {
     double x[D], sig[D][D];
     for (int d = 0; d < D; ++d) x[d] = xp[d][p];
     const double m = mass ? mp[p] : 0.0, q = stress == 1 ? viso[p] : 0.0;
+    const double ms = scalar ? m * sp[p] : 0.0;
     for (int r = 0; stress == 2 && r < D; ++r)
       for (int c = 0; c < D; ++c) sig[r][c] = vsig[(size_t)(r * D + c) * n + p];
     DIMFN(weights) s;
     DIMFN(weights_eval)(L, kind, x, 0, &s);
     const double *wx = s.w[0], *dwx = s.dw[0], *wy = s.w[1], *dwy = s.dw[1];
-    double mwx[SMAX], X[D][SMAX], Y[D][SMAX];
+    double mwx[SMAX], swx[SMAX], X[D][SMAX], Y[D][SMAX];
 #if MPM_DIM == 3
     double Z[D][SMAX];
 #endif
     for (int i = 0; i < S; ++i) {
       mwx[i] = m * wx[i];
+      swx[i] = wx[i] * ms;
       for (int d = 0; d < D; ++d) {
         X[d][i] = stress == 2 ? sig[d][0] * dwx[i] : q * dwx[i];
         Y[d][i] = stress == 2 ? sig[d][1] * wx[i] : q * wx[i];
@@ -219,6 +222,7 @@ MPM_INLINE void DIMFN(p2g_lean_loop)(const DIMFN(lattice) * L, mpm_grid_phase *p
       const mpm_lidx row = s.first + j * L->sy;
       for (int i = 0; i < S; ++i) {
         if (mass) mi[row + i] += wy[j] * mwx[i];
+        if (scalar) si[row + i] += wy[j] * swx[i];
         if (stress == 1) {
           fi[0][row + i] -= wy[j] * X[0][i];
           fi[1][row + i] -= dwy[j] * Y[1][i];
@@ -228,10 +232,11 @@ MPM_INLINE void DIMFN(p2g_lean_loop)(const DIMFN(lattice) * L, mpm_grid_phase *p
       }
     }
 #else
-    double lm[SMAX][SMAX], lf[D][SMAX][SMAX], lz[D][SMAX][SMAX];
+    double lm[SMAX][SMAX], ls[SMAX][SMAX], lf[D][SMAX][SMAX], lz[D][SMAX][SMAX];
     for (int j = 0; j < S; ++j)
       for (int i = 0; i < S; ++i) {
         lm[j][i] = wy[j] * mwx[i];
+        ls[j][i] = wy[j] * swx[i];
         if (stress == 1) {
           lf[0][j][i] = wy[j] * X[0][i], lf[1][j][i] = dwy[j] * Y[1][i];
           lz[2][j][i] = wy[j] * Z[2][i];
@@ -247,6 +252,7 @@ MPM_INLINE void DIMFN(p2g_lean_loop)(const DIMFN(lattice) * L, mpm_grid_phase *p
         const mpm_lidx row = s.first + j * L->sy + k * L->sz;
         for (int i = 0; i < S; ++i) {
           if (mass) mi[row + i] += wz * lm[j][i];
+          if (scalar) si[row + i] += wz * ls[j][i];
           if (stress == 1) {
             fi[0][row + i] -= wz * lf[0][j][i];
             fi[1][row + i] -= wz * lf[1][j][i];
@@ -265,16 +271,18 @@ MPM_INLINE void DIMFN(p2g_lean_loop)(const DIMFN(lattice) * L, mpm_grid_phase *p
 MPM_INLINE void DIMFN(p2g_lean)(const DIMFN(lattice) * L, mpm_grid_phase *ph, const mpm_p2g_args *a,
                                 mpm_shape_kind kind) {
   const int stress = a->vsig ? 2 : a->viso ? 1 : 0;
-  if (a->m && stress == 1)
-    DIMFN(p2g_lean_loop)(L, ph, a, kind, 1, 1);
+  if (a->s)
+    DIMFN(p2g_lean_loop)(L, ph, a, kind, 1, 1, 0);
+  else if (a->m && stress == 1)
+    DIMFN(p2g_lean_loop)(L, ph, a, kind, 1, 0, 1);
   else if (a->m && stress == 0)
-    DIMFN(p2g_lean_loop)(L, ph, a, kind, 1, 0);
+    DIMFN(p2g_lean_loop)(L, ph, a, kind, 1, 0, 0);
   else if (a->m)
-    DIMFN(p2g_lean_loop)(L, ph, a, kind, 1, 2);
+    DIMFN(p2g_lean_loop)(L, ph, a, kind, 1, 0, 2);
   else if (stress == 1)
-    DIMFN(p2g_lean_loop)(L, ph, a, kind, 0, 1);
+    DIMFN(p2g_lean_loop)(L, ph, a, kind, 0, 0, 1);
   else if (stress == 2)
-    DIMFN(p2g_lean_loop)(L, ph, a, kind, 0, 2);
+    DIMFN(p2g_lean_loop)(L, ph, a, kind, 0, 0, 2);
 }
 
 static void DIMFN(p2g)(mpm_grid *g, int phase, const mpm_p2g_args *a) {
@@ -282,6 +290,7 @@ static void DIMFN(p2g)(mpm_grid *g, int phase, const mpm_p2g_args *a) {
   const DIMFN(lattice) L = DIMFN(lattice_of)(g, a->lp);
   if (!a->v[0]) {
     assert(!(a->vsig && a->viso) && !a->C && !a->fext[0] && !(a->m && ph->normals));
+    assert(!a->s || (a->m && !a->vsig && !a->viso));
     switch (g->shape) {
     case MPM_SHAPE_LINEAR:
       DIMFN(p2g_lean)(&L, ph, a, MPM_SHAPE_LINEAR);
@@ -297,7 +306,7 @@ static void DIMFN(p2g)(mpm_grid *g, int phase, const mpm_p2g_args *a) {
     }
     return;
   }
-  assert(!a->viso);
+  assert(!a->viso && !a->s);
   const int apic = a->C != NULL, grad = ph->normals;
 #define P2G_CASE(kind)                                                                             \
   case kind:                                                                                       \

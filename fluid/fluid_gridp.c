@@ -112,7 +112,6 @@ struct fluid_gridp {
   int nlev;   /* levels (1 without a hierarchy) */
   double *mp; /* the pressure p of each particle (cap) */
   double *s;  /* sum_j N_j D_j / V_j at each particle (cap) */
-  double *zero;
   mpm_lidx cap;
   /* Per level: nodal pressure, then rate per unit volume (P), forces (F, dim), rates (D), the
    * nodal volume V_j they divide by (M; no wall folds it), and the spans it skips. */
@@ -127,6 +126,10 @@ struct fluid_gridp {
   fluid_gridp_solid own;
   mpm_points pts; /* the gas's particles of the deposit's state: positions, V (cap) */
   double *V;      /* each particle's volume V0 J, the weight of its deposit (cap) */
+  /* The hybrid without a solid: the deposit forms P at once (early), and the particles deposit
+   * the defect's stress sig, their vsig with +V p_h(x_p) (load) on its diagonal. */
+  int early;
+  double *load, *sig; /* (cap), (dim * dim * cap) */
 };
 
 static int refuse(const mpm_config *cfg, const char *key, const char *why, int hybrid) {
@@ -381,7 +384,7 @@ void fluid_gridp_destroy(fluid_content *fc) {
   fluid_gridp *gp = fc->gridp;
   if (!gp) return;
   fluid_gridp_reset(fc);
-  free(gp->mp), free(gp->s), free(gp->V), free(gp->zero);
+  free(gp->mp), free(gp->s), free(gp->V), free(gp->load), free(gp->sig);
   free(gp);
   fc->gridp = NULL;
 }
@@ -440,17 +443,53 @@ static int ensure_levels(mpm_module *m, fluid_gridp *gp) {
   return 0;
 }
 
-static int ensure_particles(fluid_gridp *gp, mpm_lidx cap) {
+static int ensure_particles(fluid_gridp *gp, mpm_lidx cap, int dim) {
   if (gp->cap >= cap && gp->mp) return 0;
-  free(gp->mp), free(gp->s), free(gp->V), free(gp->zero);
-  gp->mp = gp->s = gp->V = gp->zero = NULL;
+  free(gp->mp), free(gp->s), free(gp->V), free(gp->load), free(gp->sig);
+  gp->mp = gp->s = gp->V = gp->load = gp->sig = NULL;
   MPM_ALLOC(gp->mp, (size_t)cap);
   MPM_ALLOC(gp->s, (size_t)cap);
   MPM_ALLOC(gp->V, (size_t)cap);
-  gp->zero = calloc((size_t)cap, sizeof(double));
-  if (!gp->zero) MPM_FAIL(MPM_ERR_MEMORY, "out of memory for %ld particles", (long)cap);
+  if (gp->hybrid) MPM_ALLOC(gp->load, (size_t)cap);
+  if (gp->hybrid) MPM_ALLOC(gp->sig, (size_t)dim * dim * cap);
   gp->cap = cap;
   return 0;
+}
+
+/* out[l] = num[l] / V_j on the active nodes with gas, 0 elsewhere. */
+static void per_volume(const mpm_module *m, const fluid_gridp *gp, double *const *num,
+                       double *const *out) {
+  for (int l = 0; l < gp->nlev; ++l) {
+    const mpm_grid *g = level_grid(m, l);
+    const double *vol = gp->M[l];
+    const unsigned char *act = m->hier ? m->hier->level[l].active : NULL;
+    for (mpm_lidx k = 0; k < g->nnodes; ++k)
+      out[l][k] = (!act || act[k]) && vol[k] > 0.0 ? num[l][k] / vol[k] : 0.0;
+  }
+}
+
+/* The nodal pressure P of the deposits of V and V p on every level (continued into a solid's
+ * region, its open faces' pad nodes set, prolonged), and the volumes M it divides by. */
+static int nodal_pressure(mpm_module *m) {
+  fluid_content *fc = m->content;
+  fluid_gridp *gp = fc->gridp;
+  double *Q[MPM_HIER_MAX_LEVELS][MPM_MAX_DIM] = {{NULL}};
+  if (m->hier) mpm_hier_restrict(m->hier, gp->phase);
+  for (int l = 0; l < gp->nlev; ++l) {
+    const mpm_grid_phase *ph = &level_grid(m, l)->phase[gp->phase];
+    Q[l][0] = ph->m_i, Q[l][1] = ph->mv_i[0];
+  }
+  MPM_CALL(mpm_grid_halo_reverse(m->grid, Q[0], 2));
+  /* Each level's volume sum_p V_p N_j, as the pressure and the rates divide by it. */
+  for (int l = 0; l < gp->nlev; ++l)
+    memcpy(gp->M[l], Q[l][0], sizeof(double) * (size_t)level_grid(m, l)->nnodes);
+  double *q[MPM_HIER_MAX_LEVELS];
+  for (int l = 0; l < gp->nlev; ++l) q[l] = Q[l][1];
+  per_volume(m, gp, q, gp->P);
+  fluid_open_grid_pressure(fc->open, gp->P[0]);
+  if (gp->beside_solid)
+    MPM_CALL(fluid_gridp_solid_pressure(m, &gp->sol, gp->P, (const double *const *)gp->M));
+  return fluid_gridp_prolong(m, gp->P);
 }
 
 int fluid_gridp_deposit(mpm_module *m, const double *y, const fluid_batch *b) {
@@ -460,7 +499,7 @@ int fluid_gridp_deposit(mpm_module *m, const double *y, const fluid_batch *b) {
   const int dim = p->dim;
   const mpm_lidx n = p->n;
   MPM_CALL(ensure_levels(m, gp));
-  MPM_CALL(ensure_particles(gp, fc->cap));
+  MPM_CALL(ensure_particles(gp, fc->cap, dim));
   /* vsig holds -V p on its diagonal (fluid_stress_pressure): keep p, deposit no stress (the
    * hybrid keeps it, and the particles' positions and volumes for its correction). */
   for (mpm_lidx i = 0; i < n; ++i) {
@@ -473,16 +512,40 @@ int fluid_gridp_deposit(mpm_module *m, const double *y, const fluid_batch *b) {
   } else {
     memset(b->vsig, 0, sizeof(double) * (size_t)dim * dim * n);
   }
-  if (m->hier)
+  if (m->hier) {
     mpm_hier_phase_zero(m->hier, gp->phase);
-  else
-    mpm_grid_phase_zero(m->grid, gp->phase);
-  mpm_p2g_args a = {.n = n, .m = gp->V, .lp = fc->lp};
-  for (int d = 0; d < dim; ++d)
-    a.x[d] = y + (size_t)(p->offset[FLUID_X] + d) * n, a.v[d] = d ? gp->zero : gp->mp;
+  } else { /* the arrays the two-scalar deposit fills, the only ones nodal_pressure reads */
+    const size_t bytes = sizeof(double) * (size_t)m->grid->nnodes;
+    memset(m->grid->phase[gp->phase].m_i, 0, bytes);
+    memset(m->grid->phase[gp->phase].mv_i[0], 0, bytes);
+  }
+  /* The lean two-scalar deposit (mpm_kernels.h): V into m_i, V p into mv_i[0]. */
+  mpm_p2g_args a = {.n = n, .m = gp->V, .s = gp->mp, .lp = fc->lp};
+  for (int d = 0; d < dim; ++d) a.x[d] = y + (size_t)(p->offset[FLUID_X] + d) * n;
   int rc = 0;
   fluid_p2g_any(m, gp->phase, &a, &rc);
-  return rc;
+  MPM_CALL(rc);
+  /* The hybrid without a solid: the force's correction -sum_p V_p p_h(x_p) grad N_i joins the
+   * particles' own deposit (fluid_gridp_stress), one deposit fewer. Beside a solid the nodal
+   * pressure waits for the forces: its continuation reads the solid's points of this state. */
+  gp->early = gp->hybrid && !gp->beside_solid && !m->hier;
+  if (!gp->early) return 0;
+  MPM_CALL(nodal_pressure(m));
+  double *load;
+  MPM_CALL(fluid_gridp_points_load(m, &gp->own, gp->P, &load));
+  memcpy(gp->load, load, sizeof(double) * (size_t)n);
+  return 0;
+}
+
+const double *fluid_gridp_stress(const mpm_module *m, const double *vsig) {
+  const fluid_gridp *gp = ((const fluid_content *)m->content)->gridp;
+  if (!gp || !gp->early) return vsig;
+  const int dim = m->grid->dim;
+  const size_t n = (size_t)m->particles->n;
+  memcpy(gp->sig, vsig, sizeof(double) * (size_t)dim * dim * n);
+  for (int d = 0; d < dim; ++d)
+    for (size_t i = 0; i < n; ++i) gp->sig[(size_t)(d * dim + d) * n + i] += gp->load[i];
+  return gp->sig;
 }
 
 /* Restrict level arrays a[l][0 .. nf) onto the active nodes (finest level first) and sum level
@@ -500,18 +563,6 @@ int fluid_gridp_prolong(mpm_module *m, double **a) {
   for (int l = 1; m->hier && l < m->hier->nlevels; ++l)
     mpm_hier_prolong_level(m->hier, l, (const double *const *)&a[l - 1], &a[l], 1);
   return 0;
-}
-
-/* out[l] = num[l] / V_j on the active nodes with gas, 0 elsewhere. */
-static void per_volume(const mpm_module *m, const fluid_gridp *gp, double *const *num,
-                       double *const *out) {
-  for (int l = 0; l < gp->nlev; ++l) {
-    const mpm_grid *g = level_grid(m, l);
-    const double *vol = gp->M[l];
-    const unsigned char *act = m->hier ? m->hier->level[l].active : NULL;
-    for (mpm_lidx k = 0; k < g->nnodes; ++k)
-      out[l][k] = (!act || act[k]) && vol[k] > 0.0 ? num[l][k] / vol[k] : 0.0;
-  }
 }
 
 /* The obstacles' span ghost (fluid_obstacle_levels.c): the mask of the massless nodes inside a
@@ -549,23 +600,7 @@ int fluid_gridp_forces(mpm_module *m) {
   fluid_content *fc = m->content;
   fluid_gridp *gp = fc->gridp;
   const int dim = m->grid->dim;
-  double *Q[MPM_HIER_MAX_LEVELS][MPM_MAX_DIM] = {{NULL}};
-  if (m->hier) mpm_hier_restrict(m->hier, gp->phase);
-  for (int l = 0; l < gp->nlev; ++l) {
-    const mpm_grid_phase *ph = &level_grid(m, l)->phase[gp->phase];
-    Q[l][0] = ph->m_i, Q[l][1] = ph->mv_i[0];
-  }
-  MPM_CALL(mpm_grid_halo_reverse(m->grid, Q[0], 2));
-  /* Each level's volume sum_p V_p N_j, as the pressure and the rates divide by it. */
-  for (int l = 0; l < gp->nlev; ++l)
-    memcpy(gp->M[l], Q[l][0], sizeof(double) * (size_t)level_grid(m, l)->nnodes);
-  double *q[MPM_HIER_MAX_LEVELS];
-  for (int l = 0; l < gp->nlev; ++l) q[l] = Q[l][1];
-  per_volume(m, gp, q, gp->P);
-  fluid_open_grid_pressure(fc->open, gp->P[0]);
-  if (gp->beside_solid)
-    MPM_CALL(fluid_gridp_solid_pressure(m, &gp->sol, gp->P, (const double *const *)gp->M));
-  MPM_CALL(fluid_gridp_prolong(m, gp->P));
+  if (!gp->early) MPM_CALL(nodal_pressure(m));
   for (int l = 0; l < gp->nlev; ++l) {
     const mpm_grid *g = level_grid(m, l);
     for (int d = 0; d < dim; ++d) memset(gp->F[l][d], 0, sizeof(double) * (size_t)g->nnodes);
@@ -582,7 +617,7 @@ int fluid_gridp_forces(mpm_module *m) {
       for (mpm_lidx k = 0; k < g->nnodes; ++k) ph->f_i[d][k] += gp->F[l][d][k];
   }
   if (gp->beside_solid) MPM_CALL(fluid_gridp_solid_force(m, &gp->sol, gp->P));
-  if (gp->hybrid) MPM_CALL(fluid_gridp_points_force(m, &gp->own, gp->P));
+  if (gp->hybrid && !gp->early) MPM_CALL(fluid_gridp_points_force(m, &gp->own, gp->P));
   return ghost_forces(m, gp);
 }
 

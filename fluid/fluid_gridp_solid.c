@@ -59,8 +59,8 @@ static const mpm_grid *level_grid(const mpm_module *m, int l) {
   return m->hier ? m->hier->level[l].grid : m->grid;
 }
 
-/* Scratch per solid point: q, W, u, and zeros (the velocities of the continuation's deposit). */
-enum { S_Q, S_W, S_U, S_ZERO, S_COUNT };
+/* Scratch per solid point: q, W, u. */
+enum { S_Q, S_W, S_U, S_COUNT };
 static int ensure(mpm_module *m, fluid_gridp_solid *s, mpm_lidx n) {
   const int fresh = !s->A[0];
   for (int l = 0; fresh && l < (m->hier ? m->hier->nlevels : 1); ++l) {
@@ -81,14 +81,23 @@ static double *slot(const fluid_gridp_solid *s, int k) {
   return s->buf + (size_t)k * s->cap;
 }
 
-/* Zero the region phase, deposit (m, v[0]) or the lean deposit (m, viso) (mpm_kernels.h) of the
- * points through the hierarchy, restrict it and sum level 0's ghosts. */
+/* Zero the region phase, make the lean deposit (mpm_kernels.h) of the points, m with v0 (the
+ * two-scalar deposit: m v0 into mv_i[0]) or (m, viso), through the hierarchy, restrict it and
+ * sum level 0's ghosts. */
 static int deposit(mpm_module *m, const fluid_gridp_solid *s, const double *mass, const double *v0,
                    const double *viso) {
   const mpm_points *pts = s->pts;
   const int dim = m->grid->dim;
-  mpm_p2g_args a = {.n = pts->n, .m = mass, .viso = viso, .lp = ((fluid_content *)m->content)->lp};
-  for (int d = 0; d < dim; ++d) a.x[d] = pts->x[d], a.v[d] = v0 ? (d ? slot(s, S_ZERO) : v0) : NULL;
+  mpm_p2g_args a = {
+      .n = pts->n, .m = mass, .s = v0, .viso = viso, .lp = ((fluid_content *)m->content)->lp};
+  for (int d = 0; d < dim; ++d) a.x[d] = pts->x[d];
+  /* The arrays this deposit fills, the only ones its readers read: m_i, mv_i[0] or f_i. */
+  mpm_grid_phase *ph = &m->grid->phase[s->phase];
+  double *f[2 + MPM_MAX_DIM];
+  int nf = 0;
+  if (mass) f[nf++] = ph->m_i;
+  if (v0) f[nf++] = ph->mv_i[0];
+  for (int d = 0; viso && d < dim; ++d) f[nf++] = ph->f_i[d];
   int rc = 0;
   if (m->hier) {
     mpm_hier_phase_zero(m->hier, s->phase);
@@ -96,13 +105,10 @@ static int deposit(mpm_module *m, const fluid_gridp_solid *s, const double *mass
     MPM_CALL(rc);
     mpm_hier_restrict(m->hier, s->phase);
   } else {
-    mpm_grid_phase_zero(m->grid, s->phase);
+    for (int k = 0; k < nf; ++k) memset(f[k], 0, sizeof(double) * (size_t)m->grid->nnodes);
     fluid_p2g_any(m, s->phase, &a, &rc);
   }
-  mpm_grid_phase *ph = &m->grid->phase[s->phase];
-  double *f[2 + MPM_MAX_DIM] = {ph->m_i, ph->mv_i[0]};
-  for (int d = 0; d < dim; ++d) f[2 + d] = ph->f_i[d];
-  return mpm_grid_halo_reverse(m->grid, f, 2 + dim);
+  return mpm_grid_halo_reverse(m->grid, f, nf);
 }
 
 static int nlevels(const mpm_module *m) {
@@ -183,17 +189,22 @@ int fluid_gridp_solid_pressure(mpm_module *m, fluid_gridp_solid *s, double *cons
   return 0;
 }
 
-int fluid_gridp_points_force(mpm_module *m, fluid_gridp_solid *s, double *const *P) {
+int fluid_gridp_points_load(mpm_module *m, fluid_gridp_solid *s, double *const *P, double **load) {
   const mpm_points *pts = s->pts;
-  const int dim = m->grid->dim;
-  const mpm_lidx n = pts->n;
-  MPM_CALL(ensure(m, s, n));
+  MPM_CALL(ensure(m, s, pts->n));
   double *const *sc[1] = {P};
   const int out[1] = {S_Q};
   MPM_CALL(gather(m, s, s->phase, NULL, 1, sc, out, NULL));
+  double *q = *load = slot(s, S_Q);
+  for (mpm_lidx i = 0; i < pts->n; ++i) q[i] *= pts->V[i];
+  return 0;
+}
+
+int fluid_gridp_points_force(mpm_module *m, fluid_gridp_solid *s, double *const *P) {
+  const int dim = m->grid->dim;
   /* viso = +V_s p_h(x_s): the kernel's f_i -= viso grad N_i is the correction. */
-  double *q = slot(s, S_Q);
-  for (mpm_lidx i = 0; i < n; ++i) q[i] *= pts->V[i];
+  double *q;
+  MPM_CALL(fluid_gridp_points_load(m, s, P, &q));
   MPM_CALL(deposit(m, s, NULL, NULL, q));
   for (int l = 0; l < nlevels(m); ++l) {
     const mpm_grid *g = level_grid(m, l);

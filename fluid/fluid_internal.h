@@ -126,13 +126,16 @@ int fluid_volume_rate(mpm_module *m, const double *y, const double *const *v_i, 
  * particles' rate (fluid_gridp_rate_out); work: adds the pressure's de/dt to power,
  * then turns that rate into dJ/dt / J in place (hybrid: adding tr L, the particles' velocity
  * gradient whose work energy_rate booked). hybrid: the same with the particles' quadrature of
- * p - p_h kept in their stress (fluid_gridp.c). */
+ * p - p_h kept in their stress (fluid_gridp.c); without a solid (and a hierarchy) its deposit
+ * forms the nodal pressure at once and stress returns the stress to deposit, vsig with the
+ * defect's load V p_h(x_p) on its diagonal (vsig itself otherwise; vsig is left as it is). */
 int fluid_gridp_init(mpm_module *m, const mpm_config *cfg);
 int fluid_gridp_refine(mpm_module *m, const mpm_config *cfg, mpm_hier *h); /* h may be NULL */
 void fluid_gridp_destroy(fluid_content *fc);
 /* Forget the per-level arrays: the hierarchy changed (a regrid). */
 void fluid_gridp_reset(fluid_content *fc);
 int fluid_gridp_deposit(mpm_module *m, const double *y, const fluid_batch *b);
+const double *fluid_gridp_stress(const mpm_module *m, const double *vsig);
 int fluid_gridp_forces(mpm_module *m);
 int fluid_gridp_nodal_rate(mpm_module *m, const mpm_hier_nodal *v, mpm_hier_scalars *s);
 double *fluid_gridp_rate_out(const fluid_content *fc);
@@ -166,6 +169,9 @@ int fluid_gridp_solid_rate(mpm_module *m, fluid_gridp_solid *s, const mpm_hier_n
  * adds -sum_s V_s p_h(x_s) grad N_i(x_s) to the gas phase's f_i (P prolonged), rate subtracts
  * sum_s V_s N_j(x_s) div v_h(x_s) from D (vel: the velocity read, NULL the gas phase's). */
 int fluid_gridp_points_force(mpm_module *m, fluid_gridp_solid *s, double *const *P);
+/* V_s p_h(x_s) at the points into *load (scratch of s, valid until its next call): the force's
+ * load, for a caller that deposits it with its own stress. */
+int fluid_gridp_points_load(mpm_module *m, fluid_gridp_solid *s, double *const *P, double **load);
 int fluid_gridp_points_rate(mpm_module *m, fluid_gridp_solid *s, const mpm_hier_nodal *vel,
                             double *const *D);
 

@@ -353,6 +353,16 @@ static int deposit_viscous(mpm_module *m, const double *y, const fluid_batch *b)
   return rc;
 }
 
+/* Add the viscous part of V sigma (fluid_stress_viscous) of the lagged rate to b->vsig, which
+ * holds the pressure's part: the classic update's whole stress, for one deposit. */
+static void add_viscous(const fluid_content *fc, fluid_batch *b) {
+  const int nk = b->dim * b->dim;
+  double one[MPM_MAX_DIM * MPM_MAX_DIM];
+  for (mpm_lidx i = 0; i < b->n; ++i)
+    if (fluid_stress_viscous(&fc->gas, b, i, one))
+      for (int q = 0; q < nk; ++q) b->vsig[(size_t)q * b->n + i] += one[q];
+}
+
 /* The stress batch of the state y: its fields and the lagged rate (divv, D). */
 static fluid_batch batch_of(const mpm_module *m, const double *y) {
   const fluid_content *fc = m->content;
@@ -386,15 +396,16 @@ static int fluid_p2g(mpm_module *m, double t, const double *y) {
     return 0;
   }
   /* The current rate (above): the pressure's deposit; p2g_rate adds the viscous one. The grid
-   * pressure (fluid_gridp.c) in the classic update: the pressure's deposit, then the viscous
-   * one of the lagged rate at once. */
+   * pressure (fluid_gridp.c) in the classic update: its deposit reads the particles' pressure
+   * (and, but for the hybrid, takes it out of vsig), then the viscous stress of the lagged rate
+   * joins vsig for one deposit. */
   mpm_timer_start(MPM_T_STRESS);
   fluid_stress_pressure(&fc->gas, &b);
   mpm_timer_stop(MPM_T_STRESS);
   mpm_timer_start(MPM_T_P2G);
   if (fc->gridp) MPM_CALL(fluid_gridp_deposit(m, y, &b));
-  MPM_CALL(deposit(m, y, fc->vsig, NULL));
-  if (!fc->current_rate) MPM_CALL(deposit_viscous(m, y, &b));
+  if (!fc->current_rate) add_viscous(fc, &b);
+  MPM_CALL(deposit(m, y, fluid_gridp_stress(m, fc->vsig), NULL));
   mpm_timer_stop(MPM_T_P2G);
   return 0;
 }

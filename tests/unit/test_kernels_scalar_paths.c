@@ -4,7 +4,9 @@
  *      gives the nodal mass and force of the full deposit with zero velocity (and vsig = viso I),
  *      and leaves the momentum alone; with m or the stress alone, that part alone;
  *  (ii) the scalar gather (v_out[0] NULL) gives the full gather's scalars, and div_out its
- *      trace of L, L_00 + L_11 (+ L_22), for one to three scalars with and without div_out.
+ *      trace of L, L_00 + L_11 (+ L_22), for one to three scalars with and without div_out;
+ *  (iii) the two-scalar deposit (m and s, v[0] NULL) gives the nodal mass and mv_i[0] of the
+ *      full deposit with v = (s, 0, ...), and touches no other array.
  *
  * Tolerance: none, the values must be equal. The scalar paths are documented to do the full
  * kernels' operations in the full kernels' order (the grid pressure's results must not move
@@ -111,6 +113,45 @@ static void check_deposit(int dim, mpm_shape_kind shape, int with_m, int with_s)
   mpm_grid_destroy(&g);
 }
 
+/* (iii) the two-scalar deposit (m and s): m_i and mv_i[0] of the full deposit with v = (s, 0,
+ * ...), and nothing into mv_i[1..] or f_i. */
+static void check_two_scalars(int dim, mpm_shape_kind shape) {
+  if (dim < 1 || dim > 3) fail_msg("dim %d", dim); /* bounds the loops over x[3] for gcc */
+  mpm_grid *g = grid_make(dim, shape);
+  uint64_t seed = 17u + (uint64_t)(100 * dim + 10 * shape);
+  double *x[3] = {NULL};
+  positions(dim, &seed, x);
+  double *m = random_array(NP, 0.5, 2.0, &seed), *q = random_array(NP, -3.0, 3.0, &seed);
+  double *zero = calloc(NP, sizeof(double));
+  mpm_p2g_args s = {.n = NP, .m = m, .s = q, .lp = 0.25};
+  mpm_p2g_args f = {.n = NP, .m = m, .lp = 0.25};
+  for (int d = 0; d < dim && d < MPM_MAX_DIM; ++d) s.x[d] = f.x[d] = x[d], f.v[d] = d ? zero : q;
+  mpm_grid_phase_zero(g, 0);
+  mpm_grid_phase_zero(g, 1);
+  const mpm_lidx nn = g->nnodes;
+  for (int d = 0; d < dim && d < MPM_MAX_DIM; ++d) /* arrays the deposit must not touch */
+    for (mpm_lidx l = 0; l < nn; ++l) {
+      g->phase[0].f_i[d][l] = 7.0;
+      if (d) g->phase[0].mv_i[d][l] = 7.0;
+    }
+  mpm_kernels_get(dim)->p2g(g, 0, &s);
+  mpm_kernels_get(dim)->p2g(g, 1, &f);
+  const mpm_grid_phase *a = &g->phase[0], *b = &g->phase[1];
+  long dm = differ(a->m_i, b->m_i, nn), ds = differ(a->mv_i[0], b->mv_i[0], nn), other = 0;
+  for (int d = 0; d < dim && d < MPM_MAX_DIM; ++d)
+    for (mpm_lidx l = 0; l < nn; ++l) other += a->f_i[d][l] != 7.0 || (d && a->mv_i[d][l] != 7.0);
+  long touched = 0;
+  for (mpm_lidx l = 0; l < nn; ++l) touched += b->mv_i[0][l] != 0.0;
+  printf("  %d-D %-9s two-scalar deposit: %ld nodes reached; differing m_i %ld, mv_i[0] %ld, "
+         "other arrays touched %ld\n",
+         dim, mpm_shape_name(shape), touched, dm, ds, other);
+  assert_true(touched > 100);
+  assert_int_equal(dm + ds + other, 0);
+  for (int d = 0; d < dim && d < MPM_MAX_DIM; ++d) free(x[d]);
+  free(m), free(q), free(zero);
+  mpm_grid_destroy(&g);
+}
+
 /* (ii) with nscalar scalars, with and without div_out. */
 static void check_gather(int dim, mpm_shape_kind shape, int nscalar, int with_div) {
   if (dim < 1 || dim > 3) fail_msg("dim %d", dim); /* bounds the loops over x[3] for gcc */
@@ -166,6 +207,12 @@ static void test_lean_deposit(void **state) {
           if (with_m || with_s) check_deposit(dim, (mpm_shape_kind)s, with_m, with_s);
 }
 
+static void test_two_scalar_deposit(void **state) {
+  (void)state;
+  for (int dim = 2; dim <= 3; ++dim)
+    for (int s = 0; s < MPM_SHAPE_COUNT; ++s) check_two_scalars(dim, (mpm_shape_kind)s);
+}
+
 static void test_scalar_gather(void **state) {
   (void)state;
   for (int dim = 2; dim <= 3; ++dim)
@@ -178,6 +225,7 @@ static void test_scalar_gather(void **state) {
 int main(int argc, char **argv) {
   MPI_Init(&argc, &argv);
   const struct CMUnitTest tests[] = {cmocka_unit_test(test_lean_deposit),
+                                     cmocka_unit_test(test_two_scalar_deposit),
                                      cmocka_unit_test(test_scalar_gather)};
   const int rc = cmocka_run_group_tests(tests, NULL, NULL);
   MPI_Finalize();
