@@ -175,6 +175,71 @@ static inline void integrate_dim(const mpm_grid *g, const mpm_span_set *s, int d
       }
 }
 
+/* y[a] = A[a][0] x[0] + A[a][1] x[s] + A[a][2] x[2 s], a = 0 .. 2 (y at stride t): one line of
+ * axis_apply, in its order of operations. */
+static inline void line3(const double A[NA][NA], const double *x, int s, double *y, int t) {
+  const double x0 = x[0], x1 = x[s], x2 = x[2 * s];
+  for (int a = 0; a < NA; ++a) y[a * t] = A[a][0] * x0 + A[a][1] * x1 + A[a][2] * x2;
+}
+
+/* integrate_dim for dim = 2, its products and sums in the same order (so the same bits), with
+ * the axis loops written out: the sum-factorised span in registers, the kind of each span found
+ * once per row and column. The 2-D gas runs it twice a step (the grid and hybrid pressures). */
+static void integrate_2d(const mpm_grid *g, const mpm_span_set *s, const double *p,
+                         double *const *f, const double *const *v, double *D) {
+  axis_mats kind[SPAN_KINDS];
+  kinds_fill(kind, g->dx);
+  const mpm_lidx sy = g->box_n[0];
+  for (int gy = s->lo[1]; gy <= s->hi[1]; ++gy) {
+    const axis_mats *my = &kind[s->half_lo[1] && gy == s->lo[1]   ? SPAN_UPPER
+                                : s->half_hi[1] && gy == s->hi[1] ? SPAN_LOWER
+                                                                  : SPAN_FULL];
+    for (int gx = s->lo[0]; gx <= s->hi[0]; ++gx) {
+      const mpm_lidx n = (mpm_lidx)(gy - g->box_lo[1]) * sy + (gx - g->box_lo[0]);
+      if (s->skip && s->skip[n]) continue;
+      const axis_mats *mx = &kind[s->half_lo[0] && gx == s->lo[0]   ? SPAN_UPPER
+                                  : s->half_hi[0] && gx == s->hi[0] ? SPAN_LOWER
+                                                                    : SPAN_FULL];
+      const double sc0 = mx->sG * my->sM, sc1 = my->sG * mx->sM; /* span_scales */
+      const mpm_lidx base = n - 1 - sy;                          /* node (-1, -1) */
+      if (p) {
+        double x[NMAX], t[NMAX], B[NMAX], f0[NMAX], f1[NMAX];
+        for (int j = 0; j < NA; ++j)
+          for (int i = 0; i < NA; ++i) x[i + NA * j] = p[base + j * sy + i];
+        for (int j = 0; j < NA; ++j) line3(mx->M, x + NA * j, 1, t + NA * j, 1);
+        for (int i = 0; i < NA; ++i) line3(my->G, t + i, NA, f1 + i, NA);
+        for (int i = 0; i < NA; ++i) line3(my->M, x + i, NA, B + i, NA);
+        for (int j = 0; j < NA; ++j) line3(mx->G, B + NA * j, 1, f0 + NA * j, 1);
+        for (int j = 0; j < NA; ++j)
+          for (int i = 0; i < NA; ++i) {
+            f[0][base + j * sy + i] += sc0 * f0[i + NA * j];
+            f[1][base + j * sy + i] += sc1 * f1[i + NA * j];
+          }
+      }
+      if (v) {
+        double x0[NMAX], x1[NMAX], y[NMAX], t[NMAX], u[NMAX];
+        for (int j = 0; j < NA; ++j)
+          for (int i = 0; i < NA; ++i) {
+            x0[i + NA * j] = sc0 * v[0][base + j * sy + i];
+            x1[i + NA * j] = sc1 * v[1][base + j * sy + i];
+          }
+        /* span_divergence: D = G_x^T x0, then D = M_y D, then D += G_y^T (M_x x1). */
+        for (int j = 0; j < NA; ++j) line3(mx->GT, x0 + NA * j, 1, y + NA * j, 1);
+        for (int i = 0; i < NA; ++i) line3(my->M, y + i, NA, t + i, NA);
+        for (int j = 0; j < NA; ++j) line3(mx->M, x1 + NA * j, 1, u + NA * j, 1);
+        for (int i = 0; i < NA; ++i) {
+          const double u0 = u[i], u1 = u[i + NA], u2 = u[i + 2 * NA];
+          for (int a = 0; a < NA; ++a)
+            t[i + NA * a] =
+                t[i + NA * a] + (my->GT[a][0] * u0 + my->GT[a][1] * u1 + my->GT[a][2] * u2);
+        }
+        for (int j = 0; j < NA; ++j)
+          for (int i = 0; i < NA; ++i) D[base + j * sy + i] += t[i + NA * j];
+      }
+    }
+  }
+}
+
 void mpm_span_plane(const mpm_grid *g, const mpm_span_set *s, int axis, const double *q,
                     double *f) {
   static const double E[NA][NA] = {{1, 6, 1}, {6, 36, 6}, {1, 6, 1}};
@@ -208,7 +273,7 @@ static void integrate(const mpm_grid *g, const mpm_span_set *s, const double *p,
   if (g->dim == 3)
     integrate_dim(g, s, 3, p, f, v, D);
   else
-    integrate_dim(g, s, 2, p, f, v, D);
+    integrate_2d(g, s, p, f, v, D);
 }
 
 void mpm_span_force(const mpm_grid *g, const mpm_span_set *s, const double *p, double *const *f) {
