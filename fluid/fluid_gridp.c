@@ -89,6 +89,11 @@
  * particles' quadrature of p_h is nearly the span integral, the force is nearly the particles'.
  * The corrections are those of a solid's region (fluid_gridp_solid.c) with the gas's own
  * particles as the points; the particles keep -V p in their stress (viscous stresses as ever).
+ * Without a solid the force's correction is no deposit of its own: the deposit of V and V p
+ * forms the nodal pressure at once, and the particles deposit their stress with +V p_h(x_p) on
+ * its diagonal (fluid_gridp_stress), -V (p - p_h) in all; their vsig, which the energy rate
+ * reads, is left as it was. Beside a solid the nodal pressure waits for the forces, since its
+ * continuation reads the solid's points of the same state.
  * Beside a solid the continuation is the grid pressure's, D^Q taken out before its transpose.
  * Open faces are the grid pressure's: the exterior pressure integrated over the face, the pad
  * nodes' pressure set from it; a uniform stream gives p_p = p_h(x_p), so the particles' share

@@ -9,12 +9,12 @@ gives six significant digits).
 Density measure and shock position: see tests/tools/shocktube.py (particle densities joined
 by linear interpolation, averaged per cell, against the exact cell averages).
 
-Acceptance, checked for the case's own method and step (cases/sod.ini: usl at time.cfl 0.8,
+Acceptance, checked for the case's own method and step (cases/sod.ini: usl at time.cfl 0.9,
 with the hybrid pressure that fluid.pressure = auto picks for it):
   - issue 4: L1 <= 8e-3 at 400 cells, observed order >= 0.8 from 100 to 800 cells (log2 of the
     L1 ratio over the doublings, divided by their count), shock within 2 cells of x = 0.8504;
   - issue 50: the order stays >= 0.8 up to 1600 cells, over 800 -> 1600 alone too (measured
-    1.03 / 1.03 / 1.07 per doubling from 200 cells, L1 2.12e-3 at 400 and 4.96e-4 at 1600; bs32
+    1.05 / 1.01 / 1.04 per doubling from 200 cells, L1 2.08e-3 at 400 and 5.03e-4 at 1600; bs32
     with the particles' pressure, the default before, gave order 0.35 over 800 -> 1600 and
     fails it: its L1 1.79e-3 -> 1.40e-3).
 The default run (fast) checks the case's method at 100 and 200 cells: the shock within 2 cells;
