@@ -88,34 +88,6 @@ static inline void axis_apply(const double A[NA][NA], int d, int dim, const doub
     }
 }
 
-/* f[d] = G_d prod_{e != d} M_e p on one span (m[e]: axis e's matrices). The M of the axes above
- * d are shared between the components: B holds them applied, from the top axis down. */
-static inline void span_force(const axis_mats *const *m, int dim, const double *p,
-                              double f[][NMAX]) {
-  double B[NMAX], t[2][NMAX];
-  const int n = dim == 3 ? 27 : 9;
-  for (int a = 0; a < n; ++a) B[a] = p[a];
-  for (int d = dim - 1; d >= 0; --d) {
-    const double *x = B;
-    for (int e = 0; e < d; ++e) axis_apply(m[e]->M, e, dim, x, t[e & 1], 0), x = t[e & 1];
-    axis_apply(m[d]->G, d, dim, x, f[d], 0);
-    if (d > 0) axis_apply(m[d]->M, d, dim, B, t[0], 0), memcpy(B, t[0], sizeof(double) * n);
-  }
-}
-
-/* D = sum_d prod_{e != d} M_e G_d^T v_d on one span, the transpose of span_force (Horner over
- * the axes: acc = M_d acc + prod_{e < d} M_e G_d^T v_d). */
-static inline void span_divergence(const axis_mats *const *m, int dim, double v[][NMAX],
-                                   double *D) {
-  double t[2][NMAX];
-  for (int d = 0; d < dim; ++d) {
-    if (d > 0) axis_apply(m[d]->M, d, dim, D, t[1], 0), memcpy(D, t[1], sizeof(t[1]));
-    const double *x = v[d];
-    for (int e = 0; e < d; ++e) axis_apply(m[e]->M, e, dim, x, t[e & 1], 0), x = t[e & 1];
-    axis_apply(m[d]->GT, d, dim, x, D, d > 0);
-  }
-}
-
 /* sc[d] = sG_d prod_{e != d} sM_e: what turns the integer products of component d into the
  * integrals. */
 static inline void span_scales(const axis_mats *const *m, int dim, double *sc) {
@@ -137,54 +109,20 @@ static int span_offsets(const mpm_grid *g, int dim, mpm_lidx *off) {
   return na;
 }
 
-/* One walk over the spans of a dim-D grid: the force of p into f when p is set, the divergence
- * of v into D when v is set. dim is a constant at each call, so the axis loops unroll. */
-static inline void integrate_dim(const mpm_grid *g, const mpm_span_set *s, int dim, const double *p,
-                                 double *const *f, const double *const *v, double *D) {
-  axis_mats kind[SPAN_KINDS];
-  kinds_fill(kind, g->dx);
-  int lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
-  for (int d = 0; d < dim; ++d) lo[d] = s->lo[d], hi[d] = s->hi[d];
-  mpm_lidx off[NMAX];
-  const int na = span_offsets(g, dim, off);
-  int gi[3];
-  for (gi[2] = lo[2]; gi[2] <= hi[2]; ++gi[2])
-    for (gi[1] = lo[1]; gi[1] <= hi[1]; ++gi[1])
-      for (gi[0] = lo[0]; gi[0] <= hi[0]; ++gi[0]) {
-        const mpm_lidx n = mpm_grid_local_index(g, gi);
-        if (s->skip && s->skip[n]) continue;
-        const axis_mats *m[3];
-        for (int d = 0; d < dim; ++d)
-          m[d] = &kind[s->half_lo[d] && gi[d] == s->lo[d]   ? SPAN_UPPER
-                       : s->half_hi[d] && gi[d] == s->hi[d] ? SPAN_LOWER
-                                                            : SPAN_FULL];
-        double sc[3], x[3][NMAX], y[3][NMAX];
-        span_scales(m, dim, sc);
-        if (p) {
-          for (int a = 0; a < na; ++a) x[0][a] = p[n + off[a]];
-          span_force(m, dim, x[0], y);
-          for (int d = 0; d < dim; ++d)
-            for (int a = 0; a < na; ++a) f[d][n + off[a]] += sc[d] * y[d][a];
-        }
-        if (v) {
-          for (int d = 0; d < dim; ++d)
-            for (int a = 0; a < na; ++a) x[d][a] = sc[d] * v[d][n + off[a]];
-          span_divergence(m, dim, x, y[0]);
-          for (int a = 0; a < na; ++a) D[n + off[a]] += y[0][a];
-        }
-      }
-}
-
 /* y[a] = A[a][0] x[0] + A[a][1] x[s] + A[a][2] x[2 s], a = 0 .. 2 (y at stride t): one line of
- * axis_apply, in its order of operations. */
+ * axis_apply, in its order of operations. The span walks below use these with every axis and
+ * stride a constant, and keep the products and sums of the generic sum-factorised walk they
+ * replaced in its order, so its bits (checked against it on random fields with half spans and
+ * skips, 2-D and 3-D), at half its time in 2-D (bench/bench_span.c). */
 static inline void line3(const double A[NA][NA], const double *x, int s, double *y, int t) {
   const double x0 = x[0], x1 = x[s], x2 = x[2 * s];
   for (int a = 0; a < NA; ++a) y[a * t] = A[a][0] * x0 + A[a][1] * x1 + A[a][2] * x2;
 }
 
-/* integrate_dim for dim = 2, its products and sums in the same order (so the same bits), with
- * the axis loops written out: the sum-factorised span in registers, the kind of each span found
- * once per row and column. The 2-D gas runs it twice a step (the grid and hybrid pressures). */
+/* One walk over the spans of a 2-D grid: the force of p into f when p is set, the divergence of
+ * v into D when v is set, f_d = G_d prod_{e != d} M_e p and D = sum_d prod_{e != d} M_e G_d^T v_d
+ * per span (the M of the other axis applied first). The kind of each span is found once per row
+ * and column. The 2-D gas runs it twice a step (the grid and hybrid pressures). */
 static void integrate_2d(const mpm_grid *g, const mpm_span_set *s, const double *p,
                          double *const *f, const double *const *v, double *D) {
   axis_mats kind[SPAN_KINDS];
@@ -223,7 +161,7 @@ static void integrate_2d(const mpm_grid *g, const mpm_span_set *s, const double 
             x0[i + NA * j] = sc0 * v[0][base + j * sy + i];
             x1[i + NA * j] = sc1 * v[1][base + j * sy + i];
           }
-        /* span_divergence: D = G_x^T x0, then D = M_y D, then D += G_y^T (M_x x1). */
+        /* D = M_y G_x^T x0 + G_y^T M_x x1 (Horner over the axes). */
         for (int j = 0; j < NA; ++j) line3(mx->GT, x0 + NA * j, 1, y + NA * j, 1);
         for (int i = 0; i < NA; ++i) line3(my->M, y + i, NA, t + i, NA);
         for (int j = 0; j < NA; ++j) line3(mx->M, x1 + NA * j, 1, u + NA * j, 1);
@@ -238,6 +176,73 @@ static void integrate_2d(const mpm_grid *g, const mpm_span_set *s, const double 
       }
     }
   }
+}
+
+/* axis_apply on a 3-D span's 27 values along axis d (a literal). */
+static inline __attribute__((always_inline)) void apply27(const double A[NA][NA], int d,
+                                                          const double *x, double *y, int add) {
+  const int s = d == 0 ? 1 : d == 1 ? NA : NA * NA;
+  for (int o = 0; o < 27; o += NA * s)
+    for (int i = o; i < o + s; ++i) {
+      const double x0 = x[i], x1 = x[i + s], x2 = x[i + 2 * s];
+      for (int a = 0; a < NA; ++a) {
+        const double r = A[a][0] * x0 + A[a][1] * x1 + A[a][2] * x2;
+        y[i + a * s] = add ? y[i + a * s] + r : r;
+      }
+    }
+}
+
+/* The same walk in 3-D. Force: f_z from M_x then M_y, then B = M_z p shared by f_y (M_x) and,
+ * after M_y, by f_x. Divergence by Horner over the axes: D = M_z (M_y G_x^T v_x + G_y^T M_x v_y)
+ * + G_z^T M_y M_x v_z. */
+static void integrate_3d(const mpm_grid *g, const mpm_span_set *s, const double *p,
+                         double *const *f, const double *const *v, double *D) {
+  axis_mats kind[SPAN_KINDS];
+  kinds_fill(kind, g->dx);
+  mpm_lidx off[NMAX];
+  span_offsets(g, 3, off);
+  int gi[3];
+  for (gi[2] = s->lo[2]; gi[2] <= s->hi[2]; ++gi[2])
+    for (gi[1] = s->lo[1]; gi[1] <= s->hi[1]; ++gi[1])
+      for (gi[0] = s->lo[0]; gi[0] <= s->hi[0]; ++gi[0]) {
+        const mpm_lidx n = mpm_grid_local_index(g, gi);
+        if (s->skip && s->skip[n]) continue;
+        const axis_mats *m[3];
+        for (int d = 0; d < 3; ++d)
+          m[d] = &kind[s->half_lo[d] && gi[d] == s->lo[d]   ? SPAN_UPPER
+                       : s->half_hi[d] && gi[d] == s->hi[d] ? SPAN_LOWER
+                                                            : SPAN_FULL];
+        double sc[3];
+        span_scales(m, 3, sc);
+        if (p) {
+          double B[NMAX], t0[NMAX], t1[NMAX], y[3][NMAX];
+          for (int a = 0; a < 27; ++a) B[a] = p[n + off[a]];
+          apply27(m[0]->M, 0, B, t0, 0);
+          apply27(m[1]->M, 1, t0, t1, 0);
+          apply27(m[2]->G, 2, t1, y[2], 0);
+          apply27(m[2]->M, 2, B, t0, 0);
+          apply27(m[0]->M, 0, t0, t1, 0);
+          apply27(m[1]->G, 1, t1, y[1], 0);
+          apply27(m[1]->M, 1, t0, B, 0);
+          apply27(m[0]->G, 0, B, y[0], 0);
+          for (int d = 0; d < 3; ++d)
+            for (int a = 0; a < 27; ++a) f[d][n + off[a]] += sc[d] * y[d][a];
+        }
+        if (v) {
+          double x[3][NMAX], Dl[NMAX], t0[NMAX], t1[NMAX];
+          for (int d = 0; d < 3; ++d)
+            for (int a = 0; a < 27; ++a) x[d][a] = sc[d] * v[d][n + off[a]];
+          apply27(m[0]->GT, 0, x[0], Dl, 0);
+          apply27(m[1]->M, 1, Dl, t1, 0);
+          apply27(m[0]->M, 0, x[1], t0, 0);
+          apply27(m[1]->GT, 1, t0, t1, 1);
+          apply27(m[2]->M, 2, t1, Dl, 0);
+          apply27(m[0]->M, 0, x[2], t0, 0);
+          apply27(m[1]->M, 1, t0, t1, 0);
+          apply27(m[2]->GT, 2, t1, Dl, 1);
+          for (int a = 0; a < 27; ++a) D[n + off[a]] += Dl[a];
+        }
+      }
 }
 
 void mpm_span_plane(const mpm_grid *g, const mpm_span_set *s, int axis, const double *q,
@@ -271,7 +276,7 @@ void mpm_span_plane(const mpm_grid *g, const mpm_span_set *s, int axis, const do
 static void integrate(const mpm_grid *g, const mpm_span_set *s, const double *p, double *const *f,
                       const double *const *v, double *D) {
   if (g->dim == 3)
-    integrate_dim(g, s, 3, p, f, v, D);
+    integrate_3d(g, s, p, f, v, D);
   else
     integrate_2d(g, s, p, f, v, D);
 }
