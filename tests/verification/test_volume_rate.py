@@ -1,7 +1,8 @@
 """The particle volume rate over the particle's domain (fluid.volume_rate = domain;
 fluid/fluid_volume.c) on Toro's strong shock moving across the grid (his test 5: test 3 in a
 frame moving at -19.59745, bench/fv_strip.py's toro3_moving) against the same problem at rest,
-bs32 at the case's fixed step (time.cfl 0.8), one rank: every figure below is deterministic.
+bs32 at a fixed step (time.cfl 0.99 with fluid.mol_damping = 0.3, the case's settings from
+2026-12-02 to 2026-12-04, named on every run), one rank: every figure below is deterministic.
 
 What it checks is the mechanism docs/gas.md describes: with the default point rule the hot
 gas that comes to rest on the grid behind the rarefaction carries a J that runs away from its
@@ -64,7 +65,7 @@ def measure(problem, N, rule):
     PR = fv_strip.PROBLEMS[problem]
     out = shocktube.run(PR.case, N, "bs32", PR.t, 1,
                         [f"output.interval={PR.t}", f"fluid.volume_rate={rule}",
-                         "fluid.pressure=particle"]
+                         "fluid.pressure=particle", "time.cfl=0.99", "fluid.mol_damping=0.3"]
                         + PR.mpm_overrides(), x0=PR.x0)
     P = mt.particles(mt.snapshots(out)[-1][1], "fluid")
     l1, _, plat = fv_strip.mpm_measure(PR, P, N)
