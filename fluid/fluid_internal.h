@@ -46,6 +46,7 @@ typedef struct fluid_content {
   int reg_min, reg_max;      /* particles per non-empty cell after regularisation */
   int refill;                /* regularisation refills cells that expansion emptied */
   int refill_every;          /* refill every refill_every steps (0: never) */
+  int refill_holes;          /* refill the holes in the gas after every other step (-1: auto) */
   double merge_light;        /* merge particles below this share of their cell's heaviest */
   double shift;              /* particle shifting coefficient kappa (0: off; fluid_shift.c) */
   int shift_every;           /* shift every shift_every steps */
@@ -130,6 +131,10 @@ int fluid_volume_rate(mpm_module *m, const double *y, const double *const *v_i, 
  * forms the nodal pressure at once and stress returns the stress to deposit, vsig with the
  * defect's load V p_h(x_p) on its diagonal (vsig itself otherwise; vsig is left as it is). */
 int fluid_gridp_init(mpm_module *m, const mpm_config *cfg);
+
+/* Does the gas take the hybrid pressure with its grid part weighted by the filled share
+ * (fluid.hybrid_fill > 0, without a solid)? */
+int fluid_gridp_weighted(const fluid_content *fc);
 int fluid_gridp_refine(mpm_module *m, const mpm_config *cfg, mpm_hier *h); /* h may be NULL */
 void fluid_gridp_destroy(fluid_content *fc);
 /* Forget the per-level arrays: the hierarchy changed (a regrid). */
@@ -189,7 +194,15 @@ int fluid_seed(mpm_module *m, const mpm_config *cfg);
  * Collective. */
 int fluid_neighbourhood_signal(const mpm_module *m, double *smax);
 
-/* Refill emptied cells when step is a multiple of refill_every, then merge and split particles
+/* Which refill step `step` takes: 2 every cell that expansion emptied (a multiple of
+ * refill_every), 1 only the cells of holes in the gas (refill_holes), 0 none. */
+static inline int fluid_refill_due(const fluid_content *fc, long step) {
+  if (fc->refill_every > 0 && step % fc->refill_every == 0) return 2;
+  return fc->refill_holes ? 1 : 0;
+}
+
+/* Refill emptied cells when step is a multiple of refill_every (else, with refill_holes, only
+ * the cells of holes in the gas), then merge and split particles
  * so that every non-empty cell holds reg_min to reg_max of them when it is a multiple of
  * reg_every, conserving mass, momentum and total energy. Sets
  * *changed if this rank's set changed (fluid_regularise.c). Collective. */

@@ -104,6 +104,13 @@ static const mpm_key_spec fluid_keys[] = {
      "and musl no farfield or subsonic_inflow face) and particle outside it, silently; beside "
      "a solid particle; the log says which); see docs/refinement.md",
      0, NULL},
+    {"fluid.hybrid_fill", MPM_KEY_REAL, "0.5", 0, 1, 0, 0, NULL,
+     "the hybrid pressure without a solid: the share of a node's volume the particles must fill "
+     "for its grid part to act whole; below it the grid part is weighted by the share, so the "
+     "particles' own pressure takes over where the gas is torn or nearly empty (a near vacuum, "
+     "gas leaving a wall), total energy exact at every weight (0: unweighted; see "
+     "fluid/fluid_gridp.c)",
+     0, NULL},
     {"fluid.ppc", MPM_KEY_INT, "2", 1, 8, 0, 0, NULL,
      "gas particles per cell per direction at seeding", 0, "-"},
     {"fluid.regularise_every", MPM_KEY_INT, "0", 0, HUGE_VAL, 0, 0, NULL,
@@ -120,6 +127,16 @@ static const mpm_key_spec fluid_keys[] = {
      "regularisation, every fluid.regularise_every steps); a wake that expansion empties "
      "faster than regularise_every steps refill it keeps empty cells between refills",
      0, "-"},
+    {"fluid.refill_holes", MPM_KEY_ENUM, "auto", 0, 0, 0, 0, "auto|true|false",
+     "after every step with no other refill, refill the holes in the gas: empty cells next to "
+     "gas with an empty neighbour along every axis and no obstacle within a cell (gaps two "
+     "cells across, which near vacuum opens and an ordinary expansion does not), conserving "
+     "mass, momentum and energy; auto: where the gas takes the hybrid pressure with its filled "
+     "share (a gas alone), whose particles beside a wall the refills do not crush (beside "
+     "solids and obstacles the particles' pressure, refilled, blew up on the forward step); "
+     "false leaves a gas expanding into near vacuum to tear; fluid.refill = false turns it off "
+     "too (see fluid/fluid_regularise.c)",
+     0, NULL},
     {"fluid.merge_light", MPM_KEY_REAL, "0", 0, 0.5, 0, 0, NULL,
      "with regularisation or refill: at each of them, a gas particle lighter than this "
      "fraction of the heaviest particle in its cell merges with it and the two split into "
@@ -666,7 +683,7 @@ static int fluid_post_step(mpm_module *m, double t, double h, int *changed) {
    * and no shift empties a cell the refill just filled. */
   int shifted = 0;
   MPM_CALL(fluid_shift(m, m->step, h, &shifted));
-  if (shifted && fc->refill_every > 0 && m->step % fc->refill_every == 0)
+  if (shifted && fluid_refill_due(fc, m->step))
     MPM_CALL(mpm_cells_count(m->grid, m->phase, m->particles));
   *changed |= shifted;
   MPM_CALL(fluid_relevel(m, changed));
@@ -850,6 +867,9 @@ static int read_regularise(fluid_content *fc, const mpm_config *cfg, int dim) {
                            "them off; remove one of the two keys",
                            every);
   fc->refill_every = fc->refill ? (every > 0 ? every : fc->reg_every) : 0;
+  const char *holes;
+  MPM_CALL(mpm_config_get_string(cfg, "fluid.refill_holes", &holes));
+  fc->refill_holes = !fc->refill ? 0 : strcmp(holes, "auto") == 0 ? -1 : strcmp(holes, "true") == 0;
   MPM_CALL(mpm_config_get_real(cfg, "fluid.merge_light", &fc->merge_light));
   if (fc->merge_light > 0.0 && fc->reg_every == 0 && fc->refill_every == 0)
     return mpm_config_fail(cfg, "fluid.merge_light",
@@ -999,6 +1019,7 @@ static int build(mpm_module *m, const mpm_config *cfg, int seed) {
   MPM_CALL(mpm_constraints_add_walls(&fc->cons, &walls, g));
   fc->walls = walls;
   MPM_CALL(fluid_gridp_init(m, cfg));
+  if (fc->refill_holes < 0) fc->refill_holes = fluid_gridp_weighted(fc); /* auto */
   MPM_CALL(fluid_open_new(&fc->open, m, cfg, &walls, fc->gas.gamma, fc->ppc));
   MPM_CALL(fluid_obstacles_build(&fc->obs, cfg, g, fc->ppc, (const unsigned char(*)[2])m->open));
   MPM_CALL(fluid_wall_ls_init(m, cfg, fc->tr.classic));
@@ -1052,7 +1073,7 @@ int fluid_module_create(mpm_module **mp, const mpm_config *cfg, mpm_grid *grid, 
   fc->ops = fluid_ops;
   if (fc->current_rate) fc->ops.p2g_rate = fluid_p2g_rate;
   m->ops = &fc->ops;
-  m->cells_every = fc->refill_every;
+  m->cells_every = fc->refill_holes ? 1 : fc->refill_every;
   m->wall_slack = 0.5;
   m->commits_history = !fc->tr.classic && !fc->current_rate; /* the pending strain rate */
   return 0;

@@ -41,7 +41,7 @@ mpm_add_script_test(test_supersonic_bar_twin_traction SCRIPT
 # exact ones, nodal error against the default gas (see the test's header).
 mpm_add_script_test(test_wall_rarefaction SCRIPT verification/test_wall_rarefaction.py
                     LABELS verification TIMEOUT 600)
-# The issue's near-vacuum target with the default settings: an expected failure inside the test
-# (the default gas tears; see the test's header).
+# The issue's near-vacuum target with the default settings: no empty node and the particle density
+# converging; the nodal density's order an expected failure inside the test (see its header).
 mpm_add_script_test(test_near_vacuum_default SCRIPT verification/test_near_vacuum.py
                     ARGS default LABELS verification TIMEOUT 600)
