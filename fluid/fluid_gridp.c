@@ -433,7 +433,6 @@ static void wall_spans(const mpm_hier *h, int l, int d, mpm_span_set *s) {
   if (h->wall[d][1]) s->hi[d] = MPM_MIN(s->hi[d], N + half - 1);
 }
 
-/* The per-level arrays and span sets, on first use (the hierarchy is static). */
 /* The integral over [0, r] of the quadratic B-spline centred at 0, r in cells (odd in r). */
 static double bspline2_integral(double r) {
   const double a = fabs(r), sgn = r < 0.0 ? -1.0 : 1.0;
@@ -461,6 +460,7 @@ static int geometric_volume(const mpm_grid *g, double **W) {
   return 0;
 }
 
+/* The per-level arrays and span sets, on first use (the hierarchy is static). */
 static int ensure_levels(mpm_module *m, fluid_gridp *gp) {
   if (gp->P[0]) return 0;
   const mpm_hier *h = m->hier;
