@@ -30,11 +30,11 @@ import sys
 import tempfile
 import time
 
-import numpy as np
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, "bench"))
 from benchrun import ENV, git  # noqa: E402
+from euler_panel import load_errors, load_mpm  # noqa: E402
 
 
 def arg(name, default):
@@ -97,26 +97,8 @@ def run(case, cfl, keys):
             sys.exit(f"bench_panel_gas_step: {' '.join(cmd)} failed: "
                      f"{(done.stderr.strip().splitlines() or ['?'])[-1]}")
         wall = time.perf_counter() - t0
-        a = np.genfromtxt(os.path.join(d, "coupling.csv"), delimiter=",", names=True)
-    return a["t"], a["Fx_solid"], len(a["t"]) - 1, wall
-
-
-def integrals(t, F, T):
-    """The impulse and its integral on the times T."""
-    imp = np.concatenate([[0.0], np.cumsum(0.5 * (F[1:] + F[:-1]) * np.diff(t))])
-    i = np.interp(T, t, imp)
-    return i, np.concatenate([[0.0], np.cumsum(0.5 * (i[1:] + i[:-1]) * np.diff(T))])
-
-
-def errors(run_, ref):
-    T = np.linspace(0.0, T_END, 3001)
-    (t, F), (tr, Fr) = run_[:2], ref[:2]
-    i, s = integrals(t, F, T)
-    ir, sr = integrals(tr, Fr, T)
-    f, fr = np.interp(T, t, F), np.interp(T, tr, Fr)
-    return {"impulse": float(np.max(abs(i - ir)) / ir[-1]),
-            "displacement": float(np.max(abs(s - sr)) / sr[-1]),
-            "force_rms": float(math.sqrt(np.mean((f - fr) ** 2) / np.mean(fr ** 2)))}
+        t, F = load_mpm(d)
+    return t, F, len(t) - 1, wall
 
 
 def main():
@@ -130,7 +112,7 @@ def main():
             prev = None
             for cfl in CFLS:
                 r = run(case, cfl, keys)
-                e = errors(r, ref)
+                e = load_errors(r[0], r[1], ref[0], ref[1], T_END)
                 row = {"variant": name, "keys": keys, "cfl": cfl, "steps": r[2],
                        "wall_s": round(r[3], 2), **e, "ref_steps": ref[2]}
                 if prev:

@@ -67,9 +67,23 @@ def run(dx, t_end, every, cfl):
 
 
 def integrals(t, F, T):
+    """The impulse of the load F(t) and the impulse's integral, on the times T."""
     imp = np.concatenate([[0.0], np.cumsum(0.5 * (F[1:] + F[:-1]) * np.diff(t))])
     i = np.interp(T, t, imp)
     return i, np.concatenate([[0.0], np.cumsum(0.5 * (i[1:] + i[:-1]) * np.diff(T))])
+
+
+def load_errors(t, F, tr, Fr, t_end):
+    """The load F(t) against the reference Fr(tr) to t_end: the largest error of the impulse and
+    of its integral over the reference's values at t_end, the impulse's error there, and the
+    RMS error of F over the reference's RMS."""
+    T = np.linspace(0.0, t_end, 3001)
+    (i, s), (ir, sr) = integrals(t, F, T), integrals(tr, Fr, T)
+    f, fr = np.interp(T, t, F), np.interp(T, tr, Fr)
+    return {"impulse": float(np.max(abs(i - ir)) / ir[-1]),
+            "impulse_end": float((i[-1] - ir[-1]) / ir[-1]),
+            "displacement": float(np.max(abs(s - sr)) / sr[-1]),
+            "force_rms": float(np.sqrt(np.mean((f - fr) ** 2) / np.mean(fr ** 2)))}
 
 
 def load_mpm(d):
@@ -98,13 +112,7 @@ def main():
                comments="")
     T = np.linspace(0.0, a.t_end, 3001)
     ir, sr = integrals(t, F, T)
-    rows = []
-    for d in a.compare:
-        tm, Fm = load_mpm(d)
-        i, s = integrals(tm, Fm, T)
-        rows.append({"run": d, "impulse": float(np.max(abs(i - ir)) / ir[-1]),
-                     "impulse_end": float((i[-1] - ir[-1]) / ir[-1]),
-                     "displacement": float(np.max(abs(s - sr)) / sr[-1])})
+    rows = [{"run": d, **load_errors(*load_mpm(d), t, F, a.t_end)} for d in a.compare]
     summary = {"dx": a.dx, "cells": [nx, ny], "t_end": a.t_end, "steps": steps,
                "wall_s": round(wall, 1), "impulse": float(ir[-1]), "displacement": float(sr[-1]),
                "Fx_at": {f"{tq * 1e6:g}us": float(np.interp(tq, t, F))
