@@ -367,12 +367,74 @@ int mpm_grid_add_phase(mpm_grid *grid, const char *name, int *index) {
   return 0;
 }
 
+/* Zero n nodes from l of the deposit's arrays. */
+static void zero_rows(mpm_grid_phase *ph, int dim, mpm_lidx l, mpm_lidx n) {
+  const size_t bytes = (size_t)n * sizeof(double);
+  memset(ph->m_i + l, 0, bytes);
+  for (int d = 0; d < dim; ++d) memset(ph->mv_i[d] + l, 0, bytes), memset(ph->f_i[d] + l, 0, bytes);
+  for (int d = 0; ph->normals && d < dim; ++d) memset(ph->normal_i[d] + l, 0, bytes);
+}
+
 void mpm_grid_phase_zero(mpm_grid *grid, int phase) {
   mpm_grid_phase *ph = &grid->phase[phase];
-  const size_t bytes = (size_t)grid->nnodes * sizeof(double);
-  memset(ph->m_i, 0, bytes);
-  for (int d = 0; d < grid->dim; ++d) memset(ph->mv_i[d], 0, bytes), memset(ph->f_i[d], 0, bytes);
-  for (int d = 0; ph->normals && d < grid->dim; ++d) memset(ph->normal_i[d], 0, bytes);
+  if (!ph->narrowed) {
+    zero_rows(ph, grid->dim, 0, grid->nnodes);
+    return;
+  }
+  const mpm_lidx n = ph->act_hi[0] - ph->act_lo[0];
+  if (n <= 0) return; /* (an empty block: none of the phase on this rank) */
+  for (int k = mpm_phase_lo(grid, ph, 2); k < mpm_phase_hi(grid, ph, 2); ++k)
+    for (int j = mpm_phase_lo(grid, ph, 1); j < mpm_phase_hi(grid, ph, 1); ++j)
+      zero_rows(ph, grid->dim, mpm_phase_row(grid, ph, j, k), n);
+}
+
+/* The smallest block holding both a and b (box-relative [lo, hi) pairs; lo >= hi is empty). */
+static void block_union(int dim, const int *alo, const int *ahi, const int *blo, const int *bhi,
+                        int *lo, int *hi) {
+  int aempty = 0, bempty = 0;
+  for (int d = 0; d < dim; ++d) aempty |= alo[d] >= ahi[d], bempty |= blo[d] >= bhi[d];
+  for (int d = 0; d < dim; ++d) {
+    lo[d] = aempty ? blo[d] : bempty ? alo[d] : alo[d] < blo[d] ? alo[d] : blo[d];
+    hi[d] = aempty ? bhi[d] : bempty ? ahi[d] : ahi[d] > bhi[d] ? ahi[d] : bhi[d];
+  }
+}
+
+void mpm_grid_phase_narrow(mpm_grid *grid, int phase) {
+  mpm_grid_phase *ph = &grid->phase[phase];
+  const int dim = grid->dim, pad = 2;
+  int lo[MPM_MAX_DIM], hi[MPM_MAX_DIM], c[3];
+  for (int d = 0; d < dim; ++d) lo[d] = grid->box_n[d], hi[d] = 0;
+  /* the block of the nodes holding mass (over the whole box: a particle may have left the
+   * block since the last narrowing) */
+  const int ny = dim > 1 ? grid->box_n[1] : 1, nz = dim > 2 ? grid->box_n[2] : 1;
+  const int nx = grid->box_n[0];
+  for (c[2] = 0; c[2] < nz; ++c[2])
+    for (c[1] = 0; c[1] < ny; ++c[1]) {
+      const double *row = ph->m_i + ((mpm_lidx)c[2] * ny + c[1]) * nx;
+      int first = -1, last = -1;
+      for (int i = 0; i < nx; ++i)
+        if (row[i] != 0.0) last = i, first = first < 0 ? i : first;
+      if (first < 0) continue;
+      c[0] = first;
+      for (int d = 0; d < dim; ++d) lo[d] = c[d] < lo[d] ? c[d] : lo[d];
+      c[0] = last;
+      for (int d = 0; d < dim; ++d) hi[d] = c[d] + 1 > hi[d] ? c[d] + 1 : hi[d];
+    }
+  for (int d = 0; d < dim; ++d)
+    if (lo[d] < hi[d]) {
+      lo[d] = lo[d] - pad > 0 ? lo[d] - pad : 0;
+      hi[d] = hi[d] + pad < grid->box_n[d] ? hi[d] + pad : grid->box_n[d];
+    }
+  if (!ph->narrowed) /* the mass before this deposit is not known: the whole box this time */
+    for (int d = 0; d < dim; ++d) ph->act_lo[d] = 0, ph->act_hi[d] = grid->box_n[d];
+  else
+    block_union(dim, ph->held_lo, ph->held_hi, lo, hi, ph->act_lo, ph->act_hi);
+  for (int d = 0; d < dim; ++d) ph->held_lo[d] = lo[d], ph->held_hi[d] = hi[d];
+  ph->narrowed = 1;
+}
+
+void mpm_grid_phase_widen(mpm_grid *grid, int phase) {
+  grid->phase[phase].narrowed = 0;
 }
 
 /* ---- ownership ------------------------------------------------------------------------- */

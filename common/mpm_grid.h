@@ -59,6 +59,12 @@ typedef struct mpm_grid_phase {
   /* Room for a copy of m, m v, f (and the mass gradient): the coupler's velocity preview works
    * on it (coupler/mpm_cycle.c); NULL until first needed. */
   double *shadow;
+  /* The nodes the nodal passes visit (MPM_PHASE_FOR): every node of the box unless `narrowed`
+   * (mpm_grid_phase_narrow), then the box-relative block [act_lo, act_hi), outside which every
+   * nodal field of the phase is zero; held_lo/hi: the block that held mass at the narrowing. */
+  int narrowed;
+  int act_lo[MPM_MAX_DIM], act_hi[MPM_MAX_DIM];
+  int held_lo[MPM_MAX_DIM], held_hi[MPM_MAX_DIM];
 } mpm_grid_phase;
 
 typedef struct mpm_grid {
@@ -107,6 +113,37 @@ int mpm_grid_add_phase(mpm_grid *grid, const char *name, int *index);
 /* Zero m, mv and f (and the mass gradient, if the phase deposits it) of one phase on every box
  * node. */
 void mpm_grid_phase_zero(mpm_grid *grid, int phase);
+
+/* A phase's nodal passes over its active block only (a body of 200 particles substepping in a
+ * grid of 20,000 nodes, coupling.time = multirate). narrow sets the block to the nodes holding
+ * the phase's mass now or at the last narrowing (whose velocities the solve must clear), two
+ * nodes wider on every side, found in one pass over the box; the first narrowing after a
+ * widening keeps the whole box. Until it is widened again nothing may write the phase outside
+ * the block; the passes that honour it are zero, the nodal solve, and the coupler's load,
+ * captures and books (coupler/mpm_cycle.c narrows a loaded solid's phase in its substeps). */
+void mpm_grid_phase_narrow(mpm_grid *grid, int phase);
+void mpm_grid_phase_widen(mpm_grid *grid, int phase);
+
+/* The span of a phase's passes along axis d: [lo, hi) box-relative (one row beyond dim). */
+static inline int mpm_phase_lo(const mpm_grid *g, const mpm_grid_phase *ph, int d) {
+  return d < g->dim && ph->narrowed ? ph->act_lo[d] : 0;
+}
+static inline int mpm_phase_hi(const mpm_grid *g, const mpm_grid_phase *ph, int d) {
+  return d >= g->dim ? 1 : ph->narrowed ? ph->act_hi[d] : g->box_n[d];
+}
+/* The box index of row (j, k)'s first node in the span. */
+static inline mpm_lidx mpm_phase_row(const mpm_grid *g, const mpm_grid_phase *ph, int j, int k) {
+  const mpm_lidx ny = g->dim > 1 ? g->box_n[1] : 1;
+  return ((mpm_lidx)k * ny + j) * g->box_n[0] + mpm_phase_lo(g, ph, 0);
+}
+/* MPM_PHASE_FOR(g, ph, l) { ... }: every node l of phase ph's span, row by row in index order
+ * (`continue` goes to the next node). */
+#define MPM_PHASE_FOR(g, ph, l)                                                                    \
+  for (int l##_k = mpm_phase_lo(g, ph, 2); l##_k < mpm_phase_hi(g, ph, 2); ++l##_k)                \
+    for (int l##_j = mpm_phase_lo(g, ph, 1); l##_j < mpm_phase_hi(g, ph, 1); ++l##_j)              \
+      for (mpm_lidx l = mpm_phase_row(g, ph, l##_j, l##_k),                                        \
+                    l##_e = l + mpm_phase_hi(g, ph, 0) - mpm_phase_lo(g, ph, 0);                   \
+           l < l##_e; ++l)
 
 /* Local (box) index of global node (i, j, k); the caller guarantees it is in the box. */
 static inline mpm_lidx mpm_grid_local_index(const mpm_grid *g, const int *gi) {

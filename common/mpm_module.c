@@ -31,11 +31,14 @@ static void node_update(mpm_lidx nn, const double *restrict m, const double *res
 
 /* Mass and number of the owned nodes with m_i > mmin, into sum[0] and sum[1]: the owned
  * block of the box row by row (in index order, as a loop over the box would add them). */
-static void owned_mass(const mpm_grid *g, const double *m, double mmin, double *sum) {
+static void owned_mass(const mpm_grid *g, const mpm_grid_phase *ph, double mmin, double *sum) {
+  const double *m = ph->m_i;
   int lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
   mpm_lidx stride[3] = {1, 0, 0};
-  for (int d = 0; d < g->dim; ++d) {
+  for (int d = 0; d < g->dim; ++d) { /* (outside the phase's span it holds no mass) */
     lo[d] = g->own_lo[d] - g->box_lo[d], hi[d] = g->own_hi[d] - g->box_lo[d];
+    if (mpm_phase_lo(g, ph, d) > lo[d]) lo[d] = mpm_phase_lo(g, ph, d);
+    if (mpm_phase_hi(g, ph, d) < hi[d]) hi[d] = mpm_phase_hi(g, ph, d);
     if (d > 0) stride[d] = stride[d - 1] * g->box_n[d - 1];
   }
   for (int k = lo[2]; k < hi[2]; ++k)
@@ -50,9 +53,11 @@ static void owned_mass(const mpm_grid *g, const double *m, double mmin, double *
 static int largest_mass(mpm_grid *const *grids, int ngrids, int phase, double *mmax) {
   double local = 0.0;
   for (int k = 0; k < ngrids; ++k) {
-    const double *m = grids[k]->phase[phase].m_i;
-    for (mpm_lidx l = 0; l < grids[k]->nnodes; ++l) /* fmax without the call (NaN is skipped) */
+    const mpm_grid_phase *ph = &grids[k]->phase[phase];
+    const double *m = ph->m_i;
+    MPM_PHASE_FOR(grids[k], ph, l) { /* fmax without the call (NaN is skipped) */
       if (m[l] > local) local = m[l];
+    }
   }
   MPM_CALL_MPI(MPI_Allreduce(&local, mmax, 1, MPI_DOUBLE, MPI_MAX, grids[0]->comm));
   return 0;
@@ -64,7 +69,7 @@ static int mean_mass(mpm_grid *const *grids, int ngrids, int phase, double mmin,
   /* The finer levels of a hierarchy (box grids, no communicator) are alike on every rank:
    * counted on rank 0 alone. */
   for (int k = 0; k < ngrids; ++k)
-    if (k == 0 || grids[0]->rank == 0) owned_mass(grids[k], grids[k]->phase[phase].m_i, mmin, sum);
+    if (k == 0 || grids[0]->rank == 0) owned_mass(grids[k], &grids[k]->phase[phase], mmin, sum);
   MPM_CALL_MPI(MPI_Allreduce(sum, all, 2, MPI_DOUBLE, MPI_SUM, grids[0]->comm));
   *mean = all[1] > 0.0 ? all[0] / all[1] : 0.0;
   return 0;
@@ -86,8 +91,19 @@ int mpm_grid_phase_update_many(mpm_grid *const *grids, int ngrids, int phase, do
     mpm_grid_phase *ph = &g->phase[phase];
     ph->m_max = mmax, ph->m_empty = mmin;
     if (ph0->light_fraction > 0.0) ph->m_mean = mean;
-    for (int d = 0; d < g->dim; ++d)
-      node_update(g->nnodes, ph->m_i, ph->mv_i[d], ph->f_i[d], ph->v_i[d], ph->a_i[d], mmin, h);
+    if (!ph->narrowed) {
+      for (int d = 0; d < g->dim; ++d)
+        node_update(g->nnodes, ph->m_i, ph->mv_i[d], ph->f_i[d], ph->v_i[d], ph->a_i[d], mmin, h);
+      continue;
+    }
+    const mpm_lidx n = ph->act_hi[0] - ph->act_lo[0];
+    for (int kz = mpm_phase_lo(g, ph, 2); n > 0 && kz < mpm_phase_hi(g, ph, 2); ++kz)
+      for (int j = mpm_phase_lo(g, ph, 1); j < mpm_phase_hi(g, ph, 1); ++j) {
+        const mpm_lidx r = mpm_phase_row(g, ph, j, kz);
+        for (int d = 0; d < g->dim; ++d)
+          node_update(n, ph->m_i + r, ph->mv_i[d] + r, ph->f_i[d] + r, ph->v_i[d] + r,
+                      ph->a_i[d] + r, mmin, h);
+      }
   }
   return 0;
 }

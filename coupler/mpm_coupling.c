@@ -365,7 +365,7 @@ int mpm_coupling_apply_load(mpm_coupling *c, double t, double h, const double *c
   c->recording = 1;
   const mpm_grid_phase *s = mpm_coupling_phase(c, MPM_ROLE_SOLID);
   const int dim = c->grid->dim;
-  for (mpm_lidx l = 0; l < c->grid->nnodes; ++l) {
+  MPM_PHASE_FOR(c->grid, s, l) {
     if (!mpm_coupling_has_mass(c, MPM_ROLE_SOLID, l)) continue;
     const double m = m_start[l] > s->m_i[l] ? m_start[l] : s->m_i[l];
     double v[MPM_MAX_DIM], a[MPM_MAX_DIM];
@@ -412,8 +412,7 @@ void mpm_coupling_book_constrained(mpm_coupling *c, const mpm_interface *ifc, do
   mpm_timer_start(MPM_T_COUPLING);
   const mpm_grid_phase *s = mpm_coupling_phase(c, MPM_ROLE_SOLID);
   double *power = &c->rec[c->which.latest].power[MPM_ROLE_SOLID];
-  for (int d = 0; d < c->grid->dim; ++d)
-    for (mpm_lidx l = 0; l < c->grid->nnodes; ++l) {
+  for (int d = 0; d < c->grid->dim; ++d) MPM_PHASE_FOR(c->grid, s, l) {
       const double f = ifc->capture[d][l], v = s->v_i[d][l], v0 = ifc->v_solved[d][l];
       if (!c->owned[l] || (f == 0.0 && ifc->booked[d][l] == 0.0) || v == v0) continue;
       const double vn = v0 - h * ifc->a_solved[d][l]; /* the exchanges keep v - h a */

@@ -87,6 +87,15 @@ static int grid_pass(const mpm_cycle *c, double t, double h, mpm_pass pass) {
   const int hooks = c->mode == MPM_CYCLE_JOINT || c->mode == MPM_CYCLE_HELD;
   MPM_CALL(halo(c, 1));
   mpm_timer_start(MPM_T_GRID);
+  /* A loaded solid (a partitioned scheme's substep) is small beside the grid: its passes visit
+   * its own nodes (mpm_grid_phase_narrow; mpm_partitioned.c widens it after its substeps, and
+   * every other cycle sees its phases whole). */
+  for (int k = 0; k < c->nmod; ++k)
+    if (c->mode != MPM_CYCLE_LOADED || c->mod[k]->hier)
+      mpm_grid_phase_widen(c->grid, c->mod[k]->phase);
+    else
+      mpm_grid_phase_narrow(c->grid, c->mod[k]->phase);
+  if (hm) mpm_grid_phase_widen(c->grid, hm->phase);
   for (int k = 0; k < c->nmod; ++k) MPM_CALL(c->mod[k]->ops->forces(c->mod[k], t, h, pass));
   if (hm) mpm_interface_restore(c->iface), mpm_interface_predict(c->iface, t);
   /* Held and loaded first passes capture what the solid is given (mpm_interface.h). */

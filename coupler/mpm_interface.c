@@ -142,17 +142,19 @@ void mpm_interface_share(mpm_interface *ifc, int gas_phase) {
   }
 }
 
+/* Over the solid's span (mpm_grid_phase_narrow): the captures are made where it has mass. */
 void mpm_interface_capture_begin(mpm_interface *ifc) {
-  const size_t bytes = sizeof(double) * (size_t)ifc->grid->nnodes;
+  const mpm_grid_phase *ph = &ifc->grid->phase[ifc->phase];
   for (int d = 0; d < ifc->grid->dim; ++d)
-    memset(ifc->capture[d], 0, bytes), memset(ifc->booked[d], 0, bytes);
+    MPM_PHASE_FOR(ifc->grid, ph, l) ifc->capture[d][l] = ifc->booked[d][l] = 0.0;
 }
 
 void mpm_interface_solved(mpm_interface *ifc) {
   const mpm_grid_phase *ph = &ifc->grid->phase[ifc->phase];
-  const size_t bytes = sizeof(double) * (size_t)ifc->grid->nnodes;
-  for (int d = 0; d < ifc->grid->dim; ++d)
-    memcpy(ifc->v_solved[d], ph->v_i[d], bytes), memcpy(ifc->a_solved[d], ph->a_i[d], bytes);
+  for (int d = 0; d < ifc->grid->dim; ++d) MPM_PHASE_FOR(ifc->grid, ph, l) {
+      ifc->v_solved[d][l] = ph->v_i[d][l];
+      ifc->a_solved[d][l] = ph->a_i[d][l];
+    }
 }
 
 void mpm_interface_capture_accept(mpm_interface *ifc, double h, int sign) {
@@ -165,8 +167,9 @@ void mpm_interface_capture_accept(mpm_interface *ifc, double h, int sign) {
         ifc->v_gas[d][l] = ifc->touched_now[l] ? ph->v_i[d][l] : ifc->v_now[d][l];
     for (mpm_lidx l = 0; l < ifc->grid->nnodes; ++l) ifc->touched[l] |= ifc->touched_now[l];
   }
+  const mpm_grid_phase *ph = &ifc->grid->phase[ifc->phase];
   for (int d = 0; d < ifc->grid->dim; ++d)
-    for (mpm_lidx l = 0; l < ifc->grid->nnodes; ++l) ifc->impulse[d][l] += w * ifc->capture[d][l];
+    MPM_PHASE_FOR(ifc->grid, ph, l) ifc->impulse[d][l] += w * ifc->capture[d][l];
 }
 
 int mpm_interface_want_trend(mpm_interface *ifc) {

@@ -168,7 +168,9 @@ int mpm_partitioned_advance_solid_under(mpm_timescheme *ts, double t0, double t1
   mpm_interface_load(pp->ifc, t0, t1 - t0, pp->interpolate);
   for (int d = 0; q && d < ts->grid->dim; ++d)
     for (mpm_lidx l = 0; l < ts->grid->nnodes; ++l) pp->ifc->load[d][l] += q[d][l];
-  MPM_CALL(advance(ts, pp->it_solid, MPM_ROLE_SOLID, t0, t1, n));
+  const int rc = advance(ts, pp->it_solid, MPM_ROLE_SOLID, t0, t1, n);
+  mpm_grid_phase_widen(ts->grid, pp->solid->phase); /* (its substeps narrowed it) */
+  MPM_CALL(rc);
   return pp->shared ? 0 : mpm_interface_rehome(pp->ifc, ts->coupling->owned);
 }
 

@@ -1,0 +1,179 @@
+/* test_phase_narrow: a phase's nodal passes over its active block (mpm_grid_phase_narrow,
+ * common/mpm_grid.h), in 2-D and 3-D, on any number of ranks.
+ *
+ * A phase holds mass in a small block of nodes (a body beside a large grid). Checked:
+ *  - the first narrowing after a widening keeps the whole box; the next covers the nodes that
+ *    hold mass now and those that did then, two nodes wider on every side, and no more;
+ *  - MPM_PHASE_FOR visits exactly the block's nodes, once each, in increasing index order;
+ *  - zero and the nodal solve on the narrowed phase leave every field bit for bit as the
+ *    whole-box passes do, when the mass has moved since the last narrowing (the velocities
+ *    the solve must clear lie in the old block);
+ *  - a rank holding none of the phase gets an empty block and its passes visit no node;
+ *  - widening gives the whole box back. */
+#include "mpm_grid.h"
+#include "mpm_module.h"
+
+#include "mpm_testing.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+/* The global node coordinates of box node l. */
+static void global_of(const mpm_grid *g, mpm_lidx l, int *gi) {
+  gi[1] = gi[2] = 0;
+  for (int d = 0; d < g->dim; ++d) gi[d] = g->box_lo[d] + (int)(l % g->box_n[d]), l /= g->box_n[d];
+}
+
+/* Is global node gi in the block [lo, hi] (global, inclusive) along every axis? */
+static int in_block(int dim, const int *gi, const int *lo, const int *hi) {
+  for (int d = 0; d < dim; ++d)
+    if (gi[d] < lo[d] || gi[d] > hi[d]) return 0;
+  return 1;
+}
+
+/* Mass, momentum and force on the nodes of the global block [lo, hi], zero elsewhere; the
+ * velocity and acceleration left as a solve on the block [vlo, vhi] left them. */
+static void fill(mpm_grid *g, int phase, const int *lo, const int *hi, const int *vlo,
+                 const int *vhi) {
+  mpm_grid_phase *ph = &g->phase[phase];
+  for (mpm_lidx l = 0; l < g->nnodes; ++l) {
+    int gi[3];
+    global_of(g, l, gi);
+    const int in = in_block(g->dim, gi, lo, hi), was = in_block(g->dim, gi, vlo, vhi);
+    ph->m_i[l] = in ? 1.0 + 0.25 * gi[0] + 0.5 * gi[1] + 0.125 * gi[2] : 0.0;
+    for (int d = 0; d < g->dim; ++d) {
+      ph->mv_i[d][l] = in ? 0.3 * (d + 1) * ph->m_i[l] - 0.1 * gi[d] : 0.0;
+      ph->f_i[d][l] = in ? -0.7 + 0.01 * gi[0] * (d + 1) : 0.0;
+      ph->v_i[d][l] = was ? 5.0 + d + 0.03 * gi[1] : 0.0;
+      ph->a_i[d][l] = was ? -3.0 + 0.07 * gi[0] : 0.0;
+    }
+  }
+}
+
+/* Copy (to = 1) or compare (to = 0) every field of the phase with the copy in buf. */
+static int fields(mpm_grid *g, int phase, double *buf, int to) {
+  mpm_grid_phase *ph = &g->phase[phase];
+  double *a[1 + 4 * MPM_MAX_DIM];
+  int n = 0;
+  a[n++] = ph->m_i;
+  for (int d = 0; d < g->dim; ++d)
+    a[n++] = ph->mv_i[d], a[n++] = ph->f_i[d], a[n++] = ph->v_i[d], a[n++] = ph->a_i[d];
+  const size_t bytes = sizeof(double) * (size_t)g->nnodes;
+  int same = 1;
+  for (int k = 0; k < n; ++k)
+    if (to)
+      memcpy(buf + k * g->nnodes, a[k], bytes);
+    else
+      same &= memcmp(buf + k * g->nnodes, a[k], bytes) == 0;
+  return same;
+}
+
+/* Does MPM_PHASE_FOR visit exactly the box nodes of the global block [lo, hi], in increasing
+ * order? (hi < lo along an axis: no node.) */
+static int visits_block(const mpm_grid *g, const mpm_grid_phase *ph, const int *lo, const int *hi) {
+  mpm_lidx count = 0, expect = 0, last = -1;
+  int ok = 1;
+  MPM_PHASE_FOR(g, ph, l) {
+    int gi[3];
+    global_of(g, l, gi);
+    ok &= l > last && in_block(g->dim, gi, lo, hi);
+    last = l, count++;
+  }
+  for (mpm_lidx l = 0; l < g->nnodes; ++l) {
+    int gi[3];
+    global_of(g, l, gi);
+    expect += in_block(g->dim, gi, lo, hi);
+  }
+  return ok && count == expect;
+}
+
+static void run(int dim) {
+  const double lo[3] = {0, 0, 0}, hi[3] = {2.0, 1.0, 0.75};
+  const double dx = 0.125; /* 16 x 8 (x 6) cells */
+  mpm_grid *g = NULL;
+  int phase = -1;
+  CHECK(mpm_grid_new(&g, MPI_COMM_WORLD, dim, lo, hi, dx, MPM_SHAPE_QUADRATIC, NULL) == 0,
+        "grid (dim %d)", dim);
+  CHECK(mpm_grid_add_phase(g, "body", &phase) == 0, "phase");
+  mpm_grid_phase *ph = &g->phase[phase];
+  double *ref = malloc(sizeof(double) * (1 + 4 * MPM_MAX_DIM) * (size_t)g->nnodes);
+  /* the body at nodes 3..5 (x), 2..4 (y), 1..2 (z); then moved one node up x */
+  const int b0lo[3] = {3, 2, 1}, b0hi[3] = {5, 4, 2}, b1lo[3] = {4, 2, 1}, b1hi[3] = {6, 4, 2};
+  const int none[3] = {0, 0, 0}, nonehi[3] = {-1, -1, -1};
+
+  fill(g, phase, b0lo, b0hi, none, nonehi);
+  mpm_grid_phase_narrow(g, phase);
+  int all_lo[3] = {-1000, -1000, -1000}, all_hi[3] = {1000, 1000, 1000};
+  CHECK(visits_block(g, ph, all_lo, all_hi), "dim %d: the first narrowing keeps the whole box",
+        dim);
+  CHECK(mpm_grid_phase_update(g, phase, 1e-3) == 0, "solve");
+
+  /* The body moves; the block must cover both positions, padded by 2, clipped to the box. */
+  fill(g, phase, b1lo, b1hi, b0lo, b0hi);
+  mpm_grid_phase_widen(g, phase);
+  CHECK(mpm_grid_phase_update(g, phase, 1e-3) == 0, "whole-box solve");
+  fields(g, phase, ref, 1); /* the reference: the whole box */
+  /* the same state narrowed as a second substep finds it */
+  fill(g, phase, b0lo, b0hi, none, nonehi);
+  mpm_grid_phase_narrow(g, phase);
+  fill(g, phase, b1lo, b1hi, b0lo, b0hi);
+  mpm_grid_phase_narrow(g, phase);
+  /* the nodes holding mass, on this rank's box: the block expected is their union, padded */
+  int has0 = 0, has1 = 0;
+  for (mpm_lidx l = 0; l < g->nnodes; ++l) {
+    int gi[3];
+    global_of(g, l, gi);
+    has0 |= in_block(dim, gi, b0lo, b0hi), has1 |= in_block(dim, gi, b1lo, b1hi);
+  }
+  int elo[3] = {0, 0, 0}, ehi[3] = {0, 0, 0}, blo[3], bhi[3], clo[3], chi[3];
+  for (int d = 0; d < 3; ++d) { /* this rank's box, and the block of the mass on it */
+    blo[d] = d < dim ? g->box_lo[d] : 0, bhi[d] = d < dim ? g->box_lo[d] + g->box_n[d] - 1 : 0;
+    clo[d] = 1000, chi[d] = -1000;
+  }
+  for (mpm_lidx l = 0; l < g->nnodes; ++l) {
+    int gi[3];
+    global_of(g, l, gi);
+    if (in_block(dim, gi, b0lo, b0hi) || in_block(dim, gi, b1lo, b1hi))
+      for (int d = 0; d < dim; ++d)
+        clo[d] = gi[d] < clo[d] ? gi[d] : clo[d], chi[d] = gi[d] > chi[d] ? gi[d] : chi[d];
+  }
+  if (has0 || has1) {
+    for (int d = 0; d < dim; ++d) {
+      elo[d] = clo[d] - 2 > blo[d] ? clo[d] - 2 : blo[d];
+      ehi[d] = chi[d] + 2 < bhi[d] ? chi[d] + 2 : bhi[d];
+    }
+    CHECK(visits_block(g, ph, elo, ehi),
+          "dim %d, rank %d: the block is both positions padded "
+          "by 2",
+          dim, g_rank);
+  } else {
+    CHECK(visits_block(g, ph, nonehi, none), "dim %d, rank %d: no mass here, no node visited", dim,
+          g_rank);
+  }
+  CHECK(mpm_grid_phase_update(g, phase, 1e-3) == 0, "narrowed solve");
+  CHECK(fields(g, phase, ref, 0),
+        "dim %d, rank %d: the narrowed solve leaves every field as the "
+        "whole-box solve does",
+        dim, g_rank);
+  /* zero: every field of the deposit, on the block, leaves the whole phase empty */
+  mpm_grid_phase_zero(g, phase);
+  int empty = 1;
+  for (mpm_lidx l = 0; l < g->nnodes; ++l) {
+    empty &= ph->m_i[l] == 0.0;
+    for (int d = 0; d < dim; ++d) empty &= ph->mv_i[d][l] == 0.0 && ph->f_i[d][l] == 0.0;
+  }
+  CHECK(empty, "dim %d, rank %d: zero on the block empties the deposit", dim, g_rank);
+  mpm_grid_phase_widen(g, phase);
+  CHECK(visits_block(g, ph, all_lo, all_hi), "dim %d: widening gives the whole box", dim);
+  free(ref);
+  mpm_grid_destroy(&g);
+}
+
+int main(int argc, char **argv) {
+  mpm_test_init(&argc, &argv);
+  run(2);
+  run(3);
+  int rc = mpm_test_finish("test_phase_narrow");
+  MPI_Finalize();
+  return rc ? 1 : 0;
+}
