@@ -399,21 +399,23 @@ static void block_union(int dim, const int *alo, const int *ahi, const int *blo,
   }
 }
 
-void mpm_grid_phase_narrow(mpm_grid *grid, int phase) {
-  mpm_grid_phase *ph = &grid->phase[phase];
-  const int dim = grid->dim, pad = 2;
-  int lo[MPM_MAX_DIM], hi[MPM_MAX_DIM], c[3];
-  for (int d = 0; d < dim; ++d) lo[d] = grid->box_n[d], hi[d] = 0;
-  /* the block of the nodes holding mass (over the whole box: a particle may have left the
-   * block since the last narrowing) */
+/* The block [lo, hi) of the box nodes where any of the n arrays is not zero, widened by pad
+ * nodes on every side within the box (lo >= hi on some axis: none). */
+static void nonzero_block(const mpm_grid *grid, const double *const *arr, int n, int pad, int *lo,
+                          int *hi) {
+  const int dim = grid->dim, nx = grid->box_n[0];
   const int ny = dim > 1 ? grid->box_n[1] : 1, nz = dim > 2 ? grid->box_n[2] : 1;
-  const int nx = grid->box_n[0];
+  int c[3];
+  for (int d = 0; d < dim; ++d) lo[d] = grid->box_n[d], hi[d] = 0;
   for (c[2] = 0; c[2] < nz; ++c[2])
     for (c[1] = 0; c[1] < ny; ++c[1]) {
-      const double *row = ph->m_i + ((mpm_lidx)c[2] * ny + c[1]) * nx;
+      const mpm_lidx r = ((mpm_lidx)c[2] * ny + c[1]) * nx;
       int first = -1, last = -1;
-      for (int i = 0; i < nx; ++i)
-        if (row[i] != 0.0) last = i, first = first < 0 ? i : first;
+      for (int k = 0; k < n; ++k) {
+        const double *row = arr[k] + r;
+        for (int i = 0; i < nx; ++i)
+          if (row[i] != 0.0) last = i > last ? i : last, first = first < 0 || i < first ? i : first;
+      }
       if (first < 0) continue;
       c[0] = first;
       for (int d = 0; d < dim; ++d) lo[d] = c[d] < lo[d] ? c[d] : lo[d];
@@ -425,10 +427,29 @@ void mpm_grid_phase_narrow(mpm_grid *grid, int phase) {
       lo[d] = lo[d] - pad > 0 ? lo[d] - pad : 0;
       hi[d] = hi[d] + pad < grid->box_n[d] ? hi[d] + pad : grid->box_n[d];
     }
-  if (!ph->narrowed) /* the mass before this deposit is not known: the whole box this time */
-    for (int d = 0; d < dim; ++d) ph->act_lo[d] = 0, ph->act_hi[d] = grid->box_n[d];
-  else
+}
+
+void mpm_grid_phase_narrow(mpm_grid *grid, int phase) {
+  mpm_grid_phase *ph = &grid->phase[phase];
+  const int dim = grid->dim, pad = 2;
+  int lo[MPM_MAX_DIM], hi[MPM_MAX_DIM];
+  /* the block of the nodes holding mass (over the whole box: a particle may have left the
+   * block since the last narrowing) */
+  const double *m = ph->m_i;
+  nonzero_block(grid, &m, 1, pad, lo, hi);
+  if (!ph->narrowed) {
+    /* The first narrowing after a widening. The deposit before it was zeroed on the whole box,
+     * so m, m v and f hold nothing outside the mass block; the solve's v and a may, where the
+     * phase held mass at its last solve: the block takes those nodes too (one pass over the
+     * box, against every pass of this cycle over the whole box). */
+    const double *va[2 * MPM_MAX_DIM];
+    for (int d = 0; d < dim; ++d) va[d] = ph->v_i[d], va[dim + d] = ph->a_i[d];
+    int vlo[MPM_MAX_DIM], vhi[MPM_MAX_DIM];
+    nonzero_block(grid, va, 2 * dim, pad, vlo, vhi);
+    block_union(dim, vlo, vhi, lo, hi, ph->act_lo, ph->act_hi);
+  } else {
     block_union(dim, ph->held_lo, ph->held_hi, lo, hi, ph->act_lo, ph->act_hi);
+  }
   for (int d = 0; d < dim; ++d) ph->held_lo[d] = lo[d], ph->held_hi[d] = hi[d];
   ph->narrowed = 1;
 }

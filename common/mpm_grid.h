@@ -118,8 +118,9 @@ void mpm_grid_phase_zero(mpm_grid *grid, int phase);
  * grid of 20,000 nodes, coupling.time = multirate). narrow sets the block to the nodes holding
  * the phase's mass now or at the last narrowing (whose velocities the solve must clear), two
  * nodes wider on every side, found in one pass over the box; the first narrowing after a
- * widening keeps the whole box. Until it is widened again nothing may write the phase outside
- * the block; the passes that honour it are zero, the nodal solve, and the coupler's load,
+ * widening (whose deposit was zeroed on the whole box) takes the nodes where the last solve
+ * left a velocity or an acceleration too. Until it is widened again nothing may write the phase
+ * outside the block; the passes that honour it are zero, the nodal solve, and the coupler's load,
  * captures and books (coupler/mpm_cycle.c narrows a loaded solid's phase in its substeps). */
 void mpm_grid_phase_narrow(mpm_grid *grid, int phase);
 void mpm_grid_phase_widen(mpm_grid *grid, int phase);

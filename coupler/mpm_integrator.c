@@ -31,7 +31,8 @@ struct mpm_integrator {
   double rtol, atol, cfl, dt_max;
   int max_retries;
   double h_limit;   /* fixed steps: the stability-limited step of the current state (0: none) */
-  int h_limit_set;  /* h_limit belongs to the current state (direct steps) */
+  double h_cfl;     /* direct steps: the CFL step of the same state (mpm_integrator_cfl_step) */
+  int h_limit_set;  /* h_limit and h_cfl belong to the current state (direct steps) */
   double h_last;    /* direct steps: the last step taken (or the first step asked for) */
   double tstop;     /* stop time of the current step */
   double scale;     /* step reduction of the current retry (1 when not retrying) */
@@ -220,10 +221,12 @@ static int estab(N_Vector y, mpm_sunreal t, mpm_sunreal *hstab, void *user) {
 }
 
 /* The stability-limited fixed step (direct methods, non-adaptive pairs) at y: the CFL
- * fraction of the limit, capped by dt_max; 0 when nothing limits it. */
-static int fixed_limit(mpm_integrator *it, double *const *yk, double *h) {
+ * fraction of the limit, capped by dt_max; 0 when nothing limits it. Also the CFL step
+ * without the cap (mpm_integrator_cfl_step). */
+static int fixed_limit(mpm_integrator *it, double *const *yk, double *h, double *h_cfl) {
   double hs;
   MPM_CALL(stable_step(it, yk, &hs));
+  *h_cfl = isfinite(hs) ? it->cfl * hs : 0.0;
   hs = fmin(it->cfl * hs, it->dt_max);
   *h = hs > 0 && isfinite(hs) ? hs : 0.0;
   return 0;
@@ -237,7 +240,7 @@ static int fixed_step(mpm_integrator *it, double *h) {
     double *yk[MPM_MAX_MODULES];
     particle_blocks(it, yk);
     mpm_timer_start(MPM_T_STABLE);
-    const int rc = fixed_limit(it, yk, &it->h_limit);
+    const int rc = fixed_limit(it, yk, &it->h_limit, &it->h_cfl);
     mpm_timer_stop(MPM_T_STABLE);
     MPM_CALL(rc);
     it->h_limit_set = it->direct; /* ERKStep's fixed steps: the state may have changed since */
@@ -674,11 +677,22 @@ int mpm_integrator_substeps(const mpm_integrator *it) {
   return it->mri ? it->substeps : 0;
 }
 
+/* Direct steps keep the limits of the current state for its step: a partitioned scheme asks
+ * for them at the start of its coupling step, and its module's first step then takes them
+ * without a second pass over the particles. */
 int mpm_integrator_cfl_step(mpm_integrator *it, double *h) {
-  double hs, *yk[MPM_MAX_MODULES];
-  particle_blocks(it, yk);
-  MPM_CALL(stable_step(it, yk, &hs));
-  *h = isfinite(hs) ? it->cfl * hs : 0.0;
+  double *yk[MPM_MAX_MODULES];
+  if (!it->h_limit_set) {
+    double h_limit = 0.0, h_cfl = 0.0;
+    particle_blocks(it, yk);
+    mpm_timer_start(MPM_T_STABLE);
+    const int rc = fixed_limit(it, yk, &h_limit, &h_cfl);
+    mpm_timer_stop(MPM_T_STABLE);
+    MPM_CALL(rc);
+    if (!it->direct) return *h = h_cfl, 0;
+    it->h_limit = h_limit, it->h_cfl = h_cfl, it->h_limit_set = 1;
+  }
+  *h = it->h_cfl;
   return 0;
 }
 

@@ -148,27 +148,27 @@ static int stencil_touches(const shift_stencil *s, const double *mk) {
 }
 
 /* Fold phi about the domain faces this rank holds: phi(j) + phi(-j) at both, j counted from
- * the face node along d. */
+ * the face node along d. Each pair once, from its node at j >= 0: the pairs of one axis are
+ * disjoint, so the slab of nodes at j is visited in any order. */
 static void fold_faces(const mpm_grid *g, double *phi) {
   for (int d = 0; d < g->dim; ++d) {
     if (g->periodic[d]) continue;
+    mpm_lidx stride = 1; /* between neighbours along d; the slab: inner x outer nodes */
+    for (int e = 0; e < d; ++e) stride *= g->box_n[e];
+    const mpm_lidx outer = g->nnodes / (stride * g->box_n[d]);
     for (int side = 0; side < 2; ++side) {
       if (g->coord[d] != (side ? g->nproc[d] - 1 : 0)) continue;
       const int face = side ? g->ncells[d] : 0;
-      for (mpm_lidx l = 0; l < g->nnodes; ++l) {
-        int gi[3] = {0, 0, 0};
-        mpm_lidx r = l;
-        for (int e = 0; e < g->dim; ++e)
-          gi[e] = g->box_lo[e] + (int)(r % g->box_n[e]), r /= g->box_n[e];
-        const int j = gi[d] - face;
-        if (j < 0 || j > g->pad) continue; /* each pair once, from its inner node */
-        int mi[3];
-        memcpy(mi, gi, sizeof mi);
-        mi[d] = face - j;
-        if (mi[d] - g->box_lo[d] < 0 || mi[d] - g->box_lo[d] >= g->box_n[d]) continue;
-        const mpm_lidx lm = mpm_grid_local_index(g, mi);
-        const double sum = j == 0 ? 2.0 * phi[l] : phi[l] + phi[lm];
-        phi[l] = sum, phi[lm] = sum;
+      for (int j = 0; j <= g->pad; ++j) {
+        const int at = face + j - g->box_lo[d], mirror = face - j - g->box_lo[d];
+        if (at < 0 || at >= g->box_n[d] || mirror < 0 || mirror >= g->box_n[d]) continue;
+        for (mpm_lidx o = 0; o < outer; ++o)
+          for (mpm_lidx a = 0; a < stride; ++a) {
+            const mpm_lidx base = o * stride * g->box_n[d] + a;
+            const mpm_lidx l = base + at * stride, lm = base + mirror * stride;
+            const double sum = j == 0 ? 2.0 * phi[l] : phi[l] + phi[lm];
+            phi[l] = sum, phi[lm] = sum;
+          }
       }
     }
   }

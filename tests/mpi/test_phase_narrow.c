@@ -2,12 +2,13 @@
  * common/mpm_grid.h), in 2-D and 3-D, on any number of ranks.
  *
  * A phase holds mass in a small block of nodes (a body beside a large grid). Checked:
- *  - the first narrowing after a widening keeps the whole box; the next covers the nodes that
- *    hold mass now and those that did then, two nodes wider on every side, and no more;
+ *  - the first narrowing after a widening covers the nodes that hold mass and those where the
+ *    last solve left a velocity or an acceleration; the next covers the nodes that hold mass
+ *    now and those that did then; each two nodes wider on every side, and no more;
  *  - MPM_PHASE_FOR visits exactly the block's nodes, once each, in increasing index order;
  *  - zero and the nodal solve on the narrowed phase leave every field bit for bit as the
- *    whole-box passes do, when the mass has moved since the last narrowing (the velocities
- *    the solve must clear lie in the old block);
+ *    whole-box passes do, when the mass has moved since the last narrowing or since the last
+ *    solve before a widening (the velocities the solve must clear lie in the old block);
  *  - a rank holding none of the phase gets an empty block and its passes visit no node;
  *  - widening gives the whole box back. */
 #include "mpm_grid.h"
@@ -87,6 +88,35 @@ static int visits_block(const mpm_grid *g, const mpm_grid_phase *ph, const int *
   return ok && count == expect;
 }
 
+/* The blocks [a_lo, a_hi] and [b_lo, b_hi] (global, inclusive) as this rank holds them, padded
+ * by 2 and clipped to its box, into [lo, hi]; returns whether the rank holds any of them. */
+static int padded_union(const mpm_grid *g, const int *a_lo, const int *a_hi, const int *b_lo,
+                        const int *b_hi, int *lo, int *hi) {
+  int clo[3] = {1000, 1000, 1000}, chi[3] = {-1000, -1000, -1000}, any = 0;
+  for (mpm_lidx l = 0; l < g->nnodes; ++l) {
+    int gi[3];
+    global_of(g, l, gi);
+    if (!in_block(g->dim, gi, a_lo, a_hi) && !in_block(g->dim, gi, b_lo, b_hi)) continue;
+    any = 1;
+    for (int d = 0; d < g->dim; ++d)
+      clo[d] = gi[d] < clo[d] ? gi[d] : clo[d], chi[d] = gi[d] > chi[d] ? gi[d] : chi[d];
+  }
+  for (int d = 0; d < 3; ++d) {
+    const int blo = d < g->dim ? g->box_lo[d] : 0;
+    const int bhi = d < g->dim ? g->box_lo[d] + g->box_n[d] - 1 : 0;
+    lo[d] = d < g->dim ? (clo[d] - 2 > blo ? clo[d] - 2 : blo) : 0;
+    hi[d] = d < g->dim ? (chi[d] + 2 < bhi ? chi[d] + 2 : bhi) : 0;
+  }
+  return any;
+}
+
+/* The block visited is [lo, hi] where the rank holds any of the phase, none elsewhere. */
+static int visits_expected(const mpm_grid *g, const mpm_grid_phase *ph, int any, const int *lo,
+                           const int *hi) {
+  const int none[3] = {0, 0, 0}, nonehi[3] = {-1, -1, -1};
+  return any ? visits_block(g, ph, lo, hi) : visits_block(g, ph, nonehi, none);
+}
+
 static void run(int dim) {
   const double lo[3] = {0, 0, 0}, hi[3] = {2.0, 1.0, 0.75};
   const double dx = 0.125; /* 16 x 8 (x 6) cells */
@@ -101,55 +131,49 @@ static void run(int dim) {
   const int b0lo[3] = {3, 2, 1}, b0hi[3] = {5, 4, 2}, b1lo[3] = {4, 2, 1}, b1hi[3] = {6, 4, 2};
   const int none[3] = {0, 0, 0}, nonehi[3] = {-1, -1, -1};
 
+  int all_lo[3] = {-1000, -1000, -1000}, all_hi[3] = {1000, 1000, 1000};
+  int elo[3], ehi[3];
   fill(g, phase, b0lo, b0hi, none, nonehi);
   mpm_grid_phase_narrow(g, phase);
-  int all_lo[3] = {-1000, -1000, -1000}, all_hi[3] = {1000, 1000, 1000};
-  CHECK(visits_block(g, ph, all_lo, all_hi), "dim %d: the first narrowing keeps the whole box",
-        dim);
+  int any = padded_union(g, b0lo, b0hi, b0lo, b0hi, elo, ehi);
+  CHECK(visits_expected(g, ph, any, elo, ehi),
+        "dim %d, rank %d: the first narrowing, no velocity left: the mass padded by 2", dim,
+        g_rank);
   CHECK(mpm_grid_phase_update(g, phase, 1e-3) == 0, "solve");
+
+  /* The first narrowing after a widening, the last solve's velocities far from the mass: the
+   * block must cover both, padded by 2, clipped to the box. */
+  const int b2lo[3] = {11, 5, 3}, b2hi[3] = {12, 6, 4};
+  fill(g, phase, b1lo, b1hi, b2lo, b2hi);
+  mpm_grid_phase_widen(g, phase);
+  CHECK(mpm_grid_phase_update(g, phase, 1e-3) == 0, "whole-box solve");
+  fields(g, phase, ref, 1); /* the reference: the whole box */
+  any = padded_union(g, b1lo, b1hi, b2lo, b2hi, elo, ehi);
+  fill(g, phase, b1lo, b1hi, b2lo, b2hi);
+  mpm_grid_phase_narrow(g, phase);
+  CHECK(visits_expected(g, ph, any, elo, ehi),
+        "dim %d, rank %d: the first narrowing: the mass and the last solve's velocities, padded "
+        "by 2",
+        dim, g_rank);
+  CHECK(mpm_grid_phase_update(g, phase, 1e-3) == 0, "narrowed solve");
+  CHECK(fields(g, phase, ref, 0),
+        "dim %d, rank %d: the first narrowed solve leaves every field as the whole-box solve does",
+        dim, g_rank);
 
   /* The body moves; the block must cover both positions, padded by 2, clipped to the box. */
   fill(g, phase, b1lo, b1hi, b0lo, b0hi);
   mpm_grid_phase_widen(g, phase);
   CHECK(mpm_grid_phase_update(g, phase, 1e-3) == 0, "whole-box solve");
-  fields(g, phase, ref, 1); /* the reference: the whole box */
+  fields(g, phase, ref, 1);
+  any = padded_union(g, b0lo, b0hi, b1lo, b1hi, elo, ehi);
   /* the same state narrowed as a second substep finds it */
+  mpm_grid_phase_widen(g, phase);
   fill(g, phase, b0lo, b0hi, none, nonehi);
   mpm_grid_phase_narrow(g, phase);
   fill(g, phase, b1lo, b1hi, b0lo, b0hi);
   mpm_grid_phase_narrow(g, phase);
-  /* the nodes holding mass, on this rank's box: the block expected is their union, padded */
-  int has0 = 0, has1 = 0;
-  for (mpm_lidx l = 0; l < g->nnodes; ++l) {
-    int gi[3];
-    global_of(g, l, gi);
-    has0 |= in_block(dim, gi, b0lo, b0hi), has1 |= in_block(dim, gi, b1lo, b1hi);
-  }
-  int elo[3] = {0, 0, 0}, ehi[3] = {0, 0, 0}, blo[3], bhi[3], clo[3], chi[3];
-  for (int d = 0; d < 3; ++d) { /* this rank's box, and the block of the mass on it */
-    blo[d] = d < dim ? g->box_lo[d] : 0, bhi[d] = d < dim ? g->box_lo[d] + g->box_n[d] - 1 : 0;
-    clo[d] = 1000, chi[d] = -1000;
-  }
-  for (mpm_lidx l = 0; l < g->nnodes; ++l) {
-    int gi[3];
-    global_of(g, l, gi);
-    if (in_block(dim, gi, b0lo, b0hi) || in_block(dim, gi, b1lo, b1hi))
-      for (int d = 0; d < dim; ++d)
-        clo[d] = gi[d] < clo[d] ? gi[d] : clo[d], chi[d] = gi[d] > chi[d] ? gi[d] : chi[d];
-  }
-  if (has0 || has1) {
-    for (int d = 0; d < dim; ++d) {
-      elo[d] = clo[d] - 2 > blo[d] ? clo[d] - 2 : blo[d];
-      ehi[d] = chi[d] + 2 < bhi[d] ? chi[d] + 2 : bhi[d];
-    }
-    CHECK(visits_block(g, ph, elo, ehi),
-          "dim %d, rank %d: the block is both positions padded "
-          "by 2",
-          dim, g_rank);
-  } else {
-    CHECK(visits_block(g, ph, nonehi, none), "dim %d, rank %d: no mass here, no node visited", dim,
-          g_rank);
-  }
+  CHECK(visits_expected(g, ph, any, elo, ehi),
+        "dim %d, rank %d: the block is both positions padded by 2", dim, g_rank);
   CHECK(mpm_grid_phase_update(g, phase, 1e-3) == 0, "narrowed solve");
   CHECK(fields(g, phase, ref, 0),
         "dim %d, rank %d: the narrowed solve leaves every field as the "
