@@ -10,7 +10,10 @@
  *    whole-box passes do, when the mass has moved since the last narrowing or since the last
  *    solve before a widening (the velocities the solve must clear lie in the old block);
  *  - a rank holding none of the phase gets an empty block and its passes visit no node;
+ *  - the walls' fold and mirror (mpm_bc.h) on a narrowed phase beside a wall leave every field
+ *    as on the whole box, at the first narrowing and the next;
  *  - widening gives the whole box back. */
+#include "mpm_bc.h"
 #include "mpm_grid.h"
 #include "mpm_module.h"
 
@@ -193,10 +196,49 @@ static void run(int dim) {
   mpm_grid_destroy(&g);
 }
 
+/* A body on the wall y = 0 (its mass on the pad nodes beyond it too): fold, solve and mirror
+ * on the narrowed phase against the same on the whole box. */
+static void walls(int dim) {
+  const double lo[3] = {0, 0, 0}, hi[3] = {2.0, 1.0, 0.75};
+  mpm_grid *g = NULL;
+  int phase = -1;
+  CHECK(mpm_grid_new(&g, MPI_COMM_WORLD, dim, lo, hi, 0.125, MPM_SHAPE_QUADRATIC, NULL) == 0,
+        "grid (dim %d)", dim);
+  CHECK(mpm_grid_add_phase(g, "body", &phase) == 0, "phase");
+  mpm_walls w;
+  for (int d = 0; d < MPM_MAX_DIM; ++d) w.face[d][0] = w.face[d][1] = MPM_WALL_SLIP;
+  mpm_node_constraints c = {0};
+  CHECK(mpm_constraints_add_walls(&c, &w, g) == 0, "walls");
+  double *ref = malloc(sizeof(double) * (1 + 4 * MPM_MAX_DIM) * (size_t)g->nnodes);
+  const int blo[3] = {3, -1, 1}, bhi[3] = {5, 2, 2}, none[3] = {0, 0, 0}, nonehi[3] = {-1, -1, -1};
+  fill(g, phase, blo, bhi, none, nonehi);
+  mpm_constraints_fold(&c, g, phase);
+  CHECK(mpm_grid_phase_update(g, phase, 1e-3) == 0, "whole-box solve");
+  mpm_constraints_apply(&c, g, phase);
+  fields(g, phase, ref, 1);
+  for (int round = 0; round < 2; ++round) { /* the first narrowing, then the next */
+    fill(g, phase, blo, bhi, none, nonehi);
+    mpm_grid_phase_narrow(g, phase);
+    mpm_constraints_fold(&c, g, phase);
+    CHECK(mpm_grid_phase_update(g, phase, 1e-3) == 0, "narrowed solve");
+    mpm_constraints_apply(&c, g, phase);
+    CHECK(fields(g, phase, ref, 0),
+          "dim %d, rank %d, round %d: the walls on the narrowed phase leave every field as on "
+          "the whole box",
+          dim, g_rank, round);
+  }
+  mpm_grid_phase_widen(g, phase);
+  mpm_constraints_free(&c);
+  free(ref);
+  mpm_grid_destroy(&g);
+}
+
 int main(int argc, char **argv) {
   mpm_test_init(&argc, &argv);
   run(2);
   run(3);
+  walls(2);
+  walls(3);
   int rc = mpm_test_finish("test_phase_narrow");
   MPI_Finalize();
   return rc ? 1 : 0;
