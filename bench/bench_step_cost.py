@@ -114,7 +114,10 @@ def main():
     for r in rows:
         r["per_step_over_reference"] = r["per_step"] / ref["per_step"] if ref else None
     os.makedirs(a.out, exist_ok=True)
-    meta = {"revision": git("rev-parse", "--short", "HEAD"), "case": a.case, "set": a.set,
+    version = subprocess.run([a.binary, "version"], capture_output=True, text=True).stdout
+    meta = {"revision": git("rev-parse", "--short", "HEAD"), "binary": a.binary,
+            "binary_version": version.strip().splitlines()[0] if version.strip() else "unknown",
+            "case": a.case, "set": a.set,
             "from": a.t_from, "to": a.t_to, "reference": a.reference, "rows": rows}
     with open(os.path.join(a.out, "rows.json"), "w") as f:
         json.dump(meta, f, indent=1)
