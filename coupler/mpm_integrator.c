@@ -232,19 +232,27 @@ static int fixed_limit(mpm_integrator *it, double *const *yk, double *h, double 
   return 0;
 }
 
+/* h_limit and h_cfl of the current state, unless they are known. Direct steps keep them for
+ * the state's step: a partitioned scheme asks for the CFL step at the start of its coupling step,
+ * and its module's first step then takes the limit without a second pass over the particles.
+ * (ERKStep's fixed steps recompute them: the state may have changed since.) */
+static int current_limits(mpm_integrator *it) {
+  if (it->h_limit_set) return 0;
+  double *yk[MPM_MAX_MODULES];
+  particle_blocks(it, yk);
+  mpm_timer_start(MPM_T_STABLE);
+  const int rc = fixed_limit(it, yk, &it->h_limit, &it->h_cfl);
+  mpm_timer_stop(MPM_T_STABLE);
+  MPM_CALL(rc);
+  it->h_limit_set = it->direct;
+  return 0;
+}
+
 /* The fixed step from the last accepted state: its stability limit (or, without one, the
  * rest of the way to the stop time) times the retry scale, capped by the stop time so that a
  * step lands on it (and stretched to it when the limit falls short by roundoff only). */
 static int fixed_step(mpm_integrator *it, double *h) {
-  if (!it->h_limit_set) {
-    double *yk[MPM_MAX_MODULES];
-    particle_blocks(it, yk);
-    mpm_timer_start(MPM_T_STABLE);
-    const int rc = fixed_limit(it, yk, &it->h_limit, &it->h_cfl);
-    mpm_timer_stop(MPM_T_STABLE);
-    MPM_CALL(rc);
-    it->h_limit_set = it->direct; /* ERKStep's fixed steps: the state may have changed since */
-  }
+  MPM_CALL(current_limits(it));
   const double t = it->t_last, rest = it->tstop - t;
   const double hs = it->scale * (it->h_limit > 0 ? it->h_limit : rest);
   /* A limit a few ulps short of the rest (a staggered scheme's coupling step, t + H - t) would
@@ -677,21 +685,8 @@ int mpm_integrator_substeps(const mpm_integrator *it) {
   return it->mri ? it->substeps : 0;
 }
 
-/* Direct steps keep the limits of the current state for its step: a partitioned scheme asks
- * for them at the start of its coupling step, and its module's first step then takes them
- * without a second pass over the particles. */
 int mpm_integrator_cfl_step(mpm_integrator *it, double *h) {
-  double *yk[MPM_MAX_MODULES];
-  if (!it->h_limit_set) {
-    double h_limit = 0.0, h_cfl = 0.0;
-    particle_blocks(it, yk);
-    mpm_timer_start(MPM_T_STABLE);
-    const int rc = fixed_limit(it, yk, &h_limit, &h_cfl);
-    mpm_timer_stop(MPM_T_STABLE);
-    MPM_CALL(rc);
-    if (!it->direct) return *h = h_cfl, 0;
-    it->h_limit = h_limit, it->h_cfl = h_cfl, it->h_limit_set = 1;
-  }
+  MPM_CALL(current_limits(it));
   *h = it->h_cfl;
   return 0;
 }
