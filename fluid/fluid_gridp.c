@@ -309,30 +309,19 @@ static int lagged_faces(const fluid_content *fc, const mpm_grid *g) {
 }
 
 /* fluid.pressure = auto. With refinement the grid pressure (fluid_gridp_refine: the particles'
- * quadrature disturbs the gas at the refined regions' corners), beside a solid on a hierarchy
- * the particles'. Else the hybrid wherever its scope holds, beside a solid too (the gas gets no
- * grid-scale mode from the uniform part of its pressure: on the gas-column/slab resonator at 800
- * cells per metre the particles' pressure grew it to |v_y| = 0.39 c_g by t = 1.8; Sod's L1 falls,
- * docs/gas.md), the particles' pressure silently outside it and beside a solid under the
- * least-squares wall. One log line says which and why. */
+ * quadrature disturbs the gas at the refined regions' corners). Beside a solid the particles'
+ * pressure: the hybrid's coupling there is another job's (docs/gas.md). Else the hybrid
+ * wherever its scope holds (a gas alone gets no grid-scale mode from the uniform part of its
+ * pressure, and Sod's L1 falls, docs/gas.md), the particles' pressure silently outside it. One
+ * log line says which and why. */
 static int choose_auto(mpm_module *m, const mpm_config *cfg) {
   const char *const *names;
   int nsolid, levels = 1;
   MPM_CALL(mpm_config_instances(cfg, "solid", &names, &nsolid));
   if (mpm_config_has(cfg, "refine.levels"))
     MPM_CALL(mpm_config_get_int(cfg, "refine.levels", &levels));
-  const char *wall = "ghost";
-  MPM_CALL(mpm_config_get_string(cfg, "fluid.wall_treatment", &wall));
-  if (nsolid > 0 && strcmp(wall, "least_squares") == 0) {
-    /* Measured with the hybrid (test_fsi_reflection): the near-rigid slab's first gas layer
-     * -5.8 % in p against the particles' +1.5 % (bound 3 %). */
-    mpm_log(MPM_LOG_INFO, "pressure: particle (fluid.pressure = auto, beside a solid with "
-                          "fluid.wall_treatment = least_squares)");
-    return 0;
-  }
-  if (nsolid > 0 && levels > 1) {
-    mpm_log(MPM_LOG_INFO, "pressure: particle (fluid.pressure = auto, beside a solid on a "
-                          "hierarchy)");
+  if (nsolid > 0) {
+    mpm_log(MPM_LOG_INFO, "pressure: particle (fluid.pressure = auto, beside a solid)");
     return 0;
   }
   if (levels > 1) {
@@ -362,8 +351,8 @@ static int choose_auto(mpm_module *m, const mpm_config *cfg) {
             strcmp(s.key, "fluid.pressure") ? s.key : "");
     return 0;
   }
-  mpm_log(MPM_LOG_INFO, "pressure: hybrid (fluid.pressure = auto: %s, in the hybrid's scope)",
-          nsolid > 0 ? "beside a solid" : "a gas without a solid");
+  mpm_log(MPM_LOG_INFO, "pressure: hybrid (fluid.pressure = auto: a gas without a solid, in "
+                        "the hybrid's scope)");
   return enable(m, cfg, 1);
 }
 

@@ -99,11 +99,10 @@ static const mpm_key_spec fluid_keys[] = {
      "with the grid's as a defect correction: the particles integrate p - p_h, the grid p_h "
      "exactly, so a uniform pressure exerts no force whatever the particles' positions; the "
      "grid's scope without refinement or obstacles, beside a solid monolithic and not contact; "
-     "docs/gas.md) or auto (grid with refine.levels > 1, where particle is refused, or "
-     "particle there beside a solid; else hybrid where its scope holds (and no "
-     "fluid.regularise_every; under usl and musl no farfield or subsonic_inflow face; beside a "
-     "solid no fluid.wall_treatment = least_squares) and particle outside it, silently; the "
-     "log says which); see docs/refinement.md",
+     "docs/gas.md) or auto (without a solid: grid with refine.levels > 1, where particle is "
+     "refused, else hybrid where its scope holds (and no fluid.regularise_every; under usl "
+     "and musl no farfield or subsonic_inflow face) and particle outside it, silently; beside "
+     "a solid particle; the log says which); see docs/refinement.md",
      0, NULL},
     {"fluid.hybrid_fill", MPM_KEY_REAL, "0.5", 0, 1, 0, 0, NULL,
      "the hybrid pressure without a solid: the share of a node's volume the particles must fill "
