@@ -12,8 +12,9 @@ Cases (the scenes of tests/verification/test_refine_gas.py):
             Error: the mean |rho - rho_fine| over the band's rows 0.2 < y < 0.4 at t = 1.2,
             binned along x into 60 cells (the fine twin is the reference: its error is 0).
   stream3d  the stream in 3-D (x and z periodic), to t = 0.45.
-  sod, sod3 cases/sod.ini over 100 level-0 cells, 3 across (periodic in y: every level wraps),
-            regridded by the density criterion (refine_scenes.sod_refine) with 2 and 3 levels,
+  sod, sod3, sod4
+            cases/sod.ini over 100 level-0 cells, 3 across (periodic in y: every level wraps),
+            regridded by the density criterion (refine_scenes.sod_refine) with 2, 3 and 4 levels,
             against the uniform twins at the finest spacing on the same strip, with the grid
             pressure the refined run takes (fine) and the default particle pressure
             (fine_particle). Error: the density's L1 on the finest cells (tests/tools/
@@ -45,7 +46,7 @@ from riemann import Riemann  # noqa: E402
 U0 = 0.5 * C0
 GAS_STREAM = f"density = 1\npressure = 1\nvelocity = {U0!r} 0"
 TIMERS = ("restrict", "prolong", "relevel", "regrid")
-DEFAULT_CASES = "stream,pulse,stream3d,sod,sod3"
+DEFAULT_CASES = "stream,pulse,stream3d,sod,sod3,sod4"
 
 
 def run(binary, out, case, overrides):
@@ -143,7 +144,8 @@ ERRORS = {"stream": "largest deviation of rho, p, v (relative)",
           "stream3d": "largest deviation of rho, p, v (relative)",
           "pulse": "mean |rho - rho_fine| over the band's rows (fine: the reference)",
           "sod": "L1 of the density on the finest cells (fine: grid pressure, as refined)",
-          "sod3": "L1 of the density on the finest cells (fine: grid pressure, as refined)"}
+          "sod3": "L1 of the density on the finest cells (fine: grid pressure, as refined)",
+          "sod4": "L1 of the density on the finest cells (fine: grid pressure, as refined)"}
 
 
 def write_rows(out, stem, rows):
@@ -211,8 +213,8 @@ def main():
             results[name] = case_stream(a.binary, a.out, 3)
         elif name == "pulse":
             results[name] = case_pulse(a.binary, a.out)
-        elif name in ("sod", "sod3"):
-            results[name] = case_sod(a.binary, a.out, 3 if name == "sod3" else 2)
+        elif name in ("sod", "sod3", "sod4"):
+            results[name] = case_sod(a.binary, a.out, {"sod": 2, "sod3": 3, "sod4": 4}[name])
         else:
             raise SystemExit(f"unknown case {name}: choose among {DEFAULT_CASES}")
         for label, r in results[name].items():
