@@ -46,7 +46,8 @@ from riemann import Riemann  # noqa: E402
 U0 = 0.5 * C0
 GAS_STREAM = f"density = 1\npressure = 1\nvelocity = {U0!r} 0"
 TIMERS = ("restrict", "prolong", "relevel", "regrid")
-DEFAULT_CASES = "stream,pulse,stream3d,sod,sod3,sod4"
+SOD_LEVELS = {"sod": 2, "sod3": 3, "sod4": 4}  # case: refinement levels
+DEFAULT_CASES = "stream,pulse,stream3d," + ",".join(SOD_LEVELS)
 
 
 def run(binary, out, case, overrides):
@@ -143,9 +144,8 @@ def case_sod(binary, out, levels):
 ERRORS = {"stream": "largest deviation of rho, p, v (relative)",
           "stream3d": "largest deviation of rho, p, v (relative)",
           "pulse": "mean |rho - rho_fine| over the band's rows (fine: the reference)",
-          "sod": "L1 of the density on the finest cells (fine: grid pressure, as refined)",
-          "sod3": "L1 of the density on the finest cells (fine: grid pressure, as refined)",
-          "sod4": "L1 of the density on the finest cells (fine: grid pressure, as refined)"}
+          **{name: "L1 of the density on the finest cells (fine: grid pressure, as refined)"
+             for name in SOD_LEVELS}}
 
 
 def write_rows(out, stem, rows):
@@ -213,8 +213,8 @@ def main():
             results[name] = case_stream(a.binary, a.out, 3)
         elif name == "pulse":
             results[name] = case_pulse(a.binary, a.out)
-        elif name in ("sod", "sod3", "sod4"):
-            results[name] = case_sod(a.binary, a.out, {"sod": 2, "sod3": 3, "sod4": 4}[name])
+        elif name in SOD_LEVELS:
+            results[name] = case_sod(a.binary, a.out, SOD_LEVELS[name])
         else:
             raise SystemExit(f"unknown case {name}: choose among {DEFAULT_CASES}")
         for label, r in results[name].items():
