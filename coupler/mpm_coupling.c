@@ -245,44 +245,8 @@ static int save_held(mpm_coupling *c, double t, double h, mpm_pass pass) {
   return 0;
 }
 
-/* A gas that integrates its pressure over the grid's spans (fluid.pressure = grid or hybrid, the
- * gas module reads the solid's points) puts forces on nodes where it has no mass: the nodes
- * inside the solid whose supports meet the gas's pressure field, continued into the solid
- * (fluid/fluid_gridp_solid.c, which keeps those whose basis functions read a continued pressure
- * only and drops the deeper residue). Summed with the rest they vanish (sum_i grad N_i = 0), so
- * a gas's solve that dropped them lost momentum (the pulse in cases/fsi_box.ini: 1.1e-4 of its
- * momentum scale under usl; 5e-16 with this). They act on the solid, recorded as interface
- * forces; the gas's side has no velocity there, so the work they do on the solid is booked as
- * the coupling's (W_net). (The gas's field taking the solid's velocity there would close the
- * energy, but the solid's deformation rate then reaches the gas's volume rate through the
- * continuation's transpose: a shock into a slab reflected 0.15 of its jump against 0.34.) */
-static int hand_off(mpm_coupling *c, double t, double h, mpm_pass pass) {
-  (void)t, (void)pass;
-  mpm_grid_phase *s = mpm_coupling_phase(c, MPM_ROLE_SOLID);
-  mpm_grid_phase *g = mpm_coupling_phase(c, MPM_ROLE_FLUID);
-  const int dim = c->grid->dim;
-  const double rest[MPM_MAX_DIM] = {0.0, 0.0, 0.0};
-  for (mpm_lidx l = 0; l < c->grid->nnodes; ++l) {
-    if (mpm_coupling_has_mass(c, MPM_ROLE_FLUID, l) || !mpm_coupling_has_mass(c, MPM_ROLE_SOLID, l))
-      continue;
-    double v[MPM_MAX_DIM], a[MPM_MAX_DIM], given[MPM_MAX_DIM], any = 0.0;
-    for (int d = 0; d < dim; ++d) {
-      const double f = g->f_i[d][l];
-      v[d] = s->v_i[d][l] + h * f / s->m_i[l], a[d] = s->a_i[d][l] + f / s->m_i[l];
-      given[d] = -f, any += fabs(f);
-      g->f_i[d][l] = 0.0;
-    }
-    if (any == 0.0) continue;
-    mpm_coupling_exchange(c, MPM_ROLE_SOLID, l, v, a, h);
-    mpm_coupling_record_force(c, MPM_ROLE_FLUID, l, given, rest);
-  }
-  return 0;
-}
-
 int mpm_coupling_after_solve(mpm_coupling *c, double t, double h, mpm_pass pass) {
   if (!c) return 0;
-  const mpm_module *gas = c->module[MPM_ROLE_FLUID];
-  if (gas && gas->beside && c->module[MPM_ROLE_SOLID]) MPM_CALL(run_hook(c, hand_off, t, h, pass));
   MPM_CALL(run_hook(c, c->type->ops->after_solve, t, h, pass));
   if (c->type->needs & MPM_COUPLING_HOLDS) MPM_CALL(run_hook(c, save_held, t, h, pass));
   return 0;

@@ -52,7 +52,7 @@ void fluid_gridp_solid_free(fluid_gridp_solid *s) {
   free(s->buf);
   s->buf = NULL, s->cap = 0;
   for (int l = 0; l < MPM_HIER_MAX_LEVELS; ++l)
-    free(s->A[l]), free(s->B[l]), free(s->K[l]), s->A[l] = s->B[l] = s->K[l] = NULL;
+    free(s->A[l]), free(s->B[l]), s->A[l] = s->B[l] = NULL;
 }
 
 static const mpm_grid *level_grid(const mpm_module *m, int l) {
@@ -67,7 +67,6 @@ static int ensure(mpm_module *m, fluid_gridp_solid *s, mpm_lidx n) {
     const mpm_lidx nn = m->hier ? m->hier->level[l].grid->nnodes : m->grid->nnodes;
     MPM_ALLOC(s->A[l], (size_t)nn);
     MPM_ALLOC(s->B[l], (size_t)nn);
-    MPM_ALLOC(s->K[l], (size_t)nn);
   }
   if (s->cap >= n && s->buf) return 0;
   free(s->buf);
@@ -186,42 +185,8 @@ int fluid_gridp_solid_pressure(mpm_module *m, fluid_gridp_solid *s, double *cons
     const mpm_grid_phase *ph = &level_grid(m, l)->phase[s->phase];
     for (mpm_lidx k = 0; k < level_grid(m, l)->nnodes; ++k)
       if (continued(m, s, l, k, M)) P[l][k] = ph->mv_i[0][k] / ph->m_i[k];
-    for (mpm_lidx k = 0; k < level_grid(m, l)->nnodes; ++k)
-      s->K[l][k] = (active(m, l, k) && M[l][k] > 0.0) || continued(m, s, l, k, M);
   }
-  return mpm_grid_halo_forward(m->grid, &s->K[0], 1);
-}
-
-/* The forces the solid may take (the coupler hands the gas's forces on nodes where only the solid
- * has mass to it, coupler/mpm_coupling.c): those of the nodes whose basis functions' spans read
- * known pressures only, every node within two of them gas or continued. Deeper in the solid the
- * continued pressure falls to zero, and there the span integral and the solid's quadrature of
- * that fall leave a residue, not a load: it would move a prestressed body at rest in gas at rest
- * (a disk in a level-1 box: |v| 1.5e-3 c_g by t = 0.2). Those forces are dropped, as the gas's
- * solve drops every force where it has no mass. */
-static void drop_residue(const mpm_module *m, const fluid_gridp_solid *s, int l) {
-  const mpm_grid *g = level_grid(m, l);
-  const double *K = s->K[l];
-  mpm_grid_phase *ph = &((mpm_grid *)g)->phase[m->phase];
-  int total = 1;
-  for (int d = 0; d < g->dim; ++d) total *= 5;
-  for (mpm_lidx k = 0; k < g->nnodes; ++k) {
-    if (K[k] == 1.0 && active(m, l, k) && ph->m_i[k] > 0.0) continue; /* a gas node */
-    int c[MPM_MAX_DIM] = {0}, unknown = 0;
-    mpm_lidx r = k;
-    for (int d = 0; d < g->dim; ++d) c[d] = (int)(r % g->box_n[d]), r /= g->box_n[d];
-    for (int o = 0; o < total && !unknown; ++o) {
-      mpm_lidx j = 0, stride = 1;
-      int inside = 1;
-      for (int d = 0, q = o; d < g->dim; ++d, q /= 5) {
-        const int cd = c[d] + q % 5 - 2;
-        inside &= cd >= 0 && cd < g->box_n[d];
-        j += (mpm_lidx)cd * stride, stride *= g->box_n[d];
-      }
-      unknown = inside && K[j] == 0.0 && active(m, l, j);
-    }
-    for (int d = 0; unknown && d < g->dim; ++d) ph->f_i[d][k] = 0.0;
-  }
+  return 0;
 }
 
 int fluid_gridp_points_load(mpm_module *m, fluid_gridp_solid *s, double *const *P, double **load) {
@@ -253,9 +218,7 @@ int fluid_gridp_points_force(mpm_module *m, fluid_gridp_solid *s, double *const 
 int fluid_gridp_solid_force(mpm_module *m, fluid_gridp_solid *s, double *const *P) {
   if (!m->beside) return 0;
   s->pts = m->beside;
-  MPM_CALL(fluid_gridp_points_force(m, s, P));
-  for (int l = 0; l < nlevels(m); ++l) drop_residue(m, s, l);
-  return 0;
+  return fluid_gridp_points_force(m, s, P);
 }
 
 /* D_j -= sum_s V_s N_j(x_s) div v_h(x_s) on every node. */

@@ -161,7 +161,6 @@ typedef struct fluid_gridp_solid {
   const mpm_points *pts; /* the points read: m->beside, or the gas's own (hybrid) */
   mpm_lidx cap;
   double *buf, *A[MPM_HIER_MAX_LEVELS], *B[MPM_HIER_MAX_LEVELS];
-  double *K[MPM_HIER_MAX_LEVELS]; /* 1 where the nodal pressure is known: gas or continued */
 } fluid_gridp_solid;
 int fluid_gridp_prolong(mpm_module *m, double **a);
 int fluid_gridp_solid_init(fluid_gridp_solid *s, mpm_grid *g);
