@@ -332,6 +332,8 @@ static int make_parents_box(mpm_hier *h) {
   return 0;
 }
 
+static int make_leaf(mpm_hier *h);
+
 /* Levels 1 .. nlevels - 1 in turn (each snaps its boxes to the level before); why is set on an
  * input error. */
 static int build_levels(mpm_hier *h, const mpm_hier_box *box, int nbox, char *why, size_t len) {
@@ -347,6 +349,7 @@ static int build_levels(mpm_hier *h, const mpm_hier_box *box, int nbox, char *wh
   free(sp);
   for (int l = 0; l < h->nlevels && !rc; ++l) set_active(h, l);
   if (!rc && h->nranks > 1 && h->nlevels > 1) rc = make_parents_box(h);
+  if (!rc) rc = make_leaf(h);
   return rc;
 }
 
@@ -398,6 +401,7 @@ void mpm_hier_destroy(mpm_hier **hp) {
   free(h->pbox.owned), free(h->pbox.buf), free(h->sum_buf);
   mpm_hier_scratch_free(h->scratch);
   mpm_hier_census_free(h->census);
+  for (int l = 0; l < MPM_HIER_MAX_LEVELS; ++l) free(h->leaf[l]);
   free(h);
   *hp = NULL;
 }
@@ -423,11 +427,10 @@ static int stencil_in_box(const mpm_grid *g, const double *x) {
   return 1;
 }
 
-int mpm_hier_level_of(const mpm_hier *h, const double *xp) {
+/* The walk from level 0 (x wrapped). */
+static int level_walk(const mpm_hier *h, const double *x) {
   int l = 0, gi[MPM_MAX_DIM] = {0, 0, 0};
-  double x[MPM_MAX_DIM];
   const int walls = walled(h);
-  hier_wrap_point(h, xp, x);
   for (; l + 1 < h->nlevels; ++l) {
     const mpm_grid *g = h->level[l].grid;
     for (int d = 0; d < h->dim; ++d) {
@@ -443,6 +446,82 @@ int mpm_hier_level_of(const mpm_hier *h, const double *xp) {
     if (walls && !stencil_in_box(h->level[l + 1].grid, x)) return l;
   }
   return l;
+}
+
+int mpm_hier_level_walk(const mpm_hier *h, const double *xp) {
+  double x[MPM_MAX_DIM];
+  hier_wrap_point(h, xp, x);
+  return level_walk(h, x);
+}
+
+/* How far inside its span (in spans) a point must lie for a table to answer: then the next
+ * level puts it in one of the span's children, whatever the roundoff of its position in that
+ * level's units. */
+#define LEAF_MARGIN 1e-6
+
+/* Level l's table entry for x (wrapped), or -1 when x lies within the margin of its span's
+ * faces or outside the level's box. */
+static int leaf_at(const mpm_hier *h, int l, const double *x) {
+  const mpm_grid *g = h->level[l].grid;
+  mpm_lidx k = 0;
+  for (int d = h->dim - 1; d >= 0; --d) {
+    const double t = hier_xi(g, d, x[d]) - 0.5, f = floor(t), frac = t - f;
+    /* (false for NaN too) */
+    if (!(frac > LEAF_MARGIN && frac < 1.0 - LEAF_MARGIN && f + 1.0 >= g->box_lo[d] &&
+          f + 1.0 < g->box_lo[d] + g->box_n[d]))
+      return -1;
+    k = k * g->box_n[d] + ((mpm_lidx)f + 1 - g->box_lo[d]);
+  }
+  return h->leaf[l][k] == MPM_HIER_WALK ? -1 : h->leaf[l][k];
+}
+
+int mpm_hier_level_of(const mpm_hier *h, const double *xp) {
+  double x[MPM_MAX_DIM];
+  hier_wrap_point(h, xp, x);
+  for (int l = 0; l < h->nlevels && h->leaf[0]; ++l) {
+    const int v = leaf_at(h, l, x);
+    if (v < 0) break;
+    if (v != MPM_HIER_MIXED) return v;
+  }
+  return level_walk(h, x);
+}
+
+/* The level every point of span gi of level l reaches, or -1 when it differs within it: the
+ * span's own level if it is not refined, else its 2^dim children's on level l + 1 when they
+ * all agree. */
+static int uniform_level(const mpm_hier *h, int l, const int *gi) {
+  if (l + 1 == h->nlevels || !span_flag(h, l, h->level[l].refined, gi, 0)) return l;
+  int level = -1, c[MPM_MAX_DIM] = {0, 0, 0};
+  for (int k = 0; k < 1 << h->dim; ++k) {
+    for (int d = 0; d < h->dim; ++d) c[d] = 2 * gi[d] + ((k >> d) & 1);
+    const int u = uniform_level(h, l + 1, c);
+    if (u < 0 || (level >= 0 && u != level)) return -1;
+    level = u;
+  }
+  return level;
+}
+
+/* mpm_hier.leaf. Spans within three level-0 cells of a walled face are left to the walk (its
+ * stencil test for points beyond the face). */
+static int make_leaf(mpm_hier *h) {
+  const mpm_grid *g0 = h->level[0].grid;
+  int gi[MPM_MAX_DIM];
+  for (int l = 0; l < h->nlevels; ++l) {
+    const mpm_grid *g = h->level[l].grid;
+    MPM_ALLOC(h->leaf[l], (size_t)g->nnodes);
+    for (mpm_lidx k = 0; k < g->nnodes; ++k) {
+      hier_node_of(g, k, gi);
+      int near_wall = 0;
+      for (int d = 0; d < h->dim; ++d) {
+        const double x = g->lo[d] + gi[d] * g->dx, reach = 3.0 * g0->dx;
+        near_wall |=
+            (h->wall[d][0] && x < g0->lo[d] + reach) || (h->wall[d][1] && x > g0->hi[d] - reach);
+      }
+      const int u = near_wall ? -1 : uniform_level(h, l, gi);
+      h->leaf[l][k] = near_wall ? MPM_HIER_WALK : u < 0 ? MPM_HIER_MIXED : (unsigned char)u;
+    }
+  }
+  return 0;
 }
 
 /* ---- phases ----------------------------------------------------------------------------- */

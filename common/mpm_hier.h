@@ -88,7 +88,9 @@
 
 #include <stddef.h>
 
-#define MPM_HIER_MAX_LEVELS 5 /* level 0 and up to 4 finer levels */
+#define MPM_HIER_MAX_LEVELS 5   /* level 0 and up to 4 finer levels */
+#define MPM_HIER_MIXED      255 /* mpm_hier.leaf: no one level over the span: ask its children */
+#define MPM_HIER_WALK       254 /* mpm_hier.leaf: beside a wall: walk down the masks */
 
 /* A refined box: Omega_level (level >= 1) includes every level - 1 span that meets the open
  * box (lo, hi) (the box is snapped outwards to level - 1 spans). */
@@ -131,6 +133,11 @@ typedef struct mpm_hier {
   unsigned char wall[MPM_MAX_DIM][2];
   int wraps; /* some level >= 1 stores a whole period (mpm_hier_level.period) */
   mpm_hier_level level[MPM_HIER_MAX_LEVELS];
+  /* Per level and box span of that level: the level mpm_hier_level_of gives every point
+   * inside the span, MPM_HIER_MIXED where it differs within the span (its children on the
+   * next level decide), or MPM_HIER_WALK beside a wall (the walk decides there). Lookups in place
+   * of the walk: a hot path (every particle, every step). */
+  unsigned char *leaf[MPM_HIER_MAX_LEVELS];
   void *scratch; /* private to mpm_hier.c: per-level particle lists and gathered arrays */
   void *census;  /* private to mpm_hier_census.c: the points mpm_hier_levels saw last */
 } mpm_hier;
@@ -174,6 +181,9 @@ int mpm_hier_add_phases(mpm_hier *h);
 /* The finest level whose region contains x (wrapped into the domain along the periodic axes
  * when the hierarchy wraps). */
 int mpm_hier_level_of(const mpm_hier *h, const double *x);
+/* The same found by walking down the levels' masks, without mpm_hier.leaf (what the table
+ * must reproduce; for tests). */
+int mpm_hier_level_walk(const mpm_hier *h, const double *x);
 
 /* The level (mpm_hier_level_of) of each of n points x[d][i], in an array of h's that holds
  * them until the next call (NULL when out of memory). h remembers the points: a point equal bit

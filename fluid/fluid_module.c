@@ -98,8 +98,9 @@ static const mpm_key_spec fluid_keys[] = {
      "multirate with the held exchange, any coupling.scheme), hybrid (the particles' pressure "
      "with the grid's as a defect correction: the particles integrate p - p_h, the grid p_h "
      "exactly, so a uniform pressure exerts no force whatever the particles' positions; the "
-     "grid's scope without refinement or obstacles, beside a solid monolithic and not contact; "
-     "docs/gas.md) or auto (without a solid: grid with refine.levels > 1, where particle is "
+     "grid's scope without obstacles, beside a solid monolithic and not contact and without "
+     "refinement, its filled share (fluid.hybrid_fill) off on a hierarchy; docs/gas.md, "
+     "docs/refinement.md) or auto (without a solid: grid with refine.levels > 1, where particle is "
      "refused, else hybrid where its scope holds (and no fluid.regularise_every; under usl "
      "and musl no farfield or subsonic_inflow face) and particle outside it, silently; beside "
      "a solid particle; the log says which); see docs/refinement.md",

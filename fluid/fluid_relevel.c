@@ -46,10 +46,19 @@
 
 /* The level of size of particle i (0 .. MPM_HIER_MAX_LEVELS - 1), V0_0 level 0's volume. */
 int fluid_size_level(const mpm_module *m, double V0_0, mpm_lidx i) {
+  /* round(log2(r) / dim), clamped, without a logarithm (every particle, every step): level l
+   * from r >= 2^(dim (l - 1/2)) on. */
+  _Static_assert(MPM_HIER_MAX_LEVELS == 5, "one threshold per finer level");
+  static const double from[3][MPM_HIER_MAX_LEVELS - 1] = {
+      {1.4142135623730951, 2.8284271247461903, 5.656854249492381, 11.313708498984761},
+      {2.0, 8.0, 32.0, 128.0},
+      {2.8284271247461903, 22.627416997969522, 181.01933598375618, 1448.1546878700494}};
   const fluid_content *fc = m->content;
-  const double V0 = mpm_particles_comp(m->particles, fc->lay.f_V0, 0)[i];
-  const long l = lround(log2(V0_0 / V0) / m->grid->dim);
-  return (int)(l < 0 ? 0 : l >= MPM_HIER_MAX_LEVELS ? MPM_HIER_MAX_LEVELS - 1 : l);
+  const double r = V0_0 / mpm_particles_comp(m->particles, fc->lay.f_V0, 0)[i];
+  const double *t = from[m->grid->dim - 1];
+  int l = 0;
+  while (l + 1 < MPM_HIER_MAX_LEVELS && r >= t[l]) ++l;
+  return l;
 }
 
 /* The size and position levels of every particle: lev[2 i] and lev[2 i + 1] (room for the set,

@@ -38,6 +38,7 @@
 #include <math.h>
 #include <mpi.h>
 
+#include "hier_level_check.h"
 #include "hier_fixture.h"
 #include "mpm_error.h"
 
@@ -62,6 +63,7 @@ static void check_pou(hier_case c) {
     double x[3];
     fixture_point(&f, &rng, k, x);
     per_level[mpm_hier_level_of(f.h, x)]++;
+    hier_check_level(f.h, x);
     const int n = mpm_hier_eval(f.h, x, w, MAXW);
     assert_true(n > 0);
     double sw = 0.0, sdw[3] = {0, 0, 0};

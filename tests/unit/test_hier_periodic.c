@@ -38,6 +38,7 @@
 #include <math.h>
 #include <mpi.h>
 
+#include "hier_level_check.h"
 #include "mpm_hier.h"
 #include "mpm_random.h"
 
@@ -122,6 +123,7 @@ static void check_pou(pcase c) {
     double x[3];
     pfix_point(&f, &rng, k, x);
     per_level[mpm_hier_level_of(f.h, x)]++;
+    hier_check_level(f.h, x);
     const int n = mpm_hier_eval(f.h, x, w, MAXW);
     assert_true(n > 0);
     double sw = 0.0, sdw[3] = {0, 0, 0};

@@ -29,6 +29,7 @@
 #include <math.h>
 #include <mpi.h>
 
+#include "hier_level_check.h"
 #include "mpm_hier.h"
 #include "mpm_random.h"
 
@@ -143,6 +144,7 @@ static void test_pou(void **state) {
     double x[3];
     point(&rng, k, x);
     per_level[mpm_hier_level_of(f.h, x)]++;
+    hier_check_level(f.h, x);
     const int n = mpm_hier_eval(f.h, x, w, MAXW);
     assert_true(n > 0);
     double sw = 0.0;
