@@ -610,7 +610,7 @@ int fluid_gridp_deposit(mpm_module *m, const double *y, const fluid_batch *b) {
   /* The hybrid without a solid: the force's correction -sum_p V_p p_h(x_p) grad N_i joins the
    * particles' own deposit (fluid_gridp_stress), one deposit fewer. Beside a solid the nodal
    * pressure waits for the forces: its continuation reads the solid's points of this state. */
-  gp->early = gp->hybrid && !gp->beside_solid && !m->hier;
+  gp->early = gp->hybrid && !gp->beside_solid;
   if (!gp->early) return 0;
   MPM_CALL(nodal_pressure(m));
   double *load;
