@@ -38,6 +38,20 @@ int mpm_hier_lattice(const mpm_hier *h, int l, int ppc, const mpm_region *r, dou
   return 0;
 }
 
+mpm_lidx mpm_hier_keep_owned(const mpm_grid *g, double *x, mpm_gidx *id, mpm_lidx n) {
+  if (g->size == 1) return n;
+  mpm_lidx k = 0;
+  for (mpm_lidx i = 0; i < n; ++i) {
+    double xq[MPM_MAX_DIM] = {0, 0, 0};
+    for (int d = 0; d < g->dim; ++d) xq[d] = x[(size_t)d * n + i];
+    if (mpm_grid_owner_of(g, xq) != g->rank) continue;
+    for (int d = 0; d < g->dim; ++d) x[(size_t)d * n + k] = xq[d];
+    id[k++] = id[i];
+  }
+  for (int d = 1; d < g->dim; ++d) memmove(x + (size_t)d * k, x + (size_t)d * n, sizeof *x * k);
+  return k;
+}
+
 int mpm_hier_drop_refined(const mpm_hier *h, mpm_particles *p, int field_x) {
   unsigned char *keep;
   MPM_ALLOC(keep, p->n);

@@ -20,6 +20,11 @@
 int mpm_hier_lattice(const mpm_hier *h, int l, int ppc, const mpm_region *r, double **x,
                      mpm_lidx *n, mpm_gidx *span);
 
+/* Keep the points of x (n, component-major) and their ids that this rank of g owns, in order;
+ * returns their number. Every rank generates a finer level's whole lattice (mpm_hier_lattice)
+ * and numbers it, so that a point's id does not depend on the ranks. */
+mpm_lidx mpm_hier_keep_owned(const mpm_grid *g, double *x, mpm_gidx *id, mpm_lidx n);
+
 /* Drop the particles of p whose position (field field_x) lies on a level above 0. */
 int mpm_hier_drop_refined(const mpm_hier *h, mpm_particles *p, int field_x);
 

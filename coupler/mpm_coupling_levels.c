@@ -68,8 +68,10 @@ int mpm_coupling_set_hier(mpm_coupling *c, const mpm_config *cfg, const mpm_hier
     const mpm_lidx nn = lv->grid->nnodes;
     c->lev_grid[l] = lv->grid;
     MPM_ALLOC(c->lev_owned[l], nn);
+    /* On more than one rank every rank holds a finer level whole and couples it alike
+     * (mpm_hier.h, ranks); rank 0 alone books it, as the reports sum the ranks. */
     for (mpm_lidx n = 0; n < nn; ++n)
-      c->lev_owned[l][n] = lv->active[n] && !(lv->is_image && lv->is_image[n]);
+      c->lev_owned[l][n] = h->rank == 0 && lv->active[n] && !(lv->is_image && lv->is_image[n]);
     MPM_CALL(level_state(c, l, nn));
   }
   return 0;

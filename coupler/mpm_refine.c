@@ -3,8 +3,8 @@
  * What the slice refuses here, one line each naming the key: boxes without refine.levels > 1,
  * a solid beside a gas in a partitioned time scheme (coupling.time other than monolithic), off
  * the finest level (REFINE_SOLID_CELLS) or, with the gas's particle pressure (auto), with a box
- * that does not span every periodic axis (check_bands), a solid with dynamic regrids, a solid
- * on more than one rank (a gas and its obstacles run on any number), a shape other than the
+ * that does not span every periodic axis (check_bands), a solid with dynamic regrids, a shape
+ * other than the
  * quadratic B-spline, and a box within three level-0 cells of a non-periodic domain face other
  * than a gas's slip or no-slip wall (open and closed faces, and a solid's walls, act on level 0
  * alone; a gas's walls are carried to every level, mpm_hier.h, and a box or region may touch
@@ -32,8 +32,9 @@ const mpm_key_spec mpm_refine_keys[] = {
     {"refine.levels", MPM_KEY_INT, "1", 1, MPM_HIER_MAX_LEVELS, 0, 0, NULL,
      "levels of the refinement hierarchy (static boxes, or regridded with refine.criterion), each "
      "halving the spacing of the one below (1: "
-     "off); with the quadratic shape: a gas (on any number of ranks), a solid on static boxes, "
-     "or both (on bands across a periodic axis; a solid on one rank), see docs/refinement.md",
+     "off); with the quadratic shape, on any number of ranks: a gas, a solid on static boxes, "
+     "or both (on bands across a periodic axis, or any box with fluid.pressure = grid), see "
+     "docs/refinement.md",
      0, "-"},
     {"refine.buffer", MPM_KEY_INT, "2", 1, 64, 0, 0, NULL,
      "level-l cells kept between the region of level l + 1 and the edge of level l's region", 0,
@@ -133,11 +134,6 @@ static int check_coupled(const mpm_config *cfg) {
  * ranks, another shape. */
 static int check_case(const mpm_config *cfg, const mpm_grid *grid, mpm_module **mod, int nmod) {
   if (solid_of(mod, nmod) && nmod > 1) MPM_CALL(check_coupled(cfg));
-  if (grid->size > 1 && solid_of(mod, nmod))
-    return mpm_config_fail(cfg, "refine.levels",
-                           "a solid runs on the refined levels on one rank in this slice, and the "
-                           "run has %d; run without mpirun or set refine.levels = 1",
-                           grid->size);
   if (grid->shape != MPM_SHAPE_QUADRATIC)
     return mpm_config_fail(cfg, "grid.shape",
                            "refinement needs the quadratic B-spline (its knot spans nest); set "

@@ -273,22 +273,6 @@ int fluid_seed(mpm_module *m, const mpm_config *cfg) {
 
 /* ---- the finer levels of a refinement hierarchy ---------------------------------------------- */
 
-/* Keep the points of x (n, component-major) and their ids that this rank owns, in order;
- * returns their number. Every rank generates a finer level's whole lattice, so that a point's
- * id does not depend on the ranks. */
-static mpm_lidx keep_owned(const mpm_grid *g, double *x, mpm_gidx *id, mpm_lidx n) {
-  mpm_lidx k = 0;
-  for (mpm_lidx i = 0; i < n; ++i) {
-    double xq[MPM_MAX_DIM] = {0, 0, 0};
-    for (int d = 0; d < g->dim; ++d) xq[d] = x[(size_t)d * n + i];
-    if (mpm_grid_owner_of(g, xq) != g->rank) continue;
-    for (int d = 0; d < g->dim; ++d) x[(size_t)d * n + k] = xq[d];
-    id[k++] = id[i];
-  }
-  for (int d = 1; d < g->dim; ++d) memmove(x + (size_t)d * k, x + (size_t)d * n, sizeof *x * k);
-  return k;
-}
-
 /* Seed section k on level l. */
 static int seed_level(mpm_module *m, const mpm_config *cfg, gas_state *s, int k, int l) {
   const fluid_content *fc = m->content;
@@ -301,7 +285,7 @@ static int seed_level(mpm_module *m, const mpm_config *cfg, gas_state *s, int k,
   int rc = 0;
   if (!(id = malloc(sizeof *id * (size_t)(n ? n : 1)))) rc = MPM_ERR_MEMORY;
   for (mpm_lidx i = 0; !rc && i < n; ++i) id[i] = p->id_next + i;
-  if (!rc && m->grid->size > 1) n = keep_owned(m->grid, x, id, n);
+  if (!rc) n = mpm_hier_keep_owned(m->grid, x, id, n);
   if (!rc) rc = add_points(m, cfg, s, k, n, x, id, pow(lg->dx / fc->ppc, lg->dim), &total);
   free(x), free(id);
   MPM_CALL(rc);

@@ -19,9 +19,11 @@
  * scale and lagged rate are level 0's), a rigid body and a clamp (they hold level-0 nodes), an
  * odd ppc (a level-0 particle would sit on a face of the refined region), time.method = musl
  * (the remap deposits on level 0), and a traction whose region reaches a refined region (the
- * tractions load level-0 particles only). Dynamic regrids and several ranks are refused by
- * coupler/mpm_refine.c, which also asks a solid beside a gas to lie on the finest level
- * (solid_refine_inside).
+ * tractions load level-0 particles only). Dynamic regrids are refused by coupler/mpm_refine.c,
+ * which also asks a solid beside a gas to lie on the finest level (solid_refine_inside). On
+ * several ranks every rank walks a finer level's whole lattice and keeps its own points
+ * (mpm_hier_keep_owned), so a particle's id does not depend on the ranks; the hierarchy sums
+ * the deposits over the ranks (mpm_hier.h, ranks).
  *
  * Invariant: with m->hier NULL every call here is the plain kernel call, so an unrefined run is
  * bit for bit what it was. */
@@ -177,13 +179,15 @@ static int seed_level(mpm_module *m, const mpm_config *cfg, int b, int l) {
   if (!rc) rc = check_tractions(m, cfg, n, x);
   if (!rc && !(id = malloc(sizeof *id * (size_t)(n ? n : 1)))) rc = MPM_ERR_MEMORY;
   for (mpm_lidx i = 0; !rc && i < n; ++i) id[i] = p->id_next + i;
+  const mpm_lidx all = n;
+  if (!rc) n = mpm_hier_keep_owned(m->grid, x, id, n);
   if (!rc) rc = solid_seed_append(m, cfg, &s, n, x, id, lg->dx / s.ppc);
   free(x), free(id);
   solid_seed_close(&s);
   MPM_CALL(rc);
   p->id_next += span;
   mpm_log(MPM_LOG_INFO, "solid body %s: %lld particles on level %d", sc->body[b].section,
-          (long long)n, l);
+          (long long)all, l);
   return 0;
 }
 

@@ -31,7 +31,8 @@ else()
       test_supersonic_bar 18 test_forward_step 17 test_prestress 16 test_fsi_waves 15
       test_periodic 14 test_gas_time_order 13 test_refine_gas_pulse 12 test_refine_fsi_pulse 20
       test_refine_open_stream 16 test_refine_open_shock 16 test_refine_usl_pulse 12
-      test_refine_ranks_static 40 test_refine_ranks_dynamic 30 test_refine_body_rest 24
+      test_refine_ranks_static 40 test_refine_ranks_dynamic 30 test_refine_ranks_solid 30
+      test_refine_body_rest 24
       test_refine_body_sphere 14)
 endif()
 while(costs)

@@ -471,3 +471,53 @@ nu = 0
 initial_pressure = 1
 
 {box}"""
+
+# The solid on a hierarchy (tests/verification/test_refine_solid.py, test_refine_ranks.py): a 2-D
+# linear_elastic bar (E = 1, rho = 1, nu = 0: c = 1) SOLID_LENGTH long and 2 high in empty grid
+# (level 0 at dx = 1, slip faces it never reaches), a velocity pulse of amplitude SOLID_AMP and
+# half-width SOLID_WIDTH centred on its free left end; SOLID_BOX spans x = 75 .. 91 and the
+# bar's whole height with 3 cells to spare.
+SOLID_LENGTH, SOLID_X0, SOLID_WIDTH, SOLID_AMP = 145.0, 3.0, 8.0, 1e-2
+SOLID_BOX = "[refine]\nlevels = 2\n\n[refine.box]\nlevel = 1\nlo = 75 3\nhi = 91 11\n"
+
+
+def solid_bar(t_end, refine, dx=1.0, extra="", interval=None):
+    """The bar's case text to t_end with the [refine] text `refine`; extra: lines of [output]."""
+    L, X0 = SOLID_LENGTH, SOLID_X0
+    return f"""[run]
+name = refine_solid
+
+[domain]
+dim = 2
+lo = 0 0
+hi = {L + 2 * X0} 14
+
+[grid]
+dx = {dx}
+
+[boundary]
+x_lo = slip
+x_hi = slip
+y_lo = slip
+y_hi = slip
+
+[time]
+t_end = {t_end}
+
+[output]
+interval = {interval or t_end}
+{extra}
+[geometry.bar]
+type = box
+lo = {X0} 6
+hi = {L + X0} 8
+
+[solid.bar]
+geometry = bar
+material = linear_elastic
+density = 1
+E = 1
+nu = 0
+velocity_field = {SOLID_AMP}*exp(-((x-{X0})/{SOLID_WIDTH})^2); 0
+
+{refine}"""

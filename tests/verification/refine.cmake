@@ -18,8 +18,9 @@ mpm_add_script_test(test_refine_gas_ranks SCRIPT verification/test_refine_gas.py
 # stream through a band and a box on the floor (~15 s); the regridded pulse under bs32 and usl,
 # its levels' output, the particles per rank, and a restart on 2 ranks across a regrid (~15 s);
 # the obstacle scenes at rest on 2 and 3 levels, the disc in a stream and the proximity regrid,
-# their forces and surface pressures too (~25 s).
-foreach(part static dynamic obstacles)
+# their forces and surface pressures too (~25 s); a solid alone, a slab in a band beside a gas
+# and a disk in a box with the grid pressure (~20 s).
+foreach(part static dynamic obstacles solid)
   mpm_add_script_test(test_refine_ranks_${part} SCRIPT verification/test_refine_ranks.py
                       ARGS ${part} LABELS "verification;mpi" TIMEOUT 300)
 endforeach()

@@ -59,49 +59,10 @@ import mpmtest as mt  # noqa: E402
 PART = sys.argv[1] if len(sys.argv) > 1 else "wave"
 check = mt.Checks(f"test_refine_solid_{PART}")
 
-LENGTH, X0, WIDTH, AMP = 145.0, 3.0, 8.0, 1e-2
-BOX = "[refine]\nlevels = 2\n\n[refine.box]\nlevel = 1\nlo = 75 3\nhi = 91 11\n"
+from refine_scenes import (SOLID_AMP as AMP, SOLID_BOX as BOX, SOLID_LENGTH as LENGTH,  # noqa: E402
+                           SOLID_WIDTH as WIDTH, SOLID_X0 as X0, solid_bar as bar)
+
 T_WAVE = 116.0
-
-
-def bar(t_end, refine, dx=1.0, extra="", interval=None):
-    return f"""[run]
-name = refine_solid
-
-[domain]
-dim = 2
-lo = 0 0
-hi = {LENGTH + 2 * X0} 14
-
-[grid]
-dx = {dx}
-
-[boundary]
-x_lo = slip
-x_hi = slip
-y_lo = slip
-y_hi = slip
-
-[time]
-t_end = {t_end}
-
-[output]
-interval = {interval or t_end}
-{extra}
-[geometry.bar]
-type = box
-lo = {X0} 6
-hi = {LENGTH + X0} 8
-
-[solid.bar]
-geometry = bar
-material = linear_elastic
-density = 1
-E = 1
-nu = 0
-velocity_field = {AMP}*exp(-((x-{X0})/{WIDTH})^2); 0
-
-{refine}"""
 
 
 def run(name, text):
