@@ -3,11 +3,11 @@
  * What the slice refuses here, one line each naming the key: boxes without refine.levels > 1,
  * a solid beside a gas in a partitioned time scheme (coupling.time other than monolithic), off
  * the finest level (REFINE_SOLID_CELLS) or, with the gas's particle pressure (auto), with a box
- * that does not span every periodic axis (check_bands), a solid with dynamic regrids, a shape
- * other than the
- * quadratic B-spline, and a box within three level-0 cells of a non-periodic domain face other
- * than a gas's slip or no-slip wall (open and closed faces, and a solid's walls, act on level 0
- * alone; a gas's walls are carried to every level, mpm_hier.h, and a box or region may touch
+ * that does not span every periodic axis (check_bands), a solid alone with dynamic regrids (they
+ * follow a gas), dynamic regrids beside a solid without fluid.pressure = grid, a shape other
+ * than the quadratic B-spline, and a box within three level-0 cells of a non-periodic domain face
+ * other than a gas's slip or no-slip wall (open and closed faces, and a solid's walls, act on level
+ * 0 alone; a gas's walls are carried to every level, mpm_hier.h, and a box or region may touch
  * them). Along a periodic axis a box or a dynamic
  * region may touch, cross or span the periodic faces (the levels wrap there, mpm_hier.h).
  * mpm_hier_new's own reasons name the box's key. The gas and the solid refuse their own settings
@@ -33,8 +33,8 @@ const mpm_key_spec mpm_refine_keys[] = {
      "levels of the refinement hierarchy (static boxes, or regridded with refine.criterion), each "
      "halving the spacing of the one below (1: "
      "off); with the quadratic shape, on any number of ranks: a gas, a solid on static boxes, "
-     "or both (on bands across a periodic axis, or any box with fluid.pressure = grid), see "
-     "docs/refinement.md",
+     "or both (on bands across a periodic axis, or any box or regridded with fluid.pressure = "
+     "grid), see docs/refinement.md",
      0, "-"},
     {"refine.buffer", MPM_KEY_INT, "2", 1, 64, 0, 0, NULL,
      "level-l cells kept between the region of level l + 1 and the edge of level l's region", 0,
@@ -91,6 +91,22 @@ static const mpm_module *solid_of(mpm_module **mod, int nmod) {
   for (int k = 0; k < nmod; ++k)
     if (mod[k]->role == MPM_ROLE_SOLID) return mod[k];
   return NULL;
+}
+
+/* The gas module, the one the regrid criteria read (NULL: none). */
+static mpm_module *gas_of(mpm_module **mod, int nmod) {
+  for (int k = 0; k < nmod; ++k)
+    if (mod[k]->role != MPM_ROLE_SOLID) return mod[k];
+  return NULL;
+}
+
+/* Every module onto h: the gas reseeds its finer regions (seed), the solid too at the start. */
+static int refine_modules(const mpm_config *cfg, mpm_module **mod, int nmod, mpm_hier *h,
+                          int seed) {
+  for (int k = 0; k < nmod; ++k)
+    MPM_CALL(mod[k]->role == MPM_ROLE_SOLID ? solid_module_refine(mod[k], cfg, h, seed)
+                                            : fluid_module_refine(mod[k], cfg, h, seed));
+  return 0;
 }
 
 /* The walls the finer levels carry (mpm_hier.h, walls): the slip and no-slip faces of a gas-only
@@ -471,8 +487,12 @@ static int mask_boxes(const mpm_grid *g, const int *n, int l, double eps, const 
 /* The hierarchy the gas's flags ask for (*h = NULL when nothing is flagged). Level l's region
  * is the flags dilated by dilate (levels - l) spans, clipped to REFINE_CLIP + (l - 1) dilate
  * spans from every non-periodic face, so that each level nests in the one below with its
- * buffer; along a periodic axis the dilation wraps and nothing is clipped. */
-static int make_dynamic(mpm_hier **h, const dynamic *dy, mpm_grid *grid, mpm_module *gas) {
+ * buffer; along a periodic axis the dilation wraps and nothing is clipped. Beside a solid
+ * (solid not NULL) every span within REFINE_SOLID_CELLS + every finest cells of one of its
+ * particles is flagged too, so that the solid stays on the finest level with its cells to spare
+ * until the next regrid (a particle moves less than a finest cell per step: the stable step). */
+static int make_dynamic(mpm_hier **h, const dynamic *dy, mpm_grid *grid, mpm_module *gas,
+                        const mpm_module *solid) {
   int n[MPM_MAX_DIM];
   const size_t total = flag_lattice(grid, n);
   unsigned char *flag = malloc(3 * total);
@@ -486,6 +506,9 @@ static int make_dynamic(mpm_hier **h, const dynamic *dy, mpm_grid *grid, mpm_mod
     rc = fluid_refine_flags(gas, dy->crit[k], dy->threshold[k], n, tmp);
     for (size_t s = 0; s < total && !rc; ++s) flag[s] |= tmp[s];
   }
+  if (solid && !rc)
+    rc = solid_refine_flags(
+        solid, (REFINE_SOLID_CELLS + dy->every) * ldexp(grid->dx, 1 - dy->levels), n, flag);
   const double eps = 1e-6 * ldexp(grid->dx, -dy->levels);
   for (int l = 1; l < dy->levels && !rc; ++l) {
     dilate(grid, n, dy->dilate * (dy->levels - l), flag, mask, tmp);
@@ -547,15 +570,21 @@ int mpm_refine_regrid(mpm_hier **h, const mpm_config *cfg, mpm_grid *grid, mpm_m
   if (!on || nmod < 1 || (!force && step % dy.every != 0)) return 0;
   MPM_CALL(carried_walls(cfg, grid, mod, nmod, dy.wall));
   mpm_hier *next;
-  MPM_CALL(make_dynamic(&next, &dy, grid, mod[0]));
+  const mpm_module *solid = nmod > 1 ? solid_of(mod, nmod) : NULL;
+  MPM_CALL(make_dynamic(&next, &dy, grid, gas_of(mod, nmod), solid));
   if (same_regions(next, *h)) { /* keep the hierarchy, and the integrator's state */
     mpm_hier_destroy(&next);
     return 0;
   }
-  for (int k = 0; k < nmod; ++k) fluid_module_rehier(mod[k], next);
+  for (int k = 0; k < nmod; ++k)
+    mod[k]->role == MPM_ROLE_SOLID ? solid_module_rehier(mod[k], next)
+                                   : fluid_module_rehier(mod[k], next);
   mpm_hier_destroy(h);
   *h = next;
   *changed = 1;
+  /* The flags keep the solid on the finest level (make_dynamic); a body that still leaves it
+   * (faster than a finest cell per step) is an error of the run, named on its key. */
+  if (solid) MPM_CALL(solid_refine_inside(solid, cfg, REFINE_SOLID_CELLS));
   return 0;
 }
 
@@ -579,10 +608,18 @@ int mpm_refine_build(mpm_hier **h, const mpm_config *cfg, mpm_grid *grid, mpm_mo
   dynamic dy;
   int on;
   MPM_CALL(read_dynamic(cfg, &dy, &on));
-  if (on && solid_of(mod, nmod))
+  if (on && solid_of(mod, nmod) && nmod == 1)
     return mpm_config_fail(cfg, "refine.criterion",
-                           "regrids follow the gas, and a solid runs on static boxes only in "
-                           "this slice; set refine.criterion = none and give [refine.NAME] boxes");
+                           "regrids follow a gas, and a solid alone runs on static boxes; set "
+                           "refine.criterion = none and give [refine.NAME] boxes");
+  const char *pressure = "auto";
+  if (on && solid_of(mod, nmod)) MPM_CALL(mpm_config_get_string(cfg, "fluid.pressure", &pressure));
+  if (on && solid_of(mod, nmod) && strcmp(pressure, "grid") != 0)
+    return mpm_config_fail(cfg, "refine.criterion",
+                           "regrids beside a solid need fluid.pressure = grid (the particles' "
+                           "pressure needs bands across a periodic axis, which a regridded "
+                           "region is not); set fluid.pressure = grid, or refine.criterion = none "
+                           "with [refine.NAME] bands");
   if (on && nbox > 0) {
     char key[160];
     snprintf(key, sizeof key, "refine.%s.level", names[0]);
@@ -594,14 +631,15 @@ int mpm_refine_build(mpm_hier **h, const mpm_config *cfg, mpm_grid *grid, mpm_mo
   MPM_CALL(carried_walls(cfg, grid, mod, nmod, wall));
   memcpy(dy.wall, wall, sizeof wall);
   if (on) { /* from the seeded gas (on a restart the sim regrids once the particles are read) */
-    MPM_CALL(make_dynamic(h, &dy, grid, mod[0]));
-    for (int k = 0; k < nmod; ++k) MPM_CALL(fluid_module_refine(mod[k], cfg, *h, seed));
+    const mpm_module *solid = nmod > 1 ? solid_of(mod, nmod) : NULL;
+    MPM_CALL(make_dynamic(h, &dy, grid, gas_of(mod, nmod), solid));
+    MPM_CALL(refine_modules(cfg, mod, nmod, *h, seed));
+    if (solid && *h) MPM_CALL(solid_refine_inside(solid, cfg, REFINE_SOLID_CELLS));
     return 0;
   }
   mpm_hier_box *box;
   MPM_ALLOC(box, nbox);
   int rc = read_boxes(cfg, grid, names, nbox, (const unsigned char(*)[2])wall, box);
-  const char *pressure = "auto";
   if (!rc && solid_of(mod, nmod) && nmod > 1)
     rc = mpm_config_get_string(cfg, "fluid.pressure", &pressure);
   if (!rc && solid_of(mod, nmod) && nmod > 1 && strcmp(pressure, "grid") != 0)
@@ -613,9 +651,7 @@ int mpm_refine_build(mpm_hier **h, const mpm_config *cfg, mpm_grid *grid, mpm_mo
   free(box);
   if (rc == MPM_ERR_INPUT && why[0]) return fail_why(cfg, names, nbox, why);
   MPM_CALL(rc);
-  for (int k = 0; k < nmod; ++k)
-    MPM_CALL(mod[k]->role == MPM_ROLE_SOLID ? solid_module_refine(mod[k], cfg, *h, seed)
-                                            : fluid_module_refine(mod[k], cfg, *h, seed));
+  MPM_CALL(refine_modules(cfg, mod, nmod, *h, seed));
   const mpm_module *solid = solid_of(mod, nmod);
   if (solid && nmod > 1) MPM_CALL(solid_refine_inside(solid, cfg, REFINE_SOLID_CELLS));
   return 0;

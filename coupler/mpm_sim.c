@@ -507,6 +507,7 @@ int mpm_sim_restart(mpm_sim **sp, mpm_config *cfg, const char *path) {
   int regridded = 0;
   if (!rc && s->dynamic)
     rc = mpm_refine_regrid(&s->hier, cfg, s->grid, s->mod, s->nmod, s->step, 1, &regridded);
+  if (!rc && regridded) rc = mpm_coupling_set_hier(s->coupling, cfg, s->hier);
   /* The time scheme's own state (a partitioned scheme's owed momentum) follows the particles. */
   if (!rc) rc = mpm_timescheme_new(&s->it, cfg, s->grid, s->mod, s->nmod, s->coupling);
   if (!rc) rc = mpm_timescheme_restore(s->it, ck);
@@ -744,6 +745,7 @@ static int regrid(mpm_sim *s, int force) {
   mpm_timer_start(MPM_T_REGRID);
   int rc = mpm_refine_regrid(&s->hier, s->cfg, s->grid, s->mod, s->nmod, s->step, force, &changed);
   if (!rc && changed) rc = mpm_output_set_hier(s->out, s->hier);
+  if (!rc && changed) rc = mpm_coupling_set_hier(s->coupling, s->cfg, s->hier);
   if (!rc && changed) rc = mpm_timescheme_resize(s->it, s->t);
   mpm_timer_stop(MPM_T_REGRID);
   return rc;

@@ -19,7 +19,7 @@ mpm_add_script_test(test_refine_gas_ranks SCRIPT verification/test_refine_gas.py
 # its levels' output, the particles per rank, and a restart on 2 ranks across a regrid (~15 s);
 # the obstacle scenes at rest on 2 and 3 levels, the disc in a stream and the proximity regrid,
 # their forces and surface pressures too (~25 s); a solid alone, a slab in a band beside a gas
-# and a disk in a box with the grid pressure (~20 s).
+# (static and regridded) and a disk in a box with the grid pressure (~25 s).
 foreach(part static dynamic obstacles solid)
   mpm_add_script_test(test_refine_ranks_${part} SCRIPT verification/test_refine_ranks.py
                       ARGS ${part} LABELS "verification;mpi" TIMEOUT 300)
@@ -71,8 +71,8 @@ mpm_add_script_test(test_refine_open_ranks SCRIPT verification/test_refine_open.
 # prestressed slab at rest across a level-1 band (~5 s), an acoustic pulse striking the slab
 # inside the band against the impedance solution and the uniform twins (~30 s), both again
 # under usl (~3 s, ~12 s) and refined under coupling.scheme = traction (~20 s), a restart
-# (~10 s), every refusal (~5 s).
-foreach(part rest pulse rest_usl pulse_usl traction restart input)
+# (~10 s), regrids beside the slab (~25 s), every refusal (~5 s).
+foreach(part rest pulse rest_usl pulse_usl traction restart regrid input)
   mpm_add_script_test(test_refine_fsi_${part} SCRIPT verification/test_refine_fsi.py
                       ARGS ${part} LABELS verification TIMEOUT 300)
 endforeach()

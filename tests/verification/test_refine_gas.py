@@ -677,20 +677,13 @@ def part_input():
     ]
     for name, text, key, start, words in cases_dyn:
         mt.expect_input_error(check, name, text, key, mt.line_starting(text, start), words)
-    # A gas beside a solid on 2 ranks (a gas and its obstacles run there,
-    # test_refine_ranks_obstacles): one line from rank 0, exit 2, naming refine.levels.
-    out = mt.outdir("refine_ranks")
-    path = os.path.join(out, "case.ini")
-    fsi = rs.fsi_case(0.1, rs.FSI_BAND)
-    with open(path, "w") as f:
-        f.write(fsi)
-    p = mt.run(["run", path, f"output.dir={out}/run_fsi", "run.progress=false"], ranks=2,
-               check=False)
-    errors = [ln for ln in p.stderr.splitlines() if ln.startswith("error:")]
-    want = f"case.ini:{mt.line_starting(fsi, 'levels = 2')}:"
-    check(p.returncode == 2 and len(errors) == 1 and "refine.levels" in errors[0]
-          and want in errors[0], f"2 ranks beside a solid: exit {p.returncode}: "
-          f"{errors[0] if errors else p.stderr[-300:]}")
+    # Regrids beside a solid need the grid pressure (the particles' pressure keeps to bands
+    # across a periodic axis): one line naming refine.criterion, exit 2. (A solid on several
+    # ranks runs: test_refine_ranks_solid.)
+    fsi = rs.fsi_case(0.1, "[refine]\nlevels = 2\ncriterion = density\nthreshold = 0.001\n")
+    mt.expect_input_error(check, "regrids beside a solid, particle pressure", fsi,
+                          "refine.criterion", mt.line_starting(fsi, "criterion = density"),
+                          "fluid.pressure = grid")
 
 
 def part_identity():
