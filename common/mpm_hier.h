@@ -207,6 +207,9 @@ int mpm_hier_eval(const mpm_hier *h, const double *x, mpm_hier_weight *w, int ma
  * (mpm_hier_level_of of particle i's position, kept by the caller) instead of finding it again.
  * x0 NULL forgets them. The caller calls again, or forgets, before those positions change. */
 void mpm_hier_levels_known(mpm_hier *h, const double *x0, mpm_lidx n, const unsigned char *level);
+/* The levels vouched for now (x0 NULL: none), to restore after another set's transfers. */
+void mpm_hier_levels_vouched(const mpm_hier *h, const double **x0, mpm_lidx *n,
+                             const unsigned char **level);
 
 /* Composite P2G of one phase: each particle deposits (a's fields, with the unchanged kernel) on
  * the level mpm_hier_level_of gives for its position; adds, as the kernel does. Follow it with

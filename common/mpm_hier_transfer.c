@@ -60,6 +60,12 @@ void mpm_hier_levels_known(mpm_hier *h, const double *x0, mpm_lidx n, const unsi
   s->sorted = 0;
 }
 
+void mpm_hier_levels_vouched(const mpm_hier *h, const double **x0, mpm_lidx *n,
+                             const unsigned char **level) {
+  const hier_scratch *s = h->scratch;
+  *x0 = s ? s->known_x : NULL, *n = s ? s->known_n : 0, *level = s ? s->known : NULL;
+}
+
 /* Room for n particles (and a chunk of columns for them). */
 static int reserve(mpm_hier *h, mpm_lidx n) {
   hier_scratch *s = NULL;

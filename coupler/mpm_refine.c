@@ -488,16 +488,18 @@ static int mask_boxes(const mpm_grid *g, const int *n, int l, double eps, const 
  * is the flags dilated by dilate (levels - l) spans, clipped to REFINE_CLIP + (l - 1) dilate
  * spans from every non-periodic face, so that each level nests in the one below with its
  * buffer; along a periodic axis the dilation wraps and nothing is clipped. Beside a solid
- * (solid not NULL) every span within REFINE_SOLID_CELLS + every finest cells of one of its
- * particles is flagged too, so that the solid stays on the finest level with its cells to spare
- * until the next regrid (a particle moves less than a finest cell per step: the stable step). */
+ * (solid not NULL) the spans holding its particles, dilated by REFINE_SOLID_CELLS + every
+ * finest cells and half a span, are flagged too, so that the solid stays on the finest level
+ * with its cells to spare until the next regrid (a particle moves less than a finest cell per
+ * step: the stable step); *kept says whether the finest level's region holds all of them
+ * (clipping at the faces may take some away). */
 static int make_dynamic(mpm_hier **h, const dynamic *dy, mpm_grid *grid, mpm_module *gas,
-                        const mpm_module *solid) {
+                        const mpm_module *solid, int *kept) {
   int n[MPM_MAX_DIM];
   const size_t total = flag_lattice(grid, n);
-  unsigned char *flag = malloc(3 * total);
-  if (!flag) MPM_FAIL_OOM(3 * total);
-  unsigned char *mask = flag + total, *tmp = mask + total;
+  unsigned char *flag = malloc(4 * total);
+  if (!flag) MPM_FAIL_OOM(4 * total);
+  unsigned char *mask = flag + total, *tmp = mask + total, *held = tmp + total;
   mpm_hier_box *box = NULL;
   int nbox = 0, cap = 0, used = 1;
   int rc = 0;
@@ -506,9 +508,13 @@ static int make_dynamic(mpm_hier **h, const dynamic *dy, mpm_grid *grid, mpm_mod
     rc = fluid_refine_flags(gas, dy->crit[k], dy->threshold[k], n, tmp);
     for (size_t s = 0; s < total && !rc; ++s) flag[s] |= tmp[s];
   }
-  if (solid && !rc)
-    rc = solid_refine_flags(
-        solid, (REFINE_SOLID_CELLS + dy->every) * ldexp(grid->dx, 1 - dy->levels), n, flag);
+  *kept = 1;
+  if (solid && !rc) {
+    const double reach = (REFINE_SOLID_CELLS + dy->every) * ldexp(1.0, 1 - dy->levels);
+    rc = solid_refine_spans(solid, n, mask);
+    dilate(grid, n, (int)ceil(reach + 0.5), mask, held, tmp);
+    for (size_t s = 0; s < total; ++s) flag[s] |= held[s];
+  }
   const double eps = 1e-6 * ldexp(grid->dx, -dy->levels);
   for (int l = 1; l < dy->levels && !rc; ++l) {
     dilate(grid, n, dy->dilate * (dy->levels - l), flag, mask, tmp);
@@ -525,7 +531,9 @@ static int make_dynamic(mpm_hier **h, const dynamic *dy, mpm_grid *grid, mpm_mod
     if (!any) break;
     used = l + 1;
     rc = mask_boxes(grid, n, l, eps, mask, &box, &nbox, &cap);
+    for (size_t s = 0; solid && l + 1 == dy->levels && s < total; ++s) *kept &= !held[s] || mask[s];
   }
+  if (solid && used < dy->levels) *kept = 0;
   free(flag);
   char why[512] = "";
   *h = NULL;
@@ -571,7 +579,8 @@ int mpm_refine_regrid(mpm_hier **h, const mpm_config *cfg, mpm_grid *grid, mpm_m
   MPM_CALL(carried_walls(cfg, grid, mod, nmod, dy.wall));
   mpm_hier *next;
   const mpm_module *solid = nmod > 1 ? solid_of(mod, nmod) : NULL;
-  MPM_CALL(make_dynamic(&next, &dy, grid, gas_of(mod, nmod), solid));
+  int kept;
+  MPM_CALL(make_dynamic(&next, &dy, grid, gas_of(mod, nmod), solid, &kept));
   if (same_regions(next, *h)) { /* keep the hierarchy, and the integrator's state */
     mpm_hier_destroy(&next);
     return 0;
@@ -582,9 +591,15 @@ int mpm_refine_regrid(mpm_hier **h, const mpm_config *cfg, mpm_grid *grid, mpm_m
   mpm_hier_destroy(h);
   *h = next;
   *changed = 1;
-  /* The flags keep the solid on the finest level (make_dynamic); a body that still leaves it
-   * (faster than a finest cell per step) is an error of the run, named on its key. */
-  if (solid) MPM_CALL(solid_refine_inside(solid, cfg, REFINE_SOLID_CELLS));
+  /* The flags keep the solid on the finest level (make_dynamic); a body the faces' clipping
+   * takes off it is an error of the run, named on its key (solid_refine_inside finds it). */
+  if (solid && !kept) {
+    MPM_CALL(solid_refine_inside(solid, cfg, REFINE_SOLID_CELLS));
+    MPM_FAIL(MPM_ERR_INPUT,
+             "regrid: the solid's margin reaches past the finest level's region "
+             "at a domain face; keep the body %d level-0 cells from the faces",
+             REFINE_CLIP + (dy.levels - 2) * dy.dilate);
+  }
   return 0;
 }
 
@@ -632,7 +647,8 @@ int mpm_refine_build(mpm_hier **h, const mpm_config *cfg, mpm_grid *grid, mpm_mo
   memcpy(dy.wall, wall, sizeof wall);
   if (on) { /* from the seeded gas (on a restart the sim regrids once the particles are read) */
     const mpm_module *solid = nmod > 1 ? solid_of(mod, nmod) : NULL;
-    MPM_CALL(make_dynamic(h, &dy, grid, gas_of(mod, nmod), solid));
+    int kept;
+    MPM_CALL(make_dynamic(h, &dy, grid, gas_of(mod, nmod), solid, &kept));
     MPM_CALL(refine_modules(cfg, mod, nmod, *h, seed));
     if (solid && *h) MPM_CALL(solid_refine_inside(solid, cfg, REFINE_SOLID_CELLS));
     return 0;

@@ -49,8 +49,8 @@ int fluid_gridp_solid_init(fluid_gridp_solid *s, mpm_grid *g) {
 }
 
 void fluid_gridp_solid_free(fluid_gridp_solid *s) {
-  free(s->buf);
-  s->buf = NULL, s->cap = 0;
+  free(s->buf), free(s->lev);
+  s->buf = NULL, s->lev = NULL, s->cap = 0;
   for (int l = 0; l < MPM_HIER_MAX_LEVELS; ++l)
     free(s->A[l]), free(s->B[l]), s->A[l] = s->B[l] = NULL;
 }
@@ -69,12 +69,34 @@ static int ensure(mpm_module *m, fluid_gridp_solid *s, mpm_lidx n) {
     MPM_ALLOC(s->B[l], (size_t)nn);
   }
   if (s->cap >= n && s->buf) return 0;
-  free(s->buf);
+  free(s->buf), free(s->lev);
+  s->lev = NULL;
   s->cap = n + n / 4 + 16;
   const size_t count = (size_t)S_COUNT * (size_t)s->cap;
   s->buf = calloc(count, sizeof(double));
   if (!s->buf) MPM_FAIL_OOM(count * sizeof(double));
+  if (m->hier) MPM_ALLOC(s->lev, s->cap);
   return 0;
+}
+
+/* On a hierarchy: find the solid's points' levels once and vouch for them (mpm_hier_levels_known)
+ * for the transfers of one entry below (the continuation's weights, deposits and gathers: about
+ * eight per right-hand side, each of which would find them again), keeping the gas's to
+ * restore (unvouch). */
+static void vouch(mpm_module *m, fluid_gridp_solid *s) {
+  const mpm_points *pts = s->pts;
+  if (!m->hier || !s->lev) return;
+  mpm_hier_levels_vouched(m->hier, &s->saved_x, &s->saved_n, &s->saved_lev);
+  for (mpm_lidx i = 0; i < pts->n; ++i) {
+    double x[MPM_MAX_DIM] = {0, 0, 0};
+    for (int d = 0; d < m->grid->dim; ++d) x[d] = pts->x[d][i];
+    s->lev[i] = (unsigned char)mpm_hier_level_of(m->hier, x);
+  }
+  mpm_hier_levels_known(m->hier, pts->x[0], pts->n, s->lev);
+}
+
+static void unvouch(mpm_module *m, const fluid_gridp_solid *s) {
+  if (m->hier && s->lev) mpm_hier_levels_known(m->hier, s->saved_x, s->saved_n, s->saved_lev);
 }
 
 static double *slot(const fluid_gridp_solid *s, int k) {
@@ -180,7 +202,10 @@ int fluid_gridp_solid_pressure(mpm_module *m, fluid_gridp_solid *s, double *cons
   if (!m->beside) return 0;
   s->pts = m->beside;
   MPM_CALL(ensure(m, s, m->beside->n));
-  MPM_CALL(weights(m, s, M, (const double *const *)P));
+  vouch(m, s);
+  const int rc = weights(m, s, M, (const double *const *)P);
+  unvouch(m, s);
+  MPM_CALL(rc);
   for (int l = 0; l < nlevels(m); ++l) {
     const mpm_grid_phase *ph = &level_grid(m, l)->phase[s->phase];
     for (mpm_lidx k = 0; k < level_grid(m, l)->nnodes; ++k)
@@ -218,7 +243,11 @@ int fluid_gridp_points_force(mpm_module *m, fluid_gridp_solid *s, double *const 
 int fluid_gridp_solid_force(mpm_module *m, fluid_gridp_solid *s, double *const *P) {
   if (!m->beside) return 0;
   s->pts = m->beside;
-  return fluid_gridp_points_force(m, s, P);
+  MPM_CALL(ensure(m, s, m->beside->n));
+  vouch(m, s);
+  const int rc = fluid_gridp_points_force(m, s, P);
+  unvouch(m, s);
+  return rc;
 }
 
 /* D_j -= sum_s V_s N_j(x_s) div v_h(x_s) on every node. */
@@ -238,11 +267,10 @@ int fluid_gridp_points_rate(mpm_module *m, fluid_gridp_solid *s, const mpm_hier_
   return 0;
 }
 
-int fluid_gridp_solid_rate(mpm_module *m, fluid_gridp_solid *s, const mpm_hier_nodal *vel,
-                           double *const *D, const double *const *M) {
-  const mpm_points *pts = m->beside;
-  if (!pts) return 0;
-  s->pts = pts;
+/* fluid_gridp_solid_rate with the points' levels vouched for. */
+static int solid_rate(mpm_module *m, fluid_gridp_solid *s, const mpm_hier_nodal *vel,
+                      double *const *D, const double *const *M) {
+  const mpm_points *pts = s->pts;
   MPM_CALL(fluid_gridp_points_rate(m, s, vel, D));
   /* The continuation's transpose: R_c = D_c / S_c, u_s = V_s / W_s sum_c N_c R_c, and the gas
    * nodes take D_j += sum_s N_j u_s. */
@@ -266,4 +294,15 @@ int fluid_gridp_solid_rate(mpm_module *m, fluid_gridp_solid *s, const mpm_hier_n
       if (active(m, l, k) && M[l][k] > 0.0) D[l][k] += r[k];
   }
   return 0;
+}
+
+int fluid_gridp_solid_rate(mpm_module *m, fluid_gridp_solid *s, const mpm_hier_nodal *vel,
+                           double *const *D, const double *const *M) {
+  if (!m->beside) return 0;
+  s->pts = m->beside;
+  MPM_CALL(ensure(m, s, m->beside->n));
+  vouch(m, s);
+  const int rc = solid_rate(m, s, vel, D, M);
+  unvouch(m, s);
+  return rc;
 }

@@ -161,6 +161,11 @@ typedef struct fluid_gridp_solid {
   const mpm_points *pts; /* the points read: m->beside, or the gas's own (hybrid) */
   mpm_lidx cap;
   double *buf, *A[MPM_HIER_MAX_LEVELS], *B[MPM_HIER_MAX_LEVELS];
+  unsigned char *lev; /* on a hierarchy: each point's level (cap), vouched for its transfers */
+  /* the levels vouched for before (the gas's), restored after the points' transfers */
+  const double *saved_x;
+  mpm_lidx saved_n;
+  const unsigned char *saved_lev;
 } fluid_gridp_solid;
 int fluid_gridp_prolong(mpm_module *m, double **a);
 int fluid_gridp_solid_init(fluid_gridp_solid *s, mpm_grid *g);

@@ -37,9 +37,9 @@ int solid_module_refine(mpm_module *m, const mpm_config *cfg, struct mpm_hier *h
 int solid_refine_inside(const mpm_module *m, const mpm_config *cfg, int cells);
 
 /* A regrid beside a gas (mpm_refine.h): flag[s] = 1 on the spans s of level 0's flag lattice
- * (n[d] spans per axis, span i around node i, as fluid_refine_flags) within `reach` of a
- * particle of the solid along every axis, over every rank (the others left as they are). */
-int solid_refine_flags(const mpm_module *m, double reach, const int *n, unsigned char *flag);
+ * (n[d] spans per axis, span i around node i, as fluid_refine_flags) that hold a particle of
+ * the solid on some rank, 0 elsewhere. */
+int solid_refine_spans(const mpm_module *m, const int *n, unsigned char *flag);
 
 /* Put the solid on the regridded hierarchy h (its particles stay as they are). */
 void solid_module_rehier(mpm_module *m, struct mpm_hier *h);

@@ -143,41 +143,28 @@ int solid_refine_inside(const mpm_module *m, const mpm_config *cfg, int cells) {
 
 /* ---- regrids beside a gas ------------------------------------------------------------------ */
 
-int solid_refine_flags(const mpm_module *m, double reach, const int *n, unsigned char *flag) {
+int solid_refine_spans(const mpm_module *m, const int *n, unsigned char *flag) {
   const mpm_particles *p = m->particles;
   const mpm_grid *g = m->grid;
-  const int dim = g->dim;
   size_t total = 1, stride[MPM_MAX_DIM] = {1, 1, 1};
-  for (int d = 0; d < dim; ++d) stride[d] = total, total *= (size_t)n[d];
-  unsigned char *mine = calloc(total, 1);
-  if (!mine) MPM_FAIL_OOM(total);
+  for (int d = 0; d < g->dim; ++d) stride[d] = total, total *= (size_t)n[d];
+  memset(flag, 0, total);
   for (mpm_lidx i = 0; i < p->n; ++i) {
-    int lo[MPM_MAX_DIM] = {0, 0, 0}, hi[MPM_MAX_DIM] = {0, 0, 0}, at[MPM_MAX_DIM];
-    for (int d = 0; d < dim; ++d) {
-      const double x = mpm_particles_comp(p, F_X, d)[i];
-      lo[d] = (int)lround((x - reach - g->lo[d]) / g->dx);
-      hi[d] = (int)lround((x + reach - g->lo[d]) / g->dx);
-      if (!g->periodic[d]) lo[d] = MPM_MAX(lo[d], 0), hi[d] = MPM_MIN(hi[d], n[d] - 1);
+    size_t s = 0;
+    for (int d = 0; d < g->dim; ++d) {
+      long k = lround((mpm_particles_comp(p, F_X, d)[i] - g->lo[d]) / g->dx);
+      k = g->periodic[d] ? ((k % n[d]) + n[d]) % n[d] : k < 0 ? 0 : k >= n[d] ? n[d] - 1 : k;
+      s += stride[d] * (size_t)k;
     }
-    for (at[2] = lo[2]; at[2] <= hi[2]; ++at[2])
-      for (at[1] = lo[1]; at[1] <= hi[1]; ++at[1])
-        for (at[0] = lo[0]; at[0] <= hi[0]; ++at[0]) {
-          size_t s = 0;
-          for (int d = 0; d < dim; ++d) s += stride[d] * (size_t)(((at[d] % n[d]) + n[d]) % n[d]);
-          mine[s] = 1;
-        }
+    flag[s] = 1;
   }
   if (g->size > 1) {
     const int mrc = total > (size_t)INT_MAX ? MPI_ERR_COUNT
-                                            : MPI_Allreduce(MPI_IN_PLACE, mine, (int)total,
+                                            : MPI_Allreduce(MPI_IN_PLACE, flag, (int)total,
                                                             MPI_UNSIGNED_CHAR, MPI_MAX, g->comm);
-    if (mrc != MPI_SUCCESS) {
-      free(mine);
-      MPM_FAIL(MPM_ERR_MPI, "regrid: the solid's flags over %zu spans: MPI error %d", total, mrc);
-    }
+    if (mrc != MPI_SUCCESS)
+      MPM_FAIL(MPM_ERR_MPI, "regrid: the solid's spans over %zu spans: MPI error %d", total, mrc);
   }
-  for (size_t s = 0; s < total; ++s) flag[s] |= mine[s];
-  free(mine);
   return 0;
 }
 

@@ -254,10 +254,9 @@ def part_regrid():
     counts = sorted(set(d["particles_l1"].astype(int)))
     print(f"info regridded: {mt.cost(out)}; T {t:.4f} ({100 * (t / T_AC - 1):+.2f} %), R {r:.4f} "
           f"({r - R_AC:+.4f}); level 1 holds {counts[0]} to {counts[-1]} particles")
-    # Measured: T -0.31 %, R -0.0010 (bs32 -0.34 %, -0.0010; the fine grid-pressure twin under
-    # bs32 -0.36 %, +0.0033;
-    # the static band with the grid pressure +0.83 %, +0.0215: the pulse crosses level 0 there);
-    # the pulse part's bounds.
+    # Measured: T -0.31 %, R -0.0024 (the fine grid-pressure twin -0.34 %, +0.0028; the static
+    # band with the grid pressure +0.94 %, +0.0212: the pulse crosses level 0 there); the pulse
+    # part's bounds.
     check(abs(t / T_AC - 1) <= 0.02 and abs(r - R_AC) <= 0.02, f"regridded: transmitted "
           f"{t:.4f} ({100 * (t / T_AC - 1):+.2f} %, <= 2 %), reflected {r:.4f} ({r - R_AC:+.4f}, "
           f"<= 0.02)")
