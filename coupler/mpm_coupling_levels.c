@@ -44,9 +44,10 @@ int mpm_coupling_set_hier(mpm_coupling *c, const mpm_config *cfg, const mpm_hier
   if (!c) return 0;
   if (c->nlev > 0) { /* a regrid: the levels' state starts afresh on the new hierarchy */
     mpm_coupling_levels_free(c);
-    memset(c->lev_grid, 0, sizeof c->lev_grid), memset(c->lev_owned, 0, sizeof c->lev_owned);
-    memset(c->lev_wall_axes, 0, sizeof c->lev_wall_axes),
-        memset(c->lev_held, 0, sizeof c->lev_held);
+    memset(c->lev_grid, 0, sizeof c->lev_grid);
+    memset(c->lev_owned, 0, sizeof c->lev_owned);
+    memset(c->lev_wall_axes, 0, sizeof c->lev_wall_axes);
+    memset(c->lev_held, 0, sizeof c->lev_held);
     c->nlev = 0;
   }
   if (!h || h->nlevels < 2) return 0;

@@ -512,8 +512,8 @@ static int make_dynamic(mpm_hier **h, const dynamic *dy, mpm_grid *grid, mpm_mod
   if (solid && !rc) {
     const double reach = (REFINE_SOLID_CELLS + dy->every) * ldexp(1.0, 1 - dy->levels);
     rc = solid_refine_spans(solid, n, mask);
-    dilate(grid, n, (int)ceil(reach + 0.5), mask, held, tmp);
-    for (size_t s = 0; s < total; ++s) flag[s] |= held[s];
+    if (!rc) dilate(grid, n, (int)ceil(reach + 0.5), mask, held, tmp);
+    for (size_t s = 0; s < total && !rc; ++s) flag[s] |= held[s];
   }
   const double eps = 1e-6 * ldexp(grid->dx, -dy->levels);
   for (int l = 1; l < dy->levels && !rc; ++l) {
