@@ -334,6 +334,70 @@ static int make_parents_box(mpm_hier *h) {
 
 static int make_leaf(mpm_hier *h);
 
+/* near[n] = 1 for the nodes of level l's box within two nodes (per axis) of a span of Omega_l,
+ * mirrors and images looked up as span_flag does: the own span's flag, dilated by two along
+ * each axis in turn. (The box holds every span of Omega_l within reach of its nodes.) */
+static void near_mask(const mpm_hier *h, int l, unsigned char *near, unsigned char *tmp) {
+  const mpm_grid *g = h->level[l].grid;
+  int gi[MPM_MAX_DIM];
+  for (mpm_lidx n = 0; n < g->nnodes; ++n) {
+    hier_node_of(g, n, gi);
+    near[n] = (unsigned char)span_flag(h, l, h->level[l].covered, gi, 0);
+  }
+  mpm_lidx stride = 1;
+  for (int d = 0; d < h->dim; stride *= g->box_n[d], ++d) {
+    const int len = g->box_n[d];
+    for (mpm_lidx n = 0; n < g->nnodes; ++n) {
+      const int i = (int)((n / stride) % len);
+      unsigned char v = 0;
+      for (int o = -2; o <= 2 && !v; ++o)
+        if (i + o >= 0 && i + o < len) v = near[n + o * stride];
+      tmp[n] = v;
+    }
+    memcpy(near, tmp, (size_t)g->nnodes);
+  }
+}
+
+/* mpm_hier_level.near, near_idx and near_w of level l >= 1 (after make_parents_box). */
+static int make_near(mpm_hier *h, int l) {
+  mpm_hier_level *lv = &h->level[l];
+  const mpm_grid *g = lv->grid;
+  const mpm_grid *c = h->nranks > 1 && l == 1 ? h->pbox.grid : h->level[l - 1].grid;
+  const int np = 1 << h->dim;
+  unsigned char *mask, *tmp;
+  MPM_ALLOC(mask, g->nnodes);
+  tmp = malloc((size_t)g->nnodes);
+  if (!tmp) {
+    free(mask);
+    MPM_FAIL_OOM((size_t)g->nnodes);
+  }
+  near_mask(h, l, mask, tmp);
+  free(tmp);
+  lv->nnear = 0;
+  for (mpm_lidx n = 0; n < g->nnodes; ++n) {
+    mask[n] &= !lv->active[n] && !(lv->is_image && lv->is_image[n]);
+    lv->nnear += mask[n];
+  }
+  const size_t nn = (size_t)MPM_MAX(lv->nnear, 1);
+  lv->near = malloc(sizeof *lv->near * nn);
+  lv->near_idx = malloc(sizeof *lv->near_idx * nn * (size_t)np);
+  lv->near_w = malloc(sizeof *lv->near_w * nn * (size_t)np);
+  if (!lv->near || !lv->near_idx || !lv->near_w) {
+    free(mask);
+    MPM_FAIL_OOM(nn * (size_t)np * (sizeof(double) + sizeof(mpm_lidx)));
+  }
+  int gi[MPM_MAX_DIM];
+  for (mpm_lidx n = 0, k = 0; n < g->nnodes; ++n) {
+    if (!mask[n]) continue;
+    hier_node_of(g, n, gi);
+    lv->near[k] = n;
+    mpm_hier_parents(c, gi, lv->near_idx + (size_t)k * np, lv->near_w + (size_t)k * np);
+    ++k;
+  }
+  free(mask);
+  return 0;
+}
+
 /* Levels 1 .. nlevels - 1 in turn (each snaps its boxes to the level before); why is set on an
  * input error. */
 static int build_levels(mpm_hier *h, const mpm_hier_box *box, int nbox, char *why, size_t len) {
@@ -347,8 +411,10 @@ static int build_levels(mpm_hier *h, const mpm_hier_box *box, int nbox, char *wh
     if (!rc) rc = make_level(h, l, box, sp, nbox);
   }
   free(sp);
-  for (int l = 0; l < h->nlevels && !rc; ++l) set_active(h, l);
+  for (int l = 0; l < h->nlevels && !rc; ++l)
+    set_active(h, l), h->level[l].inv_h = 1.0 / h->level[l].grid->dx;
   if (!rc && h->nranks > 1 && h->nlevels > 1) rc = make_parents_box(h);
+  for (int l = 1; l < h->nlevels && !rc; ++l) rc = make_near(h, l);
   if (!rc) rc = make_leaf(h);
   return rc;
 }
@@ -396,6 +462,7 @@ void mpm_hier_destroy(mpm_hier **hp) {
     if (l > 0) mpm_grid_destroy(&lv->grid);
     free(lv->covered), free(lv->refined), free(lv->active);
     free(lv->image), free(lv->canon), free(lv->is_image);
+    free(lv->near), free(lv->near_idx), free(lv->near_w);
   }
   mpm_grid_destroy(&h->pbox.grid);
   free(h->pbox.owned), free(h->pbox.buf), free(h->sum_buf);
@@ -463,9 +530,10 @@ int mpm_hier_level_walk(const mpm_hier *h, const double *xp) {
  * faces or outside the level's box. */
 static int leaf_at(const mpm_hier *h, int l, const double *x) {
   const mpm_grid *g = h->level[l].grid;
+  const double inv_h = h->level[l].inv_h; /* (hier_xi's value, without its division) */
   mpm_lidx k = 0;
   for (int d = h->dim - 1; d >= 0; --d) {
-    const double t = hier_xi(g, d, x[d]) - 0.5, f = floor(t), frac = t - f;
+    const double t = (x[d] - g->lo[d]) * inv_h - 0.5, f = floor(t), frac = t - f;
     /* (false for NaN too) */
     if (!(frac > LEAF_MARGIN && frac < 1.0 - LEAF_MARGIN && f + 1.0 >= g->box_lo[d] &&
           f + 1.0 < g->box_lo[d] + g->box_n[d]))
@@ -476,8 +544,15 @@ static int leaf_at(const mpm_hier *h, int l, const double *x) {
 }
 
 int mpm_hier_level_of(const mpm_hier *h, const double *xp) {
+  return mpm_hier_level_from(h, xp, -1);
+}
+
+int mpm_hier_level_from(const mpm_hier *h, const double *xp, int hint) {
   double x[MPM_MAX_DIM];
   hier_wrap_point(h, xp, x);
+  /* A span of level `hint` whose table entry is the level itself answers for every point
+   * inside it (uncovered spans of the finer levels hold MPM_HIER_WALK: they never answer). */
+  if (hint >= 0 && hint < h->nlevels && h->leaf[0] && leaf_at(h, hint, x) == hint) return hint;
   for (int l = 0; l < h->nlevels && h->leaf[0]; ++l) {
     const int v = leaf_at(h, l, x);
     if (v < 0) break;
@@ -502,7 +577,8 @@ static int uniform_level(const mpm_hier *h, int l, const int *gi) {
 }
 
 /* mpm_hier.leaf. Spans within three level-0 cells of a walled face are left to the walk (its
- * stencil test for points beyond the face). */
+ * stencil test for points beyond the face); so are the spans of a finer level outside its region,
+ * which the lookup down the levels never reaches and mpm_hier_level_from's hint may. */
 static int make_leaf(mpm_hier *h) {
   const mpm_grid *g0 = h->level[0].grid;
   int gi[MPM_MAX_DIM];
@@ -517,6 +593,7 @@ static int make_leaf(mpm_hier *h) {
         near_wall |=
             (h->wall[d][0] && x < g0->lo[d] + reach) || (h->wall[d][1] && x > g0->hi[d] - reach);
       }
+      near_wall |= l > 0 && !span_flag(h, l, h->level[l].covered, gi, 0);
       const int u = near_wall ? -1 : uniform_level(h, l, gi);
       h->leaf[l][k] = near_wall ? MPM_HIER_WALK : u < 0 ? MPM_HIER_MIXED : (unsigned char)u;
     }

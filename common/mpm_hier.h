@@ -101,12 +101,21 @@ typedef struct mpm_hier_box {
 
 typedef struct mpm_hier_level {
   mpm_grid *grid; /* level 0: the shared grid (not owned); finer levels: owned box grids */
+  double inv_h;   /* 1 / grid->dx, for the level lookups (a hot path) */
   unsigned char *covered, *refined, *active;
   int period[MPM_MAX_DIM]; /* nodes per period where the box holds the whole period, else 0 */
   /* Levels >= 1 with a period: the box nodes that are images (image[k], a box index) and the
    * node in [0, N_l) each is an image of (canon[k]); is_image[n] marks them (NULL: none). */
   mpm_lidx nimage, *image, *canon;
   unsigned char *is_image;
+  /* Levels >= 1: the inactive nodes, images left out, within two nodes of a span of Omega_l
+   * (the only ones a deposit on the level reaches, with a node to spare), in box order, and
+   * their 2^dim parents on the lattice the restriction writes (level l - 1's box, or the
+   * parents box for level 1 on more than one rank): box indices near_idx[2^dim k ..] and
+   * two-scale weights near_w[2^dim k ..]. The restriction and prolongation visit these alone:
+   * the other inactive nodes, between the parts of a region that has several, stay zero. */
+  mpm_lidx nnear, *near, *near_idx;
+  double *near_w;
 } mpm_hier_level;
 
 /* On more than one rank (mpm_hier.h, ranks): level 0's nodes that level 1's nodes have as
@@ -181,6 +190,9 @@ int mpm_hier_add_phases(mpm_hier *h);
 /* The finest level whose region contains x (wrapped into the domain along the periodic axes
  * when the hierarchy wraps). */
 int mpm_hier_level_of(const mpm_hier *h, const double *x);
+/* The same, asking level `hint` first (a point's level before it moved: most points stay on
+ * it, and then one table lookup answers); any hint, or -1 for none, gives the same answer. */
+int mpm_hier_level_from(const mpm_hier *h, const double *x, int hint);
 /* The same found by walking down the levels' masks, without mpm_hier.leaf (what the table
  * must reproduce; for tests). */
 int mpm_hier_level_walk(const mpm_hier *h, const double *x);

@@ -2,9 +2,11 @@
  * restriction (fine inactive nodes onto their parents) and its transpose, prolongation, and
  * the composite weights of one point.
  *
- * Invariants: restriction and prolongation visit every inactive node of a level box, ghost
- * layer included, and read or write only its 2^dim parents, which lie in the coarser box (see
- * mpm_hier.c); restriction leaves every inactive node at exactly zero. mpm_hier_eval pushes
+ * Invariants: restriction and prolongation visit every inactive node of a level box near its
+ * region (mpm_hier_level.near: every node a deposit on the level reaches), ghost layer
+ * included, and read or write only its 2^dim parents, which lie in the coarser box (see
+ * mpm_hier.c); restriction leaves every inactive node at exactly zero (the others, which no
+ * deposit reaches, are zero already, and the prolongation leaves them so). mpm_hier_eval pushes
  * weights down exactly as P2G followed by restriction does, so the two agree to roundoff.
  * On a level that stores a whole period (mpm_hier.h, periodic axes) the restriction first
  * folds every image into its node and the prolongation ends by copying every node into its
@@ -47,11 +49,6 @@ static void copy_images(const mpm_hier_level *lv, double *const *a, int nf) {
     for (mpm_lidx q = 0; q < lv->nimage; ++q) a[k][lv->image[q]] = a[k][lv->canon[q]];
 }
 
-/* Does the restriction or prolongation skip node n of level lv (active, or an image)? */
-static int skips(const mpm_hier_level *lv, mpm_lidx n) {
-  return lv->active[n] || (lv->is_image && lv->is_image[n]);
-}
-
 /* Sum nf arrays of level l >= 1 over the ranks (mpm_hier.h, ranks): one MPI_Allreduce of them
  * packed together (per array when the room cannot be had). MPI's errors abort (the default
  * handler). */
@@ -74,23 +71,22 @@ static void sum_ranks(mpm_hier *h, int l, double *const *a, int nf) {
 }
 
 /* Restrict the inactive nodes of level l (fine, nf arrays) onto their parents in the arrays
- * `to` over the lattice c (level l - 1, or the parents box), zeroing them; add 0: only zero
- * them (a rank other than 0 whose sum rank 0 adds). */
-static void restrict_into(const mpm_hier *h, int l, double *const *fine, const mpm_grid *c,
-                          double *const *to, int nf, int add) {
+ * `to` over the lattice the level's parents index (level l - 1, or the parents box), zeroing
+ * them; add 0: only zero them (a rank other than 0 whose sum rank 0 adds). Only the nodes near
+ * the region (mpm_hier_level.near) can hold a value; a node holding zeros adds nothing. */
+static void restrict_into(const mpm_hier *h, int l, double *const *fine, double *const *to, int nf,
+                          int add) {
   const mpm_hier_level *lv = &h->level[l];
-  const mpm_grid *f = lv->grid;
-  int gi[MPM_MAX_DIM];
-  mpm_lidx idx[8];
-  double w[8];
-  for (mpm_lidx n = 0; n < f->nnodes; ++n) {
-    if (skips(lv, n)) continue;
-    hier_node_of(f, n, gi);
-    const int np = add ? mpm_hier_parents(c, gi, idx, w) : 0;
-    for (int k = 0; k < nf; ++k) {
-      const double v = fine[k][n];
-      for (int q = 0; q < np; ++q) to[k][idx[q]] += w[q] * v;
-      fine[k][n] = 0.0;
+  const int np = 1 << h->dim;
+  for (mpm_lidx k = 0; k < lv->nnear; ++k) {
+    const mpm_lidx n = lv->near[k];
+    const mpm_lidx *idx = lv->near_idx + (size_t)k * np;
+    const double *w = lv->near_w + (size_t)k * np;
+    for (int f = 0; f < nf; ++f) {
+      const double v = fine[f][n];
+      if (v == 0.0) continue;
+      fine[f][n] = 0.0;
+      for (int q = 0; add && q < np; ++q) to[f][idx[q]] += w[q] * v;
     }
   }
 }
@@ -104,7 +100,7 @@ static void restrict_ranks(mpm_hier *h, double *const *fine, double *const *coar
   double *to[1 + 3 * MPM_MAX_DIM] = {NULL};
   for (int k = 0; k < nf; ++k) to[k] = pb->buf + (size_t)k * nn;
   memset(pb->buf, 0, sizeof(double) * (size_t)nf * (size_t)nn);
-  restrict_into(h, 1, fine, pb->grid, to, nf, 1);
+  restrict_into(h, 1, fine, to, nf, 1);
   for (int k = 0; k < nf; ++k)
     for (mpm_lidx q = 0; q < nn; ++q)
       if (pb->owned[q] >= 0) coarse[k][pb->owned[q]] += to[k][q];
@@ -122,7 +118,7 @@ static void restrict_level(mpm_hier *h, int l, double *const *fine, double *cons
   if (h->nranks > 1 && l == 1)
     restrict_ranks(h, fine, coarse, nf);
   else
-    restrict_into(h, l, fine, h->level[l - 1].grid, coarse, nf, !sum || h->rank == 0);
+    restrict_into(h, l, fine, coarse, nf, !sum || h->rank == 0);
   mpm_timer_stop(MPM_T_RESTRICT);
 }
 
@@ -148,24 +144,21 @@ static void parents_ranks(mpm_hier *h, const double *const *coarse, const double
 void mpm_hier_prolong_level(mpm_hier *h, int l, const double *const *coarse, double *const *fine,
                             int nf) {
   const mpm_hier_level *lv = &h->level[l];
-  const mpm_grid *f = lv->grid, *c = h->level[l - 1].grid;
-  int gi[MPM_MAX_DIM];
-  mpm_lidx idx[8];
-  double w[8];
+  const int np = 1 << h->dim;
   const double *from[1 + 3 * MPM_MAX_DIM];
   mpm_timer_start(MPM_T_PROLONG);
   if (h->nranks > 1 && l == 1) {
     parents_ranks(h, coarse, from, nf);
-    coarse = from, c = h->pbox.grid;
+    coarse = from;
   }
-  for (mpm_lidx n = 0; n < f->nnodes; ++n) {
-    if (skips(lv, n)) continue;
-    hier_node_of(f, n, gi);
-    const int np = mpm_hier_parents(c, gi, idx, w);
-    for (int k = 0; k < nf; ++k) {
+  for (mpm_lidx k = 0; k < lv->nnear; ++k) {
+    const mpm_lidx n = lv->near[k];
+    const mpm_lidx *idx = lv->near_idx + (size_t)k * np;
+    const double *w = lv->near_w + (size_t)k * np;
+    for (int f = 0; f < nf; ++f) {
       double v = 0.0;
-      for (int q = 0; q < np; ++q) v += w[q] * coarse[k][idx[q]];
-      fine[k][n] = v;
+      for (int q = 0; q < np; ++q) v += w[q] * coarse[f][idx[q]];
+      fine[f][n] = v;
     }
   }
   copy_images(lv, fine, nf);

@@ -8,7 +8,8 @@
  * bit for bit to the one remembered at its index takes the remembered level, which is the one
  * mpm_hier_level_of gives (a pure function of the point and of h, which does not change: a
  * regrid builds a new hierarchy). So the answers are those of mpm_hier_level_of whatever the
- * callers' order; the memory only spares the search where positions did not move. */
+ * callers' order; the memory only spares the search where positions did not move, and where
+ * they moved it gives the lookup its first guess (mpm_hier_level_from). */
 #include "mpm_hier_impl.h"
 
 #include <stdint.h>
@@ -59,7 +60,7 @@ const unsigned char *mpm_hier_levels(mpm_hier *h, const double *const *x, mpm_li
     if (same) continue;
     double xp[MPM_MAX_DIM] = {0, 0, 0};
     for (int d = 0; d < h->dim; ++d) xp[d] = x[d][i], c->x[d][i] = b[d];
-    c->lev[i] = (unsigned char)mpm_hier_level_of(h, xp);
+    c->lev[i] = (unsigned char)mpm_hier_level_from(h, xp, i < c->n ? c->lev[i] : -1);
   }
   c->n = n;
   return c->lev;

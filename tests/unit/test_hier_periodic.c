@@ -23,8 +23,9 @@
  *      weights to 1e-15 (the same products in another order).
  *  (5) Reproduction: v affine along the non-periodic axes (constant along the periodic ones,
  *      so it is periodic) on level 0 and the active nodes, garbage (1e30) on the rest of the
- *      finer levels: prolongation gives the field on every node of every finer level, images
- *      included, and G2P at random particles returns it with L = the slope, to 1e-12 of the
+ *      finer levels: prolongation gives the field on every node of every finer level it fills
+ *      (hier_near.h: images included; the rest keep their garbage, which no particle reads),
+ *      and G2P at random particles returns it with L = the slope, to 1e-12 of the
  *      field's scale (5). */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -39,6 +40,7 @@
 #include <mpi.h>
 
 #include "hier_level_check.h"
+#include "hier_near.h"
 #include "mpm_hier.h"
 #include "mpm_random.h"
 
@@ -330,6 +332,7 @@ static void check_reproduction(pcase c) {
   for (int l = 1; l < f.h->nlevels; ++l) {
     const mpm_grid *g = f.h->level[l].grid;
     for (mpm_lidx i = 0; i < g->nnodes; ++i) {
+      if (!hier_node_filled(f.h, l, i)) continue;
       double x[3];
       node_x(g, i, x);
       for (int d = 0; d < dim; ++d)

@@ -18,9 +18,10 @@
  *      to 1e-15 (gradients times h): the same products in another order.
  *  (5) Affine reproduction: with v = v0 + A x (and a, and a nodal scalar, affine) on level 0
  *      and the active nodes of finer levels, prolongation reproduces the field on every
- *      inactive node, and G2P returns v_p = v0 + A x_p, a_p, s_p, L_p = A and C_p = A on every
- *      level, even with garbage (1e30) on level 0's inactive nodes (no particle reads them).
- *      Tolerance 1e-12 of the field's scale (|v0| + |A| |x|max), and for L and C of that scale
+ *      inactive node it fills (hier_near.h; garbage, 1e30, stays on the others, far from the
+ *      region, which no particle reads), and G2P returns v_p = v0 + A x_p, a_p, s_p, L_p = A and
+ * C_p = A on every level, even with garbage (1e30) on level 0's inactive nodes (no particle reads
+ * them). Tolerance 1e-12 of the field's scale (|v0| + |A| |x|max), and for L and C of that scale
  *      divided by the level spacing (the size of the terms they sum).
  *  (8) The nodal solve: on one level mpm_hier_phase_update equals mpm_grid_phase_update bit
  *      for bit (with and without the light-node rule); on several levels the largest nodal mass
@@ -40,6 +41,7 @@
 #include <mpi.h>
 
 #include "hier_fixture.h"
+#include "hier_near.h"
 #include "mpm_error.h"
 #include "mpm_module.h"
 
@@ -259,6 +261,7 @@ static double prolonged_error(const fixture *f, double *const *s) {
     const mpm_grid *g = f->h->level[l].grid;
     const mpm_grid_phase *ph = &g->phase[f->phase];
     for (mpm_lidx i = 0; i < g->nnodes; ++i) {
+      if (!hier_node_filled(f->h, l, i)) continue;
       double x[3] = {0, 0, 0};
       for (int d = 0; d < g->dim; ++d) x[d] = fixture_node_x(f, l, i, d);
       e = fmax(e, fabs(s[l][i] - affine_s(x)));
