@@ -603,6 +603,12 @@ int mpm_refine_regrid(mpm_hier **h, const mpm_config *cfg, mpm_grid *grid, mpm_m
   return 0;
 }
 
+int mpm_refine_follow(mpm_module **mod, int nmod, int *changed) {
+  for (int k = 0; k < nmod; ++k)
+    if (mod[k]->role != MPM_ROLE_SOLID) MPM_CALL(fluid_module_follow(mod[k], changed));
+  return 0;
+}
+
 int mpm_refine_build(mpm_hier **h, const mpm_config *cfg, mpm_grid *grid, mpm_module **mod,
                      int nmod, int seed) {
   int levels, buffer, nbox;

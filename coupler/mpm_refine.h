@@ -31,8 +31,13 @@ int mpm_refine_dynamic(const mpm_config *cfg);
 /* Between steps of a dynamic refinement: every refine.every steps (or now, with force) rebuild
  * *h from the gas's flags and move the modules onto it (*h may become NULL: nothing flagged);
  * *changed says a regrid ran (the integrator must then restart its RHS). The particles are not
- * touched: they follow the new levels after the next step (fluid_relevel.c). One rank. */
+ * touched: mpm_refine_follow moves them onto the new levels. */
 int mpm_refine_regrid(mpm_hier **h, const mpm_config *cfg, mpm_grid *grid, mpm_module **mod,
                       int nmod, long step, int force, int *changed);
+
+/* After a regrid: split and merge the gas's particles onto the levels of the hierarchy the
+ * modules now hold (fluid_relevel.c), as after a step; *changed (this rank's) says the set
+ * changed. Collective. */
+int mpm_refine_follow(mpm_module **mod, int nmod, int *changed);
 
 #endif

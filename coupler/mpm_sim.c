@@ -462,6 +462,8 @@ static int restore_rhs_count(mpm_sim *s, const mpm_checkpoint *ck, const char *p
   return 0;
 }
 
+static int follow_levels(mpm_sim *s, int resize);
+
 int mpm_sim_restart(mpm_sim **sp, mpm_config *cfg, const char *path) {
   MPM_CALL(sim_alloc(sp, cfg));
   mpm_sim *s = *sp;
@@ -508,6 +510,8 @@ int mpm_sim_restart(mpm_sim **sp, mpm_config *cfg, const char *path) {
   if (!rc && s->dynamic)
     rc = mpm_refine_regrid(&s->hier, cfg, s->grid, s->mod, s->nmod, s->step, 1, &regridded);
   if (!rc && regridded) rc = mpm_coupling_set_hier(s->coupling, cfg, s->hier);
+  /* The particles follow the levels, as the run did after writing the checkpoint. */
+  if (!rc && regridded) rc = follow_levels(s, 0);
   /* The time scheme's own state (a partitioned scheme's owed momentum) follows the particles. */
   if (!rc) rc = mpm_timescheme_new(&s->it, cfg, s->grid, s->mod, s->nmod, s->coupling);
   if (!rc) rc = mpm_timescheme_restore(s->it, ck);
@@ -736,11 +740,30 @@ static int after_step(mpm_sim *s, double h) {
   return 0;
 }
 
+/* After a regrid: the gas's particles split and merge onto the new levels (mpm_refine_follow),
+ * and with resize the integrator follows them (without, the caller starts it afresh). */
+static int follow_levels(mpm_sim *s, int resize) {
+  int changed = 0;
+  mpm_timer_start(MPM_T_REGRID);
+  int rc = mpm_refine_follow(s->mod, s->nmod, &changed);
+  MPM_CALL_MPI(MPI_Allreduce(MPI_IN_PLACE, &changed, 1, MPI_INT, MPI_LOR, s->comm));
+  if (!rc && changed && resize) rc = mpm_timescheme_resize(s->it, s->t);
+  mpm_timer_stop(MPM_T_REGRID);
+  return rc;
+}
+
 /* A dynamic refinement's regrid (mpm_refine.h), after the step's own work: every refine.every
  * steps, and before a checkpoint (force), so that a restart, which regrids from the checkpoint's
- * particles, continues on the same hierarchy. The integrator restarts its RHS on the new one. */
-static int regrid(mpm_sim *s, int force) {
+ * particles, continues on the same hierarchy. The integrator restarts its RHS on the new one, and
+ * the particles follow the new levels at once (a particle left a level or more too coarse for a
+ * step deposits one point where its new level has 2^dim or more nodes a span, and the sparse
+ * nodes between then take the tails of its stencil: on Sod over 4 levels such a step compressed
+ * the new level-3 particles threefold in two steps and blew the run up). Before a checkpoint
+ * they follow after it is written (*follow), as they do after a restart's regrid, so that the
+ * checkpoint holds the particles the restart regrids from. */
+static int regrid(mpm_sim *s, int force, int *follow) {
   int changed = 0;
+  *follow = 0;
   if (!s->dynamic) return 0;
   mpm_timer_start(MPM_T_REGRID);
   int rc = mpm_refine_regrid(&s->hier, s->cfg, s->grid, s->mod, s->nmod, s->step, force, &changed);
@@ -748,7 +771,9 @@ static int regrid(mpm_sim *s, int force) {
   if (!rc && changed) rc = mpm_coupling_set_hier(s->coupling, s->cfg, s->hier);
   if (!rc && changed) rc = mpm_timescheme_resize(s->it, s->t);
   mpm_timer_stop(MPM_T_REGRID);
-  return rc;
+  MPM_CALL(rc);
+  if (changed && force) *follow = 1;
+  return changed && !force ? follow_levels(s, 1) : 0;
 }
 
 /* The step count, refined once the run has taken ESTIMATE_AFTER steps. The starting state's
@@ -937,7 +962,8 @@ int mpm_sim_run(mpm_sim *s) {
     refine_estimate(s, dt);
     MPM_CALL(after_step(s, dt));
     const int ckpt_due = s->t >= t_ckpt * (1 - 1e-14) && s->t < t_stop;
-    MPM_CALL(regrid(s, ckpt_due));
+    int follow = 0;
+    MPM_CALL(regrid(s, ckpt_due, &follow));
     MPM_CALL(diagnostics(s, dt));
     MPM_CALL(guard(s, dt, tstop));
     progress(s, dt, wall0, 0);
@@ -951,6 +977,7 @@ int mpm_sim_run(mpm_sim *s) {
       snprintf(path, sizeof path, "%s/checkpoint_%06ld.h5", s->dir, s->ckpt_number++);
       MPM_CALL(write_checkpoint(s, path));
       /* Exactly what a restart from this file does. */
+      if (follow) MPM_CALL(follow_levels(s, 0));
       MPM_CALL(mpm_timescheme_start(s->it, s->t, s->h_next));
     }
     MPM_CALL(mpm_signal_agreed(s->comm, &sig));

@@ -33,9 +33,13 @@ int fluid_module_refine(mpm_module *m, const mpm_config *cfg, struct mpm_hier *h
  * solid (fluid/fluid_gridp_solid.c); else 0. */
 int fluid_module_reads_beside(const mpm_module *m);
 
-/* A regrid: move the module onto the new hierarchy h (may be NULL); the particles follow it
- * after the next step. */
+/* A regrid: move the module onto the new hierarchy h (may be NULL); fluid_module_follow then
+ * moves the particles onto its levels. */
 void fluid_module_rehier(mpm_module *m, struct mpm_hier *h);
+
+/* Split and merge the particles onto the levels of the module's hierarchy, as after every step
+ * (fluid_relevel.c); *changed is set when the set changed. Collective. */
+int fluid_module_follow(mpm_module *m, int *changed);
 
 /* A regrid's criterion (one of the list refine.criterion). */
 typedef enum {

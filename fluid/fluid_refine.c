@@ -183,6 +183,10 @@ int fluid_module_refine(mpm_module *m, const mpm_config *cfg, mpm_hier *h, int s
   return seed && h ? fluid_seed_refined(m, cfg) : 0;
 }
 
+int fluid_module_follow(mpm_module *m, int *changed) {
+  return fluid_relevel(m, changed);
+}
+
 void fluid_module_rehier(mpm_module *m, mpm_hier *h) {
   m->hier = h;
   fluid_gridp_reset(m->content);
