@@ -94,6 +94,10 @@ foreach(method usl musl)
                         ARGS ${part} ${method} LABELS verification TIMEOUT 300)
   endforeach()
 endforeach()
+# Sod over 4 levels whose regrids refine by up to three levels at once: the particles follow
+# their new levels at the regrid (~7 s).
+mpm_add_script_test(test_refine_usl_follow SCRIPT verification/test_refine_usl.py
+                    ARGS follow usl LABELS verification TIMEOUT 300)
 # Static obstacles on every level (the gas): gas at rest around a circle and a box's corner in
 # refined boxes, on 2 and 3 levels (~4 s); a uniform stream along a slab's face through bands
 # over it and its uniform twin (~6 s); a stream past a circle in a band against its aligned fine
