@@ -510,8 +510,9 @@ int mpm_sim_restart(mpm_sim **sp, mpm_config *cfg, const char *path) {
   if (!rc && s->dynamic)
     rc = mpm_refine_regrid(&s->hier, cfg, s->grid, s->mod, s->nmod, s->step, 1, &regridded);
   if (!rc && regridded) rc = mpm_coupling_set_hier(s->coupling, cfg, s->hier);
-  /* The particles follow the levels, as the run did after writing the checkpoint. */
-  if (!rc && regridded) rc = follow_levels(s, 0);
+  /* The particles follow the levels, as the run did after writing the checkpoint (always: the
+   * run's regrid may have kept its regions, or dropped them all, where this one builds). */
+  if (!rc && s->dynamic) rc = follow_levels(s, 0);
   /* The time scheme's own state (a partitioned scheme's owed momentum) follows the particles. */
   if (!rc) rc = mpm_timescheme_new(&s->it, cfg, s->grid, s->mod, s->nmod, s->coupling);
   if (!rc) rc = mpm_timescheme_restore(s->it, ck);
@@ -759,8 +760,9 @@ static int follow_levels(mpm_sim *s, int resize) {
  * step deposits one point where its new level has 2^dim or more nodes a span, and the sparse
  * nodes between then take the tails of its stencil: on Sod over 4 levels such a step compressed
  * the new level-3 particles threefold in two steps and blew the run up). Before a checkpoint
- * they follow after it is written (*follow), as they do after a restart's regrid, so that the
- * checkpoint holds the particles the restart regrids from. */
+ * they follow after it is written (*follow, whether or not the regions changed), as they do
+ * after every restart's regrid, so that the checkpoint holds the particles the restart regrids
+ * from and both relevel alike. */
 static int regrid(mpm_sim *s, int force, int *follow) {
   int changed = 0;
   *follow = 0;
@@ -772,7 +774,7 @@ static int regrid(mpm_sim *s, int force, int *follow) {
   if (!rc && changed) rc = mpm_timescheme_resize(s->it, s->t);
   mpm_timer_stop(MPM_T_REGRID);
   MPM_CALL(rc);
-  if (changed && force) *follow = 1;
+  if (force) *follow = 1; /* whether or not the regions changed, as a restart does */
   return changed && !force ? follow_levels(s, 1) : 0;
 }
 
