@@ -242,13 +242,18 @@ static int find_images(mpm_hier_level *lv, int dim) {
   return 0;
 }
 
-/* Along the periodic axes, level l stores the whole period when its box [lo, hi] would reach a
- * node outside [0, N_l): then [-1, N_l + 2^(l-1) + 2], which holds the stencil of every point
- * of the domain (at 2^(l-1) - 1 + [0, N_l + 2] on level l's lattice) with a node to spare. */
+/* Along the periodic axes, level l stores the whole period when its region crosses a periodic
+ * face, or its box [lo, hi] would reach a node outside [0, N_l): then
+ * [-1, N_l + 2^(l-1) + 2], which holds the stencil of every point of the domain (at
+ * 2^(l-1) - 1 + [0, N_l + 2] on level l's lattice) with a node to spare. The domain's low face
+ * is at node 2^(l-1) - 1/2 of level l: the region (its box less two nodes) crosses it when
+ * lo < 2^(l-1) - 2, which for l >= 3 is more than lo < 0 (a level-3 region from level-2 span 1,
+ * wholly below the face, has lo = 0 and once wrote outside its box). */
 static void wrap_level(const mpm_grid *g0, int l, int *lo, int *hi, int *period) {
+  const int lo_min = MPM_MAX(0, (1 << (l - 1)) - 2);
   for (int d = 0; d < g0->dim; ++d) {
     const int N = g0->ncells[d] << l;
-    if (!g0->periodic[d] || (lo[d] >= 0 && hi[d] <= N - 1)) continue;
+    if (!g0->periodic[d] || (lo[d] >= lo_min && hi[d] <= N - 1)) continue;
     lo[d] = -1, hi[d] = N + (1 << (l - 1)) + 2, period[d] = N;
   }
 }
