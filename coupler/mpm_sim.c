@@ -760,12 +760,11 @@ static int follow_levels(mpm_sim *s, int resize) {
  * step deposits one point where its new level has 2^dim or more nodes a span, and the sparse
  * nodes between then take the tails of its stencil: on Sod over 4 levels such a step compressed
  * the new level-3 particles threefold in two steps and blew the run up). Before a checkpoint
- * they follow after it is written (*follow, whether or not the regions changed), as they do
- * after every restart's regrid, so that the checkpoint holds the particles the restart regrids
- * from and both relevel alike. */
-static int regrid(mpm_sim *s, int force, int *follow) {
+ * (force) they follow after it is written, whether or not the regions changed, as they do after
+ * every restart's regrid, so that the checkpoint holds the particles the restart regrids from
+ * and both relevel alike (mpm_sim_run). */
+static int regrid(mpm_sim *s, int force) {
   int changed = 0;
-  *follow = 0;
   if (!s->dynamic) return 0;
   mpm_timer_start(MPM_T_REGRID);
   int rc = mpm_refine_regrid(&s->hier, s->cfg, s->grid, s->mod, s->nmod, s->step, force, &changed);
@@ -774,7 +773,6 @@ static int regrid(mpm_sim *s, int force, int *follow) {
   if (!rc && changed) rc = mpm_timescheme_resize(s->it, s->t);
   mpm_timer_stop(MPM_T_REGRID);
   MPM_CALL(rc);
-  if (force) *follow = 1; /* whether or not the regions changed, as a restart does */
   return changed && !force ? follow_levels(s, 1) : 0;
 }
 
@@ -964,8 +962,7 @@ int mpm_sim_run(mpm_sim *s) {
     refine_estimate(s, dt);
     MPM_CALL(after_step(s, dt));
     const int ckpt_due = s->t >= t_ckpt * (1 - 1e-14) && s->t < t_stop;
-    int follow = 0;
-    MPM_CALL(regrid(s, ckpt_due, &follow));
+    MPM_CALL(regrid(s, ckpt_due));
     MPM_CALL(diagnostics(s, dt));
     MPM_CALL(guard(s, dt, tstop));
     progress(s, dt, wall0, 0);
@@ -979,7 +976,7 @@ int mpm_sim_run(mpm_sim *s) {
       snprintf(path, sizeof path, "%s/checkpoint_%06ld.h5", s->dir, s->ckpt_number++);
       MPM_CALL(write_checkpoint(s, path));
       /* Exactly what a restart from this file does. */
-      if (follow) MPM_CALL(follow_levels(s, 0));
+      if (s->dynamic) MPM_CALL(follow_levels(s, 0)); /* after regrid(s, 1), as a restart */
       MPM_CALL(mpm_timescheme_start(s->it, s->t, s->h_next));
     }
     MPM_CALL(mpm_signal_agreed(s->comm, &sig));
