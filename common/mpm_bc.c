@@ -103,6 +103,11 @@ int mpm_constraints_add(mpm_node_constraints *c, mpm_lidx l, unsigned char mask)
   return add_rule(c, l, -1, mask);
 }
 
+int mpm_constraints_add_mirror(mpm_node_constraints *c, mpm_lidx l, mpm_lidx source,
+                               unsigned char mask) {
+  return add_rule(c, l, source, mask);
+}
+
 void mpm_grid_node_global(const mpm_grid *grid, mpm_lidx l, int *gi) {
   for (int d = 0; d < grid->dim; ++d) {
     gi[d] = grid->box_lo[d] + (int)(l % grid->box_n[d]);

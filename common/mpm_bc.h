@@ -66,6 +66,9 @@ typedef struct mpm_node_constraints {
 
 /* Hold the masked components of node l at zero. */
 int mpm_constraints_add(mpm_node_constraints *c, mpm_lidx l, unsigned char mask);
+/* Make pad node l the mirror of node source, the masked components negated. */
+int mpm_constraints_add_mirror(mpm_node_constraints *c, mpm_lidx l, mpm_lidx source,
+                               unsigned char mask);
 /* Add the wall rules of every wall face of w on grid (none and periodic faces have none). */
 int mpm_constraints_add_walls(mpm_node_constraints *c, const mpm_walls *w, const mpm_grid *grid);
 /* Before the nodal update: fold what particles deposited on mirrored pad nodes into their

@@ -183,6 +183,9 @@ void mpm_hier_destroy(mpm_hier **h);
  * own rules (mpm_bc.h) do the same there. No-ops without walls. */
 void mpm_hier_walls_fold(mpm_hier *h, int phase);
 void mpm_hier_walls_apply(mpm_hier *h, int phase);
+/* The mirror across a wall of axis d of box node n of finer level l (its box index), or -1 when
+ * n is not beyond a wall of d or its mirror leaves the box. */
+mpm_lidx mpm_hier_wall_mirror(const mpm_hier *h, int l, int d, mpm_lidx n);
 
 /* Give every finer level the phases the grid has and it lacks (after a module adds one). */
 int mpm_hier_add_phases(mpm_hier *h);

@@ -12,7 +12,7 @@
 
 /* The mirror of box node n of level l along axis d (its box index), or -1 when n is not beyond
  * a wall of d or its mirror leaves the box. */
-static mpm_lidx mirror_node(const mpm_hier *h, int l, int d, mpm_lidx n) {
+mpm_lidx mpm_hier_wall_mirror(const mpm_hier *h, int l, int d, mpm_lidx n) {
   const mpm_grid *g = h->level[l].grid;
   int gi[MPM_MAX_DIM];
   hier_node_of(g, n, gi);
@@ -44,7 +44,7 @@ static void each_mirror(mpm_hier *h, int phase, mirror_fn fn) {
     for (int d = 0; d < h->dim; ++d) {
       if (!has_walls(h, d)) continue;
       for (mpm_lidx n = 0; n < g->nnodes; ++n) {
-        const mpm_lidx s = mirror_node(h, l, d, n);
+        const mpm_lidx s = mpm_hier_wall_mirror(h, l, d, n);
         if (s >= 0) fn(ph, h->dim, n, s, flips(h, l, d, n));
       }
     }

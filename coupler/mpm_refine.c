@@ -6,9 +6,9 @@
  * that does not span every periodic axis (check_bands), a solid alone with dynamic regrids (they
  * follow a gas), dynamic regrids beside a solid without fluid.pressure = grid, a shape other
  * than the quadratic B-spline, and a box within three level-0 cells of a non-periodic domain face
- * other than a gas's slip or no-slip wall (open and closed faces, and a solid's walls, act on level
- * 0 alone; a gas's walls are carried to every level, mpm_hier.h, and a box or region may touch
- * them). Along a periodic axis a box or a dynamic
+ * other than a slip or no-slip wall (open and closed faces act on level 0 alone; the walls are
+ * carried to every level for both phases, mpm_hier.h, and a box or region may touch them). Along
+ * a periodic axis a box or a dynamic
  * region may touch, cross or span the periodic faces (the levels wrap there, mpm_hier.h).
  * mpm_hier_new's own reasons name the box's key. The gas and the solid refuse their own settings
  * (fluid/fluid_refine.c,
@@ -109,12 +109,11 @@ static int refine_modules(const mpm_config *cfg, mpm_module **mod, int nmod, mpm
   return 0;
 }
 
-/* The walls the finer levels carry (mpm_hier.h, walls): the slip and no-slip faces of a gas-only
- * case, as the components each constrains; none for a solid (its levels keep off every face). */
-static int carried_walls(const mpm_config *cfg, const mpm_grid *g, mpm_module **mod, int nmod,
+/* The walls the finer levels carry (mpm_hier.h, walls): the slip and no-slip faces, as the
+ * components each constrains (both phases fold and mirror their nodes there). */
+static int carried_walls(const mpm_config *cfg, const mpm_grid *g,
                          unsigned char wall[MPM_MAX_DIM][2]) {
   memset(wall, 0, sizeof(unsigned char) * MPM_MAX_DIM * 2);
-  if (solid_of(mod, nmod)) return 0;
   mpm_walls w;
   MPM_CALL(mpm_walls_from_config(&w, cfg, g->dim));
   for (int d = 0; d < g->dim; ++d)
@@ -181,9 +180,9 @@ static int read_box(const mpm_config *cfg, const mpm_grid *g, const char *name,
     if (low || b->hi[d] > g->hi[d] - gap_hi + tol)
       return mpm_config_fail(cfg, key[low ? 1 : 2],
                              "the box comes within %d level-0 cells (%g) of the domain face %c = "
-                             "%g, or past a wall: open faces, closed faces (none) and a solid's "
-                             "walls act on level 0 only; keep the box inside [%g, %g] along %c "
-                             "(a slip or no-slip wall of a gas may be touched, not crossed)",
+                             "%g, or past a wall: open faces and closed faces (none) act on "
+                             "level 0 only; keep the box inside [%g, %g] along %c (a slip or "
+                             "no-slip wall may be touched, not crossed)",
                              REFINE_FACE_CELLS, gap, "xyz"[d], low ? g->lo[d] : g->hi[d],
                              g->lo[d] + gap_lo, g->hi[d] - gap_hi, "xyz"[d]);
   }
@@ -576,7 +575,7 @@ int mpm_refine_regrid(mpm_hier **h, const mpm_config *cfg, mpm_grid *grid, mpm_m
   int on;
   MPM_CALL(read_dynamic(cfg, &dy, &on));
   if (!on || nmod < 1 || (!force && step % dy.every != 0)) return 0;
-  MPM_CALL(carried_walls(cfg, grid, mod, nmod, dy.wall));
+  MPM_CALL(carried_walls(cfg, grid, dy.wall));
   mpm_hier *next;
   const mpm_module *solid = nmod > 1 ? solid_of(mod, nmod) : NULL;
   int kept;
@@ -585,11 +584,16 @@ int mpm_refine_regrid(mpm_hier **h, const mpm_config *cfg, mpm_grid *grid, mpm_m
     mpm_hier_destroy(&next);
     return 0;
   }
-  for (int k = 0; k < nmod; ++k)
-    mod[k]->role == MPM_ROLE_SOLID ? solid_module_rehier(mod[k], next)
-                                   : fluid_module_rehier(mod[k], next);
+  int rc = 0;
+  for (int k = 0; k < nmod; ++k) {
+    if (mod[k]->role == MPM_ROLE_SOLID && !rc)
+      rc = solid_module_rehier(mod[k], next);
+    else
+      fluid_module_rehier(mod[k], next);
+  }
   mpm_hier_destroy(h);
   *h = next;
+  MPM_CALL(rc); /* (out of memory: the modules are on the new hierarchy, the run stops) */
   *changed = 1;
   /* The flags keep the solid on the finest level (make_dynamic); a body the faces' clipping
    * takes off it is an error of the run, named on its key (solid_refine_inside finds it). */
@@ -649,7 +653,7 @@ int mpm_refine_build(mpm_hier **h, const mpm_config *cfg, mpm_grid *grid, mpm_mo
                            "the [refine.NAME] boxes or set refine.criterion = none");
   }
   unsigned char wall[MPM_MAX_DIM][2];
-  MPM_CALL(carried_walls(cfg, grid, mod, nmod, wall));
+  MPM_CALL(carried_walls(cfg, grid, wall));
   memcpy(dy.wall, wall, sizeof wall);
   if (on) { /* from the seeded gas (on a restart the sim regrids once the particles are read) */
     const mpm_module *solid = nmod > 1 ? solid_of(mod, nmod) : NULL;

@@ -162,15 +162,56 @@ void solid_rigid_velocity(const solid_content *sc, int dim, mpm_lidx n, double *
  * a point half a cell from it along an axis. Holding only the nodes strictly inside puts
  * the effective root of a clamped bar up to a cell inside the clamp (B-splines do not
  * interpolate), a first-order error that dominated CSM1 (tip uy +8.7 % at dx = 5 mm, against
- * +2.8 % when the node line at the clamp's face is held). */
-static int clamps_node(const solid_content *sc, const double *x, double half, int dim) {
+ * +2.8 % when the node line at the clamp's face is held). With wall set (a finer level of a
+ * hierarchy, g0 its level 0), a point on or beyond a wall does not count: there the level's nodes
+ * lie half a cell off the wall, and the clamp acts through its pad nodes (hold_clamped). */
+static int clamps_node(const solid_content *sc, const double *x, double half, int dim,
+                       const mpm_grid *g0, const unsigned char (*wall)[2]) {
   if (solid_in_clamp(sc, x)) return 1;
   for (int d = 0; d < dim; ++d)
     for (int s = -1; s <= 1; s += 2) {
       double y[3] = {x[0], x[1], x[2]};
       y[d] += s * half;
+      if (wall && ((wall[d][0] && y[d] <= g0->lo[d]) || (wall[d][1] && y[d] >= g0->hi[d])))
+        continue;
       if (solid_in_clamp(sc, y)) return 1;
     }
+  return 0;
+}
+
+static void node_x(const mpm_grid *g, mpm_lidx l, double *x) {
+  int gi[MPM_MAX_DIM];
+  mpm_grid_node_global(g, l, gi);
+  for (int d = 0; d < g->dim; ++d) x[d] = g->lo[d] + gi[d] * g->dx;
+}
+
+/* Add every node of grid g that a clamp holds to c: level 0's grid (h NULL; its nodes on a wall
+ * are held with the rest, its pad nodes are the wall's), or finer level l of hierarchy h. There
+ * a wall is a knot, its nearest nodes half a cell inside and beyond it: a pad node whose point
+ * on the wall, midway to its mirror, lies in a clamp mirrors it with every component negated
+ * (a no-slip patch: zero velocity on the wall there, as a clamp holds level 0's wall node),
+ * where the wall alone would mirror it slip; interior nodes are held by the rule above, the
+ * wall's plane left out. */
+static int hold_clamped(const solid_content *sc, const mpm_grid *g, const mpm_hier *h, int l,
+                        mpm_node_constraints *c) {
+  const unsigned char all = (unsigned char)((1u << g->dim) - 1);
+  const unsigned char(*wall)[2] = h ? (const unsigned char(*)[2])h->wall : NULL;
+  for (mpm_lidx n = 0; n < g->nnodes; ++n) {
+    double x[3] = {0, 0, 0};
+    node_x(g, n, x);
+    int pad = 0;
+    for (int d = 0; h && d < g->dim; ++d) {
+      const mpm_lidx s = mpm_hier_wall_mirror(h, l, d, n);
+      if (s < 0) continue;
+      pad = 1;
+      double y[3] = {0, 0, 0};
+      node_x(g, s, y);
+      y[d] = 0.5 * (x[d] + y[d]);
+      if (solid_in_clamp(sc, y)) MPM_CALL(mpm_constraints_add_mirror(c, n, s, all));
+    }
+    if (!pad && clamps_node(sc, x, 0.5 * g->dx, g->dim, h ? h->level[0].grid : g, wall))
+      MPM_CALL(mpm_constraints_add(c, n, all));
+  }
   return 0;
 }
 
@@ -195,14 +236,17 @@ int solid_read_constraints(mpm_module *m, const mpm_config *cfg) {
     MPM_CALL(mpm_region_from_config(&sc->clamp[k], cfg, g->dim, geom));
     sc->nclamps = k + 1;
   }
-  const unsigned char all = (unsigned char)((1u << g->dim) - 1);
-  for (mpm_lidx l = 0; l < g->nnodes; ++l) {
-    int gi[MPM_MAX_DIM];
-    double x[3] = {0, 0, 0};
-    mpm_grid_node_global(g, l, gi);
-    for (int d = 0; d < g->dim; ++d) x[d] = g->lo[d] + gi[d] * g->dx;
-    if (clamps_node(sc, x, 0.5 * g->dx, g->dim)) MPM_CALL(mpm_constraints_add(&sc->cons, l, all));
+  return hold_clamped(sc, g, NULL, 0, &sc->cons);
+}
+
+int solid_clamp_levels(mpm_module *m) {
+  solid_content *sc = m->content;
+  for (int l = 1; l < MPM_HIER_MAX_LEVELS; ++l) {
+    mpm_constraints_free(&sc->lcons[l]);
+    memset(&sc->lcons[l], 0, sizeof sc->lcons[l]);
   }
+  for (int l = 1; m->hier && sc->nclamps > 0 && l < m->hier->nlevels; ++l)
+    MPM_CALL(hold_clamped(sc, m->hier->level[l].grid, m->hier, l, &sc->lcons[l]));
   return 0;
 }
 

@@ -8,6 +8,7 @@
 #include "mpm_config.h"
 #include "mpm_expr.h"
 #include "mpm_geometry.h"
+#include "mpm_hier.h"
 #include "mpm_kernels.h"
 #include "mpm_module.h"
 #include "mpm_transfer.h"
@@ -69,6 +70,9 @@ typedef struct {
   solid_body *body;
   solid_layout lay;
   mpm_node_constraints cons; /* wall and clamp nodes */
+  /* On a hierarchy: the clamps' nodes of each finer level (lcons[0] unused; the walls of the
+   * finer levels are the hierarchy's own, mpm_hier_walls_fold and _apply). */
+  mpm_node_constraints lcons[MPM_HIER_MAX_LEVELS];
   int nclamps;
   mpm_region **clamp; /* clamped regions */
   int nrigid;         /* rigid bodies */
@@ -144,6 +148,10 @@ int solid_read_tractions(mpm_module *m, const mpm_config *cfg);
 int solid_check_tractions(mpm_module *m, const mpm_config *cfg);
 /* Is x inside a clamped region? */
 int solid_in_clamp(const solid_content *sc, const double *x);
+/* The clamps' nodes on the finer levels of m->hier (none without one), rebuilt for a new
+ * hierarchy: every node of a level's box that a clamp holds, by the level-0 rule at the
+ * level's spacing. */
+int solid_clamp_levels(mpm_module *m);
 /* At seeding: add the tractions' force on a particle at xp of body region `body` to f. */
 void solid_traction_force(solid_content *sc, const mpm_region *body, int dim, double h,
                           const double *xp, mpm_gidx id, double *f);

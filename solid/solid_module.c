@@ -419,18 +419,29 @@ static int solid_forces(mpm_module *m, double t, double h, mpm_pass pass) {
   (void)t, (void)h;
   solid_content *sc = m->content;
   mpm_constraints_fold(&sc->cons, m->grid, m->phase);
+  for (int l = 1; m->hier && l < m->hier->nlevels; ++l) /* the clamps' pads before the walls' */
+    mpm_constraints_fold(&sc->lcons[l], m->hier->level[l].grid, m->phase);
+  if (m->hier) mpm_hier_walls_fold(m->hier, m->phase);
   if (sc->damping > 0 && pass == MPM_PASS_FIRST) damp_all(m, sc->damping);
   return 0;
 }
 
 /* After the nodal solve. Rigid bodies act before the walls and clamps: the pad nodes beyond a
- * wall mirror what a rigid body set inside, and a wall or clamp keeps its own nodes. */
+ * wall mirror what a rigid body set inside, and a wall or clamp keeps its own nodes. On a
+ * hierarchy the finer levels' clamps hold their nodes before their walls' pad nodes copy their
+ * mirrors (level 0's rules do the same in one list). */
 static int solid_constrain(mpm_module *m, double t, double h, mpm_pass pass) {
   (void)h, (void)pass;
   solid_content *sc = m->content;
   for (int b = 0; b < sc->nbodies; ++b)
     if (sc->body[b].region) solid_hold_rigid_nodes(&sc->body[b], m->grid, m->phase, t);
   mpm_constraints_apply(&sc->cons, m->grid, m->phase);
+  if (!m->hier) return 0;
+  for (int l = 1; l < m->hier->nlevels; ++l) /* held nodes; the pads again after the walls' */
+    mpm_constraints_apply(&sc->lcons[l], m->hier->level[l].grid, m->phase);
+  mpm_hier_walls_apply(m->hier, m->phase);
+  for (int l = 1; l < m->hier->nlevels; ++l)
+    mpm_constraints_apply(&sc->lcons[l], m->hier->level[l].grid, m->phase);
   return 0;
 }
 
@@ -685,6 +696,7 @@ static void solid_destroy(mpm_module *m) {
     for (int k = 0; k < sc->nclamps; ++k) mpm_region_destroy(&sc->clamp[k]);
     free(sc->clamp);
     mpm_constraints_free(&sc->cons);
+    for (int l = 1; l < MPM_HIER_MAX_LEVELS; ++l) mpm_constraints_free(&sc->lcons[l]);
     free(sc->body);
     free(sc->vsig);
     free(sc->scratch);

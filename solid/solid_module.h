@@ -41,7 +41,8 @@ int solid_refine_inside(const mpm_module *m, const mpm_config *cfg, int cells);
  * the solid on some rank, 0 elsewhere. */
 int solid_refine_spans(const mpm_module *m, const int *n, unsigned char *flag);
 
-/* Put the solid on the regridded hierarchy h (its particles stay as they are). */
-void solid_module_rehier(mpm_module *m, struct mpm_hier *h);
+/* Put the solid on the regridded hierarchy h (its particles stay as they are; its clamps hold
+ * the new levels' nodes). */
+int solid_module_rehier(mpm_module *m, struct mpm_hier *h);
 
 #endif

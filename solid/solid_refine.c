@@ -16,7 +16,7 @@
  * and deposits on, and reads from, the level of its position.
  *
  * Refused (refine_check), each naming its key: a body with a bulk viscosity (its length
- * scale and lagged rate are level 0's), a rigid body and a clamp (they hold level-0 nodes), an
+ * scale and lagged rate are level 0's), a rigid body (it holds level-0 nodes), an
  * odd ppc (a level-0 particle would sit on a face of the refined region), time.method = musl
  * (the remap deposits on level 0), and a traction whose region reaches a refined region (the
  * tractions load level-0 particles only). Dynamic regrids are refused by coupler/mpm_refine.c,
@@ -92,21 +92,23 @@ static int refine_check(const mpm_module *m, const mpm_config *cfg) {
   const solid_content *sc = m->content;
   if (sc->tr.musl) return refuse(cfg, "time.method", "MUSL's remap deposits on level 0's nodes");
   for (int b = 0; b < sc->nbodies; ++b) MPM_CALL(check_body(cfg, &sc->body[b]));
-  const char *const *names;
-  int count;
-  MPM_CALL(mpm_config_instances(cfg, "clamp", &names, &count));
-  if (count > 0) {
-    char key[160];
-    snprintf(key, sizeof key, "clamp.%s.geometry", names[0]);
-    return refuse(cfg, key, "a clamp holds level-0 nodes");
-  }
   return 0;
 }
 
 /* ---- beside a gas: the solid on the finest level -------------------------------------------- */
 
+/* Is y beyond a wall the levels carry (where they mirror the nodes inside)? */
+static int beyond_wall(const mpm_hier *h, const double *y) {
+  const mpm_grid *g0 = h->level[0].grid;
+  for (int d = 0; d < h->dim; ++d)
+    if ((h->wall[d][0] && y[d] < g0->lo[d]) || (h->wall[d][1] && y[d] > g0->hi[d])) return 1;
+  return 0;
+}
+
 /* Do the points of the cube of half-side cells h around x, a lattice of spacing h (the finest
- * region is a union of spans of side 2 h, so no gap escapes it), all lie on the finest level? */
+ * region is a union of spans of side 2 h, so no gap escapes it), all lie on the finest level?
+ * Points beyond a carried wall do not count: the region touches the wall, and the level
+ * mirrors its nodes there. */
 static int cube_on_finest(const mpm_hier *h, int dim, const double *x, int cells) {
   const int top = h->nlevels - 1, side = 2 * cells + 1;
   const double dx = h->level[top].grid->dx;
@@ -115,7 +117,7 @@ static int cube_on_finest(const mpm_hier *h, int dim, const double *x, int cells
   for (int k = 0; k < total; ++k) {
     double y[3] = {x[0], dim > 1 ? x[1] : 0, dim > 2 ? x[2] : 0};
     for (int d = 0, r = k; d < dim; r /= side, ++d) y[d] += (r % side - cells) * dx;
-    if (mpm_hier_level_of(h, y) != top) return 0;
+    if (!beyond_wall(h, y) && mpm_hier_level_of(h, y) != top) return 0;
   }
   return 1;
 }
@@ -168,8 +170,9 @@ int solid_refine_spans(const mpm_module *m, const int *n, unsigned char *flag) {
   return 0;
 }
 
-void solid_module_rehier(mpm_module *m, struct mpm_hier *h) {
+int solid_module_rehier(mpm_module *m, struct mpm_hier *h) {
   m->hier = h;
+  return solid_clamp_levels(m);
 }
 
 /* ---- seeding the finer levels ---------------------------------------------------------------- */
@@ -225,6 +228,7 @@ static int seed_level(mpm_module *m, const mpm_config *cfg, int b, int l) {
 int solid_module_refine(mpm_module *m, const mpm_config *cfg, mpm_hier *h, int seed) {
   MPM_CALL(refine_check(m, cfg));
   m->hier = h;
+  MPM_CALL(solid_clamp_levels(m));
   if (!seed || !h) return 0;
   mpm_particles *p = m->particles;
   MPM_CALL(check_tractions(m, cfg, p->n, mpm_particles_comp(p, F_X, 0)));

@@ -36,8 +36,9 @@ endforeach()
 # The solid on a static hierarchy (issue 51): an elastic pulse along a bar crossing a level-1
 # box against its uniform twins, with the grid sums (~4 s), and under usl (~2 s); a block
 # translating across the box (~1 s); a prestressed block with a box inside it (~2 s); a
-# restart (~3 s); every refusal (~3 s).
-foreach(part wave stream prestress usl restart input)
+# restart (~3 s); every refusal (~3 s); a pulse reflecting from a wall inside a box (~4 s); a
+# clamped bar on a wall on 2 and 3 levels against its uniform twins (~6 s).
+foreach(part wave stream prestress usl restart input walls clamp)
   mpm_add_script_test(test_refine_solid_${part} SCRIPT verification/test_refine_solid.py
                       ARGS ${part} LABELS verification TIMEOUT 300)
 endforeach()
