@@ -29,9 +29,10 @@ static void node_update(mpm_lidx nn, const double *restrict m, const double *res
   }
 }
 
-/* Mass and number of the owned nodes with m_i > mmin, into sum[0] and sum[1]: the owned
- * block of the box row by row (in index order, as a loop over the box would add them). */
-static void owned_mass(const mpm_grid *g, const mpm_grid_phase *ph, double mmin, double *sum) {
+/* Mass over scale and number of the owned nodes with m_i > mmin, into sum[0] and sum[1]: the
+ * owned block of the box row by row (in index order, as a loop over the box would add them). */
+static void owned_mass(const mpm_grid *g, const mpm_grid_phase *ph, double mmin, double scale,
+                       double *sum) {
   const double *m = ph->m_i;
   int lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
   mpm_lidx stride[3] = {1, 0, 0};
@@ -45,7 +46,7 @@ static void owned_mass(const mpm_grid *g, const mpm_grid_phase *ph, double mmin,
     for (int j = lo[1]; j < hi[1]; ++j) {
       const double *row = m + k * stride[2] + j * stride[1];
       for (int i = lo[0]; i < hi[0]; ++i)
-        if (row[i] > mmin) sum[0] += row[i], sum[1] += 1.0;
+        if (row[i] > mmin) sum[0] += row[i] / scale, sum[1] += 1.0;
     }
 }
 
@@ -63,13 +64,20 @@ static int largest_mass(mpm_grid *const *grids, int ngrids, int phase, double *m
   return 0;
 }
 
-/* Mean mass of the owned nodes heavier than mmin over ngrids grids (0 if none). */
+/* A node's volume on grid k over one on grids[0] (1 for grids[0] itself). */
+static double node_scale(mpm_grid *const *grids, int k) {
+  return k == 0 ? 1.0 : pow(grids[k]->dx / grids[0]->dx, grids[0]->dim);
+}
+
+/* Mean mass of the owned nodes heavier than mmin over ngrids grids (0 if none), each counted at
+ * grids[0]'s spacing (node_scale). */
 static int mean_mass(mpm_grid *const *grids, int ngrids, int phase, double mmin, double *mean) {
   double sum[2] = {0.0, 0.0}, all[2]; /* mass and count over the owned nodes with mass */
   /* The finer levels of a hierarchy (box grids, no communicator) are alike on every rank:
    * counted on rank 0 alone. */
   for (int k = 0; k < ngrids; ++k)
-    if (k == 0 || grids[0]->rank == 0) owned_mass(grids[k], &grids[k]->phase[phase], mmin, sum);
+    if (k == 0 || grids[0]->rank == 0)
+      owned_mass(grids[k], &grids[k]->phase[phase], mmin, node_scale(grids, k), sum);
   MPM_CALL_MPI(MPI_Allreduce(sum, all, 2, MPI_DOUBLE, MPI_SUM, grids[0]->comm));
   *mean = all[1] > 0.0 ? all[0] / all[1] : 0.0;
   return 0;
@@ -81,16 +89,17 @@ int mpm_grid_phase_update_many(mpm_grid *const *grids, int ngrids, int phase, do
   MPM_CALL(largest_mass(grids, ngrids, phase, &mmax));
   /* Nodes touched only by the far tail of a stencil carry roundoff-sized mass; dividing by it
    * would amplify noise, so they are treated as empty (a module may raise the fraction). */
-  double mmin = ph0->empty_fraction * mmax;
-  if (ph0->light_fraction > 0.0) {
-    MPM_CALL(mean_mass(grids, ngrids, phase, mmin, &mean));
-    mmin = fmax(mmin, ph0->light_fraction * mean);
-  }
+  const double mempty = ph0->empty_fraction * mmax;
+  if (ph0->light_fraction > 0.0) MPM_CALL(mean_mass(grids, ngrids, phase, mempty, &mean));
   for (int k = 0; k < ngrids; ++k) {
     mpm_grid *g = grids[k];
     mpm_grid_phase *ph = &g->phase[phase];
+    double mmin = mempty;
+    if (ph0->light_fraction > 0.0) {
+      ph->m_mean = mean * node_scale(grids, k);
+      mmin = fmax(mmin, ph0->light_fraction * ph->m_mean);
+    }
     ph->m_max = mmax, ph->m_empty = mmin;
-    if (ph0->light_fraction > 0.0) ph->m_mean = mean;
     if (!ph->narrowed) {
       for (int d = 0; d < g->dim; ++d)
         node_update(g->nnodes, ph->m_i, ph->mv_i[d], ph->f_i[d], ph->v_i[d], ph->a_i[d], mmin, h);

@@ -170,7 +170,9 @@ int mpm_grid_phase_update(mpm_grid *grid, int phase, double h);
 /* The same update on ngrids grids at once, as if their nodes were one grid's: the largest
  * nodal mass and the mean of the light rule are taken over all of them, with the empty and
  * light fractions of grids[0]'s phase; collective over grids[0]'s communicator (the others may
- * have none: box grids, whose nodes all count as owned). A refinement hierarchy's levels. */
+ * have none: box grids, whose nodes all count as owned). A refinement hierarchy's levels: the
+ * light rule compares each node with the mean at its own spacing, every node's mass counted in
+ * the mean as (dx_0 / dx_k)^dim times its own (a uniform gas gives every level the same). */
 int mpm_grid_phase_update_many(mpm_grid *const *grids, int ngrids, int phase, double h);
 
 /* Record a fault at particle i of p (positions from y) with a printf-style cause; returns 1. */

@@ -169,7 +169,8 @@ static const mpm_key_spec fluid_keys[] = {
     {"fluid.light_node_mass", MPM_KEY_REAL, "0", 0, 0.5, 0, 0, NULL,
      "a gas node holding less than this fraction of the mean gas nodal mass (over the nodes "
      "holding gas) is empty too, as for empty_node_mass (0: off). Relative to the mean, so a "
-     "spuriously compressed node elsewhere does not empty ordinary ones",
+     "spuriously compressed node elsewhere does not empty ordinary ones; on a refinement "
+     "hierarchy each level's nodes against the mean at that level's spacing",
      0, "-"},
     {"fluid.regularise_min", MPM_KEY_INT, NULL, 1, HUGE_VAL, 0, 0, NULL,
      "split particles in a non-empty cell holding fewer than this (default ceil(ppc^dim / 2): "

@@ -26,9 +26,10 @@
  *
  * Refused (fluid_refine_check), each naming its key: everything that reads or writes the gas's
  * nodal fields or the grid otherwise: the domain volume rate, the riemann viscosity's limiter,
- * shifting, regularisation and refill (cell counts), the neighbourhood stable step, the light-node
- * threshold, the least-squares wall treatment. An odd fluid.ppc puts level-0 particles on the span
- * faces that bound the finer regions, so it is refused too.
+ * shifting, regularisation and refill (cell counts), the neighbourhood stable step, the
+ * least-squares wall treatment. The light-node threshold compares each level's nodes with the
+ * mean at that level's spacing (mpm_grid_phase_update_many). An odd fluid.ppc puts level-0
+ * particles on the span faces that bound the finer regions, so it is refused too.
  *
  * Invariant: with m->hier NULL every call here is the plain kernel call (the refined path costs
  * one pointer test per transfer). */
@@ -143,7 +144,6 @@ static const refusal g_refused[] = {
     {"fluid.shift", NULL, "shifting reads the nodal volume fraction on level 0"},
     {"fluid.regularise_every", NULL, "merging and splitting count particles in level-0 cells"},
     {"fluid.refill_every", NULL, "refilling counts particles in level-0 cells"},
-    {"fluid.light_node_mass", NULL, "the mean nodal mass is level 0's"},
     {"fluid.wall_treatment", "least_squares",
      "the least-squares wall fits the particles in level-0 cells and books heat on level 0's "
      "nodes"},

@@ -434,6 +434,39 @@ static void test_phase_update(void **state) {
   fixture_free(&f);
 }
 
+/* The light rule on several levels: a uniform gas puts 2^-dim l of a level-0 node's mass on a
+ * level-l node, and each level compares its nodes with the mean at its own spacing, so a node
+ * at 0.8 of its level's mass stays and one at 0.2 goes (light_fraction 0.3) on every level.
+ * (One mean over the raw masses of all levels, the rule before, empties every node of level 1
+ * and finer here: their masses are at most a quarter of level 0's.) */
+static void test_light_levels(void **state) {
+  (void)state;
+  fixture f;
+  assert_int_equal(fixture_make(&f, HIER_3LEV), 0);
+  f.grid->phase[f.phase].light_fraction = 0.3; /* (the levels copy it when built) */
+  for (int l = 1; l < f.h->nlevels; ++l) f.h->level[l].grid->phase[f.phase].light_fraction = 0.3;
+  const int keep = 11, drop = 12;
+  for (int l = 0; l < f.h->nlevels; ++l) {
+    mpm_grid *g = f.h->level[l].grid;
+    mpm_grid_phase *ph = &g->phase[f.phase];
+    const double node = ldexp(1.0, -2 * l); /* a uniform gas's nodal mass at level l */
+    for (mpm_lidx i = 0; i < g->nnodes; ++i) {
+      ph->m_i[i] = i == keep ? 0.8 * node : i == drop ? 0.2 * node : node;
+      for (int d = 0; d < g->dim; ++d) ph->mv_i[d][i] = ph->m_i[i], ph->f_i[d][i] = 0.0;
+    }
+  }
+  assert_int_equal(mpm_hier_phase_update(f.h, f.phase, 0.0), 0);
+  for (int l = 0; l < f.h->nlevels; ++l) {
+    const mpm_grid *g = f.h->level[l].grid;
+    const mpm_grid_phase *ph = &g->phase[f.phase];
+    const double node = ldexp(1.0, -2 * l);
+    assert_true(fabs(ph->m_mean / node - 1.0) < 0.01); /* the two odd nodes among many */
+    assert_true(fabs(ph->m_empty - 0.3 * ph->m_mean) <= 1e-15 * node);
+    assert_true(ph->v_i[0][keep] == 1.0 && ph->v_i[0][drop] == 0.0 && ph->v_i[0][0] == 1.0);
+  }
+  fixture_free(&f);
+}
+
 /* ---- cost (printed only) ------------------------------------------------------------------ */
 
 static double now(void) {
@@ -539,7 +572,7 @@ int main(int argc, char **argv) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_conservation), cmocka_unit_test(test_p2g_is_eval),
       cmocka_unit_test(test_affine),       cmocka_unit_test(test_phase_update),
-      cmocka_unit_test(test_cost),
+      cmocka_unit_test(test_light_levels), cmocka_unit_test(test_cost),
   };
   const int rc = cmocka_run_group_tests(tests, NULL, NULL);
   MPI_Finalize();

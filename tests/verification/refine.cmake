@@ -72,8 +72,9 @@ mpm_add_script_test(test_refine_open_ranks SCRIPT verification/test_refine_open.
 # prestressed slab at rest across a level-1 band (~5 s), an acoustic pulse striking the slab
 # inside the band against the impedance solution and the uniform twins (~30 s), both again
 # under usl (~3 s, ~12 s) and refined under coupling.scheme = traction (~20 s), a restart
-# (~10 s), regrids beside the slab (~25 s), every refusal (~5 s).
-foreach(part rest pulse rest_usl pulse_usl traction restart regrid input)
+# (~10 s), regrids beside the slab (~25 s), every refusal (~5 s), the main job's scene on two
+# levels to 1 ms (~15 s).
+foreach(part rest pulse rest_usl pulse_usl traction restart regrid input bar)
   mpm_add_script_test(test_refine_fsi_${part} SCRIPT verification/test_refine_fsi.py
                       ARGS ${part} LABELS verification TIMEOUT 300)
 endforeach()

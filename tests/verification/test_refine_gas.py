@@ -565,7 +565,7 @@ def part_input():
     for key, value in [("fluid.volume_rate", "domain"), ("fluid.av_form", "riemann"),
                        ("fluid.stable_step", "neighbourhood"),
                        ("fluid.shift", "0.375"), ("fluid.regularise_every", "30"),
-                       ("fluid.refill_every", "10"), ("fluid.light_node_mass", "0.01")]:
+                       ("fluid.refill_every", "10")]:
         sec, k = key.split(".")
         if sec == "time":
             text = refined.replace("t_end = 0.1", f"t_end = 0.1\n{k} = {value}")
