@@ -62,13 +62,14 @@
  * Elsewhere period[d] = 0, and nothing changes: a hierarchy that stays clear of the periodic
  * faces computes bit for bit what it did before they were carried.
  *
- * Walls (slip and no-slip faces, given to mpm_hier_new_walled; the gas alone). The levels'
- * lattices are symmetric about a wall face: on level 0 the face is a node (node 0, or ncells[d])
- * and the middle of span 0 (or ncells[d]); on a level l >= 1 it is a knot between two nodes, so
- * node (and span) j mirrors 2^l - 1 - j at the low face and 2 N_l + 2^l - 1 - j at the high face
- * (level 0 alike: -j and 2 ncells[d] - j). The masks are looked up at the mirror for every span
- * beyond a wall, so the regions, masks and composite basis are symmetric about it and a region
- * may touch it (it then reaches past it by half a level-0 span, span 0 straddling the face):
+ * Walls (slip and no-slip faces, given to mpm_hier_new_walled; both phases fold and mirror
+ * their nodes there, and a solid's clamps add their own pads, solid/solid_constraints.c). The
+ * levels' lattices are symmetric about a wall face: on level 0 the face is a node (node 0, or
+ * ncells[d]) and the middle of span 0 (or ncells[d]); on a level l >= 1 it is a knot between two
+ * nodes, so node (and span) j mirrors 2^l - 1 - j at the low face and 2 N_l + 2^l - 1 - j at the
+ * high face (level 0 alike: -j and 2 ncells[d] - j). The masks are looked up at the mirror for
+ * every span beyond a wall, so the regions, masks and composite basis are symmetric about it and a
+ * region may touch it (it then reaches past it by half a level-0 span, span 0 straddling the face):
  * the composite basis of the constrained velocity is the even (tangential) or odd (normal)
  * extension across the wall, restricted to the domain. mpm_hier_walls_fold() then adds every
  * finer level's nodes beyond a wall into their mirrors after the restriction, as level 0's wall

@@ -586,10 +586,10 @@ int mpm_refine_regrid(mpm_hier **h, const mpm_config *cfg, mpm_grid *grid, mpm_m
   }
   int rc = 0;
   for (int k = 0; k < nmod; ++k) {
-    if (mod[k]->role == MPM_ROLE_SOLID && !rc)
-      rc = solid_module_rehier(mod[k], next);
-    else
+    if (mod[k]->role != MPM_ROLE_SOLID)
       fluid_module_rehier(mod[k], next);
+    else if (!rc)
+      rc = solid_module_rehier(mod[k], next);
   }
   mpm_hier_destroy(h);
   *h = next;

@@ -191,25 +191,28 @@ static void node_x(const mpm_grid *g, mpm_lidx l, double *x) {
  * on the wall, midway to its mirror, lies in a clamp mirrors it with every component negated
  * (a no-slip patch: zero velocity on the wall there, as a clamp holds level 0's wall node),
  * where the wall alone would mirror it slip; interior nodes are held by the rule above, the
- * wall's plane left out. */
+ * wall's plane left out. A pad node beyond two walls (a corner) is left to the walls: a clamp
+ * reaching into a corner mirrors its pads there with the walls' masks, not all components. */
 static int hold_clamped(const solid_content *sc, const mpm_grid *g, const mpm_hier *h, int l,
                         mpm_node_constraints *c) {
   const unsigned char all = (unsigned char)((1u << g->dim) - 1);
   const unsigned char(*wall)[2] = h ? (const unsigned char(*)[2])h->wall : NULL;
+  const mpm_grid *g0 = h ? h->level[0].grid : g;
   for (mpm_lidx n = 0; n < g->nnodes; ++n) {
     double x[3] = {0, 0, 0};
     node_x(g, n, x);
-    int pad = 0;
+    int pad = 0, axis = -1;
+    mpm_lidx mirror = -1;
     for (int d = 0; h && d < g->dim; ++d) {
       const mpm_lidx s = mpm_hier_wall_mirror(h, l, d, n);
-      if (s < 0) continue;
-      pad = 1;
-      double y[3] = {0, 0, 0};
-      node_x(g, s, y);
-      y[d] = 0.5 * (x[d] + y[d]);
-      if (solid_in_clamp(sc, y)) MPM_CALL(mpm_constraints_add_mirror(c, n, s, all));
+      if (s >= 0) ++pad, axis = d, mirror = s;
     }
-    if (!pad && clamps_node(sc, x, 0.5 * g->dx, g->dim, h ? h->level[0].grid : g, wall))
+    if (pad == 1) {
+      double y[3] = {x[0], x[1], x[2]}; /* the wall's point between n and its mirror, exactly */
+      y[axis] = x[axis] < g0->lo[axis] ? g0->lo[axis] : g0->hi[axis];
+      if (solid_in_clamp(sc, y)) MPM_CALL(mpm_constraints_add_mirror(c, n, mirror, all));
+    }
+    if (!pad && clamps_node(sc, x, 0.5 * g->dx, g->dim, g0, wall))
       MPM_CALL(mpm_constraints_add(c, n, all));
   }
   return 0;

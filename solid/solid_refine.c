@@ -6,8 +6,9 @@
  * L, dF/dt = L F, the APIC C) through mpm_hier_g2p; the coupler restricts, solves on every
  * level and prolongs (coupler/mpm_cycle.c). Time methods: the ERK pairs and ssprk2 (method of
  * lines) and usl. physics.damping acts on every level. The stable step takes the finest level's
- * spacing. Walls act on level 0 only: the sim keeps every box three level-0 cells from the
- * domain faces (coupler/mpm_refine.c).
+ * spacing. Slip and no-slip walls act on every level (mpm_hier.h, walls; solid_module.c folds and
+ * mirrors), clamps hold every level's nodes (solid_clamp_levels); the sim keeps every box three
+ * level-0 cells from the other non-periodic faces (coupler/mpm_refine.c).
  *
  * Seeding: the level-0 particles inside the finer regions go, and each level l >= 1 seeds each
  * body's region less the finer ones on its own lattice (mpm_hier_lattice: ppc points per axis
