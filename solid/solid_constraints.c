@@ -188,7 +188,7 @@ static void node_x(const mpm_grid *g, mpm_lidx l, double *x) {
 /* Add every node of grid g that a clamp holds to c: level 0's grid (h NULL; its nodes on a wall
  * are held with the rest, its pad nodes are the wall's), or finer level l of hierarchy h. There
  * a wall is a knot, its nearest nodes half a cell inside and beyond it: a pad node whose point
- * on the wall, midway to its mirror, lies in a clamp mirrors it with every component negated
+ * on the wall, between it and its mirror, lies in a clamp mirrors it with every component negated
  * (a no-slip patch: zero velocity on the wall there, as a clamp holds level 0's wall node),
  * where the wall alone would mirror it slip; interior nodes are held by the rule above, the
  * wall's plane left out. A pad node beyond two walls (a corner) is left to the walls: a clamp
@@ -244,10 +244,7 @@ int solid_read_constraints(mpm_module *m, const mpm_config *cfg) {
 
 int solid_clamp_levels(mpm_module *m) {
   solid_content *sc = m->content;
-  for (int l = 1; l < MPM_HIER_MAX_LEVELS; ++l) {
-    mpm_constraints_free(&sc->lcons[l]);
-    memset(&sc->lcons[l], 0, sizeof sc->lcons[l]);
-  }
+  for (int l = 1; l < MPM_HIER_MAX_LEVELS; ++l) mpm_constraints_free(&sc->lcons[l]); /* (clears) */
   for (int l = 1; m->hier && sc->nclamps > 0 && l < m->hier->nlevels; ++l)
     MPM_CALL(hold_clamped(sc, m->hier->level[l].grid, m->hier, l, &sc->lcons[l]));
   return 0;
