@@ -538,8 +538,9 @@ static int leaf_at(const mpm_hier *h, int l, const double *x) {
   const double inv_h = h->level[l].inv_h; /* (hier_xi's value, without its division) */
   mpm_lidx k = 0;
   for (int d = h->dim - 1; d >= 0; --d) {
-    const double t = (x[d] - g->lo[d]) * inv_h - 0.5, f = floor(t), frac = t - f;
-    /* (false for NaN too) */
+    const double t = (x[d] - g->lo[d]) * inv_h - 0.5;
+    if (!(t > -1e9 && t < 1e9)) return -1; /* (NaN too) beyond every box: the walk decides */
+    const double f = mpm_shape_floor(t), frac = t - f; /* (floor, inline) */
     if (!(frac > LEAF_MARGIN && frac < 1.0 - LEAF_MARGIN && f + 1.0 >= g->box_lo[d] &&
           f + 1.0 < g->box_lo[d] + g->box_n[d]))
       return -1;

@@ -148,7 +148,7 @@ typedef struct mpm_hier {
    * next level decide), or MPM_HIER_WALK beside a wall (the walk decides there). Lookups in place
    * of the walk: a hot path (every particle, every step). */
   unsigned char *leaf[MPM_HIER_MAX_LEVELS];
-  void *scratch; /* private to mpm_hier.c: per-level particle lists and gathered arrays */
+  void *scratch; /* private to mpm_hier_transfer.c: levels, their grouping, levels vouched for */
   void *census;  /* private to mpm_hier_census.c: the points mpm_hier_levels saw last */
 } mpm_hier;
 
@@ -229,7 +229,8 @@ void mpm_hier_levels_vouched(const mpm_hier *h, const double **x0, mpm_lidx *n,
 
 /* Composite P2G of one phase: each particle deposits (a's fields, with the unchanged kernel) on
  * the level mpm_hier_level_of gives for its position; adds, as the kernel does. Follow it with
- * mpm_hier_restrict before the solve. */
+ * mpm_hier_restrict before the solve. a's index list and wrap (mpm_kernels.h) stay unset: the
+ * hierarchy sets them per level (likewise for G2P). */
 int mpm_hier_p2g(mpm_hier *h, int phase, const mpm_p2g_args *a);
 
 /* Per-level nodal scalars for a composite G2P: s_i[l][j] is scalar j on level l (level 0's

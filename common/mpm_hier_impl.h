@@ -54,22 +54,13 @@ static inline int hier_mirror(const mpm_hier *h, int l, int d, int i) {
   return i;
 }
 
-/* x wrapped into [lo, hi) when it lies at most a period outside, as mpm_grid_wrap does (inline:
- * a hot path). */
-static inline double hier_wrap_coord(double x, double lo, double hi) {
-  const double len = hi - lo;
-  if (x >= hi && x < hi + len) return x - len;
-  if (x < lo && x >= lo - len) return x + len < hi ? x + len : lo;
-  return x;
-}
-
 /* x into out, wrapped into the domain along the periodic axes when the hierarchy wraps (a
  * level stores a whole period); a plain copy otherwise. */
 static inline void hier_wrap_point(const mpm_hier *h, const double *x, double *out) {
   const mpm_grid *g = h->level[0].grid;
   for (int d = 0; d < MPM_MAX_DIM; ++d) out[d] = d < h->dim ? x[d] : 0.0;
   for (int d = 0; h->wraps && d < h->dim; ++d)
-    if (g->periodic[d]) out[d] = hier_wrap_coord(out[d], g->lo[d], g->hi[d]);
+    if (g->periodic[d]) out[d] = mpm_wrap_coord(out[d], g->lo[d], g->hi[d]);
 }
 
 /* Does box node gi (global indices of g, first dim entries) lie in g's box? */

@@ -22,10 +22,25 @@
  * With s (a scalar per unit mass; needs m, and no stress) it deposits S m s into mv_i[0] beside
  * S m into m_i: the full deposit's sums for v = (s, 0, ...) in those two arrays, operation for
  * operation, and nothing into mv_i[1..] or f_i (a two-scalar deposit, such as the grid
- * pressure's V and V p). */
+ * pressure's V and V p).
+ *
+ * A subset of the particles (the refinement hierarchy's levels): with idx set a kernel visits
+ * the nidx particles idx[0 .. nidx) (distinct, each below n) of arrays that hold n entries per
+ * component, in that order, and reads and writes those indices alone; NULL: every particle.
+ * Each visited particle's arithmetic is that of a call on its own, so a subset's outputs and
+ * sums are those of the same particles copied out and run without a list.
+ * Wrapped positions (a level that stores a whole period of a periodic axis): along an axis
+ * with wrap_hi[d] > wrap_lo[d] a kernel takes each position wrapped into [wrap_lo, wrap_hi)
+ * (mpm_wrap_coord) for its weights; zero (the initialiser's): as given.
+ *
+ * G2P writes v_out[d] and a_out[d] for every d < dim whenever v_out[0] is set, s_out[j] for
+ * every j < nscalar, and each of div_out, L_out, C_out and LF_out that is set. */
 typedef struct mpm_p2g_args {
   mpm_lidx n;
-  const double *x[MPM_MAX_DIM]; /* positions */
+  const mpm_lidx *idx; /* the subset visited, or NULL (above) */
+  mpm_lidx nidx;
+  double wrap_lo[MPM_MAX_DIM], wrap_hi[MPM_MAX_DIM]; /* (above) */
+  const double *x[MPM_MAX_DIM];                      /* positions */
   const double *v[MPM_MAX_DIM]; /* velocities, or v[0] NULL: the lean deposit */
   const double *m;              /* masses */
   const double *viso;           /* the lean deposit's isotropic V sigma, or NULL */
@@ -48,6 +63,9 @@ typedef struct mpm_p2g_args {
  * are the full gather's, operation for operation. */
 typedef struct mpm_g2p_args {
   mpm_lidx n;
+  const mpm_lidx *idx; /* the subset visited, or NULL (as for P2G) */
+  mpm_lidx nidx;
+  double wrap_lo[MPM_MAX_DIM], wrap_hi[MPM_MAX_DIM]; /* wrapped positions (as for P2G) */
   const double *x[MPM_MAX_DIM];
   const double *v_i[MPM_MAX_DIM]; /* nodal velocity to interpolate (and differentiate) */
   const double *a_i[MPM_MAX_DIM]; /* nodal acceleration to interpolate */
@@ -71,6 +89,15 @@ typedef struct mpm_g2p_args {
   const double *s_i[MPM_KERNELS_MAX_SCALARS];
   double *s_out[MPM_KERNELS_MAX_SCALARS];
 } mpm_g2p_args;
+
+/* x wrapped into [lo, hi) when it lies at most a period outside, as mpm_grid_wrap does (inline:
+ * a hot path). */
+static inline double mpm_wrap_coord(double x, double lo, double hi) {
+  const double len = hi - lo;
+  if (x >= hi && x < hi + len) return x - len;
+  if (x < lo && x >= lo - len) return x + len < hi ? x + len : lo;
+  return x;
+}
 
 typedef struct mpm_kernels {
   int dim;

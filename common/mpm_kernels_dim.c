@@ -32,12 +32,18 @@
 typedef struct {
   double lo[MPM_DIM], dx, inv_dx, lp;
   int box_lo[MPM_DIM];
-  mpm_lidx sy, sz; /* index strides of y and z in the box */
+  mpm_lidx sy, sz;   /* index strides of y and z in the box */
+  int wrap[MPM_DIM]; /* positions wrapped along d (mpm_kernels.h) */
+  double wrap_lo[MPM_DIM], wrap_hi[MPM_DIM];
 } DIMFN(lattice);
 
-static DIMFN(lattice) DIMFN(lattice_of)(const mpm_grid *g, double lp) {
+static DIMFN(lattice)
+    DIMFN(lattice_of)(const mpm_grid *g, double lp, const double *wrap_lo, const double *wrap_hi) {
   DIMFN(lattice) L = {.dx = g->dx, .inv_dx = 1.0 / g->dx, .lp = lp};
-  for (int d = 0; d < MPM_DIM; ++d) L.lo[d] = g->lo[d], L.box_lo[d] = g->box_lo[d];
+  for (int d = 0; d < MPM_DIM; ++d) {
+    L.lo[d] = g->lo[d], L.box_lo[d] = g->box_lo[d];
+    L.wrap[d] = wrap_hi[d] > wrap_lo[d], L.wrap_lo[d] = wrap_lo[d], L.wrap_hi[d] = wrap_hi[d];
+  }
   L.sy = g->box_n[0];
   L.sz = (mpm_lidx)g->box_n[0] * g->box_n[1];
   return L;
@@ -55,7 +61,8 @@ MPM_INLINE void DIMFN(weights_eval)(const DIMFN(lattice) * L, mpm_shape_kind kin
                                     int with_r, DIMFN(weights) * s) {
   int gi[MPM_DIM];
   for (int d = 0; d < MPM_DIM; ++d) {
-    const double xi = (x[d] - L->lo[d]) * L->inv_dx;
+    const double xd = L->wrap[d] ? mpm_wrap_coord(x[d], L->wrap_lo[d], L->wrap_hi[d]) : x[d];
+    const double xi = (xd - L->lo[d]) * L->inv_dx;
     gi[d] = mpm_shape_1d(kind, xi, L->lp, s->w[d], s->dw[d]);
     for (int k = 0; k < SUPPORT(kind); ++k) {
       s->dw[d][k] *= L->inv_dx;
@@ -87,7 +94,10 @@ MPM_INLINE void DIMFN(p2g_loop)(const DIMFN(lattice) * L, mpm_grid_phase *ph, co
     xp[d] = a->x[d], vp[d] = a->v[d], fext[d] = a->fext[0] ? a->fext[d] : NULL;
     grav[d] = a->gravity[d];
   }
-  for (size_t p = 0; p < n; ++p) {
+  const mpm_lidx *restrict idx = a->idx;
+  const size_t count = idx ? (size_t)a->nidx : n;
+  for (size_t it = 0; it < count; ++it) {
+    const size_t p = idx ? (size_t)idx[it] : it;
     double x[D], mv[D], b[D], sig[D][D], mC[D][D];
     const double m = mp[p];
     for (int d = 0; d < D; ++d) {
@@ -192,7 +202,10 @@ MPM_INLINE void DIMFN(p2g_lean_loop)(const DIMFN(lattice) * L, mpm_grid_phase *p
   const double *restrict xp[D], *restrict mp = a->m, *restrict viso = a->viso;
   const double *restrict vsig = a->vsig, *restrict sp = a->s;
   for (int d = 0; d < D; ++d) fi[d] = ph->f_i[d], xp[d] = a->x[d];
-  for (size_t p = 0; p < n; ++p) {
+  const mpm_lidx *restrict idx = a->idx;
+  const size_t count = idx ? (size_t)a->nidx : n;
+  for (size_t it = 0; it < count; ++it) {
+    const size_t p = idx ? (size_t)idx[it] : it;
     double x[D], sig[D][D];
     for (int d = 0; d < D; ++d) x[d] = xp[d][p];
     const double m = mass ? mp[p] : 0.0, q = stress == 1 ? viso[p] : 0.0;
@@ -287,7 +300,7 @@ MPM_INLINE void DIMFN(p2g_lean)(const DIMFN(lattice) * L, mpm_grid_phase *ph, co
 
 static void DIMFN(p2g)(mpm_grid *g, int phase, const mpm_p2g_args *a) {
   mpm_grid_phase *ph = &g->phase[phase];
-  const DIMFN(lattice) L = DIMFN(lattice_of)(g, a->lp);
+  const DIMFN(lattice) L = DIMFN(lattice_of)(g, a->lp, a->wrap_lo, a->wrap_hi);
   if (!a->v[0]) {
     assert(!(a->vsig && a->viso) && !a->C && !a->fext[0] && !(a->m && ph->normals));
     assert(!a->s || (a->m && !a->vsig && !a->viso));
@@ -355,7 +368,10 @@ MPM_INLINE void DIMFN(g2p_loop)(const DIMFN(lattice) * L, const mpm_g2p_args *a,
     xp[d] = a->x[d], vi[d] = a->v_i[d], ai[d] = a->a_i[d];
     vout[d] = a->v_out[d], aout[d] = a->a_out[d];
   }
-  for (size_t p = 0; p < n; ++p) {
+  const mpm_lidx *restrict idx = a->idx;
+  const size_t count = idx ? (size_t)a->nidx : n;
+  for (size_t it = 0; it < count; ++it) {
+    const size_t p = idx ? (size_t)idx[it] : it;
     double x[D], v[D] = {0}, acc[D] = {0}, Lg[D][D] = {{0}}, B[D][D] = {{0}};
     double sc[MPM_KERNELS_MAX_SCALARS] = {0};
     for (int d = 0; d < D; ++d) x[d] = xp[d][p];
@@ -463,7 +479,7 @@ MPM_INLINE void DIMFN(g2p_scalar)(const DIMFN(lattice) * L, const mpm_g2p_args *
 }
 
 static void DIMFN(g2p)(const mpm_grid *g, const mpm_g2p_args *a) {
-  const DIMFN(lattice) L = DIMFN(lattice_of)(g, a->lp);
+  const DIMFN(lattice) L = DIMFN(lattice_of)(g, a->lp, a->wrap_lo, a->wrap_hi);
   if (!a->v_out[0]) {
     assert(!a->a_out[0] && !a->L_out && !a->C_out && !a->LF_out);
     switch (g->shape) {

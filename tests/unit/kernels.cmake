@@ -9,3 +9,7 @@ mpm_add_test(test_kernels_scalars SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/unit/test_
 # against the full kernels, bitwise, every shape, 2-D and 3-D.
 mpm_add_test(test_kernels_scalar_paths
              SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/unit/test_kernels_scalar_paths.c LABELS unit RANKS 1)
+# The kernels' index list and wrap (the hierarchy's per-level transfers) against the kernels on
+# the same particles copied out or wrapped beforehand, bitwise, every shape, 2-D and 3-D.
+mpm_add_test(test_kernels_subset SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/unit/test_kernels_subset.c
+             LABELS unit RANKS 1)
