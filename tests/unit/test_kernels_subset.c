@@ -25,22 +25,16 @@
 
 #include "mpm_grid.h"
 #include "mpm_kernels.h"
+#include "mpm_random.h"
 
 #define NP 1200
 #define NS 500 /* the subset */
 
 static const double g_lo[3] = {-1.0, 0.0, 0.5}, g_hi[3] = {1.2, 2.0, 2.6}, g_dx = 0.1;
 
-static double uniform(uint64_t *state) { /* splitmix64 */
-  uint64_t z = (*state += 0x9e3779b97f4a7c15ull);
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-  return (double)((z ^ (z >> 31)) >> 11) * 0x1.0p-53;
-}
-
 static double *random_array(size_t n, double lo, double hi, uint64_t *seed) {
   double *a = malloc(sizeof(double) * n);
-  for (size_t k = 0; k < n; ++k) a[k] = lo + (hi - lo) * uniform(seed);
+  for (size_t k = 0; k < n; ++k) a[k] = lo + (hi - lo) * mpm_test_uniform(seed);
   return a;
 }
 
@@ -73,10 +67,10 @@ static void scene_make(scene *s, int dim, uint64_t seed) {
   s->C = random_array((size_t)(dim * dim) * NP, -1.0, 1.0, &seed);
   s->F = random_array((size_t)(dim * dim) * NP, 0.5, 1.5, &seed);
   /* A shuffled subset: every other particle from a random start, then a Fisher-Yates shuffle. */
-  const int start = (int)(uniform(&seed) * 100.0);
+  const int start = (int)(mpm_test_uniform(&seed) * 100.0);
   for (int k = 0; k < NS; ++k) s->idx[k] = start + 2 * k;
   for (int k = NS - 1; k > 0; --k) {
-    const int j = (int)(uniform(&seed) * (k + 1));
+    const int j = (int)(mpm_test_uniform(&seed) * (k + 1));
     const mpm_lidx t = s->idx[k];
     s->idx[k] = s->idx[j], s->idx[j] = t;
   }
@@ -115,13 +109,24 @@ static long phases_differ(const mpm_grid *g, long *reached) {
   return diff;
 }
 
+/* a deposited into phase 0 and b into phase 1 of g, both zeroed first: the nodes that differ
+ * (phases_differ). */
+static long deposit_pair(mpm_grid *g, const mpm_p2g_args *a, const mpm_p2g_args *b, long *reached) {
+  mpm_grid_phase_zero(g, 0);
+  mpm_grid_phase_zero(g, 1);
+  mpm_kernels_get(g->dim)->p2g(g, 0, a);
+  mpm_kernels_get(g->dim)->p2g(g, 1, b);
+  return phases_differ(g, reached);
+}
+
 /* Random nodal velocity, acceleration and one scalar on phase 0. */
 static void nodal_fields(mpm_grid *g, uint64_t seed) {
   mpm_grid_phase *ph = &g->phase[0];
   for (mpm_lidx k = 0; k < g->nnodes; ++k) {
     for (int d = 0; d < g->dim; ++d)
-      ph->v_i[d][k] = -1.0 + 2.0 * uniform(&seed), ph->a_i[d][k] = -3.0 + 6.0 * uniform(&seed);
-    ph->m_i[k] = uniform(&seed); /* (the scalar) */
+      ph->v_i[d][k] = -1.0 + 2.0 * mpm_test_uniform(&seed),
+      ph->a_i[d][k] = -3.0 + 6.0 * mpm_test_uniform(&seed);
+    ph->m_i[k] = mpm_test_uniform(&seed); /* (the scalar) */
   }
 }
 
@@ -175,12 +180,8 @@ static void check_subset(int dim, mpm_shape_kind shape, int apic) {
     copy.x[d] = xs[d], copy.v[d] = vs[d], copy.fext[d] = fs[d];
     sub.gravity[d] = copy.gravity[d] = -0.5 * (d + 1);
   }
-  mpm_grid_phase_zero(g, 0);
-  mpm_grid_phase_zero(g, 1);
-  mpm_kernels_get(dim)->p2g(g, 0, &sub);
-  mpm_kernels_get(dim)->p2g(g, 1, &copy);
   long reached;
-  const long dp = phases_differ(g, &reached);
+  const long dp = deposit_pair(g, &sub, &copy, &reached);
 
   nodal_fields(g, 3u + (uint64_t)shape);
   const size_t nc = (size_t)g2p_comps(dim);
@@ -226,7 +227,7 @@ static void check_wrap(int dim, mpm_shape_kind shape) {
     const double len = whi[d] - wlo[d];
     xw[d] = malloc(sizeof(double) * NP), xpre[d] = malloc(sizeof(double) * NP);
     for (size_t p = 0; p < NP; ++p) {
-      const double u = uniform(&seed), x = s.x[d][p];
+      const double u = mpm_test_uniform(&seed), x = s.x[d][p];
       const double y = u < 1.0 / 3.0 ? x + len : u > 2.0 / 3.0 ? x - len : x;
       moved += y != x;
       xw[d][p] = y, xpre[d][p] = mpm_wrap_coord(y, wlo[d], whi[d]);
@@ -239,12 +240,8 @@ static void check_wrap(int dim, mpm_shape_kind shape) {
     a.x[d] = xw[d], b.x[d] = xpre[d], a.v[d] = b.v[d] = s.v[d];
     a.wrap_lo[d] = wlo[d], a.wrap_hi[d] = whi[d];
   }
-  mpm_grid_phase_zero(g, 0);
-  mpm_grid_phase_zero(g, 1);
-  mpm_kernels_get(dim)->p2g(g, 0, &a);
-  mpm_kernels_get(dim)->p2g(g, 1, &b);
   long reached;
-  const long dp = phases_differ(g, &reached);
+  const long dp = deposit_pair(g, &a, &b, &reached);
   nodal_fields(g, 5u + (uint64_t)shape);
   const size_t nc = (size_t)g2p_comps(dim);
   double *oa = calloc(nc * NP, sizeof(double)), *ob = calloc(nc * NP, sizeof(double));
