@@ -123,8 +123,8 @@ def page(rows, commit, command, dx, dt):
     now = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
     lines = ["# Cost of the 3-D sphere at Mach 0.8 on the hierarchy against uniform grids", "",
              f"Made by `{command}` at commit {commit}, {now}, on a shared 2-core machine (the "
-             "runs one after another; other jobs ran beside them, so the wall times carry the "
-             "machine's load: compare the user CPU column first). One rank, "
+             "runs one after another; other jobs may run beside them, and then the wall times "
+             "carry the machine's load: compare the user CPU column first). One rank, "
              f"`cases/sphere_m08.ini` with level 0 at dx = {dx:g}, every run at the fixed step "
              f"{dt:g} from the case's start, no snapshots. Wall: the stepping loop "
              "(summary.json), per particle-step: over the sum over steps of the particle count. "
