@@ -159,7 +159,7 @@ static void check_subset(int dim, mpm_shape_kind shape, int apic) {
   scene_make(&s, dim, 11u + (uint64_t)(100 * dim + 10 * shape + apic));
   const int DD = dim * dim;
   double *xs[3] = {NULL}, *vs[3] = {NULL}, *fs[3] = {NULL};
-  for (int d = 0; d < dim; ++d) {
+  for (int d = 0; d < dim && d < 3; ++d) {
     xs[d] = pick(s.x[d], 1, s.idx, NS, NP), vs[d] = pick(s.v[d], 1, s.idx, NS, NP);
     fs[d] = pick(s.fext[d], 1, s.idx, NS, NP);
   }
@@ -175,7 +175,7 @@ static void check_subset(int dim, mpm_shape_kind shape, int apic) {
                       .C = apic ? s.C : NULL,
                       .lp = 0.25};
   mpm_p2g_args copy = {.n = NS, .m = ms, .vsig = sigs, .C = apic ? Cs : NULL, .lp = 0.25};
-  for (int d = 0; d < dim; ++d) {
+  for (int d = 0; d < dim && d < 3; ++d) {
     sub.x[d] = s.x[d], sub.v[d] = s.v[d], sub.fext[d] = s.fext[d];
     copy.x[d] = xs[d], copy.v[d] = vs[d], copy.fext[d] = fs[d];
     sub.gravity[d] = copy.gravity[d] = -0.5 * (d + 1);
@@ -206,7 +206,7 @@ static void check_subset(int dim, mpm_shape_kind shape, int apic) {
          dim, mpm_shape_name(shape), apic ? "on " : "off", reached, dp, dg, touched);
   assert_true(reached > 100);
   assert_int_equal(dp + dg + touched, 0);
-  for (int d = 0; d < dim; ++d) free(xs[d]), free(vs[d]), free(fs[d]);
+  for (int d = 0; d < dim && d < 3; ++d) free(xs[d]), free(vs[d]), free(fs[d]);
   free(ms), free(sigs), free(Cs), free(Fs), free(out), free(outs), free(in);
   mpm_grid_destroy(&g);
   scene_free(&s);
@@ -222,7 +222,7 @@ static void check_wrap(int dim, mpm_shape_kind shape) {
   double wlo[3] = {0}, whi[3] = {0}, *xw[3] = {NULL}, *xpre[3] = {NULL};
   uint64_t seed = 41u + (uint64_t)shape;
   long moved = 0;
-  for (int d = 0; d < dim; ++d) {
+  for (int d = 0; d < dim && d < 3; ++d) {
     wlo[d] = g_lo[d] + 0.1, whi[d] = g_hi[d] - 0.1;
     const double len = whi[d] - wlo[d];
     xw[d] = malloc(sizeof(double) * NP), xpre[d] = malloc(sizeof(double) * NP);
@@ -236,7 +236,7 @@ static void check_wrap(int dim, mpm_shape_kind shape) {
   mpm_grid *g = grid_make(dim, shape, 2);
   mpm_p2g_args a = {.n = NP, .m = s.m, .vsig = s.vsig, .C = s.C, .lp = 0.25};
   mpm_p2g_args b = a;
-  for (int d = 0; d < dim; ++d) {
+  for (int d = 0; d < dim && d < 3; ++d) {
     a.x[d] = xw[d], b.x[d] = xpre[d], a.v[d] = b.v[d] = s.v[d];
     a.wrap_lo[d] = wlo[d], a.wrap_hi[d] = whi[d];
   }
@@ -246,7 +246,7 @@ static void check_wrap(int dim, mpm_shape_kind shape) {
   const size_t nc = (size_t)g2p_comps(dim);
   double *oa = calloc(nc * NP, sizeof(double)), *ob = calloc(nc * NP, sizeof(double));
   mpm_g2p_args ga = g2p_args(g, xw, s.F, oa, NP), gb = g2p_args(g, xpre, s.F, ob, NP);
-  for (int d = 0; d < dim; ++d) ga.wrap_lo[d] = wlo[d], ga.wrap_hi[d] = whi[d];
+  for (int d = 0; d < dim && d < 3; ++d) ga.wrap_lo[d] = wlo[d], ga.wrap_hi[d] = whi[d];
   mpm_kernels_get(dim)->g2p(g, &ga);
   mpm_kernels_get(dim)->g2p(g, &gb);
   const long dg = differ(oa, ob, nc * NP);
@@ -255,7 +255,7 @@ static void check_wrap(int dim, mpm_shape_kind shape) {
          dim, mpm_shape_name(shape), moved, reached, dp, dg);
   assert_true(moved > NP && reached > 100); /* (dim axes of NP coordinates) */
   assert_int_equal(dp + dg, 0);
-  for (int d = 0; d < dim; ++d) free(xw[d]), free(xpre[d]);
+  for (int d = 0; d < dim && d < 3; ++d) free(xw[d]), free(xpre[d]);
   free(oa), free(ob);
   mpm_grid_destroy(&g);
   scene_free(&s);
