@@ -56,7 +56,7 @@ typedef struct mpm_p2g_args {
   double lp;                   /* GIMP particle half-width in cells */
 } mpm_p2g_args;
 
-#define MPM_KERNELS_MAX_SCALARS 4
+#define MPM_KERNELS_MAX_SCALARS 8
 
 /* A scalar gather: with v_out[0] NULL the kernel computes only the scalars below and div_out,
  * reading only the arrays they need; a_out, L_out, C_out and LF_out must then be NULL. Its sums

@@ -51,6 +51,30 @@
  * its first pass (fluid_module.c, fluid_remap) and moves the volume with the same rate; only the
  * positions follow its remapped velocity.
  *
+ * The relaxation (fluid.pressure_relax = beta > 0; the grid pressure only). All particles at a
+ * node share its volume rate in proportion to their volumes, so nothing pulls a particle whose
+ * pressure differs from its neighbours' back to theirs: a particle's p enters the force only
+ * through the mean p_j, and the drift of volumes between particles (their paths through
+ * different nodes) accumulates. On the 3-D sphere at Mach 0.8 (cases/sphere_m08.ini, one
+ * flow-through) particles reached 21 times the free stream's density at J = 0.03 while the
+ * nodal density stayed near the free stream's. The relaxation exchanges volume between the
+ * particles sharing a node, towards its pressure:
+ *   dV_p/dt += V_p sum_j N_j(x_p) kappa_j (p_p - p_j),
+ *   m_p de_p/dt += -V_p sum_j N_j(x_p) kappa_j p_j (p_p - p_j),
+ * kappa_j = 1 / (beta dx_l Z_j), Z_j = sqrt(gamma p_j rho_j) the node's acoustic impedance
+ * (rho_j its gas mass over V_j: beside a wall, where the mirrored pad nodes fold their mass into
+ * the nodes inside, up to twice the gas's, so the relaxation is up to sqrt 2 slower there), dx_l
+ * its level's spacing: a pressure difference decays as exp(-c t / (beta dx_l)), over beta
+ * times a cell's sound-crossing time. Both sums vanish at every node, since p_j V_j = sum_p N_j
+ * V_p p_p: the gas's volume and its internal energy are unchanged, each node's exchange being
+ * valued at its own pressure (so mass, momentum and total energy stay as exact as without it).
+ * Per particle m de + p dV = V sum_j N_j kappa_j (p_p - p_j)^2 >= 0: entropy never falls (the
+ * exchange is the irreversible equilibration of pressure inside a node, as a multi-material
+ * cell's). The particles gather kappa, kappa p and kappa p^2 (relax_fields), from the deposit's
+ * own V_j and V_j p_j, which nothing overwrites: the open faces', a solid's or an obstacle's
+ * pressure does not enter. Under a contact discontinuity the pressures agree and nothing
+ * moves; at a shock it adds dissipation (Sod's L1 at 200 cells: docs/gas.md).
+ *
  * Obstacles. The massless nodes inside a body are its ghosts: each node with mass takes its own
  * pressure times the integral of their prolonged mask against grad N_i, and the adjoint rate
  * (ghost_forces here, fluid_obstacle_levels.c).
@@ -157,6 +181,11 @@ struct fluid_gridp {
    * its integral is not the uniform grid's W_j, and a full node would read as partly empty. */
   double fill, *W;
   int refined;
+  /* fluid.pressure_relax = beta (0: off): the nodal fields kappa, kappa p and kappa p^2 of the
+   * relaxation on every level (R), and at the particles (r[1..3]; r[0] is s). */
+  double relax, gamma;
+  double *R[MPM_HIER_MAX_LEVELS][3];
+  double *r[4];
 };
 
 static int refuse(const mpm_config *cfg, const char *key, const char *why, int hybrid) {
@@ -283,6 +312,14 @@ static int enable(mpm_module *m, const mpm_config *cfg, int hybrid) {
   memset(fc->gridp, 0, sizeof *fc->gridp);
   fc->gridp->hybrid = hybrid;
   MPM_CALL(mpm_config_get_real(cfg, "fluid.hybrid_fill", &fc->gridp->fill));
+  MPM_CALL(mpm_config_get_real(cfg, "fluid.pressure_relax", &fc->gridp->relax));
+  fc->gridp->gamma = fc->gas.gamma;
+  if (hybrid && fc->gridp->relax > 0.0 && mpm_config_has(cfg, "fluid.pressure_relax"))
+    return mpm_config_fail(cfg, "fluid.pressure_relax",
+                           "relaxes the grid pressure's particles; the hybrid keeps the "
+                           "particles' own pressure in their force: remove the key or use "
+                           "fluid.pressure = grid");
+  if (hybrid) fc->gridp->relax = 0.0; /* the default is the grid pressure's */
   int levels = 1;
   if (mpm_config_has(cfg, "refine.levels"))
     MPM_CALL(mpm_config_get_int(cfg, "refine.levels", &levels));
@@ -416,6 +453,7 @@ void fluid_gridp_reset(fluid_content *fc) {
     gp->P[l] = gp->D[l] = gp->M[l] = NULL, gp->skip[l] = NULL;
     for (int d = 0; d < MPM_MAX_DIM; ++d) free(gp->F[l][d]), gp->F[l][d] = NULL;
     for (int d = 0; d < MPM_MAX_DIM; ++d) free(gp->G[l][d]), gp->G[l][d] = NULL;
+    for (int j = 0; j < 3; ++j) free(gp->R[l][j]), gp->R[l][j] = NULL;
   }
   free(gp->W), gp->W = NULL;
   fluid_gridp_solid_free(&gp->sol); /* its level scalars are sized by the hierarchy's levels */
@@ -427,6 +465,7 @@ void fluid_gridp_destroy(fluid_content *fc) {
   if (!gp) return;
   fluid_gridp_reset(fc);
   free(gp->mp), free(gp->s), free(gp->V), free(gp->load), free(gp->sig);
+  for (int j = 1; j < 4; ++j) free(gp->r[j]);
   free(gp);
   fc->gridp = NULL;
 }
@@ -488,6 +527,7 @@ static int ensure_levels(mpm_module *m, fluid_gridp *gp) {
     for (int d = 0; d < g->dim; ++d) MPM_ALLOC(gp->F[l][d], nn);
     for (int d = 0; ((fluid_content *)m->content)->obs.count && d < g->dim; ++d)
       MPM_ALLOC(gp->G[l][d], nn);
+    for (int j = 0; gp->relax > 0.0 && j < 3; ++j) MPM_ALLOC(gp->R[l][j], nn);
     if (l == 0) {
       if (h) {
         MPM_ALLOC(gp->skip[0], nn);
@@ -517,8 +557,10 @@ static int ensure_particles(fluid_gridp *gp, mpm_lidx cap, int dim) {
   if (gp->cap >= cap && gp->mp) return 0;
   free(gp->mp), free(gp->s), free(gp->V), free(gp->load), free(gp->sig);
   gp->mp = gp->s = gp->V = gp->load = gp->sig = NULL;
+  for (int j = 1; j < 4; ++j) free(gp->r[j]), gp->r[j] = NULL;
   MPM_ALLOC(gp->mp, (size_t)cap);
   MPM_ALLOC(gp->s, (size_t)cap);
+  for (int j = 1; gp->relax > 0.0 && j < 4; ++j) MPM_ALLOC(gp->r[j], (size_t)cap);
   MPM_ALLOC(gp->V, (size_t)cap);
   if (gp->hybrid) MPM_ALLOC(gp->load, (size_t)cap);
   if (gp->hybrid) MPM_ALLOC(gp->sig, (size_t)dim * dim * cap);
@@ -703,6 +745,32 @@ int fluid_gridp_forces(mpm_module *m) {
   return ghost_forces(m, gp);
 }
 
+/* The relaxation's nodal fields kappa_j, kappa_j p_j and kappa_j p_j^2 (see the header) on the
+ * active nodes with gas, from the deposit's own V_j and V_j p_j (not the pressure the open faces,
+ * a solid's continuation or the obstacles set: the identities rest on the deposit's), prolonged,
+ * as scalars 1 to 3 of s. */
+static int relax_fields(mpm_module *m, fluid_gridp *gp, mpm_hier_scalars *s) {
+  for (int l = 0; l < gp->nlev; ++l) {
+    const mpm_grid *g = level_grid(m, l);
+    const double *Vp = g->phase[gp->phase].mv_i[0], *mass = g->phase[m->phase].m_i;
+    const double *V = gp->M[l];
+    const unsigned char *act = m->hier ? m->hier->level[l].active : NULL;
+    double *k0 = gp->R[l][0], *k1 = gp->R[l][1], *k2 = gp->R[l][2];
+    for (mpm_lidx k = 0; k < g->nnodes; ++k) {
+      k0[k] = k1[k] = k2[k] = 0.0;
+      if ((act && !act[k]) || !(V[k] > 0.0) || !(mass[k] > 0.0) || !(Vp[k] > 0.0)) continue;
+      const double p = Vp[k] / V[k], Z = sqrt(gp->gamma * p * mass[k] / V[k]);
+      k0[k] = 1.0 / (gp->relax * g->dx * Z), k1[k] = k0[k] * p, k2[k] = k1[k] * p;
+    }
+  }
+  for (int j = 0; j < 3; ++j) {
+    double *a[MPM_HIER_MAX_LEVELS];
+    for (int l = 0; l < gp->nlev; ++l) a[l] = gp->R[l][j], s->s_i[l][1 + j] = gp->R[l][j];
+    MPM_CALL(fluid_gridp_prolong(m, a));
+  }
+  return 0;
+}
+
 int fluid_gridp_nodal_rate(mpm_module *m, const mpm_hier_nodal *vel, mpm_hier_scalars *s) {
   fluid_content *fc = m->content;
   fluid_gridp *gp = fc->gridp;
@@ -728,6 +796,7 @@ int fluid_gridp_nodal_rate(mpm_module *m, const mpm_hier_nodal *vel, mpm_hier_sc
   MPM_CALL(fluid_gridp_prolong(m, gp->P));
   memset(s, 0, sizeof *s);
   for (int l = 0; l < gp->nlev; ++l) s->s_i[l][0] = gp->P[l];
+  if (gp->relax > 0.0) MPM_CALL(relax_fields(m, gp, s));
   return 0;
 }
 
@@ -740,11 +809,21 @@ void fluid_gridp_work(const mpm_module *m, const double *y, const double *L, dou
   const double *V0 = mpm_particles_comp(p, fc->lay.f_V0, 0);
   const double *J = y + (size_t)p->offset[FLUID_J] * n;
   for (mpm_lidx i = 0; i < n; ++i) power[i] -= gp->mp[i] * V0[i] * J[i] / mass[i] * gp->s[i];
+  if (gp->relax > 0.0) { /* the relaxation: its volume rate, and its work at the nodes' p */
+    const double *a = gp->r[1], *b = gp->r[2], *c = gp->r[3];
+    for (mpm_lidx i = 0; i < n; ++i) {
+      power[i] -= V0[i] * J[i] / mass[i] * (gp->mp[i] * b[i] - c[i]);
+      gp->s[i] += gp->mp[i] * a[i] - b[i];
+    }
+  }
   if (!gp->hybrid) return;
   for (int d = 0; d < p->dim; ++d) /* the point rate, whose work energy_rate has booked */
     for (mpm_lidx i = 0; i < n; ++i) gp->s[i] += L[(size_t)(d * p->dim + d) * n + i];
 }
 
-double *fluid_gridp_rate_out(const fluid_content *fc) {
-  return fc->gridp->s;
+double *const *fluid_gridp_rate_out(const fluid_content *fc, int *ns) {
+  fluid_gridp *gp = fc->gridp;
+  gp->r[0] = gp->s;
+  if (ns) *ns = gp->relax > 0.0 ? 4 : 1;
+  return gp->r;
 }

@@ -143,7 +143,9 @@ int fluid_gridp_deposit(mpm_module *m, const double *y, const fluid_batch *b);
 const double *fluid_gridp_stress(const mpm_module *m, const double *vsig);
 int fluid_gridp_forces(mpm_module *m);
 int fluid_gridp_nodal_rate(mpm_module *m, const mpm_hier_nodal *v, mpm_hier_scalars *s);
-double *fluid_gridp_rate_out(const fluid_content *fc);
+/* The particles' arrays the G2P fills with the nodal scalars of nodal_rate, and their count
+ * (1, or 4 with fluid.pressure_relax). */
+double *const *fluid_gridp_rate_out(const fluid_content *fc, int *ns);
 void fluid_gridp_work(const mpm_module *m, const double *y, const double *L, double *power);
 
 /* The grid pressure beside a solid (fluid_gridp_solid.c): the solid's region, its points
@@ -233,11 +235,11 @@ int fluid_seed_refined(mpm_module *m, const mpm_config *cfg);
 
 /* The transfers of a module that may be refined (fluid_refine.c): P2G of a into phase, on
  * the grid or composite (an error goes to *rc, which is left alone on success), and the G2P of
- * v, a and L (L_out may be NULL) from m's phase at the positions of state y, with s_out set also
- * the nodal scalar s->s_i[l][0] of every level l. */
+ * v, a and L (L_out may be NULL) from m's phase at the positions of state y, and of the nodal
+ * scalars s->s_i[l][j], j < ns, of every level l into s_out[j]. */
 void fluid_p2g_any(mpm_module *m, int phase, const mpm_p2g_args *a, int *rc);
 int fluid_g2p_phase(mpm_module *m, const double *y, double *const *v_out, double *const *a_out,
-                    double *L_out, const mpm_hier_scalars *s, double *s_out);
+                    double *L_out, const mpm_hier_scalars *s, double *const *s_out, int ns);
 /* The grid spacing of the finest level (the grid's without refinement). */
 double fluid_finest_dx(const mpm_module *m);
 /* The levels of the positions of state y (mpm_hier_levels: remembered while they do not move),

@@ -112,6 +112,15 @@ static const mpm_key_spec fluid_keys[] = {
      "gas leaving a wall), total energy exact at every weight (0: unweighted; see "
      "fluid/fluid_gridp.c)",
      0, NULL},
+    {"fluid.pressure_relax", MPM_KEY_REAL, "4", 0, HUGE_VAL, 0, 0, NULL,
+     "the grid pressure (fluid.pressure = grid, and auto on a hierarchy): relax each "
+     "particle's pressure towards its nodes' over this many times the time a sound wave takes "
+     "to cross a cell of its level, by volume exchanged between particles sharing nodes (the "
+     "gas's volume, mass, momentum and total energy as exact as without it, entropy never "
+     "falling); without it nothing pulls a particle's volume back to its neighbours' and over "
+     "long runs their densities drift apart (0: off; not with the hybrid, which keeps the "
+     "particles' own pressure; see fluid/fluid_gridp.c)",
+     0, "-"},
     {"fluid.ppc", MPM_KEY_INT, "2", 1, 8, 0, 0, NULL,
      "gas particles per cell per direction at seeding", 0, "-"},
     {"fluid.regularise_every", MPM_KEY_INT, "0", 0, HUGE_VAL, 0, 0, NULL,
@@ -447,7 +456,7 @@ static int fluid_p2g_rate(mpm_module *m, double t, const double *y) {
   double *vout[MPM_MAX_DIM], *aout[MPM_MAX_DIM], *L = fc->scratch + (size_t)2 * dim * n;
   for (int d = 0; d < dim; ++d)
     vout[d] = fc->scratch + (size_t)d * n, aout[d] = fc->scratch + (size_t)(dim + d) * n;
-  const int rc = fluid_g2p_phase(m, y, vout, aout, L, NULL, NULL);
+  const int rc = fluid_g2p_phase(m, y, vout, aout, L, NULL, NULL, 0);
   mpm_timer_stop(MPM_T_G2P);
   MPM_CALL(rc);
   if (fc->lay.f_psi >= 0) { /* this RHS's limiter, into pending (g2p keeps it) */
@@ -587,7 +596,7 @@ static int volume_rate(mpm_module *m, const double *y, double *ydot, const doubl
   rate_parts(dim, n, L, tr, D);
   const double *Jrate = tr; /* fluid.volume_rate: point, or over the particle's domain */
   if (fc->volume_domain) MPM_CALL(fluid_volume_rate(m, y, v_i, L, &Jrate));
-  if (fc->gridp) Jrate = fluid_gridp_rate_out(fc); /* fluid_gridp_work made it dJ/dt / J */
+  if (fc->gridp) Jrate = fluid_gridp_rate_out(fc, NULL)[0]; /* fluid_gridp_work: dJ/dt / J */
   for (mpm_lidx i = 0; i < n; ++i) Jdot[i] = J[i] * Jrate[i];
   /* The limiter (riemann viscosity): with the current rate p2g_rate has set this RHS's. */
   double *psi = fc->lay.f_psi < 0 ? NULL
@@ -624,12 +633,13 @@ static int g2p_rates(mpm_module *m, const double *y, double *ydot, double h) {
   const double *v = state(p, y, FLUID_V), *C = fc->tr.apic ? state(p, y, fc->lay.f_C) : NULL;
   if (!(h > 0)) {
     mpm_hier_scalars rate;
-    double *rate_out = NULL;
+    double *const *rate_out = NULL;
+    int nrate = 0;
     if (fc->gridp) {
       MPM_CALL(fluid_gridp_nodal_rate(m, NULL, &rate));
-      rate_out = fluid_gridp_rate_out(fc);
+      rate_out = fluid_gridp_rate_out(fc, &nrate);
     }
-    MPM_CALL(fluid_g2p_phase(m, y, xdot, vdot, L, &rate, rate_out));
+    MPM_CALL(fluid_g2p_phase(m, y, xdot, vdot, L, &rate, rate_out, nrate));
     energy_rate(m, L, NULL, h);
     if (fc->gridp) fluid_gridp_work(m, y, L, fc->power);
     if (!fc->tr.apic) fluid_wall_rate_mol(m, y, vdot, fc->power);
@@ -641,7 +651,7 @@ static int g2p_rates(mpm_module *m, const double *y, double *ydot, double h) {
     as_rate(vdot[0], NULL, v, nv, h);
     if (Cdot) as_rate(Cdot, NULL, C, nC, h);
   } else {
-    MPM_CALL(fluid_g2p_phase(m, y, xdot, a_p, L, NULL, NULL)); /* the remapped velocities */
+    MPM_CALL(fluid_g2p_phase(m, y, xdot, a_p, L, NULL, NULL, 0)); /* the remapped velocities */
     as_rate(vdot[0], fc->vnew, v, nv, h);
     if (Cdot) as_rate(Cdot, fc->Cnew, C, nC, h);
   }

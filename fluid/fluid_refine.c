@@ -56,7 +56,7 @@ void fluid_p2g_any(mpm_module *m, int phase, const mpm_p2g_args *a, int *rc) {
 }
 
 int fluid_g2p_phase(mpm_module *m, const double *y, double *const *v_out, double *const *a_out,
-                    double *L_out, const mpm_hier_scalars *s, double *s_out) {
+                    double *L_out, const mpm_hier_scalars *s, double *const *s_out, int ns) {
   const mpm_particles *p = m->particles;
   const mpm_grid_phase *ph = &m->grid->phase[m->phase];
   mpm_g2p_args a = {.n = p->n, .lp = ((fluid_content *)m->content)->lp, .L_out = L_out};
@@ -65,12 +65,13 @@ int fluid_g2p_phase(mpm_module *m, const double *y, double *const *v_out, double
     a.v_i[d] = ph->v_i[d], a.a_i[d] = ph->a_i[d];
     a.v_out[d] = v_out[d], a.a_out[d] = a_out[d];
   }
-  if (s_out) a.nscalar = 1, a.s_i[0] = s->s_i[0][0], a.s_out[0] = s_out;
+  for (int j = 0; j < ns; ++j) a.s_i[j] = s->s_i[0][j], a.s_out[j] = s_out[j];
+  a.nscalar = ns;
   if (!m->hier) {
     mpm_kernels_get(p->dim)->g2p(m->grid, &a);
     return 0;
   }
-  return mpm_hier_g2p(m->hier, m->phase, &a, s_out ? s : NULL);
+  return mpm_hier_g2p(m->hier, m->phase, &a, ns > 0 ? s : NULL);
 }
 
 double fluid_finest_dx(const mpm_module *m) {

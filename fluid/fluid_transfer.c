@@ -217,17 +217,22 @@ static void nodal_scalars(mpm_module *m, classic_nodal *c, double h, double **ou
   }
 }
 
-/* fluid.pressure = grid: the nodal volume rate of vbar on every level, one more scalar of a,
- * into fluid_gridp_rate_out (fluid_gridp_work reads it). */
+/* fluid.pressure = grid: the nodal volume rate of vbar on every level (and the pressure
+ * relaxation's fields), more scalars of a, into fluid_gridp_rate_out (fluid_gridp_work reads
+ * them). */
 static int gridp_scalar(mpm_module *m, classic_nodal *c, mpm_g2p_args *a) {
   fluid_content *fc = m->content;
   if (!fc->gridp) return 0;
   mpm_hier_scalars r;
   MPM_CALL(fluid_gridp_nodal_rate(m, &c->vbar, &r));
-  const int k = a->nscalar;
-  for (int l = 0; l < c->nlev; ++l) c->s.s_i[l][k] = r.s_i[l][0];
-  a->s_i[k] = r.s_i[0][0];
-  a->s_out[a->nscalar++] = fluid_gridp_rate_out(fc);
+  int ns;
+  double *const *out = fluid_gridp_rate_out(fc, &ns);
+  for (int j = 0; j < ns; ++j) {
+    const int k = a->nscalar++;
+    for (int l = 0; l < c->nlev; ++l) c->s.s_i[l][k] = r.s_i[l][j];
+    a->s_i[k] = r.s_i[0][j];
+    a->s_out[k] = out[j];
+  }
   return 0;
 }
 

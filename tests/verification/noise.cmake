@@ -9,3 +9,8 @@ mpm_add_script_test(test_gas_noise SCRIPT verification/test_gas_noise.py
 # (12 s of CPU time; 60-95 s wall on the loaded 2-core machine).
 mpm_add_script_test(test_hybrid_pressure SCRIPT verification/test_hybrid_pressure.py
                     LABELS verification TIMEOUT 300)
+# The grid pressure's relaxation of the particles' pressures (fluid.pressure_relax): two gases
+# interleaved at rest against the exact relaxation, conservation and entropy; Sod under usl with
+# and without it; its refusal with the hybrid (about 10 s of CPU time).
+mpm_add_script_test(test_pressure_relax SCRIPT verification/test_pressure_relax.py
+                    LABELS verification TIMEOUT 300)
