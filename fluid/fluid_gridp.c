@@ -51,29 +51,36 @@
  * its first pass (fluid_module.c, fluid_remap) and moves the volume with the same rate; only the
  * positions follow its remapped velocity.
  *
- * The relaxation (fluid.pressure_relax = beta > 0; the grid pressure only). All particles at a
- * node share its volume rate in proportion to their volumes, so nothing pulls a particle whose
- * pressure differs from its neighbours' back to theirs: a particle's p enters the force only
- * through the mean p_j, and the drift of volumes between particles (their paths through
- * different nodes) accumulates. On the 3-D sphere at Mach 0.8 (cases/sphere_m08.ini, one
- * flow-through) particles reached 21 times the free stream's density at J = 0.03 while the
- * nodal density stayed near the free stream's. The relaxation exchanges volume between the
- * particles sharing a node, towards its pressure:
+ * The relaxation (fluid.pressure_relax = beta > 0; the grid pressure only, by default on a
+ * hierarchy only). All particles at a node share its volume rate in proportion to their
+ * volumes, and a particle's pressure enters the force only through the nodes' means p_j, so
+ * nothing pulls a particle whose pressure differs from its neighbours' back to theirs, and the
+ * drift of volumes between particles (their paths through different nodes) accumulates. On the
+ * 3-D sphere at Mach 0.8 (cases/sphere_m08.ini, one flow-through) particles reached 21 times the
+ * free stream's density at J = 0.03 while the nodal density stayed near the free stream's. The
+ * relaxation exchanges volume between the particles sharing a node, towards its pressure:
  *   dV_p/dt += V_p sum_j N_j(x_p) kappa_j (p_p - p_j),
  *   m_p de_p/dt += -V_p sum_j N_j(x_p) kappa_j p_j (p_p - p_j),
  * kappa_j = 1 / (beta dx_l Z_j), Z_j = sqrt(gamma p_j rho_j) the node's acoustic impedance
- * (rho_j its gas mass over V_j: beside a wall, where the mirrored pad nodes fold their mass into
- * the nodes inside, up to twice the gas's, so the relaxation is up to sqrt 2 slower there), dx_l
- * its level's spacing: a pressure difference decays as exp(-c t / (beta dx_l)), over beta
- * times a cell's sound-crossing time. Both sums vanish at every node, since p_j V_j = sum_p N_j
- * V_p p_p: the gas's volume and its internal energy are unchanged, each node's exchange being
- * valued at its own pressure (so mass, momentum and total energy stay as exact as without it).
- * Per particle m de + p dV = V sum_j N_j kappa_j (p_p - p_j)^2 >= 0: entropy never falls (the
- * exchange is the irreversible equilibration of pressure inside a node, as a multi-material
- * cell's). The particles gather kappa, kappa p and kappa p^2 (relax_fields), from the deposit's
- * own V_j and V_j p_j, which nothing overwrites: the open faces', a solid's or an obstacle's
- * pressure does not enter. Under a contact discontinuity the pressures agree and nothing
- * moves; at a shock it adds dissipation (Sod's L1 at 200 cells: docs/gas.md).
+ * (rho_j its gas mass over V_j; beside a wall the mirrored pad nodes fold their mass into the
+ * nodes inside, so rho_j reads high there, up to 2^dim times in a corner, and the relaxation is
+ * slower by up to its square root), dx_l its level's spacing: a pressure difference decays as
+ * exp(-c t / (beta dx_l)), over beta times a cell's sound-crossing time. Both sums vanish at
+ * every node, since p_j V_j = sum_p N_j V_p p_p, whatever kappa_j >= 0 is: the gas's volume and
+ * its internal energy are unchanged, each node's exchange being valued at its own pressure (so
+ * mass, momentum and total energy stay as exact as without it). Per particle m de + p dV = V
+ * sum_j N_j kappa_j (p_p - p_j)^2 >= 0 in the rates: entropy never falls (the irreversible
+ * equilibration of pressure inside a node, as in a multi-material cell); the classic update's
+ * explicit step keeps that while h c / (beta dx) < 2, hence beta >= 1 (read_relax). The
+ * particles gather kappa, kappa p and kappa p^2 (relax_fields), from the deposit's own V_j and
+ * V_j p_j, which nothing overwrites: the open faces', a solid's or an obstacle's pressure does not
+ * enter. A contact (equal pressures) is left alone; at a shock it adds dissipation. It also
+ * damps smooth waves, at first order in dx: a resolved wave's particle pressures differ from
+ * their nodes' smoothed means by (k dx)^2 / 4 of its amplitude, which the exchange relaxes like a
+ * pressure diffusion of about c dx / (4 beta) (a standing wave at 100 cells per wavelength loses
+ * 12 % more of its kinetic energy over 5 periods at beta = 4; docs/refinement.md). Hence its
+ * default holds on a hierarchy, where the grid pressure is the gas's and its runs are long, and
+ * not on a uniform grid, where the grid pressure is a choice made beside solids for acoustics.
  *
  * Obstacles. The massless nodes inside a body are its ghosts: each node with mass takes its own
  * pressure times the integral of their prolonged mask against grad N_i, and the adjoint rate
@@ -304,6 +311,35 @@ static int check_scope(const fluid_content *fc, const mpm_config *cfg, const mpm
   return 0;
 }
 
+/* fluid.pressure_relax: beta, whose default (the key unset) holds on a hierarchy only; below 1
+ * refused (beta < time.cfl would let the classic update's explicit relaxation overshoot, the
+ * rate being c / (beta dx)). The hybrid does not relax: an explicit key is refused there. */
+static int read_relax(fluid_gridp *gp, const mpm_config *cfg, int hybrid) {
+  const int set = mpm_config_has(cfg, "fluid.pressure_relax");
+  MPM_CALL(mpm_config_get_real(cfg, "fluid.pressure_relax", &gp->relax));
+  if (set && gp->relax > 0.0 && gp->relax < 1.0)
+    return mpm_config_fail(cfg, "fluid.pressure_relax",
+                           "below 1 relaxes faster than a step can follow (the rate is c / (beta "
+                           "dx)); use 0 (off) or at least 1");
+  if (set && hybrid && gp->relax > 0.0)
+    return mpm_config_fail(cfg, "fluid.pressure_relax",
+                           "relaxes the grid pressure's particles; the hybrid (fluid.pressure = "
+                           "hybrid, or auto for a gas alone) keeps the particles' own pressure in "
+                           "their force: remove the key, or set fluid.pressure = grid");
+  if (hybrid || (!set && !gp->refined)) gp->relax = 0.0;
+  return 0;
+}
+
+/* An explicit fluid.pressure_relax where the gas does not take the grid pressure. */
+static int relax_unused(const fluid_content *fc, const mpm_config *cfg) {
+  if (fc->gridp || !mpm_config_has(cfg, "fluid.pressure_relax")) return 0;
+  return mpm_config_fail(cfg, "fluid.pressure_relax",
+                         "relaxes the grid pressure's particles, and this gas takes the "
+                         "particles' pressure (fluid.pressure = particle, or auto beside a "
+                         "solid, or outside the hybrid's scope: the log says which); remove the "
+                         "key, or set fluid.pressure = grid");
+}
+
 /* Check the scope, then set the grid pressure up with its grid phase. */
 static int enable(mpm_module *m, const mpm_config *cfg, int hybrid) {
   fluid_content *fc = m->content;
@@ -312,18 +348,12 @@ static int enable(mpm_module *m, const mpm_config *cfg, int hybrid) {
   memset(fc->gridp, 0, sizeof *fc->gridp);
   fc->gridp->hybrid = hybrid;
   MPM_CALL(mpm_config_get_real(cfg, "fluid.hybrid_fill", &fc->gridp->fill));
-  MPM_CALL(mpm_config_get_real(cfg, "fluid.pressure_relax", &fc->gridp->relax));
   fc->gridp->gamma = fc->gas.gamma;
-  if (hybrid && fc->gridp->relax > 0.0 && mpm_config_has(cfg, "fluid.pressure_relax"))
-    return mpm_config_fail(cfg, "fluid.pressure_relax",
-                           "relaxes the grid pressure's particles; the hybrid keeps the "
-                           "particles' own pressure in their force: remove the key or use "
-                           "fluid.pressure = grid");
-  if (hybrid) fc->gridp->relax = 0.0; /* the default is the grid pressure's */
   int levels = 1;
   if (mpm_config_has(cfg, "refine.levels"))
     MPM_CALL(mpm_config_get_int(cfg, "refine.levels", &levels));
   fc->gridp->refined = levels > 1;
+  MPM_CALL(read_relax(fc->gridp, cfg, hybrid));
   const char *const *names;
   int count;
   MPM_CALL(mpm_config_instances(cfg, "solid", &names, &count));
@@ -412,9 +442,15 @@ int fluid_gridp_weighted(const fluid_content *fc) {
 int fluid_gridp_init(mpm_module *m, const mpm_config *cfg) {
   const char *form;
   MPM_CALL(mpm_config_get_string(cfg, "fluid.pressure", &form));
-  if (strcmp(form, "auto") == 0) return choose_auto(m, cfg);
   const int hybrid = strcmp(form, "hybrid") == 0;
-  return strcmp(form, "grid") == 0 || hybrid ? enable(m, cfg, hybrid) : 0;
+  if (strcmp(form, "auto") == 0)
+    MPM_CALL(choose_auto(m, cfg));
+  else if (strcmp(form, "grid") == 0 || hybrid)
+    return enable(m, cfg, hybrid);
+  int levels = 1;
+  if (mpm_config_has(cfg, "refine.levels"))
+    MPM_CALL(mpm_config_get_int(cfg, "refine.levels", &levels));
+  return levels > 1 ? 0 : relax_unused(m->content, cfg); /* refined: fluid_gridp_refine */
 }
 
 int fluid_gridp_refine(mpm_module *m, const mpm_config *cfg, mpm_hier *h) {
@@ -430,7 +466,10 @@ int fluid_gridp_refine(mpm_module *m, const mpm_config *cfg, mpm_hier *h) {
   /* Beside a solid auto keeps the particles' pressure (the sim then keeps the levels' faces off
    * corners in the gas, coupler/mpm_refine.c, bands); grid takes the solid's region out of its
    * span integrals (fluid_gridp_solid.c) and runs in any box. */
-  if (nsolid > 0 && strcmp(form, "grid") != 0) return h ? mpm_hier_add_phases(h) : 0;
+  if (nsolid > 0 && strcmp(form, "grid") != 0) {
+    MPM_CALL(relax_unused(m->content, cfg));
+    return h ? mpm_hier_add_phases(h) : 0;
+  }
   if (strcmp(form, "particle") == 0)
     return mpm_config_fail(cfg, "fluid.pressure",
                            "the particles' quadrature is not exact at the corners of a refined "
@@ -561,6 +600,7 @@ static int ensure_particles(fluid_gridp *gp, mpm_lidx cap, int dim) {
   MPM_ALLOC(gp->mp, (size_t)cap);
   MPM_ALLOC(gp->s, (size_t)cap);
   for (int j = 1; gp->relax > 0.0 && j < 4; ++j) MPM_ALLOC(gp->r[j], (size_t)cap);
+  gp->r[0] = gp->s;
   MPM_ALLOC(gp->V, (size_t)cap);
   if (gp->hybrid) MPM_ALLOC(gp->load, (size_t)cap);
   if (gp->hybrid) MPM_ALLOC(gp->sig, (size_t)dim * dim * cap);
@@ -763,11 +803,11 @@ static int relax_fields(mpm_module *m, fluid_gridp *gp, mpm_hier_scalars *s) {
       k0[k] = 1.0 / (gp->relax * g->dx * Z), k1[k] = k0[k] * p, k2[k] = k1[k] * p;
     }
   }
-  for (int j = 0; j < 3; ++j) {
-    double *a[MPM_HIER_MAX_LEVELS];
-    for (int l = 0; l < gp->nlev; ++l) a[l] = gp->R[l][j], s->s_i[l][1 + j] = gp->R[l][j];
-    MPM_CALL(fluid_gridp_prolong(m, a));
-  }
+  for (int l = 0; l < gp->nlev; ++l)
+    for (int j = 0; j < 3; ++j) s->s_i[l][1 + j] = gp->R[l][j];
+  MPM_CALL(mpm_grid_halo_forward(m->grid, gp->R[0], 3));
+  for (int l = 1; m->hier && l < m->hier->nlevels; ++l)
+    mpm_hier_prolong_level(m->hier, l, (const double *const *)gp->R[l - 1], gp->R[l], 3);
   return 0;
 }
 
@@ -809,7 +849,9 @@ void fluid_gridp_work(const mpm_module *m, const double *y, const double *L, dou
   const double *V0 = mpm_particles_comp(p, fc->lay.f_V0, 0);
   const double *J = y + (size_t)p->offset[FLUID_J] * n;
   for (mpm_lidx i = 0; i < n; ++i) power[i] -= gp->mp[i] * V0[i] * J[i] / mass[i] * gp->s[i];
-  if (gp->relax > 0.0) { /* the relaxation: its volume rate, and its work at the nodes' p */
+  /* The relaxation: its work at the nodes' pressures, then its volume rate joins s (the work
+   * above read s without it). */
+  if (gp->relax > 0.0) {
     const double *a = gp->r[1], *b = gp->r[2], *c = gp->r[3];
     for (mpm_lidx i = 0; i < n; ++i) {
       power[i] -= V0[i] * J[i] / mass[i] * (gp->mp[i] * b[i] - c[i]);
@@ -822,8 +864,7 @@ void fluid_gridp_work(const mpm_module *m, const double *y, const double *L, dou
 }
 
 double *const *fluid_gridp_rate_out(const fluid_content *fc, int *ns) {
-  fluid_gridp *gp = fc->gridp;
-  gp->r[0] = gp->s;
+  const fluid_gridp *gp = fc->gridp;
   if (ns) *ns = gp->relax > 0.0 ? 4 : 1;
   return gp->r;
 }

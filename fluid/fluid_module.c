@@ -118,8 +118,10 @@ static const mpm_key_spec fluid_keys[] = {
      "to cross a cell of its level, by volume exchanged between particles sharing nodes (the "
      "gas's volume, mass, momentum and total energy as exact as without it, entropy never "
      "falling); without it nothing pulls a particle's volume back to its neighbours' and over "
-     "long runs their densities drift apart (0: off; not with the hybrid, which keeps the "
-     "particles' own pressure; see fluid/fluid_gridp.c)",
+     "long runs their densities drift apart. It damps smooth waves at first order in dx, so the "
+     "default 4 holds on a refinement hierarchy only (unset on a uniform grid: off); 0: off, "
+     "else at least 1; not with the hybrid or the particles' pressure (see "
+     "docs/refinement.md)",
      0, "-"},
     {"fluid.ppc", MPM_KEY_INT, "2", 1, 8, 0, 0, NULL,
      "gas particles per cell per direction at seeding", 0, "-"},

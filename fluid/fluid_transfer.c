@@ -98,6 +98,7 @@
 #include "mpm_hier.h"
 #include "mpm_kernels.h"
 
+#include <assert.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -227,6 +228,9 @@ static int gridp_scalar(mpm_module *m, classic_nodal *c, mpm_g2p_args *a) {
   MPM_CALL(fluid_gridp_nodal_rate(m, &c->vbar, &r));
   int ns;
   double *const *out = fluid_gridp_rate_out(fc, &ns);
+  /* At most 3 heat scalars before these (nodal_scalars) and 4 of the grid pressure. */
+  _Static_assert(3 + 4 <= MPM_KERNELS_MAX_SCALARS, "the classic G2P's scalars");
+  assert(a->nscalar + ns <= MPM_KERNELS_MAX_SCALARS);
   for (int j = 0; j < ns; ++j) {
     const int k = a->nscalar++;
     for (int l = 0; l < c->nlev; ++l) c->s.s_i[l][k] = r.s_i[l][j];
