@@ -132,7 +132,7 @@ def case_sod(binary, out, levels):
     rows = {}
     for label, N, extra in (("refined", SOD_COARSE, sod_refine(levels)),
                             ("coarse", SOD_COARSE, []),
-                            ("fine", fine, ["fluid.pressure=grid"]),
+                            ("fine", fine, ["fluid.pressure=grid", "fluid.pressure_relax=4"]),
                             ("fine_particle", fine, [])):
         over = [o for o in shocktube.overrides(N, "bs32", 0.2, height=height)
                 if not o.startswith("run.progress")] + ["output.interval=0.2"]

@@ -83,10 +83,12 @@ def scenes(dx, fine_side):
     half = fine_side / 2
     small = ([c - half for c in CENTER], [c + half for c in CENTER])
     return {"refined": (None, [f"grid.dx={dx!r}"]),
-            "uniform": (case_sections(True), [f"grid.dx={dx!r}", "fluid.pressure=grid"]),
+            "uniform": (case_sections(True), [f"grid.dx={dx!r}", "fluid.pressure=grid",
+                                              "fluid.pressure_relax=4"]),
             "uniform_part": (case_sections(True), [f"grid.dx={dx!r}"]),
             "fine_small": (case_sections(True, small, 0.25),
-                           [f"grid.dx={h_fine!r}", "fluid.pressure=grid"])}
+                           [f"grid.dx={h_fine!r}", "fluid.pressure=grid",
+                            "fluid.pressure_relax=4"])}
 
 
 def per_level(run_dir):

@@ -317,22 +317,33 @@ static int check_scope(const fluid_content *fc, const mpm_config *cfg, const mpm
 static int read_relax(fluid_gridp *gp, const mpm_config *cfg, int hybrid) {
   const int set = mpm_config_has(cfg, "fluid.pressure_relax");
   MPM_CALL(mpm_config_get_real(cfg, "fluid.pressure_relax", &gp->relax));
+  if (set && hybrid && gp->relax > 0.0)
+    return mpm_config_fail(cfg, "fluid.pressure_relax",
+                           "relaxes the grid pressure's particles; the hybrid (fluid.pressure = "
+                           "hybrid, or auto for a gas alone on a uniform grid) keeps the "
+                           "particles' own pressure in their force: remove the key, or set "
+                           "fluid.pressure = grid");
   if (set && gp->relax > 0.0 && gp->relax < 1.0)
     return mpm_config_fail(cfg, "fluid.pressure_relax",
                            "below 1 relaxes faster than a step can follow (the rate is c / (beta "
                            "dx)); use 0 (off) or at least 1");
-  if (set && hybrid && gp->relax > 0.0)
-    return mpm_config_fail(cfg, "fluid.pressure_relax",
-                           "relaxes the grid pressure's particles; the hybrid (fluid.pressure = "
-                           "hybrid, or auto for a gas alone) keeps the particles' own pressure in "
-                           "their force: remove the key, or set fluid.pressure = grid");
   if (hybrid || (!set && !gp->refined)) gp->relax = 0.0;
+  if (hybrid) return 0;
+  if (gp->relax > 0.0)
+    mpm_log(MPM_LOG_INFO, "pressure relaxation: beta = %g (fluid.pressure_relax%s)", gp->relax,
+            set ? "" : ", its default on a hierarchy");
+  else
+    mpm_log(MPM_LOG_INFO, "pressure relaxation: off (fluid.pressure_relax%s)",
+            set ? " = 0" : " unset: off on a uniform grid");
   return 0;
 }
 
-/* An explicit fluid.pressure_relax where the gas does not take the grid pressure. */
+/* An explicit fluid.pressure_relax > 0 where the gas does not take the grid pressure. */
 static int relax_unused(const fluid_content *fc, const mpm_config *cfg) {
+  double beta = 0.0;
   if (fc->gridp || !mpm_config_has(cfg, "fluid.pressure_relax")) return 0;
+  MPM_CALL(mpm_config_get_real(cfg, "fluid.pressure_relax", &beta));
+  if (beta == 0.0) return 0; /* off, as the particles' pressure is */
   return mpm_config_fail(cfg, "fluid.pressure_relax",
                          "relaxes the grid pressure's particles, and this gas takes the "
                          "particles' pressure (fluid.pressure = particle, or auto beside a "

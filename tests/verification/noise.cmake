@@ -11,6 +11,7 @@ mpm_add_script_test(test_hybrid_pressure SCRIPT verification/test_hybrid_pressur
                     LABELS verification TIMEOUT 300)
 # The grid pressure's relaxation of the particles' pressures (fluid.pressure_relax): two gases
 # interleaved at rest against the exact relaxation, conservation and entropy; Sod under usl with
-# and without it; its refusal with the hybrid (about 10 s of CPU time).
+# and without it; a standing wave's damping; its default (off uniform, on on two levels); its
+# refusals (about 15 s of CPU time).
 mpm_add_script_test(test_pressure_relax SCRIPT verification/test_pressure_relax.py
                     LABELS verification TIMEOUT 300)

@@ -121,7 +121,8 @@ def stream_deviation(p, u0):
 def part_stream():
     u0 = 0.5
     gas = f"{REST}\nvelocity = {u0!r} 0"
-    for name, refine, extra in (("band", FLOOR_BAND, []), ("uniform twin", "", ["fluid.pressure=grid"])):
+    twin = ["fluid.pressure=grid", "fluid.pressure_relax=4"]  # the refined run's pressure
+    for name, refine, extra in (("band", FLOOR_BAND, []), ("uniform twin", "", twin)):
         out = run("obstacles_stream_" + name.split()[0], case_text(1.6, 0.5, gas, refine,
                                                                     extra=FLOOR, height=0.8),
                   *extra)
@@ -173,7 +174,7 @@ def part_disc():
                                       ("aligned fine twin", DISC_ALIGNED, "", ["grid.dx=0.025"]),
                                       ("fine twin", DISC, "", ["grid.dx=0.025"]),
                                       ("coarse twin", DISC, "", [])):
-        grid = [] if refine else ["fluid.pressure=grid"]
+        grid = [] if refine else ["fluid.pressure=grid", "fluid.pressure_relax=4"]
         out = run("obstacles_disc_" + name.replace(" ", "_"),
                   case_text(1.6, 0.12, gas, refine, extra=obst, height=0.8), *(extra + grid))
         runs[name] = out

@@ -231,9 +231,10 @@ def part_shock():
                      free, "[refine]\nlevels = 2\ncriterion = density\nthreshold = 0.05\n"
                      "every = 5\n", interval=0.175, extra="kinetic_growth = 1e9\n")
     runs = {"refined": run("open_shock", text),
-            "coarse": run("open_shock_coarse", text, ["refine.levels=1", "fluid.pressure=grid"]),
+            "coarse": run("open_shock_coarse", text, ["refine.levels=1", "fluid.pressure=grid",
+                                                      "fluid.pressure_relax=4"]),
             "fine": run("open_shock_fine", text, ["refine.levels=1", "fluid.pressure=grid",
-                                                  "grid.dx=0.025"])}
+                                                  "fluid.pressure_relax=4", "grid.dx=0.025"])}
     for t, f in mt.snapshots(runs["refined"])[1:]:
         p = mt.particles(f, "fluid")
         rho = profile(p)

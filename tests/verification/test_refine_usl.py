@@ -155,7 +155,7 @@ def part_pulse():
     runs = {"refined": run("usl_pulse", case_text(3, 2.4, gas, box)),
             "coarse": run("usl_pulse_coarse", case_text(3, 2.4, gas, "")),
             "coarse, grid pressure": run("usl_pulse_coarse_gridp", case_text(3, 2.4, gas, ""),
-                                         "fluid.pressure=grid"),
+                                         "fluid.pressure=grid", "fluid.pressure_relax=4"),
             "fine": run("usl_pulse_fine", case_text(3, 2.4, gas, "", 0.025))}
     rest, _ = run("usl_pulse_rest", case_text(3, 2.4, REST, box))
     r = final(rest)
@@ -176,7 +176,7 @@ def part_sod():
     l1 = {}
     for label, N, extra in (("refined (2 levels over 100 cells)", SOD_COARSE, sod_refine(2)),
                             (f"uniform at {fine} cells, grid pressure", fine,
-                             ["fluid.pressure=grid"]),
+                             ["fluid.pressure=grid", "fluid.pressure_relax=4"]),
                             (f"uniform at {fine} cells, the default pressure (auto: hybrid)",
                              fine, []),
                             ("refined, fluid.pressure = hybrid", SOD_COARSE,
@@ -213,9 +213,9 @@ def part_wall():
     for label, over in (("FLIP", ()), ("pic_fraction 0.3", (PIC,))):
         runs = {"refined": run("usl_wall", wall_pulse_case(WALL_BAND, 0.05), *over),
                 "coarse": run("usl_wall_coarse", wall_pulse_case("", 0.05), *over,
-                              "fluid.pressure=grid"),
+                              "fluid.pressure=grid", "fluid.pressure_relax=4"),
                 "fine": run("usl_wall_fine", wall_pulse_case("", 0.025), *over,
-                            "fluid.pressure=grid")}
+                            "fluid.pressure=grid", "fluid.pressure_relax=4")}
         up = {k: wall_pulse_profile(final(out))[0] for k, (out, _) in runs.items()}
         energy = {k: float((u ** 2).sum()) for k, u in up.items()}
         peak = {k: float(u.max()) for k, u in up.items()}

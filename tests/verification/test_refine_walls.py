@@ -121,7 +121,7 @@ def part_stream():
     conservation("3-D stream", out, "x", 1e-12)
 
 
-GRIDP = "[fluid]\npressure = grid\n"
+GRIDP = "[fluid]\npressure = grid\npressure_relax = 4\n"  # as the refined runs
 
 
 def part_pulse():
