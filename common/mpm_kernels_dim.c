@@ -507,7 +507,8 @@ static void DIMFN(g2p)(const mpm_grid *g, const mpm_g2p_args *a) {
     DIMFN(g2p_loop)(&L, a, MPM_SHAPE_GIMP, 0, -1, 1, 0);
     break;
   case MPM_SHAPE_QUADRATIC: /* the gas's FLIP update reads one scalar, two with the grid
-                               pressure (fluid_transfer.c) */
+                               pressure, five with its relaxation (fluid_transfer.c; a
+                               run-time count) */
     if (apic_b)
       DIMFN(g2p_loop)(&L, a, MPM_SHAPE_QUADRATIC, 1, -1, 1, 0);
     else if (a->nscalar == 2)
