@@ -206,6 +206,11 @@ int mpm_hier_level_walk(const mpm_hier *h, const double *x);
  * for bit to the one the last call had at its index takes the level found then, so a caller
  * asking again at positions that did not move pays a comparison per point (mpm_hier_census.c). */
 const unsigned char *mpm_hier_levels(mpm_hier *h, const double *const *x, mpm_lidx n);
+
+/* The points were compacted to those with keep[i] != 0 (n flags, in order, as
+ * mpm_particles_edit keeps them): the memory of mpm_hier_levels follows, so that the next call
+ * looks up only the points that moved. Forgets it when it did not hold n points. */
+void mpm_hier_levels_keep(mpm_hier *h, const unsigned char *keep, mpm_lidx n);
 /* The level of every particle of p (mpm_hier_level_of at its field "x") into level[p->n]
  * (mpm_hier_census.c). */
 void mpm_hier_particle_levels(const mpm_hier *h, const mpm_particles *p, double *level);

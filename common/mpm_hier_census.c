@@ -72,6 +72,22 @@ const unsigned char *mpm_hier_levels(mpm_hier *h, const double *const *x, mpm_li
   return c->lev;
 }
 
+void mpm_hier_levels_keep(mpm_hier *h, const unsigned char *keep, mpm_lidx n) {
+  hier_census *c = h ? h->census : NULL;
+  if (!c) return;
+  if (c->n != n) {
+    c->n = 0;
+    return;
+  }
+  mpm_lidx k = 0;
+  for (mpm_lidx i = 0; i < n; ++i) {
+    if (!keep[i]) continue;
+    for (int d = 0; d < h->dim; ++d) c->x[d][k] = c->x[d][i];
+    c->lev[k++] = c->lev[i];
+  }
+  c->n = k;
+}
+
 /* The position components of p (the field "x"). */
 static void positions(const mpm_hier *h, const mpm_particles *p, const double **x) {
   const int fx = mpm_particles_find(p, "x");

@@ -55,6 +55,7 @@
 
 #include "mpm_cells.h"
 #include "mpm_error.h"
+#include "mpm_hier.h"
 #include "mpm_particles.h"
 
 #include <math.h>
@@ -383,8 +384,10 @@ int fluid_merge(mpm_module *m, const mpm_lidx *start, const mpm_lidx *member, mp
   MPM_ALLOC(state, p->n);
   memset(state, 1, (size_t)p->n);
   int rc = merge_all(m, start, member, ngroups, state, rep);
-  for (mpm_lidx i = 0; !rc && i < p->n; ++i) state[i] = state[i] != 0;
+  const mpm_lidx n0 = p->n;
+  for (mpm_lidx i = 0; !rc && i < n0; ++i) state[i] = state[i] != 0;
   if (!rc && rep->removed > 0) rc = mpm_particles_edit(p, state, 0, NULL, NULL);
+  if (!rc && rep->removed > 0) mpm_hier_levels_keep(m->hier, state, n0); /* (a merged one moved) */
   free(state);
   MPM_CALL(rc);
   return 0;

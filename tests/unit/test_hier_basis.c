@@ -27,7 +27,8 @@
  *  (8) Remembered levels (mpm_hier_levels): over 10,000 random points, then again with every
  *      third point moved to a fresh random point, the set shortened and then grown past its
  *      first size, every level equals mpm_hier_level_of's exactly (levels are integers); the
- *      moves must change some levels (else the check could not see a stale one). */
+ *      moves must change some levels (else the check could not see a stale one); and after the
+ *      set is compacted (mpm_hier_levels_keep), the memory following it. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -386,6 +387,20 @@ static void test_levels(void **state) {
     check_levels(&f, x, NPOINTS);
     check_levels(&f, x, NPOINTS / 2);
     check_levels(&f, x, 2 * NPOINTS);
+    /* Compacted (every fifth point dropped, as mpm_particles_edit keeps a set): the memory
+     * follows the points (a kept level not moved with its point would be another's). */
+    unsigned char *keep = malloc(2 * NPOINTS);
+    mpm_lidx kept = 0;
+    for (mpm_lidx i = 0; i < 2 * NPOINTS; ++i) {
+      keep[i] = i % 5 != 2;
+      for (int d = 0; d < 3 && keep[i]; ++d) x[d][kept] = x[d][i];
+      kept += keep[i];
+    }
+    mpm_hier_levels_keep(f.h, keep, 2 * NPOINTS);
+    check_levels(&f, x, kept);
+    mpm_hier_levels_keep(f.h, keep, 2 * NPOINTS); /* (not the count held: forgotten) */
+    check_levels(&f, x, kept);
+    free(keep);
     for (int d = 0; d < 3; ++d) free(x[d]);
     fixture_free(&f);
   }
