@@ -707,6 +707,10 @@ static int fluid_post_step(mpm_module *m, double t, double h, int *changed) {
 static int fluid_boundary(mpm_module *m, double t, double h, int *changed) {
   fluid_content *fc = m->content;
   fluid_walls_return(m);
+  /* A returned particle moved after the step's last RHS: the integrator restarts its first
+   * stage (a reused one would be stale where the set did not also migrate: 2 ranks would
+   * differ from 1). */
+  if (fluid_obstacles_return(&fc->obs, m->grid, m->particles, FLUID_X) > 0) *changed = 1;
   return fluid_open_exchange(fc->open, m, t, h, changed);
 }
 

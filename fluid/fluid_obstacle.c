@@ -621,6 +621,48 @@ int fluid_obstacles_which(const fluid_obstacles *o, const double *x) {
   return -1;
 }
 
+/* Inside the bounding box of obstacle k? */
+static int in_bounds(const mpm_sdf *s, int dim, const double *x) {
+  int in = 1;
+  for (int d = 0; d < dim; ++d) in &= x[d] > s->lo[d] && x[d] < s->hi[d];
+  return in;
+}
+
+/* Does x lie inside the grid's domain along its closed (not periodic, not open) axes? */
+static int inside_domain(const fluid_obstacles *o, const mpm_grid *g, const double *x) {
+  int in = 1;
+  for (int d = 0; d < g->dim; ++d)
+    in &= g->periodic[d] ||
+          ((o->open[d][0] || x[d] >= g->lo[d]) && (o->open[d][1] || x[d] < g->hi[d]));
+  return in;
+}
+
+mpm_lidx fluid_obstacles_return(const fluid_obstacles *o, const mpm_grid *grid, mpm_particles *p,
+                                int field_x) {
+  const int dim = grid->dim;
+  mpm_lidx moved = 0;
+  double *x[MPM_MAX_DIM] = {NULL, NULL, NULL};
+  for (int d = 0; d < dim; ++d) x[d] = mpm_particles_comp(p, field_x, d);
+  for (mpm_lidx i = 0; o->count > 0 && i < p->n; ++i) {
+    double xp[MPM_MAX_DIM] = {0, 0, 0}, nrm[MPM_MAX_DIM] = {0, 0, 0};
+    for (int d = 0; d < dim; ++d) xp[d] = x[d][i];
+    for (int k = 0; k < o->count; ++k) {
+      const mpm_sdf *s = &o->ob[k].sdf;
+      if (!in_bounds(s, dim, xp)) continue;
+      const double phi = mpm_sdf_eval(s, xp, nrm);
+      if (!(phi < 0.0)) continue;
+      double xm[MPM_MAX_DIM] = {0, 0, 0};
+      for (int d = 0; d < dim; ++d) xm[d] = xp[d] - 2.0 * phi * nrm[d];
+      if (fluid_obstacles_which(o, xm) >= 0 || !inside_domain(o, grid, xm))
+        for (int d = 0; d < dim; ++d) xm[d] = xp[d] - (phi - 1e-6 * grid->dx) * nrm[d];
+      for (int d = 0; d < dim; ++d) x[d][i] = xm[d];
+      ++moved;
+      break;
+    }
+  }
+  return moved;
+}
+
 /* The cell of particle i (positions x per component): the box index of its lower corner, or -1
  * outside the box. Its position into xp. */
 static mpm_lidx cell_of(const mpm_grid *g, const double *const *x, mpm_lidx i, double *xp) {

@@ -35,3 +35,10 @@ set_tests_properties(test_rae2822_targets PROPERTIES WILL_FAIL TRUE)
 # coarsest grid against its finest, and a symmetric aerofoil without lift (about 90 s, numpy).
 mpm_add_script_test(test_euler_reference SCRIPT verification/test_euler_reference.py
                     LABELS verification TIMEOUT 600)
+# Particles carried into a body go back out (fluid_obstacles_return): a stream past a circle on
+# three static levels (grid pressure, ssprk2) and on level 0 alone (usl): none inside at any
+# snapshot (~10 s and ~1 s).
+mpm_add_script_test(test_obstacle_return SCRIPT verification/test_obstacle_return.py
+                    ARGS hierarchy LABELS verification TIMEOUT 300)
+mpm_add_script_test(test_obstacle_return_uniform SCRIPT verification/test_obstacle_return.py
+                    ARGS uniform LABELS verification TIMEOUT 300)
