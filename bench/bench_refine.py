@@ -12,9 +12,11 @@ Cases (the scenes of tests/verification/test_refine_gas.py):
             Error: the mean |rho - rho_fine| over the band's rows 0.2 < y < 0.4 at t = 1.2,
             binned along x into 60 cells (the fine twin is the reference: its error is 0).
   stream3d  the stream in 3-D (x and z periodic), to t = 0.45.
-  sod, sod3, sod4
+  sod, sod3, sod4, sod3_usl, sod4_usl
             cases/sod.ini over 100 level-0 cells, 3 across (periodic in y: every level wraps),
-            regridded by the density criterion (refine_scenes.sod_refine) with 2, 3 and 4 levels,
+            regridded by the density criterion (refine_scenes.sod_refine) with 2, 3 and 4 levels
+            under bs32 (sod, sod3, sod4) and 3 and 4 under the case's usl (sod3_usl, sod4_usl),
+            both at the case's fixed time.cfl = 0.9,
             against the uniform twins at the finest spacing on the same strip, with the grid
             pressure the refined run takes (fine) and the default particle pressure
             (fine_particle). Error: the density's L1 on the finest cells (tests/tools/
@@ -46,7 +48,10 @@ from riemann import Riemann  # noqa: E402
 U0 = 0.5 * C0
 GAS_STREAM = f"density = 1\npressure = 1\nvelocity = {U0!r} 0"
 TIMERS = ("restrict", "prolong", "relevel", "regrid")
-SOD_LEVELS = {"sod": 2, "sod3": 3, "sod4": 4}  # case: refinement levels
+# case: (refinement levels, time.method); the case's own usl and the ERK pair bs32, both at the
+# case's fixed time.cfl = 0.9
+SOD_LEVELS = {"sod": (2, "bs32"), "sod3": (3, "bs32"), "sod4": (4, "bs32"),
+              "sod3_usl": (3, "usl"), "sod4_usl": (4, "usl")}
 DEFAULT_CASES = "stream,pulse,stream3d," + ",".join(SOD_LEVELS)
 KEPT_SECTION = "## Settings swept for Sod"
 
@@ -124,7 +129,7 @@ def case_pulse(binary, out):
     return rows
 
 
-def case_sod(binary, out, levels):
+def case_sod(binary, out, levels, method):
     fine = SOD_COARSE * 2 ** (levels - 1)
     exact = Riemann((1.0, 0.0, 1.0), (0.125, 0.0, 0.1), gamma=1.4, x0=0.5)
     case = os.path.join(ROOT, "cases", "sod.ini")
@@ -134,9 +139,9 @@ def case_sod(binary, out, levels):
                             ("coarse", SOD_COARSE, []),
                             ("fine", fine, ["fluid.pressure=grid", "fluid.pressure_relax=4"]),
                             ("fine_particle", fine, [])):
-        over = [o for o in shocktube.overrides(N, "bs32", 0.2, height=height)
+        over = [o for o in shocktube.overrides(N, method, 0.2, height=height)
                 if not o.startswith("run.progress")] + ["output.interval=0.2"]
-        r = run(binary, os.path.join(out, f"sod{levels}_{label}"), case, over + extra)
+        r = run(binary, os.path.join(out, f"sod{levels}_{method}_{label}"), case, over + extra)
         r["error"] = shocktube.measure(r["dir"], fine, exact, 0.2)[0]
         rows[label] = r
     return rows
@@ -215,7 +220,7 @@ def main():
         elif name == "pulse":
             results[name] = case_pulse(a.binary, a.out)
         elif name in SOD_LEVELS:
-            results[name] = case_sod(a.binary, a.out, SOD_LEVELS[name])
+            results[name] = case_sod(a.binary, a.out, *SOD_LEVELS[name])
         else:
             raise SystemExit(f"unknown case {name}: choose among {DEFAULT_CASES}")
         for label, r in results[name].items():
