@@ -470,6 +470,15 @@ static int stencil_count(const stencil *st, int dim) {
   return dim == 2 ? st->support * st->support : st->support * st->support * st->support;
 }
 
+/* Does x lie inside the grid's domain along its closed (not periodic, not open) axes? */
+static int inside_domain(const fluid_obstacles *o, const mpm_grid *g, const double *x) {
+  int in = 1;
+  for (int d = 0; d < g->dim; ++d)
+    in &= g->periodic[d] ||
+          ((o->open[d][0] || x[d] >= g->lo[d]) && (o->open[d][1] || x[d] < g->hi[d]));
+  return in;
+}
+
 /* Add V grad S_i of every seeding-lattice point inside an obstacle, in the cells of the box, to
  * G (dim arrays of nnodes). A point beyond a periodic face is tested at its image; beyond an
  * open face the body continues; beyond a wall there is none (the wall's mirror rules act). */
@@ -480,16 +489,13 @@ static void ghost_sums(const fluid_obstacles *o, const mpm_grid *g, double *cons
   for (int d = 0; d < dim; ++d) n[d] = (g->box_n[d] - 1) * ppc, npts *= n[d];
   for (int k = 0; k < npts; ++k) {
     double x[3] = {0, 0, 0}, xw[3];
-    int in_domain = 1;
     for (int d = 0, r = k; d < dim; ++d, r /= n[d - 1]) {
       const int l = r % n[d];
       x[d] = g->lo[d] + (g->box_lo[d] + l / ppc + (l % ppc + 0.5) / ppc) * g->dx;
     }
     memcpy(xw, x, sizeof x);
     mpm_grid_wrap(g, xw);
-    for (int d = 0; d < dim; ++d)
-      in_domain &= (o->open[d][0] || xw[d] > g->lo[d]) && (o->open[d][1] || xw[d] < g->hi[d]);
-    if (!in_domain || !fluid_obstacles_inside(o, xw)) continue;
+    if (!inside_domain(o, g, xw) || !fluid_obstacles_inside(o, xw)) continue;
     stencil st;
     stencil_at(&st, g, x, o->lp);
     for (int s = 0; s < stencil_count(&st, dim); ++s) {
@@ -625,15 +631,6 @@ int fluid_obstacles_which(const fluid_obstacles *o, const double *x) {
 static int in_bounds(const mpm_sdf *s, int dim, const double *x) {
   int in = 1;
   for (int d = 0; d < dim; ++d) in &= x[d] > s->lo[d] && x[d] < s->hi[d];
-  return in;
-}
-
-/* Does x lie inside the grid's domain along its closed (not periodic, not open) axes? */
-static int inside_domain(const fluid_obstacles *o, const mpm_grid *g, const double *x) {
-  int in = 1;
-  for (int d = 0; d < g->dim; ++d)
-    in &= g->periodic[d] ||
-          ((o->open[d][0] || x[d] >= g->lo[d]) && (o->open[d][1] || x[d] < g->hi[d]));
   return in;
 }
 
