@@ -627,7 +627,7 @@ int fluid_obstacles_which(const fluid_obstacles *o, const double *x) {
   return -1;
 }
 
-/* Inside the bounding box of obstacle k? */
+/* Inside the bounding box of the shape s? */
 static int in_bounds(const mpm_sdf *s, int dim, const double *x) {
   int in = 1;
   for (int d = 0; d < dim; ++d) in &= x[d] > s->lo[d] && x[d] < s->hi[d];

@@ -386,8 +386,8 @@ int fluid_merge(mpm_module *m, const mpm_lidx *start, const mpm_lidx *member, mp
   int rc = merge_all(m, start, member, ngroups, state, rep);
   const mpm_lidx n0 = p->n;
   for (mpm_lidx i = 0; !rc && i < n0; ++i) state[i] = state[i] != 0;
-  if (!rc && rep->removed > 0) rc = mpm_particles_edit(p, state, 0, NULL, NULL);
-  if (!rc && rep->removed > 0) mpm_hier_levels_keep(m->hier, state, n0); /* (a merged one moved) */
+  if (!rc && rep->removed > 0 && (rc = mpm_particles_edit(p, state, 0, NULL, NULL)) == 0)
+    mpm_hier_levels_keep(m->hier, state, n0); /* (a merged one moved: looked up again) */
   free(state);
   MPM_CALL(rc);
   return 0;

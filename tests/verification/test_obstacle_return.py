@@ -15,7 +15,7 @@ Scene: a uniform stream (rho = 1, p = 1, u = 0.6 along x, Mach 0.51) past a slip
   Without the return 2 to 6 particles sat inside, up to 0.0019 deep.
 Checks at every snapshot: no particle inside the circle (its signed distance >= 0; the mirror
 point lies as deep outside as the particle was inside, the fallback 1e-6 of a cell out) and none
-beyond the walls; the particle count unchanged (positions only: no particle is removed) and the
+beyond the walls; on level 0 alone the particle count unchanged (no particle is removed) and the
 mass exact to roundoff (diagnostics.csv). Able to fail: with the call in fluid_boundary
 (fluid/fluid_module.c) removed, the inside counts above return and both parts fail.
 """
@@ -96,8 +96,9 @@ def part(label, text):
         check(inside == 0 and beyond == 0, f"{label}, t = {p['time']:.3f}: {inside} particles "
               f"inside the circle, {beyond} beyond the walls (want 0 and 0)")
     check(len(snaps) >= 3, f"{label}: {len(snaps)} snapshots (want >= 3)")
-    check(len(set(counts)) == 1 or PART == "hierarchy",
-          f"{label}: particle counts {sorted(set(counts))} (want one: nothing removed)")
+    if label == "uniform":  # (on the hierarchy splits and merges change the count)
+        check(len(set(counts)) == 1,
+              f"{label}: particle counts {sorted(set(counts))} (want one: nothing removed)")
     d = np.genfromtxt(os.path.join(out, "diagnostics.csv"), delimiter=",", names=True)
     dm = abs(d["mass"] - d["mass"][0]).max() / d["mass"][0]
     # ~1e4 particle masses summed in another order after splits and merges: n eps ~ 1e-12.
@@ -105,7 +106,6 @@ def part(label, text):
 
 
 if PART == "hierarchy":
-    # (the refined run splits and merges particles at its boxes' faces: the count varies)
     part("hierarchy", SCENE.format(t_end=0.5, method="ssprk2", interval=0.125,
                                    time="cfl = 0.8\n[fluid]\nmol_damping = 0.1",
                                    refine=REFINE))
