@@ -278,15 +278,6 @@ static int grid_scope(const fluid_content *fc, const mpm_config *cfg, const mpm_
     return miss(s, "coupling.exchange",
                 "reads the solid's particles of the gas's own state, and with shared nodes the "
                 "solid has moved on when the gas steps: use coupling.exchange = held");
-  /* Measured (test_refine_obstacles stream, usl): on a uniform grid a stream along an obstacle's
-   * face left its uniform state by 1.09 under the classic update; the ERK pairs keep it. The
-   * cause is the obstacles' hold of barely covered nodes, an impulse in the classic update
-   * (fluid_obstacle.c), which the particle pressure shares (docs/refinement.md). */
-  MPM_CALL(mpm_config_instances(cfg, "obstacle", &names, &count));
-  if (count > 0 && fc->tr.classic)
-    return miss(s, "time.method",
-                "carries obstacles with the ERK pairs only (under the classic update a stream "
-                "along a body's face does not stay uniform); use time.method = bs32");
   int open = 0;
   for (int d = 0; d < g->dim; ++d)
     for (int k = 0; k < 2; ++k) open |= mpm_wall_is_open_gas(fc->walls.face[d][k]);

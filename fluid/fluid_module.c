@@ -1040,6 +1040,7 @@ static int build(mpm_module *m, const mpm_config *cfg, int seed) {
   if (fc->refill_holes < 0) fc->refill_holes = fluid_gridp_weighted(fc); /* auto */
   MPM_CALL(fluid_open_new(&fc->open, m, cfg, &walls, fc->gas.gamma, fc->ppc));
   MPM_CALL(fluid_obstacles_build(&fc->obs, cfg, g, fc->ppc, (const unsigned char(*)[2])m->open));
+  fc->obs.coast = fc->tr.classic; /* (fluid_obstacle.h, Nodes) */
   MPM_CALL(fluid_wall_ls_init(m, cfg, fc->tr.classic));
   fc->virt.phase = -1;
   if (!fc->gridp && fluid_open_uses_virtual(fc->open)) MPM_CALL(fluid_virtual_init(&fc->virt, g));

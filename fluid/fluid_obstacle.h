@@ -10,7 +10,13 @@
  * obstacles and ranks) is held entirely: such a node, mostly inside the body, takes the large
  * and nearly cancelling forces of the gas and of the ghosts below on a small mass, and left
  * free along the surface it made the flow past a body unstable (gas_obstacles.ini at 128
- * cells, the wedge) while a full hold costs the gas at rest nothing. phi and the normals are
+ * cells, the wedge) while a full hold costs the gas at rest nothing. Under the classic update
+ * (usl, musl; the least-squares wall's too) a held slip node coasts instead: it keeps its velocity
+ * of the step's start, slip-projected, and takes none of the step's force. A hold to rest is
+ * there an impulse (v' = 0) that FLIP carries into the particles, so the first layer over a
+ * slip face lost its tangential velocity every step (a uniform stream along a face left its
+ * state by 1.10, test_refine_obstacles stream); the ERK pairs hold a = 0 and v = 0, which
+ * their particles' velocities do not take. phi and the normals are
  * evaluated once, at build. Nodes deep inside carry no mass (no particle is seeded inside, and
  * the stencil of a particle outside reaches at most two cells in), so they cost one comparison.
  *
@@ -107,7 +113,7 @@ typedef struct fluid_obstacles {
   unsigned char open[MPM_MAX_DIM][2]; /* the gas's open faces: ghosts continue beyond them */
   mpm_rhs_records rec;                /* the latest RHS and the one before (mpm_impulse.h) */
   double *f[2];                       /* their forces on this rank, dim per obstacle */
-  int coast;   /* held nodes keep their deposited velocity, slip-projected (least_squares) */
+  int coast;                          /* held nodes keep v^n, slip-projected (the classic update) */
   int heat;    /* book the obstacles' work as heat (least_squares; see Energy above) */
   double hold; /* nodes below this fraction of the largest mass are held (FLUID_OBSTACLE_HOLD) */
   int ppc;

@@ -610,9 +610,6 @@ def part_input():
         else:
             text = plain.replace("dx = 0.05", f"dx = 0.05\n{k} = {value}")
         cases.append((f"grid pressure with {key} = {value}", text, key, f"{k} = {value}", words))
-    cases.append(("grid pressure with an obstacle under usl", plain.replace(
-        "t_end = 0.1", "t_end = 0.1\nmethod = usl") + "\n" + obstacle, "time.method",
-        "method = usl", "ERK pairs only"))
     cases.append(("grid pressure with the gauge exterior", openface.replace(
         "[refine]", grid + "\n[refine]").replace("levels = 2", "levels = 1").split(
         "\n[refine.box]")[0], "freestream.exterior", "exterior = gauge", "gauge"))
