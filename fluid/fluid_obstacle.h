@@ -15,8 +15,9 @@
  * of the step's start, slip-projected, and takes none of the step's force. A hold to rest is
  * there an impulse (v' = 0) that FLIP carries into the particles, so the first layer over a
  * slip face lost its tangential velocity every step (a uniform stream along a face left its
- * state by 1.10, test_refine_obstacles stream); the ERK pairs hold a = 0 and v = 0, which
- * their particles' velocities do not take. phi and the normals are
+ * state by 1.10, test_refine_obstacles stream). The ERK pairs still hold it at rest (a = 0,
+ * v = 0: the particles' positions follow it, their velocities do not); coasting there blew up
+ * a circle on three levels and the 3-D sphere (docs/refinement.md). phi and the normals are
  * evaluated once, at build. Nodes deep inside carry no mass (no particle is seeded inside, and
  * the stencil of a particle outside reaches at most two cells in), so they cost one comparison.
  *

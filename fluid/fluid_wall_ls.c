@@ -370,7 +370,7 @@ int fluid_wall_ls_init(mpm_module *m, const mpm_config *cfg, int classic) {
   MPM_CALL(mpm_config_get_real(cfg, "fluid.wall_blend", &blend));
   w->on = 1, w->band = band * g->dx, w->blend = blend * g->dx;
   MPM_CALL(mpm_config_get_int(cfg, "fluid.wall_fit_order", &w->order));
-  if (fc->obs.count > 0) fluid_obstacles_book_heat(&fc->obs, g); /* (held nodes coast: classic) */
+  if (fc->obs.count > 0) fluid_obstacles_book_heat(&fc->obs, g);
   const int dim = g->dim;
   w->nf = 2 * dim + 2;
   const layout L = layout_of(dim, w->nf, w->order);
