@@ -96,14 +96,11 @@ mpm_add_script_test(test_wedge SCRIPT verification/test_wedge.py ARGS fast
                     LABELS "verification;mpi" TIMEOUT 900)
 mpm_add_script_test(test_wedge_long SCRIPT verification/test_wedge.py ARGS long
                     LABELS "verification;long" TIMEOUT 1800)
-# ghost at dx = 0.005: the gas it traps inside the wedge's foot blows up at t = 0.886 since the
-# FLIP wall rule, and its lift was 44 % short before that (an expected failure; the reasons in
-# test_wedge.py).
+# ghost at dx = 0.005 (an expected failure until its held nodes coasted under usl, 2026-12-05:
+# gas trapped in the wedge's foot blew up; test_wedge.py).
 mpm_add_script_test(test_wedge_ghost_long SCRIPT verification/test_wedge.py ARGS ghost_long
                     LABELS "verification;long" TIMEOUT 1800)
-set_tests_properties(test_wedge_ghost_long PROPERTIES WILL_FAIL TRUE)
-# The same with the light-node rule (fluid.light_node_mass = 0.05): the trapped gas's nodes take
-# no force and the run completes.
+# The same with the light-node rule (fluid.light_node_mass = 0.05).
 mpm_add_script_test(test_wedge_ghost_light_long SCRIPT verification/test_wedge.py
                     ARGS ghost_light_long LABELS "verification;long" TIMEOUT 1800)
 # Woodward-Colella forward step: to t = 4 at dx = 1/80 under long; the first unit of time at
