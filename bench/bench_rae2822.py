@@ -6,8 +6,8 @@
    steadiness, against the wall time. The runs are kept in out/rae2822_dx*/ (--reuse analyses
    runs already there instead of running them again).
 2. Cost: least_squares against ghost per step, on 1 rank at dx = 0.04 over t in [0, 1]
-   (`--repeats` alternated runs each; ghost blows up on this case later, at t = 2.4, so the
-   comparison stops well before). No test asserts a time.
+   (`--repeats` alternated runs each; ghost blew up on this case at t = 2.4 before its held
+   nodes coasted, 2026-12-05, so the comparison stops well before). No test asserts a time.
 
 Writes bench/results/rae2822.{csv,json,md}, rae2822_cp.png (Cp of every resolution against the
 experiment) and rae2822_field.png (the finest run's particles).

@@ -10,8 +10,9 @@ the whole-run times are listed too.
 Cases (--case):
   wedge    cases/wedge.ini (Mach 2.5, 15 degrees) to its t = 1.2, dx 0.01 unless --dx;
   rae2822  cases/rae2822.ini (M 0.729) at its dx = 0.04 unless --dx, to t = 2 unless --t-end:
-           ghost blows up there at t = 2.4, so the comparison is over the start of the run,
-           the impulsive start and the first chord lengths of flow, not its steady state.
+           ghost blew up there at t = 2.4 before its held nodes coasted (2026-12-05), so the
+           comparison is over the start of the run, the impulsive start and the first chord
+           lengths of flow, not its steady state.
   supersonic_bar  the main job under coupling.scheme = traction at dx = 0.004 unless --dx, to
            t = 1.5 ms unless --t-end: the least-squares wall at the moving gas-solid interface
            (coupler/mpm_solid_wall.h) against traction's held nodes alone.
