@@ -9,12 +9,29 @@
 #define MPM_CELLS_H
 
 #include "mpm_grid.h"
+#include "mpm_hier.h"
 #include "mpm_particles.h"
 #include "mpm_shape.h"
 
 /* Count the particles of p (all on the ranks that own their cells: call after migration) per
  * cell into grid->phase[phase].cell_n, owned cells and ghost cells. Collective. */
 int mpm_cells_count(mpm_grid *grid, int phase, const mpm_particles *p);
+
+/* On a hierarchy (mpm_hier.h), the cells of a finer level l are its spans: span i of level l is
+ * centred on node i, [o_l + (i - 1/2) h_l, o_l + (i + 1/2) h_l], and these lie on the lattice
+ * lo + k h_l of the domain's origin (k = i - 2^(l-1)), nested in level 0's cells, so a span's
+ * particles are all on the rank owning the level-0 cell around it. Count the particles of p whose
+ * position is on level l >= 1 (lev[i], mpm_hier_levels; NULL: looked up here) per span of level l
+ * into h->level[l].grid->phase[phase].cell_n, at the span's node (its box index), summed over the
+ * ranks: every rank holds every finer level's counts whole. A particle counts on its own level
+ * only (level 0's counts are mpm_cells_count's). Collective over level 0's communicator. */
+int mpm_cells_count_levels(mpm_hier *h, int phase, const mpm_particles *p,
+                           const unsigned char *lev);
+
+/* The box index on finer level l (>= 1) of h of the cell k (global coordinates on level l's cell
+ * lattice lo + k h_l, wrapped into the domain along a periodic axis), or -1 when the cell lies
+ * outside the domain or the level's box (it then holds no particle of level l). */
+mpm_lidx mpm_cells_level_index(const mpm_hier *h, int l, const int *k);
 
 /* Global cell coordinate of x along d, clamped into the domain (as mpm_grid_owner_of). */
 static inline int mpm_cells_coord(const mpm_grid *g, int d, double x) {

@@ -727,8 +727,11 @@ static int after_step(mpm_sim *s, double h) {
     mpm_timer_stop(MPM_T_MIGRATE);
   }
   mpm_timer_start(MPM_T_POST);
-  for (int k = 0; want_cells && k < s->nmod; ++k)
+  for (int k = 0; want_cells && k < s->nmod; ++k) {
     MPM_CALL(mpm_cells_count(s->grid, s->mod[k]->phase, s->mod[k]->particles));
+    if (s->hier)
+      MPM_CALL(mpm_cells_count_levels(s->hier, s->mod[k]->phase, s->mod[k]->particles, NULL));
+  }
   for (int k = 0; k < s->nmod; ++k) {
     mpm_module *m = s->mod[k];
     if (m->ops->post_step) MPM_CALL(m->ops->post_step(m, s->t, h, &changed[k]));

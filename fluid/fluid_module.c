@@ -765,7 +765,7 @@ static double fluid_stable_dt(const mpm_module *m, const double *y) {
   if (fc->stable_local && fc->s_local < 0.0 && fluid_neighbourhood_signal(m, &fc->s_local) != 0)
     fc->s_local = -1.0; /* an MPI failure: fall back on the particle estimate below */
   if (fc->stable_local && fc->s_local >= 0.0)
-    return fc->s_local > 0.0 ? m->grid->dx / fc->s_local : HUGE_VAL;
+    return fc->s_local > 0.0 ? fluid_finest_dx(m) / fc->s_local : HUGE_VAL;
   const mpm_particles *p = m->particles;
   const mpm_lidx n = p->n;
   const double dx = fluid_finest_dx(m), gamma = fc->gas.gamma; /* one step for every level */

@@ -24,11 +24,13 @@
  * the constraint on each level's active nodes and the ghosts through the grid pressure's spans
  * (fluid_obstacle_levels.c).
  *
+ * Regularisation, refill, the light merges and the neighbourhood stable step count particles in
+ * each level's cells (fluid_regularise.c, fluid_stable.c; mpm_cells_count_levels).
+ *
  * Refused (fluid_refine_check), each naming its key: everything that reads or writes the gas's
  * nodal fields or the grid otherwise: the domain volume rate, the riemann viscosity's limiter,
- * shifting, regularisation and refill (cell counts), the neighbourhood stable step, the
- * least-squares wall treatment. The light-node threshold compares each level's nodes with the
- * mean at that level's spacing (mpm_grid_phase_update_many). An odd fluid.ppc puts level-0
+ * shifting, the least-squares wall treatment. The light-node threshold compares each level's nodes
+ * with the mean at that level's spacing (mpm_grid_phase_update_many). An odd fluid.ppc puts level-0
  * particles on the span faces that bound the finer regions, so it is refused too.
  *
  * Invariant: with m->hier NULL every call here is the plain kernel call (the refined path costs
@@ -141,21 +143,11 @@ typedef struct refusal {
 static const refusal g_refused[] = {
     {"fluid.volume_rate", "domain", "the domain rate samples the nodal velocity on level 0"},
     {"fluid.av_form", "riemann", "the riemann limiter reads the nodal velocity on level 0"},
-    {"fluid.stable_step", "neighbourhood", "the neighbourhood step sums level-0 cells"},
     {"fluid.shift", NULL, "shifting reads the nodal volume fraction on level 0"},
-    {"fluid.regularise_every", NULL, "merging and splitting count particles in level-0 cells"},
-    {"fluid.refill_every", NULL, "refilling counts particles in level-0 cells"},
     {"fluid.wall_treatment", "least_squares",
      "the least-squares wall fits the particles in level-0 cells and books heat on level 0's "
      "nodes"},
 };
-
-/* The reason g_refused gives for key (looked up, so that rows may come and go). */
-static const char *refused_why(const char *key) {
-  for (size_t k = 0; k < sizeof g_refused / sizeof g_refused[0]; ++k)
-    if (strcmp(g_refused[k].key, key) == 0) return g_refused[k].why;
-  return "";
-}
 
 int fluid_refine_check(const mpm_module *m, const mpm_config *cfg) {
   const fluid_content *fc = m->content;
@@ -164,8 +156,6 @@ int fluid_refine_check(const mpm_module *m, const mpm_config *cfg) {
     if (r->choice ? is_choice(cfg, r->key, r->choice) : is_positive(cfg, r->key))
       return refuse(cfg, r->key, r->why);
   }
-  if (fc->reg_every > 0)
-    return refuse(cfg, "fluid.regularise_every", refused_why("fluid.regularise_every"));
   if (fc->ppc % 2)
     return mpm_config_fail(
         cfg, "fluid.ppc",

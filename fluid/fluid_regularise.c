@@ -79,6 +79,13 @@
  * gets the id id_next + (global index of the target), and migration takes it to its owner:
  * the result does not depend on the rank layout.
  *
+ * On a refinement hierarchy (mpm_hier.h) every event runs level by level: a finer level's cells
+ * are its spans (mpm_cells.h), a particle belongs to the cells of its position's level, a refill's
+ * target and donor are cells wholly on one level (a level-0 cell that a finer region cuts is
+ * neither), and the ids of children count the cells of all levels (level_offset). A finer level's
+ * occupancy is summed over the ranks, so every rank finds its targets and donors alike, and the
+ * rank holding a donor's particles (a span lies in one level-0 cell) splits it.
+ *
  * Decomposition independence: the post-step hook runs after migration, so each cell's
  * particles are all on one rank. A cell's particles are processed in id order, and the j-th
  * particle a split creates in global cell c gets the id id_next + c (min - 1) + j (at most
@@ -89,6 +96,7 @@
 
 #include "mpm_cells.h"
 #include "mpm_error.h"
+#include "mpm_hier.h"
 #include "mpm_log.h"
 #include "mpm_particles.h"
 
@@ -105,25 +113,79 @@ typedef struct reg_cell {
   mpm_lidx *slot; /* local indices of the cell's original particles, by id */
 } reg_cell;
 
-/* The cells this rank owns: [c0, c0 + nc) along each axis, and the global lattice. */
+/* The cells of one level that this rank decides: [c0, c0 + nc) along each axis of the global
+ * lattice lo + c dx (ncells along each axis, periodic where the grid is). Without a hierarchy, the
+ * cells level 0's grid owns; on a hierarchy, level 0's owned cells or a finer level's whole box
+ * (mpm_cells.h: its cells are its spans), and only the particles whose position is on the level
+ * (lev[i], mpm_hier_levels) belong to its cells. g holds the occupancy (cell_n). */
 typedef struct reg_box {
   const mpm_grid *g;
-  int dim, c0[MPM_MAX_DIM], nc[MPM_MAX_DIM], ncells[MPM_MAX_DIM];
+  const mpm_hier *h; /* NULL: no hierarchy */
+  const unsigned char *lev;
+  int level;
+  int dim, c0[MPM_MAX_DIM], nc[MPM_MAX_DIM], ncells[MPM_MAX_DIM], periodic[MPM_MAX_DIM];
   double lo[MPM_MAX_DIM], dx;
 } reg_box;
 
-static void box_of(reg_box *b, const mpm_grid *g) {
-  b->g = g, b->dim = g->dim, b->dx = g->dx;
+/* Level `level`'s cells (level 0 without a hierarchy); lev: the particles' levels (h only). */
+static void box_of(reg_box *b, const mpm_module *m, int level, const unsigned char *lev) {
+  const mpm_grid *g = m->grid;
+  b->h = m->hier, b->lev = m->hier ? lev : NULL, b->level = level, b->dim = g->dim;
+  b->g = level ? m->hier->level[level].grid : g;
+  b->dx = ldexp(g->dx, -level);
   for (int d = 0; d < g->dim; ++d) {
+    b->ncells[d] = g->ncells[d] << level, b->lo[d] = g->lo[d], b->periodic[d] = g->periodic[d];
+    if (level) { /* the box's spans, as cells (mpm_cells_level_index) */
+      b->c0[d] = b->g->box_lo[d] - (1 << (level - 1)), b->nc[d] = b->g->box_n[d];
+      continue;
+    }
     b->c0[d] = g->cell_split[d][g->coord[d]];
     b->nc[d] = g->cell_split[d][g->coord[d] + 1] - b->c0[d];
-    b->ncells[d] = g->ncells[d], b->lo[d] = g->lo[d];
   }
 }
 
-/* Global cell coordinate of x along d, as mpm_grid_owner_of computes it. */
+/* The cells of all levels together: cells of level l get global indices from
+ * level_offset(m, l) on, and level_offset(m, nlevels) is the size of that numbering. */
+static mpm_gidx level_offset(const mpm_module *m, int level) {
+  mpm_gidx off = 0;
+  for (int l = 0; l < level; ++l) {
+    mpm_gidx cells = 1;
+    for (int d = 0; d < m->grid->dim; ++d) cells *= (mpm_gidx)m->grid->ncells[d] << l;
+    off += cells;
+  }
+  return off;
+}
+
+/* The levels the events visit: 1, or the hierarchy's. */
+static int levels_of(const mpm_module *m) {
+  return m->hier ? m->hier->nlevels : 1;
+}
+
+/* Global cell coordinate of x along d, as mpm_grid_owner_of computes it on level 0. */
 static int cell_coord(const reg_box *b, int d, double x) {
-  return mpm_cells_coord(b->g, d, x);
+  const int c = mpm_shape_floor((x - b->lo[d]) / b->dx);
+  return c < 0 ? 0 : c >= b->ncells[d] ? b->ncells[d] - 1 : c;
+}
+
+/* The occupancy's index of cell c (unwrapped global coordinates; level 0: inside the rank's box
+ * with its ghosts), or -1 when a finer level's box does not hold it. */
+static mpm_lidx store_index(const reg_box *b, const int *c) {
+  return b->level ? mpm_cells_level_index(b->h, b->level, c) : mpm_grid_local_index(b->g, c);
+}
+
+/* Is every point of cell c (unwrapped) on the box's level? Always without a hierarchy. A finer
+ * level's cell (a span) is wholly on one level, level 0's may straddle a finer region: its 2^dim
+ * quarter points decide. */
+static int is_leaf(const reg_box *b, const int *c) {
+  if (!b->h) return 1;
+  for (int q = 0; q < 1 << b->dim; ++q) {
+    double x[MPM_MAX_DIM] = {0};
+    for (int d = 0; d < b->dim; ++d) x[d] = b->lo[d] + (c[d] + (q >> d & 1 ? 0.75 : 0.25)) * b->dx;
+    mpm_grid_wrap(b->h->level[0].grid, x);
+    if (mpm_hier_level_of(b->h, x) != b->level) return 0;
+    if (b->level) return 1; /* a span: one point tells */
+  }
+  return 1;
 }
 
 /* Local cell index of the particle at x (clamped into the box: after migration it is inside). */
@@ -137,14 +199,15 @@ static mpm_lidx local_cell(const reg_box *b, const double *x) {
   return l;
 }
 
-/* The local cells of particles [from, p->n) into cell[from ..]. */
+/* The local cells of particles [from, p->n) into cell[from ..]; -1 for a particle on another
+ * level than the box's. */
 static void cells_from(const reg_box *b, const mpm_particles *p, mpm_lidx from, mpm_lidx *cell) {
   const double *x[MPM_MAX_DIM] = {NULL}; /* (read once: cell may alias the block) */
   for (int d = 0; d < b->dim; ++d) x[d] = mpm_particles_comp(p, 0, d);
   for (mpm_lidx i = from; i < p->n; ++i) {
     double xi[MPM_MAX_DIM] = {0};
     for (int d = 0; d < b->dim; ++d) xi[d] = x[d][i];
-    cell[i] = local_cell(b, xi);
+    cell[i] = b->lev && b->lev[i] != b->level ? -1 : local_cell(b, xi);
   }
 }
 
@@ -178,9 +241,9 @@ static const mpm_lidx *cellmap_get(reg_cellmap *map, const reg_box *b, const mpm
   return map->cell;
 }
 
-/* Particle indices grouped by local cell (cell[i]: particle i's, from cells_of): cell l holds
- * perm[start[l] .. start[l + 1]), in index order. With a mask, only the cells l with
- * mask[l] != 0 hold their particles. */
+/* Particle indices grouped by local cell (cell[i]: particle i's, from cells_of; -1: none):
+ * cell l holds perm[start[l] .. start[l + 1]), in index order. With a mask, only the cells l
+ * with mask[l] != 0 hold their particles. */
 static int group_by_cell(const reg_box *b, const mpm_particles *p, const mpm_lidx *cell,
                          const unsigned char *mask, mpm_lidx **start, mpm_lidx **perm,
                          mpm_lidx *ncell) {
@@ -192,10 +255,10 @@ static int group_by_cell(const reg_box *b, const mpm_particles *p, const mpm_lid
   if (!*start || !*perm)
     MPM_FAIL(MPM_ERR_MEMORY, "regularise: cannot group %d particles by cell", (int)p->n);
   for (mpm_lidx i = 0; i < p->n; ++i)
-    if (!mask || mask[cell[i]]) (*start)[cell[i] + 2]++;
+    if (cell[i] >= 0 && (!mask || mask[cell[i]])) (*start)[cell[i] + 2]++;
   for (mpm_lidx l = 0; l < nc; ++l) (*start)[l + 2] += (*start)[l + 1];
   for (mpm_lidx i = 0; i < p->n; ++i)
-    if (!mask || mask[cell[i]]) (*perm)[(*start)[cell[i] + 1]++] = i;
+    if (cell[i] >= 0 && (!mask || mask[cell[i]])) (*perm)[(*start)[cell[i] + 1]++] = i;
   return 0;
 }
 
@@ -442,11 +505,11 @@ static int light_cells(const fluid_content *fc, const mpm_particles *p, const mp
   MPM_ALLOC(heaviest, ncell);
   memset(heaviest, 0, sizeof *heaviest * (size_t)ncell);
   for (mpm_lidx i = 0; i < p->n; ++i) /* (not fmax, a call: the same for any mass, NaN too) */
-    if (mass[i] > heaviest[cell[i]]) heaviest[cell[i]] = mass[i];
+    if (cell[i] >= 0 && mass[i] > heaviest[cell[i]]) heaviest[cell[i]] = mass[i];
   memset(mask, 0, (size_t)ncell);
   *nlight = 0;
   for (mpm_lidx i = 0; i < p->n; ++i)
-    if (mass[i] < fc->merge_light * heaviest[cell[i]] && !mask[cell[i]])
+    if (cell[i] >= 0 && mass[i] < fc->merge_light * heaviest[cell[i]] && !mask[cell[i]])
       mask[cell[i]] = 1, ++*nlight;
   free(heaviest);
   return 0;
@@ -454,12 +517,11 @@ static int light_cells(const fluid_content *fc, const mpm_particles *p, const mp
 
 /* The local part of one event: with counts, every cell's light merges and count rules; without,
  * the light merges of the cells that need one. */
-static int regularise_local(mpm_module *m, reg_edit *e, mpm_gidx id_base, int counts,
-                            reg_cellmap *map) {
+static int regularise_local(mpm_module *m, const reg_box *bx, reg_edit *e, mpm_gidx id_base,
+                            int counts, reg_cellmap *map) {
   const fluid_content *fc = m->content;
   mpm_particles *p = m->particles;
-  reg_box b;
-  box_of(&b, m->grid);
+  const reg_box b = *bx;
   mpm_lidx *start = NULL, *perm = NULL, ncell = 1, nlight = 0;
   for (int d = 0; d < b.dim; ++d) ncell *= b.nc[d];
   reg_cell c = {0};
@@ -484,19 +546,23 @@ static int regularise_local(mpm_module *m, reg_edit *e, mpm_gidx id_base, int co
 
 /* ---- refill ------------------------------------------------------------------------------ */
 
-/* Gas particles in cell c (unwrapped global coordinates inside this rank's box). */
-static double gas_count(const mpm_module *m, const int *c) {
-  return m->grid->phase[m->phase].cell_n[mpm_grid_local_index(m->grid, c)];
+/* Particles of `phase` in cell c (unwrapped global coordinates: level 0 inside this rank's box);
+ * 0 where nothing was counted. */
+static double count_of(const reg_box *b, int phase, const int *c) {
+  const double *n = b->g->phase[phase].cell_n;
+  const mpm_lidx l = n ? store_index(b, c) : -1;
+  return l >= 0 ? n[l] : 0.0;
 }
 
-/* Global index of cell c, wrapped (as mpm_cells_wrap); -1 outside the domain. */
-static mpm_gidx cell_index(const mpm_grid *g, const int *c) {
+/* Global index of cell c on the box's level, wrapped (as mpm_cells_wrap); -1 outside the
+ * domain. */
+static mpm_gidx cell_index(const reg_box *b, const int *c) {
   mpm_gidx l = 0;
-  for (int d = g->dim - 1; d >= 0; --d) {
-    const int n = g->ncells[d];
+  for (int d = b->dim - 1; d >= 0; --d) {
+    const int n = b->ncells[d];
     int w = c[d];
     if (w < 0 || w >= n) {
-      if (!g->periodic[d]) return -1;
+      if (!b->periodic[d]) return -1;
       w = (w % n + n) % n;
     }
     l = l * n + w;
@@ -504,25 +570,24 @@ static mpm_gidx cell_index(const mpm_grid *g, const int *c) {
   return l;
 }
 
-/* Does cell c (unwrapped, inside the rank's box) hold no particle of any phase? */
-static int cell_empty(const mpm_grid *g, const int *c) {
-  const mpm_lidx l = mpm_grid_local_index(g, c);
-  for (int k = 0; k < g->nphases; ++k)
-    if (g->phase[k].cell_n && g->phase[k].cell_n[l] > 0.0) return 0;
+/* Does cell c (unwrapped, level 0: inside the rank's box) hold no particle of any phase? */
+static int cell_empty(const reg_box *b, const int *c) {
+  for (int k = 0; k < b->g->nphases; ++k)
+    if (count_of(b, k, c) > 0.0) return 0;
   return 1;
 }
 
 /* Has empty cell e an empty face neighbour inside the domain along every axis (a hole, see the
  * header)? e is at most one cell beyond its donor, its neighbours two: inside the ghost
  * layers. */
-static int in_hole(const mpm_grid *g, const int *e) {
-  for (int d = 0; d < g->dim; ++d) {
+static int in_hole(const reg_box *b, const int *e) {
+  for (int d = 0; d < b->dim; ++d) {
     int found = 0;
     for (int s = -1; s <= 1 && !found; s += 2) {
       int c[MPM_MAX_DIM] = {0};
       memcpy(c, e, sizeof c);
       c[d] += s;
-      found = cell_index(g, c) >= 0 && cell_empty(g, c);
+      found = cell_index(b, c) >= 0 && cell_empty(b, c) && is_leaf(b, c);
     }
     if (!found) return 0;
   }
@@ -530,59 +595,57 @@ static int in_hole(const mpm_grid *g, const int *e) {
 }
 
 /* Is the lattice point e + k (unwrapped; k[d] in cells) outside the obstacles? */
-static int free_at(const mpm_module *m, const int *e, const double *k) {
-  const mpm_grid *g = m->grid;
+static int free_at(const mpm_module *m, const reg_box *b, const int *e, const double *k) {
   double x[MPM_MAX_DIM] = {0};
-  for (int d = 0; d < g->dim; ++d) x[d] = g->lo[d] + (e[d] + k[d]) * g->dx;
-  mpm_grid_wrap(g, x);
+  for (int d = 0; d < b->dim; ++d) x[d] = b->lo[d] + (e[d] + k[d]) * b->dx;
+  mpm_grid_wrap(m->grid, x);
   return m->ops->reserved(m, x) == NULL;
 }
 
 /* Do the obstacles leave the 3^dim cells around cell e free (every corner of them outside)? */
-static int clear_of_obstacles(const mpm_module *m, const int *e) {
-  const int dim = m->grid->dim;
+static int clear_of_obstacles(const mpm_module *m, const reg_box *b, const int *e) {
   int n = 1;
-  for (int d = 0; d < dim; ++d) n *= 4;
+  for (int d = 0; d < b->dim; ++d) n *= 4;
   for (int c = 0; c < n; ++c) {
     double k[MPM_MAX_DIM] = {0};
-    for (int d = 0, r = c; d < dim; ++d, r /= 4) k[d] = r % 4 - 1;
-    if (!free_at(m, e, k)) return 0;
+    for (int d = 0, r = c; d < b->dim; ++d, r /= 4) k[d] = r % 4 - 1;
+    if (!free_at(m, b, e, k)) return 0;
   }
   return 1;
 }
 
 /* Is cell e (unwrapped) a refill target (see the header; holes: of a hole only, and clear of
- * the obstacles)? */
-static int refill_target(const mpm_module *m, const int *e, int holes) {
-  const mpm_grid *g = m->grid;
-  if (cell_index(g, e) < 0 || !cell_empty(g, e)) return 0;
-  if (holes && !(in_hole(g, e) && clear_of_obstacles(m, e))) return 0;
+ * the obstacles)? On a hierarchy it must lie wholly on the box's level. */
+static int refill_target(const mpm_module *m, const reg_box *b, const int *e, int holes) {
+  if (cell_index(b, e) < 0 || !cell_empty(b, e) || !is_leaf(b, e)) return 0;
+  if (holes && !(in_hole(b, e) && clear_of_obstacles(m, b, e))) return 0;
   const double centre[MPM_MAX_DIM] = {0.5, 0.5, 0.5};
-  return free_at(m, e, centre);
+  return free_at(m, b, e, centre);
 }
 
-/* The direction (0 .. 2 dim) from target e to its donor, or -1 if no neighbour holds gas. */
-static int refill_donor(const mpm_module *m, const int *e) {
-  const mpm_grid *g = m->grid;
+/* The direction (0 .. 2 dim) from target e to its donor, or -1 if no neighbour holds gas. On a
+ * hierarchy a donor lies wholly on the target's level. */
+static int refill_donor(const mpm_module *m, const reg_box *b, const int *e) {
   int best = -1;
   double nbest = 0.0;
   mpm_gidx ibest = 0;
-  for (int q = 0; q < 2 * g->dim; ++q) {
+  for (int q = 0; q < 2 * b->dim; ++q) {
     int c[MPM_MAX_DIM] = {0};
     memcpy(c, e, sizeof c);
     c[q / 2] += q % 2 ? 1 : -1;
-    const mpm_gidx ic = cell_index(g, c);
+    const mpm_gidx ic = cell_index(b, c);
     if (ic < 0) continue;
-    const double n = gas_count(m, c);
-    if (n > nbest || (n == nbest && n > 0.0 && ic < ibest)) best = q, nbest = n, ibest = ic;
+    const double n = count_of(b, m->phase, c);
+    if ((n > nbest || (n == nbest && n > 0.0 && ic < ibest)) && is_leaf(b, c))
+      best = q, nbest = n, ibest = ic;
   }
   return best;
 }
 
 /* Split the heaviest particle among perm[0 .. k) (ties: the lowest id): it keeps half, and a
  * child with the other half goes to the centre of cell e with id `id`. */
-static int refill_split(mpm_module *m, const mpm_lidx *perm, int k, const int *e, mpm_gidx id,
-                        reg_edit *ed) {
+static int refill_split(mpm_module *m, const reg_box *b, const mpm_lidx *perm, int k, const int *e,
+                        mpm_gidx id, reg_edit *ed) {
   const fluid_content *fc = m->content;
   mpm_particles *p = m->particles;
   double *mass = mpm_particles_comp(p, fc->lay.f_m, 0),
@@ -598,8 +661,7 @@ static int refill_split(mpm_module *m, const mpm_lidx *perm, int k, const int *e
   if (nc > (int)(sizeof row / sizeof row[0]))
     MPM_FAIL(MPM_ERR_INTERNAL, "refill: %d components per particle", nc);
   for (int q = 0; q < nc; ++q) row[q] = p->data[(size_t)q * p->n + h];
-  for (int d = 0; d < p->dim; ++d)
-    row[p->offset[0] + d] = m->grid->lo[d] + (e[d] + 0.5) * m->grid->dx;
+  for (int d = 0; d < p->dim; ++d) row[p->offset[0] + d] = b->lo[d] + (e[d] + 0.5) * b->dx;
   return edit_append(ed, row, id, nc);
 }
 
@@ -609,82 +671,90 @@ static int refill_split(mpm_module *m, const mpm_lidx *perm, int k, const int *e
  * a refill that finds no target (a flow with no near vacuum) groups none. Returns the number
  * of donors. */
 static mpm_lidx mark_donors(const mpm_module *m, const reg_box *b, int holes, unsigned char *mark) {
-  const mpm_grid *g = m->grid;
-  const int dim = g->dim;
-  mpm_lidx total = 1, ndonor = 0, stride[MPM_MAX_DIM] = {1, 1, 1};
+  const int dim = b->dim;
+  mpm_lidx total = 1, ndonor = 0;
   for (int d = 0; d < dim; ++d) total *= b->nc[d];
-  for (int d = 1; d < dim; ++d) stride[d] = stride[d - 1] * g->box_n[d - 1];
   for (mpm_lidx l = 0; l < total; ++l) {
     int c[MPM_MAX_DIM] = {0};
     mpm_lidx r = l;
     for (int d = 0; d < dim; ++d) c[d] = b->c0[d] + (int)(r % b->nc[d]), r /= b->nc[d];
     mark[l] = 0;
-    if (!(gas_count(m, c) > 0.0)) continue;
-    const mpm_lidx lc = mpm_grid_local_index(g, c);
+    if (!(count_of(b, m->phase, c) > 0.0)) continue;
     for (int q = 0; q < 2 * dim; ++q) {
-      /* Most neighbours hold particles and so are no target: a look at the counts in the box
-       * (the ghost layers hold the cells next to the owned ones) rejects them first. */
-      const mpm_lidx le = lc + (q % 2 ? stride[q / 2] : -stride[q / 2]);
-      int occupied = 0;
-      for (int k = 0; k < g->nphases && !occupied; ++k)
-        occupied = g->phase[k].cell_n && g->phase[k].cell_n[le] > 0.0;
-      if (occupied) continue;
       int e[MPM_MAX_DIM] = {0};
       memcpy(e, c, sizeof e);
       e[q / 2] += q % 2 ? 1 : -1;
-      if (refill_target(m, e, holes) && refill_donor(m, e) == (q ^ 1)) mark[l] |= 1u << q;
+      /* Most neighbours hold particles and so are no target: the counts reject them first (level
+       * 0's ghost layers hold the cells next to the owned ones). */
+      if (!cell_empty(b, e)) continue;
+      if (refill_target(m, b, e, holes) && refill_donor(m, b, e) == (q ^ 1)) mark[l] |= 1u << q;
     }
     ndonor += mark[l] != 0;
   }
   return ndonor;
 }
 
-/* This rank's part of a refill: each owned cell holding gas gives to the targets that chose
- * it. Returns the number of children in ed->nadd. */
-static int refill_local(mpm_module *m, int holes, reg_edit *ed, mpm_gidx id_base,
+/* This rank's part of a refill on one level: each cell of b holding gas gives to the targets
+ * that chose it, if its particles are on this rank. Appends the children to ed. */
+static int refill_local(mpm_module *m, const reg_box *b, int holes, reg_edit *ed, mpm_gidx id_base,
                         reg_cellmap *map) {
   mpm_particles *p = m->particles;
-  const mpm_grid *g = m->grid;
-  reg_box b;
-  box_of(&b, g);
   mpm_lidx ncell = 1;
-  for (int d = 0; d < g->dim; ++d) ncell *= b.nc[d];
+  for (int d = 0; d < b->dim; ++d) ncell *= b->nc[d];
   unsigned char *donor;
   MPM_ALLOC(donor, ncell);
   mpm_lidx *start = NULL, *perm = NULL;
   int rc = 0;
-  if (mark_donors(m, &b, holes, donor)) {
-    const mpm_lidx *cell = cellmap_get(map, &b, p);
+  if (mark_donors(m, b, holes, donor)) {
+    const mpm_lidx *cell = cellmap_get(map, b, p);
     if (!cell) {
       free(donor);
       MPM_FAIL(MPM_ERR_MEMORY, "refill: cannot group %d particles by cell", (int)p->n);
     }
-    rc = group_by_cell(&b, p, cell, donor, &start, &perm, &ncell);
+    rc = group_by_cell(b, p, cell, donor, &start, &perm, &ncell);
   }
   for (mpm_lidx l = 0; !rc && start && l < ncell; ++l) {
     const int k = (int)(start[l + 1] - start[l]);
     if (k == 0) continue;
     int c[MPM_MAX_DIM] = {0};
     mpm_lidx r = l;
-    for (int d = 0; d < g->dim; ++d) c[d] = b.c0[d] + (int)(r % b.nc[d]), r /= b.nc[d];
-    for (int q = 0; !rc && q < 2 * g->dim; ++q) {
+    for (int d = 0; d < b->dim; ++d) c[d] = b->c0[d] + (int)(r % b->nc[d]), r /= b->nc[d];
+    for (int q = 0; !rc && q < 2 * b->dim; ++q) {
       if (!(donor[l] >> q & 1)) continue;
       int e[MPM_MAX_DIM] = {0};
       memcpy(e, c, sizeof e);
       e[q / 2] += q % 2 ? 1 : -1;
-      rc = refill_split(m, perm + start[l], k, e, id_base + cell_index(g, e), ed);
+      rc = refill_split(m, b, perm + start[l], k, e, id_base + cell_index(b, e), ed);
     }
   }
   free(donor), free(start), free(perm);
   return rc;
 }
 
-/* One refill over all ranks (holes: of the holes only): split, append, migrate. Returns the
- * global number of children. */
+/* The particles' levels on a hierarchy (mpm_hier_levels, valid until the set or the hierarchy's
+ * census changes), NULL without one; *rc set on failure. */
+static const unsigned char *particle_levels(const mpm_module *m, int *rc) {
+  if (!m->hier) return NULL;
+  const unsigned char *lev = fluid_position_levels(m, m->particles->data);
+  if (!lev) *rc = MPM_ERR_MEMORY;
+  return lev;
+}
+
+/* One refill over all ranks and levels (holes: of the holes only): split, append, migrate.
+ * Returns the global number of children. map: level 0's cell map without a hierarchy (extended
+ * by the children); on a hierarchy each level's map is made and dropped here. */
 static int refill(mpm_module *m, int holes, double *children, int *changed, reg_cellmap *map) {
   mpm_particles *p = m->particles;
   reg_edit ed = {0};
-  int rc = refill_local(m, holes, &ed, p->id_next, map);
+  int rc = 0;
+  const unsigned char *lev = particle_levels(m, &rc);
+  for (int l = 0; !rc && l < levels_of(m); ++l) {
+    reg_box b;
+    box_of(&b, m, l, lev);
+    reg_cellmap own = {0};
+    rc = refill_local(m, &b, holes, &ed, p->id_next + level_offset(m, l), m->hier ? &own : map);
+    free(own.cell);
+  }
   /* A child lands in a cell next to its donor's: on another rank (or across a periodic face)
    * only at the edge of this rank's box. Migration is needed only for those. */
   mpm_lidx away = 0;
@@ -703,7 +773,7 @@ static int refill(mpm_module *m, int holes, double *children, int *changed, reg_
                           : NULL;
     if (grown) {
       reg_box b;
-      box_of(&b, m->grid);
+      box_of(&b, m, 0, NULL);
       cells_from(&b, p, n0, grown);
       map->cell = grown, map->n = p->n;
     }
@@ -715,9 +785,7 @@ static int refill(mpm_module *m, int holes, double *children, int *changed, reg_
   if (sum[0] > 0) MPM_FAIL(MPM_ERR_MEMORY, "refill: failed on another rank");
   *children = sum[1];
   if (sum[1] == 0) return 0;
-  mpm_gidx cells = 1;
-  for (int d = 0; d < m->grid->dim; ++d) cells *= m->grid->ncells[d];
-  p->id_next += cells;
+  p->id_next += level_offset(m, levels_of(m));
   int migrated = 0;
   if (sum[2] > 0) { /* the set changes on every rank that sends or receives: drop the map */
     free(map->cell), map->cell = NULL, map->n = 0;
@@ -735,35 +803,50 @@ static void totals(const mpm_module *m, double *t) {
   for (int d = 0; d < 3; ++d) t[1 + d] = s.momentum[d];
 }
 
+/* The merges and splits of one event on every level (counts: by count too, else the light
+ * merges alone), each level's edit applied before the next level's cells are found. */
+static int regularise_levels(mpm_module *m, int counts, reg_cellmap *map, long *tally) {
+  const fluid_content *fc = m->content;
+  int rc = 0;
+  for (int l = 0; !rc && l < levels_of(m); ++l) {
+    reg_edit e = {0};
+    const unsigned char *lev = particle_levels(m, &rc);
+    reg_box b;
+    box_of(&b, m, l, lev);
+    reg_cellmap own = {0};
+    const mpm_gidx base = m->particles->id_next + level_offset(m, l) * (fc->reg_min - 1);
+    if (!rc) rc = regularise_local(m, &b, &e, base, counts, m->hier ? &own : map);
+    free(own.cell);
+    tally[0] += e.splits, tally[1] += e.merges, tally[2] += e.light;
+    free(e.keep), free(e.add), free(e.add_id);
+  }
+  return rc;
+}
+
 int fluid_regularise(mpm_module *m, long step, int *changed) {
   const fluid_content *fc = m->content;
   const int merge_split = fc->reg_every > 0 && step % fc->reg_every == 0;
   const int full = fluid_refill_due(fc, step) == 2, fill = fluid_refill_due(fc, step) > 0;
   if (!merge_split && !fill) return 0;
   mpm_particles *p = m->particles;
-  reg_edit e = {0};
-  double sum[13] = {0}; /* failures, splits, merges, totals before (5) and after (5) */
+  long tally[3] = {0, 0, 0}; /* splits, merges, light merges */
+  double sum[13] = {0};      /* failures, splits, merges, totals before (5) and after (5) */
   double children = 0.0;
   const int logged = mpm_log_get_level() >= MPM_LOG_DEBUG; /* the totals are for the log only */
   if (logged) totals(m, sum + 3);
   reg_cellmap map = {0};
   int rc = fill ? refill(m, !full, &children, changed, &map) : 0;
   const int light = fc->merge_light > 0.0 && (merge_split || full); /* not at holes alone */
-  if (!rc && (merge_split || light)) rc = regularise_local(m, &e, p->id_next, merge_split, &map);
+  if (!rc && (merge_split || light)) rc = regularise_levels(m, merge_split, &map, tally);
   free(map.cell);
-  sum[0] = rc != 0, sum[1] = (double)e.splits, sum[2] = (double)e.merges;
+  sum[0] = rc != 0, sum[1] = (double)tally[0], sum[2] = (double)tally[1];
   if (logged) totals(m, sum + 8);
-  free(e.keep), free(e.add), free(e.add_id);
   /* One reduction: every rank learns of a failure anywhere before it goes on. */
   MPM_CALL_MPI(MPI_Allreduce(MPI_IN_PLACE, sum, 13, MPI_DOUBLE, MPI_SUM, m->grid->comm));
   MPM_CALL(rc);
   if (sum[0] > 0) MPM_FAIL(MPM_ERR_MEMORY, "regularise: failed on another rank");
-  if (sum[1] > 0) {
-    mpm_gidx cells = 1;
-    for (int d = 0; d < m->grid->dim; ++d) cells *= m->grid->ncells[d];
-    p->id_next += cells * (mpm_gidx)(fc->reg_min - 1);
-  }
-  if (e.splits || e.merges || e.light) *changed = 1;
+  if (sum[1] > 0) p->id_next += level_offset(m, levels_of(m)) * (mpm_gidx)(fc->reg_min - 1);
+  if (tally[0] || tally[1] || tally[2]) *changed = 1;
   mpm_log(MPM_LOG_DEBUG,
           "regularise step %ld: %.0f refills, %.0f splits, %.0f merges; mass %.17g -> %.17g, "
           "momentum (%.17g, %.17g, %.17g) -> (%.17g, %.17g, %.17g), energy %.17g -> %.17g",

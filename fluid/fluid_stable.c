@@ -20,24 +20,33 @@
  * not depend on the decomposition (up to the order of the sums). It is computed once per step, at
  * the first estimate after the step began (every rank asks at the same points: the estimate is
  * collective), from the state the step starts from; the adaptive pairs' stage and end-of-step
- * estimates reuse it. */
+ * estimates reuse it.
+ *
+ * On a hierarchy (mpm_hier.h) each particle counts in the cells of its position's level, and the
+ * neighbourhoods are taken on each level: level 0's cells as above, a finer level's spans (its
+ * cells, mpm_cells.h) over its box, summed over the ranks, so every rank holds them whole. As the
+ * particle estimate does there, every level's speeds take the finest spacing for the viscous
+ * length, and the one step of every level is the finest spacing over the largest s_c. */
 #include "fluid_internal.h"
 
 #include "fluid_stress.h"
 #include "mpm_cells.h"
 #include "mpm_error.h"
+#include "mpm_hier.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
 /* Deposit m, m s^2 and m |v| of every particle into its cell (at the cell's lower corner
- * node, as mpm_cells.h stores cells). */
-static void deposit(const mpm_module *m, double *const *sum) {
+ * node, as mpm_cells.h stores cells); on a hierarchy (lev: the particles' levels), a particle on
+ * level l >= 1 into fine[l]'s three fields at its span (mpm_cells_level_index). */
+static void deposit(const mpm_module *m, double *const *sum, const unsigned char *lev,
+                    double *const *fine) {
   const fluid_content *fc = m->content;
   const mpm_particles *p = m->particles;
   const mpm_grid *g = m->grid;
-  const double dx = g->dx, gamma = fc->gas.gamma;
+  const double gamma = fc->gas.gamma;
   const double *mass = mpm_particles_comp(p, fc->lay.f_m, 0);
   const double *V0 = mpm_particles_comp(p, fc->lay.f_V0, 0);
   const double *divv = mpm_particles_comp(p, fc->lay.f_divv, 0);
@@ -55,12 +64,28 @@ static void deposit(const mpm_module *m, double *const *sum) {
     }
     const double rho = fc->gas.mu > 0.0 ? mass[i] / (V0[i] * J[i]) : 1.0; /* only mu needs it */
     const double cs = sqrt(gamma * (gamma - 1.0) * fabs(e[i]));
-    const double s =
-        fc->gas.damped_step
-            ? fluid_signal_speed(&fc->gas, rho, cs, divv[i], psi ? psi[i] : 0.0, dx)
-            : cs + fluid_viscous_speed(&fc->gas, rho, cs, divv[i], psi ? psi[i] : 0.0, dx);
-    const mpm_lidx l = mpm_grid_local_index(g, c);
-    sum[0][l] += mass[i], sum[1][l] += mass[i] * s * s, sum[2][l] += mass[i] * sqrt(v2);
+    /* The spacing and viscous lengths of the particle's level (fluid_module.c's particle
+     * estimate on a hierarchy). */
+    const double dx = lev ? m->hier->level[lev[i]].grid->dx : g->dx;
+    const fluid_gas gas = lev ? fluid_gas_at(&fc->gas, &dx, 0) : fc->gas;
+    const double s = gas.damped_step
+                         ? fluid_signal_speed(&gas, rho, cs, divv[i], psi ? psi[i] : 0.0, dx)
+                         : cs + fluid_viscous_speed(&gas, rho, cs, divv[i], psi ? psi[i] : 0.0, dx);
+    double *const *to = sum;
+    mpm_lidx l;
+    if (lev && lev[i] > 0) { /* its span on level lev[i]: the cell lo + k h of that level */
+      const int L = lev[i];
+      const mpm_grid *gl = m->hier->level[L].grid;
+      for (int d = 0; d < g->dim; ++d)
+        c[d] = (int)floor((x[d][i] - g->lo[d]) * m->hier->level[L].inv_h);
+      l = mpm_cells_level_index(m->hier, L, c);
+      if (l < 0) continue; /* (no span of its level there: cannot happen) */
+      double *f[3] = {fine[L], fine[L] + gl->nnodes, fine[L] + 2 * gl->nnodes};
+      f[0][l] += mass[i], f[1][l] += mass[i] * s * s, f[2][l] += mass[i] * sqrt(v2);
+      continue;
+    }
+    l = mpm_grid_local_index(g, c);
+    to[0][l] += mass[i], to[1][l] += mass[i] * s * s, to[2][l] += mass[i] * sqrt(v2);
   }
 }
 
@@ -83,6 +108,32 @@ static void box_sum_axis(const mpm_grid *g, int d, const double *in, double *out
   }
 }
 
+/* The largest s_c over a finer level's box, times h_finest / h_l (so that the finest spacing
+ * over it is the level's step): its sums (three fields in buf, room for six), summed over the
+ * ranks, then block-summed like level 0's. */
+static int level_signal(const mpm_module *m, int l, double *buf, double *smax) {
+  const mpm_grid *g = m->hier->level[l].grid;
+  const size_t nn = (size_t)g->nnodes;
+  const double scale = fluid_finest_dx(m) / g->dx;
+  if (m->hier->nranks > 1)
+    MPM_CALL_MPI(
+        MPI_Allreduce(MPI_IN_PLACE, buf, (int)(3 * nn), MPI_DOUBLE, MPI_SUM, m->grid->comm));
+  double *sum[3] = {buf, buf + nn, buf + 2 * nn},
+         *tmp[3] = {buf + 3 * nn, buf + 4 * nn, buf + 5 * nn};
+  for (int d = 0; d < g->dim; ++d)
+    for (int j = 0; j < 3; ++j) {
+      box_sum_axis(g, d, sum[j], tmp[j]);
+      double *t = sum[j];
+      sum[j] = tmp[j], tmp[j] = t;
+    }
+  for (size_t k = 0; k < nn; ++k) {
+    if (!(sum[0][k] > 0.0)) continue;
+    const double s = (sqrt(sum[1][k] / sum[0][k]) + sum[2][k] / sum[0][k]) * scale;
+    if (s > *smax) *smax = s;
+  }
+  return 0;
+}
+
 int fluid_neighbourhood_signal(const mpm_module *m, double *smax) {
   fluid_content *fc = m->content;
   mpm_grid *g = m->grid;
@@ -90,7 +141,24 @@ int fluid_neighbourhood_signal(const mpm_module *m, double *smax) {
   double *sum[3] = {fc->cellsum, fc->cellsum + nn, fc->cellsum + 2 * nn};
   double *tmp[3] = {fc->cellsum + 3 * nn, fc->cellsum + 4 * nn, fc->cellsum + 5 * nn};
   memset(fc->cellsum, 0, sizeof *fc->cellsum * 3 * nn);
-  deposit(m, sum);
+  double *fine[MPM_HIER_MAX_LEVELS] = {NULL};
+  const unsigned char *lev = NULL;
+  const int nlevels = m->hier ? m->hier->nlevels : 1;
+  int rc = 0;
+  if (nlevels > 1) {
+    lev = fluid_position_levels(m, m->particles->data);
+    rc = lev ? 0 : MPM_ERR_MEMORY;
+  }
+  for (int l = 1; !rc && l < nlevels; ++l) {
+    const size_t nl = (size_t)m->hier->level[l].grid->nnodes;
+    fine[l] = calloc(6 * nl, sizeof *fine[l]);
+    if (!fine[l]) rc = MPM_ERR_MEMORY;
+  }
+  if (!rc) deposit(m, sum, lev, fine);
+  double best = 0.0;
+  for (int l = 1; !rc && l < nlevels; ++l) rc = level_signal(m, l, fine[l], &best);
+  for (int l = 1; l < nlevels; ++l) free(fine[l]);
+  if (rc) MPM_FAIL(rc, "the neighbourhood step: cannot sum the finer levels' cells");
   MPM_CALL(mpm_grid_halo_forward(g, sum, 3));
   /* The 3^dim block sums, one axis at a time (the halo holds the cells around the box). */
   for (int d = 0; d < g->dim; ++d)
@@ -106,14 +174,14 @@ int fluid_neighbourhood_signal(const mpm_module *m, double *smax) {
     n[d] = g->cell_split[d][g->coord[d] + 1] - lo[d];
     total *= n[d];
   }
-  double best = 0.0;
+  const double scale0 = fluid_finest_dx(m) / g->dx; /* 1 without a hierarchy */
   for (mpm_lidx k = 0; k < total; ++k) {
     int c[MPM_MAX_DIM] = {0};
     mpm_lidx r = k;
     for (int d = 0; d < g->dim; ++d) c[d] = lo[d] + (int)(r % n[d]), r /= n[d];
     const mpm_lidx l = mpm_grid_local_index(g, c);
     if (!(sum[0][l] > 0.0)) continue;
-    const double s = sqrt(sum[1][l] / sum[0][l]) + sum[2][l] / sum[0][l];
+    const double s = (sqrt(sum[1][l] / sum[0][l]) + sum[2][l] / sum[0][l]) * scale0;
     if (s > best) best = s; /* fmax's result, NaN included, without its call */
   }
   *smax = best;

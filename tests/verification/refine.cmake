@@ -24,6 +24,12 @@ foreach(part static dynamic obstacles solid)
   mpm_add_script_test(test_refine_ranks_${part} SCRIPT verification/test_refine_ranks.py
                       ARGS ${part} LABELS "verification;mpi" TIMEOUT 300)
 endforeach()
+# The gas's expansion settings on the levels (refill, light merges, merges and splits by count,
+# the neighbourhood step): a centre expanding inside a level-1 box keeps every level-1 span
+# filled (emptied without the refill), conserves, and gives the same particles on 2 ranks as
+# on 1 (~35 s).
+mpm_add_script_test(test_refine_gas_refill SCRIPT verification/test_refine_gas.py ARGS refill
+                    LABELS "verification;mpi" TIMEOUT 600)
 # The refined output (issue 51 item 6): levels in the snapshots and the XDMF index, the
 # particle level, the per-level counts, the timers, ParaView opening it when pvpython is there
 # (~8 s).

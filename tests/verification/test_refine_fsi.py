@@ -38,8 +38,8 @@ regrid Regrids beside the solid (fluid.pressure = grid, usl, density criterion 1
        and the slab on the finest level throughout (the run stops otherwise); a restart at
        t = 0.2 of the pulse to t = 0.4 bit for bit.
 bar    The main job's scene on two levels, the box around the bar touching the floor, to 1 ms
-       (the light-node rule on the levels; refill, regularisation and the neighbourhood step
-       off, as the hierarchy does not carry them): it runs, the interface balanced.
+       (the light-node rule, refill, regularisation, the light merges and the neighbourhood
+       step on the levels, the case's own settings): it runs, the interface balanced.
 input  Every refusal of a gas beside a solid on a hierarchy: exit 2, one line naming
        case.ini:LINE and the key.
 Able to fail (measured while building it): with the coupling on level 0 only (the code before
@@ -272,18 +272,17 @@ def part_regrid():
 
 
 BAR_LEVELS = ["time.t_end=0.001", "grid.dx=0.006", "fluid.pressure=grid",
-              "fluid.regularise_every=0", "fluid.refill_every=0", "fluid.merge_light=0",
-              "fluid.stable_step=particle", "refine.levels=2", "refine.box.level=1",
+              "refine.levels=2", "refine.box.level=1",
               "refine.box.lo=0.072 0", "refine.box.hi=0.156 0.078"]
 
 
 def part_bar():
     """The main job's scene on two levels (cases/supersonic_bar.ini, level 0 at 6 mm, a level-1
     box around the bar touching the floor, so the bar's floor wall and its clamp act on level
-    1): with the settings the hierarchy does not carry yet turned off (refill, regularisation,
-    the neighbourhood step) and the light-node rule kept (fluid.light_node_mass = 0.05, each
-    level's nodes against the mean at its spacing), it runs to 1 ms with the interface's
-    momentum balanced to roundoff. Without the light-node rule the same run stops at 0.08 ms
+    1): with the case's gas settings (refill, regularisation, the light merges, the
+    neighbourhood step and the light-node rule, fluid.light_node_mass = 0.05, each level's nodes
+    against the mean at its spacing), it runs to 1 ms with the interface's momentum balanced to
+    roundoff. Without the light-node rule the same run stops at 0.08 ms
     (a gas particle's e <= 0 beside the bar; measured, printed below as information)."""
     with open(os.path.join(mt.SOURCE, "cases", "supersonic_bar.ini")) as f:
         text = f.read()
