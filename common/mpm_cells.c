@@ -51,6 +51,7 @@ int mpm_cells_count_levels(mpm_hier *h, int phase, const mpm_particles *p,
   if (h->nlevels < 2) return 0;
   const double *x[MPM_MAX_DIM] = {NULL};
   for (int d = 0; d < dim; ++d) x[d] = mpm_particles_comp(p, 0, d);
+  if (!lev) lev = mpm_hier_levels(h, x, p->n); /* (NULL when out of memory: looked up below) */
   for (mpm_lidx i = 0; i < p->n; ++i) {
     double xi[MPM_MAX_DIM] = {0};
     for (int d = 0; d < dim; ++d) xi[d] = x[d][i];

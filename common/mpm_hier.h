@@ -202,9 +202,11 @@ int mpm_hier_level_from(const mpm_hier *h, const double *x, int hint);
 int mpm_hier_level_walk(const mpm_hier *h, const double *x);
 
 /* The level (mpm_hier_level_of) of each of n points x[d][i], in an array of h's that holds
- * them until the next call (NULL when out of memory). h remembers the points: a point equal bit
- * for bit to the one the last call had at its index takes the level found then, so a caller
- * asking again at positions that did not move pays a comparison per point (mpm_hier_census.c). */
+ * them until the next call (NULL when out of memory). h remembers the points of the last few
+ * sets, each by the address x[0]: a point equal bit for bit to the one the set's last call had at
+ * its index takes the level found then, so a caller asking again at positions that did not move
+ * pays a comparison per point, whatever other sets were asked about in between
+ * (mpm_hier_census.c). */
 const unsigned char *mpm_hier_levels(mpm_hier *h, const double *const *x, mpm_lidx n);
 
 /* The points were compacted to those with keep[i] != 0 (n flags, in order, as

@@ -4,8 +4,9 @@
  *
  * Invariants: a particle's level is mpm_hier_level_of at its position (the particle field "x"),
  * the level it deposits on and reads; the counts are those levels tallied, so they sum to p->n.
- * mpm_hier_levels remembers the points it last saw and their levels (h->census): a point equal
- * bit for bit to the one remembered at its index takes the remembered level, which is the one
+ * mpm_hier_levels remembers the points it last saw and their levels (h->census; a few sets,
+ * each keyed by the address of its positions): a point equal bit for bit to the one remembered
+ * at its index takes the remembered level, which is the one
  * mpm_hier_level_of gives (a pure function of the point and of h, which does not change: a
  * regrid builds a new hierarchy). So the answers are those of mpm_hier_level_of whatever the
  * callers' order; the memory only spares the search where positions did not move, and where
@@ -16,39 +17,67 @@
 #include <stdlib.h>
 #include <string.h>
 
-typedef struct hier_census {
+/* One remembered set of points, keyed by the address of its first component array: the gas's
+ * positions between steps, an integrator's stage positions, a solid's. */
+typedef struct census_set {
+  const double *key;        /* x[0] of the set's last call (NULL: unused) */
+  unsigned long used;       /* the census clock at its last call */
   mpm_lidx cap, n;          /* points the arrays hold, points remembered */
   uint64_t *x[MPM_MAX_DIM]; /* the remembered points' bits, component-major */
   unsigned char *lev;       /* their levels */
+} census_set;
+
+/* A few sets, so that callers alternating between sets (a gas and a solid counted for the
+ * diagnostics, the stages and the step's end) do not make each other look everything up again;
+ * the least recently used one makes room for a new set. */
+#define CENSUS_SETS 4
+typedef struct hier_census {
+  census_set set[CENSUS_SETS];
+  unsigned long clock;
 } hier_census;
 
 void mpm_hier_census_free(void *census) {
   hier_census *c = census;
   if (!c) return;
-  for (int d = 0; d < MPM_MAX_DIM; ++d) free(c->x[d]);
-  free(c->lev), free(c);
+  for (int k = 0; k < CENSUS_SETS; ++k) {
+    for (int d = 0; d < MPM_MAX_DIM; ++d) free(c->set[k].x[d]);
+    free(c->set[k].lev);
+  }
+  free(c);
 }
 
-/* The memory, with room for n points (NULL when out of memory: nothing is remembered). */
-static hier_census *room(mpm_hier *h, mpm_lidx n) {
+/* The set remembered for key (or the least recently used one, emptied), with room for n points
+ * (NULL when out of memory: nothing is remembered). */
+static census_set *room(mpm_hier *h, const double *key, mpm_lidx n) {
   hier_census *c = h->census;
   if (!c && !(c = h->census = calloc(1, sizeof *c))) return NULL;
-  if (n <= c->cap) return c;
+  census_set *s = NULL;
+  for (int k = 0; k < CENSUS_SETS && !s; ++k)
+    if (c->set[k].key == key) s = &c->set[k];
+  if (!s) {
+    s = &c->set[0];
+    for (int k = 1; k < CENSUS_SETS; ++k)
+      if (c->set[k].used < s->used) s = &c->set[k];
+    s->key = key, s->n = 0;
+  }
+  s->used = ++c->clock;
+  if (n <= s->cap) return s;
   const mpm_lidx cap = n + n / 4 + 16;
-  unsigned char *lev = realloc(c->lev, (size_t)cap);
-  if (lev) c->lev = lev;
+  unsigned char *lev = realloc(s->lev, (size_t)cap);
+  if (lev) s->lev = lev;
   for (int d = 0; d < h->dim && lev; ++d) {
-    uint64_t *x = realloc(c->x[d], sizeof(uint64_t) * (size_t)cap);
-    if (x) c->x[d] = x;
+    uint64_t *x = realloc(s->x[d], sizeof(uint64_t) * (size_t)cap);
+    if (x) s->x[d] = x;
     lev = x ? lev : NULL;
   }
-  if (!lev) return c->n = 0, c->cap = 0, NULL; /* (the arrays kept are freed with h) */
-  c->cap = cap;
-  return c;
+  if (!lev)
+    return s->n = 0, s->cap = 0, s->key = NULL, NULL; /* (the arrays kept are freed with h) */
+  s->cap = cap;
+  return s;
 }
 
 const unsigned char *mpm_hier_levels(mpm_hier *h, const double *const *x, mpm_lidx n) {
-  hier_census *c = room(h, n);
+  census_set *c = room(h, n > 0 ? x[0] : NULL, n);
   if (!c) return NULL;
   /* Most calls of a step ask again at the points that did not move: one comparison of the
    * whole arrays answers them. */
@@ -73,19 +102,19 @@ const unsigned char *mpm_hier_levels(mpm_hier *h, const double *const *x, mpm_li
 }
 
 void mpm_hier_levels_keep(mpm_hier *h, const unsigned char *keep, mpm_lidx n) {
-  hier_census *c = h ? h->census : NULL;
-  if (!c) return;
-  if (c->n != n) {
-    c->n = 0;
-    return;
+  hier_census *cs = h ? h->census : NULL;
+  if (!cs) return;
+  for (int q = 0; q < CENSUS_SETS; ++q) { /* every set of n points (a point keeps its level) */
+    census_set *c = &cs->set[q];
+    if (c->n != n) continue;
+    mpm_lidx k = 0;
+    for (mpm_lidx i = 0; i < n; ++i) {
+      if (!keep[i]) continue;
+      for (int d = 0; d < h->dim; ++d) c->x[d][k] = c->x[d][i];
+      c->lev[k++] = c->lev[i];
+    }
+    c->n = k;
   }
-  mpm_lidx k = 0;
-  for (mpm_lidx i = 0; i < n; ++i) {
-    if (!keep[i]) continue;
-    for (int d = 0; d < h->dim; ++d) c->x[d][k] = c->x[d][i];
-    c->lev[k++] = c->lev[i];
-  }
-  c->n = k;
 }
 
 /* The position components of p (the field "x"). */

@@ -28,7 +28,8 @@
  *      third point moved to a fresh random point, the set shortened and then grown past its
  *      first size, every level equals mpm_hier_level_of's exactly (levels are integers); the
  *      moves must change some levels (else the check could not see a stale one); and after the
- *      set is compacted (mpm_hier_levels_keep), the memory following it. */
+ *      set is compacted (mpm_hier_levels_keep), the memory following it; six sets asked about
+ *      in turn (more than the memory holds), some moved between their calls, answer alike. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -401,6 +402,25 @@ static void test_levels(void **state) {
     mpm_hier_levels_keep(f.h, keep, 2 * NPOINTS); /* (not the count held: forgotten) */
     check_levels(&f, x, kept);
     free(keep);
+    /* Several sets asked about in turn (a gas, a solid, stage positions): each is remembered by
+     * its address, more sets than the memory holds evict the least recently used, and every
+     * answer stays mpm_hier_level_of's, a set's points moved between its calls too. */
+    enum { NSETS = 6 };
+    double *y[NSETS][3];
+    for (int s = 0; s < NSETS; ++s)
+      for (int d = 0; d < 3; ++d) {
+        y[s][d] = calloc(NPOINTS, sizeof(double));
+        for (mpm_lidx i = 0; i < NPOINTS; ++i) y[s][d][i] = x[d][(i + 97 * s) % kept];
+      }
+    for (int round = 0; round < 3; ++round)
+      for (int s = 0; s < NSETS; ++s) {
+        if (round == 1 && s % 2) /* this set's points move between its calls */
+          for (mpm_lidx i = 0; i < NPOINTS; i += 7) y[s][0][i] = y[(s + 1) % NSETS][0][i];
+        check_levels(&f, y[s], NPOINTS - 13 * s);
+        check_levels(&f, y[0], NPOINTS); /* one set asked again between the others */
+      }
+    for (int s = 0; s < NSETS; ++s)
+      for (int d = 0; d < 3; ++d) free(y[s][d]);
     for (int d = 0; d < 3; ++d) free(x[d]);
     fixture_free(&f);
   }
