@@ -58,7 +58,9 @@
 #   _rest3d (in test_refine_obstacles_rest and _stream), the ranks' comparisons
 #   test_refine_ranks_static and _dynamic (the levels over ranks in test_hier_ranks,
 #   test_refine_ranks_obstacles and test_refine_gas_ranks), the bodies in a box
-#   test_refine_body_rest and _sphere (in _pulse and _input);
+#   test_refine_body_rest and _sphere (in _pulse and _input), the expansion settings on the levels
+#   test_refine_gas_refill (2.5 minutes there; refill, merges and the neighbourhood step on level 1
+#   run there in test_refine_fsi_bar);
 # - test_euler_reference: the inviscid aerofoil reference in numpy, which runs no mpmfsi at all.
 # The input refusal drivers (test_input_safety, test_bad_input, test_cases) run under the
 # sanitizers without the leak check at exit (NO_LEAK_CHECK in tests/CMakeLists.txt).
@@ -79,6 +81,7 @@ PLAIN_ONLY+="|refine_musl_wall|refine_musl_regrid|refine_fsi_pulse|refine_fsi_pu
 PLAIN_ONLY+="|refine_fsi_traction"
 PLAIN_ONLY+="|refine_open_stream|refine_open_shock|refine_obstacles_disc|refine_obstacles_rest3d"
 PLAIN_ONLY+="|refine_ranks_static|refine_ranks_dynamic|refine_body_rest|refine_body_sphere"
+PLAIN_ONLY+="|refine_gas_refill"
 BOTH="checkpoint_integrity"
 
 # The tests also need clang-format (test_format) and ParaView under Xvfb (test_paraview), and
