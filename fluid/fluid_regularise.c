@@ -671,22 +671,35 @@ static int refill_split(mpm_module *m, const reg_box *b, const mpm_lidx *perm, i
  * a refill that finds no target (a flow with no near vacuum) groups none. Returns the number
  * of donors. */
 static mpm_lidx mark_donors(const mpm_module *m, const reg_box *b, int holes, unsigned char *mark) {
+  const mpm_grid *g = b->g;
   const int dim = b->dim;
-  mpm_lidx total = 1, ndonor = 0;
+  mpm_lidx total = 1, ndonor = 0, stride[MPM_MAX_DIM] = {1, 1, 1};
   for (int d = 0; d < dim; ++d) total *= b->nc[d];
+  for (int d = 1; d < dim; ++d) stride[d] = stride[d - 1] * g->box_n[d - 1];
   for (mpm_lidx l = 0; l < total; ++l) {
     int c[MPM_MAX_DIM] = {0};
     mpm_lidx r = l;
     for (int d = 0; d < dim; ++d) c[d] = b->c0[d] + (int)(r % b->nc[d]), r /= b->nc[d];
     mark[l] = 0;
     if (!(count_of(b, m->phase, c) > 0.0)) continue;
+    const mpm_lidx lc = b->level ? -1 : mpm_grid_local_index(g, c);
     for (int q = 0; q < 2 * dim; ++q) {
+      /* Most neighbours hold particles and so are no target: the counts reject them first. On
+       * level 0 a look at the neighbour's counts in the box (the ghost layers hold the cells next
+       * to the owned ones: every step of a run that refills, so it is kept cheap); a finer
+       * level's box is looked up (its periodic images hold no counts). */
       int e[MPM_MAX_DIM] = {0};
       memcpy(e, c, sizeof e);
       e[q / 2] += q % 2 ? 1 : -1;
-      /* Most neighbours hold particles and so are no target: the counts reject them first (level
-       * 0's ghost layers hold the cells next to the owned ones). */
-      if (!cell_empty(b, e)) continue;
+      int occupied = 0;
+      if (lc >= 0) {
+        const mpm_lidx le = lc + (q % 2 ? stride[q / 2] : -stride[q / 2]);
+        for (int k = 0; k < g->nphases && !occupied; ++k)
+          occupied = g->phase[k].cell_n && g->phase[k].cell_n[le] > 0.0;
+      } else {
+        occupied = !cell_empty(b, e);
+      }
+      if (occupied) continue;
       if (refill_target(m, b, e, holes) && refill_donor(m, b, e) == (q ^ 1)) mark[l] |= 1u << q;
     }
     ndonor += mark[l] != 0;
