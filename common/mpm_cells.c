@@ -39,6 +39,13 @@ mpm_lidx mpm_cells_level_index(const mpm_hier *h, int l, const int *k) {
   return idx;
 }
 
+mpm_lidx mpm_cells_level_index_at(const mpm_hier *h, int l, const double *x) {
+  const mpm_grid *g0 = h->level[0].grid;
+  int k[MPM_MAX_DIM] = {0};
+  for (int d = 0; d < g0->dim; ++d) k[d] = (int)floor((x[d] - g0->lo[d]) * h->level[l].inv_h);
+  return mpm_cells_level_index(h, l, k);
+}
+
 int mpm_cells_count_levels(mpm_hier *h, int phase, const mpm_particles *p,
                            const unsigned char *lev) {
   const mpm_grid *g0 = h->level[0].grid;
@@ -57,10 +64,7 @@ int mpm_cells_count_levels(mpm_hier *h, int phase, const mpm_particles *p,
     for (int d = 0; d < dim; ++d) xi[d] = x[d][i];
     const int l = lev ? lev[i] : mpm_hier_level_of(h, xi);
     if (l < 1) continue;
-    int k[MPM_MAX_DIM] = {0};
-    const double inv = h->level[l].inv_h;
-    for (int d = 0; d < dim; ++d) k[d] = (int)floor((xi[d] - g0->lo[d]) * inv);
-    const mpm_lidx j = mpm_cells_level_index(h, l, k);
+    const mpm_lidx j = mpm_cells_level_index_at(h, l, xi);
     if (j >= 0) h->level[l].grid->phase[phase].cell_n[j] += 1.0;
   }
   if (h->nranks < 2) return 0;

@@ -32,6 +32,8 @@ int mpm_cells_count_levels(mpm_hier *h, int phase, const mpm_particles *p,
  * lattice lo + k h_l, wrapped into the domain along a periodic axis), or -1 when the cell lies
  * outside the domain or the level's box (it then holds no particle of level l). */
 mpm_lidx mpm_cells_level_index(const mpm_hier *h, int l, const int *k);
+/* The same for the cell of level l holding the point x. */
+mpm_lidx mpm_cells_level_index_at(const mpm_hier *h, int l, const double *x);
 
 /* Global cell coordinate of x along d, clamped into the domain (as mpm_grid_owner_of). */
 static inline int mpm_cells_coord(const mpm_grid *g, int d, double x) {

@@ -25,8 +25,8 @@
  * On a hierarchy (mpm_hier.h) each particle counts in the cells of its position's level, and the
  * neighbourhoods are taken on each level: level 0's cells as above, a finer level's spans (its
  * cells, mpm_cells.h) over its box, summed over the ranks, so every rank holds them whole. As the
- * particle estimate does there, every level's speeds take the finest spacing for the viscous
- * length, and the one step of every level is the finest spacing over the largest s_c. */
+ * particle estimate does there, a particle's speed takes its level's spacing and viscous lengths,
+ * and the one step of every level is the smallest of h_l / s_c over the levels' cells. */
 #include "fluid_internal.h"
 
 #include "fluid_stress.h"
@@ -34,6 +34,7 @@
 #include "mpm_error.h"
 #include "mpm_hier.h"
 
+#include <limits.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -67,24 +68,24 @@ static void deposit(const mpm_module *m, double *const *sum, const unsigned char
     /* The spacing and viscous lengths of the particle's level (fluid_module.c's particle
      * estimate on a hierarchy). */
     const double dx = lev ? m->hier->level[lev[i]].grid->dx : g->dx;
-    const fluid_gas gas = lev ? fluid_gas_at(&fc->gas, &dx, 0) : fc->gas;
-    const double s = gas.damped_step
-                         ? fluid_signal_speed(&gas, rho, cs, divv[i], psi ? psi[i] : 0.0, dx)
-                         : cs + fluid_viscous_speed(&gas, rho, cs, divv[i], psi ? psi[i] : 0.0, dx);
-    double *const *to = sum;
+    fluid_gas at_level;
+    const fluid_gas *gas = &fc->gas;
+    if (lev) at_level = fluid_gas_at(&fc->gas, &dx, 0), gas = &at_level;
+    const double s = gas->damped_step
+                         ? fluid_signal_speed(gas, rho, cs, divv[i], psi ? psi[i] : 0.0, dx)
+                         : cs + fluid_viscous_speed(gas, rho, cs, divv[i], psi ? psi[i] : 0.0, dx);
+    double *to[3] = {sum[0], sum[1], sum[2]};
     mpm_lidx l;
-    if (lev && lev[i] > 0) { /* its span on level lev[i]: the cell lo + k h of that level */
+    if (lev && lev[i] > 0) { /* its span on level lev[i] */
       const int L = lev[i];
-      const mpm_grid *gl = m->hier->level[L].grid;
-      for (int d = 0; d < g->dim; ++d)
-        c[d] = (int)floor((x[d][i] - g->lo[d]) * m->hier->level[L].inv_h);
-      l = mpm_cells_level_index(m->hier, L, c);
-      if (l < 0) continue; /* (no span of its level there: cannot happen) */
-      double *f[3] = {fine[L], fine[L] + gl->nnodes, fine[L] + 2 * gl->nnodes};
-      f[0][l] += mass[i], f[1][l] += mass[i] * s * s, f[2][l] += mass[i] * sqrt(v2);
-      continue;
+      const double xi[MPM_MAX_DIM] = {x[0][i], g->dim > 1 ? x[1][i] : 0.0,
+                                      g->dim > 2 ? x[2][i] : 0.0};
+      if ((l = mpm_cells_level_index_at(m->hier, L, xi)) < 0) continue; /* (cannot happen) */
+      const size_t nl = (size_t)m->hier->level[L].grid->nnodes;
+      to[0] = fine[L], to[1] = fine[L] + nl, to[2] = fine[L] + 2 * nl;
+    } else {
+      l = mpm_grid_local_index(g, c);
     }
-    l = mpm_grid_local_index(g, c);
     to[0][l] += mass[i], to[1][l] += mass[i] * s * s, to[2][l] += mass[i] * sqrt(v2);
   }
 }
@@ -108,6 +109,23 @@ static void box_sum_axis(const mpm_grid *g, int d, const double *in, double *out
   }
 }
 
+/* The 3^dim block sums of the three fields sum[] over g's box, one axis at a time, into sum[]
+ * (tmp: room for three more; the pointers are swapped as the passes go). */
+static void block_sums(const mpm_grid *g, double **sum, double **tmp) {
+  for (int d = 0; d < g->dim; ++d)
+    for (int j = 0; j < 3; ++j) {
+      box_sum_axis(g, d, sum[j], tmp[j]);
+      double *t = sum[j];
+      sum[j] = tmp[j], tmp[j] = t;
+    }
+}
+
+/* s_c of cell (box index) k from its block sums, times scale; 0 for a cell without gas. */
+static double cell_signal(double *const *sum, size_t k, double scale) {
+  if (!(sum[0][k] > 0.0)) return 0.0;
+  return (sqrt(sum[1][k] / sum[0][k]) + sum[2][k] / sum[0][k]) * scale;
+}
+
 /* The largest s_c over a finer level's box, times h_finest / h_l (so that the finest spacing
  * over it is the level's step): its sums (three fields in buf, room for six), summed over the
  * ranks, then block-summed like level 0's. */
@@ -115,20 +133,15 @@ static int level_signal(const mpm_module *m, int l, double *buf, double *smax) {
   const mpm_grid *g = m->hier->level[l].grid;
   const size_t nn = (size_t)g->nnodes;
   const double scale = fluid_finest_dx(m) / g->dx;
+  if (3 * nn > INT_MAX) MPM_FAIL(MPM_ERR_INTERNAL, "the neighbourhood step: level %d too large", l);
   if (m->hier->nranks > 1)
     MPM_CALL_MPI(
         MPI_Allreduce(MPI_IN_PLACE, buf, (int)(3 * nn), MPI_DOUBLE, MPI_SUM, m->grid->comm));
   double *sum[3] = {buf, buf + nn, buf + 2 * nn},
          *tmp[3] = {buf + 3 * nn, buf + 4 * nn, buf + 5 * nn};
-  for (int d = 0; d < g->dim; ++d)
-    for (int j = 0; j < 3; ++j) {
-      box_sum_axis(g, d, sum[j], tmp[j]);
-      double *t = sum[j];
-      sum[j] = tmp[j], tmp[j] = t;
-    }
+  block_sums(g, sum, tmp);
   for (size_t k = 0; k < nn; ++k) {
-    if (!(sum[0][k] > 0.0)) continue;
-    const double s = (sqrt(sum[1][k] / sum[0][k]) + sum[2][k] / sum[0][k]) * scale;
+    const double s = cell_signal(sum, k, scale);
     if (s > *smax) *smax = s;
   }
   return 0;
@@ -160,13 +173,7 @@ int fluid_neighbourhood_signal(const mpm_module *m, double *smax) {
   for (int l = 1; l < nlevels; ++l) free(fine[l]);
   if (rc) MPM_FAIL(rc, "the neighbourhood step: cannot sum the finer levels' cells");
   MPM_CALL(mpm_grid_halo_forward(g, sum, 3));
-  /* The 3^dim block sums, one axis at a time (the halo holds the cells around the box). */
-  for (int d = 0; d < g->dim; ++d)
-    for (int j = 0; j < 3; ++j) {
-      box_sum_axis(g, d, sum[j], tmp[j]);
-      double *t = sum[j];
-      sum[j] = tmp[j], tmp[j] = t;
-    }
+  block_sums(g, sum, tmp); /* (the halo holds the cells around the box) */
   int lo[MPM_MAX_DIM] = {0}, n[MPM_MAX_DIM] = {1, 1, 1};
   mpm_lidx total = 1;
   for (int d = 0; d < g->dim; ++d) {
@@ -179,9 +186,7 @@ int fluid_neighbourhood_signal(const mpm_module *m, double *smax) {
     int c[MPM_MAX_DIM] = {0};
     mpm_lidx r = k;
     for (int d = 0; d < g->dim; ++d) c[d] = lo[d] + (int)(r % n[d]), r /= n[d];
-    const mpm_lidx l = mpm_grid_local_index(g, c);
-    if (!(sum[0][l] > 0.0)) continue;
-    const double s = (sqrt(sum[1][l] / sum[0][l]) + sum[2][l] / sum[0][l]) * scale0;
+    const double s = cell_signal(sum, (size_t)mpm_grid_local_index(g, c), scale0);
     if (s > best) best = s; /* fmax's result, NaN included, without its call */
   }
   *smax = best;
