@@ -209,10 +209,14 @@ int mpm_hier_level_walk(const mpm_hier *h, const double *x);
  * (mpm_hier_census.c). */
 const unsigned char *mpm_hier_levels(mpm_hier *h, const double *const *x, mpm_lidx n);
 
-/* The points were compacted to those with keep[i] != 0 (n flags, in order, as
- * mpm_particles_edit keeps them): the memory of mpm_hier_levels follows, so that the next call
- * looks up only the points that moved. Forgets it when it did not hold n points. */
-void mpm_hier_levels_keep(mpm_hier *h, const unsigned char *keep, mpm_lidx n);
+/* The set of n points remembered under the address from (its x[0]) was edited and now lives at
+ * to: compacted to the points with keep[i] != 0 (n flags, in order, as mpm_particles_edit keeps
+ * a set; NULL: every point kept, any added after them). The memory of mpm_hier_levels follows,
+ * so that the next call at to looks up only the points that moved or were added. An edit moves
+ * a particle set's arrays (their stride is the count), so without this the next call would
+ * look every point up again. Forgets the set when it did not hold n points. */
+void mpm_hier_levels_keep(mpm_hier *h, const double *from, const double *to,
+                          const unsigned char *keep, mpm_lidx n);
 /* The level of every particle of p (mpm_hier_level_of at its field "x") into level[p->n]
  * (mpm_hier_census.c). */
 void mpm_hier_particle_levels(const mpm_hier *h, const mpm_particles *p, double *level);

@@ -101,20 +101,30 @@ const unsigned char *mpm_hier_levels(mpm_hier *h, const double *const *x, mpm_li
   return c->lev;
 }
 
-void mpm_hier_levels_keep(mpm_hier *h, const unsigned char *keep, mpm_lidx n) {
+void mpm_hier_levels_keep(mpm_hier *h, const double *from, const double *to,
+                          const unsigned char *keep, mpm_lidx n) {
   hier_census *cs = h ? h->census : NULL;
   if (!cs) return;
-  for (int q = 0; q < CENSUS_SETS; ++q) { /* every set of n points (a point keeps its level) */
-    census_set *c = &cs->set[q];
-    if (c->n != n) continue;
-    mpm_lidx k = 0;
+  census_set *c = NULL;
+  for (int q = 0; q < CENSUS_SETS && !c; ++q)
+    if (from && cs->set[q].key == from) c = &cs->set[q];
+  if (!c) return;
+  if (c->n != n) { /* not the count held: forgotten */
+    c->n = 0, c->key = NULL;
+    return;
+  }
+  for (int q = 0; q < CENSUS_SETS; ++q) /* another set remembered at the new address is stale */
+    if (&cs->set[q] != c && cs->set[q].key == to) cs->set[q].n = 0, cs->set[q].key = NULL;
+  mpm_lidx k = n;
+  if (keep) {
+    k = 0;
     for (mpm_lidx i = 0; i < n; ++i) {
       if (!keep[i]) continue;
       for (int d = 0; d < h->dim; ++d) c->x[d][k] = c->x[d][i];
       c->lev[k++] = c->lev[i];
     }
-    c->n = k;
   }
+  c->n = k, c->key = to;
 }
 
 /* The position components of p (the field "x"). */

@@ -205,9 +205,12 @@ static int split_apply(mpm_module *m, const mpm_lidx *idx, mpm_lidx k, const mpm
   MPM_ALLOC(id, nadd);
   for (mpm_lidx a = 0; a < k; ++a)
     for (int j = 0; j < nnew; ++j) id[a * nnew + j] = first[a] + j;
+  const double *from = mpm_particles_comp(p, FLUID_X, 0);
   const int rc = mpm_particles_edit(p, NULL, nadd, id, NULL);
   free(id);
   MPM_CALL(rc);
+  /* (the parents moved and the children are new: looked up again) */
+  mpm_hier_levels_keep(m->hier, from, mpm_particles_comp(p, FLUID_X, 0), NULL, n0);
   for (mpm_lidx a = 0; a < k; ++a) split_fill(m, idx, a, n0, rep);
   rep->parents = k, rep->children = nadd;
   for (mpm_lidx a = 0; a < k; ++a) rep->away += is_away(m, idx[a]);
@@ -386,8 +389,10 @@ int fluid_merge(mpm_module *m, const mpm_lidx *start, const mpm_lidx *member, mp
   int rc = merge_all(m, start, member, ngroups, state, rep);
   const mpm_lidx n0 = p->n;
   for (mpm_lidx i = 0; !rc && i < n0; ++i) state[i] = state[i] != 0;
+  const double *from = mpm_particles_comp(p, FLUID_X, 0);
   if (!rc && rep->removed > 0 && (rc = mpm_particles_edit(p, state, 0, NULL, NULL)) == 0)
-    mpm_hier_levels_keep(m->hier, state, n0); /* (a merged one moved: looked up again) */
+    mpm_hier_levels_keep(m->hier, from, mpm_particles_comp(p, FLUID_X, 0), state,
+                         n0); /* (a merged one moved: looked up again) */
   free(state);
   MPM_CALL(rc);
   return 0;

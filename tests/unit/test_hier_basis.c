@@ -28,7 +28,8 @@
  *      third point moved to a fresh random point, the set shortened and then grown past its
  *      first size, every level equals mpm_hier_level_of's exactly (levels are integers); the
  *      moves must change some levels (else the check could not see a stale one); and after the
- *      set is compacted (mpm_hier_levels_keep), the memory following it; six sets asked about
+ *      set is compacted (mpm_hier_levels_keep), moved to new arrays and grown by appended
+ *      points, the memory following it; six sets asked about
  *      in turn (more than the memory holds), some moved between their calls, answer alike. */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -397,10 +398,38 @@ static void test_levels(void **state) {
       for (int d = 0; d < 3 && keep[i]; ++d) x[d][kept] = x[d][i];
       kept += keep[i];
     }
-    mpm_hier_levels_keep(f.h, keep, 2 * NPOINTS);
+    mpm_hier_levels_keep(f.h, x[0], x[0], keep, 2 * NPOINTS);
     check_levels(&f, x, kept);
-    mpm_hier_levels_keep(f.h, keep, 2 * NPOINTS); /* (not the count held: forgotten) */
+    mpm_hier_levels_keep(f.h, x[0], x[0], keep, 2 * NPOINTS); /* (not the count held) */
     check_levels(&f, x, kept);
+    /* Moved to new arrays (an edit's new block), compacted again and then grown by points
+     * appended after the kept ones (a split's children), some kept points moved: the memory
+     * follows the set to its new address, and every answer stays mpm_hier_level_of's. */
+    double *z[3];
+    for (int d = 0; d < 3; ++d) z[d] = calloc(2 * NPOINTS, sizeof(double));
+    mpm_lidx nz = 0;
+    for (mpm_lidx i = 0; i < kept; ++i) {
+      keep[i] = i % 7 != 3;
+      for (int d = 0; d < 3 && keep[i]; ++d) z[d][nz] = x[d][i];
+      nz += keep[i];
+    }
+    mpm_hier_levels_keep(f.h, x[0], z[0], keep, kept);
+    check_levels(&f, z, nz);
+    for (int d = 0; d < 3; ++d) memcpy(x[d], z[d], sizeof(double) * (size_t)nz);
+    for (mpm_lidx i = nz; i < 2 * nz && i < 2 * NPOINTS; ++i) { /* children, parents moved */
+      double p[3];
+      fixture_point(&f, &rng, (int)i + 1, p);
+      for (int d = 0; d < 3; ++d) x[d][i] = p[d];
+      if (i % 11 == 0)
+        for (int d = 0; d < 3; ++d) x[d][i - nz] = p[d];
+    }
+    const mpm_lidx grown = MPM_MIN(2 * nz, 2 * NPOINTS);
+    mpm_hier_levels_keep(f.h, z[0], x[0], NULL, nz);
+    check_levels(&f, x, grown);
+    mpm_hier_levels_keep(f.h, z[0], x[0], NULL, nz); /* (z is no longer remembered: no-op) */
+    check_levels(&f, x, grown);
+    for (int d = 0; d < 3; ++d) free(z[d]);
+    kept = grown;
     free(keep);
     /* Several sets asked about in turn (a gas, a solid, stage positions): each is remembered by
      * its address, more sets than the memory holds evict the least recently used, and every
