@@ -245,8 +245,36 @@ static int save_held(mpm_coupling *c, double t, double h, mpm_pass pass) {
   return 0;
 }
 
+/* The hybrid pressure beside a solid (fluid/fluid_gridp_solid.c) continues the gas's pressure
+ * through the solid, and its span integrals put forces on the nodes where the gas has no mass
+ * and the solid has: the solid's quadrature of its defect from the gas's pressure, which at rest
+ * cancels its prestress node by node. The gas's solve drops them; here the solid takes them,
+ * booked as an interface exchange (the gas's record the opposite force at the power the solid's
+ * takes), so that momentum stays exact. Before the scheme's exchange: these nodes are not
+ * shared. */
+static int hand_over(mpm_coupling *c, double t, double h, mpm_pass pass) {
+  (void)t, (void)pass;
+  const mpm_grid_phase *g = mpm_coupling_phase(c, MPM_ROLE_FLUID);
+  mpm_grid_phase *s = &c->grid->phase[c->phase[MPM_ROLE_SOLID]];
+  const int dim = c->grid->dim;
+  for (mpm_lidx l = 0; l < c->grid->nnodes; ++l) {
+    if (g->m_i[l] > g->m_empty || !(s->m_i[l] > s->m_empty)) continue;
+    double v[MPM_MAX_DIM], a[MPM_MAX_DIM], f[MPM_MAX_DIM], vc[MPM_MAX_DIM];
+    for (int d = 0; d < dim; ++d) {
+      const double da = g->f_i[d][l] / s->m_i[l];
+      v[d] = s->v_i[d][l] + h * da, a[d] = s->a_i[d][l] + da;
+      vc[d] = h > 0 ? 0.5 * (s->v_i[d][l] - h * s->a_i[d][l] + v[d]) : s->v_i[d][l];
+    }
+    mpm_coupling_exchange_force(c, MPM_ROLE_SOLID, l, v, a, h, f);
+    for (int d = 0; d < dim; ++d) f[d] = -f[d];
+    mpm_coupling_record_force(c, MPM_ROLE_FLUID, l, f, vc);
+  }
+  return 0;
+}
+
 int mpm_coupling_after_solve(mpm_coupling *c, double t, double h, mpm_pass pass) {
   if (!c) return 0;
+  if (c->hand_over) MPM_CALL(run_hook(c, hand_over, t, h, pass));
   MPM_CALL(run_hook(c, c->type->ops->after_solve, t, h, pass));
   if (c->type->needs & MPM_COUPLING_HOLDS) MPM_CALL(run_hook(c, save_held, t, h, pass));
   return 0;

@@ -91,8 +91,10 @@ struct mpm_coupling {
   mpm_coupling_record rec[2];         /* the latest RHS and the one before (mpm_impulse.h) */
   mpm_rhs_records which;              /* their times and which is the latest */
   int recording;                      /* inside a first pass: exchanges are recorded */
-  int nbodies;                        /* solid bodies reported one by one (0: one body, or more than
-                                         MPM_COUPLING_MAX_BODIES: the resultant only) */
+  int hand_over; /* the gas's forces where it has no mass and the solid has go to the solid
+                    (set by the sim: fluid_module_hands_over; mpm_coupling.c, hand_over) */
+  int nbodies;   /* solid bodies reported one by one (0: one body, or more than
+                    MPM_COUPLING_MAX_BODIES: the resultant only) */
   const char *body_name[MPM_COUPLING_MAX_BODIES];
   double *da[MPM_MAX_DIM]; /* with nbodies: the solid's interface acceleration per node */
   double *held_v[MPM_MAX_DIM], *held_a[MPM_MAX_DIM]; /* MPM_COUPLING_HOLDS: the solid's v and a

@@ -278,6 +278,7 @@ static int build_modules(mpm_sim *s, int seed) {
                            "the case defines neither bodies nor gas: add a [solid.NAME] or a "
                            "[gas.NAME] section");
   MPM_CALL(mpm_coupling_new(&s->coupling, s->cfg, s->grid, s->mod, s->nmod));
+  if (s->coupling && solid && fluid) s->coupling->hand_over = fluid_module_hands_over(fluid);
   if (seed) MPM_CALL(mpm_scene_check_overlaps(s->cfg, s->grid, s->mod, s->nmod));
   /* The walls a coupling scheme offers are attached: a module that needs one and has none says
    * so now (mpm_module.h). */

@@ -160,6 +160,8 @@ void fluid_gridp_work(const mpm_module *m, const double *y, const double *L, dou
  * of the level scalars a[l] and prolongs them into the inactive nodes. */
 typedef struct fluid_gridp_solid {
   int phase;
+  int deep;  /* continue through the whole solid (the hybrid; fluid_gridp_solid_pressure) */
+  double *W; /* with deep: each node's geometric volume (fluid_gridp_geometric_volume) */
   const mpm_points *pts; /* the points read: m->beside, or the gas's own (hybrid) */
   mpm_lidx cap;
   double *buf, *A[MPM_HIER_MAX_LEVELS], *B[MPM_HIER_MAX_LEVELS];
@@ -170,6 +172,8 @@ typedef struct fluid_gridp_solid {
   const unsigned char *saved_lev;
 } fluid_gridp_solid;
 int fluid_gridp_prolong(mpm_module *m, double **a);
+/* W_j = the integral over the domain of N_j on level 0's nodes (*W allocated here). */
+int fluid_gridp_geometric_volume(const mpm_grid *g, double **W);
 int fluid_gridp_solid_init(fluid_gridp_solid *s, mpm_grid *g);
 void fluid_gridp_solid_free(fluid_gridp_solid *s);
 int fluid_gridp_solid_pressure(mpm_module *m, fluid_gridp_solid *s, double *const *P,

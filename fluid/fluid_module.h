@@ -33,6 +33,10 @@ int fluid_module_refine(mpm_module *m, const mpm_config *cfg, struct mpm_hier *h
  * solid (fluid/fluid_gridp_solid.c); else 0. */
 int fluid_module_reads_beside(const mpm_module *m);
 
+/* 1 if the gas's forces on the nodes where it has no mass belong to the solid there (the hybrid
+ * pressure beside a solid, fluid/fluid_gridp_solid.c): the coupler hands them over. */
+int fluid_module_hands_over(const mpm_module *m);
+
 /* A regrid: move the module onto the new hierarchy h (may be NULL); fluid_module_follow then
  * moves the particles onto its levels. */
 void fluid_module_rehier(mpm_module *m, struct mpm_hier *h);
