@@ -52,7 +52,8 @@ mpm_add_script_test(test_prestress SCRIPT verification/test_prestress.py
 # against the exact roots of Z_g cot(k_g L_g) + Z_s cot(k_s L_s) = 0 at 50, 100, 200 cells per
 # metre under velocity (usl; monolithic and multirate), their convergence, and the gas beside
 # the slab staying 1-D (40 s of CPU); `long` adds contact, traction, bs32, 400 cells per metre
-# and 20 periods at 400 and 800 (bs32 alone took 314 s at 200 cells under load).
+# and 20 periods at 400 and 800 (bs32 alone took 314 s at 200 cells under load), and the named
+# hybrid pressure's study and 20 periods at 800 (about 13 minutes of CPU more).
 mpm_add_script_test(test_fsi_resonator SCRIPT verification/test_fsi_resonator.py
                     LABELS verification TIMEOUT 600)
 mpm_add_script_test(test_fsi_resonator_long SCRIPT verification/test_fsi_resonator.py ARGS long

@@ -51,8 +51,8 @@ Checks and tolerances:
   exactly, as an ordinary check: measured 5.2e-14 over 20 periods (2026-12-03); and with
   transfer.velocity = apic and the particles' pressure, also an ordinary check: measured 7.2e-15
   (2026-12-06; APIC is no default for the gas, docs/gas.md); and with fluid.pressure = hybrid,
-  also an ordinary check: measured HYB800 (2026-12-06; test_hybrid_pressure holds the column and
-  this scene to t = 0.5).
+  also an ordinary check: measured 8.5e-14 (400: 3.6e-14; 2026-12-06; test_hybrid_pressure
+  holds the column and this scene to t = 0.5).
 """
 import glob
 import math
