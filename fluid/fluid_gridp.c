@@ -133,7 +133,7 @@
  * at rest against a prestressed solid stays at rest, the span force inside the solid being
  * the negative of its prestress's node by node. The work of the forces handed over is not in
  * the gas's volume rate, which reads the gas's velocity (zero there): total energy is exact to
- * that work (cases/fsi_box.ini under bs32: 2.0e-6 of the total, against 8.8e-7 with the
+ * that work (cases/fsi_box.ini under bs32: 2.0e-6 of the total, against 8.6e-7 with the
  * particles' pressure).
  * Open faces are the grid pressure's: the exterior pressure integrated over the face, the pad
  * nodes' pressure set from it; a uniform stream gives p_p = p_h(x_p), so the particles' share

@@ -40,7 +40,6 @@
 #include "mpm_hier.h"
 #include "mpm_kernels.h"
 
-#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
