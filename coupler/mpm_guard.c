@@ -96,9 +96,11 @@ int mpm_guard_check(mpm_guard *g, double t, long step, double h, int cut_short, 
              "the run blew up at t = %.6g (step %ld): the kinetic energy %.6g J is more than "
              "time.kinetic_growth = %g times %.6g J, the largest of the first half of the "
              "steps (or %g of the largest total energy %.6g J, if larger): a velocity mode "
-             "grows geometrically while the total energy (%.6g J) does not show it; lower "
-             "time.cfl, refine grid.dx, or try another time.method (raise time.kinetic_growth "
-             "only if kinetic energy really enters the scene that fast)",
+             "grows geometrically while the total energy (%.6g J) does not show it; a gas under "
+             "its particles' pressure grows a grid-scale mode, which fluid.pressure = hybrid or "
+             "a PIC share (fluid.pic_fraction, usl and musl) removes; else lower time.cfl or "
+             "try another time.method (raise time.kinetic_growth only if kinetic energy really "
+             "enters the scene that fast)",
              t, step, kinetic, g->kgrowth, fmax(khalf, kfloor), MPM_GUARD_KINETIC_FLOOR,
              g->emax[g->n - 1], energy);
   if (g->ratio <= 0 || g->h0 <= 0 || cut_short) return 0;
