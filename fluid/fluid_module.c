@@ -1033,7 +1033,7 @@ int fluid_particles_new(mpm_particles **p, int dim, fluid_layout *lay, int apic,
  * noise"): on the gas-column/slab resonator (cases/fsi_resonator.ini, usl) the blow-up guard
  * stopped it at t = 1.86 at 800 cells per metre. With 0.02 (the main job's and RAE 2822's
  * share) it stays 1-D over 20 periods at 400 and 800 cells per metre, and its coupled
- * frequencies move by under 0.004 % of the exact ones; 0.005 let the mode grow (2.3e-7 c by
+ * frequencies move by under 0.005 % of the exact ones; 0.005 let the mode grow (2.3e-7 c by
  * t = 3 at 800). The ERK pairs take no PIC share (mpm_transfer.c): there the cure is named
  * (fluid.pressure = hybrid). */
 #define FLUID_PIC_BESIDE_SOLID 0.02
