@@ -46,9 +46,9 @@ Checks and tolerances:
   update the gas beside a solid takes a PIC share of 0.02 by default (fluid.pic_fraction unset,
   fluid/fluid_module.c, pic_auto): measured 4.3e-14 and 9.6e-13 over 20 periods at 400 and 800
   cells per metre (2026-12-06); f_1 moves by at most 0.004 % and f_2 by 0.005 % of the exact
-  values from pure FLIP's. Without it (the
-  control, `fluid.pic_fraction=0`, expected to fail) the run goes unstable from t ~ 1 (|v_y| /
-  c_g ~ 1.8 by t = 3; the blow-up guard stops it at t = 1.86) in the middle of the column, 300
+  values from pure FLIP's. Without it (the control, `fluid.pic_fraction=0`, expected to fail)
+  the run goes unstable from t ~ 1 (|v_y| / c_g ~ 1.8 by t = 3; the blow-up guard stops it at
+  t = 1.86) in the middle of the column, 300
   cells from the slab, as the gas column alone between slip walls (no slab) does (|v_y| / c_g
   1.2 at t = 3): the gas's own grid-scale transverse mode under usl with its particles off the
   seeding lattice (docs/gas.md), not the interface. Its cause: the particles' quadrature of the
