@@ -106,7 +106,9 @@ static const mpm_key_spec fluid_keys[] = {
      "docs/refinement.md) or auto (without a solid: grid with refine.levels > 1, where particle is "
      "refused, else hybrid where its scope holds (and no fluid.regularise_every; under usl "
      "and musl no farfield or subsonic_inflow face) and particle outside it, silently; beside "
-     "a solid particle; the log says which); see docs/refinement.md",
+     "a solid under usl and musl particle, whose PIC share keeps the gas stable there "
+     "(fluid.pic_fraction), under the ERK pairs, which take no PIC share, hybrid where its "
+     "scope holds and particle outside it; the log says which); see docs/gas.md",
      0, NULL},
     {"fluid.hybrid_fill", MPM_KEY_REAL, "0.5", 0, 1, 0, 0, NULL,
      "the hybrid pressure without a solid: the share of a node's volume the particles must fill "
