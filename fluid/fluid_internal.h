@@ -48,6 +48,7 @@ typedef struct fluid_content {
   int refill_every;          /* refill every refill_every steps (0: never) */
   int refill_holes;          /* refill the holes in the gas after every other step (-1: auto) */
   double merge_light;        /* merge particles below this share of their cell's heaviest */
+  double merge_light_holes;  /* the same after a refill of holes alone (fluid_regularise.c) */
   double shift;              /* particle shifting coefficient kappa (0: off; fluid_shift.c) */
   int shift_every;           /* shift every shift_every steps */
   double shift_J;            /* only particles with J >= shift_J move */
