@@ -402,7 +402,8 @@ static int lagged_faces(const fluid_content *fc, const mpm_grid *g) {
  * uniform part of its pressure and Sod's L1 falls; beside a solid under the ERK pairs, which
  * take no PIC share, the particles' pressure grows that mode from roundoff (the resonator at
  * 800 cells per metre under bs32: the guard stopped it at t = 1.53; the hybrid held it at
- * 7e-15 of c, test_fsi_resonator long). Outside the scope the particles' pressure, silently.
+ * 6.8e-14 of c over 20 periods, test_fsi_resonator long). Outside the scope the particles'
+ * pressure, silently.
  * One log line says which and why. */
 static int choose_auto(mpm_module *m, const mpm_config *cfg) {
   const char *const *names;
