@@ -102,6 +102,8 @@ def default_case():
     with open("double_rarefaction_default.ini", "w") as f:
         f.writelines(keep)
     return "double_rarefaction_default.ini"
+
+
 EVENT = re.compile(r"regularise step (\d+): (\d+) refills, (\d+) splits, (\d+) merges; "
                    r"mass (\S+) -> (\S+), momentum \((\S+), (\S+), (\S+)\) -> "
                    r"\((\S+), (\S+), (\S+)\), energy (\S+) -> (\S+)")
