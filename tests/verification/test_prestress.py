@@ -21,8 +21,9 @@ Measured per run:
   max |p_gas - p| / p <= 1e-10 (measured 2e-13).
 Runs: coupling.scheme velocity, contact, traction under time.method usl and the default bs32
 (contact refuses bs32: its on/off switch is non-smooth for an adaptive pair; it runs usl and
-musl); traction with the least-squares wall (fluid.wall_treatment); coupling.time multirate and
-staggered gas_first; velocity usl on 2 ranks and in 3-D (the strip 3 cells deep, periodic in z); the other models (linear_elastic, stvk, hypoelastic, j2) under velocity usl
+musl); traction with the least-squares wall (fluid.wall_treatment); coupling.time multirate
+(usl, and bs32, which is MRIStep and takes the hybrid pressure by default) and staggered
+gas_first; velocity usl on 2 ranks and in 3-D (the strip 3 cells deep, periodic in z); the other models (linear_elastic, stvk, hypoelastic, j2) under velocity usl
 (speed only: their stress is not in the output); the gas with fluid.pressure = hybrid under
 velocity usl, traction bs32 and velocity bs32 on 2 ranks (its pressure continued through the
 whole slab, the span forces there handed to it: at rest they are the negative of the slab's own
@@ -128,6 +129,9 @@ for scheme, method in (("velocity", "usl"), ("velocity", "bs32"), ("contact", "u
 at_rest("traction usl, least-squares wall",
         run("prestress_ls", "coupling.scheme=traction", "fluid.wall_treatment=least_squares"))
 at_rest("velocity usl, multirate", run("prestress_multirate", "coupling.time=multirate"))
+at_rest("velocity bs32, multirate (MRIStep), the hybrid pressure (auto)",
+        run("prestress_multirate_bs32", "coupling.time=multirate", "time.method=bs32",
+            "time.adaptive=false"))
 at_rest("velocity usl, 2 ranks", run("prestress_np2", ranks=2))
 at_rest("velocity usl, 3-D", run("prestress_3d", *THREE_D))
 at_rest("velocity usl, the hybrid pressure", run("prestress_hybrid", "fluid.pressure=hybrid"))
