@@ -14,3 +14,8 @@ mpm_add_script_test(test_multirate_face SCRIPT verification/test_multirate_face.
 # monolithic's falls at every halving; the booked W's own part to 0.05 only (~8 min).
 mpm_add_script_test(test_multirate_face_long SCRIPT verification/test_multirate_face.py ARGS long
                     LABELS "verification;long" TIMEOUT 1800)
+# MRIStep (bs32, fixed steps) on the same face against monolithic bs32 at time.cfl 0.4, 0.2, 0.1:
+# the face's motion within 3 % of the exact interface speed, the balance, the total energy's
+# change within twice monolithic's and its excess over monolithic's falling with the step.
+mpm_add_script_test(test_multirate_face_mri SCRIPT verification/test_multirate_face.py ARGS mri
+                    LABELS "verification;long" TIMEOUT 1800)

@@ -33,6 +33,26 @@ Checks, at time.cfl = 0.4 and 0.2, multirate with coupling.exchange = shared:
 - `long` as the argument (test_multirate_face_long) runs these checks alone at time.cfl 0.4,
   0.2, 0.1, 0.05 and 0.025: dE - dE_monolithic and W - W_monolithic fall at every halving
   (below; W - W_monolithic did not from 0.05 to 0.025 in pure FLIP);
+- `mri` as the argument (test_multirate_face_mri) runs multirate under bs32, ARKODE's MRIStep
+  (time.adaptive = false; the gas takes the hybrid pressure, its default beside a solid under
+  the ERK pairs), against monolithic bs32 with fixed steps at the same time.cfl 0.4, 0.2, 0.1.
+  Under the method of lines a particle moves with the grid's velocity, and its own velocity is
+  a separate state that the grid reads only through its deposit; next to the shocked face the
+  two part (below), so the face's speed is the slope of its displacement over the window
+  (least squares). Checks: that speed within 3 % of u*; the balance to 1e-9; the total
+  energy's change within twice monolithic's in size; its excess over monolithic's falling at
+  each halving (the coupling's booked W is at roundoff under the ERK pairs, 6e-19 J under
+  MRIStep and 6e-20 J under monolithic bs32 at 0.4, so the total's change is what is compared). Measured 2026-12-06: the
+  face moves at -0.14, -0.15, -0.14 % of u* (monolithic bs32 -0.14 % at each; usl monolithic
+  +0.26 %); dE -1.099e-3, -1.107e-3, -1.110e-3 J against monolithic's -1.122e-3, -1.113e-3,
+  -1.111e-3 (usl monolithic at 0.4: -1.65e-3 of the 0.568 J in the strip), excess 2.34e-5,
+  5.44e-6, 1.20e-6 J (order 2.1); imbalance 3.4e-16 - 3.9e-16; 388, 776, 1,552 slow steps
+  against monolithic's 2,738, 5,475, 10,949. The face particle's own velocity is reported as
+  EXPECTED-FAIL against the 3 %: +58.3, +29.4, +25.9 % of u* (monolithic bs32 +25.6 % at every
+  step, so a spatial mode, not the coupling: the face layer's particles hold +1.53 against their
+  neighbours' 1.28, 0.95, 1.45 at t = 0.3 while all move at u*; usl +0.67 %). A relaxation of
+  the solid's particle velocity towards what the grid sees (the gas's fluid.mol_damping, for
+  the solid) would remove it; not built;
 - the interface balances momentum to 1e-9 of the interface force;
 - shared with what it cannot serve (the traction scheme, the linear predictor, slow substeps)
   is one error line naming the file, the line and the key, exit 2;
@@ -118,8 +138,9 @@ import mpmtest as mt  # noqa: E402
 
 EXCHANGE = "held" if "held" in sys.argv[1:] else "shared"
 LONG = "long" in sys.argv[1:]  # the coupling-step sweep only (test_multirate_face_long)
+MRI = "mri" in sys.argv[1:]  # MRIStep under bs32 only (test_multirate_face_mri)
 check = mt.Checks("test_multirate_face" + ("_held" if EXCHANGE == "held" else "")
-                  + ("_long" if LONG else ""))
+                  + ("_long" if LONG else "") + ("_mri" if MRI else ""))
 U_STAR = 1.254242511527340  # the exact interface speed (docstring)
 T_HIT = 0.2 / 2.366431913239846  # ambient gap / incident shock speed 2 c0
 T_END = 0.3
@@ -163,6 +184,57 @@ def work_until(out, t):
     c = np.genfromtxt(os.path.join(out, "coupling.csv"), delimiter=",", names=True)
     return float(np.interp(t, c["t"], c["W_net"]))
 
+
+def face_motion(out):
+    """The face particle's speed as it moves: the least-squares slope of its displacement over
+    the window (under the method of lines a particle moves with the grid's velocity, and its own
+    velocity is a separate state, see the docstring)."""
+    p = np.genfromtxt(os.path.join(out, "probes.csv"), delimiter=",", names=True)
+    sel = (p["t"] > WINDOW[0]) & (p["t"] <= WINDOW[1])
+    return float(np.polyfit(p["t"][sel], p["face_ux"][sel], 1)[0])
+
+
+def part_mri():
+    """MRIStep (bs32, fixed steps) against monolithic bs32 with fixed steps at the same time.cfl:
+    its face's motion, its balance, and the energy it adds."""
+    cfls, de = (0.4, 0.2, 0.1), {}
+    for cfl in cfls:
+        for label in ("monolithic", "mristep"):
+            out, _ = run(f"mrf_bs32_{label}_{cfl}", [
+                "time.method=bs32", "time.adaptive=false", f"time.cfl={cfl}",
+                f"coupling.time={'multirate' if label == 'mristep' else 'monolithic'}"])
+            de[label, cfl] = energy_change(out)
+            speed, (mean, rattle, n) = face_motion(out), face(out)
+            tag = f"bs32 {label} at time.cfl {cfl}"
+            print(f"info {tag}: total energy {de[label, cfl]:+.4e} J; the face moves at "
+                  f"{speed:.5f} ({100 * (speed / U_STAR - 1):+.2f} % of u*), its particle's "
+                  f"velocity {100 * (mean / U_STAR - 1):+.2f} %, rattle "
+                  f"{100 * rattle / U_STAR:.2f} % over {n} rows; {mt.cost(out)}")
+            if label == "monolithic":
+                continue
+            check(abs(speed / U_STAR - 1) <= TOL_MEAN, f"{tag}: the face moves at "
+                  f"{100 * (speed / U_STAR - 1):+.2f} % of u* (within {100 * TOL_MEAN:g} %)")
+            imb = summary(out)["coupling_imbalance"]
+            check(imb < 1e-9, f"{tag}: interface imbalance {imb:.1e} (tolerance 1e-9)")
+            check(abs(de[label, cfl]) <= TOL_W * abs(de["monolithic", cfl]),
+                  f"{tag}: total energy change {de[label, cfl]:+.3e} J, monolithic's "
+                  f"{de['monolithic', cfl]:+.3e} (at most {TOL_W:g} times in size)")
+            msg = (f"{tag}: the face particle's own velocity {100 * (mean / U_STAR - 1):+.2f} % "
+                   f"of u* (within {100 * TOL_MEAN:g} %)")
+            if abs(mean / U_STAR - 1) <= TOL_MEAN:
+                check(True, msg)
+            else:  # expected to fail (the docstring): reported, not counted
+                print(f"EXPECTED-FAIL {msg}: the ERK pairs' particle velocity carries a mode the "
+                      "grid does not see (monolithic bs32 too)")
+    own = [abs(de["mristep", c] - de["monolithic", c]) for c in cfls]
+    for c0, c1, e0, e1 in zip(cfls, cfls[1:], own, own[1:]):
+        check(e1 < e0, f"mristep: the total energy's change beyond monolithic's "
+              f"|dE - dE_monolithic| {e0:.2e} J at time.cfl {c0}, {e1:.2e} at {c1} (falls)")
+
+
+if MRI:
+    part_mri()
+    sys.exit(check.finish())
 
 result = {}
 for cfl in CFLS:
