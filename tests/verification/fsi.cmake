@@ -61,8 +61,8 @@ mpm_add_script_test(test_fsi_resonator SCRIPT verification/test_fsi_resonator.py
 mpm_add_script_test(test_fsi_resonator_long SCRIPT verification/test_fsi_resonator.py ARGS long
                     LABELS "verification;long" TIMEOUT 10800)
 # Multirate under bs32 (MRIStep, with the hybrid pressure, auto's choice there): the frequencies
-# at 50 to 400 cells per metre and 20 periods at 400 and 800 (the 400 alone: 85,247 steps,
-# 37 minutes beside three other runs).
+# at 50 to 400 cells per metre and 20 periods at 400 and 800 (85,247 and 170,463 steps: 37 and
+# 105 minutes beside other runs).
 mpm_add_script_test(test_fsi_resonator_mri SCRIPT verification/test_fsi_resonator.py ARGS mri
                     LABELS "verification;long" TIMEOUT 14400)
 # The grid pressure beside a solid under multirate and contact (test_gridp_beside.py): the

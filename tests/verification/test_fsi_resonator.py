@@ -66,8 +66,9 @@ Checks and tolerances:
   XFAIL as above). Under multirate (MRIStep) with the hybrid (`mri`; 2026-12-06): f_1 +0.1265
   / +0.0796 / +0.0422 / +0.0206 %, f_2 -0.1519 / -0.0275 / -0.0022 / +0.0009 % (400: the first
   18 s of the 20-period run; order 0.87, XFAIL), max |v_y| / c_g 6.1e-14 over 20 periods at 400
-  (85,247 steps) and R800 at 800; with the particles' pressure, before the hybrid carried
-  MRIStep, the guard stopped it at t = 1.54 at 800. `long` also runs 800 under
+  (85,247 steps) and 1.3e-13 at 800 (170,463 steps, 105 minutes beside another job;
+  f_1 +0.0091 %, f_2 +0.0001 % from its first 18 s); with the particles' pressure, before the
+  hybrid carried MRIStep, the guard stopped it at t = 1.54 at 800. `long` also runs 800 under
   multirate (usl, the PIC share's rate as under monolithic), and the other cures as ordinary
   checks: fluid.pressure = grid, which integrates the nodal pressure exactly (measured 5.2e-14
   over 20 periods, 2026-12-03); transfer.velocity = apic with the particles' pressure (7.2e-15,
