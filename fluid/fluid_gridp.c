@@ -232,9 +232,10 @@ static int miss(scope_miss *s, const char *key, const char *why) {
  * Multirate beside a solid under an ERK pair is MRIStep, whose slow right-hand side is the joint
  * cycle: every stage deposits both modules, as the monolithic cycle does. Measured there
  * (bs32, mri_gark_erk33a): the fsi box's momentum 3.3e-16, a pre-stressed slab at rest to
- * 2.7e-13 of c over 1,002 steps, the resonator at 800 cells per metre within 6e-14 of c at
- * t = 3 (test_hybrid_pressure, test_fsi_resonator long). Under the classic update multirate is
- * the held exchange, and there the hybrid's momentum drifted by 1e-4 on the fsi box. */
+ * 2.3e-13 of c over 1,002 steps, the resonator at 800 cells per metre 1-D to 1.3e-13 of c over
+ * 20 periods (test_hybrid_pressure, test_prestress, test_fsi_resonator_mri). Under the classic
+ * update multirate is the held exchange, and there the hybrid's momentum drifted by 1e-4 on the
+ * fsi box. */
 static int hybrid_scope(const fluid_content *fc, const mpm_config *cfg, scope_miss *s) {
   const char *const *names;
   int count;
