@@ -227,8 +227,9 @@ def part_mri():
             if abs(mean / U_STAR - 1) <= TOL_MEAN:
                 check(True, msg)
             else:  # expected to fail (the docstring): reported, not counted
-                print(f"EXPECTED-FAIL {msg}: the ERK pairs' particle velocity carries a mode the "
-                      "grid does not see (monolithic bs32 too)")
+                print(f"EXPECTED-FAIL {msg}: under the method of lines the face particle's own "
+                      "velocity parts from the velocity it moves with (monolithic bs32 too; see "
+                      "the docstring)")
     own = [abs(de["mristep", c] - de["monolithic", c]) for c in cfls]
     for c0, c1, e0, e1 in zip(cfls, cfls[1:], own, own[1:]):
         check(e1 < e0, f"mristep: the total energy's change beyond monolithic's "
