@@ -253,12 +253,8 @@ static int hybrid_scope(const fluid_content *fc, const mpm_config *cfg, scope_mi
                 "does not carry a solid under coupling.time = multirate with the classic update "
                 "(its held exchange drifts the momentum by 1e-4): use an ERK pair (time.method "
                 "= bs32) or coupling.time = monolithic");
-  if (strcmp(time, "monolithic") != 0 && strcmp(time, "multirate") != 0)
-    return miss(s, "fluid.pressure",
-                "does not carry a solid under coupling.time = staggered (not measured): use "
-                "coupling.time = monolithic or multirate");
-  /* The grid pressure's contact (test_gridp_beside) was not measured with the particles' share
-   * beside it. */
+  /* Staggered is outside the grid pressure's scope (grid_scope). The grid pressure's contact
+   * (test_gridp_beside) was not measured with the particles' share beside it. */
   if (strcmp(scheme, "contact") == 0)
     return miss(s, "fluid.pressure",
                 "does not carry a solid under coupling.scheme = contact (not measured): use "

@@ -22,12 +22,12 @@ velocity, contact and traction under usl; velocity under bs32 (adaptive, the def
 solid it takes the hybrid pressure by default since 2026-12-06), under
 coupling.time = multirate and under usl with fluid.pressure = hybrid (the pressure continued
 through the whole slab, docs/gas.md), at 50, 100, 200, 400; and the stability runs over 20 periods
-(t = 36) at 400 and 800. `mri` (test_fsi_resonator_mri): velocity under bs32 with
-coupling.time = multirate (ARKODE's MRIStep, time.adaptive = false; the gas takes the hybrid
-pressure there by default since 2026-12-06) at 50, 100, 200, 400, and 20 periods at 400 and 800. `standin` replaces the initial stress by the issue's stand-in, a
-constant traction -p0 on the stress-free slab's gas-side particle layer (that is all main could
-do): the frequencies then fail (+0.52 ... +0.66 % on f_1, not converging) and the gas beside
-the slab goes unstable at 200 cells per metre.
+(t = 36) at 400 and 800. `mri` (test_fsi_resonator_mri): velocity under bs32 with coupling.time =
+multirate (ARKODE's MRIStep, time.adaptive = false; the gas takes the hybrid pressure there by
+default since 2026-12-06) at 50, 100, 200, 400, and 20 periods at 400 and 800. `standin` replaces
+the initial stress by the issue's stand-in, a constant traction -p0 on the stress-free slab's gas-
+side particle layer (that is all main could do): the frequencies then fail (+0.52 ... +0.66 % on
+f_1, not converging) and the gas beside the slab goes unstable at 200 cells per metre.
 
 Checks and tolerances:
 - |f_k / f_k,exact - 1| <= 0.1 % at the finest resolution (the issue's acceptance; the fit's
