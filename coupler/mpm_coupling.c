@@ -7,7 +7,6 @@
 #include "mpm_timer.h"
 
 #include <math.h>
-#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -122,7 +121,7 @@ static int build(mpm_coupling *c, const mpm_config *cfg, mpm_module **mods, int 
     c->nbodies = nb;
     for (int d = 0; d < g->dim; ++d) MPM_ALLOC(c->da[d], g->nnodes);
   }
-  for (int d = 0; c->type->needs & MPM_COUPLING_HOLDS && d < g->dim; ++d) {
+  for (int d = 0; c->type->needs & (MPM_COUPLING_HOLDS | MPM_COUPLING_RELAXES) && d < g->dim; ++d) {
     MPM_ALLOC(c->held_v[d], g->nnodes);
     MPM_ALLOC(c->held_a[d], g->nnodes);
   }
@@ -272,11 +271,49 @@ static int hand_over(mpm_coupling *c, double t, double h, mpm_pass pass) {
   return 0;
 }
 
+/* Does this pass relax the phases' own velocities at the shared nodes (mpm_coupling.h)? */
+static int relaxes(const mpm_coupling *c, double h, mpm_pass pass) {
+  return c->type->needs & MPM_COUPLING_RELAXES && h == 0 && pass == MPM_PASS_FIRST &&
+         c->relax_rate > 0;
+}
+
+/* The method of lines' relaxation of the phases' own velocities (mpm_coupling.h, relax_rate):
+ * at a shared node, in each component no constraint has set since after_solve, the phases
+ * exchange the force k mu (u_g - u_s), u their deposited velocities mv / m and mu = m_s m_g /
+ * (m_s + m_g); it conserves momentum node by node and removes k mu |u_g - u_s|^2 of the
+ * particles' kinetic energy, which is the power it books. */
+static int relax(mpm_coupling *c, double t, double h, mpm_pass pass) {
+  (void)t, (void)h, (void)pass;
+  mpm_grid_phase *s = &c->grid->phase[c->phase[MPM_ROLE_SOLID]];
+  mpm_grid_phase *g = &c->grid->phase[c->phase[MPM_ROLE_FLUID]];
+  const int dim = c->grid->dim;
+  const double k = c->relax_rate;
+  for (mpm_lidx l = 0; l < c->grid->nnodes; ++l) {
+    if (!mpm_coupling_shared(c, l)) continue;
+    const double ms = s->m_i[l], mg = g->m_i[l], mu = ms * mg / (ms + mg);
+    double f[MPM_MAX_DIM], us[MPM_MAX_DIM], ug[MPM_MAX_DIM];
+    int any = 0;
+    for (int d = 0; d < dim; ++d) {
+      us[d] = s->mv_i[d][l] / ms, ug[d] = g->mv_i[d][l] / mg, f[d] = 0.0;
+      if (s->v_i[d][l] != c->held_v[d][l] || s->a_i[d][l] != c->held_a[d][l]) continue;
+      f[d] = k * mu * (ug[d] - us[d]);
+      s->a_i[d][l] += f[d] / ms, g->a_i[d][l] -= f[d] / mg;
+      any = 1;
+    }
+    if (!any) continue;
+    mpm_coupling_record_force(c, MPM_ROLE_SOLID, l, f, us);
+    for (int d = 0; d < dim; ++d) f[d] = -f[d];
+    mpm_coupling_record_force(c, MPM_ROLE_FLUID, l, f, ug);
+  }
+  return 0;
+}
+
 int mpm_coupling_after_solve(mpm_coupling *c, double t, double h, mpm_pass pass) {
   if (!c) return 0;
   if (c->hand_over) MPM_CALL(run_hook(c, hand_over, t, h, pass));
   MPM_CALL(run_hook(c, c->type->ops->after_solve, t, h, pass));
-  if (c->type->needs & MPM_COUPLING_HOLDS) MPM_CALL(run_hook(c, save_held, t, h, pass));
+  if (c->type->needs & MPM_COUPLING_HOLDS || relaxes(c, h, pass))
+    MPM_CALL(run_hook(c, save_held, t, h, pass));
   return 0;
 }
 
@@ -300,6 +337,7 @@ int mpm_coupling_after_constrain(mpm_coupling *c, double t, double h, mpm_pass p
   if (!c) return 0;
   if (c->type->needs & MPM_COUPLING_HOLDS) MPM_CALL(run_hook(c, follow_held, t, h, pass));
   MPM_CALL(run_hook(c, c->type->ops->after_constrain, t, h, pass));
+  if (relaxes(c, h, pass)) MPM_CALL(run_hook(c, relax, t, h, pass));
   if (pass == MPM_PASS_FIRST) mpm_coupling_record_inside(c);
   return 0;
 }

@@ -12,6 +12,13 @@
  *                    may correct them where the phases meet;
  *   after_constrain  each module has applied its walls, clamps, obstacles; a scheme may
  *                    reconcile the phases there (optional).
+ * Then, in the method of lines' first pass, a scheme that asks for it (MPM_COUPLING_RELAXES:
+ * `velocity`) relaxes the phases' own velocities towards each other at the shared nodes. There
+ * a particle moves with the nodal velocity but keeps its own velocity as a state, which takes
+ * the nodal acceleration only, so the shared velocity a scheme sets never reaches it (the
+ * classic update's impulse carries it, once a step): each phase takes the force
+ * k m_s m_g / (m_s + m_g) (u_other - u_own), u the phases' deposited velocities mv / m, k =
+ * relax_rate, in every component no constraint set after the solve.
  * Every hook acts on all box nodes (owners hold the summed values; ghosts are overwritten by
  * the forward halo that follows, so what a scheme writes there does not matter).
  *
@@ -45,7 +52,7 @@ typedef struct mpm_coupling mpm_coupling;
  * the gas slid through the root along it. `contact` does not take it: on the main job at 2 mm it
  * trapped gas in the clamped root, where its step fell to 5e-9 s by 2.5 ms (43 000 steps, against
  * 30 188 for the whole run without it). */
-enum { MPM_COUPLING_NORMALS = 1, MPM_COUPLING_HOLDS = 2 };
+enum { MPM_COUPLING_NORMALS = 1, MPM_COUPLING_HOLDS = 2, MPM_COUPLING_RELAXES = 4 };
 
 typedef struct mpm_coupling_ops {
   /* Read the scheme's own keys, allocate its content. Optional. */
@@ -102,6 +109,9 @@ struct mpm_coupling {
   unsigned char *wall_axes; /* MPM_COUPLING_NORMALS: per box node, bit d set where the node lies
                                on a wall face across axis d (slip, no_slip) */
   mpm_interface *capture;   /* non-NULL: what the solid is given goes there instead (held) */
+  double relax_share; /* MPM_COUPLING_RELAXES: k in units of the stable rate (coupling.mol_rate) */
+  double relax_rate;  /* k, 1/s (0: none); set before each RHS by the integrator
+                         (coupler/mpm_integrator.c) */
   /* On a refinement hierarchy (mpm_coupling_set_hier; 0 levels: the grid alone): every hook and
    * the interpenetration run on each level in turn, grid and owned set to the level's, so that a
    * scheme acts on the active nodes of every level (coupler/mpm_coupling_levels.c). */

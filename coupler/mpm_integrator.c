@@ -135,6 +135,25 @@ static int check_state(mpm_integrator *it, double *const *yk) {
   return check_modules(it, yk, 0, it->nmod);
 }
 
+/* The rate of the coupling's relaxation of the phases' own velocities at the shared nodes
+ * (mpm_coupling.h, relax_rate): coupling.mol_rate over the largest of the modules' stable steps
+ * at this state, the slowest module's. A step is never longer than time.cfl times it (under
+ * multirate the slow step is the slow module's), so h k stays below coupling.mol_rate time.cfl,
+ * and monolithic and multirate solve the same equations (with the step-setting modules' rate
+ * instead, MRIStep's energy on test_multirate_face_mri no longer converged to monolithic's).
+ * Collective. */
+static int set_relax_rate(mpm_integrator *it, double *const *yk) {
+  mpm_coupling *c = it->cycle.coupling;
+  if (!c || !(c->type->needs & MPM_COUPLING_RELAXES) || !(c->relax_share > 0)) return 0;
+  double h[MPM_MAX_MODULES], slowest = 0.0;
+  for (int k = 0; k < it->nmod; ++k) h[k] = it->mod[k]->ops->stable_dt(it->mod[k], yk[k]);
+  MPM_CALL_MPI(MPI_Allreduce(MPI_IN_PLACE, h, it->nmod, MPI_DOUBLE, MPI_MIN, it->comm));
+  for (int k = 0; k < it->nmod; ++k)
+    if (isfinite(h[k])) slowest = fmax(slowest, h[k]);
+  c->relax_rate = slowest > 0 ? c->relax_share / slowest : 0.0;
+  return 0;
+}
+
 /* ERKStep's RHS (the ERK pairs): the MPM cycle with h = 0 (the method of lines) on a state
  * that passes the modules' checks; an unphysical one is a recoverable failure. */
 static int rhs(mpm_sunreal t, N_Vector y, N_Vector ydot, void *user) {
@@ -144,6 +163,10 @@ static int rhs(mpm_sunreal t, N_Vector y, N_Vector ydot, void *user) {
   vector_blocks(it, ydot, ydk);
   if (check_state(it, yk)) return 1;
   it->rhs_evals++;
+  if (set_relax_rate(it, yk) != 0) {
+    it->rhs_error = 1;
+    return -1;
+  }
   if (mpm_cycle_rhs(&it->cycle, t, yk, ydk, 0.0) != 0) {
     it->rhs_error = 1;
     return -1;

@@ -408,8 +408,9 @@ BODY_BOX = "[refine]\nlevels = 2\n\n[refine.box]\nlevel = 1\nlo = {lo}\nhi = {hi
 
 
 def body_case(t_end, refine=BODY_BOX, dim=2, pulse=False, material="linear_elastic",
-              pressure="grid", interval=None):
-    """The body scene; refine "" for the uniform twin, pressure "auto" for the particles'."""
+              pressure="grid", interval=None, mol_rate=None):
+    """The body scene; refine "" for the uniform twin, pressure "auto" for the particles';
+    mol_rate: coupling.mol_rate (None: the default)."""
     lo, hi, c = (" ".join([v] * dim) for v in ("0", "1", "0.5"))
     faces = "".join(f"{a}_lo = periodic\n{a}_hi = periodic\n" for a in "xyz"[:dim])
     gas = "density = 1\npressure = 1\n"
@@ -434,7 +435,7 @@ dx = 0.05
 {faces}
 [coupling]
 scheme = velocity
-
+{"" if mol_rate is None else f"mol_rate = {mol_rate}"}
 [time]
 t_end = {t_end}
 
