@@ -104,9 +104,19 @@ static void traction_destroy(mpm_coupling *c) {
   c->content = NULL;
 }
 
+/* The relaxation of the phases' own velocities under the method of lines (mpm_coupling.h)
+ * acts where this scheme ties them: along the normal on the solid's surface, every component
+ * inside it. */
+static int traction_relax_normal(const mpm_coupling *c, mpm_lidx l, double *n) {
+  return mpm_coupling_solid_surface(c, l, TRACTION_SURFACE, n);
+}
+
+static const mpm_key_spec traction_keys[] = {MPM_COUPLING_MOL_RATE_KEY("velocity and traction")};
+
 static const mpm_coupling_ops traction_ops = {
     .create = traction_create,
     .after_solve = traction_after_solve,
+    .relax_normal = traction_relax_normal,
     .destroy = traction_destroy,
 };
 
@@ -115,6 +125,8 @@ const mpm_coupling_type coupling_traction = {
     .help = "separate solves; the gas sees the solid's surface as a moving slip wall and its "
             "load goes back to the solid as an equal and opposite nodal force: the seed paper's "
             "explicit procedure",
-    .needs = MPM_COUPLING_NORMALS | MPM_COUPLING_HOLDS,
+    .needs = MPM_COUPLING_NORMALS | MPM_COUPLING_HOLDS | MPM_COUPLING_RELAXES,
+    .keys = traction_keys,
+    .nkeys = sizeof traction_keys / sizeof traction_keys[0],
     .ops = &traction_ops,
 };

@@ -13,29 +13,7 @@
  * an external constraint, not an interface exchange. */
 #include "mpm_coupling.h"
 
-#include <math.h>
-#include <stdlib.h>
-
-/* The method of lines' relaxation (mpm_coupling.h, MPM_COUPLING_RELAXES), in units of the
- * slowest module's stable rate: no step is longer than time.cfl times that module's stable step,
- * so h k stays below 2 time.cfl, inside bs32's real stability interval (-2.5, 0) for time.cfl <
- * 1.25, as the gas's wall rate argues (fluid/fluid_transfer.c). The default is as fast as that
- * allows, so that the phases' velocities meet within a few steps: at 1 the Mach 2 face of
- * test_multirate_face_mri read 1.9 % below u* under MRIStep at time.cfl = 0.4, at 2 0.3 % (58 %
- * above without it). */
-static const mpm_key_spec velocity_keys[] = {
-    {"coupling.mol_rate", MPM_KEY_REAL, "2", 0, 2, 0, 0, NULL,
-     "velocity, ERK pairs: the rate at which the phases' own velocities relax towards each "
-     "other at the shared nodes, in units of the slowest module's stable rate (1 / the largest "
-     "of the modules' stable steps); the method of lines moves a particle with the shared "
-     "nodal velocity but gives its own velocity only the nodal acceleration (0: off; the "
-     "classic update's impulse does this once a step and ignores the key)",
-     0, "-"},
-};
-
-static int velocity_create(mpm_coupling *c, const mpm_config *cfg) {
-  return mpm_config_get_real(cfg, "coupling.mol_rate", &c->relax_share);
-}
+static const mpm_key_spec velocity_keys[] = {MPM_COUPLING_MOL_RATE_KEY("velocity and traction")};
 
 static int velocity_after_solve(mpm_coupling *c, double t, double h, mpm_pass pass) {
   (void)t, (void)pass;
@@ -67,7 +45,6 @@ static int velocity_after_constrain(mpm_coupling *c, double t, double h, mpm_pas
 }
 
 static const mpm_coupling_ops velocity_ops = {
-    .create = velocity_create,
     .after_solve = velocity_after_solve,
     .after_constrain = velocity_after_constrain,
 };

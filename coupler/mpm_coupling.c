@@ -18,6 +18,13 @@ static mpm_key_spec g_scheme_key[] = {
     {"coupling.scheme", MPM_KEY_ENUM, "velocity", 0, 0, 0, 0, g_choices, g_help, 0, NULL},
 };
 
+/* Does type t declare key? */
+static int declares(const mpm_coupling_type *t, const char *key) {
+  for (int k = 0; k < t->nkeys; ++k)
+    if (strcmp(t->keys[k].key, key) == 0) return 1;
+  return 0;
+}
+
 int mpm_coupling_add_schema(mpm_config *cfg) {
   int n;
   const mpm_coupling_type *const *types = mpm_coupling_types(&n);
@@ -28,14 +35,11 @@ int mpm_coupling_add_schema(mpm_config *cfg) {
                        n < 16 ? n : 16);
   MPM_CALL(mpm_config_add_schema(cfg, g_scheme_key, 1));
   for (int k = 0; k < n; ++k)
-    if (types[k]->nkeys) MPM_CALL(mpm_config_add_schema(cfg, types[k]->keys, types[k]->nkeys));
-  return 0;
-}
-
-/* Does type t declare key? */
-static int declares(const mpm_coupling_type *t, const char *key) {
-  for (int k = 0; k < t->nkeys; ++k)
-    if (strcmp(t->keys[k].key, key) == 0) return 1;
+    for (int j = 0; j < types[k]->nkeys; ++j) { /* a key two schemes share, once */
+      int earlier = 0;
+      for (int i = 0; i < k && !earlier; ++i) earlier = declares(types[i], types[k]->keys[j].key);
+      if (!earlier) MPM_CALL(mpm_config_add_schema(cfg, &types[k]->keys[j], 1));
+    }
   return 0;
 }
 
@@ -125,6 +129,8 @@ static int build(mpm_coupling *c, const mpm_config *cfg, mpm_module **mods, int 
     MPM_ALLOC(c->held_v[d], g->nnodes);
     MPM_ALLOC(c->held_a[d], g->nnodes);
   }
+  if (c->type->needs & MPM_COUPLING_RELAXES)
+    MPM_CALL(mpm_config_get_real(cfg, "coupling.mol_rate", &c->relax_share));
   if (c->type->ops->create) MPM_CALL(c->type->ops->create(c, cfg));
   if (c->type->ops->setup) MPM_CALL(c->type->ops->setup(c));
   return 0;
@@ -280,23 +286,28 @@ static int relaxes(const mpm_coupling *c, double h, mpm_pass pass) {
 /* The method of lines' relaxation of the phases' own velocities (mpm_coupling.h, relax_rate):
  * at a shared node, in each component no constraint has set since after_solve, the phases
  * exchange the force k mu (u_g - u_s), u their deposited velocities mv / m and mu = m_s m_g /
- * (m_s + m_g); it conserves momentum node by node and removes k mu |u_g - u_s|^2 of the
- * particles' kinetic energy, which is the power it books. */
+ * (m_s + m_g), or its part along the normal where the scheme ties the phases along it alone
+ * (relax_normal); it conserves momentum node by node and removes k mu |u_g - u_s|^2 (its
+ * normal part) of the particles' kinetic energy, which is the power it books. */
 static int relax(mpm_coupling *c, double t, double h, mpm_pass pass) {
   (void)t, (void)h, (void)pass;
   mpm_grid_phase *s = &c->grid->phase[c->phase[MPM_ROLE_SOLID]];
   mpm_grid_phase *g = &c->grid->phase[c->phase[MPM_ROLE_FLUID]];
   const int dim = c->grid->dim;
   const double k = c->relax_rate;
+  int (*along)(const mpm_coupling *, mpm_lidx, double *) = c->type->ops->relax_normal;
   for (mpm_lidx l = 0; l < c->grid->nnodes; ++l) {
     if (!mpm_coupling_shared(c, l)) continue;
     const double ms = s->m_i[l], mg = g->m_i[l], mu = ms * mg / (ms + mg);
-    double f[MPM_MAX_DIM], us[MPM_MAX_DIM], ug[MPM_MAX_DIM];
+    double f[MPM_MAX_DIM], us[MPM_MAX_DIM], ug[MPM_MAX_DIM], n[MPM_MAX_DIM], un = 0.0;
+    for (int d = 0; d < dim; ++d) us[d] = s->mv_i[d][l] / ms, ug[d] = g->mv_i[d][l] / mg;
+    const int normal = along && along(c, l, n);
+    for (int d = 0; normal && d < dim; ++d) un += (ug[d] - us[d]) * n[d];
     int any = 0;
     for (int d = 0; d < dim; ++d) {
-      us[d] = s->mv_i[d][l] / ms, ug[d] = g->mv_i[d][l] / mg, f[d] = 0.0;
+      f[d] = 0.0;
       if (s->v_i[d][l] != c->held_v[d][l] || s->a_i[d][l] != c->held_a[d][l]) continue;
-      f[d] = k * mu * (ug[d] - us[d]);
+      f[d] = k * mu * (normal ? un * n[d] : ug[d] - us[d]);
       s->a_i[d][l] += f[d] / ms, g->a_i[d][l] -= f[d] / mg;
       any = 1;
     }
