@@ -77,6 +77,10 @@ typedef struct mpm_module_ops {
   int (*g2p)(mpm_module *m, double t, const double *y, double *ydot, double h);
   /* Largest stable step on this rank (before the CFL factor). */
   double (*stable_dt)(const mpm_module *m, const double *y);
+  /* The fastest signal on this rank at state y, m/s: the largest sound speed plus |v| of a
+   * particle, from y alone (no viscous share, nothing kept between calls), so that a rate the
+   * RHS scales by it stays a function of the state. Optional. */
+  double (*signal_speed)(const mpm_module *m, const double *y);
   /* Local check of a state: fills *fault and returns 1 if it is unphysical. */
   int (*check)(const mpm_module *m, const double *y, mpm_fault *fault);
   void (*sums)(const mpm_module *m, mpm_module_sums *s);

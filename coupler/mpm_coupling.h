@@ -71,7 +71,8 @@ typedef struct mpm_coupling_ops {
 
 /* The key of the method of lines' relaxation (MPM_COUPLING_RELAXES), which each scheme that
  * relaxes lists among its keys (declared once in the schema). In units of the slowest module's
- * stable rate: no step is longer than time.cfl times that module's stable step, so h k stays
+ * signal rate (its fastest sound speed plus |v| over the cell size): no step is longer than
+ * time.cfl times its inverse, so h k stays
  * below 2 time.cfl, inside bs32's real stability interval (-2.5, 0) for time.cfl < 1.25, as the
  * gas's wall rate argues (fluid/fluid_transfer.c). The default is as fast as that allows, so
  * that the phases' velocities meet within a few steps: at 1 the Mach 2 face of
@@ -82,8 +83,9 @@ typedef struct mpm_coupling_ops {
     "coupling.mol_rate", MPM_KEY_REAL, "2", 0, 2, 0, 0, NULL,                                      \
         schemes                                                                                    \
         ", ERK pairs: the rate at which the phases' own velocities relax towards each other "      \
-        "at the shared nodes, in units of the slowest module's stable rate (1 / the largest "      \
-        "of the modules' stable steps); the method of lines moves a particle with the shared "     \
+        "at the shared nodes, in units of the slowest module's signal rate (its fastest sound "    \
+        "speed plus |v| over the cell size); the method of lines moves a particle with the "       \
+        "shared "                                                                                  \
         "nodal velocity but gives its own velocity only the nodal acceleration (0: off; the "      \
         "classic update's impulse does this once a step and ignores the key)",                     \
         0, "-"                                                                                     \
@@ -133,7 +135,7 @@ struct mpm_coupling {
   unsigned char *wall_axes; /* MPM_COUPLING_NORMALS: per box node, bit d set where the node lies
                                on a wall face across axis d (slip, no_slip) */
   mpm_interface *capture;   /* non-NULL: what the solid is given goes there instead (held) */
-  double relax_share; /* MPM_COUPLING_RELAXES: k in units of the stable rate (coupling.mol_rate) */
+  double relax_share; /* MPM_COUPLING_RELAXES: k in units of the signal rate (coupling.mol_rate) */
   double relax_rate;  /* k, 1/s (0: none); set before each RHS by the integrator
                          (coupler/mpm_integrator.c) */
   /* On a refinement hierarchy (mpm_coupling_set_hier; 0 levels: the grid alone): every hook and

@@ -136,21 +136,25 @@ static int check_state(mpm_integrator *it, double *const *yk) {
 }
 
 /* The rate of the coupling's relaxation of the phases' own velocities at the shared nodes
- * (mpm_coupling.h, relax_rate): coupling.mol_rate over the largest of the modules' stable steps
- * at this state, the slowest module's. A step is never longer than time.cfl times it (under
- * multirate the slow step is the slow module's), so h k stays below coupling.mol_rate time.cfl,
- * and monolithic and multirate solve the same equations (with the step-setting modules' rate
- * instead, MRIStep's energy on test_multirate_face_mri no longer converged to monolithic's).
- * Collective. */
+ * (mpm_coupling.h, relax_rate): coupling.mol_rate times the slowest module's signal rate, its
+ * fastest signal at this state over the grid's spacing (the smallest over the modules). No
+ * step is longer than time.cfl times that module's stable step (under multirate the slow step
+ * is the slow module's), so h k stays below coupling.mol_rate time.cfl, and monolithic and
+ * multirate solve the same equations (with the step-setting modules' rate instead, MRIStep's
+ * energy on test_multirate_face_mri no longer converged to monolithic's). The signal is read
+ * from y alone (mpm_module.h, signal_speed): a rate from the stable step, which reads what the
+ * modules commit between steps, differed between an integrator restarted after a migration and
+ * one reusing its last stage (2 ranks against 1: 1e-8 of the piston's velocities). Collective. */
 static int set_relax_rate(mpm_integrator *it, double *const *yk) {
   mpm_coupling *c = it->cycle.coupling;
   if (!c || !(c->type->needs & MPM_COUPLING_RELAXES) || !(c->relax_share > 0)) return 0;
-  double h[MPM_MAX_MODULES], slowest = 0.0;
-  for (int k = 0; k < it->nmod; ++k) h[k] = it->mod[k]->ops->stable_dt(it->mod[k], yk[k]);
-  MPM_CALL_MPI(MPI_Allreduce(MPI_IN_PLACE, h, it->nmod, MPI_DOUBLE, MPI_MIN, it->comm));
+  double s[MPM_MAX_MODULES], slowest = HUGE_VAL;
   for (int k = 0; k < it->nmod; ++k)
-    if (isfinite(h[k])) slowest = fmax(slowest, h[k]);
-  c->relax_rate = slowest > 0 ? c->relax_share / slowest : 0.0;
+    s[k] = it->mod[k]->ops->signal_speed ? it->mod[k]->ops->signal_speed(it->mod[k], yk[k]) : 0.0;
+  MPM_CALL_MPI(MPI_Allreduce(MPI_IN_PLACE, s, it->nmod, MPI_DOUBLE, MPI_MAX, it->comm));
+  for (int k = 0; k < it->nmod; ++k)
+    if (s[k] > 0) slowest = fmin(slowest, s[k]);
+  c->relax_rate = isfinite(slowest) ? c->relax_share * slowest / it->grid->dx : 0.0;
   return 0;
 }
 

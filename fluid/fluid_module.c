@@ -737,6 +737,16 @@ static int fluid_output(mpm_module *m) {
  * (their position's level, fluid_position_level) over their signal speed, each computed as on a
  * uniform grid of spacing h (the artificial viscosity's length h too), returned as dx_finest /
  * smax. */
+/* |v|^2 of particle i at state y. */
+static double speed_squared(const mpm_particles *p, const double *y, mpm_lidx i) {
+  double v2 = 0.0;
+  for (int d = 0; d < p->dim; ++d) {
+    const double v = state(p, y, FLUID_V)[(size_t)d * p->n + i];
+    v2 += v * v;
+  }
+  return v2;
+}
+
 static double refined_stable_dt(const mpm_module *m, const double *y, double dx) {
   const fluid_content *fc = m->content;
   const mpm_particles *p = m->particles;
@@ -750,11 +760,7 @@ static double refined_stable_dt(const mpm_module *m, const double *y, double dx)
   const unsigned char *lev = fluid_position_levels(m, y);
   double smax = 0.0;
   for (mpm_lidx i = 0; i < n; ++i) {
-    double v2 = 0.0;
-    for (int d = 0; d < p->dim; ++d) {
-      const double v = state(p, y, FLUID_V)[(size_t)d * n + i];
-      v2 += v * v;
-    }
+    const double v2 = speed_squared(p, y, i);
     const double h =
         m->hier ? m->hier->level[fluid_position_level(m, lev, y, i)].grid->dx : m->grid->dx;
     const fluid_gas g = fluid_gas_at(&fc->gas, &h, 0);
@@ -766,6 +772,19 @@ static double refined_stable_dt(const mpm_module *m, const double *y, double dx)
     smax = fmax(smax, s * (dx / h));
   }
   return smax > 0.0 ? dx / smax : HUGE_VAL;
+}
+
+static double fluid_fastest_signal(const mpm_module *m, const double *y) {
+  const fluid_content *fc = m->content;
+  const mpm_particles *p = m->particles;
+  const mpm_lidx n = p->n;
+  const double gamma = fc->gas.gamma, *e = state(p, y, FLUID_E);
+  double smax = 0.0;
+  for (mpm_lidx i = 0; i < n; ++i) {
+    const double v2 = speed_squared(p, y, i);
+    smax = fmax(smax, sqrt(gamma * (gamma - 1.0) * fabs(e[i])) + sqrt(v2));
+  }
+  return smax;
 }
 
 static double fluid_stable_dt(const mpm_module *m, const double *y) {
@@ -786,11 +805,7 @@ static double fluid_stable_dt(const mpm_module *m, const double *y) {
   if (fc->refined) return refined_stable_dt(m, y, dx);
   double smax = 0.0; /* the fastest signal: dt = dx / smax */
   for (mpm_lidx i = 0; i < n; ++i) {
-    double v2 = 0.0;
-    for (int d = 0; d < p->dim; ++d) {
-      const double v = state(p, y, FLUID_V)[(size_t)d * n + i];
-      v2 += v * v;
-    }
+    const double v2 = speed_squared(p, y, i);
     const double rho = viscous ? mass[i] / (V0[i] * J[i]) : 1.0; /* only viscosity needs it */
     const double c = sqrt(gamma * (gamma - 1.0) * fabs(e[i]));   /* sqrt(gamma p / rho) */
     const double s =
@@ -864,6 +879,7 @@ static const mpm_module_ops fluid_ops = {
     .constrain = fluid_constrain,
     .g2p = fluid_g2p,
     .stable_dt = fluid_stable_dt,
+    .signal_speed = fluid_fastest_signal,
     .check = fluid_check,
     .sums = fluid_sums,
     .boundary = fluid_boundary,

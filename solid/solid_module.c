@@ -650,6 +650,22 @@ static double solid_stable_dt(const mpm_module *m, const double *y) {
   return dt;
 }
 
+static double solid_signal_speed(const mpm_module *m, const double *y) {
+  const solid_content *sc = m->content;
+  const mpm_particles *p = m->particles;
+  const double *body = mpm_particles_comp(p, sc->lay.f_body, 0);
+  double smax = 0.0;
+  for (mpm_lidx i = 0; i < p->n; ++i) {
+    double v2 = 0.0;
+    for (int d = 0; d < p->dim; ++d) {
+      const double v = y[(size_t)(p->offset[F_V] + d) * p->n + i];
+      v2 += v * v;
+    }
+    smax = fmax(smax, sc->body[(int)body[i]].c + sqrt(v2));
+  }
+  return smax;
+}
+
 static int solid_check(const mpm_module *m, const double *y, mpm_fault *fault) {
   if (mpm_module_check_positions(m, y, fault)) return 1;
   const mpm_particles *p = m->particles;
@@ -718,6 +734,7 @@ static const mpm_module_ops solid_ops = {
     .body_loads = solid_body_loads,
     .g2p = solid_g2p,
     .stable_dt = solid_stable_dt,
+    .signal_speed = solid_signal_speed,
     .check = solid_check,
     .sums = solid_sums,
     .post_step = solid_post_step,

@@ -149,6 +149,10 @@ Known failures, marked EXPECTED-FAIL (printed with the reason; not counted as fa
   15.7 % (bs32). Under bs32 with the hybrid pressure, which the gas takes beside a solid under
   the ERK pairs since 2026-12-06: rigid RMS 1.49 %, largest 4.94 %, median -0.20 %, first
   layer p -57.2 %; soft RMS 2.43 %, largest 14.33 %, median -0.62 %, first layer p -58.7 %.
+  With the relaxation of the phases' own velocities at the shared nodes as well (the velocity
+  and traction schemes under the ERK pairs, coupling.mol_rate, since 2026-12-06): rigid RMS
+  0.28 %, largest 0.82 %, median -0.18 %, first layer p -57.2 %; soft RMS 2.31 %, largest
+  14.50 %, median -0.62 %, first layer p -60.2 % (velocity:bs32).
   The linear coefficient does the work (RMS
   velocity:usl: 0.06 -> 5.62 %, 0.3 -> 3.48 %, 1.0 -> 2.55 %; c2 1.2 or 1.5 alike: the strain jump
   is only 2.9 %), at the price of the stable step (soft usl 4042 steps -> 7141; rigid usl 630 ->

@@ -47,7 +47,7 @@ Checks, at time.cfl = 0.4 and 0.2, multirate with coupling.exchange = shared:
   together at a shared node (common/mpm_impulse.h at h = 0 gives both the shared velocity and
   acceleration), and the face particle read +58.3, +29.4, +25.9 % of u* under MRIStep
   (monolithic bs32 +25.6 % at every step) while it moved at -0.14 %. The coupling now relaxes
-  the phases' deposited velocities towards each other at twice the slowest module's stable rate
+  the phases' deposited velocities towards each other at twice the slowest module's signal rate
   (coupler/mpm_coupling.c, relax; coupler/mpm_integrator.c, set_relax_rate), as the classic
   update's impulse does once a step. Measured 2026-12-06 at time.cfl 0.4, 0.2, 0.1: the face
   particle -0.32, -0.49, -0.59 % of u* under MRIStep (monolithic bs32 -0.58, -0.59, -0.59 %);
@@ -293,14 +293,12 @@ for k in (0, 3):  # W, then the total energy's change
 if LONG:
     sys.exit(check.finish())
 
-# Bad input: shared with what it cannot serve is one error line naming the file, the line and
-# the key (exit 2).
+# Bad input: one error line naming the file, the line and the key (exit 2).
 BASE = open(mt.case("fsi_multirate_face.ini")).read()
-BAD = (("scheme = traction", "coupling.exchange"), ("predictor = linear", "coupling.predictor"),
-       ("slow_substeps = 0", "coupling.slow_substeps"))
-for extra, key in BAD:
-    text = BASE.replace("time = multirate", f"time = multirate\nexchange = shared\n{extra}")
-    text = text.replace("scheme = velocity\n", "") if extra.startswith("scheme") else text
+
+
+def refused(text, key, what):
+    """Check that `mpmfsi check` refuses the case text in one line naming case.ini:LINE and key."""
     line = next(k for k, ln in enumerate(text.splitlines(), 1)
                 if ln.startswith(key.split(".")[1] + " ="))
     path = os.path.join(mt.outdir("mrf_bad"), "case.ini")
@@ -309,22 +307,23 @@ for extra, key in BAD:
     p = mt.run(["check", path], check=False)
     errors = [ln for ln in p.stderr.splitlines() if ln.startswith("error")]
     check(p.returncode == 2 and len(errors) == 1 and f"case.ini:{line}" in errors[0]
-          and key in errors[0], f"shared with {extra}: exit {p.returncode}, "
-          f"{errors[0] if errors else 'no error line'}")
+          and key in errors[0], f"{what}: exit {p.returncode}, "
+          f"{errors[0][:160] if errors else 'no error line'}")
+
+
+# Shared with what it cannot serve.
+BAD = (("scheme = traction", "coupling.exchange"), ("predictor = linear", "coupling.predictor"),
+       ("slow_substeps = 0", "coupling.slow_substeps"))
+for extra, key in BAD:
+    text = BASE.replace("time = multirate", f"time = multirate\nexchange = shared\n{extra}")
+    text = text.replace("scheme = velocity\n", "") if extra.startswith("scheme") else text
+    refused(text, key, f"shared with {extra}")
 # coupling.mol_rate (the velocity and traction schemes' relaxation under the ERK pairs) outside
-# [0, 2], or under contact, which does not read it: the same one line.
+# [0, 2], or under contact, which does not read it.
 for extra, scheme in (("mol_rate = 2.5", "velocity"), ("mol_rate = -1", "velocity"),
                       ("mol_rate = 1", "contact")):
-    text = BASE.replace("scheme = velocity\n", f"scheme = {scheme}\n{extra}\n")
-    line = next(k for k, ln in enumerate(text.splitlines(), 1) if ln.startswith("mol_rate ="))
-    path = os.path.join(mt.outdir("mrf_bad_rate"), "case.ini")
-    with open(path, "w") as f:
-        f.write(text)
-    p = mt.run(["check", path], check=False)
-    errors = [ln for ln in p.stderr.splitlines() if ln.startswith("error")]
-    check(p.returncode == 2 and len(errors) == 1 and f"case.ini:{line}" in errors[0]
-          and "coupling.mol_rate" in errors[0], f"{extra} under {scheme}: exit {p.returncode}, "
-          f"{errors[0][:120] if errors else 'no error line'}")
+    refused(BASE.replace("scheme = velocity\n", f"scheme = {scheme}\n{extra}\n"),
+            "coupling.mol_rate", f"{extra} under {scheme}")
 
 # A clamp holding the slab where the gas meets it (a rigid wall): the gas takes the clamped
 # velocity on the shared nodes, under every exchange (the default held one too).
