@@ -76,7 +76,7 @@ typedef struct mpm_coupling_ops {
  * below 2 time.cfl, inside bs32's real stability interval (-2.5, 0) for time.cfl < 1.25, as the
  * gas's wall rate argues (fluid/fluid_transfer.c). The default is as fast as that allows, so
  * that the phases' velocities meet within a few steps: at 1 the Mach 2 face of
- * test_multirate_face_mri read 1.9 % below u* under MRIStep at time.cfl = 0.4, at 2 0.3 % (58 %
+ * test_multirate_face_mri read 1.9 % below u* under MRIStep at time.cfl = 0.4, at 2 0.6 % (58 %
  * above without it). */
 #define MPM_COUPLING_MOL_RATE_KEY(schemes)                                                         \
   {                                                                                                \

@@ -46,14 +46,15 @@ MRI-GARK-ERK33a; coupler/timescheme_multirate.c), on the same stiff piston:
    substeps about five times in each) with an overall observed order of at least 1.5. Predicted:
    the table's 3, reduced towards 2 by the MPM right-hand side, which is only once continuously
    differentiable in the positions (the quadratic B-spline's gradient has kinks where a particle
-   crosses a cell face): monolithic bs32 itself shows 1.96 and 2.98 here. Measured 1.70 and
-   2.60 (overall 2.15; 2026-12-06, both with the hybrid pressure, which the gas beside a solid
-   takes under the ERK pairs by default; with the particles' pressure 1.45 and 2.50, overall
-   1.98). From d8fcec1 to 2026-11-28 the gas's wall rule for the method of lines
+   crosses a cell face): monolithic bs32 itself shows 1.96 and 2.98 here. Measured 2.45 and
+   2.67 (overall 2.56; 2026-12-06, both with the hybrid pressure, which the gas beside a solid
+   takes under the ERK pairs by default, and with the coupling's relaxation of the phases' own
+   velocities, coupling.mol_rate; without it 1.70 and 2.60, overall 2.15; with the particles'
+   pressure 1.45 and 2.50, overall 1.98). From d8fcec1 to 2026-11-28 the gas's wall rule for the method of lines
    scaled the velocity into the slip ends after each accepted step, a change whose strength
    depended on the step: this check failed at orders 0.21 and 0.33 (monolithic bs32 about 1);
    the rule is now a rate in the right-hand side (fluid/fluid_transfer.c). Its ratio to
-   monolithic bs32's error at the same time.cfl is printed (measured 2.8-4.4x), not checked:
+   monolithic bs32's error at the same time.cfl is printed (measured 2.9-3.5x), not checked:
    there monolithic's gas steps at
    the slab's limit, five times smaller than MRIStep's, so the ratio measures the gas's own time
    error at its own step, not the coupling (without the artificial viscosity it is 56x at
