@@ -13,14 +13,15 @@
  *   after_constrain  each module has applied its walls, clamps, obstacles; a scheme may
  *                    reconcile the phases there (optional).
  * Then, in the method of lines' first pass, a scheme that asks for it (MPM_COUPLING_RELAXES:
- * `velocity`) relaxes the phases' own velocities towards each other at the shared nodes. There
- * a particle moves with the nodal velocity but keeps its own velocity as a state, which takes
- * the nodal acceleration only, so the shared velocity a scheme sets never reaches it (the
- * classic update's impulse carries it, once a step): each phase takes the force
- * k m_s m_g / (m_s + m_g) (u_other - u_own), u the phases' deposited velocities mv / m, k =
- * relax_rate, in every component no constraint set after the solve.
- * Every hook acts on all box nodes (owners hold the summed values; ghosts are overwritten by
- * the forward halo that follows, so what a scheme writes there does not matter).
+ * `velocity`, `traction`) relaxes the phases' own velocities towards each other at the shared
+ * nodes. There a particle moves with the nodal velocity but keeps its own velocity as a state,
+ * which takes the nodal acceleration only, so the shared velocity a scheme sets never reaches it
+ * (the classic update's impulse carries it, once a step): each phase takes the force k m_s m_g /
+ * (m_s + m_g) (u_other - u_own), u the phases' deposited velocities mv / m, k = relax_rate, in
+ * every component no constraint set after the solve (along the normal alone where the scheme ties
+ * the phases along it, relax_normal). Every hook acts on all box nodes (owners hold the summed
+ * values; ghosts are overwritten by the forward halo that follows, so what a scheme writes there
+ * does not matter).
  *
  * The balance. Whatever a scheme changes goes through mpm_coupling_exchange(), an impulse in
  * the classic update (common/mpm_impulse.h, as the gas's static obstacles apply theirs), which
@@ -72,12 +73,11 @@ typedef struct mpm_coupling_ops {
 /* The key of the method of lines' relaxation (MPM_COUPLING_RELAXES), which each scheme that
  * relaxes lists among its keys (declared once in the schema). In units of the slowest module's
  * signal rate (its fastest sound speed plus |v| over the cell size): no step is longer than
- * time.cfl times its inverse, so h k stays
- * below 2 time.cfl, inside bs32's real stability interval (-2.5, 0) for time.cfl < 1.25, as the
- * gas's wall rate argues (fluid/fluid_transfer.c). The default is as fast as that allows, so
- * that the phases' velocities meet within a few steps: at 1 the Mach 2 face of
- * test_multirate_face_mri read 1.9 % below u* under MRIStep at time.cfl = 0.4, at 2 0.6 % (58 %
- * above without it). */
+ * time.cfl times its inverse, so h k stays below 2 time.cfl, inside bs32's real stability interval
+ * (-2.5, 0) for time.cfl < 1.25, as the gas's wall rate argues (fluid/fluid_transfer.c). The
+ * default is as fast as that allows, so that the phases' velocities meet within a few steps: at 1
+ * the Mach 2 face of test_multirate_face_mri read 1.9 % below u* under MRIStep at time.cfl = 0.4,
+ * at 2 0.6 % (58 % above without it). */
 #define MPM_COUPLING_MOL_RATE_KEY(schemes)                                                         \
   {                                                                                                \
     "coupling.mol_rate", MPM_KEY_REAL, "2", 0, 2, 0, 0, NULL,                                      \
@@ -85,9 +85,8 @@ typedef struct mpm_coupling_ops {
         ", ERK pairs: the rate at which the phases' own velocities relax towards each other "      \
         "at the shared nodes, in units of the slowest module's signal rate (its fastest sound "    \
         "speed plus |v| over the cell size); the method of lines moves a particle with the "       \
-        "shared "                                                                                  \
-        "nodal velocity but gives its own velocity only the nodal acceleration (0: off; the "      \
-        "classic update's impulse does this once a step and ignores the key)",                     \
+        "shared nodal velocity but gives its own velocity only the nodal acceleration (0: off; "   \
+        "the classic update's impulse does this once a step and ignores the key)",                 \
         0, "-"                                                                                     \
   }
 

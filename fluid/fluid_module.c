@@ -733,10 +733,6 @@ static int fluid_output(mpm_module *m) {
   return 0;
 }
 
-/* The stable step of a refined gas: the smallest over the particles of their level's spacing h
- * (their position's level, fluid_position_level) over their signal speed, each computed as on a
- * uniform grid of spacing h (the artificial viscosity's length h too), returned as dx_finest /
- * smax. */
 /* |v|^2 of particle i at state y. */
 static double speed_squared(const mpm_particles *p, const double *y, mpm_lidx i) {
   double v2 = 0.0;
@@ -747,6 +743,10 @@ static double speed_squared(const mpm_particles *p, const double *y, mpm_lidx i)
   return v2;
 }
 
+/* The stable step of a refined gas: the smallest over the particles of their level's spacing h
+ * (their position's level, fluid_position_level) over their signal speed, each computed as on a
+ * uniform grid of spacing h (the artificial viscosity's length h too), returned as dx_finest /
+ * smax. */
 static double refined_stable_dt(const mpm_module *m, const double *y, double dx) {
   const fluid_content *fc = m->content;
   const mpm_particles *p = m->particles;
