@@ -85,10 +85,12 @@ csv = mt.csv_rows
 
 
 def balance(out):
-    """The largest |F_solid + F_fluid| of coupling.csv over the largest |F_solid|."""
+    """The largest |F_solid + F_fluid| of coupling.csv over the largest |F_solid|, that
+    largest |F_solid|, and the largest |F_solid + F_fluid| itself, N."""
     c = csv(out, "coupling.csv")
     worst = max(np.abs(c[f"F{a}_solid"] + c[f"F{a}_fluid"]).max() for a in "xy")
-    return worst / max(np.abs(c["Fx_solid"]).max(), 1e-300), np.abs(c["Fx_solid"]).max()
+    fmax = np.abs(c["Fx_solid"]).max()
+    return worst / max(fmax, 1e-300), fmax, worst
 
 
 def traction(text):
@@ -110,7 +112,7 @@ def part_rest(scheme=lambda text: text):
         for phase in ("fluid", "solid"):
             vmax = max(vmax, float(np.abs(mt.particles(path, phase)["v"]).max()))
     d = csv(out, "diagnostics.csv")
-    rel, fmax = balance(out)
+    rel, fmax, worst = balance(out)
     print(f"info {mt.cost(out)}; largest |v| {vmax:.1e}, kinetic energy {d['kinetic'].max():.1e}"
           f", largest interface force {fmax:.1e}")
     # Measured 0 to 1e-16 (roundoff of the sums; the uniform twin alike): the slab's stress
@@ -120,8 +122,11 @@ def part_rest(scheme=lambda text: text):
           f" (c_g = 1.18)")
     check(d["kinetic"].max() <= 1e-24, f"kinetic energy {d['kinetic'].max():.1e} <= 1e-24 J "
           f"(total {d['total'][0]:.3g} J)")
-    check(rel <= 1e-12 or fmax <= 1e-15, f"interface force balance {rel:.1e} of the largest "
-          f"force {fmax:.1e} N (roundoff)")
+    # At rest every interface force is roundoff (under the ERK pairs the relaxation of the
+    # phases' own velocities adds its own, about 1e-15 N), so the balance is measured against
+    # the gas's load on the slab's face, p0 H = 0.06 N (H the strip's 3 cells of 0.02).
+    check(worst <= 1e-12 * 0.06, f"interface force balance {worst:.1e} N, {rel:.1e} of the "
+          f"largest force {fmax:.1e} N (at most 1e-12 of p0 H = 0.06 N)")
 
 
 # The transmitted wave's window at the probe: from before the pulse's front (t = 0.338) to
@@ -191,7 +196,7 @@ def part_pulse(method=plain):
           f"refined between its twins: T {t:.4f} in [{lo_t:.4f}, {hi_t:.4f}], R {r:.4f} in "
           f"[{lo_r:.4f}, {hi_r:.4f}] (1 % of T, 0.01 of R to spare)")
     out = runs["refined"]
-    rel, fmax = balance(out)
+    rel, fmax, _ = balance(out)
     # Measured 2.9e-14: the exchange is per node, each level's (roundoff of the sums).
     check(rel <= 1e-12, f"interface momentum balance of coupling.csv: |F_solid + F_fluid| "
           f"{rel:.1e} of the largest force {fmax:.1e} N (<= 1e-12)")
@@ -208,7 +213,7 @@ def part_traction():
     part_rest(traction)
     out = run("refine_fsi_traction", traction(pulse_case(rs.FSI_BAND)))
     t, r = transmitted(out), reflected(out)
-    rel, fmax = balance(out)
+    rel, fmax, _ = balance(out)
     print(f"info traction: {mt.cost(out)}; T {t:.4f}, R {r:.4f}, balance {rel:.1e}")
     # Measured T 1.3372, R 0.3420 (velocity's to 4 digits), balance 2.9e-14; the bounds of the
     # pulse part.
@@ -250,7 +255,7 @@ def part_regrid():
     check(vmax <= 1e-12, f"regridded, at rest: largest |v| {vmax:.1e} <= 1e-12 (c_g = 1.18)")
     out = run("refine_fsi_regrid", regridded(pulse_case(REGRID)))
     t, r = transmitted(out), reflected(out)
-    rel, fmax = balance(out)
+    rel, fmax, _ = balance(out)
     d = csv(out, "diagnostics.csv")
     drift = abs(d["total"] - d["total"][0]).max() / d["total"][0]
     mass = abs(d["mass"] - d["mass"][0]).max() / d["mass"][0]
@@ -289,7 +294,7 @@ def part_bar():
         text = f.read()
     out = mt.run_text("refine_fsi_bar", text, BAR_LEVELS)
     print(f"info refined: {mt.cost(out)}")
-    worst, peak = balance(out)
+    worst, peak, _ = balance(out)
     tip = csv(out, "probes.csv")
     print(f"info tip displacement at {tip['t'][-1] * 1e3:.2f} ms: {tip['tip_ux'][-1] * 1e3:.2f} mm")
     check(abs(tip["t"][-1] - 1e-3) <= 1e-9, f"bar on 2 levels: reached t = {tip['t'][-1]:.3g} s "
