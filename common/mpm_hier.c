@@ -533,18 +533,19 @@ int mpm_hier_level_walk(const mpm_hier *h, const double *xp) {
 
 /* Level l's table entry for x (wrapped), or -1 when x lies within the margin of its span's
  * faces or outside the level's box. */
-static int leaf_at(const mpm_hier *h, int l, const double *x) {
+static inline int leaf_at(const mpm_hier *h, int l, const double *x) {
   const mpm_grid *g = h->level[l].grid;
   const double inv_h = h->level[l].inv_h; /* (hier_xi's value, without its division) */
   mpm_lidx k = 0;
   for (int d = h->dim - 1; d >= 0; --d) {
-    const double t = (x[d] - g->lo[d]) * inv_h - 0.5;
-    if (!(t > -1e9 && t < 1e9)) return -1; /* (NaN too) beyond every box: the walk decides */
-    const double f = mpm_shape_floor(t), frac = t - f; /* (floor, inline) */
-    if (!(frac > LEAF_MARGIN && frac < 1.0 - LEAF_MARGIN && f + 1.0 >= g->box_lo[d] &&
-          f + 1.0 < g->box_lo[d] + g->box_n[d]))
-      return -1;
-    k = k * g->box_n[d] + ((mpm_lidx)f + 1 - g->box_lo[d]);
+    const double t = (x[d] - g->lo[d]) * inv_h + 0.5; /* the span's index plus its fraction */
+    /* Inside the box's spans (false for NaN and for any point far outside: no cast overflows),
+     * then away from the span's faces. */
+    if (!(t >= g->box_lo[d] && t < g->box_lo[d] + g->box_n[d])) return -1;
+    const int f = mpm_shape_floor(t);
+    const double frac = t - (double)f;
+    if (!(frac > LEAF_MARGIN && frac < 1.0 - LEAF_MARGIN)) return -1;
+    k = k * g->box_n[d] + (f - g->box_lo[d]);
   }
   return h->leaf[l][k] == MPM_HIER_WALK ? -1 : h->leaf[l][k];
 }

@@ -22,19 +22,15 @@ mpm_lidx mpm_hier_wall_mirror(const mpm_hier *h, int l, int d, mpm_lidx n) {
   return hier_in_box(g, gi) ? mpm_grid_local_index(g, gi) : -1;
 }
 
-/* The components a wall of axis d constrains at box node n (the wall on n's side). */
-static unsigned char flips(const mpm_hier *h, int l, int d, mpm_lidx n) {
-  int gi[MPM_MAX_DIM];
-  hier_node_of(h->level[l].grid, n, gi);
-  return h->wall[d][2 * gi[d] > (1 << l) - 1];
-}
-
 static int has_walls(const mpm_hier *h, int d) {
   return h->wall[d][0] || h->wall[d][1];
 }
 
 /* Call fn on every node n of a finer level beyond a wall of axis d, with its mirror s and the
- * components the wall flips there: both passes walk the same nodes, axis by axis. */
+ * components the wall flips there (the wall on n's side): both passes walk the same nodes, axis
+ * by axis. Only the layers beyond a wall are visited: along d the mirror maps layer j of the box
+ * onto layer m, so node n's mirror is n + (m - j) stride_d. Within one axis every mirror lies
+ * inside and takes one node, so the order of the layers does not change a sum. */
 typedef void (*mirror_fn)(mpm_grid_phase *ph, int dim, mpm_lidx n, mpm_lidx s, unsigned char mask);
 
 static void each_mirror(mpm_hier *h, int phase, mirror_fn fn) {
@@ -43,9 +39,20 @@ static void each_mirror(mpm_hier *h, int phase, mirror_fn fn) {
     mpm_grid_phase *ph = &g->phase[phase];
     for (int d = 0; d < h->dim; ++d) {
       if (!has_walls(h, d)) continue;
-      for (mpm_lidx n = 0; n < g->nnodes; ++n) {
-        const mpm_lidx s = mpm_hier_wall_mirror(h, l, d, n);
-        if (s >= 0) fn(ph, h->dim, n, s, flips(h, l, d, n));
+      mpm_lidx stride = 1; /* nodes per layer step along d */
+      for (int e = 0; e < d; ++e) stride *= g->box_n[e];
+      const mpm_lidx slab = stride * g->box_n[d], outer = g->nnodes / slab;
+      const int lo = g->box_lo[d], hi = lo + g->box_n[d];
+      for (int j = lo; j < hi; ++j) {
+        const int m = hier_mirror(h, l, d, j);
+        if (m == j || m < lo || m >= hi) continue; /* not beyond a wall, or its mirror outside */
+        const unsigned char mask = h->wall[d][2 * j > (1 << l) - 1];
+        const mpm_lidx shift = (mpm_lidx)(m - j) * stride;
+        for (mpm_lidx o = 0; o < outer; ++o)
+          for (mpm_lidx q = 0; q < stride; ++q) {
+            const mpm_lidx n = o * slab + (mpm_lidx)(j - lo) * stride + q;
+            fn(ph, h->dim, n, n + shift, mask);
+          }
       }
     }
   }

@@ -225,10 +225,10 @@ int fluid_regularise(mpm_module *m, long step, int *changed);
  * particle moved. Collective. */
 int fluid_shift(mpm_module *m, long step, double h, int *changed);
 
-/* After an accepted step of a refined gas: split the particles that entered a finer level and
- * merge, 2^dim at a time, those that left one (fluid_relevel.c); sets *changed when the set
- * changed. One rank (the hierarchy's). */
-int fluid_relevel(mpm_module *m, int *changed);
+/* After an accepted step of a refined gas (regrid 0) or a regrid (1): split the particles that
+ * entered a finer level and merge, 2^dim at a time, those that left one (between regrids in
+ * batches: fluid_relevel.c); sets *changed when the set changed. Collective. */
+int fluid_relevel(mpm_module *m, int regrid, int *changed);
 
 /* The level of size of gas particle i (0 .. MPM_HIER_MAX_LEVELS - 1) from its reference volume,
  * V0_0 = (dx / ppc)^dim being level 0's: round(log2(V0_0 / V0) / dim) (fluid_relevel.c). */

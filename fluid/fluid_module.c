@@ -708,7 +708,7 @@ static int fluid_post_step(mpm_module *m, double t, double h, int *changed) {
   if (shifted && fluid_refill_due(fc, m->step))
     MPM_CALL(mpm_cells_count(m->grid, m->phase, m->particles));
   *changed |= shifted;
-  MPM_CALL(fluid_relevel(m, changed));
+  MPM_CALL(fluid_relevel(m, 0, changed));
   return fluid_regularise(m, m->step, changed);
 }
 

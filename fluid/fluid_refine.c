@@ -175,7 +175,7 @@ int fluid_module_refine(mpm_module *m, const mpm_config *cfg, mpm_hier *h, int s
 }
 
 int fluid_module_follow(mpm_module *m, int *changed) {
-  return fluid_relevel(m, changed);
+  return fluid_relevel(m, 1, changed);
 }
 
 void fluid_module_rehier(mpm_module *m, mpm_hier *h) {

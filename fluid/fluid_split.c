@@ -91,15 +91,17 @@ static int is_away(const mpm_module *m, mpm_lidx i) {
   return mpm_grid_owner_of(m->grid, x) != m->grid->rank;
 }
 
-/* Key of a candidate: a global lattice index (cell or slot), its id and its place in the list. */
+/* Key of a candidate: a global lattice index (cell, slot or span), a finer one within it (a
+ * merge's slot within its span, else 0), its id and its place in the list. */
 typedef struct split_key {
-  mpm_gidx cell, id;
+  mpm_gidx cell, sub, id;
   mpm_lidx a;
 } split_key;
 
 static int key_cmp(const void *pa, const void *pb) {
   const split_key *a = pa, *b = pb;
   if (a->cell != b->cell) return a->cell < b->cell ? -1 : 1;
+  if (a->sub != b->sub) return a->sub < b->sub ? -1 : 1;
   return (a->id > b->id) - (a->id < b->id);
 }
 
@@ -125,7 +127,7 @@ static int split_places(const mpm_module *m, const mpm_lidx *idx, mpm_lidx k, mp
       MPM_FAIL(MPM_ERR_INTERNAL, "split: particle %lld is not on the rank owning its cell",
                (long long)p->id[idx[a]]);
     }
-    key[a] = (split_key){global_cell(m->grid, p, idx[a]), p->id[idx[a]], a};
+    key[a] = (split_key){global_cell(m->grid, p, idx[a]), 0, p->id[idx[a]], a};
   }
   qsort(key, (size_t)k, sizeof *key, key_cmp);
   *most = 0;
@@ -285,6 +287,21 @@ static double unwrap(const mpm_grid *g, int d, double u, double ref) {
   return u - ref > 0.5 * L ? u - L : ref - u > 0.5 * L ? u + L : u;
 }
 
+void fluid_merge_centre(const mpm_module *m, const mpm_lidx *mem, int c, double *x) {
+  const fluid_content *fc = m->content;
+  const mpm_particles *p = m->particles;
+  const double *mass = mpm_particles_comp(p, fc->lay.f_m, 0);
+  double M = 0.0;
+  for (int d = 0; d < MPM_MAX_DIM; ++d) x[d] = 0.0;
+  for (int a = 0; a < c; ++a) {
+    M += mass[mem[a]];
+    for (int d = 0; d < p->dim; ++d)
+      x[d] += mass[mem[a]] * unwrap(m->grid, d, pos(p, d, mem[a]), pos(p, d, mem[0]));
+  }
+  for (int d = 0; d < p->dim; ++d) x[d] /= M;
+  mpm_grid_wrap(m->grid, x);
+}
+
 /* The sums of the c members mem[] (rules above) into acc (ncomp). */
 static void merge_sums(const mpm_module *m, const mpm_lidx *mem, int c, double *acc) {
   const fluid_content *fc = m->content;
@@ -401,6 +418,8 @@ int fluid_merge(mpm_module *m, const mpm_lidx *start, const mpm_lidx *member, mp
 /* ---- groups by parent slot --------------------------------------------------------------- */
 
 /* Global index of the slot (lattice of spacing H from lo) holding particle i. */
+/* The cell of particle i on the lattice of spacing H from the domain's lower corner (clamped
+ * to the domain's cells of that lattice). */
 static mpm_gidx slot_of(const mpm_grid *g, const mpm_particles *p, mpm_lidx i, double H) {
   mpm_gidx s = 0;
   for (int d = g->dim - 1; d >= 0; --d) {
@@ -433,15 +452,16 @@ static void groups_of_runs(const split_key *key, mpm_lidx k, int size, int full,
   *ngroups = ng;
 }
 
-int fluid_merge_groups(const mpm_module *m, const mpm_lidx *idx, mpm_lidx k, double H, int full,
-                       mpm_lidx **start, mpm_lidx **member, mpm_lidx *ngroups) {
+int fluid_merge_groups(const mpm_module *m, const mpm_lidx *idx, mpm_lidx k, double H, double span,
+                       int full, mpm_lidx **start, mpm_lidx **member, mpm_lidx *ngroups) {
   const mpm_particles *p = m->particles;
   const mpm_grid *g = m->grid;
   *start = NULL, *member = NULL, *ngroups = 0;
   double slots = 1.0;
   for (int d = 0; d < g->dim; ++d) slots *= ceil((g->hi[d] - g->lo[d]) / H);
-  if (!(H > 0.0) || !(slots < 0x1p62))
-    MPM_FAIL(MPM_ERR_INTERNAL, "merge: slot spacing %g is not positive or too small", H);
+  if (!(H > 0.0) || !(slots < 0x1p62) || !(span == 0.0 || span >= H))
+    MPM_FAIL(MPM_ERR_INTERNAL, "merge: slot spacing %g or span %g is not positive or too small", H,
+             span);
   unsigned char *used;
   MPM_ALLOC(used, p->n);
   const int rc = mark_indices(p, idx, k, used, "merge");
@@ -449,7 +469,11 @@ int fluid_merge_groups(const mpm_module *m, const mpm_lidx *idx, mpm_lidx k, dou
   MPM_CALL(rc);
   split_key *key;
   MPM_ALLOC(key, k);
-  for (mpm_lidx a = 0; a < k; ++a) key[a] = (split_key){slot_of(g, p, idx[a], H), p->id[idx[a]], a};
+  for (mpm_lidx a = 0; a < k; ++a) {
+    const mpm_gidx slot = slot_of(g, p, idx[a], H);
+    key[a] = (split_key){span > 0.0 ? slot_of(g, p, idx[a], span) : slot, span > 0.0 ? slot : 0,
+                         p->id[idx[a]], a};
+  }
   qsort(key, (size_t)k, sizeof *key, key_cmp);
   *start = malloc(sizeof **start * (size_t)(k / 2 + 2));
   *member = malloc(sizeof **member * (size_t)(k > 0 ? k : 1));

@@ -62,8 +62,15 @@ int fluid_merge(mpm_module *m, const mpm_lidx *start, const mpm_lidx *member, mp
  * sits at the slots' centres, and a parent's children in its slot). A slot of c candidates
  * gives ceil(c / 2^dim) groups of as equal sizes as can be, in id order, or with full set
  * floor(c / 2^dim) groups of exactly 2^dim, in id order, the rest left out; slots of one
- * candidate give none. *start (ngroups + 1) and *member (from malloc) are the caller's. Local. */
-int fluid_merge_groups(const mpm_module *m, const mpm_lidx *idx, mpm_lidx k, double H, int full,
-                       mpm_lidx **start, mpm_lidx **member, mpm_lidx *ngroups);
+ * candidate give none. With span > 0 (a multiple of H) the candidates share a cell of the
+ * lattice of that spacing from the same corner instead, taken slot by slot in the slots'
+ * global order and in id order within a slot. *start (ngroups + 1) and *member (from malloc)
+ * are the caller's. Local. */
+int fluid_merge_groups(const mpm_module *m, const mpm_lidx *idx, mpm_lidx k, double H, double span,
+                       int full, mpm_lidx **start, mpm_lidx **member, mpm_lidx *ngroups);
+
+/* The centre of mass of the c particles mem[] as a merge places it (wrapped into the domain
+ * along a periodic axis) into x. */
+void fluid_merge_centre(const mpm_module *m, const mpm_lidx *mem, int c, double *x);
 
 #endif

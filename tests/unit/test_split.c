@@ -377,7 +377,7 @@ static void round_trip_slots(int dim) {
   assert_int_equal(fluid_split(&s.m, idx, n, &r), 0);
   for (mpm_lidx i = 0; i < p->n; ++i) idx[i] = p->n - 1 - i; /* any order */
   mpm_lidx *start, *member, ng;
-  assert_int_equal(fluid_merge_groups(&s.m, idx, p->n, H, 0, &start, &member, &ng), 0);
+  assert_int_equal(fluid_merge_groups(&s.m, idx, p->n, H, 0.0, 0, &start, &member, &ng), 0);
   assert_int_equal(ng, n);
   assert_int_equal(fluid_merge(&s.m, start, member, ng, &r), 0);
   assert_int_equal(p->n, n);
