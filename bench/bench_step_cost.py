@@ -23,6 +23,7 @@ import csv
 import json
 import os
 import re
+import shlex
 import subprocess
 import sys
 import tempfile
@@ -84,7 +85,8 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--binary", required=True)
     ap.add_argument("--case", required=True)
-    ap.add_argument("--set", default="", help="overrides every configuration shares")
+    ap.add_argument("--set", default="",
+                    help="overrides every configuration shares (split as a shell splits words)")
     ap.add_argument("--config", action="append", required=True, metavar='NAME="k=v ..."')
     ap.add_argument("--reference", help="the configuration the ratios divide by")
     ap.add_argument("--from", dest="t_from", type=float, required=True)
@@ -98,14 +100,14 @@ def main():
         name, sep, rest = c.partition("=")
         if not sep or not name:
             ap.error(f'--config {c!r}: write NAME="key=value ..."')
-        configs.append((name, rest.split()))
+        configs.append((name, shlex.split(rest)))
     names = [n for n, _ in configs]
     if a.reference and a.reference not in names:
         ap.error(f"--reference {a.reference}: not one of the configurations {names}")
     rows = []
     with tempfile.TemporaryDirectory(prefix="step_cost_") as scratch:
         for name, extra in configs:
-            rows.append(measure(a.binary, a.case, a.set.split(), extra, a.t_from, a.t_to,
+            rows.append(measure(a.binary, a.case, shlex.split(a.set), extra, a.t_from, a.t_to,
                                 scratch, name))
             r = rows[-1]
             print(f"{name}: {r['steps']} steps, {r['rhs_evals']} RHS, "
