@@ -185,7 +185,8 @@ static void test_round_trip(int dim) {
   CHECK(mpm_particles_migrate(p, dist.m.grid, NULL) == 0, "migrate");
   for (mpm_lidx i = 0; i < p->n; ++i) idx[i] = i;
   mpm_lidx *start = NULL, *member = NULL, ng = 0;
-  CHECK(fluid_merge_groups(&dist.m, idx, p->n, g_dx / PPC, 0.0, 0, &start, &member, &ng) == 0, "groups");
+  CHECK(fluid_merge_groups(&dist.m, idx, p->n, g_dx / PPC, 0.0, 0, &start, &member, &ng) == 0,
+        "groups");
   CHECK(fluid_merge(&dist.m, start, member, ng, &r) == 0, "merge");
   row *c;
   const mpm_lidx nm = gather(p, MPI_COMM_WORLD, &c);
