@@ -417,7 +417,6 @@ int fluid_merge(mpm_module *m, const mpm_lidx *start, const mpm_lidx *member, mp
 
 /* ---- groups by parent slot --------------------------------------------------------------- */
 
-/* Global index of the slot (lattice of spacing H from lo) holding particle i. */
 /* The cell of particle i on the lattice of spacing H from the domain's lower corner (clamped
  * to the domain's cells of that lattice). */
 static mpm_gidx slot_of(const mpm_grid *g, const mpm_particles *p, mpm_lidx i, double H) {
