@@ -60,10 +60,11 @@ Checks and tolerances:
   8e-16), and the PIC share damps it. The default ERK pair takes no PIC share (mpm_transfer.c)
   and with the particles' pressure goes unstable at 800 (the guard at t = 1.53; the control,
   expected to fail), so beside a solid it takes the hybrid pressure by default (fluid.pressure
-  = auto, fluid/fluid_gridp.c): measured 3.7e-14 and 6.8e-14 over 20 periods at 400 and 800
-  (2026-12-06; 101,071 and 184,559 steps), and f_1 +0.1255 / +0.0799 / +0.0422 / +0.0205 %,
-  f_2 -0.1514 / -0.0273 / -0.0026 / +0.0009 % at 50 / 100 / 200 / 400 (f_1's order 0.87,
-  XFAIL as above). Under multirate (MRIStep) with the hybrid (`mri`; 2026-12-06): f_1 +0.1265
+  = auto, fluid/fluid_gridp.c): measured 5.1e-14 and 6.7e-14 over 20 periods at 400 and 800
+  (2026-12-06, with the relaxation of the phases' own velocities, coupling.mol_rate; 96,083 and
+  186,658 steps; before it 3.7e-14 and 6.8e-14), and f_1 +0.1257 / +0.0779 / +0.0422 /
+  +0.0206 %, f_2 -0.1514 / -0.0274 / -0.0022 / +0.0009 % at 50 / 100 / 200 / 400 (f_1's order
+  0.87, XFAIL as above). Under multirate (MRIStep) with the hybrid (`mri`; 2026-12-06): f_1 +0.1265
   / +0.0796 / +0.0422 / +0.0206 %, f_2 -0.1519 / -0.0275 / -0.0022 / +0.0009 % (400: the first
   18 s of the 20-period run; order 0.87, XFAIL), max |v_y| / c_g 6.1e-14 over 20 periods at 400
   (85,247 steps) and 1.3e-13 at 800 (170,463 steps, 105 minutes beside another job;
