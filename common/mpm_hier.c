@@ -158,7 +158,10 @@ static inline int span_flag(const mpm_hier *h, int l, const unsigned char *mask,
   mpm_lidx k = 0;
   int d = h->dim - 1;
   for (; d >= 0; --d) {
-    const int c = hier_canon_1d(&h->level[l], d, hier_mirror(h, l, d, gi[d]));
+    const int *plain = h->level[l].plain[d];
+    const int c = gi[d] >= plain[0] && gi[d] <= plain[1]
+                      ? gi[d]
+                      : hier_canon_1d(&h->level[l], d, hier_mirror(h, l, d, gi[d]));
     if (c < g->box_lo[d] || c >= g->box_lo[d] + g->box_n[d]) break;
     k = k * g->box_n[d] + (c - g->box_lo[d]);
   }
@@ -202,12 +205,33 @@ static int node_active(const mpm_hier *h, int l, const int *gi) {
   return !refined;
 }
 
+/* node_active where spans gi - 1 .. gi + 1 all lie in the plain range (mpm_hier_level.plain):
+ * the masks read in place around box index n. */
+static int node_active_plain(const mpm_hier_level *lv, int dim, mpm_lidx n) {
+  const mpm_grid *g = lv->grid;
+  const mpm_lidx sy = g->box_n[0], sz = dim == 3 ? sy * g->box_n[1] : 0;
+  int refined = 1;
+  for (int c = dim == 3 ? -1 : 0; c <= (dim == 3 ? 1 : 0); ++c)
+    for (int b = -1; b <= 1; ++b)
+      for (int a = -1; a <= 1; ++a) {
+        const mpm_lidx k = n + a + b * sy + c * sz;
+        if (!lv->covered[k]) return 0;
+        refined &= lv->refined[k];
+      }
+  return !refined;
+}
+
 static void set_active(mpm_hier *h, int l) {
-  const mpm_grid *g = h->level[l].grid;
+  const mpm_hier_level *lv = &h->level[l];
+  const mpm_grid *g = lv->grid;
   int gi[MPM_MAX_DIM];
   for (mpm_lidx n = 0; n < g->nnodes; ++n) {
     hier_node_of(g, n, gi);
-    h->level[l].active[n] = (unsigned char)node_active(h, l, gi);
+    int plain = 1;
+    for (int d = 0; d < h->dim; ++d)
+      plain &= gi[d] - 1 >= lv->plain[d][0] && gi[d] + 1 <= lv->plain[d][1];
+    h->level[l].active[n] =
+        (unsigned char)(plain ? node_active_plain(lv, h->dim, n) : node_active(h, l, gi));
   }
 }
 
@@ -339,15 +363,25 @@ static int make_parents_box(mpm_hier *h) {
 
 static int make_leaf(mpm_hier *h);
 
-/* near[n] = 1 for the nodes of level l's box within two nodes (per axis) of a span of Omega_l,
- * mirrors and images looked up as span_flag does: the own span's flag, dilated by two along
- * each axis in turn. (The box holds every span of Omega_l within reach of its nodes.) */
+/* near[n] = 1 for the nodes of level l's box within two nodes (per axis) of a span of level l's
+ * own points (in Omega_l, not refined: where its particles deposit) or within three level-0
+ * cells of a walled face (a point beyond a wall may stay on a coarser level than its span's,
+ * level_walk), mirrors and images looked up as span_flag does: those spans' flags, dilated by
+ * two along each axis in turn. (The box holds every span of Omega_l within reach of its
+ * nodes.) */
 static void near_mask(const mpm_hier *h, int l, unsigned char *near, unsigned char *tmp) {
-  const mpm_grid *g = h->level[l].grid;
+  const mpm_hier_level *lv = &h->level[l];
+  const mpm_grid *g = lv->grid, *g0 = h->level[0].grid;
   int gi[MPM_MAX_DIM];
   for (mpm_lidx n = 0; n < g->nnodes; ++n) {
     hier_node_of(g, n, gi);
-    near[n] = (unsigned char)span_flag(h, l, h->level[l].covered, gi, 0);
+    int wall = 0;
+    for (int d = 0; d < h->dim; ++d) {
+      const double x = g->lo[d] + gi[d] * g->dx, reach = 3.0 * g0->dx;
+      wall |= (h->wall[d][0] && x < g0->lo[d] + reach) || (h->wall[d][1] && x > g0->hi[d] - reach);
+    }
+    near[n] = (unsigned char)(span_flag(h, l, lv->covered, gi, 0) &&
+                              (wall || !span_flag(h, l, lv->refined, gi, 0)));
   }
   mpm_lidx stride = 1;
   for (int d = 0; d < h->dim; stride *= g->box_n[d], ++d) {
@@ -361,6 +395,17 @@ static void near_mask(const mpm_hier *h, int l, unsigned char *near, unsigned ch
     }
     memcpy(near, tmp, (size_t)g->nnodes);
   }
+}
+
+/* Mark in near the parents on level l of level l + 1's near nodes (their values pass through
+ * level l), each image's node with the image (the restriction folds it there). */
+static void mark_parents(const mpm_hier *h, int l, unsigned char *near) {
+  const mpm_hier_level *lv = &h->level[l], *fv = &h->level[l + 1];
+  const size_t np = (size_t)1 << h->dim;
+  for (mpm_lidx k = 0; k < fv->nnear; ++k)
+    for (size_t q = 0; q < np; ++q) near[fv->near_idx[(size_t)k * np + q]] = 1;
+  for (mpm_lidx q = 0; q < lv->nimage; ++q)
+    if (near[lv->image[q]]) near[lv->canon[q]] = 1;
 }
 
 /* mpm_hier_level.near, near_idx and near_w of level l >= 1 (after make_parents_box). */
@@ -378,6 +423,7 @@ static int make_near(mpm_hier *h, int l) {
   }
   near_mask(h, l, mask, tmp);
   free(tmp);
+  if (l + 1 < h->nlevels) mark_parents(h, l, mask);
   lv->nnear = 0;
   for (mpm_lidx n = 0; n < g->nnodes; ++n) {
     mask[n] &= !lv->active[n] && !(lv->is_image && lv->is_image[n]);
@@ -403,23 +449,39 @@ static int make_near(mpm_hier *h, int l) {
   return 0;
 }
 
+/* mpm_hier_level.plain of level l (its box, period and h's walls set). */
+static void set_plain(mpm_hier *h, int l) {
+  mpm_hier_level *lv = &h->level[l];
+  const mpm_grid *g = lv->grid;
+  for (int d = 0; d < h->dim; ++d) {
+    int a = g->box_lo[d], z = g->box_lo[d] + g->box_n[d] - 1;
+    const int twice_lo = (1 << l) - 1, twice_hi = 2 * (h->level[0].grid->ncells[d] << l) + twice_lo;
+    if (h->wall[d][0]) a = MPM_MAX(a, (twice_lo + 1) / 2); /* (hier_mirror: 2 i >= twice_lo) */
+    if (h->wall[d][1]) z = MPM_MIN(z, twice_hi / 2);       /* (2 i <= twice_hi) */
+    if (lv->period[d]) a = MPM_MAX(a, 0), z = MPM_MIN(z, lv->period[d] - 1);
+    lv->plain[d][0] = a, lv->plain[d][1] = z;
+  }
+}
+
 /* Levels 1 .. nlevels - 1 in turn (each snaps its boxes to the level before); why is set on an
  * input error. */
 static int build_levels(mpm_hier *h, const mpm_hier_box *box, int nbox, char *why, size_t len) {
   box_spans *sp;
   MPM_ALLOC(sp, nbox);
   int rc = 0;
+  set_plain(h, 0);
   for (int l = 1; l < h->nlevels && !rc; ++l) {
     for (int k = 0; k < nbox; ++k)
       if (box[k].level == l) sp[k] = snap_box(h->level[l - 1].grid, &box[k]);
     rc = check_nesting(h, l, sp, box, nbox, why, len);
     if (!rc) rc = make_level(h, l, box, sp, nbox);
+    if (!rc) set_plain(h, l);
   }
   free(sp);
   for (int l = 0; l < h->nlevels && !rc; ++l)
     set_active(h, l), h->level[l].inv_h = 1.0 / h->level[l].grid->dx;
   if (!rc && h->nranks > 1 && h->nlevels > 1) rc = make_parents_box(h);
-  for (int l = 1; l < h->nlevels && !rc; ++l) rc = make_near(h, l);
+  for (int l = h->nlevels - 1; l >= 1 && !rc; --l) rc = make_near(h, l); /* (finest first) */
   if (!rc) rc = make_leaf(h);
   return rc;
 }
@@ -531,9 +593,15 @@ int mpm_hier_level_walk(const mpm_hier *h, const double *xp) {
  * level's units. */
 #define LEAF_MARGIN 1e-6
 
+/* How far inside a span (in spans) the box mpm_hier_level_box gives stops: twice the table's
+ * margin, so that every point of the box passes leaf_at's test whatever the roundoff of its
+ * position in level units (a few ulps of the span index). */
+#define BOX_MARGIN (2.0 * LEAF_MARGIN)
+
 /* Level l's table entry for x (wrapped), or -1 when x lies within the margin of its span's
- * faces or outside the level's box. */
-static inline int leaf_at(const mpm_hier *h, int l, const double *x) {
+ * faces or outside the level's box. With lo and hi set, also the span's box shrunk by
+ * BOX_MARGIN (lo[d] <= x[d] <= hi[d]: every point in it has the same entry). */
+static inline int leaf_at(const mpm_hier *h, int l, const double *x, double *lo, double *hi) {
   const mpm_grid *g = h->level[l].grid;
   const double inv_h = h->level[l].inv_h; /* (hier_xi's value, without its division) */
   mpm_lidx k = 0;
@@ -546,6 +614,10 @@ static inline int leaf_at(const mpm_hier *h, int l, const double *x) {
     const double frac = t - (double)f;
     if (!(frac > LEAF_MARGIN && frac < 1.0 - LEAF_MARGIN)) return -1;
     k = k * g->box_n[d] + (f - g->box_lo[d]);
+    if (lo) {
+      lo[d] = g->lo[d] + ((double)f - 0.5 + BOX_MARGIN) * g->dx;
+      hi[d] = g->lo[d] + ((double)f + 0.5 - BOX_MARGIN) * g->dx;
+    }
   }
   return h->leaf[l][k] == MPM_HIER_WALK ? -1 : h->leaf[l][k];
 }
@@ -555,16 +627,50 @@ int mpm_hier_level_of(const mpm_hier *h, const double *xp) {
 }
 
 int mpm_hier_level_from(const mpm_hier *h, const double *xp, int hint) {
+  return mpm_hier_level_box(h, xp, hint, NULL, NULL);
+}
+
+/* The box of a table's answer for x (wrapped) clipped to the domain along the axes the
+ * hierarchy wraps (to [lo, hi - 1e-9 dx], where wrapping changes no point), so that a point in
+ * it is its own image; the point alone otherwise. */
+static void answer_box(const mpm_hier *h, const double *x, int tabled, double *lo, double *hi) {
+  const mpm_grid *g = h->level[0].grid;
+  for (int d = 0; d < h->dim; ++d) {
+    if (!tabled) {
+      lo[d] = hi[d] = x[d];
+    } else if (h->wraps && g->periodic[d]) {
+      const double top = g->hi[d] - 1e-9 * g->dx;
+      lo[d] = lo[d] < g->lo[d] ? g->lo[d] : lo[d];
+      hi[d] = hi[d] > top ? top : hi[d];
+    }
+  }
+}
+
+int mpm_hier_level_box(const mpm_hier *h, const double *xp, int hint, double *lo, double *hi) {
   double x[MPM_MAX_DIM];
   hier_wrap_point(h, xp, x);
   /* A span of level `hint` whose table entry is the level itself answers for every point
    * inside it (uncovered spans of the finer levels hold MPM_HIER_WALK: they never answer). */
-  if (hint >= 0 && hint < h->nlevels && h->leaf[0] && leaf_at(h, hint, x) == hint) return hint;
-  for (int l = 0; l < h->nlevels && h->leaf[0]; ++l) {
-    const int v = leaf_at(h, l, x);
-    if (v < 0) break;
-    if (v != MPM_HIER_MIXED) return v;
+  if (hint >= 0 && hint < h->nlevels && h->leaf[0] && leaf_at(h, hint, x, lo, hi) == hint) {
+    if (lo) { /* the coarsest span about x all of whose points have that level: the widest box */
+      double a[MPM_MAX_DIM], z[MPM_MAX_DIM];
+      for (int l = hint - 1; l >= 0 && leaf_at(h, l, x, a, z) == hint; --l)
+        for (int d = 0; d < h->dim; ++d) lo[d] = a[d], hi[d] = z[d];
+      answer_box(h, x, 1, lo, hi);
+    }
+    return hint;
   }
+  for (int l = 0; l < h->nlevels && h->leaf[0]; ++l) {
+    const int v = leaf_at(h, l, x, lo, hi);
+    if (v < 0) break;
+    if (v != MPM_HIER_MIXED) {
+      if (lo) answer_box(h, x, 1, lo, hi);
+      return v;
+    }
+  }
+  /* The walk's answer holds for the point itself: the box of an unmoved point (the raw x, which
+   * wrapping may change). */
+  if (lo) answer_box(h, xp, 0, lo, hi);
   return level_walk(h, x);
 }
 

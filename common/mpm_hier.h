@@ -105,16 +105,22 @@ typedef struct mpm_hier_level {
   double inv_h;   /* 1 / grid->dx, for the level lookups (a hot path) */
   unsigned char *covered, *refined, *active;
   int period[MPM_MAX_DIM]; /* nodes per period where the box holds the whole period, else 0 */
+  /* Per axis, the indices [plain[d][0], plain[d][1]] in the box that are neither beyond a wall
+   * nor images: a span there is its own mirror and image (the masks' lookups, a hot path). */
+  int plain[MPM_MAX_DIM][2];
   /* Levels >= 1 with a period: the box nodes that are images (image[k], a box index) and the
    * node in [0, N_l) each is an image of (canon[k]); is_image[n] marks them (NULL: none). */
   mpm_lidx nimage, *image, *canon;
   unsigned char *is_image;
-  /* Levels >= 1: the inactive nodes, images left out, within two nodes of a span of Omega_l
-   * (the only ones a deposit on the level reaches, with a node to spare), in box order, and
+  /* Levels >= 1: the inactive nodes, images left out, within two nodes of a span of the
+   * level's own points (Omega_l less Omega_{l+1}) or within three level-0 cells of a wall (the
+   * only ones a deposit on the level reaches, with a node to spare), and the parents of level
+   * l + 1's (what it restricts onto and prolongs from), in box order, and
    * their 2^dim parents on the lattice the restriction writes (level l - 1's box, or the
    * parents box for level 1 on more than one rank): box indices near_idx[2^dim k ..] and
    * two-scale weights near_w[2^dim k ..]. The restriction and prolongation visit these alone:
-   * the other inactive nodes, between the parts of a region that has several, stay zero. */
+   * the other inactive nodes (under a finer level, or between the parts of a region that has
+   * several) stay zero. */
   mpm_lidx nnear, *near, *near_idx;
   double *near_w;
 } mpm_hier_level;
@@ -203,10 +209,11 @@ int mpm_hier_level_walk(const mpm_hier *h, const double *x);
 
 /* The level (mpm_hier_level_of) of each of n points x[d][i], in an array of h's that holds
  * them until the next call (NULL when out of memory). h remembers the points of the last few
- * sets, each by the address x[0]: a point equal bit for bit to the one the set's last call had at
- * its index takes the level found then, so a caller asking again at positions that did not move
- * pays a comparison per point, whatever other sets were asked about in between
- * (mpm_hier_census.c). */
+ * sets, each by the address x[0], with their levels and a box about each in which every point
+ * has that level: a point still inside the box the set's last call had at its index takes the
+ * level found then, so a caller asking again at positions that did not move pays one
+ * comparison of the arrays, and one that moved them a little a few comparisons per point,
+ * whatever other sets were asked about in between (mpm_hier_census.c). */
 const unsigned char *mpm_hier_levels(mpm_hier *h, const double *const *x, mpm_lidx n);
 
 /* The set of n points remembered under the address from (its x[0]) was edited and now lives at

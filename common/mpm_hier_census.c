@@ -4,13 +4,15 @@
  *
  * Invariants: a particle's level is mpm_hier_level_of at its position (the particle field "x"),
  * the level it deposits on and reads; the counts are those levels tallied, so they sum to p->n.
- * mpm_hier_levels remembers the points it last saw and their levels (h->census; a few sets,
- * each keyed by the address of its positions): a point equal bit for bit to the one remembered
- * at its index takes the remembered level, which is the one
- * mpm_hier_level_of gives (a pure function of the point and of h, which does not change: a
- * regrid builds a new hierarchy). So the answers are those of mpm_hier_level_of whatever the
- * callers' order; the memory only spares the search where positions did not move, and where
- * they moved it gives the lookup its first guess (mpm_hier_level_from). */
+ * mpm_hier_levels remembers the points it last saw, their levels and the box of each level
+ * (h->census; a few sets, each keyed by the address of its positions). The box is that of
+ * mpm_hier_level_box: a table span's interior, where every point has the level found, or the
+ * point alone where the walk answered. A point inside the box remembered at its index takes the
+ * remembered level, which is the one mpm_hier_level_of gives (a pure function of the point and
+ * of h, which does not change: a regrid builds a new hierarchy). So the answers are those of
+ * mpm_hier_level_of whatever the callers' order; the memory only spares the search where
+ * points stayed in their boxes (a point that did not move always does), and elsewhere gives
+ * the lookup its first guess. */
 #include "mpm_hier_impl.h"
 
 #include <stdint.h>
@@ -20,11 +22,12 @@
 /* One remembered set of points, keyed by the address of its first component array: the gas's
  * positions between steps, an integrator's stage positions, a solid's. */
 typedef struct census_set {
-  const double *key;        /* x[0] of the set's last call (NULL: unused) */
-  unsigned long used;       /* the census clock at its last call */
-  mpm_lidx cap, n;          /* points the arrays hold, points remembered */
-  uint64_t *x[MPM_MAX_DIM]; /* the remembered points' bits, component-major */
-  unsigned char *lev;       /* their levels */
+  const double *key;                         /* x[0] of the set's last call (NULL: unused) */
+  unsigned long used;                        /* the census clock at its last call */
+  mpm_lidx cap, n;                           /* points the arrays hold, points remembered */
+  uint64_t *x[MPM_MAX_DIM];                  /* the remembered points' bits, component-major */
+  double *lo[MPM_MAX_DIM], *hi[MPM_MAX_DIM]; /* the boxes of their levels */
+  unsigned char *lev;                        /* their levels */
 } census_set;
 
 /* A few sets, so that callers alternating between sets (a gas and a solid counted for the
@@ -42,7 +45,8 @@ void mpm_hier_census_free(void *census) {
   hier_census *c = census;
   if (!c) return;
   for (int k = 0; k < CENSUS_SETS; ++k) {
-    for (int d = 0; d < MPM_MAX_DIM; ++d) free(c->set[k].x[d]);
+    for (int d = 0; d < MPM_MAX_DIM; ++d)
+      free(c->set[k].x[d]), free(c->set[k].lo[d]), free(c->set[k].hi[d]);
     free(c->set[k].lev);
   }
   free(c);
@@ -70,12 +74,25 @@ static census_set *room(mpm_hier *h, const double *key, mpm_lidx n) {
   for (int d = 0; d < h->dim && lev; ++d) {
     uint64_t *x = realloc(s->x[d], sizeof(uint64_t) * (size_t)cap);
     if (x) s->x[d] = x;
-    lev = x ? lev : NULL;
+    double *lo = x ? realloc(s->lo[d], sizeof(double) * (size_t)cap) : NULL;
+    if (lo) s->lo[d] = lo;
+    double *hi = lo ? realloc(s->hi[d], sizeof(double) * (size_t)cap) : NULL;
+    if (hi) s->hi[d] = hi;
+    lev = hi ? lev : NULL;
   }
   if (!lev)
     return s->n = 0, s->cap = 0, s->key = NULL, NULL; /* (the arrays kept are freed with h) */
   s->cap = cap;
   return s;
+}
+
+/* Point i of x, new or out of its box: its level (asking level hint first) and its box. */
+static void look_up(const mpm_hier *h, census_set *c, const double *const *x, mpm_lidx i,
+                    int hint) {
+  double xp[MPM_MAX_DIM] = {0, 0, 0}, lo[MPM_MAX_DIM], hi[MPM_MAX_DIM];
+  for (int d = 0; d < h->dim; ++d) xp[d] = x[d][i];
+  c->lev[i] = (unsigned char)mpm_hier_level_box(h, xp, hint, lo, hi);
+  for (int d = 0; d < h->dim; ++d) c->lo[d][i] = lo[d], c->hi[d][i] = hi[d];
 }
 
 const unsigned char *mpm_hier_levels(mpm_hier *h, const double *const *x, mpm_lidx n) {
@@ -87,10 +104,12 @@ const unsigned char *mpm_hier_levels(mpm_hier *h, const double *const *x, mpm_li
   for (int d = 0; d < h->dim && !moved; ++d)
     moved = n > 0 && memcmp(c->x[d], x[d], sizeof(uint64_t) * (size_t)n) != 0;
   if (!moved) return c->lev;
-  for (mpm_lidx i = 0; i < n; ++i) {
-    /* A block that did not move at all (after an edit that moved a few: a merge's kept
-     * particles, a split's parents and children) is skipped at once. */
-    if (i % CENSUS_BLOCK == 0 && i + CENSUS_BLOCK <= c->n) {
+  /* Otherwise most points are still in their boxes (a point that did not move always is, a
+   * NaN never): four comparisons each in 2-D, after a block of points that did not move at all
+   * (an edit's kept particles, a split's parents) is passed over at once. */
+  const mpm_lidx kept = n < c->n ? n : c->n;
+  for (mpm_lidx i = 0; i < kept; ++i) {
+    if (i % CENSUS_BLOCK == 0 && i + CENSUS_BLOCK <= kept) {
       int same = 1;
       for (int d = 0; d < h->dim && same; ++d)
         same = memcmp(c->x[d] + i, x[d] + i, sizeof(uint64_t) * CENSUS_BLOCK) == 0;
@@ -99,16 +118,17 @@ const unsigned char *mpm_hier_levels(mpm_hier *h, const double *const *x, mpm_li
         continue;
       }
     }
-    uint64_t b[MPM_MAX_DIM] = {0, 0, 0};
-    int same = i < c->n;
+    int inside = 1;
     for (int d = 0; d < h->dim; ++d) {
-      memcpy(&b[d], &x[d][i], sizeof b[d]);
-      same &= b[d] == c->x[d][i];
+      const double v = x[d][i];
+      inside &= (c->lo[d][i] <= v) & (v <= c->hi[d][i]);
+      memcpy(&c->x[d][i], &v, sizeof v); /* (its bits, for the comparison above) */
     }
-    if (same) continue;
-    double xp[MPM_MAX_DIM] = {0, 0, 0};
-    for (int d = 0; d < h->dim; ++d) xp[d] = x[d][i], c->x[d][i] = b[d];
-    c->lev[i] = (unsigned char)mpm_hier_level_from(h, xp, i < c->n ? c->lev[i] : -1);
+    if (!inside) look_up(h, c, x, i, c->lev[i]);
+  }
+  for (mpm_lidx i = kept; i < n; ++i) {
+    for (int d = 0; d < h->dim; ++d) memcpy(&c->x[d][i], &x[d][i], sizeof(double));
+    look_up(h, c, x, i, -1);
   }
   c->n = n;
   return c->lev;
@@ -133,7 +153,8 @@ void mpm_hier_levels_keep(mpm_hier *h, const double *from, const double *to,
     k = 0;
     for (mpm_lidx i = 0; i < n; ++i) {
       if (!keep[i]) continue;
-      for (int d = 0; d < h->dim; ++d) c->x[d][k] = c->x[d][i];
+      for (int d = 0; d < h->dim; ++d)
+        c->x[d][k] = c->x[d][i], c->lo[d][k] = c->lo[d][i], c->hi[d][k] = c->hi[d][i];
       c->lev[k++] = c->lev[i];
     }
   }

@@ -103,6 +103,12 @@ static inline double hier_parent_k(int dim, const int (*p)[2], int k, int *q) {
  * indices in c and weights; returns 2^dim. */
 int mpm_hier_parents(const mpm_grid *c, const int *gi, mpm_lidx *idx, double *w);
 
+/* mpm_hier_level_from, and a box lo[d] <= y[d] <= hi[d] (first dim entries) of points y that
+ * all have the level found (raw points: no wrapping needed). The box is the answering table
+ * span's, shrunk by a margin (and clipped to the domain along the axes the hierarchy wraps),
+ * or x alone when the walk answered. lo and hi may be NULL. */
+int mpm_hier_level_box(const mpm_hier *h, const double *x, int hint, double *lo, double *hi);
+
 /* Release the transfer scratch (mpm_hier_transfer.c). */
 void mpm_hier_scratch_free(void *scratch);
 /* Release the remembered levels (mpm_hier_census.c). */

@@ -378,6 +378,23 @@ static void test_levels(void **state) {
       for (int d = 0; d < 3; ++d) x[d][k] = p[d];
     }
     check_levels(&f, x, NPOINTS);
+    /* Small moves, as a step makes them (up to 0.3 of the finest spacing): most points stay in
+     * the box remembered with their level, some leave it within the level, and some change level;
+     * every answer stays mpm_hier_level_of's. */
+    const double hf = f.h->level[f.h->nlevels - 1].grid->dx;
+    int changed = 0;
+    for (int round = 0; round < 8; ++round) {
+      for (int k = 0; k < NPOINTS; ++k) {
+        const double q[3] = {x[0][k], x[1][k], x[2][k]};
+        double p[3] = {0, 0, 0};
+        for (int d = 0; d < f.grid->dim; ++d)
+          p[d] = q[d] + 0.3 * hf * (2.0 * mpm_test_uniform(&rng) - 1.0);
+        changed += mpm_hier_level_of(f.h, p) != mpm_hier_level_of(f.h, q);
+        for (int d = 0; d < f.grid->dim; ++d) x[d][k] = p[d];
+      }
+      check_levels(&f, x, NPOINTS);
+    }
+    assert_true(changed > 0);
     int moved_level = 0;
     for (int k = 0; k < NPOINTS; k += 3) { /* a fresh point at index k */
       double p[3], q[3] = {x[0][k], x[1][k], x[2][k]};
