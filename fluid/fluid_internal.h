@@ -250,10 +250,16 @@ double fluid_finest_dx(const mpm_module *m);
 /* The levels of the positions of state y (mpm_hier_levels: remembered while they do not move),
  * NULL without a hierarchy or out of memory. */
 const unsigned char *fluid_position_levels(const mpm_module *m, const double *y);
+/* The level of particle i's position in state y, found afresh (m->hier set). */
+int fluid_position_level_of(const mpm_module *m, const double *y, mpm_lidx i);
 /* The level particle i of state y deposits on (its position's): lev[i] from
- * fluid_position_levels, found afresh when lev is NULL; 0 without a hierarchy. */
-int fluid_position_level(const mpm_module *m, const unsigned char *lev, const double *y,
-                         mpm_lidx i);
+ * fluid_position_levels, found afresh when lev is NULL; 0 without a hierarchy. (Inline: every
+ * particle, several times a step.) */
+static inline int fluid_position_level(const mpm_module *m, const unsigned char *lev,
+                                       const double *y, mpm_lidx i) {
+  if (!m->hier) return 0;
+  return lev ? lev[i] : fluid_position_level_of(m, y, i);
+}
 /* On a refinement, at the start of an RHS: the level of each particle's position in state y
  * into fc->lev, handed to the hierarchy for this RHS's transfers (mpm_hier_levels_known; the
  * RHS's last phase forgets them), and each particle's artificial viscosity length, its level's

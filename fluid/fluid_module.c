@@ -758,18 +758,27 @@ static double refined_stable_dt(const mpm_module *m, const double *y, double dx)
   const double *psi = fc->lay.f_psi >= 0 ? field(p, y, fc->lay.f_psi) : NULL;
   const double *J = state(p, y, FLUID_J), *e = state(p, y, FLUID_E);
   const unsigned char *lev = fluid_position_levels(m, y);
+  /* Per level: its spacing, the gas there and the ratio to the finest spacing. */
+  const int nlev = m->hier ? m->hier->nlevels : 1;
+  double hl[MPM_HIER_MAX_LEVELS], ratio[MPM_HIER_MAX_LEVELS];
+  fluid_gas gl[MPM_HIER_MAX_LEVELS];
+  for (int l = 0; l < nlev; ++l) {
+    hl[l] = m->hier ? m->hier->level[l].grid->dx : m->grid->dx;
+    gl[l] = fluid_gas_at(&fc->gas, &hl[l], 0), ratio[l] = dx / hl[l];
+  }
   double smax = 0.0;
   for (mpm_lidx i = 0; i < n; ++i) {
     const double v2 = speed_squared(p, y, i);
-    const double h =
-        m->hier ? m->hier->level[fluid_position_level(m, lev, y, i)].grid->dx : m->grid->dx;
-    const fluid_gas g = fluid_gas_at(&fc->gas, &h, 0);
+    const int l = !m->hier ? 0 : lev ? lev[i] : fluid_position_level(m, NULL, y, i);
+    const double h = hl[l];
+    const fluid_gas *g = &gl[l];
     const double rho = mass[i] / (V0[i] * J[i]);
     const double c = sqrt(gamma * (gamma - 1.0) * fabs(e[i]));
     const double q = psi ? psi[i] : 0.0;
-    const double s = g.damped_step ? sqrt(v2) + fluid_signal_speed(&g, rho, c, divv[i], q, h)
-                                   : c + sqrt(v2) + fluid_viscous_speed(&g, rho, c, divv[i], q, h);
-    smax = fmax(smax, s * (dx / h));
+    const double s = g->damped_step ? sqrt(v2) + fluid_signal_speed(g, rho, c, divv[i], q, h)
+                                    : c + sqrt(v2) + fluid_viscous_speed(g, rho, c, divv[i], q, h);
+    const double sl = s * ratio[l];
+    if (sl > smax) smax = sl; /* (fmax's answer, NaN passed over alike, without its call) */
   }
   return smax > 0.0 ? dx / smax : HUGE_VAL;
 }

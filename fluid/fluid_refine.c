@@ -89,11 +89,8 @@ const unsigned char *fluid_position_levels(const mpm_module *m, const double *y)
   return mpm_hier_levels(m->hier, x, p->n);
 }
 
-int fluid_position_level(const mpm_module *m, const unsigned char *lev, const double *y,
-                         mpm_lidx i) {
+int fluid_position_level_of(const mpm_module *m, const double *y, mpm_lidx i) {
   const mpm_particles *p = m->particles;
-  if (!m->hier) return 0;
-  if (lev) return lev[i];
   double x[MPM_MAX_DIM] = {0, 0, 0};
   for (int d = 0; d < p->dim; ++d) x[d] = y[(size_t)(p->offset[FLUID_X] + d) * p->n + i];
   return mpm_hier_level_of(m->hier, x);
@@ -108,10 +105,12 @@ void fluid_av_lengths(mpm_module *m, const double *y) {
     return;
   }
   const unsigned char *lev = fluid_position_levels(m, y);
-  for (mpm_lidx i = 0; i < p->n; ++i) {
-    fc->lev[i] = (unsigned char)fluid_position_level(m, lev, y, i);
-    fc->av_l[i] = m->hier->level[fc->lev[i]].grid->dx;
-  }
+  double h[MPM_HIER_MAX_LEVELS];
+  for (int l = 0; l < m->hier->nlevels; ++l) h[l] = m->hier->level[l].grid->dx;
+  if (lev && p->n > 0) memcpy(fc->lev, lev, (size_t)p->n);
+  for (mpm_lidx i = 0; !lev && i < p->n; ++i)
+    fc->lev[i] = (unsigned char)fluid_position_level_of(m, y, i);
+  for (mpm_lidx i = 0; i < p->n; ++i) fc->av_l[i] = h[fc->lev[i]];
   mpm_hier_levels_known(m->hier, y + (size_t)p->offset[FLUID_X] * p->n, p->n, fc->lev);
 }
 

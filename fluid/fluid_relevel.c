@@ -142,16 +142,28 @@ static int merge_groups(const mpm_module *m, int L, const mpm_lidx *idx, mpm_lid
   MPM_CALL(fluid_merge_groups(m, idx, k, h / fc->ppc, 0.0, 1, start, member, ng));
   const mpm_lidx grouped = (*start)[*ng];
   if (L < 2 || k - grouped < 1 << m->grid->dim) return 0;
+  /* The rest, in idx's order: idx rises (merge_levels' scan), so a member's place in it is
+   * found by bisection. */
   unsigned char *in;
   mpm_lidx *rest = malloc(sizeof *rest * (size_t)(k - grouped));
-  if (!rest || !(in = calloc((size_t)m->particles->n, 1))) {
+  if (!rest || !(in = calloc((size_t)k, 1))) {
     free(rest), free(*start), free(*member);
-    MPM_FAIL_OOM((size_t)m->particles->n);
+    MPM_FAIL_OOM((size_t)k);
   }
-  for (mpm_lidx a = 0; a < grouped; ++a) in[(*member)[a]] = 1;
+  for (mpm_lidx a = 0; a < grouped; ++a) {
+    mpm_lidx lo = 0, hi = k; /* the first place whose index is not below the member's */
+    while (lo < hi) {
+      const mpm_lidx mid = lo + (hi - lo) / 2;
+      if (idx[mid] < (*member)[a])
+        lo = mid + 1;
+      else
+        hi = mid;
+    }
+    in[lo] = 1;
+  }
   mpm_lidx kr = 0;
   for (mpm_lidx a = 0; a < k; ++a)
-    if (!in[idx[a]]) rest[kr++] = idx[a];
+    if (!in[a]) rest[kr++] = idx[a];
   free(in);
   mpm_lidx *s2, *m2, ng2;
   int rc = fluid_merge_groups(m, rest, kr, h / fc->ppc, h, 1, &s2, &m2, &ng2);
@@ -267,8 +279,8 @@ static int none_left(const mpm_grid *g, mpm_lidx k) {
 }
 
 static int relevel(mpm_module *m, int regrid, int *changed) {
-  mpm_lidx *idx;
-  MPM_ALLOC(idx, m->particles->n > 0 ? m->particles->n : 1);
+  mpm_lidx *idx = malloc(sizeof *idx * (size_t)MPM_MAX(m->particles->n, 1)); /* (no zeroing) */
+  if (!idx) MPM_FAIL_OOM(sizeof *idx * (size_t)MPM_MAX(m->particles->n, 1));
   levels lv = {0};
   mpm_lidx merged = 0;
   int rc = classify(m, &lv);

@@ -83,6 +83,21 @@ static int mark_indices(const mpm_particles *p, const mpm_lidx *idx, mpm_lidx k,
   return 0;
 }
 
+/* Are the k indices idx in range and distinct? A rising list (the relevel's scans) in one pass;
+ * any other marked in a flag per particle. */
+static int check_indices(const mpm_particles *p, const mpm_lidx *idx, mpm_lidx k,
+                         const char *what) {
+  int rising = 1;
+  for (mpm_lidx a = 0; a < k; ++a)
+    rising &= idx[a] >= 0 && idx[a] < p->n && (a == 0 || idx[a] > idx[a - 1]);
+  if (rising) return 0;
+  unsigned char *used;
+  MPM_ALLOC(used, p->n);
+  const int rc = mark_indices(p, idx, k, used, what);
+  free(used);
+  return rc;
+}
+
 /* Is particle i in a cell of another rank (or outside the domain)? */
 static int is_away(const mpm_module *m, mpm_lidx i) {
   double x[MPM_MAX_DIM] = {0};
@@ -227,11 +242,7 @@ static int split_prepare(mpm_module *m, const mpm_lidx *idx, mpm_lidx k, mpm_gid
   const int nnew = (1 << p->dim) - 1;
   if ((int64_t)k * nnew + p->n > INT32_MAX)
     MPM_FAIL(MPM_ERR_MEMORY, "split: %d parents would exceed the local index range", (int)k);
-  unsigned char *used;
-  MPM_ALLOC(used, p->n);
-  int rc = mark_indices(p, idx, k, used, "split");
-  free(used);
-  MPM_CALL(rc);
+  MPM_CALL(check_indices(p, idx, k, "split"));
   MPM_CALL(split_places(m, idx, k, cell, r, most));
   return 0;
 }
@@ -461,11 +472,7 @@ int fluid_merge_groups(const mpm_module *m, const mpm_lidx *idx, mpm_lidx k, dou
   if (!(H > 0.0) || !(slots < 0x1p62) || !(span == 0.0 || span >= H))
     MPM_FAIL(MPM_ERR_INTERNAL, "merge: slot spacing %g or span %g is not positive or too small", H,
              span);
-  unsigned char *used;
-  MPM_ALLOC(used, p->n);
-  const int rc = mark_indices(p, idx, k, used, "merge");
-  free(used);
-  MPM_CALL(rc);
+  MPM_CALL(check_indices(p, idx, k, "merge"));
   split_key *key;
   MPM_ALLOC(key, k);
   for (mpm_lidx a = 0; a < k; ++a) {
