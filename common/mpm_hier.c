@@ -692,12 +692,37 @@ static int uniform_level(const mpm_hier *h, int l, const int *gi) {
 /* mpm_hier.leaf. Spans within three level-0 cells of a walled face are left to the walk (its
  * stencil test for points beyond the face); so are the spans of a finer level outside its region,
  * which the lookup down the levels never reaches and mpm_hier_level_from's hint may. */
+/* uniform_level, reading the next level's answers from below (box order, found first) for
+ * children in its plain range, where the box node is the child itself. */
+static int uniform_below(const mpm_hier *h, int l, const int *gi, const signed char *below) {
+  if (l + 1 == h->nlevels || !span_flag(h, l, h->level[l].refined, gi, 0)) return l;
+  const mpm_hier_level *fv = &h->level[l + 1];
+  int level = -1, c[MPM_MAX_DIM] = {0, 0, 0};
+  for (int k = 0; k < 1 << h->dim; ++k) {
+    int plain = 1;
+    for (int d = 0; d < h->dim; ++d) {
+      c[d] = 2 * gi[d] + ((k >> d) & 1);
+      plain &= c[d] >= fv->plain[d][0] && c[d] <= fv->plain[d][1];
+    }
+    const int u = plain ? below[mpm_grid_local_index(fv->grid, c)] : uniform_level(h, l + 1, c);
+    if (u < 0 || (level >= 0 && u != level)) return -1;
+    level = u;
+  }
+  return level;
+}
+
 static int make_leaf(mpm_hier *h) {
   const mpm_grid *g0 = h->level[0].grid;
   int gi[MPM_MAX_DIM];
-  for (int l = 0; l < h->nlevels; ++l) {
+  signed char *below = NULL;                  /* level l + 1's uniform_level at each box node */
+  for (int l = h->nlevels - 1; l >= 0; --l) { /* (finest first) */
     const mpm_grid *g = h->level[l].grid;
-    MPM_ALLOC(h->leaf[l], (size_t)g->nnodes);
+    signed char *uni = malloc((size_t)g->nnodes);
+    h->leaf[l] = malloc((size_t)g->nnodes);
+    if (!uni || !h->leaf[l]) {
+      free(uni), free(below);
+      MPM_FAIL_OOM(2 * (size_t)g->nnodes);
+    }
     for (mpm_lidx k = 0; k < g->nnodes; ++k) {
       hier_node_of(g, k, gi);
       int near_wall = 0;
@@ -707,10 +732,13 @@ static int make_leaf(mpm_hier *h) {
             (h->wall[d][0] && x < g0->lo[d] + reach) || (h->wall[d][1] && x > g0->hi[d] - reach);
       }
       near_wall |= l > 0 && !span_flag(h, l, h->level[l].covered, gi, 0);
-      const int u = near_wall ? -1 : uniform_level(h, l, gi);
+      const int u = uni[k] = (signed char)uniform_below(h, l, gi, below);
       h->leaf[l][k] = near_wall ? MPM_HIER_WALK : u < 0 ? MPM_HIER_MIXED : (unsigned char)u;
     }
+    free(below);
+    below = uni;
   }
+  free(below);
   return 0;
 }
 

@@ -108,23 +108,20 @@ const unsigned char *mpm_hier_levels(mpm_hier *h, const double *const *x, mpm_li
    * NaN never): four comparisons each in 2-D, after a block of points that did not move at all
    * (an edit's kept particles, a split's parents) is passed over at once. */
   const mpm_lidx kept = n < c->n ? n : c->n;
-  for (mpm_lidx i = 0; i < kept; ++i) {
-    if (i % CENSUS_BLOCK == 0 && i + CENSUS_BLOCK <= kept) {
-      int same = 1;
-      for (int d = 0; d < h->dim && same; ++d)
-        same = memcmp(c->x[d] + i, x[d] + i, sizeof(uint64_t) * CENSUS_BLOCK) == 0;
-      if (same) {
-        i += CENSUS_BLOCK - 1;
-        continue;
-      }
-    }
-    int inside = 1;
+  for (mpm_lidx i0 = 0; i0 < kept; i0 += CENSUS_BLOCK) {
+    const mpm_lidx i1 = kept - i0 < CENSUS_BLOCK ? kept : i0 + CENSUS_BLOCK;
+    int same = i1 - i0 == CENSUS_BLOCK;
+    for (int d = 0; d < h->dim && same; ++d)
+      same = memcmp(c->x[d] + i0, x[d] + i0, sizeof(uint64_t) * CENSUS_BLOCK) == 0;
+    if (same) continue;
+    unsigned char out[CENSUS_BLOCK] = {0}; /* (a loop per axis without branches) */
     for (int d = 0; d < h->dim; ++d) {
-      const double v = x[d][i];
-      inside &= (c->lo[d][i] <= v) & (v <= c->hi[d][i]);
-      memcpy(&c->x[d][i], &v, sizeof v); /* (its bits, for the comparison above) */
+      const double *xd = x[d] + i0, *lo = c->lo[d] + i0, *hi = c->hi[d] + i0;
+      for (mpm_lidx i = 0; i < i1 - i0; ++i) out[i] |= !((lo[i] <= xd[i]) & (xd[i] <= hi[i]));
+      memcpy(c->x[d] + i0, xd, sizeof(uint64_t) * (size_t)(i1 - i0)); /* (their bits) */
     }
-    if (!inside) look_up(h, c, x, i, c->lev[i]);
+    for (mpm_lidx i = i0; i < i1; ++i)
+      if (out[i - i0]) look_up(h, c, x, i, c->lev[i]);
   }
   for (mpm_lidx i = kept; i < n; ++i) {
     for (int d = 0; d < h->dim; ++d) memcpy(&c->x[d][i], &x[d][i], sizeof(double));
@@ -183,5 +180,7 @@ void mpm_hier_count_levels(mpm_hier *h, const mpm_particles *p, double *count) {
   const double *x[MPM_MAX_DIM];
   positions(h, p, x);
   const unsigned char *lev = mpm_hier_levels(h, x, p->n);
-  for (mpm_lidx i = 0; i < p->n; ++i) count[lev ? lev[i] : level_at(h, x, i)] += 1.0;
+  int64_t c[MPM_HIER_MAX_LEVELS] = {0}; /* (integers: no chain of dependent additions) */
+  for (mpm_lidx i = 0; i < p->n; ++i) c[lev ? lev[i] : level_at(h, x, i)]++;
+  for (int l = 0; l < h->nlevels; ++l) count[l] += (double)c[l];
 }

@@ -87,19 +87,21 @@ static int classify(mpm_hier *h, mpm_lidx n, const double *const *x, mpm_lidx *f
     return first[1] == n;
   }
   s->sorted = known;
-  for (mpm_lidx p = 0; p < n; ++p) {
+  const unsigned char *lev = known ? s->known : s->lev;
+  for (mpm_lidx p = 0; !known && p < n; ++p) {
     double xp[MPM_MAX_DIM] = {0, 0, 0};
-    for (int d = 0; d < h->dim && !known; ++d) xp[d] = x[d][p];
-    s->lev[p] = known ? s->known[p] : (unsigned char)mpm_hier_level_of(h, xp);
-    count[s->lev[p] + 1]++;
+    for (int d = 0; d < h->dim; ++d) xp[d] = x[d][p];
+    s->lev[p] = (unsigned char)mpm_hier_level_of(h, xp);
   }
+  for (mpm_lidx p = 0; p < n; ++p) count[lev[p] + 1]++;
   first[0] = 0;
   for (int l = 0; l < h->nlevels; ++l) first[l + 1] = first[l] + count[l + 1];
   for (int l = 0; known && l <= h->nlevels; ++l) s->first[l] = first[l];
   if (first[1] == n) return 1;
   mpm_lidx next[MPM_HIER_MAX_LEVELS];
   for (int l = 0; l < h->nlevels; ++l) next[l] = first[l];
-  for (mpm_lidx p = 0; p < n; ++p) s->order[next[s->lev[p]]++] = p;
+  mpm_lidx *order = s->order;
+  for (mpm_lidx p = 0; p < n; ++p) order[next[lev[p]]++] = p;
   return 0;
 }
 
