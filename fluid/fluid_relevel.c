@@ -94,8 +94,9 @@ static void classify_one(const mpm_module *m, levels *L, mpm_lidx i) {
   L->lev[2 * i + 1] = (unsigned char)fluid_position_level(m, NULL, m->particles->data, i);
 }
 
-/* The size and position levels of every particle. */
-static int classify(const mpm_module *m, levels *L) {
+/* The size and position levels of every particle; *parents: those to split (a coarser size
+ * than their position's level). */
+static int classify(const mpm_module *m, levels *L, mpm_lidx *parents) {
   const fluid_content *fc = m->content;
   const mpm_lidx n = m->particles->n;
   MPM_CALL(levels_room(L, MPM_MAX(n, 1)));
@@ -103,10 +104,14 @@ static int classify(const mpm_module *m, levels *L) {
   const double V0_0 = pow(m->grid->dx / fc->ppc, dim);
   const double *V0 = mpm_particles_comp(m->particles, fc->lay.f_V0, 0);
   const unsigned char *at = fluid_position_levels(m, m->particles->data);
+  mpm_lidx k = 0;
   for (mpm_lidx i = 0; i < n; ++i) {
-    L->lev[2 * i] = (unsigned char)size_level_of(dim, V0_0 / V0[i]);
-    L->lev[2 * i + 1] = (unsigned char)fluid_position_level(m, at, m->particles->data, i);
+    const int size = size_level_of(dim, V0_0 / V0[i]);
+    const int level = fluid_position_level(m, at, m->particles->data, i);
+    L->lev[2 * i] = (unsigned char)size, L->lev[2 * i + 1] = (unsigned char)level;
+    k += size < level;
   }
+  *parents = k;
   return 0;
 }
 
@@ -213,13 +218,21 @@ static int merge_levels(mpm_module *m, int regrid, levels *lv, mpm_lidx *idx, mp
   const unsigned char *lev = lv->lev;
   mpm_lidx *start = NULL, *member = NULL, ng = 0, nm = 0, removed = 0;
   int rc = 0;
+  /* The candidates of every size level L at once, in index order within each: idx[at[L] ..
+   * at[L + 1]). */
+  mpm_lidx at[MPM_HIER_MAX_LEVELS + 1] = {0};
+  for (mpm_lidx i = 0; i < n; ++i)
+    if (lev[2 * i] > lev[2 * i + 1]) at[lev[2 * i] + 1]++;
+  for (int L = 0; L < MPM_HIER_MAX_LEVELS; ++L) at[L + 1] += at[L];
+  mpm_lidx fill[MPM_HIER_MAX_LEVELS];
+  memcpy(fill, at, sizeof fill);
+  for (mpm_lidx i = 0; at[MPM_HIER_MAX_LEVELS] > 0 && i < n; ++i)
+    if (lev[2 * i] > lev[2 * i + 1]) idx[fill[lev[2 * i]]++] = i;
   for (int L = MPM_HIER_MAX_LEVELS - 1; !rc && L >= 1; --L) {
-    mpm_lidx k = 0;
-    for (mpm_lidx i = 0; i < n; ++i)
-      if (lev[2 * i] == L && lev[2 * i + 1] < L) idx[k++] = i;
+    const mpm_lidx k = at[L + 1] - at[L];
     if (k == 0) continue;
     mpm_lidx *s1, *m1, n1;
-    if ((rc = merge_groups(m, L, idx, k, &s1, &m1, &n1)) != 0) break;
+    if ((rc = merge_groups(m, L, idx + at[L], k, &s1, &m1, &n1)) != 0) break;
     mpm_lidx *st = n1 ? realloc(start, sizeof *st * (size_t)(ng + n1 + 1)) : start;
     mpm_lidx *mb = n1 ? realloc(member, sizeof *mb * (size_t)(nm + s1[n1])) : member;
     if (st) start = st;
@@ -283,12 +296,10 @@ static int relevel(mpm_module *m, int regrid, int *changed) {
   if (!idx) MPM_FAIL_OOM(sizeof *idx * (size_t)MPM_MAX(m->particles->n, 1));
   levels lv = {0};
   mpm_lidx merged = 0;
-  int rc = classify(m, &lv);
-  /* Split candidates, from one scan (a merge adds none: its particle lies outside its
-   * members' finer level). */
+  /* Split candidates counted in the same scan (a merge adds none: its particle lies outside
+   * its members' finer level). */
   mpm_lidx parents = 0;
-  for (mpm_lidx i = 0; !rc && i < m->particles->n; ++i)
-    parents += lv.lev[2 * i] < lv.lev[2 * i + 1];
+  int rc = classify(m, &lv, &parents);
   if (!rc) rc = merge_levels(m, regrid, &lv, idx, &merged);
   /* Split until every particle has its level's size: a regrid may put a particle two levels
    * below its new level (idx grows with the set). After a pass only its parents (moved, in
