@@ -363,12 +363,12 @@ static int make_parents_box(mpm_hier *h) {
 
 static int make_leaf(mpm_hier *h);
 
-/* near[n] = 1 for the nodes of level l's box within two nodes (per axis) of a span of level l's
- * own points (in Omega_l, not refined: where its particles deposit) or within three level-0
- * cells of a walled face (a point beyond a wall may stay on a coarser level than its span's,
- * level_walk), mirrors and images looked up as span_flag does: those spans' flags, dilated by
- * two along each axis in turn. (The box holds every span of Omega_l within reach of its
- * nodes.) */
+/* near[n] = 1 for the nodes of level l's box within one node (per axis) of a span of level l's
+ * own points (in Omega_l, not refined: where its particles deposit; a point's stencil spans its
+ * span's node and the two beside it) or within three level-0 cells of a walled face (a point
+ * beyond a wall may stay on a coarser level than its span's, level_walk), mirrors and images
+ * looked up as span_flag does: those spans' flags, dilated by one along each axis in turn. (The
+ * box holds every span of Omega_l within reach of its nodes.) */
 static void near_mask(const mpm_hier *h, int l, unsigned char *near, unsigned char *tmp) {
   const mpm_hier_level *lv = &h->level[l];
   const mpm_grid *g = lv->grid, *g0 = h->level[0].grid;
@@ -389,7 +389,7 @@ static void near_mask(const mpm_hier *h, int l, unsigned char *near, unsigned ch
     for (mpm_lidx n = 0; n < g->nnodes; ++n) {
       const int i = (int)((n / stride) % len);
       unsigned char v = 0;
-      for (int o = -2; o <= 2 && !v; ++o)
+      for (int o = -1; o <= 1 && !v; ++o)
         if (i + o >= 0 && i + o < len) v = near[n + o * stride];
       tmp[n] = v;
     }

@@ -112,10 +112,10 @@ typedef struct mpm_hier_level {
    * node in [0, N_l) each is an image of (canon[k]); is_image[n] marks them (NULL: none). */
   mpm_lidx nimage, *image, *canon;
   unsigned char *is_image;
-  /* Levels >= 1: the inactive nodes, images left out, within two nodes of a span of the
+  /* Levels >= 1: the inactive nodes, images left out, within one node of a span of the
    * level's own points (Omega_l less Omega_{l+1}) or within three level-0 cells of a wall (the
-   * only ones a deposit on the level reaches, with a node to spare), and the parents of level
-   * l + 1's (what it restricts onto and prolongs from), in box order, and
+   * only ones a deposit on the level reaches), and the parents of level l + 1's (what it
+   * restricts onto and prolongs from), in box order, and
    * their 2^dim parents on the lattice the restriction writes (level l - 1's box, or the
    * parents box for level 1 on more than one rank): box indices near_idx[2^dim k ..] and
    * two-scale weights near_w[2^dim k ..]. The restriction and prolongation visit these alone:
