@@ -363,6 +363,18 @@ static int make_parents_box(mpm_hier *h) {
 
 static int make_leaf(mpm_hier *h);
 
+/* Does node gi of lattice g lie within three level-0 cells of a walled face? (The spans there
+ * are left to the walk, and every node there may take a deposit: level_walk.) */
+static int beside_wall(const mpm_hier *h, const mpm_grid *g, const int *gi) {
+  const mpm_grid *g0 = h->level[0].grid;
+  int near = 0;
+  for (int d = 0; d < h->dim; ++d) {
+    const double x = g->lo[d] + gi[d] * g->dx, reach = 3.0 * g0->dx;
+    near |= (h->wall[d][0] && x < g0->lo[d] + reach) || (h->wall[d][1] && x > g0->hi[d] - reach);
+  }
+  return near;
+}
+
 /* near[n] = 1 for the nodes of level l's box within one node (per axis) of a span of level l's
  * own points (in Omega_l, not refined: where its particles deposit; a point's stencil spans its
  * span's node and the two beside it) or within three level-0 cells of a walled face (a point
@@ -371,17 +383,12 @@ static int make_leaf(mpm_hier *h);
  * box holds every span of Omega_l within reach of its nodes.) */
 static void near_mask(const mpm_hier *h, int l, unsigned char *near, unsigned char *tmp) {
   const mpm_hier_level *lv = &h->level[l];
-  const mpm_grid *g = lv->grid, *g0 = h->level[0].grid;
+  const mpm_grid *g = lv->grid;
   int gi[MPM_MAX_DIM];
   for (mpm_lidx n = 0; n < g->nnodes; ++n) {
     hier_node_of(g, n, gi);
-    int wall = 0;
-    for (int d = 0; d < h->dim; ++d) {
-      const double x = g->lo[d] + gi[d] * g->dx, reach = 3.0 * g0->dx;
-      wall |= (h->wall[d][0] && x < g0->lo[d] + reach) || (h->wall[d][1] && x > g0->hi[d] - reach);
-    }
     near[n] = (unsigned char)(span_flag(h, l, lv->covered, gi, 0) &&
-                              (wall || !span_flag(h, l, lv->refined, gi, 0)));
+                              (beside_wall(h, g, gi) || !span_flag(h, l, lv->refined, gi, 0)));
   }
   mpm_lidx stride = 1;
   for (int d = 0; d < h->dim; stride *= g->box_n[d], ++d) {
@@ -689,9 +696,6 @@ static int uniform_level(const mpm_hier *h, int l, const int *gi) {
   return level;
 }
 
-/* mpm_hier.leaf. Spans within three level-0 cells of a walled face are left to the walk (its
- * stencil test for points beyond the face); so are the spans of a finer level outside its region,
- * which the lookup down the levels never reaches and mpm_hier_level_from's hint may. */
 /* uniform_level, reading the next level's answers from below (box order, found first) for
  * children in its plain range, where the box node is the child itself. */
 static int uniform_below(const mpm_hier *h, int l, const int *gi, const signed char *below) {
@@ -711,8 +715,10 @@ static int uniform_below(const mpm_hier *h, int l, const int *gi, const signed c
   return level;
 }
 
+/* mpm_hier.leaf. Spans within three level-0 cells of a walled face are left to the walk (its
+ * stencil test for points beyond the face); so are the spans of a finer level outside its region,
+ * which the lookup down the levels never reaches and mpm_hier_level_from's hint may. */
 static int make_leaf(mpm_hier *h) {
-  const mpm_grid *g0 = h->level[0].grid;
   int gi[MPM_MAX_DIM];
   signed char *below = NULL;                  /* level l + 1's uniform_level at each box node */
   for (int l = h->nlevels - 1; l >= 0; --l) { /* (finest first) */
@@ -725,13 +731,8 @@ static int make_leaf(mpm_hier *h) {
     }
     for (mpm_lidx k = 0; k < g->nnodes; ++k) {
       hier_node_of(g, k, gi);
-      int near_wall = 0;
-      for (int d = 0; d < h->dim; ++d) {
-        const double x = g->lo[d] + gi[d] * g->dx, reach = 3.0 * g0->dx;
-        near_wall |=
-            (h->wall[d][0] && x < g0->lo[d] + reach) || (h->wall[d][1] && x > g0->hi[d] - reach);
-      }
-      near_wall |= l > 0 && !span_flag(h, l, h->level[l].covered, gi, 0);
+      const int near_wall =
+          beside_wall(h, g, gi) || (l > 0 && !span_flag(h, l, h->level[l].covered, gi, 0));
       const int u = uni[k] = (signed char)uniform_below(h, l, gi, below);
       h->leaf[l][k] = near_wall ? MPM_HIER_WALK : u < 0 ? MPM_HIER_MIXED : (unsigned char)u;
     }
