@@ -462,7 +462,8 @@ static void set_plain(mpm_hier *h, int l) {
   const mpm_grid *g = lv->grid;
   for (int d = 0; d < h->dim; ++d) {
     int a = g->box_lo[d], z = g->box_lo[d] + g->box_n[d] - 1;
-    const int twice_lo = (1 << l) - 1, twice_hi = 2 * (h->level[0].grid->ncells[d] << l) + twice_lo;
+    int twice_lo, twice_hi;
+    hier_faces(h, l, d, &twice_lo, &twice_hi);
     if (h->wall[d][0]) a = MPM_MAX(a, (twice_lo + 1) / 2); /* (hier_mirror: 2 i >= twice_lo) */
     if (h->wall[d][1]) z = MPM_MIN(z, twice_hi / 2);       /* (2 i <= twice_hi) */
     if (lv->period[d]) a = MPM_MAX(a, 0), z = MPM_MIN(z, lv->period[d] - 1);

@@ -44,11 +44,18 @@ static inline void hier_canon(const mpm_hier_level *lv, int dim, int *gi) {
   for (int d = 0; d < dim; ++d) gi[d] = hier_canon_1d(lv, d, gi[d]);
 }
 
+/* Twice the index of level l's lattice along d at the domain's low and high faces. */
+static inline void hier_faces(const mpm_hier *h, int l, int d, int *twice_lo, int *twice_hi) {
+  *twice_lo = (1 << l) - 1;
+  *twice_hi = 2 * (h->level[0].grid->ncells[d] << l) + *twice_lo;
+}
+
 /* Index i of level l's lattice along d at its mirror when it lies beyond a walled face
  * (mpm_hier.h, walls), else i: beyond the low face when 2 i < 2^l - 1, the high face when
  * 2 i > 2 N_l + 2^l - 1 (N_l = ncells[d] 2^l). */
 static inline int hier_mirror(const mpm_hier *h, int l, int d, int i) {
-  const int twice_lo = (1 << l) - 1, twice_hi = 2 * (h->level[0].grid->ncells[d] << l) + twice_lo;
+  int twice_lo, twice_hi;
+  hier_faces(h, l, d, &twice_lo, &twice_hi);
   if (h->wall[d][0] && 2 * i < twice_lo) return twice_lo - i;
   if (h->wall[d][1] && 2 * i > twice_hi) return twice_hi - i;
   return i;
