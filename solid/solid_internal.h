@@ -65,6 +65,16 @@ typedef struct {
   double off_x[3]; /* its position */
 } solid_traction;
 
+/* The projected dilatation (solid_dilatation.c): which bodies take it, the grid phase its
+ * deposit fills, and its per-particle scratch (the projecting particles; V, tr L and the
+ * projection, 3 cap). */
+typedef struct {
+  int on, phase;
+  unsigned char *body;
+  mpm_lidx cap, *idx;
+  double *work;
+} solid_dilatation;
+
 typedef struct {
   int nbodies;
   solid_body *body;
@@ -93,6 +103,7 @@ typedef struct {
   int pts_on;
   double *pts_buf;
   mpm_module_ops ops; /* the module's table: solid_ops, with p2g_rate for the current rate */
+  solid_dilatation dil;
 } solid_content;
 
 /* "SECTION.NAME" into key. */

@@ -13,6 +13,7 @@
  * sigma0 for a rate-form model), V0 = seeded volume / det F0. On a refinement hierarchy (m->hier)
  * the P2G and G2P go through it and the finer levels are seeded by solid_refine.c; without one they
  * are the plain kernel calls. */
+#include "solid_dilatation.h"
 #include "solid_internal.h"
 #include "solid_module.h"
 #include "solid_tensor.h"
@@ -73,6 +74,14 @@ static mpm_key_spec solid_keys[] = {
      "quadratic coefficient c2 of the bulk viscosity (see bulk_viscosity_linear); LS-DYNA's "
      "default is 1.5 (Abaqus/Explicit's 1.2)",
      0, "-"},
+    {"solid.*.dilatation", MPM_KEY_ENUM, "particle", 0, 0, 0, 0, "particle|projected",
+     "the rate of volume change the deformation gradient takes: particle (tr L at the particle, "
+     "classic MPM) or projected (tr L projected onto the grid's nodes, weighted by the "
+     "particles' volumes, and interpolated back, the deviatoric part the particle's own: an "
+     "F-bar for MPM; removes particle-scale alternations of the volume that the grid's forces "
+     "do not see, such as a coupling face leaves; one scalar deposit and gather more per RHS; "
+     "not with refinement; docs/solid.md)",
+     0, NULL},
     {"clamp.*.geometry", MPM_KEY_STRING, NULL, 0, 0, 0, 0, NULL,
      "region whose nodes and particles are held fixed (a [geometry.NAME])", 0, NULL},
     {"traction.*.geometry", MPM_KEY_STRING, NULL, 0, 0, 0, 0, NULL,
@@ -86,7 +95,8 @@ static mpm_key_spec solid_keys[] = {
 
 int solid_add_schema(mpm_config *cfg) {
   for (size_t k = 0; k < sizeof solid_keys / sizeof solid_keys[0]; ++k)
-    if (solid_keys[k].type == MPM_KEY_ENUM) solid_keys[k].choices = solid_material_names();
+    if (solid_keys[k].type == MPM_KEY_ENUM && !solid_keys[k].choices)
+      solid_keys[k].choices = solid_material_names();
   return mpm_config_add_schema(cfg, solid_keys, (int)(sizeof solid_keys / sizeof solid_keys[0]));
 }
 
@@ -528,7 +538,8 @@ static int solid_g2p(mpm_module *m, double t, const double *y, double *ydot, dou
   /* dF/dt = L F comes out of the kernel directly; L itself is kept only for rate-form
    * models and the bulk viscosity's lagged tr L. */
   const int lagged = sc->lay.f_divv >= 0 && sc->lay.f_pending < 0;
-  double *L = sc->lay.f_sigma >= 0 || lagged ? sc->scratch + (size_t)2 * dim * n : NULL;
+  double *L =
+      sc->lay.f_sigma >= 0 || lagged || sc->dil.on ? sc->scratch + (size_t)2 * dim * n : NULL;
   double *xdot[MPM_MAX_DIM] = {NULL}, *vdot[MPM_MAX_DIM] = {NULL};
   for (int d = 0; d < dim; ++d) {
     xdot[d] = ydot + (size_t)(p->offset[F_X] + d) * n;
@@ -547,8 +558,9 @@ static int solid_g2p(mpm_module *m, double t, const double *y, double *ydot, dou
     const double *C = state_C(sc, p, y);
     for (size_t k = 0; k < (size_t)dim * dim * (size_t)n; ++k) Cdot[k] = (Cdot[k] - C[k]) / h;
   }
+  if (lagged) lag_divv(p, sc->lay.f_divv, y, ydot, L, h); /* the particle's own rate */
+  if (sc->dil.on) MPM_CALL(solid_dilatation_apply(m, y, L, ydot + (size_t)p->offset[F_F] * n));
   if (sc->lay.f_sigma >= 0) solid_stress_rates(m, y, ydot, L);
-  if (lagged) lag_divv(p, sc->lay.f_divv, y, ydot, L, h);
   if (sc->lay.f_fixed >= 0) solid_hold_fixed(p, sc->lay.f_fixed, ydot);
   if (sc->nrigid) solid_move_rigid(sc, p, ydot);
   return 0;
@@ -721,6 +733,7 @@ static void solid_destroy(mpm_module *m) {
     free(sc->vnew);
     free(sc->zero);
     free(sc->count);
+    solid_dilatation_free(&sc->dil);
     free(sc);
   }
   mpm_particles_destroy(&m->particles);
@@ -795,7 +808,7 @@ static int read_bodies(mpm_module *m, const mpm_config *cfg) {
   MPM_CALL(mpm_config_get_real(cfg, "physics.damping", &sc->damping));
   MPM_CALL(mpm_transfer_from_config(&sc->tr, cfg, NULL));
   for (int b = 0; b < count; ++b) MPM_CALL(read_bulkq(m, cfg, &sc->body[b]));
-  return 0;
+  return solid_dilatation_read(m, cfg);
 }
 
 int solid_module_create(mpm_module **mp, const mpm_config *cfg, mpm_grid *grid, int seed) {

@@ -78,6 +78,13 @@ static int check_body(const mpm_config *cfg, const solid_body *body) {
               body->q.c1 > 0 ? "bulk_viscosity_linear" : "bulk_viscosity_quadratic");
     return refuse(cfg, key, "the bulk viscosity's length is level 0's cell");
   }
+  solid_key(key, sizeof key, body->section, "dilatation");
+  if (mpm_config_has(cfg, key)) {
+    const char *kind;
+    MPM_CALL(mpm_config_get_string(cfg, key, &kind));
+    if (strcmp(kind, "projected") == 0)
+      return refuse(cfg, key, "the projection deposits on level 0's nodes");
+  }
   solid_key(key, sizeof key, body->section, "ppc");
   MPM_CALL(mpm_config_get_int(cfg, key, &ppc));
   if (ppc % 2)

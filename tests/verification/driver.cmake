@@ -27,6 +27,10 @@ mpm_add_script_test(test_damping SCRIPT verification/test_damping.py LABELS veri
 # bitwise restart (~35 s).
 mpm_add_script_test(test_solid_bulkq SCRIPT verification/test_solid_bulkq.py
                     LABELS "verification;mpi" TIMEOUT 300)
+# The projected dilatation (solid.NAME.dilatation = projected): exact under a uniform
+# dilatation, a pre-stressed slab at rest, 2 ranks against 1, bad input (~20 s).
+mpm_add_script_test(test_solid_dilatation SCRIPT verification/test_solid_dilatation.py
+                    LABELS "verification;mpi" TIMEOUT 300)
 mpm_add_script_test(test_model_swap SCRIPT verification/test_model_swap.py
                     LABELS verification TIMEOUT 600)
 mpm_add_script_test(test_disks SCRIPT verification/test_disks.py LABELS verification

@@ -192,15 +192,22 @@ Known failures, marked EXPECTED-FAIL (printed with the reason; not counted as fa
   of the velocity exchange at nodes holding little of its mass (not kept) broke the coupling: a
   momentum imbalance up to 1.2 times the interface force with one threshold, a failed run
   (t = 0.105) with another.
+  The projected dilatation (solid.slab.dilatation = projected, the `fbar` variants under long;
+  solid/solid_dilatation.c) stops the face's rate from building the volumetric half of the
+  alternation; at nu = 0 the deviatoric half carries the other half of the slab's stress, and it
+  stays. Soft slab, 2026-12-07: velocity:usl RMS 2.25 %, largest 9.80 % (an ordinary check:
+  met), velocity:bs32 1.68 %, 10.62 % (expected to fail), and, run by hand, velocity:musl 2.31 %,
+  10.03 %, traction:usl:ls 2.20 %, 9.97 %; the first layer p -61.9 % (usl; -63.7 % without).
 
-Arguments: [long] [slab:scheme:method[:ls] ...]. Default (~80 s idle before the rigid slab took
+Arguments: [long] [slab:scheme:method[:ls][:fbar] ...] (fbar: the projected dilatation).
+Default (~80 s idle before the rigid slab took
 the viscosity, whose usl runs now take twice the steps, a few seconds more; 149-209 s measured
 with the machine's load at 10-12): the rigid slab under
 velocity:usl, contact:usl, traction:usl, traction:usl:ls (fluid.wall_treatment =
 least_squares) and velocity:bs32 (the default time method); the soft slab under velocity:usl
 and traction:usl:ls. `long` runs the rest: rigid traction:bs32, velocity:musl,
 traction:musl; soft contact:usl, traction:usl, velocity:bs32 (3-4 minutes alone),
-traction:bs32, velocity:musl (about 8 minutes in all; measured 467 s with another run
+traction:bs32, velocity:musl, velocity:usl:fbar, velocity:bs32:fbar (about 12 minutes in all; measured 467 s with another run
 sharing the core, before the viscosity under bs32). Rigid under musl: ringing RMS 0.29 %,
 largest 0.98 % (1.4 %, 6.0 % without the viscosity).
 """
@@ -235,6 +242,11 @@ PEAK_REASON = ("within 15 cells of the soft slab's face the cell averages hold +
                "carries the gas's velocity into the first column's rate), which the grid does not "
                "see, so neither elasticity nor the bulk viscosity removes it; see the docstring")
 
+FBAR_REASON = ("the projected dilatation (solid.slab.dilatation = projected) smooths the volumetric "
+               "half of the face's strain alternation; with nu = 0 the deviatoric half carries "
+               "the other half of the slab's stress, and under this method its residue stays "
+               "just above the bound; see the docstring")
+
 SLABS = {
     "rigid": dict(case="fsi_reflect_rigid.ini", mach=1.21, rho_s=4000.0, E=1e5, x_s=1.5,
                   x_i=1.7, L=3.0, t_end=0.5),
@@ -268,8 +280,9 @@ def exact(sl):
 Q = (0.5, 1.5)
 
 
-def run(name, sl, ex, scheme, method, ls):
-    tag = f"{name} {scheme} {method}" + (" least_squares" if ls else "")
+def run(name, sl, ex, scheme, method, ls, fbar):
+    tag = (f"{name} {scheme} {method}" + (" least_squares" if ls else "")
+           + (" projected" if fbar else ""))
     out = mt.outdir(tag.replace(" ", "_"))
     extra = [f"domain.hi={sl['x_i'] + sl['L']} {H}", f"geometry.shocked.hi={sl['x_s']} {H}",
              f"geometry.ambient.hi={sl['x_i']} {H}", f"geometry.slab.hi={sl['x_i'] + sl['L']} {H}",
@@ -279,6 +292,8 @@ def run(name, sl, ex, scheme, method, ls):
              f"time.t_end={sl['t_end']}"]
     if ls:
         extra.append("fluid.wall_treatment=least_squares")
+    if fbar:
+        extra.append("solid.slab.dilatation=projected")
     extra += [f"solid.slab.bulk_viscosity_linear={Q[0]!r}",
               f"solid.slab.bulk_viscosity_quadratic={Q[1]!r}"]
     mt.run(["run", mt.case(sl["case"]), f"output.dir={out}", f"grid.dx={DX}",
@@ -305,8 +320,8 @@ def verdict(cond, reason, msg):
         check(cond, msg)
 
 
-def measure(name, sl, ex, scheme, method, ls):
-    tag, out = run(name, sl, ex, scheme, method, ls)
+def measure(name, sl, ex, scheme, method, ls, fbar):
+    tag, out = run(name, sl, ex, scheme, method, ls, fbar)
     snaps = mt.snapshots(out)
     # The first layer in time (diagnosis: does it approach p* or stay?).
     hist = []
@@ -380,23 +395,27 @@ def measure(name, sl, ex, scheme, method, ls):
             f"largest {100 * dev:.2f} % of the jump (<= {100 * TOL_RMS:g} %, {100 * TOL_MAX:g} %)")
     soft = name == "soft"
     check(rms <= TOL_RMS, ring + " [RMS]")
-    verdict(dev <= TOL_MAX, PEAK_REASON if soft else None, ring + " [largest]")
+    reason = PEAK_REASON if soft and not fbar else FBAR_REASON if soft and method != "usl" else None
+    verdict(dev <= TOL_MAX, reason, ring + " [largest]")
 
 
 def variants():
     if ARGS:
         for a in ARGS:
             f = a.split(":")
-            yield f[0], f[1], f[2], len(f) > 3 and f[3] == "ls"
+            yield f[0], f[1], f[2], "ls" in f[3:], "fbar" in f[3:]
         return
-    rigid = [("velocity", "usl", False), ("contact", "usl", False), ("traction", "usl", False),
-             ("traction", "usl", True), ("velocity", "bs32", False)]
-    soft = [("velocity", "usl", False), ("traction", "usl", True)]
+    rigid = [("velocity", "usl", False, False), ("contact", "usl", False, False),
+             ("traction", "usl", False, False), ("traction", "usl", True, False),
+             ("velocity", "bs32", False, False)]
+    soft = [("velocity", "usl", False, False), ("traction", "usl", True, False)]
     if LONG:  # the rest: soft under bs32 alone takes about 6 minutes
-        rigid = [("traction", "bs32", False), ("velocity", "musl", False),
-                 ("traction", "musl", False)]
-        soft = [("contact", "usl", False), ("traction", "usl", False), ("velocity", "bs32", False),
-                ("traction", "bs32", False), ("velocity", "musl", False)]
+        rigid = [("traction", "bs32", False, False), ("velocity", "musl", False, False),
+                 ("traction", "musl", False, False)]
+        soft = [("contact", "usl", False, False), ("traction", "usl", False, False),
+                ("velocity", "bs32", False, False), ("traction", "bs32", False, False),
+                ("velocity", "musl", False, False), ("velocity", "usl", False, True),
+                ("velocity", "bs32", False, True)]
     for v in rigid:
         yield ("rigid",) + v
     for v in soft:
@@ -410,7 +429,7 @@ for name, sl in SLABS.items():
           f"{ex['W']:+.4f}; "
           f"transmitted U {ex['U']:.4f}, strain {1 - ex['Fs'] / ex['F0']:.4f}; impact at "
           f"{ex['t_hit']:.4f}; Z_s / Z_g {math.sqrt(sl['rho_s'] * sl['E']) / sound(RHO0, P0):.4g}")
-for name, scheme, method, ls in variants():
-    measure(name, SLABS[name], exact(SLABS[name]), scheme, method, ls)
+for name, scheme, method, ls, fbar in variants():
+    measure(name, SLABS[name], exact(SLABS[name]), scheme, method, ls, fbar)
 
 sys.exit(check.finish())
