@@ -30,7 +30,7 @@
 #include "mpm_shape.h"
 #include "mpm_types.h"
 
-#define MPM_GRID_MAX_PHASES 6
+#define MPM_GRID_MAX_PHASES 8
 
 /* Nodal fields of one phase (one module), each an array of box nodes. */
 typedef struct mpm_grid_phase {

@@ -536,7 +536,7 @@ static int solid_g2p(mpm_module *m, double t, const double *y, double *ydot, dou
   const int dim = p->dim;
   const mpm_lidx n = p->n;
   /* dF/dt = L F comes out of the kernel directly; L itself is kept only for rate-form
-   * models and the bulk viscosity's lagged tr L. */
+   * models, the bulk viscosity's lagged tr L and the projected dilatation. */
   const int lagged = sc->lay.f_divv >= 0 && sc->lay.f_pending < 0;
   double *L =
       sc->lay.f_sigma >= 0 || lagged || sc->dil.on ? sc->scratch + (size_t)2 * dim * n : NULL;

@@ -17,7 +17,8 @@
  * and deposits on, and reads from, the level of its position.
  *
  * Refused (refine_check), each naming its key: a body with a bulk viscosity (its length
- * scale and lagged rate are level 0's), a rigid body (it holds level-0 nodes), an
+ * scale and lagged rate are level 0's) or the projected dilatation (its deposit is level 0's),
+ * a rigid body (it holds level-0 nodes), an
  * odd ppc (a level-0 particle would sit on a face of the refined region), time.method = musl
  * (the remap deposits on level 0), and a traction whose region reaches a refined region (the
  * tractions load level-0 particles only). Dynamic regrids are refused by coupler/mpm_refine.c,
@@ -66,7 +67,7 @@ static int refuse(const mpm_config *cfg, const char *key, const char *why) {
                          why);
 }
 
-static int check_body(const mpm_config *cfg, const solid_body *body) {
+static int check_body(const mpm_config *cfg, const solid_body *body, int projected) {
   char key[160];
   int ppc;
   if (body->mat->ops->rigid) {
@@ -78,12 +79,9 @@ static int check_body(const mpm_config *cfg, const solid_body *body) {
               body->q.c1 > 0 ? "bulk_viscosity_linear" : "bulk_viscosity_quadratic");
     return refuse(cfg, key, "the bulk viscosity's length is level 0's cell");
   }
-  solid_key(key, sizeof key, body->section, "dilatation");
-  if (mpm_config_has(cfg, key)) {
-    const char *kind;
-    MPM_CALL(mpm_config_get_string(cfg, key, &kind));
-    if (strcmp(kind, "projected") == 0)
-      return refuse(cfg, key, "the projection deposits on level 0's nodes");
+  if (projected) {
+    solid_key(key, sizeof key, body->section, "dilatation");
+    return refuse(cfg, key, "the projection deposits on level 0's nodes");
   }
   solid_key(key, sizeof key, body->section, "ppc");
   MPM_CALL(mpm_config_get_int(cfg, key, &ppc));
@@ -99,7 +97,7 @@ static int check_body(const mpm_config *cfg, const solid_body *body) {
 static int refine_check(const mpm_module *m, const mpm_config *cfg) {
   const solid_content *sc = m->content;
   if (sc->tr.musl) return refuse(cfg, "time.method", "MUSL's remap deposits on level 0's nodes");
-  for (int b = 0; b < sc->nbodies; ++b) MPM_CALL(check_body(cfg, &sc->body[b]));
+  for (int b = 0; b < sc->nbodies; ++b) MPM_CALL(check_body(cfg, &sc->body[b], sc->dil.body[b]));
   return 0;
 }
 
