@@ -38,7 +38,7 @@ import mpmtest as mt  # noqa: E402
 check = mt.Checks("test_solid_dilatation")
 TOL_F, TOL_REST, TOL_RANKS = 1e-12, 1e-10, 1e-12
 
-BLOCK = """[run]
+SCENE = """[run]
 name = expanding_block
 [domain]
 dim = 2
@@ -53,32 +53,23 @@ dt_max = 0.01
 method = {method}
 [output]
 interval = 0.1
-[geometry.block]
+"""
+# A block 24 cells square expanding about its centre xc (E so small that nothing else moves it).
+BODY = """[geometry.{name}]
 type = box
-lo = 0 0
-hi = 2.4 2.4
-[solid.block]
-geometry = block
+lo = {lo} 0
+hi = {hi} 2.4
+[solid.{name}]
+geometry = {name}
 material = linear_elastic
 density = 1
 E = 1e-12
 nu = 0.3
-velocity_field = 0.01*(x - 1.2); 0.01*(y - 1.2)
-ppc = 2
-{extra}
-[geometry.twin]
-type = box
-lo = 2.8 0
-hi = 5.2 2.4
-[solid.twin]
-geometry = twin
-material = linear_elastic
-density = 1
-E = 1e-12
-nu = 0.3
-velocity_field = 0.01*(x - 4); 0.01*(y - 1.2)
+velocity_field = 0.01*(x - {xc}); 0.01*(y - 1.2)
 ppc = 2
 """
+BLOCK = (SCENE + BODY.format(name="block", lo=0, hi=2.4, xc=1.2) + "{extra}\n"
+         + BODY.format(name="twin", lo=2.8, hi=5.2, xc=4.0))
 
 
 def final_F(method, extra):
