@@ -51,11 +51,12 @@ int mpm_coupling_set_hier(mpm_coupling *c, const mpm_config *cfg, const mpm_hier
     c->nlev = 0;
   }
   if (!h || h->nlevels < 2) return 0;
-  if (strcmp(c->type->name, "contact") == 0)
+  if (strcmp(c->type->name, "contact") == 0 || strcmp(c->type->name, "sharp") == 0)
     return mpm_config_fail(cfg, "coupling.scheme",
-                           "coupling.scheme = contact is not carried to the refined levels "
+                           "coupling.scheme = %s is not carried to the refined levels "
                            "(refine.levels > 1); use velocity or traction, or set refine.levels "
-                           "= 1 (docs/refinement.md)");
+                           "= 1 (docs/refinement.md)",
+                           c->type->name);
   if (strcmp(c->type->name, "traction") == 0 && c->content) /* its least-squares wall */
     return mpm_config_fail(cfg, "fluid.wall_treatment",
                            "the solid's surface as the gas's least-squares wall is not carried "

@@ -255,10 +255,13 @@ static int hybrid_scope(const fluid_content *fc, const mpm_config *cfg, scope_mi
                 "= bs32) or coupling.time = monolithic");
   /* Staggered is outside the grid pressure's scope (grid_scope). The grid pressure's contact
    * (test_gridp_beside) was not measured with the particles' share beside it. */
-  if (strcmp(scheme, "contact") == 0)
+  if (strcmp(scheme, "contact") == 0 || strcmp(scheme, "sharp") == 0)
     return miss(s, "fluid.pressure",
-                "does not carry a solid under coupling.scheme = contact (not measured): use "
-                "velocity or traction");
+                strcmp(scheme, "sharp") == 0
+                    ? "does not carry a solid under coupling.scheme = sharp (not measured): use "
+                      "velocity or traction"
+                    : "does not carry a solid under coupling.scheme = contact (not measured): "
+                      "use velocity or traction");
   return 0;
 }
 
