@@ -52,6 +52,9 @@ Tolerances and why:
                 beside a solid takes by default (0.02, docs/gas.md); in pure FLIP the soft
                 layer sat at -3.0 %, -3.4 % (the second column alike; -3.9 %, -4.0 % with the
                 moving-slab start), and the rigid one at +1.5 %.
+                coupling.scheme = sharp (the phases tied at points on the solid's face alone,
+                coupler/coupling_sharp.c) meets it next to the rigid slab: p -0.37 %, rho
+                -1.29 % (usl, 2026-12-07); next to the soft one it fails (Known failures).
   plateau       2 % in p and in rho: the slip-wall reflection of the same shock in gas alone
                 (what the interface should reach) scatters by 1-2 % over such a region under
                 usl (FLIP noise behind a shock).
@@ -68,6 +71,12 @@ Tolerances and why:
                 The pre-stressed start brings the issue's -10 % median to -1.6 %.
 
 Known failures, marked EXPECTED-FAIL (printed with the reason; not counted as failures):
+- the soft slab under coupling.scheme = sharp (long): first layer p +34.8 %, rho -7.3 %;
+  plateau -2.40 %, force -2.07 %, transmitted -2.42 %, ringing RMS 3.02 %, largest 16.0 %
+  (2026-12-07). The slab (rho_s 0.1) is lighter than the shocked gas (2.7): at the impact the
+  points' multipliers drive the slab's light tail nodes on the gas side, its face columns pile up
+  within a few thousandths of a metre, and gas enters the first cell. Before the phases were tied
+  deep inside the solid (two cells or more from a face) the gas went through the slab.
 - the first layer under every scheme but the least-squares wall
   (measured: p -59 %, rho -47 % next to the rigid slab; -63 %, -48 % next to the soft one). The
   solid's particles reach, through the quadratic B-spline, every node within 1.5 cells of them,
@@ -247,6 +256,11 @@ FBAR_REASON = ("the projected dilatation (solid.slab.dilatation = projected) smo
                "the other half of the slab's stress, and under this method its residue stays "
                "just above the bound; see the docstring")
 
+SHARP_SOFT_REASON = ("coupling.scheme = sharp ties the phases at the solid's surface alone; the soft "
+                     "slab is lighter than the shocked gas (rho_s 0.1 against 2.7), and at the "
+                     "impact its face columns, driven through their light tail nodes, pile up "
+                     "and let the gas into the first cell; see the docstring")
+
 SLABS = {
     "rigid": dict(case="fsi_reflect_rigid.ini", mach=1.21, rho_s=4000.0, E=1e5, x_s=1.5,
                   x_i=1.7, L=3.0, t_end=0.5),
@@ -376,25 +390,29 @@ def measure(name, sl, ex, scheme, method, ls, fbar):
           f"{100 * scat:.2f} % of the jump")
     e_p, e_r = lay[0][0] / ex["ps"] - 1, lay[0][1] / ex["rs"] - 1
     layer_ok = abs(e_p) <= TOL_LAYER and abs(e_r) <= TOL_LAYER
-    verdict(layer_ok, None if ls else LAYER_REASON,
+    sharp_soft = scheme == "sharp" and name == "soft"
+    verdict(layer_ok,
+            None if ls or scheme == "sharp" and name == "rigid"
+            else SHARP_SOFT_REASON if sharp_soft else LAYER_REASON,
             f"{tag}: first gas layer p {lay[0][0]:.4f} ({100 * e_p:+.2f} %), rho "
             f"{lay[0][1]:.4f} ({100 * e_r:+.2f} %) against p* {ex['ps']:.5f}, rho* {ex['rs']:.5f} "
             f"(<= {100 * TOL_LAYER:g} %); second column {100 * (lay[1][0] / ex['ps'] - 1):+.2f} %, "
             f"{100 * (lay[1][1] / ex['rs'] - 1):+.2f} %")
     e_pp, e_rp = p_pl / ex["ps"] - 1, r_pl / ex["rs"] - 1
-    check(abs(e_pp) <= TOL_PLATEAU and abs(e_rp) <= TOL_PLATEAU,
-          f"{tag}: reflected plateau [{x_refl + 5 * DX:.3f}, {face - 4 * DX:.3f}] p {p_pl:.4f} "
+    sharp_reason = SHARP_SOFT_REASON if sharp_soft else None
+    verdict(abs(e_pp) <= TOL_PLATEAU and abs(e_rp) <= TOL_PLATEAU, sharp_reason,
+            f"{tag}: reflected plateau [{x_refl + 5 * DX:.3f}, {face - 4 * DX:.3f}] p {p_pl:.4f} "
           f"({100 * e_pp:+.2f} %), rho {r_pl:.4f} ({100 * e_rp:+.2f} %) "
           f"(<= {100 * TOL_PLATEAU:g} %)")
     e_f = p_if / ex["ps"] - 1
-    check(abs(e_f) <= TOL_FORCE, f"{tag}: interface force / H {p_if:.5f} against p* "
+    verdict(abs(e_f) <= TOL_FORCE, sharp_reason, f"{tag}: interface force / H {p_if:.5f} against p* "
           f"{ex['ps']:.5f}: {100 * e_f:+.3f} % (<= {100 * TOL_FORCE:g} %)")
-    check(abs(T - 1) <= TOL_T, f"{tag}: transmitted stress jump (median) {-med - P0:.5f} against "
+    verdict(abs(T - 1) <= TOL_T, sharp_reason, f"{tag}: transmitted stress jump (median) {-med - P0:.5f} against "
           f"p* - p0 = {jump:.5f}: {100 * (T - 1):+.2f} % (<= {100 * TOL_T:g} %)")
     ring = (f"{tag}: ringing of the transmitted stress (cell averages): RMS {100 * rms:.2f} %, "
             f"largest {100 * dev:.2f} % of the jump (<= {100 * TOL_RMS:g} %, {100 * TOL_MAX:g} %)")
     soft = name == "soft"
-    check(rms <= TOL_RMS, ring + " [RMS]")
+    verdict(rms <= TOL_RMS, sharp_reason, ring + " [RMS]")
     reason = PEAK_REASON if soft and not fbar else FBAR_REASON if soft and method != "usl" else None
     verdict(dev <= TOL_MAX, reason, ring + " [largest]")
 
@@ -407,7 +425,7 @@ def variants():
         return
     rigid = [("velocity", "usl", False, False), ("contact", "usl", False, False),
              ("traction", "usl", False, False), ("traction", "usl", True, False),
-             ("velocity", "bs32", False, False)]
+             ("velocity", "bs32", False, False), ("sharp", "usl", False, False)]
     soft = [("velocity", "usl", False, False), ("traction", "usl", True, False)]
     if LONG:  # the rest: soft under bs32 alone takes about 6 minutes
         rigid = [("traction", "bs32", False, False), ("velocity", "musl", False, False),
@@ -415,7 +433,7 @@ def variants():
         soft = [("contact", "usl", False, False), ("traction", "usl", False, False),
                 ("velocity", "bs32", False, False), ("traction", "bs32", False, False),
                 ("velocity", "musl", False, False), ("velocity", "usl", False, True),
-                ("velocity", "bs32", False, True)]
+                ("velocity", "bs32", False, True), ("sharp", "usl", False, False)]
     for v in rigid:
         yield ("rigid",) + v
     for v in soft:

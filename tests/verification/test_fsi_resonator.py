@@ -14,18 +14,18 @@ Measured: the slab's gas-side particle's displacement (probes.csv) over t = [0, 
 of mode 1), fitted by least squares with two damped sinusoids and a constant (variable
 projection, started from a Hann-windowed FFT's parabolic peaks).
 
-Arguments: [long] [standin] [scheme:method:time ...]; default velocity:usl:monolithic and
-velocity:usl:multirate at 50, 100, 200 cells per metre (40 s of CPU, measured; in this 1-D
-strip the interface normal is the whole velocity, and velocity, contact and traction give the
-same figures to the printed digits). `long`:
-velocity, contact and traction under usl; velocity under bs32 (adaptive, the default; beside a
-solid it takes the hybrid pressure by default since 2026-12-06), under
-coupling.time = multirate and under usl with fluid.pressure = hybrid (the pressure continued
-through the whole slab, docs/gas.md), at 50, 100, 200, 400; and the stability runs over 20 periods
-(t = 36) at 400 and 800. `mri` (test_fsi_resonator_mri): velocity under bs32 with coupling.time =
-multirate (ARKODE's MRIStep, time.adaptive = false; the gas takes the hybrid pressure there by
-default since 2026-12-06) at 50, 100, 200, 400, and 20 periods at 400 and 800. `standin` replaces
-the initial stress by the issue's stand-in, a constant traction -p0 on the stress-free slab's gas-
+Arguments: [long] [standin] [scheme:method:time ...]; default velocity:usl:monolithic,
+velocity:usl:multirate and sharp:usl:monolithic at 50, 100, 200 cells per metre (about a
+minute of CPU; in this 1-D strip the interface normal is the whole velocity, and velocity,
+contact and traction give the same figures to the printed digits). `long`: velocity, contact
+and traction under usl; velocity under bs32 (adaptive, the default; beside a solid it takes the
+hybrid pressure by default since 2026-12-06), under coupling.time = multirate and under usl with
+fluid.pressure = hybrid (the pressure continued through the whole slab, docs/gas.md); sharp
+under usl; each at 50, 100, 200, 400; and the stability runs over 20 periods (t = 36)
+at 400 and 800 (sharp at 800). `mri` (test_fsi_resonator_mri): velocity under bs32 with
+coupling.time = multirate (ARKODE's MRIStep, time.adaptive = false; the gas takes the hybrid
+pressure there by default since 2026-12-06) at 50, 100, 200, 400, and 20 periods at 400 and 800.
+`standin` replaces the initial stress by the issue's stand-in, a constant traction -p0 on the stress-free slab's gas-
 side particle layer (that is all main could do): the frequencies then fail (+0.52 ... +0.66 % on
 f_1, not converging) and the gas beside the slab goes unstable at 200 cells per metre.
 
@@ -41,6 +41,15 @@ Checks and tolerances:
   f_2's error is at the fit's scatter at 200 already. With fluid.pressure = hybrid: +0.140,
   +0.083, +0.039, +0.018 % at 50 to 400 (order 0.99, local orders 0.76, 1.08, 1.13; f_2
   -0.142, -0.025, -0.007, -0.004 %; 2026-12-06), also reported XFAIL while below 1.
+  With coupling.scheme = sharp (the phases' fields tied at points on the solid's surface alone,
+  coupler/coupling_sharp.c) the check is an ordinary one: f_1 -0.0885, -0.0282, -0.0090,
+  +0.0056 % and f_2 -0.1815, -0.0457, -0.0098, +0.0052 % at 50, 100, 200, 400 (order 1.65 from
+  50 to 200, 1.33 to 400; 2026-12-07). A 1-D Galerkin model of the discretisation (quadratic
+  B-splines, two particles per cell, lumped mass) gives f_1 +0.159, +0.090, +0.048, +0.024 % with
+  one field and -0.044, -0.011, -0.0027, -0.0007 % with two fields tied at the interface point:
+  the first order of the other schemes is one C1 field across the interface's strain jump.
+  Under musl sharp gave f_1 -0.0645, -0.0326, -0.0057, +0.0199 % (order 1.75 to 200 but 0.57 to
+  400, not understood; not run here).
 - A stability run the blow-up guard stops (exit 1) counts as unstable: the particles' pressure at
   800 cells per metre stops at t = 1.86 (before the guard watched the kinetic energy it ended
   with exit 0, and this test read its snapshots).
@@ -102,9 +111,11 @@ elif MRI:
 elif LONG:
     CONFIGS = [("velocity", "usl", "monolithic"), ("contact", "usl", "monolithic"),
                ("traction", "usl", "monolithic"), ("velocity", "bs32", "monolithic"),
-               ("velocity", "usl", "multirate"), ("velocity", "usl", "monolithic", "hybrid")]
+               ("velocity", "usl", "multirate"), ("velocity", "usl", "monolithic", "hybrid"),
+               ("sharp", "usl", "monolithic")]
 else:
-    CONFIGS = [("velocity", "usl", "monolithic"), ("velocity", "usl", "multirate")]
+    CONFIGS = [("velocity", "usl", "monolithic"), ("velocity", "usl", "multirate"),
+               ("sharp", "usl", "monolithic")]
 CELLS = [50, 100, 200, 400] if LONG or MRI else [50, 100, 200]
 STABLE_CELLS = [400, 800] if LONG else []
 T_END, T_STABLE = 18.0, 36.0  # 10 and 20 periods of mode 1
@@ -242,22 +253,22 @@ def study(scheme, method, time_scheme, pressure="auto"):
     order = math.log(e0 / e1) / math.log(CELLS[-1] / CELLS[0]) if e1 > 0 else float("inf")
     msg = (f"{tag}: f_1's observed order {CELLS[0]} -> {CELLS[-1]} cells/m {order:.2f} "
            f"(>= {ORDER_MIN:g})")
-    if order >= ORDER_MIN or STANDIN:
+    if order >= ORDER_MIN or STANDIN or scheme == "sharp":  # sharp: ties at the surface alone
         check(order >= ORDER_MIN, msg)
     else:  # expected to fail (see the docstring): reported, not counted
         print(f"XFAIL {msg}: below the issue's target; the B-spline interface's own order")
 
 
 def stability(cells, pressure="particle", transfer="flip", method="usl", time_scheme="monolithic",
-              extra=(), xfail=None):
+              extra=(), xfail=None, scheme="velocity"):
     """20 periods; xfail: the reason the run is expected to go unstable (reported, not counted)."""
     # A run that stops early (the blow-up guard's exit 1, or any other failure) is unstable.
-    out = run(cells, "velocity", method, time_scheme, T_STABLE,
+    out = run(cells, scheme, method, time_scheme, T_STABLE,
               [f"fluid.pressure={pressure}", f"transfer.velocity={transfer}"] + list(extra),
               check_exit=False)
     vy, first = max_vy(out) if out else (math.inf, "the run's stop")
     what = " ".join([method, time_scheme, pressure, "pressure", transfer] + list(extra))
-    msg = (f"stability velocity {what} {cells} cells/m, 20 periods: max |v_y| / c_g "
+    msg = (f"stability {scheme} {what} {cells} cells/m, 20 periods: max |v_y| / c_g "
            f"{vy / C_G:.1e} (<= {TOL_VY:g}; first above at t = {first})")
     if xfail is None or vy <= TOL_VY * C_G:
         check(vy <= TOL_VY * C_G, msg)
@@ -283,6 +294,7 @@ if LONG and not ARGS:
     stability(800, "grid")
     stability(800, transfer="apic")
     stability(800, "hybrid")
+    stability(800, scheme="sharp")
 if MRI and not ARGS:
     for cells in (400, 800):
         stability(cells, "auto", method="bs32", time_scheme="multirate")
