@@ -9,11 +9,7 @@ extern const mpm_coupling_type coupling_traction;
 extern const mpm_coupling_type coupling_sharp;
 
 static const mpm_coupling_type *const g_types[] = {
-    &coupling_none,
-    &coupling_velocity,
-    &coupling_contact,
-    &coupling_traction,
-    &coupling_sharp,
+    &coupling_none, &coupling_velocity, &coupling_contact, &coupling_traction, &coupling_sharp,
 };
 
 const mpm_coupling_type *const *mpm_coupling_types(int *n) {
