@@ -316,6 +316,13 @@ COUPLING_CASES = [
     ("slow substeps with another time scheme", FSI, "time = staggered\nslow_substeps = 0",
      "coupling.slow_substeps", "key of the multirate time scheme"),
 ]
+# sharp ties the phases in one nodal solve of the classic update.
+COUPLING_CASES += [
+    ("sharp with an ERK pair", FSI.replace("method = usl", "method = bs32", 1), "scheme = sharp",
+     "coupling.scheme", "classic update"),
+    ("sharp with multirate", FSI, "scheme = sharp\ntime = multirate", "coupling.time",
+     "coupling.time = monolithic"),
+]
 for name, base, body, key, words in COUPLING_CASES:
     text = base.rstrip("\n") + "\n\n[coupling]\n" + body + "\n"
     expect_error(name, text, key, words, line_of(text, body.splitlines()[-1]))

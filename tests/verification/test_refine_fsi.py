@@ -337,6 +337,8 @@ def part_input():
          "refine.band.lo", "lo = 0.9 0.01", "periodic axis y"),
         ("contact", usl(text.replace("scheme = velocity", "scheme = contact")),
          "coupling.scheme", "scheme = contact", "not carried"),
+        ("sharp", usl(text.replace("scheme = velocity", "scheme = sharp")),
+         "coupling.scheme", "scheme = sharp", "not carried"),
         ("MUSL", text.replace("t_end = 0.1", "t_end = 0.1\nmethod = musl"),
          "time.method", "method = musl", "not carried"),
         ("two bodies", text.replace("hi = 2.6 0.06", "hi = 1.8 0.06") +
