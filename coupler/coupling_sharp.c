@@ -212,6 +212,26 @@ static int add_point(mpm_coupling *c, const double *x, const double *n) {
   return 0;
 }
 
+/* Does the gas have mass on a node within a cell of x along every axis (the 3^dim nodes around
+ * the nearest one)? A surface particle's face point has gas in its stencil; a particle two
+ * cells or more inside the solid has none around it, and is passed over without its stencils. */
+static int gas_near(const mpm_coupling *c, const double *x) {
+  const mpm_grid *g = c->grid;
+  const int dim = g->dim;
+  int near[MPM_MAX_DIM];
+  for (int d = 0; d < dim; ++d) near[d] = mpm_shape_floor((x[d] - g->lo[d]) / g->dx + 0.5);
+  for (int k = 0; k < (dim == 3 ? 27 : 9); ++k) {
+    int gi[MPM_MAX_DIM];
+    int inside = 1;
+    for (int d = 0, r = k; d < dim; ++d, r /= 3) {
+      gi[d] = near[d] + r % 3 - 1;
+      inside &= gi[d] >= g->box_lo[d] && gi[d] < g->box_lo[d] + g->box_n[d];
+    }
+    if (inside && mpm_coupling_has_mass(c, MPM_ROLE_FLUID, mpm_grid_local_index(g, gi))) return 1;
+  }
+  return 0;
+}
+
 /* The surface particles' face points (see the header), as candidates. */
 static int find_candidates(mpm_coupling *c) {
   sharp *s = c->content;
@@ -226,6 +246,7 @@ static int find_candidates(mpm_coupling *c) {
     mpm_lidx node[SHARP_STENCIL];
     double w[SHARP_STENCIL], dw[SHARP_STENCIL][MPM_MAX_DIM], x[MPM_MAX_DIM], y[MPM_MAX_DIM];
     for (int d = 0; d < dim; ++d) x[d] = mpm_particles_comp(p, 0, d)[i];
+    if (!gas_near(c, x)) continue;
     int count = stencil(g, x, node, w, dw);
     double grad[MPM_MAX_DIM] = {0}, norm = 0.0;
     for (int k = 0; k < count; ++k)
