@@ -640,3 +640,30 @@ int mpm_grid_halo_forward(mpm_grid *grid, double *const *fields, int nfields) {
   }
   return 0;
 }
+
+int mpm_grid_point_stencil(const mpm_grid *g, const double *x, mpm_lidx *node, double *w,
+                           double (*dw)[MPM_MAX_DIM]) {
+  const int dim = g->dim, sup = mpm_shape_support(g->shape);
+  int base[MPM_MAX_DIM];
+  double xi[MPM_MAX_DIM], wt[MPM_MAX_DIM][MPM_SHAPE_MAX_SUPPORT],
+      dwt[MPM_MAX_DIM][MPM_SHAPE_MAX_SUPPORT];
+  for (int d = 0; d < dim; ++d) xi[d] = (x[d] - g->lo[d]) / g->dx;
+  mpm_shape_eval(g->shape, dim, xi, 0.0, base, wt, dwt);
+  const int count = dim == 2 ? sup * sup : sup * sup * sup;
+  for (int k = 0; k < count; ++k) {
+    int gi[MPM_MAX_DIM];
+    double W = 1.0;
+    for (int d = 0, r = k; d < dim; r /= sup, ++d) {
+      gi[d] = base[d] + r % sup;
+      if (gi[d] < g->box_lo[d] || gi[d] >= g->box_lo[d] + g->box_n[d]) return 0;
+      W *= wt[d][r % sup];
+    }
+    for (int e = 0; dw && e < dim; ++e) {
+      double D = 1.0;
+      for (int d = 0, r = k; d < dim; r /= sup, ++d) D *= d == e ? dwt[d][r % sup] : wt[d][r % sup];
+      dw[k][e] = D;
+    }
+    node[k] = mpm_grid_local_index(g, gi), w[k] = W;
+  }
+  return count;
+}

@@ -159,6 +159,14 @@ int mpm_grid_node_is_owned(const mpm_grid *g, mpm_lidx l);
 /* Rank (in grid->comm) that owns the cell containing x; -1 if x is outside [lo, hi). */
 int mpm_grid_owner_of(const mpm_grid *g, const double *x);
 
+/* Nodes of a point's stencil at most (the cubic shape in 3-D). */
+#define MPM_GRID_STENCIL_MAX (MPM_SHAPE_MAX_SUPPORT * MPM_SHAPE_MAX_SUPPORT * MPM_SHAPE_MAX_SUPPORT)
+/* The stencil of the point x: its nodes (box indices) and shape weights, and with dw non-NULL
+ * each weight's derivative along each axis per unit of xi (over dx for a physical gradient);
+ * their count, or 0 if the stencil leaves the box. */
+int mpm_grid_point_stencil(const mpm_grid *g, const double *x, mpm_lidx *node, double *w,
+                           double (*dw)[MPM_MAX_DIM]);
+
 /* Map x back into [lo, hi) along every periodic axis where it lies at most one period
  * outside (a farther point is left alone, for the caller to report). Returns the number of
  * coordinates changed. */

@@ -46,7 +46,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-enum { SHARP_STENCIL = MPM_SHAPE_MAX_SUPPORT * MPM_SHAPE_MAX_SUPPORT * MPM_SHAPE_MAX_SUPPORT };
+enum { SHARP_STENCIL = MPM_GRID_STENCIL_MAX };
 
 /* Surface test: the solid's interpolated nodal mass one particle width outside a particle, over
  * the seeded material's, below which the particle is on the surface. */
@@ -143,35 +143,6 @@ static int room(sharp *s, int n) {
   return 0;
 }
 
-/* The stencil of x: box nodes, weights and weight derivatives along each axis (per unit xi);
- * its size, or 0 where it leaves the box. */
-static int stencil(const mpm_grid *g, const double *x, mpm_lidx *node, double *w,
-                   double (*dw)[MPM_MAX_DIM]) {
-  const int dim = g->dim, sup = mpm_shape_support(g->shape);
-  int base[MPM_MAX_DIM];
-  double xi[MPM_MAX_DIM], wt[MPM_MAX_DIM][MPM_SHAPE_MAX_SUPPORT],
-      dwt[MPM_MAX_DIM][MPM_SHAPE_MAX_SUPPORT];
-  for (int d = 0; d < dim; ++d) xi[d] = (x[d] - g->lo[d]) / g->dx;
-  mpm_shape_eval(g->shape, dim, xi, 0.0, base, wt, dwt);
-  const int count = dim == 1 ? sup : dim == 2 ? sup * sup : sup * sup * sup;
-  for (int k = 0; k < count; ++k) {
-    int gi[MPM_MAX_DIM];
-    double W = 1.0;
-    for (int d = 0, r = k; d < dim; r /= sup, ++d) {
-      gi[d] = base[d] + r % sup;
-      if (gi[d] < g->box_lo[d] || gi[d] >= g->box_lo[d] + g->box_n[d]) return 0;
-      W *= wt[d][r % sup];
-    }
-    for (int e = 0; dw && e < dim; ++e) {
-      double D = 1.0;
-      for (int d = 0, r = k; d < dim; r /= sup, ++d) D *= d == e ? dwt[d][r % sup] : wt[d][r % sup];
-      dw[k][e] = D;
-    }
-    node[k] = mpm_grid_local_index(g, gi), w[k] = W;
-  }
-  return count;
-}
-
 /* A surface particle's point, before the merge: its face point, its normal and its key (the
  * particle's cell and the axis and sign its normal points along most). */
 typedef struct candidate {
@@ -194,7 +165,7 @@ static int add_point(mpm_coupling *c, const double *x, const double *n) {
   mpm_lidx *nq = s->node + (size_t)q * SHARP_STENCIL;
   double *cg = s->cg + (size_t)q * SHARP_STENCIL, *cs = s->cs + (size_t)q * SHARP_STENCIL;
   double w[SHARP_STENCIL];
-  const int count = stencil(c->grid, x, nq, w, NULL);
+  const int count = mpm_grid_point_stencil(c->grid, x, nq, w, NULL);
   if (!count) return 0;
   double wg = 0.0, ws = 0.0;
   for (int k = 0; k < count; ++k) {
@@ -247,7 +218,7 @@ static int find_candidates(mpm_coupling *c) {
     double w[SHARP_STENCIL], dw[SHARP_STENCIL][MPM_MAX_DIM], x[MPM_MAX_DIM], y[MPM_MAX_DIM];
     for (int d = 0; d < dim; ++d) x[d] = mpm_particles_comp(p, 0, d)[i];
     if (!gas_near(c, x)) continue;
-    int count = stencil(g, x, node, w, dw);
+    int count = mpm_grid_point_stencil(g, x, node, w, dw);
     double grad[MPM_MAX_DIM] = {0}, norm = 0.0;
     for (int k = 0; k < count; ++k)
       for (int d = 0; d < dim; ++d) grad[d] += dw[k][d] * ps->m_i[node[k]];
@@ -263,7 +234,7 @@ static int find_candidates(mpm_coupling *c) {
     }
     const double r = 0.5 * pow(V0[i], 1.0 / dim) * sqrt(Ftn), full = m[i] / V0[i] * cell;
     for (int d = 0; d < dim; ++d) y[d] = x[d] + 2.0 * r * n[d];
-    count = stencil(g, y, node, w, NULL);
+    count = mpm_grid_point_stencil(g, y, node, w, NULL);
     double fill = 0.0;
     for (int k = 0; k < count; ++k) fill += w[k] * ps->m_i[node[k]];
     if (!count || !(fill < SHARP_FILL * full)) continue;

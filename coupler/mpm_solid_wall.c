@@ -222,39 +222,15 @@ static int wall_prepare(void *ctx, double h, double reach, double range, unsigne
   return mark_near(w, (int)ceil((range + g->dx) / g->dx) + 1, 2, cells);
 }
 
-/* The nodes of the stencil of x (box indices) and their weights, at most 64; their count, or 0
- * if the stencil leaves the box. */
-enum { STENCIL_MAX = 64 };
-static int stencil(const mpm_grid *g, const double *x, mpm_lidx *node, double *weight) {
-  const int dim = g->dim, sup = mpm_shape_support(g->shape);
-  int base[MPM_MAX_DIM];
-  double xi[MPM_MAX_DIM], wt[MPM_MAX_DIM][MPM_SHAPE_MAX_SUPPORT],
-      dw[MPM_MAX_DIM][MPM_SHAPE_MAX_SUPPORT];
-  for (int d = 0; d < dim; ++d) xi[d] = (x[d] - g->lo[d]) / g->dx;
-  mpm_shape_eval(g->shape, dim, xi, 0.0, base, wt, dw);
-  const int count = dim == 2 ? sup * sup : sup * sup * sup;
-  for (int k = 0; k < count; ++k) {
-    int gi[MPM_MAX_DIM];
-    double W = 1.0;
-    for (int d = 0, r = k; d < dim; r /= sup, ++d) {
-      gi[d] = base[d] + r % sup;
-      if (gi[d] < g->box_lo[d] || gi[d] >= g->box_lo[d] + g->box_n[d]) return 0;
-      W *= wt[d][r % sup];
-    }
-    node[k] = mpm_grid_local_index(g, gi), weight[k] = W;
-  }
-  return count;
-}
-
 /* The solid's nodal sums at x over its stencil: sum S m, sum S m v, sum S grad m; 0 if x's
  * stencil leaves the box. */
 static int nodal_at(const mpm_solid_wall *w, const double *x, double *m, double *mv, double *gm) {
   const mpm_grid *g = w->c->grid;
   const mpm_grid_phase *s = mpm_coupling_phase(w->c, MPM_ROLE_SOLID);
   const int dim = g->dim;
-  mpm_lidx node[STENCIL_MAX];
-  double W[STENCIL_MAX];
-  const int count = stencil(g, x, node, W);
+  mpm_lidx node[MPM_GRID_STENCIL_MAX];
+  double W[MPM_GRID_STENCIL_MAX];
+  const int count = mpm_grid_point_stencil(g, x, node, W, NULL);
   *m = 0.0;
   for (int d = 0; d < dim; ++d) mv[d] = gm[d] = 0.0;
   for (int k = 0; k < count; ++k) {
@@ -317,9 +293,10 @@ static double wall_impulse(void *ctx, const double *x, const double *J) {
   const mpm_grid_phase *s = mpm_coupling_phase(c, MPM_ROLE_SOLID);
   const int dim = g->dim;
   const double h = w->h;
-  mpm_lidx node[STENCIL_MAX];
-  double share[STENCIL_MAX], sum = 0.0, work = 0.0;
-  const int count = stencil(g, x, node, share); /* wall_at found it inside the box, with mass */
+  mpm_lidx node[MPM_GRID_STENCIL_MAX];
+  double share[MPM_GRID_STENCIL_MAX], sum = 0.0, work = 0.0;
+  /* (wall_at found x inside the box, with mass) */
+  const int count = mpm_grid_point_stencil(g, x, node, share, NULL);
   for (int k = 0; k < count; ++k) share[k] *= w->nod_ptr[0][node[k]], sum += share[k];
   /* The work at the nodes' time-centred velocity v - h a / 2, as the solid's exchange counts
    * it (wall_finish): what the gas gains the solid loses, less the impulse's own sum J^2 / 2m. */
