@@ -15,10 +15,13 @@
  * Interface points. A solid particle p lies on the surface where the solid's nodal mass,
  * interpolated one particle width outside it, x_p + 2 r_p n, fills less than half of what the
  * seeded material gives (sum S_i m_i < rho_0 dx^dim / 2, rho_0 = m_p / V0_p; on a straight face
- * the first layer reads 0.38 there and the second 0.62), with r_p = V0_p^(1/dim) / 2 and n the
- * outward unit normal -grad(sum S_i m_i) at x_p. Its point is x_q = x_p + r_p n, the face of its
- * cell: on a straight face exactly the face, whatever the particle spacing along it. A point
- * whose stencil holds gas on less than half its weight is dropped (no gas there to tie).
+ * the first layer reads 0.38 there and the second 0.62), with n the outward unit normal
+ * -grad(sum S_i m_i) at x_p and r_p = |F^T n| V0_p^(1/dim) / 2 its current half-width along n
+ * (with the reference width, the faces of a pre-stressed slab sat 3e-5 off and the gas beside it
+ * moved). Its face point is x_p + r_p n: on a straight face exactly the face, whatever the
+ * particle spacing along it. The face points of one particle cell and face direction merge
+ * into one point (find_points). A point whose stencil holds gas on less than half its weight is
+ * dropped (no gas there to tie).
  *
  * The constraint. At point q, with c_q(phase) the stencil weights over the nodes where that
  * phase has mass, normalised to sum 1 (so that a point beside the phase's edge reads the
@@ -34,10 +37,12 @@
  * inelastic impact does). Where the solid's clamp holds a node the gas follows it
  * (MPM_COUPLING_HOLDS).
  *
+ * Deep inside the solid the phases share the centre-of-mass velocity (tie_inside).
+ *
  * Limits (refused at input): the classic update (usl, musl) with coupling.time = monolithic; no
- * refinement hierarchy. The cost: per step a conjugate-gradient solve whose every iteration
- * deposits the points' impulses, sums and fills the halo of 2 dim nodal arrays of the whole box,
- * and gathers them back. */
+ * refinement hierarchy. The cost: per step three preconditioned conjugate-gradient passes
+ * (solve) whose every iteration clears, deposits, sums over the halo and gathers back 2 dim
+ * nodal arrays of the whole box. */
 #include "mpm_coupling.h"
 #include "mpm_error.h"
 #include "mpm_shape.h"
