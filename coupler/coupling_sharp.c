@@ -340,24 +340,20 @@ static int dot(const mpm_coupling *c, const double *a, const double *b, double *
   return 0;
 }
 
-/* A's diagonal, A_qq = sum_k (c_g,k^2 / m_g,k + c_s,k^2 / m_s,k) over the free components, into
- * diag; its largest value over the ranks in *amax. */
+/* A's diagonal, A_qq = sum_k (c_g,k^2 / m_g,k + c_s,k^2 / m_s,k) (n_q a unit vector), into diag;
+ * its largest value over the ranks in *amax. */
 static int diagonal(const mpm_coupling *c, double *diag, double *amax) {
   const sharp *s = c->content;
-  const int dim = c->grid->dim;
   const mpm_grid_phase *g = mpm_coupling_phase(c, MPM_ROLE_FLUID);
   const mpm_grid_phase *so = mpm_coupling_phase(c, MPM_ROLE_SOLID);
   double big = 0.0;
   for (int q = 0; q < s->npt; ++q) {
-    const double *n = s->n + (size_t)q * MPM_MAX_DIM;
     double a = 0.0;
     for (int k = 0; k < SHARP_STENCIL; ++k) {
       const size_t at = (size_t)q * SHARP_STENCIL + (size_t)k;
       const mpm_lidx l = s->node[at];
-      double nn = 0.0;
-      for (int d = 0; d < dim; ++d) nn += n[d] * n[d];
-      if (s->cg[at] != 0.0) a += nn * s->cg[at] * s->cg[at] / g->m_i[l];
-      if (s->cs[at] != 0.0) a += nn * s->cs[at] * s->cs[at] / so->m_i[l];
+      if (s->cg[at] != 0.0) a += s->cg[at] * s->cg[at] / g->m_i[l];
+      if (s->cs[at] != 0.0) a += s->cs[at] * s->cs[at] / so->m_i[l];
     }
     diag[q] = a, big = fmax(big, a);
   }
@@ -397,7 +393,7 @@ static int pcg(mpm_coupling *c, double delta) {
  * definite (without one, the roundoff outside A's range grew lam to 1e21 at a shock's impact),
  * and SHARP_REFINE passes of iterative refinement, lam += (A + delta I)^-1 (g - A lam), remove
  * its bias on A's range (each pass by a factor delta / A) and leave the rest bounded: the shift
- * alone left the gas against a pre-stressed slab moving at 1e-10 c after 1,000 steps.
+ * alone left the gas against a pre-stressed slab moving at 5e-10 c after 1,000 steps.
  * Collective: every rank iterates alike. */
 static int solve(mpm_coupling *c, const double *jump) {
   sharp *s = c->content;
