@@ -257,11 +257,8 @@ static int hybrid_scope(const fluid_content *fc, const mpm_config *cfg, scope_mi
    * (test_gridp_beside) was not measured with the particles' share beside it. */
   if (strcmp(scheme, "contact") == 0 || strcmp(scheme, "sharp") == 0)
     return miss(s, "fluid.pressure",
-                strcmp(scheme, "sharp") == 0
-                    ? "does not carry a solid under coupling.scheme = sharp (not measured): use "
-                      "velocity or traction"
-                    : "does not carry a solid under coupling.scheme = contact (not measured): "
-                      "use velocity or traction");
+                "does not carry a solid under coupling.scheme = contact or sharp (not "
+                "measured): use velocity or traction");
   return 0;
 }
 
