@@ -12,11 +12,12 @@ Cases (the scenes of tests/verification/test_refine_gas.py):
             Error: the mean |rho - rho_fine| over the band's rows 0.2 < y < 0.4 at t = 1.2,
             binned along x into 60 cells (the fine twin is the reference: its error is 0).
   stream3d  the stream in 3-D (x and z periodic), to t = 0.45.
-  sod, sod3, sod4, sod3_usl, sod4_usl
+  sod, sod3, sod4, sod3_usl, sod4_usl, sod4_cost
             cases/sod.ini over 100 level-0 cells, 3 across (periodic in y: every level wraps),
             regridded by the density criterion (refine_scenes.sod_refine) with 2, 3 and 4 levels
             under bs32 (sod, sod3, sod4) and 3 and 4 under the case's usl (sod3_usl, sod4_usl),
-            both at the case's fixed time.cfl = 0.9,
+            both at the case's fixed time.cfl = 0.9, and with the settings of issue 51's cost
+            bar (sod4_cost: refine_scenes.SOD_COST, usl),
             against the uniform twins at the finest spacing on the same strip, with the grid
             pressure the refined run takes (fine) and the default particle pressure
             (fine_particle). Error: the density's L1 on the finest cells (tests/tools/
@@ -27,6 +28,11 @@ one after another, the twins of a case next to each other, so compare within a c
 rows as JSON and CSV under --out (default out/bench_refine/) and the page --md (default
 bench/results/refine_cost.md).
   /usr/bin/python3 bench/bench_refine.py [--binary build/app/mpmfsi] [--cases stream,pulse,...]
+      [--pairs N] [--instructions]
+--pairs N times each Sod case's refined run and its fine twin N more times, in turn, and prints
+the median and range of the user-time ratio (the machine's speed drifts within minutes: a pair
+run back to back shares it); --instructions counts both under cachegrind (about 40 times
+slower), the measure the machine's load does not change.
 """
 import argparse
 import csv
@@ -42,28 +48,40 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, "tests", "tools"))
 import mpmtest as mt  # noqa: E402
 import shocktube  # noqa: E402
-from refine_scenes import BOX, BOX_3D, C0, CASE_3D, SOD_COARSE, case_text, sod_refine  # noqa: E402
+from refine_scenes import (BOX, BOX_3D, C0, CASE_3D, SOD_COARSE, SOD_COST, case_text,  # noqa: E402
+                           sod_refine)
 from riemann import Riemann  # noqa: E402
 
 U0 = 0.5 * C0
 GAS_STREAM = f"density = 1\npressure = 1\nvelocity = {U0!r} 0"
 TIMERS = ("restrict", "prolong", "relevel", "regrid")
-# case: (refinement levels, time.method); the case's own usl and the ERK pair bs32, both at the
-# case's fixed time.cfl = 0.9
+# case: (refinement levels, time.method, refinement settings); the case's own usl and the ERK
+# pair bs32, both at the case's fixed time.cfl = 0.9; sod4_cost: the settings of issue 51's cost
+# bar (refine_scenes.SOD_COST)
 SOD_LEVELS = {"sod": (2, "bs32"), "sod3": (3, "bs32"), "sod4": (4, "bs32"),
               "sod3_usl": (3, "usl"), "sod4_usl": (4, "usl")}
+SOD_LEVELS = {k: (n, m, sod_refine(n)) for k, (n, m) in SOD_LEVELS.items()}
+SOD_LEVELS["sod4_cost"] = (SOD_COST["levels"], "usl",
+                           sod_refine(SOD_COST["levels"], SOD_COST["threshold"], SOD_COST["every"]))
 DEFAULT_CASES = "stream,pulse,stream3d," + ",".join(SOD_LEVELS)
 KEPT_SECTION = "## Settings swept for Sod"
 
 
-def run(binary, out, case, overrides):
-    """One run: its summary, timers, peak memory (MB), user CPU (s) and output folder."""
+def run(binary, out, case, overrides, instructions=False):
+    """One run: its summary, timers, peak memory (MB), user CPU (s) and output folder; with
+    instructions, under cachegrind, its instruction count instead of the times."""
     os.makedirs(out, exist_ok=True)
-    cmd = ["/usr/bin/time", "-f", "%M %U", binary, "run", case, f"output.dir={out}/run",
-           "output.overwrite=true", "run.progress=false"] + overrides
-    p = subprocess.run(cmd, capture_output=True, text=True)
+    cmd = [binary, "run", case, f"output.dir={out}/run", "output.overwrite=true",
+           "run.progress=false"] + overrides
+    if instructions:
+        cmd = ["valgrind", "--tool=cachegrind", "--cache-sim=no",
+               f"--cachegrind-out-file={out}/cachegrind.out"] + cmd
+    p = subprocess.run(["/usr/bin/time", "-f", "%M %U"] + cmd, capture_output=True, text=True)
     if p.returncode != 0:
         raise SystemExit(f"{' '.join(cmd)} failed:\n{p.stderr[-2000:]}")
+    if instructions:
+        refs = [ln for ln in p.stderr.splitlines() if "I   refs:" in ln]
+        return {"instructions": int(refs[-1].split()[-1].replace(",", ""))}
     rss_kb, user_s = p.stderr.strip().splitlines()[-1].split()
     rss_mb = int(rss_kb) / 1024.0
     run_dir = os.path.join(out, "run")
@@ -129,21 +147,38 @@ def case_pulse(binary, out):
     return rows
 
 
-def case_sod(binary, out, levels, method):
+def case_sod(binary, out, name, levels, method, refine, pairs=0, instructions=False):
+    """The Sod runs of case `name`; then, with pairs, the refined run and its fine twin timed
+    in turn that many times more (user CPU: the ratio of each pair), and with instructions
+    both counted under cachegrind."""
     fine = SOD_COARSE * 2 ** (levels - 1)
     exact = Riemann((1.0, 0.0, 1.0), (0.125, 0.0, 0.1), gamma=1.4, x0=0.5)
     case = os.path.join(ROOT, "cases", "sod.ini")
     height = 3.0 / SOD_COARSE
-    rows = {}
-    for label, N, extra in (("refined", SOD_COARSE, sod_refine(levels)),
-                            ("coarse", SOD_COARSE, []),
-                            ("fine", fine, ["fluid.pressure=grid", "fluid.pressure_relax=4"]),
-                            ("fine_particle", fine, [])):
+    runs = {"refined": (SOD_COARSE, refine), "coarse": (SOD_COARSE, []),
+            "fine": (fine, ["fluid.pressure=grid", "fluid.pressure_relax=4"]),
+            "fine_particle": (fine, [])}
+
+    def one(label, **kw):
+        N, extra = runs[label]
         over = [o for o in shocktube.overrides(N, method, 0.2, height=height)
                 if not o.startswith("run.progress")] + ["output.interval=0.2"]
-        r = run(binary, os.path.join(out, f"sod{levels}_{method}_{label}"), case, over + extra)
-        r["error"] = shocktube.measure(r["dir"], fine, exact, 0.2)[0]
-        rows[label] = r
+        return run(binary, os.path.join(out, f"{name}_{label}"), case, over + extra, **kw)
+
+    rows = {}
+    for label in runs:
+        rows[label] = one(label)
+        rows[label]["error"] = shocktube.measure(rows[label]["dir"], fine, exact, 0.2)[0]
+    ratios = []
+    for k in range(pairs):
+        ratios.append(one("refined")["user_s"] / one("fine")["user_s"])
+        print(f"{name} pair {k + 1}: user time refined / fine {ratios[-1]:.3f}", flush=True)
+    if ratios:
+        rows["refined"]["pairs"] = ratios
+    if instructions:
+        for label in ("refined", "fine"):
+            rows[label]["instructions"] = one(label, instructions=True)["instructions"]
+            print(f"{name} {label}: {rows[label]['instructions']:,} instructions", flush=True)
     return rows
 
 
@@ -198,8 +233,16 @@ def page(results, commit, command):
                   f"{ref['particle_steps'] / fine['particle_steps']:.2f}× the "
                   f"particle-steps, {ref['rss_mb'] / fine['rss_mb']:.2f}× the peak memory", ""]
         if name.startswith("sod"):
-            lines[-2] += f", {ref['error'] / fine['error']:.2f}× the error"
+            lines[-2] += f", {ref['error'] / fine['error']:.3f}× the error"
         lines[-2] += "."
+        if "pairs" in ref:
+            q = ref["pairs"]
+            lines.insert(-1, f"User CPU time refined over fine, {len(q)} pairs timed in turn: "
+                         f"median {np.median(q):.3f}, {min(q):.3f} to {max(q):.3f}.")
+        if "instructions" in ref:
+            lines.insert(-1, f"Instructions (cachegrind): refined {ref['instructions']:,}, fine "
+                         f"{fine['instructions']:,}, a ratio of "
+                         f"{ref['instructions'] / fine['instructions']:.3f}.")
     return "\n".join(lines)
 
 
@@ -209,6 +252,10 @@ def main():
     ap.add_argument("--cases", default=DEFAULT_CASES)
     ap.add_argument("--out", default=os.path.join(ROOT, "out", "bench_refine"))
     ap.add_argument("--md", default=os.path.join(ROOT, "bench", "results", "refine_cost.md"))
+    ap.add_argument("--pairs", type=int, default=0,
+                    help="Sod cases: time the refined run and its fine twin in turn N times more")
+    ap.add_argument("--instructions", action="store_true",
+                    help="Sod cases: count both runs' instructions under cachegrind (slow)")
     a = ap.parse_args()
     os.environ["MPMFSI_BIN"] = a.binary
     results = {}
@@ -220,20 +267,26 @@ def main():
         elif name == "pulse":
             results[name] = case_pulse(a.binary, a.out)
         elif name in SOD_LEVELS:
-            results[name] = case_sod(a.binary, a.out, *SOD_LEVELS[name])
+            results[name] = case_sod(a.binary, a.out, name, *SOD_LEVELS[name], pairs=a.pairs,
+                                     instructions=a.instructions)
         else:
             raise SystemExit(f"unknown case {name}: choose among {DEFAULT_CASES}")
         for label, r in results[name].items():
             print(f"{name} {label}: {r['steps']} steps, {r['wall_s']:.2f} s ({r['user_s']:.2f} s user), {r['rss_mb']:.0f} MB,"
                   f" error {r['error']:.2e}", flush=True)
     os.makedirs(a.out, exist_ok=True)
-    flat = [dict(case=n, run=label, **{k: v for k, v in r.items() if k not in ("timers", "dir")},
+    flat = [dict(case=n, run=label,
+                 **{k: v for k, v in r.items()
+                    if k not in ("timers", "dir", "pairs", "instructions")},
+                 pairs=" ".join(f"{q:.4f}" for q in r.get("pairs", [])),
+                 instructions=r.get("instructions", ""),
                  **{f"t_{k}": r["timers"].get(k, 0.0) for k in TIMERS})
             for n, rows in results.items() for label, r in rows.items()]
     write_rows(a.out, "refine_cost", flat)
     commit = head_commit()
     command = "/usr/bin/python3 bench/bench_refine.py" + (
-        f" --cases {a.cases}" if a.cases != DEFAULT_CASES else "")
+        f" --cases {a.cases}" if a.cases != DEFAULT_CASES else "") + (
+        f" --pairs {a.pairs}" if a.pairs else "") + (" --instructions" if a.instructions else "")
     # The sweep of Sod's settings below the generated tables is measured by hand (the page says
     # when): keep it, which the docs link to.
     kept = ""

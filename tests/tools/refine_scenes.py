@@ -150,10 +150,22 @@ STARVE = "[refine]\nlevels = 2\ncriterion = starvation\nmin_particles = 2.5\neve
 SOD_COARSE = 100
 
 
-def sod_refine(levels):
-    """Command-line settings of the refined Sod run with `levels` levels over SOD_COARSE cells."""
-    return [f"refine.levels={levels}", "refine.criterion=density", "refine.threshold=0.02",
-            "refine.dilate=1"]
+def sod_refine(levels, threshold=0.02, every=None):
+    """Command-line settings of the refined Sod run with `levels` levels over SOD_COARSE cells,
+    regridded by the density criterion at `threshold` every `every` steps (None: the default
+    refine.every)."""
+    return [f"refine.levels={levels}", "refine.criterion=density",
+            f"refine.threshold={threshold}", "refine.dilate=1"] + (
+        [f"refine.every={every}"] if every else [])
+
+
+# The settings of issue 51's cost bar (a third of the uniform fine run's cost at an L1 within
+# 10 % of its): 4 levels under the case's usl, regridded every 30 steps at threshold 0.03 (the
+# shock crosses about 1.2 level-0 cells between regrids). From the sweep of thresholds 0.02 to
+# 0.06 and intervals 10 to 40 in docs/refinement.md: 0.04 and above lose accuracy, and every
+# 40 steps saves 1.5 % more of the instructions for 0.3 % of L1 and a shock that outruns more
+# of its region.
+SOD_COST = {"levels": 4, "threshold": 0.03, "every": 30}
 
 # A gas beside a solid on the hierarchy (tests/verification/test_refine_fsi.py): a quasi-1-D
 # strip periodic along y (3 level-0 cells high), slip walls at the x ends: gas rho 1, p 1

@@ -49,9 +49,12 @@ foreach(part wave stream prestress usl restart input walls clamp)
                       ARGS ${part} LABELS verification TIMEOUT 300)
 endforeach()
 # Sod with a fine region following the waves against its uniform twin at the finest spacing
-# (issue 51's acceptance, L1 within 10 %): 2 levels (~3 s); 3 levels under long (~15 s).
+# (issue 51's acceptance, L1 within 10 %): 2 levels (~3 s); 3 levels under long (~15 s); the
+# cost bar's settings, 4 levels under usl (~15 s).
 mpm_add_script_test(test_refine_sod SCRIPT verification/test_refine_sod.py LABELS verification
                     TIMEOUT 300)
+mpm_add_script_test(test_refine_sod_cost SCRIPT verification/test_refine_sod.py ARGS cost
+                    LABELS verification TIMEOUT 600)
 mpm_add_script_test(test_refine_sod_long SCRIPT verification/test_refine_sod.py ARGS long
                     LABELS "verification;long" TIMEOUT 600)
 # Finer levels at slip and no-slip walls (the gas): gas at rest in a closed box refined in its
