@@ -25,6 +25,11 @@ along its tangential directions, and the run blew up near 0.84 ms. Measured sinc
 49.3, 53.8 and 56.9 mm (3.8 mm at most from the slip obstacle's), mean drag +2.1 % of the slip
 obstacle's (2026-12-02, the case with its 2 % PIC share; 4.0 mm and +1.8 % before it).
 
+Argument `sharp` runs `sharp` alone (test_supersonic_bar_twin_sharp), against the slip
+obstacle: it ties the phases along the normal at points on the solid's surface. Measured
+2026-12-07 (1 rank): stand-off 47.3, 52.4 and 54.0 mm (2.0 mm at most from the slip
+obstacle's), mean drag -4.3 % of the slip obstacle's (-2.4 % of the reference's).
+
 Tolerances, with their reasons:
 - stand-off, the slip obstacle against the reference: 2 dx (8 mm). The MPM shock spreads
   over two to three cells, and the 1.5 x free-stream crossing sits inside it; the reference at
@@ -125,7 +130,7 @@ print("reference stand-off (mm): " + ", ".join(f"{1e3 * v:.1f}" for v in ref_so.
 
 MODE = sys.argv[1] if len(sys.argv) > 1 else "schemes"
 SCHEMES = {"schemes": (("velocity", "no_slip"), ("contact", "slip")),
-           "traction": (("traction", "slip"),)}[MODE]
+           "traction": (("traction", "slip"),), "sharp": (("sharp", "slip"),)}[MODE]
 obst = {c: run(f"twin_obstacle_{c}", obstacle_case(c)) for c in {c for _, c in SCHEMES}}
 if "slip" in obst:
     so, drag = obst["slip"]

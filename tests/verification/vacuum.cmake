@@ -37,6 +37,10 @@ mpm_add_script_test(test_supersonic_bar_twin SCRIPT verification/test_supersonic
 mpm_add_script_test(test_supersonic_bar_twin_traction SCRIPT
                     verification/test_supersonic_bar_twin.py ARGS traction
                     LABELS "verification;mpi;long" TIMEOUT 900)
+# The same for the sharp scheme.
+mpm_add_script_test(test_supersonic_bar_twin_sharp SCRIPT
+                    verification/test_supersonic_bar_twin.py ARGS sharp
+                    LABELS "verification;mpi;long" TIMEOUT 900)
 # Gas leaving a slip wall under the strong-expansion settings: particle densities against the
 # exact ones, nodal error against the default gas (see the test's header).
 mpm_add_script_test(test_wall_rarefaction SCRIPT verification/test_wall_rarefaction.py
