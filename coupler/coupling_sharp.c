@@ -39,10 +39,20 @@
  *
  * Deep inside the solid the phases share the centre-of-mass velocity (tie_inside).
  *
- * Limits (refused at input): the classic update (usl, musl) with coupling.time = monolithic; no
- * refinement hierarchy. The cost: per step three preconditioned conjugate-gradient passes
- * (solve) whose every iteration clears, deposits, sums over the halo and gathers back 2 dim
- * nodal arrays of the whole box. */
+ * The method of lines (the ERK pairs). A particle moves with the nodal velocity but its own
+ * velocity takes the nodal acceleration only (mpm_coupling.h). So each RHS makes the points'
+ * normal velocities equal (the positions' kinematics, no force) and then their normal
+ * accelerations, the latter with the drift of the phases' deposited velocities u = mv / m
+ * relaxed at the rate k = relax_rate (coupling.mol_rate, MPM_COUPLING_RATE):
+ * n . (a_g - a_s)(x_q) = -k n . (u_g - u_s)(x_q). The same matrix, two solves, applied together
+ * (apply); the forces of the second are the interface's, equal and opposite. Deep inside the solid
+ * the phases share the centre-of-mass velocity and acceleration, and relax their own velocities
+ * node by node.
+ *
+ * Limits (refused at input): usl, musl or an ERK pair (not euler or ssprk2, whose RHS gets no
+ * relaxation rate) with coupling.time = monolithic; no refinement hierarchy. The cost: per
+ * solve three preconditioned conjugate-gradient passes whose every iteration clears, deposits,
+ * sums over the halo and gathers back 2 dim nodal arrays of the whole box. */
 #include "mpm_coupling.h"
 #include "mpm_error.h"
 #include "mpm_shape.h"
@@ -78,18 +88,23 @@ typedef struct sharp {
   double *lam, *r, *p, *Ap, *z, *dinv, *g; /* per point */
   double *nod; /* 2 dim nnodes: the deposited impulses per mass, gas then solid */
   double *nod_ptr[2 * MPM_MAX_DIM];
-  double *sync_ptr[2 * (MPM_MAX_DIM + 1)]; /* the phases' m_i and v_i, for the halo fill */
+  double *sync_ptr[2 * (2 * MPM_MAX_DIM + 1)]; /* the phases' m_i, v_i (and a_i), halo fill */
+  double *ju; /* per point: the acceleration's jump (method of lines) */
+  double *dv; /* 2 dim nnodes: the velocity tie's spread (method of lines) */
 } sharp;
+
+static const mpm_key_spec sharp_keys[] = {
+    MPM_COUPLING_MOL_RATE_KEY("velocity, traction and sharp")};
 
 static int sharp_create(mpm_coupling *c, const mpm_config *cfg) {
   const char *method, *time;
   MPM_CALL(mpm_config_get_string(cfg, "time.method", &method));
-  if (strcmp(method, "usl") != 0 && strcmp(method, "musl") != 0)
+  if (strcmp(method, "euler") == 0 || strcmp(method, "ssprk2") == 0)
     return mpm_config_fail(cfg, "coupling.scheme",
-                           "sharp needs the classic update (time.method = usl or musl): its "
-                           "interface impulses act on the step's new nodal velocities; use "
+                           "sharp runs with usl, musl or an ERK pair (bs32, ...): under %s the "
+                           "phases' own velocities get no relaxation and drift apart; use "
                            "velocity or traction with %s",
-                           method);
+                           method, method);
   MPM_CALL(mpm_config_get_string(cfg, "coupling.time", &time));
   if (strcmp(time, "monolithic") != 0)
     return mpm_config_fail(
@@ -108,6 +123,7 @@ static void sharp_destroy(mpm_coupling *c) {
   if (s) {
     free(s->node), free(s->cg), free(s->cs), free(s->n), free(s->cand);
     free(s->lam), free(s->r), free(s->p), free(s->Ap), free(s->z), free(s->dinv), free(s->g);
+    free(s->ju), free(s->dv);
     free(s->nod);
   }
   free(s);
@@ -123,6 +139,7 @@ static int sharp_setup(mpm_coupling *c) {
     MPM_FAIL(MPM_ERR_INTERNAL, "the solid has no m, V0 or F field");
   const int dim = c->grid->dim;
   MPM_ALLOC(s->nod, (size_t)(2 * dim) * (size_t)c->grid->nnodes);
+  MPM_ALLOC(s->dv, (size_t)(2 * dim) * (size_t)c->grid->nnodes);
   for (int k = 0; k < 2 * dim; ++k) s->nod_ptr[k] = s->nod + (size_t)k * c->grid->nnodes;
   return 0;
 }
@@ -142,8 +159,8 @@ static int room(sharp *s, int n) {
   MPM_CALL(grow((void **)&s->cg, sizeof *s->cg * cap * SHARP_STENCIL));
   MPM_CALL(grow((void **)&s->cs, sizeof *s->cs * cap * SHARP_STENCIL));
   MPM_CALL(grow((void **)&s->n, sizeof *s->n * cap * MPM_MAX_DIM));
-  double **vec[7] = {&s->lam, &s->r, &s->p, &s->Ap, &s->z, &s->dinv, &s->g};
-  for (int k = 0; k < 7; ++k) MPM_CALL(grow((void **)vec[k], sizeof **vec[k] * cap));
+  double **vec[8] = {&s->lam, &s->r, &s->p, &s->Ap, &s->z, &s->dinv, &s->g, &s->ju};
+  for (int k = 0; k < 8; ++k) MPM_CALL(grow((void **)vec[k], sizeof **vec[k] * cap));
   s->cap = (int)cap;
   return 0;
 }
@@ -419,19 +436,83 @@ static int solve(mpm_coupling *c, const double *jump) {
  * the centre of mass with the solid, as under `traction`: the points tie the fields at the
  * surface only, and a gas particle that crossed it would otherwise pass through the solid. Gas
  * outside the solid does not reach those nodes (its stencil ends 1.25 cells beyond its last
- * particle), so the linear interface is left as the points make it. */
+ * particle), so the linear interface is left as the points make it. In the method of lines
+ * (h = 0) the acceleration of the centre of mass too, and the phases' own velocities relax
+ * towards each other at the rate k, by equal and opposite forces k mu (u_g - u_s), as the
+ * shared nodes of `velocity` do (mpm_coupling.h). */
 static void tie_inside(mpm_coupling *c, double h) {
   const mpm_grid_phase *s = mpm_coupling_phase(c, MPM_ROLE_SOLID);
   const mpm_grid_phase *g = mpm_coupling_phase(c, MPM_ROLE_FLUID);
   const int dim = c->grid->dim;
+  const double k = h > 0 ? 0.0 : c->relax_rate;
   for (mpm_lidx l = 0; l < c->grid->nnodes; ++l) {
-    double n[MPM_MAX_DIM], v[MPM_MAX_DIM];
+    double n[MPM_MAX_DIM], v[MPM_MAX_DIM], as[MPM_MAX_DIM], ag[MPM_MAX_DIM];
     if (!mpm_coupling_shared(c, l) || mpm_coupling_solid_surface(c, l, SHARP_INSIDE, n)) continue;
-    const double ms = s->m_i[l], mg = g->m_i[l];
-    for (int d = 0; d < dim; ++d) v[d] = (ms * s->v_i[d][l] + mg * g->v_i[d][l]) / (ms + mg);
-    mpm_coupling_exchange(c, MPM_ROLE_FLUID, l, v, NULL, h);
-    mpm_coupling_exchange(c, MPM_ROLE_SOLID, l, v, NULL, h);
+    const double ms = s->m_i[l], mg = g->m_i[l], mu = ms * mg / (ms + mg);
+    for (int d = 0; d < dim; ++d) {
+      const double a = (ms * s->a_i[d][l] + mg * g->a_i[d][l]) / (ms + mg);
+      const double f = k * mu * (g->v_i[d][l] - s->v_i[d][l]); /* (v_i = mv / m here) */
+      v[d] = (ms * s->v_i[d][l] + mg * g->v_i[d][l]) / (ms + mg);
+      as[d] = a + f / ms, ag[d] = a - f / mg;
+    }
+    mpm_coupling_exchange(c, MPM_ROLE_FLUID, l, v, ag, h);
+    mpm_coupling_exchange(c, MPM_ROLE_SOLID, l, v, as, h);
   }
+}
+
+/* out_q = n_q . (C_g w_g - C_s w_s)(x_q), w the phases' nodal v_i (0) or a_i (1). */
+static void jumps(const mpm_coupling *c, int accel, double *out) {
+  const sharp *s = c->content;
+  const int dim = c->grid->dim;
+  const mpm_grid_phase *g = mpm_coupling_phase(c, MPM_ROLE_FLUID);
+  const mpm_grid_phase *so = mpm_coupling_phase(c, MPM_ROLE_SOLID);
+  double *const *wg = accel ? g->a_i : g->v_i, *const *ws = accel ? so->a_i : so->v_i;
+  for (int q = 0; q < s->npt; ++q) {
+    const mpm_lidx *nq = s->node + (size_t)q * SHARP_STENCIL;
+    const double *n = s->n + (size_t)q * MPM_MAX_DIM;
+    const double *cg = s->cg + (size_t)q * SHARP_STENCIL, *cs = s->cs + (size_t)q * SHARP_STENCIL;
+    double jump = 0.0;
+    for (int k = 0; k < SHARP_STENCIL; ++k)
+      for (int d = 0; d < dim; ++d) jump += n[d] * (cg[k] * wg[d][nq[k]] - cs[k] * ws[d][nq[k]]);
+    out[q] = jump;
+  }
+}
+
+/* The multipliers of the jumps g, spread to the nodes: per unit nodal mass, what the gas loses
+ * and the solid gains (spread), copied into `into` (2 dim nnodes) unless NULL. Collective. */
+static int multipliers(mpm_coupling *c, const double *g, double *into) {
+  sharp *s = c->content;
+  MPM_CALL(solve(c, g));
+  MPM_CALL(spread(c, s->lam));
+  if (into) memcpy(into, s->nod, sizeof *into * (size_t)(2 * c->grid->dim) * c->grid->nnodes);
+  return 0;
+}
+
+/* Apply the spread multipliers, one exchange per node and phase: dv (2 dim nnodes, NULL: none)
+ * to the velocities (in the classic update an impulse over the step h; in the method of lines
+ * the positions' kinematics) and da (NULL: none) to the accelerations (a force). In the method
+ * of lines the velocity and acceleration change in one exchange, which books the force's power
+ * at the deposited velocity and the module's own force's on the kinematic correction
+ * (common/mpm_impulse.h); two exchanges in turn would book it at a corrected velocity. */
+static void apply(mpm_coupling *c, const double *dv, const double *da, double h) {
+  const mpm_grid *grid = c->grid;
+  const int dim = grid->dim;
+  const size_t nn = (size_t)grid->nnodes;
+  mpm_grid_phase *ph[2] = {mpm_coupling_phase(c, MPM_ROLE_FLUID),
+                           mpm_coupling_phase(c, MPM_ROLE_SOLID)};
+  const mpm_role role[2] = {MPM_ROLE_FLUID, MPM_ROLE_SOLID};
+  const double sign[2] = {-1.0, 1.0};
+  for (mpm_lidx l = 0; l < grid->nnodes; ++l)
+    for (int f = 0; f < 2; ++f) {
+      double v[MPM_MAX_DIM], a[MPM_MAX_DIM], change = 0.0;
+      for (int d = 0; d < dim; ++d) {
+        const size_t at = (size_t)(f * dim + d) * nn + (size_t)l;
+        const double uv = dv ? dv[at] : 0.0, ua = da ? da[at] : 0.0;
+        v[d] = ph[f]->v_i[d][l] + sign[f] * uv;
+        a[d] = ph[f]->a_i[d][l] + sign[f] * ua, change += fabs(uv) + fabs(ua);
+      }
+      if (change > 0.0) mpm_coupling_exchange(c, role[f], l, v, da ? a : NULL, h);
+    }
 }
 
 static int sharp_after_solve(mpm_coupling *c, double t, double h, mpm_pass pass) {
@@ -447,32 +528,21 @@ static int sharp_after_solve(mpm_coupling *c, double t, double h, mpm_pass pass)
   for (int f = 0; f < 2; ++f) {
     s->sync_ptr[nsync++] = ph[f]->m_i;
     for (int d = 0; d < dim; ++d) s->sync_ptr[nsync++] = ph[f]->v_i[d];
+    for (int d = 0; h == 0 && d < dim; ++d) s->sync_ptr[nsync++] = ph[f]->a_i[d];
   }
   MPM_CALL(mpm_grid_halo_forward(g, s->sync_ptr, nsync));
   MPM_CALL(find_points(c));
-  for (int q = 0; q < s->npt; ++q) { /* the jumps n . (v_g - v_s) at the points */
-    const mpm_lidx *nq = s->node + (size_t)q * SHARP_STENCIL;
-    const double *n = s->n + (size_t)q * MPM_MAX_DIM;
-    double jump = 0.0;
-    for (int k = 0; k < SHARP_STENCIL; ++k)
-      for (int d = 0; d < dim; ++d)
-        jump += n[d] * (s->cg[(size_t)q * SHARP_STENCIL + k] * ph[0]->v_i[d][nq[k]] -
-                        s->cs[(size_t)q * SHARP_STENCIL + k] * ph[1]->v_i[d][nq[k]]);
-    s->g[q] = jump;
+  jumps(c, 0, s->g); /* n . (v_g - v_s) at the points; in the method of lines v = u = mv / m */
+  if (h > 0) {
+    MPM_CALL(multipliers(c, s->g, NULL));
+    apply(c, s->nod, NULL, h);
+    return 0;
   }
-  MPM_CALL(solve(c, s->g));
-  MPM_CALL(spread(c, s->lam));
-  const mpm_role role[2] = {MPM_ROLE_FLUID, MPM_ROLE_SOLID};
-  const double sign[2] = {-1.0, 1.0};
-  for (mpm_lidx l = 0; l < g->nnodes; ++l)
-    for (int f = 0; f < 2; ++f) {
-      double v[MPM_MAX_DIM], change = 0.0;
-      for (int d = 0; d < dim; ++d) {
-        const double u = s->nod_ptr[f * dim + d][l];
-        v[d] = ph[f]->v_i[d][l] + sign[f] * u, change += fabs(u);
-      }
-      if (change > 0.0) mpm_coupling_exchange(c, role[f], l, v, NULL, h);
-    }
+  MPM_CALL(multipliers(c, s->g, s->dv));
+  jumps(c, 1, s->ju); /* n . (a_g - a_s), the drift relaxed: n . (a_g - a_s) = -k n . (u_g - u_s) */
+  for (int q = 0; q < s->npt; ++q) s->ju[q] += c->relax_rate * s->g[q];
+  MPM_CALL(multipliers(c, s->ju, NULL));
+  apply(c, s->dv, s->nod, h);
   return 0;
 }
 
@@ -487,7 +557,9 @@ const mpm_coupling_type coupling_sharp = {
     .name = "sharp",
     .help = "separate fields tied at the solid's surface only: the normal velocities of both "
             "fields, interpolated at points on the surface, made equal by equal and opposite "
-            "nodal impulses (usl, musl; monolithic)",
-    .needs = MPM_COUPLING_NORMALS | MPM_COUPLING_HOLDS,
+            "nodal impulses (usl, musl, the ERK pairs; monolithic)",
+    .needs = MPM_COUPLING_NORMALS | MPM_COUPLING_HOLDS | MPM_COUPLING_RATE,
+    .keys = sharp_keys,
+    .nkeys = sizeof sharp_keys / sizeof sharp_keys[0],
     .ops = &sharp_ops,
 };

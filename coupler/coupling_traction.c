@@ -111,7 +111,8 @@ static int traction_relax_normal(const mpm_coupling *c, mpm_lidx l, double *n) {
   return mpm_coupling_solid_surface(c, l, TRACTION_SURFACE, n);
 }
 
-static const mpm_key_spec traction_keys[] = {MPM_COUPLING_MOL_RATE_KEY("velocity and traction")};
+static const mpm_key_spec traction_keys[] = {
+    MPM_COUPLING_MOL_RATE_KEY("velocity, traction and sharp")};
 
 static const mpm_coupling_ops traction_ops = {
     .create = traction_create,

@@ -13,7 +13,8 @@
  * an external constraint, not an interface exchange. */
 #include "mpm_coupling.h"
 
-static const mpm_key_spec velocity_keys[] = {MPM_COUPLING_MOL_RATE_KEY("velocity and traction")};
+static const mpm_key_spec velocity_keys[] = {
+    MPM_COUPLING_MOL_RATE_KEY("velocity, traction and sharp")};
 
 static int velocity_after_solve(mpm_coupling *c, double t, double h, mpm_pass pass) {
   (void)t, (void)pass;

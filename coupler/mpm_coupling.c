@@ -129,7 +129,7 @@ static int build(mpm_coupling *c, const mpm_config *cfg, mpm_module **mods, int 
     MPM_ALLOC(c->held_v[d], g->nnodes);
     MPM_ALLOC(c->held_a[d], g->nnodes);
   }
-  if (c->type->needs & MPM_COUPLING_RELAXES)
+  if (c->type->needs & (MPM_COUPLING_RELAXES | MPM_COUPLING_RATE))
     MPM_CALL(mpm_config_get_real(cfg, "coupling.mol_rate", &c->relax_share));
   if (c->type->ops->create) MPM_CALL(c->type->ops->create(c, cfg));
   if (c->type->ops->setup) MPM_CALL(c->type->ops->setup(c));

@@ -52,8 +52,15 @@ typedef struct mpm_coupling mpm_coupling;
  * alone, needs the latter: at a clamped root on a wall the solid's normal points into the wall, and
  * the gas slid through the root along it. `contact` does not take it: on the main job at 2 mm it
  * trapped gas in the clamped root, where its step fell to 5e-9 s by 2.5 ms (43 000 steps, against
- * 30 188 for the whole run without it). */
-enum { MPM_COUPLING_NORMALS = 1, MPM_COUPLING_HOLDS = 2, MPM_COUPLING_RELAXES = 4 };
+ * 30 188 for the whole run without it). MPM_COUPLING_RATE: the scheme reads relax_rate (the key
+ * coupling.mol_rate, in its keys) and relaxes the phases itself, not at every shared node
+ * (`sharp`, at its interface points). */
+enum {
+  MPM_COUPLING_NORMALS = 1,
+  MPM_COUPLING_HOLDS = 2,
+  MPM_COUPLING_RELAXES = 4,
+  MPM_COUPLING_RATE = 8
+};
 
 typedef struct mpm_coupling_ops {
   /* Read the scheme's own keys, allocate its content. Optional. */
@@ -83,7 +90,8 @@ typedef struct mpm_coupling_ops {
     "coupling.mol_rate", MPM_KEY_REAL, "2", 0, 2, 0, 0, NULL,                                      \
         schemes                                                                                    \
         ", ERK pairs: the rate at which the phases' own velocities relax towards each other "      \
-        "at the shared nodes, in units of the slowest module's signal rate (its fastest sound "    \
+        "at the shared nodes (sharp: along the normal at its interface points), in units of "      \
+        "the slowest module's signal rate (its fastest sound "                                     \
         "speed plus |v| over the cell size); the method of lines moves a particle with the "       \
         "shared nodal velocity but gives its own velocity only the nodal acceleration (0: off; "   \
         "the classic update's impulse does this once a step and ignores the key)",                 \
@@ -134,9 +142,10 @@ struct mpm_coupling {
   unsigned char *wall_axes; /* MPM_COUPLING_NORMALS: per box node, bit d set where the node lies
                                on a wall face across axis d (slip, no_slip) */
   mpm_interface *capture;   /* non-NULL: what the solid is given goes there instead (held) */
-  double relax_share; /* MPM_COUPLING_RELAXES: k in units of the signal rate (coupling.mol_rate) */
-  double relax_rate;  /* k, 1/s (0: none); set before each RHS by the integrator
-                         (coupler/mpm_integrator.c) */
+  double relax_share;       /* MPM_COUPLING_RELAXES or _RATE: k in units of the signal rate
+                             * (coupling.mol_rate) */
+  double relax_rate;        /* k, 1/s (0: none); set before each RHS by the integrator
+                               (coupler/mpm_integrator.c) */
   /* On a refinement hierarchy (mpm_coupling_set_hier; 0 levels: the grid alone): every hook and
    * the interpenetration run on each level in turn, grid and owned set to the level's, so that a
    * scheme acts on the active nodes of every level (coupler/mpm_coupling_levels.c). */

@@ -147,7 +147,8 @@ static int check_state(mpm_integrator *it, double *const *yk) {
  * one reusing its last stage (2 ranks against 1: 1e-8 of the piston's velocities). Collective. */
 static int set_relax_rate(mpm_integrator *it, double *const *yk) {
   mpm_coupling *c = it->cycle.coupling;
-  if (!c || !(c->type->needs & MPM_COUPLING_RELAXES) || !(c->relax_share > 0)) return 0;
+  if (!c || !(c->type->needs & (MPM_COUPLING_RELAXES | MPM_COUPLING_RATE)) || !(c->relax_share > 0))
+    return 0;
   double s[MPM_MAX_MODULES], slowest = HUGE_VAL;
   for (int k = 0; k < it->nmod; ++k)
     s[k] = it->mod[k]->ops->signal_speed ? it->mod[k]->ops->signal_speed(it->mod[k], yk[k]) : 0.0;

@@ -21,7 +21,7 @@ contact and traction give the same figures to the printed digits). `long`: veloc
 and traction under usl; velocity under bs32 (adaptive, the default; beside a solid it takes the
 hybrid pressure by default since 2026-12-06), under coupling.time = multirate and under usl with
 fluid.pressure = hybrid (the pressure continued through the whole slab, docs/gas.md); sharp
-under usl; each at 50, 100, 200, 400; and the stability runs over 20 periods (t = 36)
+under usl and bs32; each at 50, 100, 200, 400; and the stability runs over 20 periods (t = 36)
 at 400 and 800 (sharp at 800). `mri` (test_fsi_resonator_mri): velocity under bs32 with
 coupling.time = multirate (ARKODE's MRIStep, time.adaptive = false; the gas takes the hybrid
 pressure there by default since 2026-12-06) at 50, 100, 200, 400, and 20 periods at 400 and 800.
@@ -48,6 +48,15 @@ Checks and tolerances:
   B-splines, two particles per cell, lumped mass) gives f_1 +0.159, +0.090, +0.048, +0.024 % with
   one field and -0.044, -0.011, -0.0027, -0.0007 % with two fields tied at the interface point:
   the first order of the other schemes is one C1 field across the interface's strain jump.
+  Under bs32 (the method of lines: its points tied in velocity and in acceleration, the drift
+  relaxed at coupling.mol_rate) sharp gives f_1 -0.1425, -0.0227, -0.0057, +0.0043 % and f_2
+  -0.1906, -0.0509, -0.0108, +0.0016 % (order 2.32 to 200, 1.68 to 400; 2026-12-07). Its gas
+  is not stable at 400: a particle-scale transverse mode in the gas's last columns at the face
+  (the sign of v_y alternating row by row) grows from roundoff, tenfold every 5 s (max
+  |v_y| / c_g 1.0e-10 at 200 after 18 s, 2.6e-8 at 400, first above the bound at t = 17),
+  where `velocity` with the same particles' pressure stays at 3.1e-10; without the drift's
+  relaxation (coupling.mol_rate = 0) 3.5e-11 at 200, and without the velocity tie 1.6e-10 and
+  f_1 three times worse. Not understood: an expected failure (VY_XFAIL).
   Under musl sharp gave f_1 -0.0645, -0.0326, -0.0057, +0.0199 % (order 1.75 to 200 but 0.57 to
   400, not understood; not run here). Over 20 periods at 800 cells/m (`long`) sharp's gas stays within the
   bound but its transverse mode grows, about tenfold every 6 s (max |v_y| / c_g 5e-13 at t = 6,
@@ -115,7 +124,7 @@ elif LONG:
     CONFIGS = [("velocity", "usl", "monolithic"), ("contact", "usl", "monolithic"),
                ("traction", "usl", "monolithic"), ("velocity", "bs32", "monolithic"),
                ("velocity", "usl", "multirate"), ("velocity", "usl", "monolithic", "hybrid"),
-               ("sharp", "usl", "monolithic")]
+               ("sharp", "usl", "monolithic"), ("sharp", "bs32", "monolithic")]
 else:
     CONFIGS = [("velocity", "usl", "monolithic"), ("velocity", "usl", "multirate"),
                ("sharp", "usl", "monolithic")]
@@ -129,6 +138,11 @@ XFAIL_FLIP = ("without a PIC share the gas's own transverse mode under usl at th
               "(the docstring)")
 XFAIL_ERK = ("the ERK pairs take no PIC share: the particles' pressure grows the gas's transverse "
              "mode (the docstring); the hybrid, their default beside a solid, is the cure")
+# (scheme, method): the resolution from which the study's transverse check is expected to fail
+VY_XFAIL = {("sharp", "bs32"): (400, "sharp under an ERK pair (no PIC share, the particles' "
+                                     "pressure): a particle-scale transverse mode in the gas's "
+                                     "last columns at the face grows, tenfold every 5 s at 400 "
+                                     "cells/m; not understood (the docstring)")}
 
 GAMMA, RHO, P0 = 1.4, 1.0, 1.0
 L_G, L_S, RHO_S, E_S, NU_S = 1.0, 0.4, 10.0 / 3.0, 7.8, 0.3
@@ -247,8 +261,13 @@ def study(scheme, method, time_scheme, pressure="auto"):
         errs.append(e)
         print(f"info {tag} {cells} cells/m: f_1 {100 * e[0]:+.4f} %, f_2 {100 * e[1]:+.4f} % "
               f"(fit rms {rms:.1e} of the peak); max |v_y| / c_g {vy / C_G:.1e}")
-        check(vy <= TOL_VY * C_G, f"{tag} {cells} cells/m: max |v_y| / c_g {vy / C_G:.1e} "
-              f"(<= {TOL_VY:g}; first above at t = {first})")
+        msg = (f"{tag} {cells} cells/m: max |v_y| / c_g {vy / C_G:.1e} (<= {TOL_VY:g}; first "
+               f"above at t = {first})")
+        xfail = VY_XFAIL.get((scheme, method))
+        if xfail and cells >= xfail[0] and vy > TOL_VY * C_G:
+            print(f"XFAIL {msg}: {xfail[1]}")  # expected (see the docstring): not counted
+        else:
+            check(vy <= TOL_VY * C_G, msg)
     for k in range(2):
         check(abs(errs[-1][k]) <= TOL_F, f"{tag}: f_{k + 1} at {CELLS[-1]} cells/m "
               f"{100 * errs[-1][k]:+.4f} % (|.| <= {100 * TOL_F:g} %)")

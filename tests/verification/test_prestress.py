@@ -21,7 +21,7 @@ Measured per run:
   max |p_gas - p| / p <= 1e-10 (measured 2e-13).
 Runs: coupling.scheme velocity, contact, traction under time.method usl and the default bs32
 (contact refuses bs32: its on/off switch is non-smooth for an adaptive pair; it runs usl and
-musl); sharp under usl and musl (it refuses the ERK pairs), on 2 ranks and in 3-D (its
+musl); sharp under usl, musl and bs32, on 2 ranks and in 3-D (its
 multipliers carry the interface's p0 only if its points sit on the slab's current faces: with
 the reference volume's half-width they sat 3e-5 off and the gas moved at 1e-4 c_g); traction with the least-squares wall (fluid.wall_treatment); coupling.time multirate
 (usl, and bs32, which is MRIStep and takes the hybrid pressure by default) and staggered
@@ -124,7 +124,7 @@ def at_rest(label, out, stress_too=True):
 # ---- every spatial scheme, usl and the default pair -------------------------------------------
 for scheme, method in (("velocity", "usl"), ("velocity", "bs32"), ("contact", "usl"),
                        ("contact", "musl"), ("traction", "usl"), ("traction", "bs32"),
-                       ("sharp", "usl"), ("sharp", "musl")):
+                       ("sharp", "usl"), ("sharp", "musl"), ("sharp", "bs32")):
     out = run(f"prestress_{scheme}_{method}", f"coupling.scheme={scheme}", f"time.method={method}")
     at_rest(f"{scheme} {method}", out)
     if scheme == "velocity" and method == "usl":
