@@ -333,8 +333,10 @@ static int spread(mpm_coupling *c, const double *lam) {
   return mpm_grid_halo_forward(g, s->nod_ptr, 2 * dim);
 }
 
-/* out_q = n_q . (C_g u_g + C_s u_s)(x_q) from spread's arrays. */
-static void gather(const mpm_coupling *c, double *out) {
+/* out_q = n_q . (C_g w_g + sign C_s w_s)(x_q): with spread's arrays and sign 1, A applied to
+ * spread's multipliers (gather); with the phases' v_i or a_i and sign -1, their jumps. */
+static void normal_sums(const mpm_coupling *c, double *const *wg, double *const *ws, double sign,
+                        double *out) {
   const sharp *s = c->content;
   const int dim = c->grid->dim;
   for (int q = 0; q < s->npt; ++q) {
@@ -344,9 +346,15 @@ static void gather(const mpm_coupling *c, double *out) {
     double sum = 0.0;
     for (int k = 0; k < SHARP_STENCIL; ++k)
       for (int d = 0; d < dim; ++d)
-        sum += n[d] * (cg[k] * s->nod_ptr[d][nq[k]] + cs[k] * s->nod_ptr[dim + d][nq[k]]);
+        sum += n[d] * (cg[k] * wg[d][nq[k]] + sign * cs[k] * ws[d][nq[k]]);
     out[q] = sum;
   }
+}
+
+/* out_q = n_q . (C_g u_g + C_s u_s)(x_q) from spread's arrays. */
+static void gather(const mpm_coupling *c, double *out) {
+  const sharp *s = c->content;
+  normal_sums(c, s->nod_ptr, s->nod_ptr + c->grid->dim, 1.0, out);
 }
 
 static int dot(const mpm_coupling *c, const double *a, const double *b, double *out) {
@@ -462,20 +470,9 @@ static void tie_inside(mpm_coupling *c, double h) {
 
 /* out_q = n_q . (C_g w_g - C_s w_s)(x_q), w the phases' nodal v_i (0) or a_i (1). */
 static void jumps(const mpm_coupling *c, int accel, double *out) {
-  const sharp *s = c->content;
-  const int dim = c->grid->dim;
   const mpm_grid_phase *g = mpm_coupling_phase(c, MPM_ROLE_FLUID);
   const mpm_grid_phase *so = mpm_coupling_phase(c, MPM_ROLE_SOLID);
-  double *const *wg = accel ? g->a_i : g->v_i, *const *ws = accel ? so->a_i : so->v_i;
-  for (int q = 0; q < s->npt; ++q) {
-    const mpm_lidx *nq = s->node + (size_t)q * SHARP_STENCIL;
-    const double *n = s->n + (size_t)q * MPM_MAX_DIM;
-    const double *cg = s->cg + (size_t)q * SHARP_STENCIL, *cs = s->cs + (size_t)q * SHARP_STENCIL;
-    double jump = 0.0;
-    for (int k = 0; k < SHARP_STENCIL; ++k)
-      for (int d = 0; d < dim; ++d) jump += n[d] * (cg[k] * wg[d][nq[k]] - cs[k] * ws[d][nq[k]]);
-    out[q] = jump;
-  }
+  normal_sums(c, accel ? g->a_i : g->v_i, accel ? so->a_i : so->v_i, -1.0, out);
 }
 
 /* The multipliers of the jumps g, spread to the nodes: per unit nodal mass, what the gas loses
