@@ -51,8 +51,9 @@ Checks and tolerances:
   Under bs32 (the method of lines: its points tied in velocity and in acceleration, the drift
   relaxed at coupling.mol_rate) sharp gives f_1 -0.1425, -0.0227, -0.0057, +0.0043 % and f_2
   -0.1906, -0.0509, -0.0108, +0.0016 % (order 2.32 to 200, 1.68 to 400; 2026-12-07). Its gas
-  is not stable at 400: a particle-scale transverse mode in the gas's last columns at the face
-  (the sign of v_y alternating row by row) grows from roundoff, tenfold every 5 s (max
+  is not stable at 400: a transverse mode in the gas's last two particle columns at the face
+  (v_y of opposite signs in the two, varying along y with the strip's period) grows from
+  roundoff, tenfold every 5 s (max
   |v_y| / c_g 1.0e-10 at 200 after 18 s, 2.6e-8 at 400, first above the bound at t = 17),
   where `velocity` with the same particles' pressure stays at 3.1e-10; without the drift's
   relaxation (coupling.mol_rate = 0) 3.5e-11 at 200, and without the velocity tie 1.6e-10 and
@@ -140,8 +141,8 @@ XFAIL_ERK = ("the ERK pairs take no PIC share: the particles' pressure grows the
              "mode (the docstring); the hybrid, their default beside a solid, is the cure")
 # (scheme, method): the resolution from which the study's transverse check is expected to fail
 VY_XFAIL = {("sharp", "bs32"): (400, "sharp under an ERK pair (no PIC share, the particles' "
-                                     "pressure): a particle-scale transverse mode in the gas's "
-                                     "last columns at the face grows, tenfold every 5 s at 400 "
+                                     "pressure): a transverse mode in the gas's last two "
+                                     "columns at the face grows, tenfold every 5 s at 400 "
                                      "cells/m; not understood (the docstring)")}
 
 GAMMA, RHO, P0 = 1.4, 1.0, 1.0
