@@ -50,7 +50,7 @@ Checks and tolerances:
   the first order of the other schemes is one C1 field across the interface's strain jump.
   Under bs32 (the method of lines: its points tied in velocity and in acceleration, the drift
   relaxed at coupling.mol_rate) sharp gives f_1 -0.1425, -0.0227, -0.0057, +0.0043 % and f_2
-  -0.1906, -0.0509, -0.0108, +0.0016 % (order 2.32 to 200, 1.68 to 400; 2026-12-07). Its gas
+  -0.1906, -0.0509, -0.0108, +0.0016 % (order 2.32 to 200, 1.69 to 400; 2026-12-07). Its gas
   is not stable at 400: a transverse mode in the gas's last two particle columns at the face
   (v_y of opposite signs in the two, varying along y with the strip's period) grows from
   roundoff, tenfold every 5 s (max
