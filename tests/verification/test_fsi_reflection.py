@@ -54,7 +54,9 @@ Tolerances and why:
                 moving-slab start), and the rigid one at +1.5 %.
                 coupling.scheme = sharp (the phases tied at points on the solid's face alone,
                 coupler/coupling_sharp.c) meets it next to the rigid slab: p -0.37 %, rho
-                -1.29 % (usl, 2026-12-07); next to the soft one it fails (Known failures).
+                -1.29 % (usl), +1.56 %, +0.23 % (bs32, long; plateau -0.12 %, force -0.068 %,
+                transmitted -0.10 %, ringing 0.39 %, 2.31 %; 2026-12-07); next to the soft one
+                it fails (Known failures).
   plateau       2 % in p and in rho: the slip-wall reflection of the same shock in gas alone
                 (what the interface should reach) scatters by 1-2 % over such a region under
                 usl (FLIP noise behind a shock).
@@ -76,7 +78,9 @@ Known failures, marked EXPECTED-FAIL (printed with the reason; not counted as fa
   (2026-12-07). The slab (rho_s 0.1) is lighter than the shocked gas (2.7): at the impact the
   points' multipliers drive the slab's light tail nodes on the gas side, its face columns pile up
   within a few thousandths of a metre, and gas enters the first cell. Before the phases were tied
-  deep inside the solid (two cells or more from a face) the gas went through the slab.
+  deep inside the solid (two cells or more from a face) the gas went through the slab. Under
+  bs32 the step collapses after the impact and the guard stops the run (t = 0.094, the impact
+  at 0.085; 2026-12-07): not run here.
 - the first layer under every scheme but the least-squares wall
   (measured: p -59 %, rho -47 % next to the rigid slab; -63 %, -48 % next to the soft one). The
   solid's particles reach, through the quadratic B-spline, every node within 1.5 cells of them,
@@ -429,7 +433,7 @@ def variants():
     soft = [("velocity", "usl", False, False), ("traction", "usl", True, False)]
     if LONG:  # the rest: soft under bs32 alone takes about 6 minutes
         rigid = [("traction", "bs32", False, False), ("velocity", "musl", False, False),
-                 ("traction", "musl", False, False)]
+                 ("traction", "musl", False, False), ("sharp", "bs32", False, False)]
         soft = [("contact", "usl", False, False), ("traction", "usl", False, False),
                 ("velocity", "bs32", False, False), ("traction", "bs32", False, False),
                 ("velocity", "musl", False, False), ("velocity", "usl", False, True),
