@@ -61,8 +61,8 @@ static int size_level_of(int dim, double r) {
       {2.0, 8.0, 32.0, 128.0},
       {2.8284271247461903, 22.627416997969522, 181.01933598375618, 1448.1546878700494}};
   const double *t = from[dim - 1];
-  /* (the thresholds rise: the count of those reached is the level; no branch, so that the
-   * loops over the particles vectorise; NaN reaches none) */
+  /* (the thresholds rise: the count of those reached is the level, without a branch; NaN
+   * reaches none) */
   return (r >= t[0]) + (r >= t[1]) + (r >= t[2]) + (r >= t[3]);
 }
 
@@ -104,21 +104,12 @@ static int classify(const mpm_module *m, levels *L, mpm_lidx *parents) {
   const double V0_0 = pow(m->grid->dx / fc->ppc, dim);
   const double *V0 = mpm_particles_comp(m->particles, fc->lay.f_V0, 0);
   const unsigned char *at = fluid_position_levels(m, m->particles->data);
-  unsigned char *lev = L->lev;
   mpm_lidx k = 0;
-  if (at) { /* (the common case, in a loop without calls) */
-    for (mpm_lidx i = 0; i < n; ++i) {
-      const int size = size_level_of(dim, V0_0 / V0[i]);
-      lev[2 * i] = (unsigned char)size, lev[2 * i + 1] = at[i];
-      k += size < at[i];
-    }
-  } else {
-    for (mpm_lidx i = 0; i < n; ++i) {
-      const int size = size_level_of(dim, V0_0 / V0[i]);
-      const int level = fluid_position_level(m, NULL, m->particles->data, i);
-      lev[2 * i] = (unsigned char)size, lev[2 * i + 1] = (unsigned char)level;
-      k += size < level;
-    }
+  for (mpm_lidx i = 0; i < n; ++i) {
+    const int size = size_level_of(dim, V0_0 / V0[i]);
+    const int level = fluid_position_level(m, at, m->particles->data, i);
+    L->lev[2 * i] = (unsigned char)size, L->lev[2 * i + 1] = (unsigned char)level;
+    k += size < level;
   }
   *parents = k;
   return 0;
