@@ -49,8 +49,14 @@
  * the phases share the centre-of-mass velocity and acceleration, and relax their own velocities
  * node by node.
  *
+ * Multirate. The scheme needs nothing of its own there. Under the classic update the gas's held
+ * cycle solves the same multipliers against the held solid, whose share is captured and handed
+ * to the solid's substeps as their load (mpm_cycle.c, mpm_partitioned.h); under MRIStep the
+ * ties belong to the slow right-hand side, the joint cycle less the solid's own rates.
+ *
  * Limits (refused at input): usl, musl or an ERK pair (not euler or ssprk2, whose RHS gets no
- * relaxation rate) with coupling.time = monolithic; no refinement hierarchy. The cost: per
+ * relaxation rate) with coupling.time = monolithic or multirate (staggered is not measured); no
+ * refinement hierarchy. The cost: per
  * solve three preconditioned conjugate-gradient passes whose every iteration clears, deposits,
  * sums over the halo and gathers back 2 dim nodal arrays of the whole box. */
 #include "mpm_coupling.h"
@@ -106,11 +112,11 @@ static int sharp_create(mpm_coupling *c, const mpm_config *cfg) {
                            "velocity or traction with %s",
                            method, method);
   MPM_CALL(mpm_config_get_string(cfg, "coupling.time", &time));
-  if (strcmp(time, "monolithic") != 0)
+  if (strcmp(time, "monolithic") != 0 && strcmp(time, "multirate") != 0)
     return mpm_config_fail(
         cfg, mpm_config_has(cfg, "coupling.time") ? "coupling.time" : "coupling.scheme",
-        "sharp ties both phases' fields in one nodal solve and needs "
-        "coupling.time = monolithic; use velocity or traction with %s",
+        "sharp is measured under coupling.time = monolithic and multirate only; use one of "
+        "them, or velocity or traction with %s",
         time);
   sharp *s;
   MPM_ALLOC(s, 1);
@@ -554,7 +560,7 @@ const mpm_coupling_type coupling_sharp = {
     .name = "sharp",
     .help = "separate fields tied at the solid's surface only: the normal velocities of both "
             "fields, interpolated at points on the surface, made equal by equal and opposite "
-            "nodal impulses (usl, musl, the ERK pairs; monolithic)",
+            "nodal impulses (usl, musl, the ERK pairs; monolithic or multirate)",
     .needs = MPM_COUPLING_NORMALS | MPM_COUPLING_HOLDS | MPM_COUPLING_RATE,
     .keys = sharp_keys,
     .nkeys = sizeof sharp_keys / sizeof sharp_keys[0],
