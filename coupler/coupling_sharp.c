@@ -49,6 +49,11 @@
  * the phases share the centre-of-mass velocity and acceleration, and relax their own velocities
  * node by node.
  *
+ * The gauge. Each phase's field ends at the face, and so does the particles' quadrature of the
+ * ambient pressure over the gas's last columns: with no PIC share (the ERK pairs) it grows a
+ * transverse mode there from roundoff. physics.gauge_pressure at the ambient pressure takes it
+ * out of both phases' forces (fluid/fluid_gauge.c); the test and the docs run sharp with it.
+ *
  * Multirate. The scheme needs nothing of its own there. Under the classic update the gas's held
  * cycle solves the same multipliers against the held solid, whose share is captured and handed
  * to the solid's substeps as their load (mpm_cycle.c, mpm_partitioned.h); under MRIStep the

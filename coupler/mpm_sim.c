@@ -115,6 +115,14 @@ static const mpm_key_spec sim_keys[] = {
      "shape function", 0, NULL},
     {"grid.ranks", MPM_KEY_REALS, "0 0 0", 0, 65536, 0, 3, NULL,
      "MPI ranks per direction (0: mpmfsi chooses, the layout with the smallest halo)", 0, "-"},
+    {"physics.gauge_pressure", MPM_KEY_REAL, "0", 0, HUGE_VAL, 0, 0, NULL,
+     "a uniform pressure taken out of every phase's stress in its nodal forces (the gas's p - "
+     "p_g, a solid's sigma + p_g I), not out of its energy: the particles' quadrature then sees "
+     "the departures from it only; set it to the ambient pressure beside coupling.scheme = "
+     "sharp, whose gas otherwise grows a transverse mode at the solid's face; walls and "
+     "periodic faces only (no open faces, obstacles, refinement, grid or hybrid pressure); 0: "
+     "none",
+     0, "Pa"},
     {"physics.gravity", MPM_KEY_REALS, "0 0 0", -HUGE_VAL, HUGE_VAL, 0, 3, NULL,
      "body acceleration, m/s^2", 0, "m/s^2"},
     {"transfer.velocity", MPM_KEY_ENUM, "flip", 0, 0, 0, 0, "flip|apic",

@@ -273,6 +273,10 @@ static int grid_scope(const fluid_content *fc, const mpm_config *cfg, const mpm_
   if (fc->volume_domain)
     return miss(s, "fluid.volume_rate", "sets the volume rate itself (from the nodes)");
   if (fc->shift > 0.0) return miss(s, "fluid.shift", "is not carried with shifting");
+  if (fc->gas.gauge != 0.0)
+    return miss(s, "physics.gauge_pressure",
+                "integrates the whole pressure and takes no gauge (the "
+                "particles' pressure does)");
   const char *const *names;
   int count;
   MPM_CALL(mpm_config_instances(cfg, "solid", &names, &count));

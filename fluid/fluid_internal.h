@@ -132,6 +132,8 @@ int fluid_volume_rate(mpm_module *m, const double *y, const double *const *v_i, 
  * forms the nodal pressure at once and stress returns the stress to deposit, vsig with the
  * defect's load V p_h(x_p) on its diagonal (vsig itself otherwise; vsig is left as it is). */
 int fluid_gridp_init(mpm_module *m, const mpm_config *cfg);
+/* physics.gauge_pressure outside what carries it: MPM_ERR_INPUT naming the key (fluid_gauge.c). */
+int fluid_gauge_check(const mpm_module *m, const mpm_config *cfg);
 
 /* Does the gas take the hybrid pressure with its grid part weighted by the filled share
  * (fluid.hybrid_fill > 0, without a solid)? */

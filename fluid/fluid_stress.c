@@ -3,8 +3,8 @@
 
 #include "fluid_eos.h"
 
-/* -V (p + q) on the diagonal (q only with av); the viscous part, if any, is added by
- * viscous_stress. */
+/* -V (p + q - p_g) on the diagonal (q only with av; p_g the gauge, fluid_gauge.c); the viscous
+ * part, if any, is added by viscous_stress. */
 static void pressure_stress(const fluid_gas *g, const fluid_batch *b, int av) {
   const int dim = b->dim;
   const mpm_lidx n = b->n;
@@ -20,7 +20,7 @@ static void pressure_stress(const fluid_gas *g, const fluid_batch *b, int av) {
     const double q = av ? fluid_av_pressure(&gi, rho, fluid_sound_speed(g->gamma, rho, p),
                                             b->divv[i], b->psi ? b->psi[i] : 0.0)
                         : 0.0;
-    s00[i] = -V * (p + q);
+    s00[i] = -V * (p + q - g->gauge);
   }
   for (int d = 1; d < dim; ++d) {
     double *sdd = b->vsig + (size_t)(d * dim + d) * n;

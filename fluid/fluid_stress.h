@@ -32,6 +32,7 @@ typedef struct fluid_gas {
   int av_riemann;         /* fluid.av_form = riemann (else vnr) */
   int damped_step;        /* fluid.viscous_step = damped (else additive) */
   double l;               /* artificial viscosity length: the cell size */
+  double gauge;           /* physics.gauge_pressure, Pa: out of the forces' pressure (below) */
 } fluid_gas;
 
 /* Particles in component-major arrays of stride n (tensors: component r*dim + c). */

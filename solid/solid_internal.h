@@ -89,6 +89,7 @@ typedef struct {
   int ntractions;
   solid_traction *traction;
   double gravity[MPM_MAX_DIM];
+  double gauge;           /* physics.gauge_pressure, Pa: in the forces (solid_p2g) */
   double damping;         /* mass-proportional damping rate alpha, 1/s: f_i -= alpha (m v)_i */
   mpm_transfer tr;        /* [transfer] settings and the time method's kind */
   double *vnew;           /* MUSL: the particles' new velocities (dim n) */

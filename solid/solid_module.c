@@ -367,6 +367,18 @@ static const double *state_C(const solid_content *sc, const mpm_particles *p, co
   return sc->lay.f_C >= 0 ? y + (size_t)p->offset[sc->lay.f_C] * p->n : NULL;
 }
 
+/* The gauge pressure p_g (physics.gauge_pressure, fluid/fluid_gauge.c): V sigma + V p_g I in the
+ * forces; the stored energy stays sigma's. */
+static void add_gauge(solid_content *sc, const mpm_particles *p, const double *y) {
+  const int dim = p->dim;
+  const mpm_lidx n = p->n;
+  const double *F = y + (size_t)p->offset[F_F] * n, *V0 = mpm_particles_comp(p, sc->lay.f_V0, 0);
+  for (mpm_lidx i = 0; i < n; ++i) {
+    const double pV = sc->gauge * V0[i] * solid_det(dim, F, n, i);
+    for (int d = 0; d < dim; ++d) sc->vsig[(size_t)(d * dim + d) * n + i] += pV;
+  }
+}
+
 static int solid_p2g(mpm_module *m, double t, const double *y) {
   (void)t;
   solid_content *sc = m->content;
@@ -386,6 +398,7 @@ static int solid_p2g(mpm_module *m, double t, const double *y) {
                       y + (size_t)p->offset[sc->lay.f_divv] * n, sc->vsig);
     idx += sc->count[b];
   }
+  if (sc->gauge != 0.0) add_gauge(sc, p, y);
   mpm_timer_stop(MPM_T_STRESS);
   if (sc->pts_on) fill_points(sc, p, y);
 
@@ -806,6 +819,15 @@ static int read_bodies(mpm_module *m, const mpm_config *cfg) {
   MPM_CALL(mpm_config_get_reals(cfg, "physics.gravity", g, 3, &nv));
   memcpy(sc->gravity, g, sizeof g);
   MPM_CALL(mpm_config_get_real(cfg, "physics.damping", &sc->damping));
+  MPM_CALL(mpm_config_get_real(cfg, "physics.gauge_pressure", &sc->gauge));
+  const char *const *gases;
+  int ngas;
+  MPM_CALL(mpm_config_instances(cfg, "gas", &gases, &ngas));
+  if (sc->gauge != 0.0 && ngas == 0)
+    return mpm_config_fail(cfg, "physics.gauge_pressure",
+                           "is a pressure taken out of a gas's and a solid's stress alike, and "
+                           "this scene has no gas: its solids would carry it on their free "
+                           "surfaces; remove the key");
   MPM_CALL(mpm_transfer_from_config(&sc->tr, cfg, NULL));
   for (int b = 0; b < count; ++b) MPM_CALL(read_bulkq(m, cfg, &sc->body[b]));
   return solid_dilatation_read(m, cfg);

@@ -353,4 +353,22 @@ text = OBST + SOLID.format(lo="0.82 0.2", hi="0.88 0.3")
 expect_error("solid overlapping a static obstacle", text, "obstacle.block.shape",
              "must not overlap a static obstacle", line_of(text, "shape = box"))
 
+# physics.gauge_pressure: walls and periodic faces only, the particles' pressure, a gas present.
+GAUGE = "\n[physics]\ngauge_pressure = 1\n"
+OPEN = SOD.replace("x_hi = slip", "x_hi = outflow", 1) + \
+    "\n[freestream]\ndensity = 1\npressure = 1\nvelocity = 0 0\n"
+for name, text, words, args in (
+        ("gauge with an open face", OPEN + GAUGE, "open face (boundary.x_hi)", ()),
+        ("gauge with static obstacles", OBST + GAUGE, "static obstacles", ()),
+        ("gauge with the least-squares wall", SOD + GAUGE, "least_squares",
+         ("fluid.wall_treatment=least_squares",)),
+        ("gauge with refinement", SOD + GAUGE, "refinement levels", ("refine.levels=2",)),
+        ("gauge with the hybrid pressure", GAS + GAUGE, "takes no gauge",
+         ("fluid.pressure=hybrid",)),
+        ("gauge without a gas", BASE.replace("gravity = 0 -9.81", "gravity = 0 -9.81\n"
+                                             "gauge_pressure = 1", 1), "no gas", ()),
+        ("negative gauge", SOD + GAUGE.replace("= 1", "= -1"), ">= 0", ())):
+    expect_error(name, text, "physics.gauge_pressure", words,
+                 line_of(text, "gauge_pressure ="), args)
+
 sys.exit(check.finish())

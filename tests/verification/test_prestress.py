@@ -21,7 +21,8 @@ Measured per run:
   max |p_gas - p| / p <= 1e-10 (measured 2e-13).
 Runs: coupling.scheme velocity, contact, traction under time.method usl and the default bs32
 (contact refuses bs32: its on/off switch is non-smooth for an adaptive pair; it runs usl and
-musl); sharp under usl, musl and bs32, under multirate (usl and bs32), on 2 ranks and in 3-D (its
+musl); sharp under usl, musl and bs32, under multirate (usl and bs32), with the gauge
+(physics.gauge_pressure = p, bs32), on 2 ranks and in 3-D (its
 multipliers carry the interface's p0 only if its points sit on the slab's current faces: with
 the reference volume's half-width they sat 3e-5 off and the gas moved at 1e-4 c_g); traction with the least-squares wall (fluid.wall_treatment); coupling.time multirate
 (usl, and bs32, which is MRIStep and takes the hybrid pressure by default) and staggered
@@ -140,6 +141,9 @@ at_rest("sharp usl, multirate",
 at_rest("sharp bs32, multirate (MRIStep)",
         run("prestress_sharp_multirate_bs32", "coupling.scheme=sharp", "coupling.time=multirate",
             "time.method=bs32", "time.adaptive=false"))
+at_rest("sharp bs32, the gauge at p",
+        run("prestress_sharp_gauge", "coupling.scheme=sharp", "time.method=bs32",
+            f"physics.gauge_pressure={P!r}"))
 at_rest("velocity usl, 2 ranks", run("prestress_np2", ranks=2))
 at_rest("sharp usl, 2 ranks", run("prestress_sharp_np2", "coupling.scheme=sharp", ranks=2))
 at_rest("sharp usl, 3-D", run("prestress_sharp_3d", "coupling.scheme=sharp", *THREE_D))
