@@ -50,16 +50,19 @@ mpm_add_script_test(test_prestress SCRIPT verification/test_prestress.py
                     LABELS "verification;mpi" TIMEOUT 600)
 # The gas-column/slab resonator (cases/fsi_resonator.ini): the first two coupled frequencies
 # against the exact roots of Z_g cot(k_g L_g) + Z_s cot(k_s L_s) = 0 at 50, 100, 200 cells per
-# metre under velocity (usl; monolithic and multirate), their convergence, and the gas beside
-# the slab staying 1-D (40 s of CPU); `long` adds contact, traction, bs32, 400 cells per metre
+# metre under velocity (usl; monolithic and multirate) and sharp (usl; monolithic and multirate,
+# with its gauge), their convergence, and the gas beside the slab staying 1-D (about 70 s of
+# CPU); `long` adds contact, traction, bs32, 400 cells per metre
 # and 20 periods at 400 and 800 (bs32 alone took 314 s at 200 cells under load), the named
 # hybrid pressure's study and 20 periods at 800 (about 13 minutes of CPU more), and 20 periods at
 # 400 and 800 under bs32 with its default pressure beside a solid, the hybrid (12 and 43 minutes
-# beside another run: 101,071 and 184,559 steps).
+# beside another run: 101,071 and 184,559 steps), and sharp under bs32 and multirate: its study
+# (about 20 minutes), 20 periods at 800 (about an hour) and the control at 400 without the gauge.
+# Its runs add up to about 6 hours on one core (their single timings, 2026-12-07).
 mpm_add_script_test(test_fsi_resonator SCRIPT verification/test_fsi_resonator.py
                     LABELS verification TIMEOUT 600)
 mpm_add_script_test(test_fsi_resonator_long SCRIPT verification/test_fsi_resonator.py ARGS long
-                    LABELS "verification;long" TIMEOUT 10800)
+                    LABELS "verification;long" TIMEOUT 28800)
 # Multirate under bs32 (MRIStep, with the hybrid pressure, auto's choice there): the frequencies
 # at 50 to 400 cells per metre and 20 periods at 400 and 800 (85,247 and 170,463 steps: 37 and
 # 105 minutes beside other runs).
