@@ -540,10 +540,13 @@ static void energy_rate(mpm_module *m, const double *y, const double *L, const d
   const double pg = fc->gas.gauge;
   double *pw = fc->power; /* heat may be this array: read each entry before writing it */
   for (mpm_lidx i = 0; i < n; ++i) {
-    double work = 0.0, trL = 0.0;
+    double work = 0.0;
     for (int k = 0; k < nk; ++k) work += fc->vsig[(size_t)k * n + i] * L[(size_t)k * n + i];
-    for (int d = 0; pg != 0.0 && d < dim; ++d) trL += L[(size_t)(d * dim + d) * n + i];
-    work -= pg * V0[i] * J[i] * trL;
+    if (pg != 0.0) {
+      double trL = 0.0;
+      for (int d = 0; d < dim; ++d) trL += L[(size_t)(d * dim + d) * n + i];
+      work -= pg * V0[i] * J[i] * trL;
+    }
     pw[i] = work / mass[i] + (heat ? heat[i] / h : 0.0);
   }
 }
