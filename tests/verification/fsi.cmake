@@ -36,7 +36,8 @@ mpm_add_script_test(test_traction_ls SCRIPT verification/test_traction_ls.py
 # (Mach 2, 3.4) (tests/verification/test_fsi_reflection.py): the first gas layer, the reflected
 # plateau, the interface force and the transmitted stress plateau against the exact reflection;
 # the first layer and some ringing are marked expected to fail (see the driver). Default: velocity,
-# contact, traction (with and without least_squares), usl and bs32 (~80 s); `long` the rest.
+# contact, traction (with and without least_squares), usl and bs32, and sharp under usl (~110 s);
+# `long` the rest.
 mpm_add_script_test(test_fsi_reflection SCRIPT verification/test_fsi_reflection.py
                     LABELS verification TIMEOUT 600)
 mpm_add_script_test(test_fsi_reflection_long SCRIPT verification/test_fsi_reflection.py ARGS long
