@@ -98,7 +98,7 @@ Known failures, marked EXPECTED-FAIL (printed with the reason; not counted as fa
   weights scaled in the rows, the gas's own tail node beyond the face, which no row reads, took
   the gas's outward push alone, and the first column expanded into the face (usl p -47 %, the
   layer at p / p* 0.53 by t_end; bs32 -4.5 %). A near-empty node of either phase now moves
-  with the centre of mass (tie_near_empty).
+  with the centre of mass along the solid's normal (tie_near_empty).
 - the first layer under every scheme but the least-squares wall
   (measured: p -59 %, rho -47 % next to the rigid slab; -63 %, -48 % next to the soft one). The
   solid's particles reach, through the quadratic B-spline, every node within 1.5 cells of them,
