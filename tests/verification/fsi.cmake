@@ -69,6 +69,11 @@ mpm_add_script_test(test_fsi_resonator_long SCRIPT verification/test_fsi_resonat
 # 105 minutes beside other runs).
 mpm_add_script_test(test_fsi_resonator_mri SCRIPT verification/test_fsi_resonator.py ARGS mri
                     LABELS "verification;long" TIMEOUT 14400)
+# sharp under multirate (usl; bs32, MRIStep), with its gauge: 20 periods at 400 and 800 cells
+# per metre, the gas 1-D (208, 1,081, 1,541 and 4,720 s beside other runs; 2026-12-07).
+mpm_add_script_test(test_fsi_resonator_sharp_stable SCRIPT verification/test_fsi_resonator.py
+                    ARGS stable sharp:usl:multirate sharp:bs32:multirate
+                    LABELS "verification;long" TIMEOUT 21600)
 # The grid pressure beside a solid under multirate and contact (test_gridp_beside.py): the
 # resonator strip stays 1-D and balances under multirate (usl, MRIStep), a body in gas at rest
 # stays at rest and a pulse on it keeps the gas's energy booked under contact (23, 5 and 3 s);

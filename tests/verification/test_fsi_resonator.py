@@ -26,6 +26,8 @@ at 400 and 800 (sharp at 800 under usl and bs32; the control: bs32 at 400 withou
 the gauge). `mri` (test_fsi_resonator_mri): velocity under bs32 with
 coupling.time = multirate (ARKODE's MRIStep, time.adaptive = false; the gas takes the hybrid
 pressure there by default since 2026-12-06) at 50, 100, 200, 400, and 20 periods at 400 and 800.
+`stable` (test_fsi_resonator_sharp_stable) runs the named configurations' 20 periods at 400 and
+800 instead of their studies: sharp under multirate, usl and bs32 (MRIStep), with the gauge.
 `standin` replaces the initial stress by the issue's stand-in, a constant traction -p0 on the stress-free slab's gas-
 side particle layer (that is all main could do): the frequencies then fail (+0.52 ... +0.66 % on
 f_1, not converging) and the gas beside the slab goes unstable at 200 cells per metre.
@@ -60,7 +62,11 @@ Checks and tolerances:
     bs32 multirate (MRIStep): f_1 -0.0659, -0.0230, -0.0065, -0.0022 %, f_2 -0.2001, -0.0513,
                -0.0128, -0.0033 % (order 1.64); 5.3e-15
   Over 20 periods at 800 cells/m (`long`): usl 2.5e-15 (f_1 -0.005 % over the 20 periods),
-  bs32 7.5e-15 (f_1 -0.0008 % over the 20 periods; 179,326 steps, 64 minutes).
+  bs32 7.5e-15 (f_1 -0.0008 % over the 20 periods; 179,326 steps, 64 minutes). Under multirate
+  (`stable`, test_fsi_resonator_sharp_stable; 2026-12-07): usl 3.5e-15 at 400 and 3.1e-15 at 800
+  (f_1 -0.0042 % and -0.0035 %; 63,935 and 127,835 coupling steps, 208 and 1,081 s), bs32
+  (MRIStep) 5.6e-15 at 400 (f_1 -0.0016 %; 85,247 steps, 1,541 s beside other runs) and
+  1.5e-14 at 800 (f_1 -0.0007 %; 170,462 steps, 4,720 s beside other runs).
   Without the gauge the ambient pressure's quadrature over the gas's last particle columns,
   where the gas's field ends at the face, grows a transverse mode from roundoff (v_y of opposite
   signs in the two columns, varying along y with the strip's period): under bs32 tenfold every
@@ -70,8 +76,9 @@ Checks and tolerances:
   50 to 400 to +0.052 % at 800. The hybrid pressure (its pressure run on through the solid) held
   the mode near 1e-10 at 400 under bs32 but smeared the interface again: f_1 +0.0171 % at 400.
   With the gauge and the PIC share under usl f_1 converged at order 1.07 only (-0.0164 % at 400).
-  Under musl sharp (without the gauge) gave f_1 -0.0645, -0.0326, -0.0057, +0.0199 % (not run
-  here).
+  Under musl sharp (without the gauge) gave f_1 -0.0645, -0.0326, -0.0057, +0.0199 %, and
+  with the gauge -0.0855, -0.0349, -0.0084, -0.0026 % (order 1.69; f_2 -0.0035 % at 400;
+  2026-12-07; not run here).
 - A stability run the blow-up guard stops (exit 1) counts as unstable: the particles' pressure at
   800 cells per metre stops at t = 1.86 (before the guard watched the kinetic energy it ended
   with exit 0, and this test read its snapshots).
@@ -125,7 +132,8 @@ ARGS = sys.argv[1:]
 LONG = "long" in ARGS
 STANDIN = "standin" in ARGS
 MRI = "mri" in ARGS  # multirate under bs32 (MRIStep) alone: its study and 20 periods
-ARGS = [a for a in ARGS if a not in ("long", "standin", "mri")]
+STABLE = "stable" in ARGS  # the named configurations' 20 periods at 400 and 800, no study
+ARGS = [a for a in ARGS if a not in ("long", "standin", "mri", "stable")]
 if ARGS:
     CONFIGS = [tuple(a.split(":")) for a in ARGS]
 elif MRI:
@@ -297,6 +305,11 @@ def stability(cells, pressure="particle", transfer="flip", method="usl", time_sc
               [f"fluid.pressure={pressure}", f"transfer.velocity={transfer}"] + list(extra),
               check_exit=False)
     vy, first = max_vy(out) if out else (math.inf, "the run's stop")
+    if out:
+        e, rms = frequencies(out)
+        print(f"info stability {scheme} {method} {time_scheme} {cells} cells/m: f_1 "
+              f"{100 * e[0]:+.4f} %, f_2 {100 * e[1]:+.4f} % over the 20 periods (fit rms "
+              f"{rms:.1e} of the peak)")
     what = " ".join([method, time_scheme, pressure, "pressure", transfer] + list(extra))
     msg = (f"stability {scheme} {what} {cells} cells/m, 20 periods: max |v_y| / c_g "
            f"{vy / C_G:.1e} (<= {TOL_VY:g}; first above at t = {first})")
@@ -309,7 +322,12 @@ def stability(cells, pressure="particle", transfer="flip", method="usl", time_sc
 print(f"info exact: f_1 = {F_EX[0]:.6f}, f_2 = {F_EX[1]:.6f} (Z_s / Z_g = {Z_S / Z_G:.4f}, "
       f"c_s / c_g = {C_S / C_G:.4f})")
 for cfg in CONFIGS:
-    study(*cfg)
+    if STABLE:
+        for cells in (400, 800):
+            stability(cells, cfg[3] if len(cfg) > 3 else "particle", method=cfg[1],
+                      time_scheme=cfg[2], scheme=cfg[0])
+    else:
+        study(*cfg)
 for cells in STABLE_CELLS:
     stability(cells)  # the particles' pressure takes the PIC share beside a solid (docstring)
 if LONG and not ARGS:
