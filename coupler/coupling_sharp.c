@@ -535,14 +535,14 @@ static void tie_near_empty(mpm_coupling *c, double h) {
     for (int k = lo[2]; k <= hi[2]; ++k)
       for (int j = lo[1]; j <= hi[1]; ++j)
         for (int i = lo[0]; i <= hi[0]; ++i) {
-          const mpm_lidx n = l + i + j * stride[1] + k * stride[2];
-          for (int f = 0; f < 2; ++f) full[f] = fmax(full[f], ph[f]->m_i[n]);
+          const mpm_lidx nb = l + i + j * stride[1] + k * stride[2];
+          for (int f = 0; f < 2; ++f) full[f] = fmax(full[f], ph[f]->m_i[nb]);
         }
     double n[MPM_MAX_DIM];
-    if (!mpm_coupling_solid_normal(c, l, n)) continue;
     for (int f = 0; f < 2; ++f) {
       const double beta = 1.0 - ph[f]->m_i[l] / (SHARP_NEAR_EMPTY * full[f]);
       if (!(beta > 0.0)) continue;
+      if (!mpm_coupling_solid_normal(c, l, n)) break;
       const mpm_grid_phase *me = ph[f], *other = ph[1 - f];
       const double m = me->m_i[l], mo = other->m_i[l];
       double jv = 0.0, ja = 0.0, v[2][MPM_MAX_DIM], a[2][MPM_MAX_DIM];
