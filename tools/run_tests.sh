@@ -28,9 +28,10 @@
 #   test_ssprk2_input) and the wedge's particle noise test_gas_noise (32 s; the least-squares wall
 #   in test_obstacles, the output field rho_grid in every gas test's snapshots);
 # - coupled studies: test_fsi_waves (6 minutes under the sanitizers), test_fsi_reflection,
-#   test_fsi_resonator, test_multirate_face and test_prestress (15-80 s each plain, 140 s
-#   instrumented for the last; the initial stress's solve runs there in test_materials and
-#   test_bad_input, the interface in test_traction_ls, multirate in test_timeschemes_quick),
+#   test_fsi_resonator, test_multirate_face, test_prestress and test_bar_in_gas (15-80 s each
+#   plain, 140 s instrumented for test_prestress; the initial stress's solve runs there in
+#   test_materials and test_bad_input, the interface in test_traction_ls, multirate in
+#   test_timeschemes_quick),
 #   multirate's coupling-step and predictor study test_multirate_step (63 s there; the damped
 #   viscous step and the predictor run in test_timeschemes_quick's restarts), test_piperno_farhat,
 #   test_timeschemes and test_timeschemes_mri (9.5 minutes there; test_timeschemes_quick runs
@@ -71,7 +72,7 @@ PLAIN_ONLY="wedge|forward_step|supersonic_bar|supersonic_bar_standoff|supersonic
 PLAIN_ONLY+="|near_vacuum_order"
 PLAIN_ONLY+="|slanted_wall|bluff_bodies|sod|strong_shock|gas_time_order|gas_shear|gas_shear_3d"
 PLAIN_ONLY+="|farfield_gauge|mol_damping|time_order_gas|gas_noise|multirate_step"
-PLAIN_ONLY+="|fsi_waves|fsi_reflection|fsi_resonator|multirate_face|prestress"
+PLAIN_ONLY+="|fsi_waves|fsi_reflection|fsi_resonator|multirate_face|prestress|bar_in_gas"
 PLAIN_ONLY+="|piperno_farhat|timeschemes|timeschemes_mri|blowup_guard_coupled"
 PLAIN_ONLY+="|csm1|csm3_fast|axial_bar|cantilever3d|model_swap|ranks_solid|periodic|stability|disks"
 PLAIN_ONLY+="|decomposition|restart_cases|run_safety|euler_reference"
