@@ -44,7 +44,8 @@ stress (fluid_gauge.c refuses them; with the refusal lifted its drag fell 11.6 %
 the hybrid, which leaves its tip as it was (period 1.023 against 1.021 ms at 2 mm, 0.15 mm RMS
 apart): in its flow the spring does not set the tip. docs/coupling.md, "The gauge".
 
-Arguments: [long] (long: 1 mm as well, `velocity` only). Default: twelve runs, about 65 s on one core.
+Arguments: [long] (long: 1 mm as well, `velocity` only). Default: twelve runs, about 65 s on
+one core.
 """
 import os
 import sys
