@@ -58,6 +58,7 @@ check = mt.Checks("test_bar_in_gas")
 LONG = sys.argv[1:2] == ["long"]
 P0 = 1.0e5  # the case's ambient pressure
 TOL_SPREAD, BAND = 0.005, (0.0, 0.02)
+CASES = mt.outdir("bar_in_gas_cases")  # the scenes' case files, one folder for all
 REASON = ("without the gauge the particles' quadrature of the ambient pressure at the bar's "
           "faces acts as a spring whose stiffness depends on where the faces lie between "
           "nodes; see the docstring")
@@ -72,7 +73,7 @@ def verdict(expected, cond, msg):
 
 
 def period(tag, dx, shift, gas, keys=()):
-    case = os.path.join(mt.outdir("bar_in_gas_cases"), f"{tag}.ini")
+    case = os.path.join(CASES, f"{tag}.ini")
     bar_scene.write(case, gas=gas, shift=shift)
     out = mt.outdir(f"bar_in_gas_{tag}")
     mt.run(["run", case, f"output.dir={out}", f"grid.dx={dx!r}", "run.progress=false"]
