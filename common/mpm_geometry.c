@@ -547,6 +547,33 @@ void mpm_region_bounds(const mpm_region *r, double *lo, double *hi) {
   for (int d = 0; d < r->dim; ++d) lo[d] = r->lo[d], hi[d] = r->hi[d];
 }
 
+double mpm_region_volume(const mpm_region *r, double h, double max_points) {
+  const int dim = r->dim;
+  double w[MPM_MAX_DIM] = {1, 1, 1}, points;
+  int64_t n[MPM_MAX_DIM] = {1, 1, 1};
+  do { /* cells of exactly (hi - lo) / n, so that a box's volume comes out exact */
+    points = 1.0;
+    for (int d = 0; d < dim; ++d) {
+      n[d] = (int64_t)fmax(1.0, ceil((r->hi[d] - r->lo[d]) / h - 1e-9));
+      w[d] = (r->hi[d] - r->lo[d]) / (double)n[d];
+      points *= (double)n[d];
+    }
+    h *= 1.25;
+  } while (points > max_points);
+  int64_t inside = 0;
+  for (int64_t k = 0; k < n[2]; ++k)
+    for (int64_t j = 0; j < n[1]; ++j)
+      for (int64_t i = 0; i < n[0]; ++i) {
+        const int64_t at[3] = {i, j, k};
+        double x[3] = {0, 0, 0};
+        for (int d = 0; d < dim; ++d) x[d] = r->lo[d] + ((double)at[d] + 0.5) * w[d];
+        inside += mpm_region_contains(r, x);
+      }
+  double cell = 1.0;
+  for (int d = 0; d < dim; ++d) cell *= w[d];
+  return (double)inside * cell;
+}
+
 /* ------------------------------------------------------------------------- seeding --- */
 
 /* The lattice has ncells[d] * ppc points along d; point L sits in cell L / ppc at

@@ -33,6 +33,10 @@ int mpm_polygon_check(const mpm_config *cfg, const char *key, const double *xy, 
 int mpm_region_contains(const mpm_region *r, const double *x);
 /* Axis-aligned bounding box. */
 void mpm_region_bounds(const mpm_region *r, double *lo, double *hi);
+/* The region's volume (area in 2-D) by the midpoint rule on a lattice of spacing about h over
+ * its bounding box, the spacing widened until the lattice holds at most max_points points: to
+ * within about h times the surface's measure. Each rank computes the same value. */
+double mpm_region_volume(const mpm_region *r, double h, double max_points);
 
 /* Seed ppc particles per cell per direction at the cell-centred sub-lattice, in every cell
  * that this rank owns on grid, keeping the points inside r. For each point it gives the

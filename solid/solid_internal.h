@@ -125,6 +125,9 @@ typedef struct solid_seed {
   char vkey[160]; /* the velocity_field key */
 } solid_seed;
 int solid_seed_open(mpm_module *m, const mpm_config *cfg, int b, solid_seed *s);
+/* Log each body's seeded volume against its geometry's, and warn where they differ by more
+ * than 2 % (a face off the particle lattice); after the last seeding (solid_module.c). */
+int solid_seed_report(mpm_module *m, const mpm_config *cfg);
 void solid_seed_close(solid_seed *s);
 /* Append n particles of body s->b at x (component-major, stride n) with ids id, on a lattice
  * of spacing `spacing` (volume spacing^dim): the body's initial state, clamps and tractions. */

@@ -305,6 +305,40 @@ static int seed_body(mpm_module *m, const mpm_config *cfg, int b, double *lp) {
   return 0;
 }
 
+/* A body whose seeded volume is off its geometry's by more than this share draws a warning. */
+#define SEED_VOLUME_WARN 0.02
+
+int solid_seed_report(mpm_module *m, const mpm_config *cfg) {
+  const solid_content *sc = m->content;
+  const mpm_particles *p = m->particles;
+  const mpm_grid *g = m->grid;
+  const double *mass = mpm_particles_comp(p, sc->lay.f_m, 0);
+  const double *body = mpm_particles_comp(p, sc->lay.f_body, 0);
+  for (int b = 0; b < sc->nbodies; ++b) {
+    double seeded = 0.0;
+    for (mpm_lidx i = 0; i < p->n; ++i)
+      if ((int)body[i] == b) seeded += mass[i];
+    seeded /= sc->body[b].rho;
+    MPM_CALL_MPI(MPI_Allreduce(MPI_IN_PLACE, &seeded, 1, MPI_DOUBLE, MPI_SUM, g->comm));
+    solid_seed s;
+    MPM_CALL(solid_seed_open(m, cfg, b, &s));
+    const double spacing = g->dx / s.ppc;
+    const double exact = mpm_region_volume(s.region, spacing / 8.0, 4e6);
+    solid_seed_close(&s);
+    const double rel = exact > 0.0 ? seeded / exact - 1.0 : 0.0;
+    mpm_log(MPM_LOG_INFO, "solid body %s: seeded volume %.6g, its geometry's %.6g (%+.2f %%)",
+            sc->body[b].section, seeded, exact, 100.0 * rel);
+    if (fabs(rel) > SEED_VOLUME_WARN)
+      mpm_log(MPM_LOG_WARN,
+              "solid body %s: its particles' volume is %+.1f %% off its geometry's: faces off "
+              "the particle lattice (spacing %g) move by up to half a spacing, and the body's "
+              "mass and stiffness with them; a grid.dx whose particle spacing (grid.dx / ppc) "
+              "divides the body's extents seeds it whole (docs/solid.md, \"Seeding\")",
+              sc->body[b].section, 100.0 * rel, spacing);
+  }
+  return 0;
+}
+
 /* Grow the scratch arrays to the current particle count. */
 static int ensure_scratch(mpm_module *m) {
   solid_content *sc = m->content;
@@ -882,6 +916,9 @@ int solid_module_create(mpm_module **mp, const mpm_config *cfg, mpm_grid *grid, 
     sc->lp = lp;
   }
   if (!rc && seed) rc = solid_check_tractions(m, cfg);
+  int levels = 1; /* on a hierarchy the bodies are seeded again, level by level */
+  if (!rc && seed) rc = mpm_config_get_int(cfg, "refine.levels", &levels);
+  if (!rc && seed && levels <= 1) rc = solid_seed_report(m, cfg);
   if (rc) {
     mpm_module_destroy(mp);
     return mpm_trace(__FILE__, __LINE__, __func__, rc);

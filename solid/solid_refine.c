@@ -242,5 +242,5 @@ int solid_module_refine(mpm_module *m, const mpm_config *cfg, mpm_hier *h, int s
   const solid_content *sc = m->content;
   for (int l = 1; l < h->nlevels; ++l)
     for (int b = 0; b < sc->nbodies; ++b) MPM_CALL(seed_level(m, cfg, b, l));
-  return 0;
+  return solid_seed_report(m, cfg);
 }

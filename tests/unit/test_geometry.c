@@ -207,6 +207,46 @@ static void test_disk_area(void **state) {
   mpm_region_destroy(&r);
 }
 
+/* mpm_region_volume: a box (its lattice divides the box exactly) to roundoff; a disk and a
+ * difference (box minus disk) within the midpoint rule's bound, the perimeter times the sample
+ * spacing's half-diagonal; the point cap widens the spacing and keeps the bound with it. */
+static void test_region_volume(void **state) {
+  (void)state;
+  mpm_region *box =
+      region_from("[geometry.b]\ntype = box\nlo = 0.1 0.2\nhi = 0.106 0.23\n", 2, "b");
+  const double vb = mpm_region_volume(box, 0.0001, 4e6);
+  printf("  box      %.12e against %.12e\n", vb, 0.006 * 0.03);
+  assert_true(fabs(vb - 0.006 * 0.03) <= 1e-12 * 0.006 * 0.03);
+  mpm_region_destroy(&box);
+  mpm_region *d = region_from("[geometry.d]\ntype = disk\ncenter = 1.03 0.97\nradius = 0.7\n"
+                              "[geometry.b]\ntype = box\nlo = 0 0\nhi = 2 2\n"
+                              "[geometry.c]\ntype = difference\nof = b d\n",
+                              2, "d");
+  mpm_region *c = region_from("[geometry.d]\ntype = disk\ncenter = 1.03 0.97\nradius = 0.7\n"
+                              "[geometry.b]\ntype = box\nlo = 0 0\nhi = 2 2\n"
+                              "[geometry.c]\ntype = difference\nof = b d\n",
+                              2, "c");
+  const double disk = PI * 0.7 * 0.7, perimeter = 2.0 * PI * 0.7;
+  const double h[] = {0.01, 0.001}, cap[] = {4e6, 1e4};
+  for (int k = 0; k < 2; ++k) {
+    /* The sample spacing: h, or where the cap binds, at most the spacing that puts 1.25^2 cap
+     * points on the bounding box (each widening multiplies it by 1.25). A cut cell is wrong by
+     * at most its area, and the cells the circle cuts cover at most its perimeter times the
+     * cell's diagonal. */
+    const double bbox_d = 1.4 * 1.4, bbox_c = 2.0 * 2.0;
+    const double wd = fmax(h[k], sqrt(bbox_d * 1.5625 / cap[k]));
+    const double wc = fmax(h[k], sqrt(bbox_c * 1.5625 / cap[k]));
+    const double vd = mpm_region_volume(d, h[k], cap[k]), vc = mpm_region_volume(c, h[k], cap[k]);
+    printf("  disk     %.6f against %.6f (bound %.2e); box minus disk %.6f against %.6f (bound "
+           "%.2e)\n",
+           vd, disk, perimeter * wd * sqrt(2.0), vc, 4.0 - disk, perimeter * wc * sqrt(2.0));
+    assert_true(fabs(vd - disk) <= perimeter * wd * sqrt(2.0));
+    assert_true(fabs(vc - (4.0 - disk)) <= perimeter * wc * sqrt(2.0));
+  }
+  mpm_region_destroy(&d);
+  mpm_region_destroy(&c);
+}
+
 static double ball_volume(double r) {
   return 4.0 / 3.0 * PI * r * r * r;
 }
@@ -598,12 +638,13 @@ int main(int argc, char **argv) {
     MPI_Abort(MPI_COMM_WORLD, 1);
   }
   const struct CMUnitTest tests[] = {
-      cmocka_unit_test(test_box_count),         cmocka_unit_test(test_ids_and_span),
-      cmocka_unit_test(test_disk_area),         cmocka_unit_test(test_sphere_volume),
-      cmocka_unit_test(test_cylinder_volume),   cmocka_unit_test(test_polygon_triangle),
-      cmocka_unit_test(test_polygon_ell),       cmocka_unit_test(test_union_difference),
-      cmocka_unit_test(test_rank_independence), cmocka_unit_test(test_real_grid),
-      cmocka_unit_test(test_bad_configs),       cmocka_unit_test(test_schema_validates),
+      cmocka_unit_test(test_box_count),        cmocka_unit_test(test_ids_and_span),
+      cmocka_unit_test(test_disk_area),        cmocka_unit_test(test_region_volume),
+      cmocka_unit_test(test_sphere_volume),    cmocka_unit_test(test_cylinder_volume),
+      cmocka_unit_test(test_polygon_triangle), cmocka_unit_test(test_polygon_ell),
+      cmocka_unit_test(test_union_difference), cmocka_unit_test(test_rank_independence),
+      cmocka_unit_test(test_real_grid),        cmocka_unit_test(test_bad_configs),
+      cmocka_unit_test(test_schema_validates),
   };
   int failed = cmocka_run_group_tests_name("geometry", tests, NULL, NULL);
   for (int i = 0; i < g_nfiles; ++i) unlink(g_files[i]);
