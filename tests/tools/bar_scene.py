@@ -2,6 +2,7 @@
 cut to 132 x 48 mm around it with slip walls: alone (test_bar_clamp) or in the case's gas at
 rest (test_bar_in_gas), and its period from the probes."""
 import configparser
+import math
 import os
 
 import numpy as np
@@ -15,10 +16,12 @@ GAS = ("freestream", "fluid", "coupling", "geometry.air", "gas.air")
 T_END = 0.0035  # six zero crossings of the tip's velocity
 
 
-def write(path, gas=False, shift=0.0):
+def write(path, gas=False, shift=0.0, dx=None):
     """The scene as a case file at path: without the gas, or with the case's gas at rest (its
     free stream's state and gas settings, no open face). shift moves the domain, and with it
-    the node lattice, by -shift along x (the bar stays where the case puts it)."""
+    the node lattice, by -shift along x (the bar stays where the case puts it). dx, if given,
+    is the grid's spacing, and the domain grows to whole cells of it (the cut's 132 x 48 mm
+    divides 2 mm, 1.5 mm and 1 mm, not every spacing)."""
     cfg = configparser.ConfigParser(inline_comment_prefixes=("#",))
     cfg.optionxform = str  # keys are case-sensitive (solid.bar.E)
     cfg.read(mt.case("supersonic_bar.ini"))
@@ -30,7 +33,11 @@ def write(path, gas=False, shift=0.0):
             cfg.remove_section(s)
     if shift:
         cfg["domain"]["lo"] = cfg["geometry.channel"]["lo"] = f"{-shift!r} 0"
-    cfg["domain"]["hi"] = cfg["geometry.channel"]["hi"] = f"{0.132 - shift!r} 0.048"
+    size = (0.132, 0.048)
+    if dx is not None:
+        cfg["grid"]["dx"] = repr(dx)
+        size = tuple(math.ceil(s / dx - 1e-9) * dx for s in size)
+    cfg["domain"]["hi"] = cfg["geometry.channel"]["hi"] = f"{size[0] - shift!r} {size[1]!r}"
     cfg["boundary"]["x_lo"] = cfg["boundary"]["x_hi"] = "slip"
     cfg["solid.bar"]["velocity_field"] = MODE
     cfg["time"]["t_end"] = repr(T_END)
