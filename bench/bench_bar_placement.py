@@ -1,15 +1,16 @@
 #!/usr/bin/python3
 """The main job's tip against where its bar's faces lie between the grid's nodes, and the main
-job on two levels against those uniform runs (issue 51's main-job item).
+job on two and three levels against those uniform runs (issue 51's main-job item).
 
 Every uniform grid that divides the case's 0.03 m bar height evenly (1, 1.5, 2, 2.5 mm) puts the
 bar's top face (y = 0.03) on a node line, as the floor always is. Level 1 of a hierarchy puts its
 nodes half a cell off level 0's (o_1 = lo - h_1 / 2), so there the top face and the floor lie
 halfway between nodes. A uniform grid whose spacing is 0.03 / (k + 1/2) (2.4, 1.62, 1.18 mm)
 puts the top face halfway too (the floor stays a node line). This bench runs the case
-(`cases/supersonic_bar.ini`, its defaults: `velocity`, `usl`) on both families and on the
-docs' two-level run (level 0 at 4 mm, a level-1 box of 2 mm around the bar), and reports per
-run: the tip's maxima and the periods between them, its largest u_x, the RMS of its u_x(t)
+(`cases/supersonic_bar.ini`, its defaults: `velocity`, `usl`) on both families, on two levels
+(level 0 at 4 mm, a level-1 box of 2 mm around the bar) and on three (a 1 mm level-2 box inside),
+and reports per run: the tip's maxima and the periods between them, the bar alone's period on
+the same grid, the load's slope against the tip's swing, its largest u_x, the RMS of its u_x(t)
 against each family's finest run over 0-3 ms, the stand-off's mean over 1.5-3 ms
 (tools/supersonic_bar.py) and the wall time. Runs are kept under --out and reused when their
 folder holds a finished run of the same command (delete it to re-run).

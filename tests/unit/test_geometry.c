@@ -218,14 +218,10 @@ static void test_region_volume(void **state) {
   printf("  box      %.12e against %.12e\n", vb, 0.006 * 0.03);
   assert_true(fabs(vb - 0.006 * 0.03) <= 1e-12 * 0.006 * 0.03);
   mpm_region_destroy(&box);
-  mpm_region *d = region_from("[geometry.d]\ntype = disk\ncenter = 1.03 0.97\nradius = 0.7\n"
-                              "[geometry.b]\ntype = box\nlo = 0 0\nhi = 2 2\n"
-                              "[geometry.c]\ntype = difference\nof = b d\n",
-                              2, "d");
-  mpm_region *c = region_from("[geometry.d]\ntype = disk\ncenter = 1.03 0.97\nradius = 0.7\n"
-                              "[geometry.b]\ntype = box\nlo = 0 0\nhi = 2 2\n"
-                              "[geometry.c]\ntype = difference\nof = b d\n",
-                              2, "c");
+  const char *text = "[geometry.d]\ntype = disk\ncenter = 1.03 0.97\nradius = 0.7\n"
+                     "[geometry.b]\ntype = box\nlo = 0 0\nhi = 2 2\n"
+                     "[geometry.c]\ntype = difference\nof = b d\n";
+  mpm_region *d = region_from(text, 2, "d"), *c = region_from(text, 2, "c");
   const double disk = PI * 0.7 * 0.7, perimeter = 2.0 * PI * 0.7;
   const double h[] = {0.01, 0.001}, cap[] = {4e6, 1e4};
   for (int k = 0; k < 2; ++k) {
